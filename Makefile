@@ -1,0 +1,102 @@
+# hbvmgen - one flat Makefile.
+#   make            the generator gen/hbvmgen and runtime/libhbvmrt.a
+#   make check      install missing packages, build, run every test suite
+#   make demo       generate, build and run the pendulum with HBVM(2,2)
+#   make generated  regenerate the committed solvers in generated/
+#   make tables     the paper's tables beside ours (docs/tables.md)
+#   make SANITIZE=1 ...   everything with -fsanitize=address,undefined
+
+CC      ?= cc
+CFLAGS  ?= -O2 -g
+WARN    := -std=c99 -Wall -Wextra -pedantic
+ifdef SANITIZE
+SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+B       := build-san
+else
+SAN     :=
+B       := build
+endif
+GSL     := $(shell pkg-config --cflags gsl 2>/dev/null)
+GSLLIB  := $(shell pkg-config --libs gsl 2>/dev/null)
+CHECK   := $(shell pkg-config --cflags check 2>/dev/null)
+CHECKLIB:= $(shell pkg-config --libs check 2>/dev/null)
+ALLCFLAGS = $(WARN) $(CFLAGS) $(SAN) -MMD -MP
+
+GEN_SRC  := util.c ast.c dag.c ad.c mass.c model.c method.c step.c emit.c emit_main.c
+GEN_OBJ  := $(addprefix $(B)/gen/,$(GEN_SRC:.c=.o) parser.o lexer.o)
+RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
+SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
+SOLV_OBJ := $(addprefix $(B)/generated/,$(addsuffix .o,$(SOLVERS)))
+TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c
+TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
+
+HBVMGEN  := gen/hbvmgen
+LIBRT    := runtime/libhbvmrt.a
+
+.PHONY: all deps check demo generated tables figures bench clean
+all: $(HBVMGEN) $(LIBRT)
+
+deps:
+	@scripts/deps.sh
+
+$(B)/gen/parser.c $(B)/gen/parser.h &: gen/parser.y
+	@mkdir -p $(@D)
+	bison -Wall -Werror --defines=$(B)/gen/parser.h -o $(B)/gen/parser.c $<
+
+$(B)/gen/lexer.c $(B)/gen/lexer.h &: gen/lexer.l $(B)/gen/parser.h
+	@mkdir -p $(@D)
+	flex --header-file=$(B)/gen/lexer.h -o $(B)/gen/lexer.c $<
+
+# flex's output is not pedantic-clean; it gets the same warnings minus that one.
+$(B)/gen/lexer.o: $(B)/gen/lexer.c
+	$(CC) $(WARN) -Wno-unused-function $(CFLAGS) $(SAN) -Igen -I$(B)/gen -c -o $@ $<
+
+$(B)/gen/parser.o: $(B)/gen/parser.c $(B)/gen/lexer.h
+	$(CC) $(ALLCFLAGS) -Igen -I$(B)/gen -c -o $@ $<
+
+$(B)/gen/%.o: gen/%.c | $(B)/gen/parser.h
+	@mkdir -p $(@D)
+	$(CC) $(ALLCFLAGS) $(GSL) -Igen -I$(B)/gen -c -o $@ $<
+
+$(HBVMGEN): $(GEN_OBJ) $(B)/gen/main.o
+	$(CC) $(SAN) -o $@ $^ $(GSLLIB) -lm
+
+$(B)/runtime/%.o: runtime/%.c
+	@mkdir -p $(@D)
+	$(CC) $(ALLCFLAGS) -Iruntime -c -o $@ $<
+
+$(LIBRT): $(RT_OBJ)
+	rm -f $@
+	ar rcs $@ $^
+
+# The committed solvers compile with -Werror: they must stay warning-free.
+$(B)/generated/%.o: generated/%.c generated/%.h
+	@mkdir -p $(@D)
+	$(CC) $(WARN) -Werror $(CFLAGS) $(SAN) -Igenerated -c -o $@ $<
+
+$(B)/tests/%.o: tests/%.c
+	@mkdir -p $(@D)
+	$(CC) $(ALLCFLAGS) $(GSL) $(CHECK) -Igen -I$(B)/gen -Iruntime -Igenerated -Itests -c -o $@ $<
+
+$(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(LIBRT)
+	$(CC) $(SAN) -o $@ $^ $(CHECKLIB) $(GSLLIB) -lm
+
+check: deps
+	@$(MAKE) --no-print-directory $(B)/tests/runner $(HBVMGEN)
+	cd tests && ../$(B)/tests/runner
+
+generated: $(HBVMGEN)
+	scripts/regen.sh $(HBVMGEN) generated
+
+demo: deps
+	@$(MAKE) --no-print-directory all
+	scripts/demo.sh
+
+tables: deps
+	@$(MAKE) --no-print-directory $(B)/tests/runner
+	$(B)/tests/runner --tables docs/tables.md
+
+clean:
+	rm -rf build build-san $(HBVMGEN) $(LIBRT) demo
+
+-include $(shell find $(B) -name '*.d' 2>/dev/null)

@@ -1,0 +1,610 @@
+/* ast.c - semantic analysis: from statements to a Model.
+ *
+ * Statements are taken in file order, so a name must be defined before it
+ * is used. Each expression is lowered straight into the DAG: names become
+ * coordinates (input slots), constants, shared subexpressions or
+ * parameters; index variables of `sum` and `for` are integers substituted
+ * as constants while their body is lowered, so arrays, sums and
+ * comprehensions are fully expanded. M, q0 and p0 depend on the final
+ * number of coordinates and are lowered after the last statement (still
+ * seeing only the names defined before them).
+ *
+ * Every lowering function returns a node id, or -1 after reporting an
+ * error; analysis goes on with the next statement so several errors can be
+ * reported in one run. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hbvmgen.h"
+
+#define MAX_COORDS 100000
+#define MAX_CONSTRAINTS 100000
+#define MAX_PARAMS 10000
+#define MAX_WORK 20000000L   /* terms expanded by sum/for over the whole model */
+#define MAX_INDEX 1000000000L
+
+typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_PARAM, SYM_INDEX } SymKind;
+
+typedef struct Sym Sym;
+struct Sym {
+  SymKind kind;
+  const char *name;
+  Loc loc;
+  int stmt;      /* statement that defines it (file order) */
+  int base;      /* COORD, ARRAY: first input slot; PARAM: parameter number */
+  int size;      /* ARRAY */
+  int node;      /* VALUE */
+  long ival;     /* INDEX */
+  int used;
+  Sym *next;     /* hash chain */
+};
+
+#define NBUCKETS 4096
+
+typedef struct {
+  Model *mod;
+  Dag *d;
+  Sym *buckets[NBUCKETS];
+  int stmt;        /* index of the statement being analysed */
+  long work;
+  IntVec g, g_line, g_col;
+  const char **names; /* coordinate names */
+  int nnamed, ncap;
+  Stmt *mass, *q0, *p0, *pot;
+  int mass_stmt, q0_stmt, p0_stmt;
+  Param *params;
+  int nparams, pcap;
+} Ctx;
+
+// A new syntax tree node. Its depth is bounded so that the recursive
+// lowering below cannot overflow the stack: the first node deeper than
+// MAX_AST_DEPTH is an error (the parser goes on, nothing is lowered).
+Ast *ast_new(AstKind kind, Loc loc, Ast *a, Ast *b, Ast *c) {
+  Ast *n = arena_alloc(sizeof *n);
+  n->kind = kind;
+  n->loc = loc;
+  n->a = a;
+  n->b = b;
+  n->c = c;
+  int depth = 0;
+  const Ast *kids[3] = {a, b, c};
+  for (int i = 0; i < 3; i++)
+    if (kids[i] && kids[i]->depth > depth) depth = kids[i]->depth;
+  n->depth = depth + 1;
+  if (n->depth == MAX_AST_DEPTH + 1) error_at(loc, "expression nested more than %d deep", MAX_AST_DEPTH);
+  return n;
+}
+
+// Attach an argument list to n, which becomes deeper than its deepest argument.
+void ast_set_args(Ast *n, Ast *args) {
+  n->args = args;
+  int depth = n->depth - 1;
+  for (const Ast *a = args; a; a = a->next)
+    if (a->depth > depth) depth = a->depth;
+  if (depth + 1 > n->depth) {
+    n->depth = depth + 1;
+    if (n->depth == MAX_AST_DEPTH + 1) error_at(n->loc, "expression nested more than %d deep", MAX_AST_DEPTH);
+  }
+}
+
+static unsigned hash_name(const char *s) {
+  unsigned h = 2166136261u;
+  for (; *s; s++) h = (h ^ (unsigned char)*s) * 16777619u;
+  return h % NBUCKETS;
+}
+
+static Sym *lookup(Ctx *cx, const char *name) {
+  for (Sym *s = cx->buckets[hash_name(name)]; s; s = s->next)
+    if (!strcmp(s->name, name)) return s;
+  return NULL;
+}
+
+static const char *sym_kind_name(const Sym *s) {
+  switch (s->kind) {
+  case SYM_COORD: return "a coordinate";
+  case SYM_ARRAY: return "an array of coordinates";
+  case SYM_VALUE: return "a definition";
+  case SYM_PARAM: return "a parameter";
+  case SYM_INDEX: return "an index variable";
+  }
+  return "a name";
+}
+
+// Define a new name, or report that it exists (returns NULL then).
+static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
+  if (!strcmp(name, "pi")) {
+    error_at(loc, "'pi' is the constant 3.14159... and cannot be redefined");
+    return NULL;
+  }
+  Sym *old = lookup(cx, name);
+  if (old) {
+    error_at(loc, "'%s' is already defined as %s at line %d, column %d", name, sym_kind_name(old), old->loc.line,
+             old->loc.col);
+    return NULL;
+  }
+  Sym *s = arena_alloc(sizeof *s);
+  s->kind = kind;
+  s->name = name;
+  s->loc = loc;
+  s->stmt = cx->stmt;
+  unsigned h = hash_name(name);
+  s->next = cx->buckets[h];
+  cx->buckets[h] = s;
+  return s;
+}
+
+static void undefine(Ctx *cx, Sym *sym) {
+  Sym **p = &cx->buckets[hash_name(sym->name)];
+  while (*p != sym) p = &(*p)->next;
+  *p = sym->next;
+}
+
+static int lower(Ctx *cx, const Ast *e);
+
+static int is_integer(double v) { return v == floor(v) && fabs(v) <= MAX_INDEX; }
+
+// Lower e and require a constant integer (sizes, indices, ranges).
+static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
+  int n = lower(cx, e);
+  if (n < 0) return -1;
+  const Node *nd = &cx->d->nodes[n];
+  if (nd->op != OP_CONST) {
+    error_at(e->loc, "%s must be a constant integer, but it depends on %s", what,
+             nd->flags & DEP_INPUT ? "a coordinate" : "a parameter");
+    return -1;
+  }
+  if (!is_integer(nd->val)) {
+    error_at(e->loc, "%s must be an integer, got %.17g", what, nd->val);
+    return -1;
+  }
+  *out = (long)nd->val;
+  return 0;
+}
+
+// Resolve a plain name in an expression.
+static int lower_name(Ctx *cx, const Ast *e) {
+  if (!strcmp(e->name, "pi")) return dag_const(cx->d, 3.14159265358979323846);
+  Sym *s = lookup(cx, e->name);
+  if (!s || s->stmt > cx->stmt) {
+    if (s)
+      error_at(e->loc, "'%s' is used before its definition at line %d", e->name, s->loc.line);
+    else
+      error_at(e->loc, "unknown name '%s'", e->name);
+    return -1;
+  }
+  s->used = 1;
+  switch (s->kind) {
+  case SYM_COORD: return dag_input(cx->d, s->base);
+  case SYM_ARRAY:
+    error_at(e->loc, "'%s' is an array of %d coordinates: index it, as in %s[1]", e->name, s->size, e->name);
+    return -1;
+  case SYM_VALUE: return s->node;
+  case SYM_PARAM: return dag_param(cx->d, s->base);
+  case SYM_INDEX: return dag_const(cx->d, (double)s->ival);
+  }
+  return -1;
+}
+
+static int lower_index(Ctx *cx, const Ast *e) {
+  Sym *s = lookup(cx, e->name);
+  if (!s || s->stmt > cx->stmt) {
+    error_at(e->loc, "unknown name '%s'", e->name);
+    return -1;
+  }
+  if (s->kind != SYM_ARRAY) {
+    error_at(e->loc, "'%s' is %s, not an array, and cannot be indexed", e->name, sym_kind_name(s));
+    return -1;
+  }
+  long i;
+  if (lower_int(cx, e->a, "an index", &i) < 0) return -1;
+  if (i < 1 || i > s->size) {
+    error_at(e->a->loc, "index %ld out of range: '%s' has indices 1..%d", i, e->name, s->size);
+    return -1;
+  }
+  s->used = 1;
+  return dag_input(cx->d, s->base + (int)i - 1);
+}
+
+// Build op(a, b) from lowered operands; a constant result that is not a
+// finite number is an error at loc (x/0, sqrt(-1), log(0), 1e308*10, ...).
+static int build(Ctx *cx, Op op, int a, int b, Loc loc, const char *what) {
+  const Node *na = &cx->d->nodes[a], *nb = b >= 0 ? &cx->d->nodes[b] : NULL;
+  if (na->op == OP_CONST && (!nb || nb->op == OP_CONST)) {
+    double v = op_apply(op, na->val, nb ? nb->val : 0);
+    if (!isfinite(v)) {
+      if (op == OP_DIV && nb->val == 0)
+        error_at(loc, "division by zero");
+      else
+        error_at(loc, "%s of constant operands is %s", what, isnan(v) ? "not a number (outside its domain)" : "infinite");
+      return -1;
+    }
+  }
+  if (op == OP_DIV && nb && nb->op == OP_CONST && nb->val == 0) {
+    error_at(loc, "division by zero");
+    return -1;
+  }
+  return dag_op(cx->d, op, a, b);
+}
+
+static const struct {
+  const char *name;
+  Op op;
+} functions[] = {
+    {"sin", OP_SIN},   {"cos", OP_COS},   {"tan", OP_TAN},     {"asin", OP_ASIN}, {"acos", OP_ACOS},
+    {"atan", OP_ATAN}, {"atan2", OP_ATAN2}, {"sinh", OP_SINH}, {"cosh", OP_COSH}, {"tanh", OP_TANH},
+    {"exp", OP_EXP},   {"log", OP_LOG},   {"sqrt", OP_SQRT},   {"pow", OP_POW},   {"abs", OP_ABS},
+};
+
+static int lower_call(Ctx *cx, const Ast *e) {
+  Op op = OP_COUNT;
+  for (size_t i = 0; i < sizeof functions / sizeof functions[0]; i++)
+    if (!strcmp(functions[i].name, e->name)) op = functions[i].op;
+  ASSERT(op != OP_COUNT);
+  int nargs = 0;
+  for (const Ast *a = e->args; a; a = a->next) nargs++;
+  int arity = op_arity(op);
+  if (nargs != arity) {
+    error_at(e->loc, "'%s' takes %d argument%s, got %d", e->name, arity, arity == 1 ? "" : "s", nargs);
+    return -1;
+  }
+  int x = lower(cx, e->args);
+  int y = arity == 2 ? lower(cx, e->args->next) : -1;
+  if (x < 0 || (arity == 2 && y < 0)) return -1;
+  return build(cx, op, x, y, e->loc, e->name);
+}
+
+// Run body once for each integer i in [lo, hi] bound to name (a new index
+// variable), calling fn(cx, body, acc) which returns <0 on error.
+typedef int (*RangeFn)(Ctx *cx, const Ast *body, void *acc);
+
+static int for_range(Ctx *cx, const Ast *at, const char *name, const Ast *lo_e, const Ast *hi_e, const Ast *body,
+                     RangeFn fn, void *acc) {
+  long lo, hi;
+  if (lower_int(cx, lo_e, "a range bound", &lo) < 0 || lower_int(cx, hi_e, "a range bound", &hi) < 0) return -1;
+  if (hi - lo + 1 > MAX_WORK - cx->work) {
+    error_at(at->loc, "range %ld..%ld expands to too many terms (the model may expand to %ld in all)", lo, hi, MAX_WORK);
+    return -1;
+  }
+  Sym *iv = define(cx, name, at->loc, SYM_INDEX);
+  if (!iv) return -1;
+  iv->used = 1;
+  int rc = 0;
+  for (long i = lo; i <= hi && rc >= 0; i++) {
+    cx->work++;
+    iv->ival = i;
+    rc = fn(cx, body, acc);
+  }
+  undefine(cx, iv);
+  return rc;
+}
+
+static int sum_term(Ctx *cx, const Ast *body, void *acc) {
+  int *sum = acc;
+  int t = lower(cx, body);
+  if (t < 0) return -1;
+  *sum = dag_add(cx->d, *sum, t);
+  return 0;
+}
+
+// Lower a scalar expression.
+static int lower(Ctx *cx, const Ast *e) {
+  switch (e->kind) {
+  case A_NUM: return dag_const(cx->d, e->num);
+  case A_NAME: return lower_name(cx, e);
+  case A_INDEX: return lower_index(cx, e);
+  case A_NEG: {
+    int a = lower(cx, e->a);
+    return a < 0 ? -1 : dag_neg(cx->d, a);
+  }
+  case A_BIN: {
+    int a = lower(cx, e->a), b = a < 0 ? -1 : lower(cx, e->b);
+    if (a < 0 || b < 0) return -1;
+    static const char *names[] = {"addition", "subtraction", "product", "division", "power"};
+    const char *ops = "+-*/^";
+    static const Op bops[] = {OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW};
+    int k = (int)(strchr(ops, e->op) - ops);
+    return build(cx, bops[k], a, b, e->loc, names[k]);
+  }
+  case A_CALL: return lower_call(cx, e);
+  case A_SUM: {
+    int sum = dag_const(cx->d, 0);
+    return for_range(cx, e, e->name, e->a, e->b, e->c, sum_term, &sum) < 0 ? -1 : sum;
+  }
+  case A_LIST:
+  case A_FOR: error_at(e->loc, "a list is not allowed here: expected a single value"); return -1;
+  case A_IDENTITY: error_at(e->loc, "'identity' is only allowed as 'M = identity'"); return -1;
+  case A_DIAG: error_at(e->loc, "'diag' is only allowed as 'M = diag(...)'"); return -1;
+  }
+  return -1;
+}
+
+/* ---- lists: g, q0, p0, diag(...) ---- */
+
+typedef struct {
+  IntVec nodes, lines, cols;
+} List;
+
+static int flatten(Ctx *cx, const Ast *e, List *out);
+
+static int flatten_item(Ctx *cx, const Ast *body, void *acc) { return flatten(cx, body, acc); }
+
+// Append the values of e to out: lists and comprehensions nest and flatten.
+static int flatten(Ctx *cx, const Ast *e, List *out) {
+  if (e->kind == A_LIST) {
+    for (const Ast *a = e->args; a; a = a->next)
+      if (flatten(cx, a, out) < 0) return -1;
+    return 0;
+  }
+  if (e->kind == A_FOR) return for_range(cx, e, e->name, e->a, e->b, e->c, flatten_item, out);
+  int n = lower(cx, e);
+  if (n < 0) return -1;
+  intvec_push(&out->nodes, n);
+  intvec_push(&out->lines, e->loc.line);
+  intvec_push(&out->cols, e->loc.col);
+  return 0;
+}
+
+// Flatten a list of constants (q0, p0, diag entries) into m doubles.
+static double *constant_list(Ctx *cx, const Stmt *st, const char *what, int want) {
+  List l = {{0}, {0}, {0}};
+  if (flatten(cx, st->expr, &l) < 0) return NULL;
+  for (int i = 0; i < l.nodes.n; i++) {
+    const Node *nd = &cx->d->nodes[l.nodes.v[i]];
+    if (nd->op != OP_CONST) {
+      Loc loc = {l.lines.v[i], l.cols.v[i]};
+      error_at(loc, "%s must be constant, but this value depends on %s", what,
+               nd->flags & DEP_INPUT ? "a coordinate" : "a parameter");
+      return NULL;
+    }
+  }
+  if (l.nodes.n != want) {
+    error_at(st->loc, "%s has %d value%s, expected %d (one per coordinate)", what, l.nodes.n,
+             l.nodes.n == 1 ? "" : "s", want);
+    return NULL;
+  }
+  double *v = arena_alloc((size_t)want * sizeof(double));
+  for (int i = 0; i < want; i++) v[i] = cx->d->nodes[l.nodes.v[i]].val;
+  return v;
+}
+
+/* ---- statements ---- */
+
+// Name coordinate slot for comments in the emitted code: "x" or "x[3]".
+static void name_coord(Ctx *cx, const char *name, long index) {
+  if (cx->mod->m > cx->ncap) {
+    int cap = cx->ncap ? 2 * cx->ncap : 64;
+    while (cap < cx->mod->m) cap *= 2;
+    const char **names = arena_alloc((size_t)cap * sizeof *names);
+    if (cx->nnamed) memcpy(names, cx->names, (size_t)cx->nnamed * sizeof *names);
+    cx->names = names;
+    cx->ncap = cap;
+  }
+  char buf[32] = "";
+  if (index > 0) snprintf(buf, sizeof buf, "[%ld]", index);
+  size_t len = strlen(name);
+  char *full = arena_alloc(len + strlen(buf) + 1);
+  memcpy(full, name, len);
+  strcpy(full + len, buf);
+  cx->names[cx->nnamed++] = full;
+}
+
+static void declare_variables(Ctx *cx, const Stmt *st) {
+  Model *mod = cx->mod;
+  for (const Decl *dc = st->decls; dc; dc = dc->next) {
+    long size = 1;
+    if (dc->size && lower_int(cx, dc->size, "an array size", &size) < 0) continue;
+    if (dc->size && size < 1) {
+      error_at(dc->size->loc, "array size must be at least 1, got %ld", size);
+      continue;
+    }
+    if (size > MAX_COORDS - mod->m) {
+      error_at(dc->loc, "too many coordinates (at most %d)", MAX_COORDS);
+      continue;
+    }
+    Sym *s = define(cx, dc->name, dc->loc, dc->size ? SYM_ARRAY : SYM_COORD);
+    if (!s) continue;
+    s->used = 1;
+    s->base = mod->m;
+    s->size = (int)size;
+    mod->m += (int)size;
+    for (long i = 0; i < size; i++) name_coord(cx, dc->name, dc->size ? i + 1 : 0);
+  }
+}
+
+static void define_value(Ctx *cx, const Stmt *st) {
+  int n = lower(cx, st->expr);
+  Sym *s = define(cx, st->name, st->name_loc, SYM_VALUE);
+  if (s) s->node = n < 0 ? dag_const(cx->d, 0) : n;
+}
+
+static void define_param(Ctx *cx, const Stmt *st) {
+  int n = lower(cx, st->expr);
+  if (n >= 0 && cx->d->nodes[n].op != OP_CONST) {
+    error_at(st->expr->loc, "the default of param '%s' must be a constant number", st->name);
+    n = -1;
+  }
+  if (cx->nparams >= MAX_PARAMS) {
+    error_at(st->loc, "too many parameters (at most %d)", MAX_PARAMS);
+    return;
+  }
+  Sym *s = define(cx, st->name, st->name_loc, SYM_PARAM);
+  if (!s) return;
+  if (cx->nparams == cx->pcap) {
+    int cap = cx->pcap ? 2 * cx->pcap : 8;
+    Param *p = arena_alloc((size_t)cap * sizeof *p);
+    if (cx->nparams) memcpy(p, cx->params, (size_t)cx->nparams * sizeof *p);
+    cx->params = p;
+    cx->pcap = cap;
+  }
+  s->base = cx->nparams;
+  Param *p = &cx->params[cx->nparams++];
+  p->name = st->name;
+  p->loc = st->name_loc;
+  p->value = n >= 0 ? cx->d->nodes[n].val : 0;
+}
+
+static int once(Stmt **slot, int *slot_stmt, Stmt *st, int stmt, const char *what) {
+  if (*slot) {
+    error_at(st->loc, "%s is defined twice (first at line %d, column %d)", what, (*slot)->loc.line, (*slot)->loc.col);
+    return 0;
+  }
+  *slot = st;
+  if (slot_stmt) *slot_stmt = stmt;
+  return 1;
+}
+
+static void add_constraints(Ctx *cx, const Stmt *st) {
+  List l = {{0}, {0}, {0}};
+  if (flatten(cx, st->expr, &l) < 0) return;
+  for (int i = 0; i < l.nodes.n; i++) {
+    Loc loc = {l.lines.v[i], l.cols.v[i]};
+    if (!(cx->d->nodes[l.nodes.v[i]].flags & DEP_INPUT)) {
+      error_at(loc, "constraint %d does not depend on any coordinate", cx->g.n + 1);
+      continue;
+    }
+    if (cx->g.n >= MAX_CONSTRAINTS) {
+      error_at(loc, "too many constraints (at most %d)", MAX_CONSTRAINTS);
+      return;
+    }
+    intvec_push(&cx->g, l.nodes.v[i]);
+    intvec_push(&cx->g_line, loc.line);
+    intvec_push(&cx->g_col, loc.col);
+  }
+}
+
+// Lower M = ... into a dense matrix when written as [[...]], else into its
+// diagonal; mass_setup then checks it and finds its structure.
+static void lower_mass(Ctx *cx) {
+  Model *mod = cx->mod;
+  int m = mod->m;
+  if (!cx->mass) {
+    mass_setup(mod, NULL, (Loc){0, 0});
+    return;
+  }
+  cx->stmt = cx->mass_stmt;
+  const Ast *e = cx->mass->expr;
+  if (e->kind == A_IDENTITY) {
+    mass_setup(mod, NULL, e->loc);
+    return;
+  }
+  if (e->kind == A_DIAG) {
+    Stmt tmp = *cx->mass;
+    Ast list = *e;
+    list.kind = A_LIST;
+    tmp.expr = &list;
+    double *dg = constant_list(cx, &tmp, "diag(...) of M", m);
+    if (!dg) return;
+    double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
+    if (!dense) internal_error("out of memory");
+    for (int i = 0; i < m; i++) dense[(size_t)i * m + i] = dg[i];
+    mass_setup(mod, dense, e->loc);
+    free(dense);
+    return;
+  }
+  if (e->kind == A_LIST) {
+    int rows = 0;
+    for (const Ast *r = e->args; r; r = r->next) rows++;
+    if (rows != m) {
+      error_at(e->loc, "M has %d rows, expected %d (one per coordinate)", rows, m);
+      return;
+    }
+    double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
+    if (!dense) internal_error("out of memory");
+    int i = 0;
+    for (const Ast *r = e->args; r; r = r->next, i++) {
+      Stmt row = *cx->mass;
+      row.expr = (Ast *)r;
+      row.loc = r->loc;
+      double *v = r->kind == A_LIST ? constant_list(cx, &row, "a row of M", m) : NULL;
+      if (r->kind != A_LIST) error_at(r->loc, "M = [[...], ...] needs each row as a list");
+      if (!v) {
+        free(dense);
+        return;
+      }
+      memcpy(dense + (size_t)i * m, v, (size_t)m * sizeof(double));
+    }
+    mass_setup(mod, dense, e->loc);
+    free(dense);
+    return;
+  }
+  int n = lower(cx, e);
+  if (n < 0) return;
+  const Node *nd = &cx->d->nodes[n];
+  if (nd->op != OP_CONST) {
+    error_at(e->loc, "M must be constant, but it depends on %s", nd->flags & DEP_INPUT ? "a coordinate" : "a parameter");
+    return;
+  }
+  double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
+  if (!dense) internal_error("out of memory");
+  for (int i = 0; i < m; i++) dense[(size_t)i * m + i] = nd->val;
+  mass_setup(mod, dense, e->loc);
+  free(dense);
+}
+
+static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc *loc) {
+  if (!st) return arena_alloc((size_t)cx->mod->m * sizeof(double));
+  cx->stmt = stmt;
+  *loc = st->loc;
+  return constant_list(cx, st, what, cx->mod->m);
+}
+
+static void warn_unused(Ctx *cx) {
+  for (int b = 0; b < NBUCKETS; b++)
+    for (Sym *s = cx->buckets[b]; s; s = s->next)
+      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_PARAM))
+        warning_at(s->loc, "%s '%s' is never used", s->kind == SYM_PARAM ? "param" : "definition", s->name);
+}
+
+// Analyse the statements of a model. Returns NULL if any error was reported.
+Model *analyse(const char *file, Stmt *prog) {
+  Ctx *cx = calloc(1, sizeof *cx);
+  if (!cx) internal_error("out of memory");
+  Model *mod = arena_alloc(sizeof *mod);
+  mod->file = file;
+  cx->mod = mod;
+  cx->d = mod->dag = dag_new();
+  mod->U = dag_const(cx->d, 0);
+  int stmt = 0;
+  for (Stmt *st = prog; st && !diag_too_many(); st = st->next, stmt++) {
+    cx->stmt = stmt;
+    switch (st->kind) {
+    case S_VARIABLES: declare_variables(cx, st); break;
+    case S_DEF: define_value(cx, st); break;
+    case S_PARAM: define_param(cx, st); break;
+    case S_POTENTIAL:
+      if (once(&cx->pot, NULL, st, stmt, "U")) {
+        int n = lower(cx, st->expr);
+        if (n >= 0) mod->U = n;
+      }
+      break;
+    case S_CONSTRAINTS: add_constraints(cx, st); break;
+    case S_MASS: once(&cx->mass, &cx->mass_stmt, st, stmt, "M"); break;
+    case S_Q0: once(&cx->q0, &cx->q0_stmt, st, stmt, "q0"); break;
+    case S_P0: once(&cx->p0, &cx->p0_stmt, st, stmt, "p0"); break;
+    }
+  }
+  if (mod->m == 0 && !diag_error_count()) error_at((Loc){1, 1}, "the model declares no coordinates: add 'variables x, ...'");
+  if (mod->m > 0 && !diag_too_many()) {
+    lower_mass(cx);
+    mod->q0 = initial_values(cx, cx->q0, cx->q0_stmt, "q0", &mod->q0_loc);
+    mod->p0 = initial_values(cx, cx->p0, cx->p0_stmt, "p0", &mod->p0_loc);
+  }
+  mod->nu = cx->g.n;
+  mod->g = cx->g.v;
+  mod->g_loc = arena_alloc((size_t)(mod->nu + 1) * sizeof(Loc));
+  for (int a = 0; a < mod->nu; a++) mod->g_loc[a] = (Loc){cx->g_line.v[a], cx->g_col.v[a]};
+  mod->coord_names = cx->names;
+  mod->params = cx->params;
+  mod->nparams = cx->nparams;
+  mod->degU = cx->d->nodes[mod->U].deg;
+  mod->degg = 0;
+  for (int a = 0; a < mod->nu; a++) {
+    int dg = cx->d->nodes[mod->g[a]].deg;
+    if (dg == DEG_NONPOLY || mod->degg == DEG_NONPOLY) mod->degg = DEG_NONPOLY;
+    else if (dg > mod->degg) mod->degg = dg;
+  }
+  if (!diag_error_count()) warn_unused(cx);
+  free(cx);
+  return diag_error_count() ? NULL : mod;
+}

@@ -1,0 +1,362 @@
+/* dag.c - the expression DAG.
+ *
+ * Every expression of a model, its derivatives and finally the whole step
+ * of the method live in one Dag. Nodes are hash-consed: asking for a node
+ * that exists returns the existing id, so common subexpressions are shared
+ * by construction. As each node is built it is folded when all operands are
+ * constants (unless the result would be NaN, an infinity or -0.0, which are
+ * left for run time and reported by the caller) and simplified by the
+ * algebraic identities x+0, x*1, x*0, x-x, -(-x), x^1, x^0.
+ *
+ * Nodes are numbered in creation order and an operand is always created
+ * before its user, so id order is a topological order: evaluation, degree
+ * analysis, reverse sweeps and emission are loops over ids. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hbvmgen.h"
+
+static const struct {
+  const char *name;
+  int arity;
+  const char *cfun;
+} op_info[OP_COUNT] = {
+#define X(name, arity, cfun) {#name, arity, cfun},
+    OPS(X)
+#undef X
+};
+
+int op_arity(Op op) { return op_info[op].arity; }
+const char *op_cfun(Op op) { return op_info[op].cfun; }
+const char *op_name(Op op) { return op_info[op].name; }
+
+Dag *dag_new(void) {
+  Dag *d = arena_alloc(sizeof *d);
+  d->cap = 1024;
+  d->nodes = arena_alloc((size_t)d->cap * sizeof(Node));
+  d->tcap = 2048;
+  d->table = arena_alloc((size_t)d->tcap * sizeof(int));
+  memset(d->table, 0xff, (size_t)d->tcap * sizeof(int));
+  return d;
+}
+
+int dag_full(const Dag *d) { return d->n >= MAX_NODES; }
+
+static uint64_t hash_node(const Node *n) {
+  uint64_t bits;
+  memcpy(&bits, &n->val, sizeof bits);
+  uint64_t h = 1469598103934665603ull;
+  uint64_t parts[5] = {n->op, (uint64_t)(uint32_t)n->a, (uint64_t)(uint32_t)n->b, (uint64_t)(uint32_t)n->idx, bits};
+  for (int i = 0; i < 5; i++) {
+    h ^= parts[i];
+    h *= 1099511628211ull;
+    h ^= h >> 29;
+  }
+  return h;
+}
+
+static int same_node(const Node *x, const Node *y) {
+  return x->op == y->op && x->a == y->a && x->b == y->b && x->idx == y->idx &&
+         memcmp(&x->val, &y->val, sizeof x->val) == 0;
+}
+
+static void rehash(Dag *d) {
+  int tcap = d->tcap * 2;
+  int *table = arena_alloc((size_t)tcap * sizeof(int));
+  memset(table, 0xff, (size_t)tcap * sizeof(int));
+  for (int id = 0; id < d->n; id++) {
+    uint64_t h = hash_node(&d->nodes[id]) & (uint64_t)(tcap - 1);
+    while (table[h] >= 0) h = (h + 1) & (uint64_t)(tcap - 1);
+    table[h] = id;
+  }
+  d->table = table;
+  d->tcap = tcap;
+}
+
+static int saturate(long deg) { return deg > (1 << 20) ? (1 << 20) : (int)deg; }
+
+// Polynomial degree of a new node in the inputs (parameters count as constants).
+static int node_degree(const Dag *d, const Node *n) {
+  int da = n->a >= 0 ? d->nodes[n->a].deg : 0;
+  int db = n->b >= 0 ? d->nodes[n->b].deg : 0;
+  switch ((Op)n->op) {
+  case OP_CONST:
+  case OP_PARAM:
+    return 0;
+  case OP_INPUT:
+    return 1;
+  case OP_ADD:
+  case OP_SUB:
+    return da < 0 || db < 0 ? DEG_NONPOLY : (da > db ? da : db);
+  case OP_MUL:
+    return da < 0 || db < 0 ? DEG_NONPOLY : saturate((long)da + db);
+  case OP_DIV:
+    return db == 0 ? da : DEG_NONPOLY;
+  case OP_NEG:
+    return da;
+  case OP_POW: {
+    const Node *e = &d->nodes[n->b];
+    if (e->op == OP_CONST && e->val >= 0 && e->val == floor(e->val) && e->val <= (1 << 20))
+      return da < 0 ? DEG_NONPOLY : saturate((long)da * (long)e->val);
+    return da == 0 && db == 0 ? 0 : DEG_NONPOLY;
+  }
+  default:
+    return da == 0 && db == 0 ? 0 : DEG_NONPOLY;
+  }
+}
+
+// Find or create the node *proto; returns its id.
+static int intern(Dag *d, Node proto) {
+  uint64_t h = hash_node(&proto) & (uint64_t)(d->tcap - 1);
+  while (d->table[h] >= 0) {
+    if (same_node(&d->nodes[d->table[h]], &proto)) return d->table[h];
+    h = (h + 1) & (uint64_t)(d->tcap - 1);
+  }
+  if (d->n >= MAX_NODES) {
+    fprintf(stderr, "hbvmgen: error: the model needs more than %d expression nodes\n", MAX_NODES);
+    exit(1);
+  }
+  if (d->n == d->cap) {
+    Node *nodes = arena_alloc((size_t)d->cap * 2 * sizeof(Node));
+    memcpy(nodes, d->nodes, (size_t)d->n * sizeof(Node));
+    d->nodes = nodes;
+    d->cap *= 2;
+  }
+  proto.flags = (unsigned char)((proto.a >= 0 ? d->nodes[proto.a].flags : 0) |
+                                (proto.b >= 0 ? d->nodes[proto.b].flags : 0) |
+                                (proto.op == OP_INPUT ? DEP_INPUT : 0) | (proto.op == OP_PARAM ? DEP_PARAM : 0));
+  proto.deg = node_degree(d, &proto);
+  int id = d->n++;
+  d->nodes[id] = proto;
+  d->table[h] = id;
+  if (2 * d->n > d->tcap) rehash(d);
+  return id;
+}
+
+static Node leaf(Op op) {
+  Node n;
+  memset(&n, 0, sizeof n);
+  n.op = (unsigned char)op;
+  n.a = n.b = -1;
+  return n;
+}
+
+int dag_const(Dag *d, double v) {
+  Node n = leaf(OP_CONST);
+  n.val = v == 0 ? 0.0 : v; /* one zero */
+  return intern(d, n);
+}
+
+int dag_input(Dag *d, int slot) {
+  Node n = leaf(OP_INPUT);
+  n.idx = slot;
+  return intern(d, n);
+}
+
+int dag_param(Dag *d, int idx) {
+  Node n = leaf(OP_PARAM);
+  n.idx = idx;
+  return intern(d, n);
+}
+
+int dag_is_const(const Dag *d, int id, double v) {
+  return d->nodes[id].op == OP_CONST && d->nodes[id].val == v;
+}
+
+int dag_is_zero(const Dag *d, int id) { return dag_is_const(d, id, 0.0); }
+
+// The value of op applied to constants (b unused for unary operations).
+double op_apply(Op op, double a, double b) {
+  switch (op) {
+  case OP_ADD: return a + b;
+  case OP_SUB: return a - b;
+  case OP_MUL: return a * b;
+  case OP_DIV: return a / b;
+  case OP_NEG: return -a;
+  case OP_POW: return pow(a, b);
+  case OP_SIN: return sin(a);
+  case OP_COS: return cos(a);
+  case OP_TAN: return tan(a);
+  case OP_ASIN: return asin(a);
+  case OP_ACOS: return acos(a);
+  case OP_ATAN: return atan(a);
+  case OP_ATAN2: return atan2(a, b);
+  case OP_SINH: return sinh(a);
+  case OP_COSH: return cosh(a);
+  case OP_TANH: return tanh(a);
+  case OP_EXP: return exp(a);
+  case OP_LOG: return log(a);
+  case OP_SQRT: return sqrt(a);
+  case OP_ABS: return fabs(a);
+  case OP_SIGN: return (a > 0) - (a < 0);
+  default: internal_error("op_apply on %s", op_name(op));
+  }
+  return 0;
+}
+
+static int is_neg(const Dag *d, int id) { return d->nodes[id].op == OP_NEG; }
+
+// Algebraic identities; returns the simplified node or -1 when none applies.
+static int simplify(Dag *d, Op op, int a, int b) {
+  switch (op) {
+  case OP_ADD:
+    if (dag_is_zero(d, a)) return b;
+    if (dag_is_zero(d, b)) return a;
+    if (is_neg(d, b)) return dag_op(d, OP_SUB, a, d->nodes[b].a);
+    if (is_neg(d, a)) return dag_op(d, OP_SUB, b, d->nodes[a].a);
+    return -1;
+  case OP_SUB:
+    if (dag_is_zero(d, b)) return a;
+    if (dag_is_zero(d, a)) return dag_op(d, OP_NEG, b, -1);
+    if (a == b) return dag_const(d, 0);
+    if (is_neg(d, b)) return dag_op(d, OP_ADD, a, d->nodes[b].a);
+    return -1;
+  case OP_MUL:
+    if (dag_is_zero(d, a) || dag_is_zero(d, b)) return dag_const(d, 0);
+    if (dag_is_const(d, a, 1)) return b;
+    if (dag_is_const(d, b, 1)) return a;
+    if (dag_is_const(d, a, -1)) return dag_op(d, OP_NEG, b, -1);
+    if (dag_is_const(d, b, -1)) return dag_op(d, OP_NEG, a, -1);
+    if (is_neg(d, a) && is_neg(d, b)) return dag_op(d, OP_MUL, d->nodes[a].a, d->nodes[b].a);
+    if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_MUL, d->nodes[a].a, b), -1);
+    if (is_neg(d, b)) return dag_op(d, OP_NEG, dag_op(d, OP_MUL, a, d->nodes[b].a), -1);
+    return -1;
+  case OP_DIV:
+    if (dag_is_const(d, b, 1)) return a;
+    if (dag_is_const(d, b, -1)) return dag_op(d, OP_NEG, a, -1);
+    if (dag_is_zero(d, a) && !dag_is_zero(d, b)) return a;
+    if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_DIV, d->nodes[a].a, b), -1);
+    return -1;
+  case OP_NEG:
+    if (is_neg(d, a)) return d->nodes[a].a;
+    if (dag_is_zero(d, a)) return a;
+    return -1;
+  case OP_POW:
+    if (dag_is_const(d, b, 1)) return a;
+    if (dag_is_zero(d, b) || dag_is_const(d, a, 1)) return dag_const(d, 1);
+    if (dag_is_const(d, b, 0.5)) return dag_op(d, OP_SQRT, a, -1);
+    return -1;
+  default:
+    return -1;
+  }
+}
+
+// Build op(a, b): fold constants, simplify, share. b is -1 for unary ops.
+int dag_op(Dag *d, Op op, int a, int b) {
+  ASSERT(a >= 0 && a < d->n && (op_arity(op) == 1 ? b < 0 : b >= 0 && b < d->n));
+  const Node *na = &d->nodes[a], *nb = b >= 0 ? &d->nodes[b] : NULL;
+  if (na->op == OP_CONST && (!nb || nb->op == OP_CONST)) {
+    double v = op_apply(op, na->val, nb ? nb->val : 0);
+    if (isfinite(v) && !(v == 0 && signbit(v))) return dag_const(d, v);
+  }
+  int s = simplify(d, op, a, b);
+  if (s >= 0) return s;
+  if ((op == OP_ADD || op == OP_MUL) && a > b) {
+    int t = a;
+    a = b;
+    b = t;
+  }
+  Node n = leaf(op);
+  n.a = a;
+  n.b = b;
+  return intern(d, n);
+}
+
+int dag_add(Dag *d, int a, int b) { return dag_op(d, OP_ADD, a, b); }
+int dag_sub(Dag *d, int a, int b) { return dag_op(d, OP_SUB, a, b); }
+int dag_mul(Dag *d, int a, int b) { return dag_op(d, OP_MUL, a, b); }
+int dag_div(Dag *d, int a, int b) { return dag_op(d, OP_DIV, a, b); }
+int dag_neg(Dag *d, int a) { return dag_op(d, OP_NEG, a, -1); }
+
+// Start a labelled section: nodes created from now on belong to it (for
+// the comments of the emitted code).
+void dag_section(Dag *d, const char *label) {
+  if (d->nlabels == d->labcap) {
+    int cap = d->labcap ? 2 * d->labcap : 16;
+    const char **labels = arena_alloc((size_t)cap * sizeof *labels);
+    if (d->nlabels) memcpy(labels, d->labels, (size_t)d->nlabels * sizeof *labels);
+    d->labels = labels;
+    d->labcap = cap;
+  }
+  intvec_push(&d->marks, d->n);
+  d->labels[d->nlabels++] = label;
+}
+
+// Mark every node reachable from the roots (mark has room for all ids).
+void dag_reach(const Dag *d, const int *roots, int nroots, unsigned char *mark) {
+  IntVec stack = {0};
+  for (int i = 0; i < nroots; i++)
+    if (roots[i] >= 0 && !mark[roots[i]]) {
+      mark[roots[i]] = 1;
+      intvec_push(&stack, roots[i]);
+    }
+  while (stack.n) {
+    const Node *n = &d->nodes[stack.v[--stack.n]];
+    int kids[2] = {n->a, n->b};
+    for (int k = 0; k < 2; k++)
+      if (kids[k] >= 0 && !mark[kids[k]]) {
+        mark[kids[k]] = 1;
+        intvec_push(&stack, kids[k]);
+      }
+  }
+}
+
+// Evaluate the roots at the given inputs and parameter values.
+void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inputs, const double *params,
+                   double *out) {
+  int top = -1;
+  for (int i = 0; i < nroots; i++)
+    if (roots[i] > top) top = roots[i];
+  if (top < 0) return;
+  double *v = malloc((size_t)(top + 1) * sizeof *v);
+  unsigned char *mark = calloc((size_t)top + 1, 1);
+  if (!v || !mark) internal_error("out of memory in dag_eval");
+  dag_reach(d, roots, nroots, mark);
+  for (int id = 0; id <= top; id++) {
+    if (!mark[id]) continue;
+    const Node *n = &d->nodes[id];
+    switch ((Op)n->op) {
+    case OP_CONST: v[id] = n->val; break;
+    case OP_INPUT: v[id] = inputs[n->idx]; break;
+    case OP_PARAM: v[id] = params[n->idx]; break;
+    default: v[id] = op_apply((Op)n->op, v[n->a], n->b >= 0 ? v[n->b] : 0);
+    }
+  }
+  for (int i = 0; i < nroots; i++) out[i] = v[roots[i]];
+  free(v);
+  free(mark);
+}
+
+double dag_eval(const Dag *d, int root, const double *inputs, const double *params) {
+  double out;
+  dag_eval_many(d, &root, 1, inputs, params, &out);
+  return out;
+}
+
+// Rebuild the roots with input slot i replaced by node map[i] (for
+// i < nmap; other inputs stay). out[r] receives the image of roots[r].
+void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, int *out) {
+  int top = -1;
+  for (int i = 0; i < nroots; i++)
+    if (roots[i] > top) top = roots[i];
+  if (top < 0) return;
+  unsigned char *mark = calloc((size_t)top + 1, 1);
+  int *img = malloc((size_t)(top + 1) * sizeof *img);
+  if (!mark || !img) internal_error("out of memory in dag_subst");
+  dag_reach(d, roots, nroots, mark);
+  for (int id = 0; id <= top; id++) {
+    if (!mark[id]) continue;
+    Node n = d->nodes[id];
+    if (n.op == OP_INPUT && n.idx < nmap)
+      img[id] = map[n.idx];
+    else if (n.a < 0)
+      img[id] = id;
+    else
+      img[id] = dag_op(d, (Op)n.op, img[n.a], n.b >= 0 ? img[n.b] : -1);
+  }
+  for (int i = 0; i < nroots; i++) out[i] = img[roots[i]];
+  free(mark);
+  free(img);
+}

@@ -1,0 +1,292 @@
+/* hbvmgen.h - the one shared header of the generator.
+ *
+ * A model travels through the generator in this order, one file per pass:
+ *   lexer.l, parser.y   text -> syntax tree (Ast, Stmt)
+ *   ast.c               names, shapes, semantic errors; lowers to the DAG (Model)
+ *   dag.c               hash-consed expression DAG: CSE, folding, degrees
+ *   ad.c                reverse-mode gradients and Jacobians on the DAG
+ *   mass.c              the mass matrix: SPD check and structure of M^-1
+ *   method.c            HBVM(k,s) constants and the choice of k
+ *   step.c              the step of the method, built as one more DAG
+ *   emit.c, emit_main.c C text for NAME.h / NAME.c / NAME_main.c
+ *   main.c              the command line
+ * util.c holds the arena and the diagnostics every pass uses. */
+#ifndef HBVMGEN_H
+#define HBVMGEN_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#define HBVMGEN_VERSION "0.1.0"
+
+/* ---- util.c: arena, growable arrays, diagnostics ---- */
+
+typedef struct {
+  int line, col;
+} Loc;
+
+void *arena_alloc(size_t size);          /* zeroed; dies cleanly on exhaustion */
+char *arena_strndup(const char *s, size_t n);
+void arena_free_all(void);
+
+/* A growable array of ints living in the arena. */
+typedef struct {
+  int *v;
+  int n, cap;
+} IntVec;
+void intvec_push(IntVec *vec, int x);
+
+void diag_begin(const char *file, const char *src, size_t len);
+void error_at(Loc loc, const char *fmt, ...);
+void warning_at(Loc loc, const char *fmt, ...);
+void note(const char *fmt, ...);
+int diag_error_count(void);
+int diag_too_many(void);                 /* true once the error cap is hit */
+void internal_error(const char *fmt, ...);
+#define ASSERT(c) ((c) ? (void)0 : internal_error("%s:%d: %s", __FILE__, __LINE__, #c))
+
+/* ---- parser.y / lexer.l: the syntax tree ---- */
+
+typedef enum {
+  A_NUM,      /* num */
+  A_NAME,     /* name */
+  A_INDEX,    /* name[a] */
+  A_NEG,      /* -a */
+  A_BIN,      /* a op b, op one of + - * / ^ */
+  A_CALL,     /* name(args), args a list via next */
+  A_SUM,      /* sum(name in a..b, c) */
+  A_LIST,     /* [args] */
+  A_FOR,      /* [c for name in a..b] */
+  A_IDENTITY, /* identity */
+  A_DIAG      /* diag(args) */
+} AstKind;
+
+typedef struct Ast Ast;
+struct Ast {
+  AstKind kind;
+  Loc loc;
+  int op;            /* A_BIN: '+', '-', '*', '/', '^' */
+  double num;        /* A_NUM */
+  const char *name;  /* A_NAME, A_INDEX, A_CALL, A_SUM, A_FOR */
+  Ast *a, *b, *c;    /* operands, range bounds, body */
+  Ast *args;         /* A_CALL, A_LIST, A_DIAG: first of a list linked by next */
+  Ast *next;
+  int depth;         /* nesting depth, bounded by MAX_AST_DEPTH */
+};
+
+typedef enum { S_VARIABLES, S_DEF, S_PARAM, S_MASS, S_POTENTIAL, S_CONSTRAINTS, S_Q0, S_P0 } StmtKind;
+
+typedef struct Decl Decl;
+struct Decl {          /* one name of a variables statement */
+  const char *name;
+  Loc loc;
+  Ast *size;           /* NULL for a scalar */
+  Decl *next;
+};
+
+typedef struct Stmt Stmt;
+struct Stmt {
+  StmtKind kind;
+  Loc loc;
+  const char *name;    /* S_DEF, S_PARAM */
+  Loc name_loc;
+  Ast *expr;
+  Decl *decls;         /* S_VARIABLES */
+  Stmt *next;
+};
+
+#define MAX_AST_DEPTH 5000
+#define MAX_NESTING 1000
+
+Ast *ast_new(AstKind kind, Loc loc, Ast *a, Ast *b, Ast *c);
+void ast_set_args(Ast *n, Ast *args);
+Stmt *parse_model(const char *src, size_t len);   /* NULL only on a fatal error */
+
+/* ---- dag.c: the expression DAG ---- */
+
+/* X-macro of operations: name, arity, C function (NULL for operators). */
+#define OPS(X)                   \
+  X(CONST, 0, NULL)              \
+  X(INPUT, 0, NULL)              \
+  X(PARAM, 0, NULL)              \
+  X(ADD, 2, NULL)                \
+  X(SUB, 2, NULL)                \
+  X(MUL, 2, NULL)                \
+  X(DIV, 2, NULL)                \
+  X(NEG, 1, NULL)                \
+  X(POW, 2, "pow")               \
+  X(SIN, 1, "sin")               \
+  X(COS, 1, "cos")               \
+  X(TAN, 1, "tan")               \
+  X(ASIN, 1, "asin")             \
+  X(ACOS, 1, "acos")             \
+  X(ATAN, 1, "atan")             \
+  X(ATAN2, 2, "atan2")           \
+  X(SINH, 1, "sinh")             \
+  X(COSH, 1, "cosh")             \
+  X(TANH, 1, "tanh")             \
+  X(EXP, 1, "exp")               \
+  X(LOG, 1, "log")               \
+  X(SQRT, 1, "sqrt")             \
+  X(ABS, 1, "fabs")              \
+  X(SIGN, 1, NULL)
+
+typedef enum {
+#define X(name, arity, cfun) OP_##name,
+  OPS(X)
+#undef X
+  OP_COUNT
+} Op;
+
+int op_arity(Op op);
+const char *op_cfun(Op op);
+const char *op_name(Op op);
+
+/* Node flags: what a node depends on. */
+enum { DEP_INPUT = 1, DEP_PARAM = 2 };
+
+#define DEG_NONPOLY (-1)
+
+typedef struct {
+  unsigned char op;
+  unsigned char flags; /* DEP_* */
+  int a, b;            /* children, -1 when absent */
+  int idx;             /* OP_INPUT: input slot; OP_PARAM: parameter number */
+  int deg;             /* polynomial degree in the inputs, DEG_NONPOLY otherwise */
+  double val;          /* OP_CONST */
+} Node;
+
+/* Nodes are numbered in creation order, so children always have smaller ids
+ * and every pass over the DAG is a loop over ids, never a recursion. */
+typedef struct {
+  Node *nodes;
+  int n, cap;
+  int *table;          /* open-addressing hash of node ids, -1 empty */
+  int tcap;
+  IntVec marks;        /* section labels for the emitter: (first id, label index) */
+  const char **labels;
+  int nlabels, labcap;
+} Dag;
+
+#define MAX_NODES 4000000
+
+Dag *dag_new(void);
+int dag_const(Dag *d, double v);
+int dag_input(Dag *d, int slot);
+int dag_param(Dag *d, int idx);
+int dag_op(Dag *d, Op op, int a, int b);  /* folds and simplifies; b = -1 for unary */
+int dag_add(Dag *d, int a, int b);
+int dag_sub(Dag *d, int a, int b);
+int dag_mul(Dag *d, int a, int b);
+int dag_div(Dag *d, int a, int b);
+int dag_neg(Dag *d, int a);
+int dag_is_const(const Dag *d, int n, double v);
+int dag_is_zero(const Dag *d, int n);
+void dag_section(Dag *d, const char *label);
+double op_apply(Op op, double a, double b);
+void dag_reach(const Dag *d, const int *roots, int nroots, unsigned char *mark);
+double dag_eval(const Dag *d, int root, const double *inputs, const double *params);
+void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inputs, const double *params,
+                   double *out);
+void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, int *out);
+int dag_full(const Dag *d);
+
+/* ---- ad.c: reverse-mode differentiation ---- */
+
+/* Gradient of root with respect to inputs 0..n-1 as nodes: grad[i]. */
+void ad_gradient(Dag *d, int root, int n, int *grad);
+/* grad[i] = d(sum_r seeds[r] * roots[r]) / d(input i); seeds NULL: ones. */
+void ad_reverse(Dag *d, const int *roots, const int *seeds, int nroots, int n, int *grad);
+
+/* ---- the analysed model (ast.c, mass.c) ---- */
+
+typedef enum { MASS_IDENTITY, MASS_SCALAR, MASS_DIAG, MASS_DENSE } MassKind;
+
+typedef struct {
+  const char *name;
+  double value;
+  Loc loc;
+} Param;
+
+/* One structurally nonzero entry of a gradient or Jacobian column. */
+typedef struct {
+  int coord, node;
+} Entry;
+
+typedef struct {
+  Entry *e;
+  int n;
+} SparseVec;
+
+typedef struct {
+  const char *file;
+  int m, nu;
+  const char **coord_names;   /* "x", "x[3]", ... for comments */
+  Param *params;
+  int nparams;
+  Dag *dag;                   /* inputs 0..m-1 are the coordinates */
+  int U;                      /* potential node */
+  int *g;                     /* nu constraint nodes */
+  Loc *g_loc;
+  int *gradU;                 /* m nodes */
+  SparseVec *jac;             /* nu columns: grad g_a, structural nonzeros only */
+  MassKind mass;
+  double *minv;               /* m*m row-major inverse mass (dense only), else NULL */
+  double *minv_diag;          /* m entries of diag(M^-1) */
+  double *q0, *p0;            /* m each */
+  Loc q0_loc, p0_loc, stmt_loc_end;
+  int degU, degg;             /* DEG_NONPOLY or degree; degg = 0 without constraints */
+} Model;
+
+Model *analyse(const char *file, Stmt *prog);      /* NULL when errors were reported */
+int mass_setup(Model *mod, const double *dense, Loc loc); /* 0 ok, else error reported */
+void minv_apply(const Model *mod, Dag *d, const int *v, int *out); /* out = M^-1 v, nodes */
+void model_differentiate(Model *mod);
+void model_check_initial(const Model *mod);
+
+/* ---- method.c: HBVM(k,s) constants and the choice of k ---- */
+
+typedef struct {
+  int k, s;
+  double *c, *b;      /* k nodes and weights on [0,1] */
+  double *Phat;       /* k x s: P_j(c_l) */
+  double *Ihat;       /* k x s: integral_0^{c_l} P_j */
+  double *W;          /* k x s: b_l P_j(c_l) */
+  double *xi;         /* s+1 values xi_0..xi_s */
+  double *E;          /* s x s x s: warm start, E[j][i] = sum_d E[(j*s+i)*s+d] r^d */
+} Method;
+
+int method_auto_k(int s, int degU, int degg, const char **why);
+Method *method_new(int k, int s);
+double legendre_shifted(int j, double x);
+
+/* ---- step.c: the step as a DAG ---- */
+
+typedef struct {
+  int m, nu, s;
+  int in_q0, in_p0, in_gam, in_h, in_g0;  /* first input slot of each */
+  int ninputs;
+  int *gam_new;        /* s*m */
+  int *dp;             /* m: p1 - p0 */
+  int *lambda;         /* nu */
+  int *pivot, *adiag;  /* nu: pivots of the LU of A, and diag of A */
+  int *predict0;       /* m: M^-1 p0, the first step's gamma_0 */
+  int *g_at_q0;        /* nu: g(q0) */
+  int *energy;         /* 1: H(q, p) with q = inputs q0, p = inputs p0 */
+  int *hidden;         /* nu: grad g(q)' M^-1 p */
+} Step;
+
+Step *step_build(Model *mod, const Method *meth);
+
+/* ---- emit.c, emit_main.c ---- */
+
+typedef struct {
+  const char *name;     /* C prefix */
+  const char *model_file;
+  int emit_main;
+} EmitOptions;
+
+int emit_solver(FILE *h, FILE *c, const Model *mod, const Method *meth, const Step *st, const EmitOptions *o);
+int emit_driver(FILE *f, const Model *mod, const Method *meth, const EmitOptions *o);
+
+#endif

@@ -1,0 +1,84 @@
+/* mass.c - the mass matrix M and products with its inverse.
+ *
+ * However M is written (identity, c, diag(...), or a full [[...]] matrix),
+ * it is checked to be symmetric positive definite (GSL's Cholesky) and
+ * classified by what it really is: identity, a scalar multiple of the
+ * identity, diagonal, or dense. Products M^-1 v are then built as DAG nodes
+ * for exactly that structure, so equal matrices written differently give
+ * the same generated code, and multiplications by 1 and 0 never appear. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_linalg.h>
+
+#include "hbvmgen.h"
+
+// Check a dense M (row-major m x m; NULL means identity) and record its
+// structure and inverse in mod. Returns 0, or -1 after reporting an error.
+int mass_setup(Model *mod, const double *dense, Loc loc) {
+  int m = mod->m;
+  mod->minv_diag = arena_alloc((size_t)m * sizeof(double));
+  mod->mass = MASS_IDENTITY;
+  for (int i = 0; i < m; i++) mod->minv_diag[i] = 1;
+  if (!dense) return 0;
+  if (loc.line == 0) loc = (Loc){1, 1};
+  int diagonal = 1;
+  for (int i = 0; i < m; i++)
+    for (int j = 0; j < m; j++) {
+      double a = dense[(size_t)i * m + j], b = dense[(size_t)j * m + i];
+      if (i != j && a != 0) diagonal = 0;
+      if (fabs(a - b) > 1e-14 * (fabs(a) + fabs(b))) {
+        error_at(loc, "M is not symmetric: M[%d][%d] = %.17g but M[%d][%d] = %.17g", i + 1, j + 1, a, j + 1, i + 1, b);
+        return -1;
+      }
+    }
+  if (diagonal) {
+    for (int i = 0; i < m; i++) {
+      double d = dense[(size_t)i * m + i];
+      if (!(d > 0)) {
+        error_at(loc, "M is not positive definite: diagonal entry %d is %.17g", i + 1, d);
+        return -1;
+      }
+      mod->minv_diag[i] = 1 / d;
+      if (d != dense[0]) mod->mass = MASS_DIAG;
+    }
+    if (mod->mass == MASS_IDENTITY && dense[0] != 1) mod->mass = MASS_SCALAR;
+    return 0;
+  }
+  gsl_error_handler_t *old = gsl_set_error_handler_off();
+  gsl_matrix *a = gsl_matrix_alloc((size_t)m, (size_t)m);
+  memcpy(a->data, dense, (size_t)m * (size_t)m * sizeof(double));
+  int rc = gsl_linalg_cholesky_decomp1(a);
+  if (rc == 0) rc = gsl_linalg_cholesky_invert(a);
+  gsl_set_error_handler(old);
+  if (rc) {
+    gsl_matrix_free(a);
+    error_at(loc, "M is not positive definite (its Cholesky factorisation fails)");
+    return -1;
+  }
+  mod->mass = MASS_DENSE;
+  mod->minv = arena_alloc((size_t)m * (size_t)m * sizeof(double));
+  memcpy(mod->minv, a->data, (size_t)m * (size_t)m * sizeof(double));
+  for (int i = 0; i < m; i++) mod->minv_diag[i] = mod->minv[(size_t)i * m + i];
+  gsl_matrix_free(a);
+  return 0;
+}
+
+// out = M^-1 v for node vectors of length m (out may not alias v).
+void minv_apply(const Model *mod, Dag *d, const int *v, int *out) {
+  int m = mod->m;
+  for (int i = 0; i < m; i++) {
+    if (mod->mass != MASS_DENSE) {
+      out[i] = dag_mul(d, dag_const(d, mod->minv_diag[i]), v[i]);
+      continue;
+    }
+    int acc = dag_const(d, 0);
+    for (int j = 0; j < m; j++) {
+      double c = mod->minv[(size_t)i * m + j];
+      if (c != 0 && !dag_is_zero(d, v[j])) acc = dag_add(d, acc, dag_mul(d, dag_const(d, c), v[j]));
+    }
+    out[i] = acc;
+  }
+}

@@ -1,0 +1,118 @@
+/* method.c - the constants of HBVM(k,s) and the choice of k.
+ *
+ * Gauss-Legendre nodes and weights on [0,1] come from GSL; the shifted,
+ * normalised Legendre polynomials P_j(x) = sqrt(2j+1) L_j(2x-1) from their
+ * three-term recurrence; the integrals int_0^c P_j from the closed form of
+ * METHOD.md. All are computed once here in double precision and printed
+ * into the generated code with 17 significant digits. */
+#include <math.h>
+#include <stdlib.h>
+
+#include <gsl/gsl_integration.h>
+
+#include "hbvmgen.h"
+
+#define NONPOLY_MIN_K 6
+
+// P_j(x) = sqrt(2j+1) L_j(2x-1): orthonormal on [0,1].
+double legendre_shifted(int j, double x) {
+  double t = 2 * x - 1, lm1 = 1, l = t;
+  if (j == 0) return 1;
+  for (int n = 1; n < j; n++) {
+    double next = ((2 * n + 1) * t * l - n * lm1) / (n + 1);
+    lm1 = l;
+    l = next;
+  }
+  return sqrt(2.0 * j + 1) * l;
+}
+
+static double xi(int j) { return 1 / (2 * sqrt(fabs(4.0 * j * j - 1))); }
+
+static double binomial(int n, int k) {
+  double r = 1;
+  for (int i = 1; i <= k; i++) r = r * (n - k + i) / i;
+  return r;
+}
+
+// The smallest k >= s for which the Gauss quadrature conserves H and g
+// exactly: H and g polynomial of degree <= 2k/s (the kinetic energy has
+// degree 2). For a non-polynomial U or g no k is exact; we take
+// max(2s, NONPOLY_MIN_K), a quadrature of order >= 12 whose error O(h^2k)
+// is below round-off for the step sizes at which the fixed point converges.
+int method_auto_k(int s, int degU, int degg, const char **why) {
+  int k = s;
+  *why = "H and g are at most quadratic: k = s (Gauss collocation) conserves both";
+  int degs[2] = {degU, degg};
+  for (int i = 0; i < 2; i++) {
+    if (degs[i] == DEG_NONPOLY) continue;
+    int need = (s * degs[i] + 1) / 2;
+    if (need > k) {
+      k = need;
+      *why = "smallest k with deg <= 2k/s: the quadrature is exact for H and g";
+    }
+  }
+  if (degU == DEG_NONPOLY || degg == DEG_NONPOLY) {
+    int need = 2 * s > NONPOLY_MIN_K ? 2 * s : NONPOLY_MIN_K;
+    if (need > k) k = need;
+    *why = "U or g is not a polynomial: k = max(2s, 6) keeps the quadrature error O(h^2k) at round-off";
+  }
+  return k;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+// Fill the constants of HBVM(k,s).
+Method *method_new(int k, int s) {
+  Method *me = arena_alloc(sizeof *me);
+  me->k = k;
+  me->s = s;
+  me->c = arena_alloc((size_t)k * sizeof(double));
+  me->b = arena_alloc((size_t)k * sizeof(double));
+  gsl_integration_glfixed_table *t = gsl_integration_glfixed_table_alloc((size_t)k);
+  double (*cb)[2] = malloc((size_t)k * sizeof *cb);
+  if (!t || !cb) internal_error("cannot build the Gauss-Legendre table for k=%d", k);
+  for (int l = 0; l < k; l++) gsl_integration_glfixed_point(0, 1, (size_t)l, &cb[l][0], &cb[l][1], t);
+  qsort(cb, (size_t)k, sizeof *cb, cmp_double);
+  for (int l = 0; l < k; l++) {
+    me->c[l] = cb[l][0];
+    me->b[l] = cb[l][1];
+  }
+  free(cb);
+  gsl_integration_glfixed_table_free(t);
+  me->Phat = arena_alloc((size_t)k * s * sizeof(double));
+  me->Ihat = arena_alloc((size_t)k * s * sizeof(double));
+  me->W = arena_alloc((size_t)k * s * sizeof(double));
+  me->xi = arena_alloc((size_t)(s + 1) * sizeof(double));
+  for (int j = 0; j <= s; j++) me->xi[j] = xi(j);
+  for (int l = 0; l < k; l++)
+    for (int j = 0; j < s; j++) {
+      double c = me->c[l];
+      me->Phat[l * s + j] = legendre_shifted(j, c);
+      me->W[l * s + j] = me->b[l] * me->Phat[l * s + j];
+      me->Ihat[l * s + j] =
+          j == 0 ? c : xi(j + 1) * legendre_shifted(j + 1, c) - xi(j) * legendre_shifted(j - 1, c);
+    }
+  /* Warm start: gamma_j of the next step (size r*h) from this step's
+   * polynomial: E_ji(r) = int_0^1 P_j(x) P_i(1 + r x) dx = sum_d E_jid r^d,
+   * with E_jid = P_i^(d)(1)/d! * int_0^1 P_j(x) x^d dx (exact by Gauss). */
+  me->E = arena_alloc((size_t)s * s * s * sizeof(double));
+  for (int i = 0; i < s; i++) {
+    double *mono = calloc((size_t)s, sizeof(double)); /* P_i(x) = sum_n mono[n] x^n */
+    for (int n = 0; n <= i; n++)
+      mono[n] = sqrt(2.0 * i + 1) * ((i + n) % 2 ? -1 : 1) * binomial(i, n) * binomial(i + n, n);
+    for (int d = 0; d <= i; d++) {
+      double taylor = 0;
+      for (int n = d; n <= i; n++) taylor += mono[n] * binomial(n, d);
+      for (int j = 0; j < s; j++) {
+        double moment = 0;
+        for (int l = 0; l < k; l++) moment += me->W[l * s + j] * pow(me->c[l], d);
+        me->E[(j * s + i) * s + d] = taylor * moment;
+      }
+    }
+    free(mono);
+  }
+  return me;
+}

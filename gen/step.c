@@ -1,0 +1,290 @@
+/* step.c - one fixed-point sweep of HBVM(k,s), built as a DAG.
+ *
+ * The sweep maps (q0, p0, gamma, h, g(q0)) to the new gamma, lambda and
+ * p1 - p0 exactly as METHOD.md writes it:
+ *   Q_l     = q0 + h sum_j Ihat[l][j] gamma_j                  stage points
+ *   F_l, G_l = grad U(Q_l), grad g(Q_l)                         model derivatives
+ *   psi_j   = sum_l b_l P_j(c_l) F_l,  rho_j likewise with G_l
+ *   A lambda = r                                                the multiplier system
+ *   gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)]
+ * Building it in the DAG (rather than printing loops) lets folding and
+ * sharing do the structural work: zero Jacobian entries, constant
+ * gradients, an identity M, and the zeros of A and of its LU factors never
+ * reach the emitted code. A is factored without pivoting, in the order of
+ * the constraints: its symmetric part h xi_0 rho_0' M^-1 rho_0 is positive
+ * definite when the constraints are independent, so no pivot vanishes, and
+ * a banded A (a chain) keeps its band. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "hbvmgen.h"
+
+#define MAX_DENSE_NU 4096
+
+typedef struct {
+  Model *mod;
+  const Method *me;
+  Dag *d;
+  Step *st;
+  int m, nu, s, k;
+  int h;          /* node of the step size */
+  int **psi;      /* s x m */
+  int ***rho;     /* s x nu x (entries of jac[a]) */
+  int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
+  int **vpsi;     /* s x m: M^-1 psi_j */
+} Build;
+
+static int *nodes(int n) { return arena_alloc((size_t)(n > 0 ? n : 1) * sizeof(int)); }
+
+static int *zeros(Dag *d, int n) {
+  int *v = nodes(n), z = dag_const(d, 0);
+  for (int i = 0; i < n; i++) v[i] = z;
+  return v;
+}
+
+// Stage points, model derivatives at each stage, and their projections
+// psi_j and rho_j onto the Legendre basis.
+static void build_stages(Build *b) {
+  Dag *d = b->d;
+  const Method *me = b->me;
+  int m = b->m, s = b->s;
+  int nroots = m;
+  for (int a = 0; a < b->nu; a++) nroots += b->mod->jac[a].n;
+  int *roots = nodes(nroots), *img = nodes(nroots), *Q = nodes(m);
+  memcpy(roots, b->mod->gradU, (size_t)m * sizeof(int));
+  for (int a = 0, r = m; a < b->nu; a++)
+    for (int e = 0; e < b->mod->jac[a].n; e++) roots[r++] = b->mod->jac[a].e[e].node;
+  b->psi = arena_alloc((size_t)s * sizeof(int *));
+  b->rho = arena_alloc((size_t)s * sizeof(int **));
+  for (int j = 0; j < s; j++) {
+    b->psi[j] = zeros(d, m);
+    b->rho[j] = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
+    for (int a = 0; a < b->nu; a++) b->rho[j][a] = zeros(d, b->mod->jac[a].n);
+  }
+  for (int l = 0; l < b->k; l++) {
+    char *label = arena_alloc(128);
+    snprintf(label, 128, "stage %d of %d: Q = q0 + h sum_j Ihat[%d][j] gamma_j, grad U(Q), grad g(Q)", l + 1, b->k, l + 1);
+    dag_section(d, label);
+    for (int i = 0; i < m; i++) {
+      int acc = dag_const(d, 0);
+      for (int j = 0; j < s; j++)
+        acc = dag_add(d, acc, dag_mul(d, dag_const(d, me->Ihat[l * s + j]), dag_input(d, b->st->in_gam + j * m + i)));
+      Q[i] = dag_add(d, dag_input(d, b->st->in_q0 + i), dag_mul(d, b->h, acc));
+    }
+    dag_subst(d, roots, nroots, Q, m, img);
+    for (int j = 0; j < s; j++) {
+      int w = dag_const(d, me->W[l * s + j]);
+      for (int i = 0; i < m; i++) b->psi[j][i] = dag_add(d, b->psi[j][i], dag_mul(d, w, img[i]));
+      for (int a = 0, r = m; a < b->nu; a++)
+        for (int e = 0; e < b->mod->jac[a].n; e++, r++)
+          b->rho[j][a][e] = dag_add(d, b->rho[j][a][e], dag_mul(d, w, img[r]));
+    }
+  }
+}
+
+// <rho_j[:, a], v> over the structural nonzeros of column a.
+static int dot_col(Build *b, int j, int a, const int *v) {
+  Dag *d = b->d;
+  const SparseVec *col = &b->mod->jac[a];
+  int acc = dag_const(d, 0);
+  for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, b->rho[j][a][e], v[col->e[e].coord]));
+  return acc;
+}
+
+// M^-1 psi_j and M^-1 rho_j[:, a] as dense node vectors.
+static void build_minv_products(Build *b) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s;
+  dag_section(d, "M^-1 psi_j and M^-1 rho_j");
+  int *dense = nodes(m);
+  b->vpsi = arena_alloc((size_t)s * sizeof(int *));
+  b->vrho = arena_alloc((size_t)s * sizeof(int **));
+  for (int j = 0; j < s; j++) {
+    b->vpsi[j] = nodes(m);
+    minv_apply(b->mod, d, b->psi[j], b->vpsi[j]);
+    b->vrho[j] = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
+    for (int a = 0; a < b->nu; a++) {
+      const SparseVec *col = &b->mod->jac[a];
+      int z = dag_const(d, 0);
+      for (int i = 0; i < m; i++) dense[i] = z;
+      for (int e = 0; e < col->n; e++) dense[col->e[e].coord] = b->rho[j][a][e];
+      b->vrho[j][a] = nodes(m);
+      minv_apply(b->mod, d, dense, b->vrho[j][a]);
+    }
+  }
+}
+
+// The combination xi_0 <x_0, y_0> + sum_j xi_j (<x_j, y_{j-1}> - <x_{j-1}, y_j>)
+// with x = rho[:, a] and y_j given by yj(j).
+static int skew_form(Build *b, int a, int **y) {
+  Dag *d = b->d;
+  const double *xi = b->me->xi;
+  int acc = dag_mul(d, dag_const(d, xi[0]), dot_col(b, 0, a, y[0]));
+  for (int j = 1; j < b->s; j++) {
+    int t = dag_sub(d, dot_col(b, j, a, y[j - 1]), dot_col(b, j - 1, a, y[j]));
+    acc = dag_add(d, acc, dag_mul(d, dag_const(d, xi[j]), t));
+  }
+  return acc;
+}
+
+// Assemble A (nu x nu, dense node matrix) and r, then solve A lambda = r
+// by an LU factorisation without pivoting whose zeros fold away.
+static void build_multipliers(Build *b) {
+  Dag *d = b->d;
+  int nu = b->nu, m = b->m, s = b->s;
+  Step *st = b->st;
+  dag_section(d, "multiplier system A lambda = r");
+  int *A = nodes(nu * nu), *r = nodes(nu);
+  int **y = arena_alloc((size_t)s * sizeof(int *));
+  /* which constraints touch each coordinate through M^-1 rho */
+  IntVec *touch = arena_alloc((size_t)m * sizeof(IntVec));
+  for (int a = 0; a < nu; a++)
+    for (int i = 0; i < m; i++) {
+      int any = 0;
+      for (int j = 0; j < s; j++) any |= !dag_is_zero(d, b->vrho[j][a][i]);
+      if (any) intvec_push(&touch[i], a);
+    }
+  int *pair = nodes(nu);
+  for (int a = 0; a < nu; a++) pair[a] = -1;
+  int *minvp0 = nodes(m), *p0 = nodes(m);
+  for (int i = 0; i < m; i++) p0[i] = dag_input(d, st->in_p0 + i);
+  minv_apply(b->mod, d, p0, minvp0);
+  for (int a = 0; a < nu; a++) {
+    for (int c = 0; c < nu; c++) A[a * nu + c] = dag_const(d, 0);
+    const SparseVec *col = &b->mod->jac[a];
+    for (int e = 0; e < col->n; e++) {
+      IntVec *t = &touch[col->e[e].coord];
+      for (int q = 0; q < t->n; q++) {
+        int c = t->v[q];
+        if (pair[c] == a) continue;
+        pair[c] = a;
+        for (int j = 0; j < s; j++) y[j] = b->vrho[j][c];
+        A[a * nu + c] = dag_mul(d, b->h, skew_form(b, a, y));
+      }
+    }
+    for (int j = 0; j < s; j++) y[j] = b->vpsi[j];
+    int rhs = dag_sub(d, dot_col(b, 0, a, minvp0), dag_mul(d, b->h, skew_form(b, a, y)));
+    r[a] = dag_add(d, rhs, dag_div(d, dag_input(d, st->in_g0 + a), b->h));
+    st->adiag[a] = A[a * nu + a];
+  }
+  for (int k = 0; k < nu; k++) {
+    st->pivot[k] = A[k * nu + k];
+    for (int i = k + 1; i < nu; i++) {
+      if (dag_is_zero(d, A[i * nu + k])) continue;
+      int f = dag_div(d, A[i * nu + k], A[k * nu + k]);
+      for (int c = k + 1; c < nu; c++)
+        if (!dag_is_zero(d, A[k * nu + c])) A[i * nu + c] = dag_sub(d, A[i * nu + c], dag_mul(d, f, A[k * nu + c]));
+      r[i] = dag_sub(d, r[i], dag_mul(d, f, r[k]));
+    }
+  }
+  for (int k = nu - 1; k >= 0; k--) {
+    int acc = r[k];
+    for (int c = k + 1; c < nu; c++)
+      if (!dag_is_zero(d, A[k * nu + c])) acc = dag_sub(d, acc, dag_mul(d, A[k * nu + c], st->lambda[c]));
+    st->lambda[k] = dag_div(d, acc, A[k * nu + k]);
+  }
+}
+
+// gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i], Theta_i = psi_i + rho_i lambda;
+// and p1 - p0 = -h Theta_0.
+static void build_update(Build *b) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s;
+  const double *xi = b->me->xi;
+  Step *st = b->st;
+  dag_section(d, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)]");
+  int **theta = arena_alloc((size_t)s * sizeof(int *));
+  for (int j = 0; j < s; j++) {
+    theta[j] = nodes(m);
+    memcpy(theta[j], b->psi[j], (size_t)m * sizeof(int));
+    for (int a = 0; a < b->nu; a++) {
+      const SparseVec *col = &b->mod->jac[a];
+      for (int e = 0; e < col->n; e++) {
+        int i = col->e[e].coord;
+        theta[j][i] = dag_add(d, theta[j][i], dag_mul(d, b->rho[j][a][e], st->lambda[a]));
+      }
+    }
+  }
+  int *v = nodes(m);
+  for (int j = 0; j < s; j++) {
+    for (int i = 0; i < m; i++) {
+      int x = j == 0 ? dag_mul(d, dag_const(d, xi[0]), theta[0][i])
+                     : dag_mul(d, dag_const(d, xi[j]), theta[j - 1][i]);
+      if (j + 1 < s) x = dag_sub(d, x, dag_mul(d, dag_const(d, xi[j + 1]), theta[j + 1][i]));
+      x = dag_mul(d, b->h, x);
+      v[i] = j == 0 ? dag_sub(d, dag_input(d, st->in_p0 + i), x) : dag_neg(d, x);
+    }
+    minv_apply(b->mod, d, v, st->gam_new + j * m);
+  }
+  for (int i = 0; i < m; i++) st->dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
+}
+
+// Functions of the state outside the step: g(q), H(q,p), grad g(q)' M^-1 p,
+// and the first step's prediction gamma_0 = M^-1 p0.
+static void build_diagnostics(Build *b) {
+  Dag *d = b->d;
+  Model *mod = b->mod;
+  int m = b->m, nu = b->nu;
+  Step *st = b->st;
+  int *q = nodes(m), *p = nodes(m);
+  for (int i = 0; i < m; i++) {
+    q[i] = dag_input(d, st->in_q0 + i);
+    p[i] = dag_input(d, st->in_p0 + i);
+  }
+  dag_section(d, "g(q0)");
+  dag_subst(d, mod->g, nu, q, m, st->g_at_q0);
+  minv_apply(mod, d, p, st->predict0);
+  dag_section(d, "energy");
+  int kin = dag_const(d, 0);
+  for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, p[i], st->predict0[i]));
+  int U;
+  dag_subst(d, &mod->U, 1, q, m, &U);
+  st->energy[0] = dag_add(d, dag_mul(d, dag_const(d, 0.5), kin), U);
+  dag_section(d, "hidden constraints");
+  for (int a = 0; a < nu; a++) {
+    const SparseVec *col = &mod->jac[a];
+    int acc = dag_const(d, 0);
+    for (int e = 0; e < col->n; e++) {
+      int ga;
+      dag_subst(d, &col->e[e].node, 1, q, m, &ga);
+      acc = dag_add(d, acc, dag_mul(d, ga, st->predict0[col->e[e].coord]));
+    }
+    st->hidden[a] = acc;
+  }
+}
+
+Step *step_build(Model *mod, const Method *me) {
+  Step *st = arena_alloc(sizeof *st);
+  int m = mod->m, nu = mod->nu, s = me->s;
+  if (nu > MAX_DENSE_NU) {
+    error_at((Loc){0, 0}, "%d constraints: at most %d are supported", nu, MAX_DENSE_NU);
+    return NULL;
+  }
+  st->m = m;
+  st->nu = nu;
+  st->s = s;
+  st->in_q0 = m;
+  st->in_p0 = 2 * m;
+  st->in_gam = 3 * m;
+  st->in_h = 3 * m + s * m;
+  st->in_g0 = st->in_h + 1;
+  st->ninputs = st->in_g0 + nu;
+  st->gam_new = nodes(s * m);
+  st->dp = nodes(m);
+  st->lambda = nodes(nu);
+  st->pivot = nodes(nu);
+  st->adiag = nodes(nu);
+  st->predict0 = nodes(m);
+  st->g_at_q0 = nodes(nu);
+  st->energy = nodes(1);
+  st->hidden = nodes(nu);
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, dag_input(mod->dag, st->in_h), NULL, NULL, NULL, NULL};
+  build_stages(&b);
+  if (nu) {
+    build_minv_products(&b);
+    build_multipliers(&b);
+  }
+  build_update(&b);
+  build_diagnostics(&b);
+  return st;
+}

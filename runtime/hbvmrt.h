@@ -1,0 +1,50 @@
+/* hbvmrt.h - the small runtime behind a standalone hbvmgen solver.
+ *
+ * A generated NAME_main.c describes its model with an hbvmrt_model (sizes,
+ * parameter names, and adapter functions that call NAME_step and friends on
+ * opaque state and parameter blocks) and hands argc/argv to hbvmrt_main.
+ * The runtime parses the driver options of SPEC section 4, runs the loop,
+ * writes the CSV, keeps the running maxima and prints the summary line.
+ * The generated step never needs this library. */
+#ifndef HBVMRT_H
+#define HBVMRT_H
+
+#include <stddef.h>
+
+/* What one step reports back to the driver. */
+typedef struct {
+  int iters;          /* fixed-point iterations of the step */
+  double increment;   /* final scaled increment */
+} hbvmrt_stats;
+
+/* One run-time parameter: its name and where it lives in the params block. */
+typedef struct {
+  const char *name;
+  size_t offset;      /* byte offset of the double in the params block */
+} hbvmrt_param;
+
+/* Everything the driver needs to know about one generated model.
+ * State and params are opaque blocks of state_size / params_size bytes;
+ * t, q, p, lambda are found at the given byte offsets inside the state. */
+typedef struct {
+  const char *name;
+  int m, nu, k, s;
+  size_t state_size, params_size;
+  size_t off_t, off_q, off_p, off_lambda;
+  int nparams;
+  const hbvmrt_param *params;
+  const double *q0, *p0;                 /* model defaults, m values each */
+  void (*init)(void *x, const double *q0, const double *p0);
+  void (*params_default)(void *prm);
+  int (*step)(void *x, double h, const void *prm, hbvmrt_stats *st);
+  const char *(*strerror)(int code);     /* name of a nonzero step code */
+  double (*energy)(const void *x, const void *prm);
+  void (*constraints)(const void *x, const void *prm, double *g);
+  void (*hidden)(const void *x, const void *prm, double *gp);
+} hbvmrt_model;
+
+/* Run the standalone driver: returns the process exit status
+ * (0 success, 1 bad arguments, 2 a failed step). */
+int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
+
+#endif
