@@ -27,8 +27,9 @@ GEN_OBJ  := $(addprefix $(B)/gen/,$(GEN_SRC:.c=.o) parser.o lexer.o)
 RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
 SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
 SOLV_OBJ := $(addprefix $(B)/generated/,$(addsuffix .o,$(SOLVERS)))
-TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c
+TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c tests/solvers.c
 TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
+
 
 HBVMGEN  := gen/hbvmgen
 LIBRT    := runtime/libhbvmrt.a
@@ -92,9 +93,15 @@ demo: deps
 	@$(MAKE) --no-print-directory all
 	scripts/demo.sh
 
+$(B)/tests/tables: $(B)/tests/tables.o $(B)/tests/paper.o $(B)/tests/ref.o $(B)/tests/solvers.o $(SOLV_OBJ)
+	$(CC) $(SAN) -o $@ $^ $(GSLLIB) -lm
+
 tables: deps
-	@$(MAKE) --no-print-directory $(B)/tests/runner
-	$(B)/tests/runner --tables docs/tables.md
+	@$(MAKE) --no-print-directory $(B)/tests/tables
+	@mkdir -p docs
+	$(B)/tests/tables tests/data docs/tables.md
+	@echo "tables: written to docs/tables.md"
+
 
 clean:
 	rm -rf build build-san $(HBVMGEN) $(LIBRT) demo

@@ -295,7 +295,7 @@ static void conical_k2s2_kahan(double *a, double *c, double b)
 int conical_k2s2_step(conical_k2s2_state *x, double h, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
-  double inc = HUGE_VAL, inc_old, smax;
+  double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_k2s2_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k2s2_EBADSTEP;
@@ -303,20 +303,19 @@ int conical_k2s2_step(conical_k2s2_state *x, double h, const conical_k2s2_params
   conical_k2s2_g(x->q, x->p, NULL, 0, NULL, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     conical_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
-    smax = 0;
-    for (i = 0; i < M; i++) smax = fmax(smax, fabs(x->q[i]) + fabs(h * sw[i]));
+    scale = 0;
+    for (i = 0; i < M; i++) scale = fmax(scale, fabs(x->q[i]) + fabs(h * sw[i]));
     for (i = 0; i < S * M; i++) {
-      double scale = fabs(x->q[i % M]) + fabs(h * sw[i % M]) + 1e-10 * smax;
-      double di = fabs(h * (sw[i] - gam[i]));
-      if (di > 0) inc = fmax(inc, scale > 0 ? di / scale : HUGE_VAL);
-      if (!isfinite(sw[i])) inc = NAN;
+      inc = fmax(inc, fabs(h * (sw[i] - gam[i])));
       gam[i] = sw[i];
     }
-    for (i = S * M; i < S * M + M + NU; i++)
-      if (!isfinite(sw[i])) inc = NAN;
-    if (isnan(inc)) { rc = conical_k2s2_ENONFINITE; break; }
+    if (scale > 0) inc /= scale;
+    for (i = 0; i < S * M + M + NU; i++)
+      if (!isfinite(sw[i])) rc = conical_k2s2_ENONFINITE;
+    if (rc == conical_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_k2s2_ENONFINITE; break; }
     for (i = 0; i < NU; i++)
       if (!(fabs(sw[S * M + M + NU + i]) > SINGTOL * fabs(sw[S * M + M + 2 * NU + i]))) rc = conical_k2s2_ESINGULAR;
     if (rc == conical_k2s2_ESINGULAR) break;

@@ -207,7 +207,7 @@ static void pendulum_k1s1_kahan(double *a, double *c, double b)
 int pendulum_k1s1_step(pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
-  double inc = HUGE_VAL, inc_old, smax;
+  double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_k1s1_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_k1s1_EBADSTEP;
@@ -215,20 +215,19 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, double h, const pendulum_k1s1_par
   pendulum_k1s1_g(x->q, x->p, NULL, 0, NULL, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     pendulum_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
-    smax = 0;
-    for (i = 0; i < M; i++) smax = fmax(smax, fabs(x->q[i]) + fabs(h * sw[i]));
+    scale = 0;
+    for (i = 0; i < M; i++) scale = fmax(scale, fabs(x->q[i]) + fabs(h * sw[i]));
     for (i = 0; i < S * M; i++) {
-      double scale = fabs(x->q[i % M]) + fabs(h * sw[i % M]) + 1e-10 * smax;
-      double di = fabs(h * (sw[i] - gam[i]));
-      if (di > 0) inc = fmax(inc, scale > 0 ? di / scale : HUGE_VAL);
-      if (!isfinite(sw[i])) inc = NAN;
+      inc = fmax(inc, fabs(h * (sw[i] - gam[i])));
       gam[i] = sw[i];
     }
-    for (i = S * M; i < S * M + M + NU; i++)
-      if (!isfinite(sw[i])) inc = NAN;
-    if (isnan(inc)) { rc = pendulum_k1s1_ENONFINITE; break; }
+    if (scale > 0) inc /= scale;
+    for (i = 0; i < S * M + M + NU; i++)
+      if (!isfinite(sw[i])) rc = pendulum_k1s1_ENONFINITE;
+    if (rc == pendulum_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_k1s1_ENONFINITE; break; }
     for (i = 0; i < NU; i++)
       if (!(fabs(sw[S * M + M + NU + i]) > SINGTOL * fabs(sw[S * M + M + 2 * NU + i]))) rc = pendulum_k1s1_ESINGULAR;
     if (rc == pendulum_k1s1_ESINGULAR) break;

@@ -1,0 +1,419 @@
+/* args.c - the standalone driver's options (SPEC section 4).
+ *
+ *   NAME [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..] [--p0 a,b,..]
+ *        [--param name=value] [--csv FILE] [--quiet] [--help]
+ *
+ * Options are read left to right; a repeated option overrides the earlier one
+ * (--param per name).  A value is the next argument, so `-h -0.01` works; it
+ * may also be attached: `-h0.01`, `--every=10`.  Every value is checked here,
+ * so the loop never meets a bad one: the first problem is reported as one line
+ * `NAME: error: ...` on stderr and the driver exits with status 1. */
+#include <ctype.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hbvmrt_internal.h"
+
+typedef enum {
+  OPT_STEP, OPT_TIME, OPT_STEPS, OPT_EVERY, OPT_Q0, OPT_P0, OPT_PARAM,
+  OPT_CSV, OPT_QUIET, OPT_HELP
+} OptId;
+
+typedef struct {
+  const char *name;
+  OptId id;
+  int takes_value;
+} Option;
+
+static const Option options[] = {
+  {"-h", OPT_STEP, 1},      {"-T", OPT_TIME, 1},     {"-N", OPT_STEPS, 1},
+  {"--every", OPT_EVERY, 1}, {"--q0", OPT_Q0, 1},    {"--p0", OPT_P0, 1},
+  {"--param", OPT_PARAM, 1}, {"--csv", OPT_CSV, 1},  {"--quiet", OPT_QUIET, 0},
+  {"--help", OPT_HELP, 0},
+};
+
+/* What was seen on the way, for the checks that need all options. */
+typedef struct {
+  int have_T, have_N;
+  double T;
+} Seen;
+
+void hbvmrt_error(const hbvmrt_model *md, const char *fmt, ...)
+{
+  va_list ap;
+
+  fprintf(stderr, "%s: error: ", md->name);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+/* Read a finite number at s (blanks before and after it allowed); returns
+ * where the text after it starts, or NULL. */
+static const char *scan_real(const char *s, double *v)
+{
+  char *end;
+
+  *v = strtod(s, &end);
+  if (end == s || !isfinite(*v))
+    return NULL;
+  while (isspace((unsigned char)*end))
+    end++;
+  return end;
+}
+
+/* a finite number that is all of s */
+static int parse_real(const char *s, double *v)
+{
+  const char *end = scan_real(s, v);
+  return end && *end == '\0' ? 0 : -1;
+}
+
+/* A whole number >= lo for -N and --every ("1e6" is fine, "1.5" is not). */
+static int parse_count(const hbvmrt_model *md, const char *opt, const char *s,
+                       long lo, long *n)
+{
+  double v;
+
+  if (parse_real(s, &v) != 0 || v != floor(v)) {
+    hbvmrt_error(md, "invalid value '%s' for %s (expected a whole number)",
+                 s, opt);
+    return -1;
+  }
+  if (v >= (double)LONG_MAX) {
+    hbvmrt_error(md, "%s is too large (got %s)", opt, s);
+    return -1;
+  }
+  if (v < (double)lo) {
+    hbvmrt_error(md, "%s must be >= %ld (got %s)", opt, lo, s);
+    return -1;
+  }
+  *n = (long)v;
+  return 0;
+}
+
+static int parse_number(const hbvmrt_model *md, const char *opt, const char *s,
+                        double *v)
+{
+  if (parse_real(s, v) == 0)
+    return 0;
+  hbvmrt_error(md, "invalid value '%s' for %s (expected a finite number)",
+               s, opt);
+  return -1;
+}
+
+/* --q0/--p0: exactly m comma-separated finite numbers into *out (allocated
+ * on first use, overwritten when the option is repeated). */
+static int parse_vector(const hbvmrt_model *md, const char *opt, const char *s,
+                        double **out)
+{
+  const char *p = s;
+  int n = 0;
+  double v;
+
+  if (!*out && !(*out = calloc((size_t)md->m + 1, sizeof **out))) {
+    hbvmrt_error(md, "out of memory");
+    return -1;
+  }
+  for (;;) {
+    const char *end = scan_real(p, &v);
+    if (!end || (*end != ',' && *end != '\0')) {
+      hbvmrt_error(md, "invalid value '%s' for %s (expected %d finite "
+                   "numbers separated by commas)", s, opt, md->m);
+      return -1;
+    }
+    if (n < md->m)
+      (*out)[n] = v;
+    n++;
+    if (*end == '\0')
+      break;
+    p = end + 1;
+  }
+  if (n != md->m) {
+    hbvmrt_error(md, "%s needs %d value%s (m=%d), got %d", opt, md->m,
+                 md->m == 1 ? "" : "s", md->m, n);
+    return -1;
+  }
+  return 0;
+}
+
+/* The error for --param with a name the model does not have, listing the
+ * names it has. */
+static void unknown_param(const hbvmrt_model *md, const char *name, size_t len)
+{
+  int i;
+
+  fprintf(stderr, "%s: error: unknown parameter '%.*s' ", md->name, (int)len,
+          name);
+  if (md->nparams == 0)
+    fputs("(the model has no parameters)\n", stderr);
+  for (i = 0; i < md->nparams; i++)
+    fprintf(stderr, "%s%s", i ? ", " : "(parameters: ", md->params[i].name);
+  if (md->nparams > 0)
+    fputs(")\n", stderr);
+}
+
+/* --param name=value: the name must be one of the model's parameters. */
+static int parse_param(const hbvmrt_model *md, const char *s, hbvmrt_opts *o)
+{
+  const char *eq = strchr(s, '=');
+  size_t len;
+  int i;
+
+  if (!eq || eq == s) {
+    hbvmrt_error(md, "invalid value '%s' for --param (expected name=value)", s);
+    return -1;
+  }
+  len = (size_t)(eq - s);
+  for (i = 0; i < md->nparams; i++) {
+    const char *name = md->params[i].name;
+    if (strlen(name) == len && strncmp(name, s, len) == 0)
+      break;
+  }
+  if (i == md->nparams) {
+    unknown_param(md, s, len);
+    return -1;
+  }
+  if (parse_real(eq + 1, &o->param_val[i]) != 0) {
+    hbvmrt_error(md, "invalid value '%s' for --param %s (expected a finite "
+                 "number)", eq + 1, md->params[i].name);
+    return -1;
+  }
+  o->param_set[i] = 1;
+  return 0;
+}
+
+/* The option named by arg, with its attached value (`-h0.1`, `--every=3`)
+ * in *val when there is one; NULL if arg names no option. */
+static const Option *match(const char *arg, const char **val)
+{
+  size_t i;
+
+  *val = NULL;
+  for (i = 0; i < sizeof options / sizeof options[0]; i++) {
+    const Option *op = &options[i];
+    size_t n = strlen(op->name);
+    if (strncmp(arg, op->name, n) != 0)
+      continue;
+    if (arg[n] == '\0')
+      return op;
+    if (op->name[1] == '-' && arg[n] == '=') {
+      *val = arg + n + 1;
+      return op;
+    }
+    if (op->name[1] != '-' && op->takes_value) {
+      *val = arg + n;
+      return op;
+    }
+  }
+  return NULL;
+}
+
+static void print_vector(FILE *out, const double *v, int n)
+{
+  int i;
+
+  if (!v) {
+    fputs("model default", out);
+    return;
+  }
+  for (i = 0; i < n; i++)
+    fprintf(out, "%s%.17g", i ? "," : "", v[i]);
+}
+
+/* Usage, the model's sizes and its parameters with their defaults. */
+static int print_help(const hbvmrt_model *md, FILE *out)
+{
+  void *prm = calloc(1, md->params_size + 1);
+  int i;
+
+  fprintf(out,
+    "usage: %s [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..]\n"
+    "       %*s [--p0 a,b,..] [--param name=value] [--csv FILE] [--quiet]\n"
+    "\n"
+    "Integrates the model %s (m=%d coordinates, nu=%d constraints) with the\n"
+    "HBVM(k=%d,s=%d) line integral method, N steps of the constant step h.\n"
+    "\n"
+    "  -h STEP            step size h, nonzero, negative to go back in time\n"
+    "                     (default %g)\n"
+    "  -T TIME            time span, TIME >= 0: N = ceil(TIME/|h|) steps, so\n"
+    "                     the last time is N*h (default %g)\n"
+    "  -N STEPS           number of steps N >= 0 instead of -T\n"
+    "  --every K          a CSV row every K steps, K >= 1; t=0 and the last\n"
+    "                     step are always written (default 1)\n"
+    "  --q0 a,b,..        initial positions, %d values (default ",
+    md->name, (int)strlen(md->name), "", md->name, md->m, md->nu, md->k,
+    md->s, HBVMRT_DEFAULT_H, HBVMRT_DEFAULT_T, md->m);
+  print_vector(out, md->q0, md->m);
+  fprintf(out, ")\n  --p0 a,b,..        initial momenta, %d values (default ",
+          md->m);
+  print_vector(out, md->p0, md->m);
+  fputs(")\n"
+    "  --param name=value set a run-time parameter (repeatable)\n"
+    "  --csv FILE         write the rows t,q1..,p1..,lam1..,H,g1..,hc1.. to\n"
+    "                     FILE ('-' for stdout); no CSV without it\n"
+    "  --quiet            no progress line on a terminal\n"
+    "  --help             this text\n", out);
+  if (md->nparams > 0) {
+    fputs("\nparameters (default):\n", out);
+    if (prm && md->params_default)
+      md->params_default(prm);
+    for (i = 0; i < md->nparams; i++) {
+      double v = 0;
+      if (prm)
+        memcpy(&v, (char *)prm + md->params[i].offset, sizeof v);
+      fprintf(out, "  %s = %.17g\n", md->params[i].name, v);
+    }
+  }
+  fputs("\nAt the end one line on stderr:\n"
+    "  steps=N iters_mean=X iters_max=Y max_dH=E max_g=E max_hc=E seconds=S\n"
+    "with the maxima of |H-H0|, |g_i| and |hc_i| over every step.\n"
+    "Exit status: 0 success, 1 bad arguments or an output error, 2 a failed "
+    "step.\n", out);
+  free(prm);
+  if (fflush(out) != 0 || ferror(out)) {
+    hbvmrt_error(md, "cannot write the help text");
+    return -1;
+  }
+  return 0;
+}
+
+/* Store one option's value in o (or seen); -1 after reporting an error. */
+static int apply(const hbvmrt_model *md, const Option *op, const char *val,
+                 hbvmrt_opts *o, Seen *seen)
+{
+  switch (op->id) {
+  case OPT_STEP:
+    if (parse_number(md, op->name, val, &o->h) != 0)
+      return -1;
+    if (o->h == 0) {
+      hbvmrt_error(md, "-h must be nonzero");
+      return -1;
+    }
+    return 0;
+  case OPT_TIME:
+    if (parse_number(md, op->name, val, &seen->T) != 0)
+      return -1;
+    if (seen->T < 0) {
+      hbvmrt_error(md, "-T must be >= 0 (got %s)", val);
+      return -1;
+    }
+    seen->have_T = 1;
+    return 0;
+  case OPT_STEPS:
+    seen->have_N = 1;
+    return parse_count(md, op->name, val, 0, &o->nsteps);
+  case OPT_EVERY:
+    return parse_count(md, op->name, val, 1, &o->every);
+  case OPT_Q0:
+    return parse_vector(md, op->name, val, &o->q0);
+  case OPT_P0:
+    return parse_vector(md, op->name, val, &o->p0);
+  case OPT_PARAM:
+    return parse_param(md, val, o);
+  case OPT_CSV:
+    o->csv = val;
+    return 0;
+  case OPT_QUIET:
+    o->quiet = 1;
+    return 0;
+  case OPT_HELP:
+    break;
+  }
+  return 0;
+}
+
+/* The checks that need every option: -T against -N, and N from the span. */
+static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
+{
+  double n;
+
+  if (seen->have_T && seen->have_N) {
+    hbvmrt_error(md, "-T and -N cannot be used together");
+    return -1;
+  }
+  if (seen->have_N)
+    return 0;
+  /* the 1e-9 keeps T/h = 1000.0000000000001 from becoming 1001 steps */
+  n = ceil((seen->have_T ? seen->T : HBVMRT_DEFAULT_T) / fabs(o->h) - 1e-9);
+  if (n < 0)
+    n = 0;
+  if (n >= (double)LONG_MAX) {
+    hbvmrt_error(md, "too many steps: T/|h| = %g", n);
+    return -1;
+  }
+  o->nsteps = (long)n;
+  return 0;
+}
+
+/* Parse argv into *o (which hbvmrt_opts_free releases in every case).
+ * Returns HBVMRT_ARGS_RUN, HBVMRT_ARGS_DONE after --help, or
+ * HBVMRT_ARGS_ERROR after printing the one-line error. */
+int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
+                      hbvmrt_opts *o)
+{
+  Seen seen = {0, 0, 0.0};
+  size_t np = (size_t)(md->nparams > 0 ? md->nparams : 0) + 1;
+  int i;
+
+  memset(o, 0, sizeof *o);
+  o->h = HBVMRT_DEFAULT_H;
+  o->every = 1;
+  o->param_val = calloc(np, sizeof *o->param_val);
+  o->param_set = calloc(np, 1);
+  if (!o->param_val || !o->param_set) {
+    hbvmrt_error(md, "out of memory");
+    return HBVMRT_ARGS_ERROR;
+  }
+  for (i = 1; i < argc; i++) {
+    const char *arg = argv[i], *val;
+    const Option *op = match(arg, &val);
+    if (!op) {
+      hbvmrt_error(md, "%s '%s' (try --help)", arg[0] == '-' && arg[1]
+                   ? "unknown option" : "unexpected argument", arg);
+      return HBVMRT_ARGS_ERROR;
+    }
+    if (op->id == OPT_HELP)
+      return print_help(md, stdout) == 0 ? HBVMRT_ARGS_DONE
+                                          : HBVMRT_ARGS_ERROR;
+    if (op->takes_value && !val) {
+      if (i + 1 >= argc) {
+        hbvmrt_error(md, "option %s needs a value", op->name);
+        return HBVMRT_ARGS_ERROR;
+      }
+      val = argv[++i];
+    } else if (!op->takes_value && val) {
+      hbvmrt_error(md, "option %s takes no value", op->name);
+      return HBVMRT_ARGS_ERROR;
+    }
+    if (apply(md, op, val, o, &seen) != 0)
+      return HBVMRT_ARGS_ERROR;
+  }
+  return finish(md, o, &seen) == 0 ? HBVMRT_ARGS_RUN : HBVMRT_ARGS_ERROR;
+}
+
+void hbvmrt_opts_free(hbvmrt_opts *o)
+{
+  free(o->q0);
+  free(o->p0);
+  free(o->param_val);
+  free(o->param_set);
+  memset(o, 0, sizeof *o);
+}
+
+/* Write the --param values into a params block already holding defaults. */
+void hbvmrt_apply_params(const hbvmrt_model *md, const hbvmrt_opts *o,
+                         void *prm)
+{
+  int i;
+
+  for (i = 0; i < md->nparams; i++)
+    if (o->param_set[i])
+      memcpy((char *)prm + md->params[i].offset, &o->param_val[i],
+             sizeof o->param_val[i]);
+}

@@ -1,0 +1,56 @@
+/* hbvmrt_internal.h - what the runtime's files share; not installed, not
+ * seen by generated code.  One section per file: args.c parses the driver
+ * options into an hbvmrt_opts, csv.c writes the header and rows, run.c
+ * (hbvmrt_main) ties them to the loop. */
+#ifndef HBVMRT_INTERNAL_H
+#define HBVMRT_INTERNAL_H
+
+#include <stdio.h>
+
+#include "hbvmrt.h"
+
+#if defined(__GNUC__)
+#define HBVMRT_PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define HBVMRT_PRINTF(f, a)
+#endif
+
+/* args.c */
+
+#define HBVMRT_DEFAULT_H 0.01   /* step when -h is not given */
+#define HBVMRT_DEFAULT_T 10.0   /* time span when neither -T nor -N is given */
+
+/* The driver options once parsed and checked. */
+typedef struct {
+  double h;            /* step, nonzero, may be negative */
+  long nsteps;         /* N >= 0 (from -N, or from -T and h) */
+  long every;          /* K >= 1: a CSV row every K steps */
+  double *q0, *p0;     /* m values each; NULL when the option was not given */
+  double *param_val;   /* nparams values from --param ... */
+  char *param_set;     /* ... nonzero where one was given */
+  const char *csv;     /* NULL: no CSV; "-": stdout */
+  int quiet;           /* no progress line */
+} hbvmrt_opts;
+
+/* What hbvmrt_parse_args tells the caller to do next. */
+enum {
+  HBVMRT_ARGS_RUN,     /* options fine: run */
+  HBVMRT_ARGS_DONE,    /* --help printed: exit 0 */
+  HBVMRT_ARGS_ERROR    /* error printed: exit 1 */
+};
+
+int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
+                      hbvmrt_opts *o);
+void hbvmrt_opts_free(hbvmrt_opts *o);
+void hbvmrt_apply_params(const hbvmrt_model *md, const hbvmrt_opts *o,
+                         void *prm);
+void hbvmrt_error(const hbvmrt_model *md, const char *fmt, ...)
+  HBVMRT_PRINTF(2, 3);
+
+/* csv.c: both return 0, or -1 once the stream is in error. */
+
+int hbvmrt_csv_header(FILE *f, const hbvmrt_model *md);
+int hbvmrt_csv_row(FILE *f, const hbvmrt_model *md, const void *x, double H,
+                   const double *g, const double *hc);
+
+#endif

@@ -1,0 +1,322 @@
+/* run.c - hbvmrt_main: the standalone driver's loop (SPEC section 4).
+ *
+ * After the options (args.c) it allocates the state and params blocks, fills
+ * the params with the defaults and the --param values, initialises the state
+ * and takes N steps of the constant step h.  After t=0 and after every step it
+ * evaluates H, g and the hidden constraints hc, so the maxima in the summary
+ * are over every step, not just the rows written (every K-th step, t=0 and
+ * the last step).  A failed step stops the loop: the state it left is the
+ * last good one, written as the final row, and the exit status is 2.
+ *
+ * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
+ * not be opened or written: an incomplete file is never silent; this wins over
+ * a failed step), 2 a failed step. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "hbvmrt_internal.h"
+
+/* One run: the blocks, scratch for g and hc, and the running figures. */
+typedef struct {
+  const hbvmrt_model *md;
+  const hbvmrt_opts *o;
+  void *x, *prm;
+  double *g, *hc;             /* nu values each (one spare) */
+  double H0, H;               /* energy at t=0 and now */
+  double max_dh, max_g, max_hc;
+  double iters_sum;
+  int iters_max;
+  long steps;                 /* steps taken successfully */
+  int fail_code;              /* the failed step's code, or 0 */
+  FILE *csv;                  /* NULL: no CSV */
+  int csv_errno;              /* errno of the first failed write, or 0 */
+} Run;
+
+/* The progress line: drawn only on a terminal, after a second, at most ten
+ * times a second; the clock is read every `stride` steps, a stride that
+ * adapts so that it is read every 10 to 50 ms whatever a step costs. */
+typedef struct {
+  int on;
+  double start, last_check, last_draw;
+  long stride, next;          /* read the clock again at step `next` */
+  int width;                  /* of the line drawn, 0 if none */
+} Progress;
+
+/* Wall-clock seconds (CLOCK_MONOTONIC): the summary's `seconds` is the wall
+ * time of the loop, CSV writing included, since that is what the user waits
+ * for and what the progress line's steps per second mean. */
+static double now(void)
+{
+  struct timespec ts;
+
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* max = max(max, |v|), except that a NaN, once seen, stays */
+static void keep_max(double *max, double v)
+{
+  v = fabs(v);
+  if (!(v <= *max) && !isnan(*max))
+    *max = v;
+}
+
+/* H, g and hc of the current state, into the running maxima. */
+static void observe(Run *r)
+{
+  const hbvmrt_model *md = r->md;
+  int i;
+
+  r->H = md->energy(r->x, r->prm);
+  keep_max(&r->max_dh, r->H - r->H0);
+  if (md->nu <= 0)
+    return;
+  md->constraints(r->x, r->prm, r->g);
+  md->hidden(r->x, r->prm, r->hc);
+  for (i = 0; i < md->nu; i++) {
+    keep_max(&r->max_g, r->g[i]);
+    keep_max(&r->max_hc, r->hc[i]);
+  }
+}
+
+/* Allocate the blocks, set the params and the initial state (SPEC 3:
+ * NULL q0/p0 means the model defaults).  -1 after reporting. */
+static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
+{
+  const double *q0 = o->q0, *p0 = o->p0;
+  size_t nu = (size_t)(md->nu > 0 ? md->nu : 0);
+
+  memset(r, 0, sizeof *r);
+  r->md = md;
+  r->o = o;
+  r->x = calloc(1, md->state_size + 1);
+  r->prm = calloc(1, md->params_size + 1);
+  r->g = calloc(nu + 1, sizeof *r->g);
+  r->hc = calloc(nu + 1, sizeof *r->hc);
+  if (!r->x || !r->prm || !r->g || !r->hc) {
+    hbvmrt_error(md, "out of memory");
+    return -1;
+  }
+  if (md->params_default)
+    md->params_default(r->prm);
+  hbvmrt_apply_params(md, o, r->prm);
+  if (q0 || p0) {
+    q0 = q0 ? q0 : md->q0;
+    p0 = p0 ? p0 : md->p0;
+  }
+  md->init(r->x, q0, p0);
+  r->H0 = md->energy(r->x, r->prm);
+  return 0;
+}
+
+static void teardown(Run *r)
+{
+  free(r->x);
+  free(r->prm);
+  free(r->g);
+  free(r->hc);
+}
+
+static const char *csv_name(const Run *r)
+{
+  return strcmp(r->o->csv, "-") == 0 ? "standard output" : r->o->csv;
+}
+
+/* Open --csv FILE (stdout for "-") and write the header; -1 after
+ * reporting.  Nothing is opened before the options are known to be good. */
+static int open_csv(Run *r)
+{
+  const char *path = r->o->csv;
+
+  if (!path)
+    return 0;
+  r->csv = strcmp(path, "-") == 0 ? stdout : fopen(path, "w");
+  if (!r->csv) {
+    hbvmrt_error(r->md, "cannot open '%s': %s", path, strerror(errno));
+    return -1;
+  }
+  if (hbvmrt_csv_header(r->csv, r->md) != 0)
+    r->csv_errno = errno ? errno : EIO;
+  return 0;
+}
+
+/* The current state as a CSV row; -1 (errno kept) once writing failed. */
+static int write_row(Run *r)
+{
+  if (!r->csv)
+    return 0;
+  if (r->csv_errno == 0 &&
+      hbvmrt_csv_row(r->csv, r->md, r->x, r->H, r->g, r->hc) != 0)
+    r->csv_errno = errno ? errno : EIO;
+  return r->csv_errno ? -1 : 0;
+}
+
+/* Close (or for stdout, flush) the CSV; -1 after reporting a write error,
+ * whether it happened now or during the loop. */
+static int close_csv(Run *r)
+{
+  int err = r->csv_errno;
+
+  if (!r->csv)
+    return 0;
+  errno = 0;
+  if (r->csv == stdout ? fflush(stdout) != 0 || ferror(stdout)
+                       : fclose(r->csv) != 0)
+    err = err ? err : errno ? errno : EIO;
+  r->csv = NULL;
+  if (!err)
+    return 0;
+  hbvmrt_error(r->md, "cannot write '%s': %s", csv_name(r), strerror(err));
+  return -1;
+}
+
+static void progress_start(Progress *pg, const Run *r)
+{
+  int csv_on_tty = r->o->csv && strcmp(r->o->csv, "-") == 0 &&
+                   isatty(fileno(stdout));
+
+  memset(pg, 0, sizeof *pg);
+  pg->on = !r->o->quiet && !csv_on_tty && isatty(fileno(stderr));
+  pg->start = pg->last_check = pg->last_draw = now();
+  pg->stride = pg->next = 1;
+}
+
+/* At step n: adapt the stride, and redraw when a second has gone by since
+ * the start and a tenth since the last drawing. */
+static void progress_tick(Progress *pg, const Run *r, long n)
+{
+  double t = now(), since = t - pg->last_check;
+  char line[160];
+  int len;
+
+  if (since < 0.01 && pg->stride < (1L << 20))
+    pg->stride *= 2;
+  else if (since > 0.05 && pg->stride > 1)
+    pg->stride /= 2;
+  pg->last_check = t;
+  pg->next = n + pg->stride;
+  if (t - pg->start < 1.0 || t - pg->last_draw < 0.1)
+    return;
+  pg->last_draw = t;
+  len = snprintf(line, sizeof line, "%s: %5.1f%%  %.0f steps/s  |H-H0|=%.2e",
+                 r->md->name, 100.0 * (double)n / (double)r->o->nsteps,
+                 (double)n / (t - pg->start), fabs(r->H - r->H0));
+  if (len > (int)sizeof line - 1)
+    len = (int)sizeof line - 1;
+  fprintf(stderr, "\r%-*s", pg->width, line);
+  if (len > pg->width)
+    pg->width = len;
+}
+
+static void progress_clear(Progress *pg)
+{
+  if (pg->width > 0)
+    fprintf(stderr, "\r%*s\r", pg->width, "");
+  pg->width = 0;
+}
+
+/* Rows at t=0, every K steps and at the last step taken; stops at the
+ * first failed step (code in r->fail_code) or failed write. */
+static void loop(Run *r, Progress *pg)
+{
+  const hbvmrt_model *md = r->md;
+  long n, N = r->o->nsteps, K = r->o->every;
+
+  observe(r);
+  if (write_row(r) != 0)
+    return;
+  for (n = 1; n <= N; n++) {
+    hbvmrt_stats st = {0, 0.0};
+    int code = md->step(r->x, r->o->h, r->prm, &st);
+    if (code != 0) {
+      r->fail_code = code;
+      if (r->steps % K != 0)
+        write_row(r);          /* the state the failed step left */
+      return;
+    }
+    r->steps = n;
+    r->iters_sum += st.iters;
+    if (st.iters > r->iters_max)
+      r->iters_max = st.iters;
+    observe(r);
+    if ((n % K == 0 || n == N) && write_row(r) != 0)
+      return;
+    if (pg->on && n >= pg->next)
+      progress_tick(pg, r, n);
+  }
+}
+
+/* `NAME: error: step failed at t=T: REASON`, T the time of the state the
+ * failed step left alone. */
+static void report_failure(const Run *r)
+{
+  const hbvmrt_model *md = r->md;
+  const char *why = md->strerror ? md->strerror(r->fail_code) : NULL;
+  double t;
+
+  memcpy(&t, (const char *)r->x + md->off_t, sizeof t);
+  fprintf(stderr, "%s: error: step failed at t=%.15g: ", md->name, t);
+  if (why)
+    fprintf(stderr, "%s\n", why);
+  else
+    fprintf(stderr, "code %d\n", r->fail_code);
+}
+
+/* The summary line of SPEC 4; without constraints max_g and max_hc are
+ * kept, as a plain 0, so every run's line has the same fields. */
+static void summary(const Run *r, double seconds)
+{
+  double mean = r->steps > 0 ? r->iters_sum / (double)r->steps : 0.0;
+
+  fprintf(stderr, "steps=%ld iters_mean=%.3g iters_max=%d max_dH=%.3e ",
+          r->steps, mean, r->iters_max, r->max_dh);
+  if (r->md->nu > 0)
+    fprintf(stderr, "max_g=%.3e max_hc=%.3e", r->max_g, r->max_hc);
+  else
+    fputs("max_g=0 max_hc=0", stderr);
+  fprintf(stderr, " seconds=%.3g\n", seconds);
+}
+
+/* The loop and everything reported after it; returns the exit status. */
+static int simulate(Run *r)
+{
+  Progress pg;
+  double seconds;
+  int out_failed;
+
+  progress_start(&pg, r);
+  loop(r, &pg);
+  seconds = now() - pg.start;
+  progress_clear(&pg);
+  if (r->fail_code != 0)
+    report_failure(r);
+  out_failed = close_csv(r) != 0;
+  summary(r, seconds);
+  return out_failed ? 1 : r->fail_code != 0 ? 2 : 0;
+}
+
+/* The standalone driver: see hbvmrt.h and the comment at the top. */
+int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv)
+{
+  hbvmrt_opts o;
+  Run r;
+  int status = hbvmrt_parse_args(model, argc, argv, &o);
+
+  if (status != HBVMRT_ARGS_RUN) {
+    hbvmrt_opts_free(&o);
+    return status == HBVMRT_ARGS_DONE ? 0 : 1;
+  }
+  status = 1;
+  if (setup(&r, model, &o) == 0 && open_csv(&r) == 0)
+    status = simulate(&r);
+  teardown(&r);
+  hbvmrt_opts_free(&o);
+  return status;
+}

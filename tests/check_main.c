@@ -1,0 +1,27 @@
+/* check_main.c - the one test runner: every module's suite, run from tests/. */
+#include <check.h>
+#include <stdlib.h>
+
+Suite *parser_suite(void);
+Suite *errors_suite(void);
+Suite *dag_suite(void);
+Suite *ad_suite(void);
+Suite *ref_suite(void);
+Suite *runtime_suite(void);
+Suite *solver_suite(void);
+Suite *tables_suite(void);
+
+int main(void) {
+  SRunner *sr = srunner_create(parser_suite());
+  srunner_add_suite(sr, errors_suite());
+  srunner_add_suite(sr, dag_suite());
+  srunner_add_suite(sr, ad_suite());
+  srunner_add_suite(sr, ref_suite());
+  srunner_add_suite(sr, runtime_suite());
+  srunner_add_suite(sr, solver_suite());
+  srunner_add_suite(sr, tables_suite());
+  srunner_run_all(sr, CK_NORMAL);
+  int failed = srunner_ntests_failed(sr);
+  srunner_free(sr);
+  return failed ? EXIT_FAILURE : EXIT_SUCCESS;
+}

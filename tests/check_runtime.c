@@ -1,0 +1,892 @@
+/* check_runtime.c - the standalone driver's runtime (runtime/libhbvmrt.a).
+ *
+ * Two hand-written fake models stand in for generated code:
+ *   osc   m=1 nu=0, the harmonic oscillator H = (q^2 + p^2)/2 stepped by the
+ *         exact rotation, so q(t) = cos t, p(t) = -sin t from (1, 0);
+ *   ring  m=2 nu=1, a free particle on the unit circle, H = k |p|^2 / 2 with
+ *         the run-time parameter k, stepped by the exact rotation by k L h
+ *         (L = q1 p2 - q2 p1); lambda = k |p|^2, g = |q|^2 - 1, hc = 2 q.p.
+ * Each test calls hbvmrt_main with an argv built from a string, stdout and
+ * stderr captured in temporary files, and checks the exit status, the CSV and
+ * the summary line. */
+#define _XOPEN_SOURCE 700         /* mkstemp, dup2, posix_openpt */
+
+#include <check.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "hbvmrt.h"
+
+/* --- osc: m=1, nu=0, no parameters ------------------------------------- */
+
+typedef struct {
+  double t, q[1], p[1], lambda[1];
+  long n;                       /* steps taken */
+} OscState;
+
+static const double osc_q0[1] = {1.0}, osc_p0[1] = {0.0};
+
+static void osc_init(void *x, const double *q0, const double *p0)
+{
+  OscState *s = x;
+
+  memset(s, 0, sizeof *s);
+  s->q[0] = q0 ? q0[0] : osc_q0[0];
+  s->p[0] = p0 ? p0[0] : osc_p0[0];
+}
+
+static void osc_params_default(void *prm)
+{
+  (void)prm;
+}
+
+/* exact rotation; iters = 1 + n%3, so 2,3,1,2,3,1,... */
+static int osc_step(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  OscState *s = x;
+  double c = cos(h), sn = sin(h), q = s->q[0], p = s->p[0];
+
+  (void)prm;
+  s->q[0] = c * q + sn * p;
+  s->p[0] = -sn * q + c * p;
+  s->t += h;
+  s->n++;
+  if (st) {
+    st->iters = 1 + (int)(s->n % 3);
+    st->increment = 0;
+  }
+  return 0;
+}
+
+/* as osc_step, but the sixth step fails and leaves the state alone */
+static int osc_step_fail(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  if (((OscState *)x)->n == 5)
+    return 7;
+  return osc_step(x, h, prm, st);
+}
+
+/* as osc_step, taking a millisecond: 1500 steps run 1.5 s */
+static int osc_step_slow(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  struct timespec ms = {0, 1000000};
+
+  nanosleep(&ms, NULL);
+  return osc_step(x, h, prm, st);
+}
+
+static const char *osc_strerror(int code)
+{
+  return code == 7 ? "did not converge" : "unknown";
+}
+
+static double osc_energy(const void *x, const void *prm)
+{
+  const OscState *s = x;
+
+  (void)prm;
+  return 0.5 * (s->q[0] * s->q[0] + s->p[0] * s->p[0]);
+}
+
+static const hbvmrt_model osc = {
+  "osc", 1, 0, 2, 2,
+  sizeof(OscState), 0,
+  offsetof(OscState, t), offsetof(OscState, q), offsetof(OscState, p),
+  offsetof(OscState, lambda),
+  0, NULL,
+  osc_q0, osc_p0,
+  osc_init, osc_params_default, osc_step, osc_strerror, osc_energy,
+  NULL, NULL                    /* nu = 0: never called */
+};
+
+/* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
+
+typedef struct {
+  double t, q[2], p[2], lambda[1];
+} RingState;
+
+typedef struct {
+  double k;
+} RingParams;
+
+static const hbvmrt_param ring_params[] = {{"k", offsetof(RingParams, k)}};
+static const double ring_q0[2] = {1.0, 0.0}, ring_p0[2] = {0.0, 1.0};
+
+static double ring_k(const void *prm)
+{
+  return prm ? ((const RingParams *)prm)->k : 1.0;
+}
+
+static void ring_init(void *x, const double *q0, const double *p0)
+{
+  RingState *s = x;
+
+  memset(s, 0, sizeof *s);
+  memcpy(s->q, q0 ? q0 : ring_q0, sizeof s->q);
+  memcpy(s->p, p0 ? p0 : ring_p0, sizeof s->p);
+  s->lambda[0] = s->p[0] * s->p[0] + s->p[1] * s->p[1];
+}
+
+static void ring_params_default(void *prm)
+{
+  ((RingParams *)prm)->k = 1.0;
+}
+
+static void rotate(double *v, double c, double sn)
+{
+  double a = v[0], b = v[1];
+
+  v[0] = c * a - sn * b;
+  v[1] = sn * a + c * b;
+}
+
+static int ring_step(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  RingState *s = x;
+  double k = ring_k(prm), L = s->q[0] * s->p[1] - s->q[1] * s->p[0];
+  double c = cos(k * L * h), sn = sin(k * L * h);
+
+  rotate(s->q, c, sn);
+  rotate(s->p, c, sn);
+  s->lambda[0] = k * (s->p[0] * s->p[0] + s->p[1] * s->p[1]);
+  s->t += h;
+  if (st)
+    st->iters = 4;
+  return 0;
+}
+
+static const char *ring_strerror(int code)
+{
+  (void)code;
+  return "unknown";
+}
+
+static double ring_energy(const void *x, const void *prm)
+{
+  const RingState *s = x;
+
+  return 0.5 * ring_k(prm) * (s->p[0] * s->p[0] + s->p[1] * s->p[1]);
+}
+
+static void ring_constraints(const void *x, const void *prm, double *g)
+{
+  const RingState *s = x;
+
+  (void)prm;
+  g[0] = s->q[0] * s->q[0] + s->q[1] * s->q[1] - 1.0;
+}
+
+static void ring_hidden(const void *x, const void *prm, double *gp)
+{
+  const RingState *s = x;
+
+  (void)prm;
+  gp[0] = 2.0 * (s->q[0] * s->p[0] + s->q[1] * s->p[1]);
+}
+
+static const hbvmrt_model ring = {
+  "ring", 2, 1, 3, 2,
+  sizeof(RingState), sizeof(RingParams),
+  offsetof(RingState, t), offsetof(RingState, q), offsetof(RingState, p),
+  offsetof(RingState, lambda),
+  1, ring_params,
+  ring_q0, ring_p0,
+  ring_init, ring_params_default, ring_step, ring_strerror, ring_energy,
+  ring_constraints, ring_hidden
+};
+
+/* --- running the driver ---------------------------------------------------- */
+
+/* What one hbvmrt_main call left behind. */
+typedef struct {
+  int status;
+  char *out, *err, *csv;        /* stdout, stderr, the --csv @ file */
+} Result;
+
+static char *slurp(const char *path)
+{
+  FILE *f = fopen(path, "rb");
+  char *buf;
+  long n;
+
+  ck_assert_ptr_nonnull(f);
+  fseek(f, 0, SEEK_END);
+  n = ftell(f);
+  rewind(f);
+  buf = calloc(1, (size_t)n + 1);
+  ck_assert_ptr_nonnull(buf);
+  ck_assert_int_eq(fread(buf, 1, (size_t)n, f), n);
+  fclose(f);
+  return buf;
+}
+
+static void temp_path(char *path)
+{
+  int fd;
+
+  strcpy(path, "/tmp/check_runtime_XXXXXX");
+  fd = mkstemp(path);
+  ck_assert_int_ge(fd, 0);
+  close(fd);
+}
+
+/* Point fd (1 or 2) at path; returns a copy of the old fd to restore. */
+static int redirect(int fd, const char *path)
+{
+  FILE *f = fopen(path, "w");
+  int saved = dup(fd);
+
+  ck_assert_ptr_nonnull(f);
+  ck_assert_int_ge(saved, 0);
+  ck_assert_int_ge(dup2(fileno(f), fd), 0);
+  fclose(f);
+  return saved;
+}
+
+static void restore(int fd, int saved)
+{
+  ck_assert_int_ge(dup2(saved, fd), 0);
+  close(saved);
+}
+
+/* A pseudo-terminal for stderr: returns the master's fd and the slave's in
+ * *slave, or -1 where there is none. */
+static int open_tty(int *slave)
+{
+  int master = posix_openpt(O_RDWR | O_NOCTTY);
+
+  if (master < 0)
+    return -1;
+  if (grantpt(master) != 0 || unlockpt(master) != 0 ||
+      (*slave = open(ptsname(master), O_RDWR | O_NOCTTY)) < 0) {
+    close(master);
+    return -1;
+  }
+  return master;
+}
+
+/* All the master has until the slave side is closed. */
+static char *drain_tty(int master)
+{
+  size_t len = 0, cap = 4096;
+  char *buf = malloc(cap);
+  ssize_t n;
+
+  ck_assert_ptr_nonnull(buf);
+  while ((n = read(master, buf + len, cap - len - 1)) > 0 ||
+         (n < 0 && errno == EINTR)) {
+    len += n > 0 ? (size_t)n : 0;
+    if (cap - len < 2) {
+      buf = realloc(buf, cap *= 2);
+      ck_assert_ptr_nonnull(buf);
+    }
+  }
+  buf[len] = '\0';
+  close(master);
+  return buf;
+}
+
+/* Run model md with the options in cmd (split at blanks; an argument ending
+ * in "@" has it replaced by a temporary CSV file), capturing stdout, and
+ * stderr in a file or, with tty, on a pseudo-terminal (in which case the
+ * caller must have checked that open_tty works). */
+static Result run_on(const hbvmrt_model *md, const char *cmd, int tty)
+{
+  char csv[64], out[64], err[64], buf[512], args[32][96], *argv[32], *tok;
+  int argc = 0, save_out, save_err, master = -1, slave = -1;
+  Result r;
+
+  temp_path(csv);
+  temp_path(out);
+  temp_path(err);
+  ck_assert_uint_lt(strlen(cmd), sizeof buf);
+  strcpy(buf, cmd);
+  argv[argc++] = (char *)md->name;
+  for (tok = strtok(buf, " "); tok; tok = strtok(NULL, " ")) {
+    size_t n = strlen(tok);
+    ck_assert_int_lt(argc, 31);
+    if (tok[n - 1] == '@') {
+      snprintf(args[argc], sizeof args[argc], "%.*s%s", (int)n - 1, tok, csv);
+      tok = args[argc];
+    }
+    argv[argc++] = tok;
+  }
+  argv[argc] = NULL;
+
+  fflush(stdout);
+  fflush(stderr);
+  save_out = redirect(1, out);
+  if (tty) {
+    master = open_tty(&slave);
+    ck_assert_int_ge(master, 0);
+    save_err = dup(2);
+    ck_assert_int_ge(dup2(slave, 2), 0);
+    close(slave);
+  } else {
+    save_err = redirect(2, err);
+  }
+  r.status = hbvmrt_main(md, argc, argv);
+  fflush(stdout);
+  fflush(stderr);
+  restore(1, save_out);
+  restore(2, save_err);
+
+  r.out = slurp(out);
+  r.err = tty ? drain_tty(master) : slurp(err);
+  r.csv = slurp(csv);
+  unlink(csv);
+  unlink(out);
+  unlink(err);
+  return r;
+}
+
+static Result run(const hbvmrt_model *md, const char *cmd)
+{
+  return run_on(md, cmd, 0);
+}
+
+static void done(Result *r)
+{
+  free(r->out);
+  free(r->err);
+  free(r->csv);
+}
+
+static int count_lines(const char *s)
+{
+  int n = 0;
+
+  for (; *s; s++)
+    n += *s == '\n';
+  return n;
+}
+
+/* Value in data row `row` (0 = first after the header), column `col`. */
+static double cell(const char *csv, int row, int col)
+{
+  const char *p = csv;
+  char *end;
+  double v;
+  int i;
+
+  for (i = 0; i <= row; i++) {
+    p = strchr(p, '\n');
+    ck_assert_msg(p != NULL, "no row %d", row);
+    p++;
+  }
+  for (i = 0; i < col; i++) {
+    p = strpbrk(p, ",\n");
+    ck_assert_msg(p && *p == ',', "no column %d in row %d", col, row);
+    p++;
+  }
+  v = strtod(p, &end);
+  ck_assert_msg(end != p && (*end == ',' || *end == '\n'),
+                "bad value in row %d column %d", row, col);
+  return v;
+}
+
+/* The summary line's fields. */
+typedef struct {
+  long steps;
+  double iters_mean;
+  int iters_max;
+  double max_dH, max_g, max_hc, seconds;
+} Summary;
+
+static Summary summary_of(const char *err)
+{
+  const char *p = strstr(err, "steps=");
+  Summary s;
+
+  ck_assert_msg(p != NULL, "no summary in: %s", err);
+  ck_assert_msg(p == err || p[-1] == '\n', "summary not at a line start");
+  ck_assert_int_eq(sscanf(p, "steps=%ld iters_mean=%lf iters_max=%d "
+                          "max_dH=%lf max_g=%lf max_hc=%lf seconds=%lf",
+                          &s.steps, &s.iters_mean, &s.iters_max, &s.max_dH,
+                          &s.max_g, &s.max_hc, &s.seconds), 7);
+  ck_assert_ptr_eq(strchr(p, '\n'), p + strlen(p) - 1);
+  return s;
+}
+
+/* --- tests ----------------------------------------------------------------- */
+
+START_TEST(header_nu0)
+{
+  Result r = run(&osc, "-N 1 --csv @");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(strncmp(r.csv, "t,q1,p1,H\n", 10), 0);
+  done(&r);
+}
+END_TEST
+
+START_TEST(header_nu1)
+{
+  Result r = run(&ring, "-N 1 --csv @");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(strncmp(r.csv, "t,q1,q2,p1,p2,lam1,H,g1,hc1\n", 28), 0);
+  done(&r);
+}
+END_TEST
+
+/* rows for -N/--every: t=0, every K-th step, and the last step */
+static const struct {
+  const char *cmd;
+  int rows;
+  double last_t;
+} row_cases[] = {
+  {"-h 0.1 -N 10 --csv @", 11, 1.0},
+  {"-h 0.1 -N 10 --every 3 --csv @", 5, 1.0},
+  {"-h 0.1 -N 9 --every 3 --csv @", 4, 0.9},
+  {"-h 0.1 -N 10 --every 10 --csv @", 2, 1.0},
+  {"-h 0.1 -N 10 --every 20 --csv @", 2, 1.0},
+  {"-h 0.1 -N 1 --every 100 --csv @", 2, 0.1},
+  {"-h 0.1 -N 0 --csv @", 1, 0.0},
+  {"-h 0.1 -N 0 --every 5 --csv @", 1, 0.0},
+  {"-h 0.1 -T 1 --csv @", 11, 1.0},
+  {"-h 0.3 -T 1 --csv @", 5, 1.2},
+  {"-h 0.1 -T 0.3 --csv @", 4, 0.3},
+  {"-h -0.1 -T 1 --csv @", 11, -1.0},
+  {"-T 0 --csv @", 1, 0.0},
+  {"--csv @", 1001, 10.0},      /* defaults h = 0.01, T = 10 */
+  {"-N10 --every=5 -h0.1 --csv=@", 3, 1.0},
+};
+
+START_TEST(rows)
+{
+  Result r = run(&osc, row_cases[_i].cmd);
+
+  ck_assert_msg(r.status == 0, "%s: status %d, %s", row_cases[_i].cmd,
+                r.status, r.err);
+  ck_assert_int_eq(count_lines(r.csv), 1 + row_cases[_i].rows);
+  ck_assert_double_eq(cell(r.csv, 0, 0), 0.0);
+  ck_assert_double_eq_tol(cell(r.csv, row_cases[_i].rows - 1, 0),
+                          row_cases[_i].last_t, 1e-12);
+  done(&r);
+}
+END_TEST
+
+START_TEST(values_read_back)
+{
+  Result r = run(&osc, "-h 0.1 -N 20 --every 4 --csv @");
+  int i;
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 6);
+  for (i = 0; i < 6; i++) {
+    double t = cell(r.csv, i, 0);
+    ck_assert_double_eq_tol(t, 0.4 * i, 1e-12);
+    ck_assert_double_eq_tol(cell(r.csv, i, 1), cos(t), 1e-12);
+    ck_assert_double_eq_tol(cell(r.csv, i, 2), -sin(t), 1e-12);
+    ck_assert_double_eq_tol(cell(r.csv, i, 3), 0.5, 1e-14);
+  }
+  done(&r);
+}
+END_TEST
+
+/* %.17g: the t=0 row holds exactly the initial values given */
+START_TEST(values_exact)
+{
+  Result r = run(&osc, "-N 0 --q0 0.1 --p0 -0.30000000000000004 --csv @");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(cell(r.csv, 0, 1), 0.1);
+  ck_assert_double_eq(cell(r.csv, 0, 2), -0.30000000000000004);
+  done(&r);
+}
+END_TEST
+
+START_TEST(summary_nu0)
+{
+  Result r = run(&osc, "-h 0.1 -N 10");
+  Summary s = summary_of(r.err);
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_str_eq(r.out, "");
+  ck_assert_int_eq(count_lines(r.err), 1);
+  ck_assert_int_eq(s.steps, 10);
+  ck_assert_double_eq(s.iters_mean, 2.0);     /* 2,3,1,2,3,1,2,3,1,2 */
+  ck_assert_int_eq(s.iters_max, 3);
+  ck_assert_double_le(s.max_dH, 1e-14);
+  ck_assert_ptr_nonnull(strstr(r.err, " max_g=0 max_hc=0 "));
+  ck_assert_double_ge(s.seconds, 0.0);
+  done(&r);
+}
+END_TEST
+
+/* the maxima of |g| and |hc|, with q0 off the constraint */
+START_TEST(summary_nu1)
+{
+  Result r = run(&ring, "-h 0.1 -N 7 --q0 0,-2 --p0 0.5,0.25");
+  Summary s = summary_of(r.err);
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(s.steps, 7);
+  ck_assert_double_eq(s.iters_mean, 4.0);
+  ck_assert_int_eq(s.iters_max, 4);
+  ck_assert_double_eq(s.max_g, 3.0);          /* |q|^2 - 1 on radius 2 */
+  ck_assert_double_eq(s.max_hc, 1.0);         /* |2 q.p| */
+  ck_assert_double_le(s.max_dH, 1e-14);
+  done(&r);
+}
+END_TEST
+
+/* osc whose energy is off by 0.25 after step 3 only */
+static double osc_energy_spike(const void *x, const void *prm)
+{
+  return osc_energy(x, prm) + (((const OscState *)x)->n == 3 ? 0.25 : 0.0);
+}
+
+/* the maxima cover every step, not only the rows written */
+START_TEST(summary_every_step)
+{
+  hbvmrt_model spiky = osc;
+  Result r;
+
+  spiky.energy = osc_energy_spike;
+  r = run(&spiky, "-h 0.1 -N 7 --every 5 --csv @");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 3);              /* 0 5 7 */
+  ck_assert_double_eq_tol(summary_of(r.err).max_dH, 0.25, 1e-14);
+  done(&r);
+}
+END_TEST
+
+START_TEST(ring_default_run)
+{
+  Result r = run(&ring, "-h 0.25 -N 4 --csv @");
+  int i;
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 5);
+  for (i = 0; i < 5; i++) {
+    double t = cell(r.csv, i, 0);
+    ck_assert_double_eq_tol(cell(r.csv, i, 1), cos(t), 1e-12);
+    ck_assert_double_eq_tol(cell(r.csv, i, 2), sin(t), 1e-12);
+    ck_assert_double_eq_tol(cell(r.csv, i, 5), 1.0, 1e-12);   /* lam1 */
+    ck_assert_double_eq_tol(cell(r.csv, i, 6), 0.5, 1e-12);   /* H */
+    ck_assert_double_eq_tol(cell(r.csv, i, 7), 0.0, 1e-12);   /* g1 */
+    ck_assert_double_eq_tol(cell(r.csv, i, 8), 0.0, 1e-12);   /* hc1 */
+  }
+  done(&r);
+}
+END_TEST
+
+START_TEST(param_changes_model)
+{
+  Result r = run(&ring, "-h 0.25 -N 4 --param k=2 --csv @");
+  double t;
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq_tol(cell(r.csv, 0, 6), 1.0, 1e-15);     /* H = k/2 */
+  ck_assert_double_eq_tol(cell(r.csv, 4, 5), 2.0, 1e-12);     /* lam1 = k */
+  t = cell(r.csv, 4, 0);
+  ck_assert_double_eq_tol(cell(r.csv, 4, 1), cos(2 * t), 1e-12);
+  ck_assert_double_eq_tol(cell(r.csv, 4, 2), sin(2 * t), 1e-12);
+  done(&r);
+}
+END_TEST
+
+START_TEST(param_last_wins)
+{
+  Result r = run(&ring, "-N 0 --param k=2 --param=k=3 --csv @");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq_tol(cell(r.csv, 0, 6), 1.5, 1e-15);
+  done(&r);
+}
+END_TEST
+
+/* only --q0: p0 is the model default, and the other way round */
+START_TEST(q0_alone)
+{
+  Result r = run(&ring, "-N 0 --q0 0,1 --csv @");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(cell(r.csv, 0, 1), 0.0);
+  ck_assert_double_eq(cell(r.csv, 0, 2), 1.0);
+  ck_assert_double_eq(cell(r.csv, 0, 3), 0.0);
+  ck_assert_double_eq(cell(r.csv, 0, 4), 1.0);
+  ck_assert_double_eq(cell(r.csv, 0, 8), 2.0);                /* hc = 2 q.p */
+  done(&r);
+  r = run(&ring, "-N 0 --p0 3,-4 --csv @");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(cell(r.csv, 0, 1), 1.0);
+  ck_assert_double_eq(cell(r.csv, 0, 2), 0.0);
+  ck_assert_double_eq(cell(r.csv, 0, 3), 3.0);
+  ck_assert_double_eq(cell(r.csv, 0, 4), -4.0);
+  ck_assert_double_eq(cell(r.csv, 0, 6), 12.5);
+  done(&r);
+}
+END_TEST
+
+START_TEST(csv_to_stdout)
+{
+  Result r = run(&osc, "-h 0.1 -N 3 --csv -");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(strncmp(r.out, "t,q1,p1,H\n0,1,0,0.5\n", 20), 0);
+  ck_assert_int_eq(count_lines(r.out), 5);
+  ck_assert_int_eq(count_lines(r.err), 1);
+  done(&r);
+}
+END_TEST
+
+START_TEST(no_csv)
+{
+  Result r = run(&osc, "-N 5 --quiet");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_str_eq(r.out, "");
+  ck_assert_str_eq(r.csv, "");
+  done(&r);
+}
+END_TEST
+
+START_TEST(step_failure)
+{
+  const char *want =
+    "osc: error: step failed at t=0.5: did not converge\nsteps=5 ";
+  hbvmrt_model failing = osc;
+  Result r;
+
+  failing.step = osc_step_fail;
+  r = run(&failing, "-h 0.1 -N 10 --csv @");
+  ck_assert_int_eq(r.status, 2);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 6);                /* t=0..0.5 */
+  ck_assert_double_eq_tol(cell(r.csv, 5, 0), 0.5, 1e-12);
+  ck_assert_int_eq(strncmp(r.err, want, strlen(want)), 0);
+  ck_assert_int_eq(summary_of(r.err).steps, 5);
+  ck_assert_int_eq(count_lines(r.err), 2);
+  done(&r);
+}
+END_TEST
+
+/* the state the failed step left is the last row, even between K's */
+START_TEST(step_failure_every)
+{
+  hbvmrt_model failing = osc;
+  Result r;
+
+  failing.step = osc_step_fail;
+  r = run(&failing, "-h 0.1 -N 10 --every 2 --csv @");
+  ck_assert_int_eq(r.status, 2);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 4);                /* 0 2 4 5 */
+  ck_assert_double_eq_tol(cell(r.csv, 3, 0), 0.5, 1e-12);
+  ck_assert_double_eq_tol(cell(r.csv, 2, 0), 0.4, 1e-12);
+  done(&r);
+}
+END_TEST
+
+/* bad arguments: one line `NAME: error: ...`, status 1, no CSV written */
+static const struct {
+  const hbvmrt_model *md;
+  const char *cmd;
+} bad_cases[] = {
+  {&osc, "-h 0 --csv @"},
+  {&osc, "-h abc --csv @"},
+  {&osc, "-h 0.1x --csv @"},
+  {&osc, "-h inf --csv @"},
+  {&osc, "-h nan --csv @"},
+  {&osc, "-h 1e999 --csv @"},
+  {&osc, "--csv @ -h"},
+  {&osc, "-N -1 --csv @"},
+  {&osc, "-N 1.5 --csv @"},
+  {&osc, "-N ten --csv @"},
+  {&osc, "-N 1e30 --csv @"},
+  {&osc, "-T -1 --csv @"},
+  {&osc, "-T nan --csv @"},
+  {&osc, "-T 1 -N 5 --csv @"},
+  {&osc, "-N 5 -T 1 --csv @"},
+  {&osc, "-T 1e300 -h 1e-300 --csv @"},
+  {&osc, "--every 0 --csv @"},
+  {&osc, "--every -3 --csv @"},
+  {&osc, "--q0 1,2 --csv @"},
+  {&osc, "--p0 1, --csv @"},
+  {&osc, "--p0 , --csv @"},
+  {&ring, "--q0 1 --csv @"},
+  {&ring, "--q0 1,2,3 --csv @"},
+  {&ring, "--p0 1;2 --csv @"},
+  {&ring, "--p0 1,,2 --csv @"},
+  {&ring, "--q0 1,nan --csv @"},
+  {&ring, "--param nope=1 --csv @"},
+  {&ring, "--param k --csv @"},
+  {&ring, "--param =1 --csv @"},
+  {&ring, "--param k=two --csv @"},
+  {&ring, "--param k=inf --csv @"},
+  {&ring, "--param kk=1 --csv @"},
+  {&osc, "--param k=1 --csv @"},
+  {&osc, "--bogus --csv @"},
+  {&osc, "--every5 --csv @"},
+  {&osc, "--quiet=1 --csv @"},
+  {&osc, "stray --csv @"},
+  {&osc, "- --csv @"},
+  {&osc, "-x 1 --csv @"},
+  {&osc, "--csv /nonexistent-dir/x.csv"},
+};
+
+START_TEST(bad_args)
+{
+  Result r = run(bad_cases[_i].md, bad_cases[_i].cmd);
+  char prefix[32];
+
+  snprintf(prefix, sizeof prefix, "%s: error: ", bad_cases[_i].md->name);
+  ck_assert_msg(r.status == 1, "'%s': status %d", bad_cases[_i].cmd,
+                r.status);
+  ck_assert_msg(strncmp(r.err, prefix, strlen(prefix)) == 0 &&
+                count_lines(r.err) == 1 && r.err[strlen(r.err) - 1] == '\n',
+                "'%s': stderr is '%s'", bad_cases[_i].cmd, r.err);
+  ck_assert_str_eq(r.out, "");
+  ck_assert_str_eq(r.csv, "");
+  done(&r);
+}
+END_TEST
+
+START_TEST(disk_full)
+{
+  Result r;
+
+  if (access("/dev/full", W_OK) != 0)
+    return;                     /* not on this system */
+  r = run(&osc, "-h 0.1 -N 10 --csv /dev/full");
+  ck_assert_int_eq(r.status, 1);
+  ck_assert_ptr_nonnull(strstr(r.err, "osc: error: cannot write '/dev/full'"));
+  ck_assert_int_eq(summary_of(r.err).steps, 10);
+  done(&r);
+  /* large enough to fail inside the loop, not only at fclose */
+  r = run(&osc, "-h 0.1 -N 100000 --csv /dev/full");
+  ck_assert_int_eq(r.status, 1);
+  ck_assert_int_eq(count_lines(r.err), 2);
+  ck_assert_int_lt(summary_of(r.err).steps, 100000);
+  done(&r);
+}
+END_TEST
+
+START_TEST(help)
+{
+  Result r = run(&ring, "--help");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_str_eq(r.err, "");
+  ck_assert_int_eq(strncmp(r.out, "usage: ring ", 12), 0);
+  ck_assert_ptr_nonnull(strstr(r.out, "-h STEP"));
+  ck_assert_ptr_nonnull(strstr(r.out, "-T TIME"));
+  ck_assert_ptr_nonnull(strstr(r.out, "-N STEPS"));
+  ck_assert_ptr_nonnull(strstr(r.out, "--every K"));
+  ck_assert_ptr_nonnull(strstr(r.out, "--param name=value"));
+  ck_assert_ptr_nonnull(strstr(r.out, "--csv FILE"));
+  ck_assert_ptr_nonnull(strstr(r.out, "--quiet"));
+  ck_assert_ptr_nonnull(strstr(r.out, "m=2 "));
+  ck_assert_ptr_nonnull(strstr(r.out, "nu=1 "));
+  ck_assert_ptr_nonnull(strstr(r.out, "k=3,s=2"));
+  ck_assert_ptr_nonnull(strstr(r.out, "N*h"));
+  ck_assert_ptr_nonnull(strstr(r.out, "  k = 1\n"));
+  ck_assert_ptr_nonnull(strstr(r.out, "default 1,0)"));     /* q0 */
+  done(&r);
+  r = run(&osc, "-N 3 --help --csv @");                      /* no run */
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_str_eq(r.csv, "");
+  ck_assert_ptr_null(strstr(r.out, "parameters"));
+  done(&r);
+}
+END_TEST
+
+/* A run of 1.5 s with stderr on a file: no progress line, the summary */
+START_TEST(no_progress_off_terminal)
+{
+  hbvmrt_model slow = osc;
+  Result r;
+
+  slow.step = osc_step_slow;
+  r = run(&slow, "-N 1500");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_ptr_null(strchr(r.err, '\r'));
+  ck_assert_int_eq(count_lines(r.err), 1);
+  ck_assert_int_eq(summary_of(r.err).steps, 1500);
+  done(&r);
+}
+END_TEST
+
+/* The same on a terminal: progress lines (\r, percent, steps/s, |H-H0|),
+ * cleared before the summary; none with --quiet. */
+START_TEST(progress_on_terminal)
+{
+  hbvmrt_model slow = osc;
+  int slave, master = open_tty(&slave);
+  const char *last;
+  Result r;
+
+  if (master < 0)
+    return;                     /* no pseudo-terminals here */
+  close(master);
+  close(slave);
+  slow.step = osc_step_slow;
+  r = run_on(&slow, "-N 1500", 1);
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_msg(strstr(r.err, "\rosc: ") != NULL, "no progress: %s", r.err);
+  ck_assert_ptr_nonnull(strstr(r.err, "% "));
+  ck_assert_ptr_nonnull(strstr(r.err, " steps/s "));
+  ck_assert_ptr_nonnull(strstr(r.err, "|H-H0|="));
+  /* the clearing, \r blanks \r, then the summary (its \n is \r\n here) */
+  last = strstr(r.err, "steps=1500 ");
+  ck_assert_ptr_nonnull(last);
+  ck_assert_int_eq(*--last, '\r');
+  while (last > r.err && last[-1] == ' ')
+    last--;
+  ck_assert_int_eq(last[-1], '\r');
+  ck_assert_ptr_null(strchr(strstr(r.err, "steps="), '%'));
+  done(&r);
+
+  r = run_on(&slow, "-N 1500 --quiet", 1);
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(strncmp(r.err, "steps=1500 ", 11), 0);
+  ck_assert_int_eq(count_lines(r.err), 1);
+  done(&r);
+}
+END_TEST
+
+Suite *runtime_suite(void)
+{
+  Suite *s = suite_create("runtime");
+  TCase *csv = tcase_create("csv");
+  TCase *args = tcase_create("args");
+  TCase *run_ = tcase_create("run");
+
+  tcase_add_test(csv, header_nu0);
+  tcase_add_test(csv, header_nu1);
+  tcase_add_loop_test(csv, rows, 0,
+                      (int)(sizeof row_cases / sizeof row_cases[0]));
+  tcase_add_test(csv, values_read_back);
+  tcase_add_test(csv, values_exact);
+  tcase_add_test(csv, csv_to_stdout);
+  tcase_add_test(csv, no_csv);
+  tcase_add_test(csv, disk_full);
+  suite_add_tcase(s, csv);
+
+  tcase_add_loop_test(args, bad_args, 0,
+                      (int)(sizeof bad_cases / sizeof bad_cases[0]));
+  tcase_add_test(args, param_changes_model);
+  tcase_add_test(args, param_last_wins);
+  tcase_add_test(args, q0_alone);
+  tcase_add_test(args, help);
+  suite_add_tcase(s, args);
+
+  tcase_add_test(run_, summary_nu0);
+  tcase_add_test(run_, summary_nu1);
+  tcase_add_test(run_, summary_every_step);
+  tcase_add_test(run_, ring_default_run);
+  tcase_add_test(run_, step_failure);
+  tcase_add_test(run_, step_failure_every);
+  tcase_add_test(run_, no_progress_off_terminal);
+  tcase_add_test(run_, progress_on_terminal);
+  tcase_set_timeout(run_, 30);
+  suite_add_tcase(s, run_);
+  return s;
+}
