@@ -1,16 +1,16 @@
 #!/bin/sh
 # Install the Debian packages hbvmgen needs, if any are missing.
-#   scripts/deps.sh            build and test: bison flex libgsl-dev check libsubunit-dev pkg-config
+#   scripts/deps.sh            build and test: bison flex libgsl-dev check libsubunit-dev pkg-config valgrind
 #   scripts/deps.sh bench      also the benchmark peers and plotting
 #   scripts/deps.sh embedded   also the ARM cross compiler for the embedded build check
 #   scripts/deps.sh fuzz       also clang with libFuzzer
 # As root it runs apt-get install -y; otherwise it prints the exact line to run.
 set -eu
 
-pkgs="bison flex libgsl-dev check libsubunit-dev pkg-config gcc make"
+pkgs="bison flex libgsl-dev check libsubunit-dev pkg-config valgrind gcc make"
 for set in "$@"; do
   case "$set" in
-    bench)    pkgs="$pkgs libsundials-dev gnuplot-nox valgrind" ;;
+    bench)    pkgs="$pkgs libsundials-dev gnuplot-nox" ;;
     embedded) pkgs="$pkgs gcc-arm-none-eabi libnewlib-arm-none-eabi" ;;
     fuzz)     pkgs="$pkgs clang libclang-rt-14-dev" ;;
     *) echo "deps.sh: unknown package set '$set' (bench, embedded, fuzz)" >&2; exit 1 ;;

@@ -1,0 +1,440 @@
+/* check_dag.c - Check suite for the expression DAG (gen/dag.c) and the
+ * choice of k (method_auto_k in gen/method.c).
+ *
+ * Expressions are written in reverse Polish notation and built by rpn()
+ * through the public dag_* calls, so every case is one line of a table:
+ *   - common subexpressions: node counts and node identity, also after the
+ *     node array and the hash table have grown;
+ *   - constant folding, which must never create a NaN, an infinity or -0.0
+ *     constant, and the algebraic simplifications;
+ *   - the polynomial degree of each node;
+ *   - method_auto_k on polynomial and non-polynomial degrees;
+ *   - dag_eval, dag_eval_many and dag_subst against C evaluation.
+ * The suite is exposed as dag_suite(); the project's runner calls it. */
+#include <check.h>
+#include <ctype.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "hbvmgen.h"
+
+Suite *dag_suite(void);
+
+#define SEED 20240601u
+#define NPOINTS 20
+#define NCASES(t) ((int)(sizeof(t) / sizeof((t)[0])))
+
+/* ---- helpers ---- */
+
+/* Uniform number in [lo, hi) from the C library's generator (seeded by
+ * each test that uses it, so results do not depend on test order). */
+static double uniform(double lo, double hi)
+{
+  return lo + (hi - lo) * (rand() / (RAND_MAX + 1.0));
+}
+
+/* The operation named by an RPN token: + - * / ^ ~ (negation), or an
+ * operation's name in any case (sin, atan2, pow, abs...); OP_COUNT if the
+ * token names none. */
+static Op rpn_op(const char *tok)
+{
+  static const char sym[] = "+-*/^~";
+  static const Op symop[] = {OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW, OP_NEG};
+  const char *c = tok[0] && !tok[1] ? strchr(sym, tok[0]) : NULL;
+  if (c)
+    return symop[c - sym];
+  for (int op = OP_ADD; op < OP_COUNT; op++) {
+    const char *name = op_name((Op)op);
+    size_t i = 0;
+    while (name[i] && tok[i] && toupper((unsigned char)tok[i]) == name[i])
+      i++;
+    if (!name[i] && !tok[i])
+      return (Op)op;
+  }
+  return OP_COUNT;
+}
+
+/* Build the expression src, written in reverse Polish notation with tokens
+ * separated by blanks: x y z are inputs 0..2, p q parameters 0..1, numbers
+ * constants, the rest operations (see rpn_op). Fails the test on a
+ * malformed expression. */
+static int rpn(Dag *d, const char *src)
+{
+  int stack[32], top = 0;
+  const char *s = src;
+  for (;;) {
+    char tok[32], *end;
+    s += strspn(s, " ");
+    size_t n = strcspn(s, " ");
+    if (!n)
+      break;
+    ck_assert_msg(n < sizeof tok && top < 32, "bad rpn '%s'", src);
+    memcpy(tok, s, n);
+    tok[n] = 0;
+    s += n;
+    double v = strtod(tok, &end);
+    Op op = rpn_op(tok);
+    if (!*end)
+      stack[top++] = dag_const(d, v);
+    else if (n == 1 && strchr("xyz", tok[0]))
+      stack[top++] = dag_input(d, tok[0] - 'x');
+    else if (n == 1 && strchr("pq", tok[0]))
+      stack[top++] = dag_param(d, tok[0] - 'p');
+    else {
+      ck_assert_msg(op < OP_COUNT && op_arity(op) <= top, "bad token '%s' in '%s'", tok, src);
+      int arity = op_arity(op);
+      top -= arity;
+      stack[top] = dag_op(d, op, stack[top], arity == 2 ? stack[top + 1] : -1);
+      top++;
+    }
+  }
+  ck_assert_msg(top == 1, "rpn '%s' leaves %d values", src, top);
+  return stack[0];
+}
+
+/* Number of nodes of the DAG with operation op. */
+static int count_op(const Dag *d, Op op)
+{
+  int k = 0;
+  for (int id = 0; id < d->n; id++)
+    k += d->nodes[id].op == op;
+  return k;
+}
+
+/* True when node id is a constant that folding must never produce: NaN, an
+ * infinity or -0.0. */
+static int bad_const(const Dag *d, int id)
+{
+  const Node *n = &d->nodes[id];
+  return n->op == OP_CONST && (!isfinite(n->val) || (n->val == 0 && signbit(n->val)));
+}
+
+/* Checked teardown: release the arena after every test. */
+static void teardown(void)
+{
+  arena_free_all();
+}
+
+/* ---- common subexpressions ---- */
+
+/* Pairs of expressions that must (or must not) be the same node. */
+static const struct {
+  const char *a, *b;
+  int same;
+} same_cases[] = {
+    {"x y *", "y x *", 1},         {"x y +", "y x +", 1},
+    {"x sin", "x sin", 1},         {"x y * z +", "z y x * +", 1},
+    {"x 2 ^ y exp *", "y exp x 2 ^ *", 1},
+    {"x y -", "y x -", 0},         {"x y /", "y x /", 0},
+    {"x y ^", "y x ^", 0},         {"x y atan2", "y x atan2", 0},
+    {"x sin", "x cos", 0},         {"x p *", "x q *", 0},
+};
+
+START_TEST(test_cse_identity)
+{
+  Dag *d = dag_new();
+  for (int i = 0; i < NCASES(same_cases); i++) {
+    int a = rpn(d, same_cases[i].a), b = rpn(d, same_cases[i].b);
+    ck_assert_msg((a == b) == same_cases[i].same, "'%s' vs '%s': nodes %d and %d", same_cases[i].a,
+                  same_cases[i].b, a, b);
+  }
+}
+END_TEST
+
+/* Expressions and how many nodes of one operation they may create. */
+static const struct {
+  const char *e;
+  Op op;
+  int count, nodes; /* nodes: total size of the DAG, 0 to skip */
+} count_cases[] = {
+    {"x y * x y * +", OP_MUL, 1, 4},
+    {"x y * y x * +", OP_MUL, 1, 4},
+    {"x sin x sin *", OP_SIN, 1, 3},
+    {"x sin y cos * x sin y cos * -", OP_SIN, 1, 0},
+    {"x y + sqrt x y + sqrt / y x + sqrt +", OP_SQRT, 1, 0},
+    {"x y + sqrt x y + sqrt / y x + sqrt +", OP_ADD, 2, 0},
+};
+
+START_TEST(test_cse_counts)
+{
+  for (int i = 0; i < NCASES(count_cases); i++) {
+    Dag *d = dag_new();
+    rpn(d, count_cases[i].e);
+    ck_assert_msg(count_op(d, count_cases[i].op) == count_cases[i].count, "'%s': %d %s nodes, want %d",
+                  count_cases[i].e, count_op(d, count_cases[i].op), op_name(count_cases[i].op),
+                  count_cases[i].count);
+    if (count_cases[i].nodes)
+      ck_assert_int_eq(d->n, count_cases[i].nodes);
+  }
+}
+END_TEST
+
+/* Build a chain of NCHAIN distinct nodes, t = t * x + i; returns the last. */
+#define NCHAIN 6000
+static int chain(Dag *d)
+{
+  int t = dag_input(d, 0);
+  for (int i = 1; i <= NCHAIN; i++)
+    t = dag_add(d, dag_mul(d, t, dag_input(d, 0)), dag_const(d, i));
+  return t;
+}
+
+/* Sharing survives the growth of the node array and of the hash table. */
+START_TEST(test_cse_growth)
+{
+  Dag *d = dag_new();
+  int last = chain(d), n = d->n;
+  ck_assert_int_gt(n, 3 * NCHAIN);
+  ck_assert_int_eq(chain(d), last);
+  ck_assert_int_eq(d->n, n);
+}
+END_TEST
+
+/* ---- folding and simplification ---- */
+
+START_TEST(test_fold_values)
+{
+  const struct {
+    const char *e;
+    double v;
+  } cases[] = {
+      {"2 3 * 1 +", 7},
+      {"2 sin", sin(2)},
+      {"4 sqrt 3 ^", 8},
+      {"1 2 atan2 3 / 0.5 exp -", atan2(1, 2) / 3 - exp(0.5)},
+      {"1 3 / ~ 2 pow", pow(-1.0 / 3, 2)},
+      {"-1 abs 0.5 acos +", 1 + acos(0.5)},
+      {"0 -1 *", 0},
+      {"0 ~", 0},
+      {"0 -1 /", 0},
+  };
+  Dag *d = dag_new();
+  for (int i = 0; i < NCASES(cases); i++) {
+    int id = rpn(d, cases[i].e);
+    ck_assert_msg(d->nodes[id].op == OP_CONST, "'%s' not folded", cases[i].e);
+    ck_assert_msg(d->nodes[id].val == cases[i].v && !signbit(d->nodes[id].val) == !signbit(cases[i].v),
+                  "'%s' folds to %.17g, want %.17g", cases[i].e, d->nodes[id].val, cases[i].v);
+  }
+  ck_assert_int_eq(count_op(d, OP_CONST), d->n);
+  ck_assert_int_eq(dag_const(d, -0.0), dag_const(d, 0.0));
+  ck_assert(!signbit(d->nodes[dag_const(d, -0.0)].val));
+}
+END_TEST
+
+/* Operations on constants whose value is NaN, an infinity or -0.0. */
+static const struct {
+  Op op;
+  double a, b;
+} nonfinite_cases[] = {
+    {OP_DIV, 1, 0},      {OP_DIV, -1, 0},      {OP_DIV, 0, 0},       {OP_LOG, 0, 0},
+    {OP_LOG, -1, 0},     {OP_SQRT, -1, 0},     {OP_POW, 0, -1},      {OP_POW, -8, 0.5},
+    {OP_ASIN, 2, 0},     {OP_ACOS, -3, 0},     {OP_EXP, 1000, 0},    {OP_COSH, -1000, 0},
+    {OP_MUL, 1e300, 1e300}, {OP_SUB, -1e308, 1e308}, {OP_MUL, -1e-200, 1e-200},
+    {OP_MUL, 0, -1},     {OP_MUL, -2, 0},      {OP_NEG, 0, 0},       {OP_DIV, 0, -5},
+    {OP_SIN, 0, 0},      {OP_TANH, 0, 0},      {OP_ATAN, 0, 0},      {OP_ASIN, 0, 0},
+};
+
+/* No case folds to a bad constant: either the node is left for run time,
+ * where it evaluates as C does, or it is a constant equal to the C value
+ * (+0 for the signed zeros). */
+START_TEST(test_fold_nonfinite)
+{
+  Dag *d = dag_new();
+  for (int i = 0; i < NCASES(nonfinite_cases); i++) {
+    Op op = nonfinite_cases[i].op;
+    double a = nonfinite_cases[i].a, b = nonfinite_cases[i].b, c = op_apply(op, a, b);
+    int id = dag_op(d, op, dag_const(d, a), op_arity(op) == 2 ? dag_const(d, b) : -1);
+    double v = dag_eval(d, id, NULL, NULL);
+    ck_assert_msg(!bad_const(d, id), "%s(%g, %g) folded to %g", op_name(op), a, b, d->nodes[id].val);
+    if (d->nodes[id].op == OP_CONST)
+      ck_assert_msg(v == c, "%s(%g, %g) = %g, want %g", op_name(op), a, b, v, c);
+    else
+      ck_assert_msg(!isfinite(c) || (c == 0 && signbit(c)), "%s(%g, %g) = %g not folded", op_name(op), a, b, c);
+    if (!isfinite(c))
+      ck_assert_msg(d->nodes[id].op != OP_CONST && (v == c || (isnan(v) && isnan(c))),
+                    "%s(%g, %g) evaluates to %g, want %g", op_name(op), a, b, v, c);
+  }
+  for (int id = 0; id < d->n; id++)
+    ck_assert_msg(!bad_const(d, id), "node %d is the constant %g", id, d->nodes[id].val);
+}
+END_TEST
+
+/* Each expression simplifies to the node of the second one. */
+static const struct {
+  const char *e, *want;
+} simplify_cases[] = {
+    {"x 0 +", "x"},      {"0 x +", "x"},         {"x 0 -", "x"},         {"x 1 *", "x"},
+    {"1 x *", "x"},      {"x 0 *", "0"},         {"0 x *", "0"},         {"x x -", "0"},
+    {"x ~ ~", "x"},      {"x 1 ^", "x"},         {"x 0 ^", "1"},         {"x 1 /", "x"},
+    {"x sin 0 *", "0"},  {"x y * y x * -", "0"}, {"x y + ~ ~", "y x +"}, {"x y + 1 ^", "x y +"},
+    {"x sin 0 ^", "1"},  {"0 x ~ -", "x"},       {"x y ~ +", "x y -"},   {"x p * 1 *", "p x *"},
+};
+
+START_TEST(test_simplify)
+{
+  Dag *d = dag_new();
+  for (int i = 0; i < NCASES(simplify_cases); i++) {
+    int want = rpn(d, simplify_cases[i].want);
+    ck_assert_msg(rpn(d, simplify_cases[i].e) == want, "'%s' does not simplify to '%s'", simplify_cases[i].e,
+                  simplify_cases[i].want);
+  }
+}
+END_TEST
+
+/* ---- degrees ---- */
+
+static const struct {
+  const char *e;
+  int deg;
+} degree_cases[] = {
+    {"2", 0},           {"p", 0},           {"x", 1},            {"x y *", 2},
+    {"x 3 ^", 3},       {"x y + 2 ^", 2},   {"x 2 /", 1},        {"1 x /", DEG_NONPOLY},
+    {"x sin", DEG_NONPOLY}, {"2 sin", 0},   {"p x 2 ^ *", 2},    {"x sqrt", DEG_NONPOLY},
+    {"x 2.5 ^", DEG_NONPOLY}, {"p sin x *", 1}, {"x p /", 1},    {"x -1 ^", DEG_NONPOLY},
+    {"x y 3 ^ * z -", 4}, {"x y ^", DEG_NONPOLY}, {"p 2.5 ^", 0}, {"x ~ 2 ^ y +", 2},
+    {"x abs", DEG_NONPOLY}, {"x 2 ^ 3 ^", 6},  {"x sin 2 ^", DEG_NONPOLY},
+};
+
+START_TEST(test_degree)
+{
+  Dag *d = dag_new();
+  for (int i = 0; i < NCASES(degree_cases); i++) {
+    int id = rpn(d, degree_cases[i].e);
+    ck_assert_msg(d->nodes[id].deg == degree_cases[i].deg, "deg('%s') = %d, want %d", degree_cases[i].e,
+                  d->nodes[id].deg, degree_cases[i].deg);
+  }
+}
+END_TEST
+
+/* ---- method_auto_k ---- */
+
+START_TEST(test_auto_k)
+{
+  static const struct {
+    int s, degU, degg, k;
+  } cases[] = {
+      {2, 1, 2, 2},           {1, 4, 6, 3}, {2, 4, 6, 6},           {3, 4, 6, 9},
+      {2, 3, 0, 3},           {1, 1, 0, 1}, {1, DEG_NONPOLY, 2, 6}, {4, DEG_NONPOLY, 2, 8},
+      {2, 2, DEG_NONPOLY, 6}, {5, 4, 6, 15},        {1, 3, 0, 2}, {3, 3, 2, 5},
+      {5, 1, 3, 8},
+  };
+  for (int i = 0; i < NCASES(cases); i++) {
+    const char *why = NULL;
+    int k = method_auto_k(cases[i].s, cases[i].degU, cases[i].degg, &why);
+    ck_assert_msg(k == cases[i].k, "auto k(s=%d, degU=%d, degg=%d) = %d, want %d", cases[i].s, cases[i].degU,
+                  cases[i].degg, k, cases[i].k);
+    ck_assert_msg(why && *why, "no reason given for k=%d", k);
+  }
+}
+END_TEST
+
+/* ---- evaluation and substitution ---- */
+
+/* The expressions of eval_cases written directly in C (v: x y z, p: p q). */
+static double c_e0(const double *v, const double *p) { (void)p; return v[0] * v[1] + sin(v[0]); }
+static double c_e1(const double *v, const double *p) { (void)p; return atan2(v[1], v[2]) * exp(v[0]) - pow(v[0], 3); }
+static double c_e2(const double *v, const double *p) { (void)p; return pow(v[0] / v[1], -v[2]); }
+static double c_e3(const double *v, const double *p) { (void)p; return cosh(v[0]) / tanh(v[1]) + sqrt(v[0] * v[1]); }
+static double c_e4(const double *v, const double *p) { return p[0] * pow(v[0], 2) + p[1] * v[1] - fabs(p[1] * v[2]); }
+static double c_e5(const double *v, const double *p) { (void)p; return asin(v[0] / 3) + acos(v[1] / 3) + atan(v[2]) * tan(v[2] / 2); }
+static double c_e6(const double *v, const double *p) { (void)p; return log(v[0]) * sinh(v[1]) - cos(v[0] - v[2]); }
+static double c_e7(const double *v, const double *p) { (void)p; return -(v[0] * v[0] - 1) / (v[1] + v[2]); }
+
+static const struct {
+  const char *e;
+  double (*c)(const double *v, const double *p);
+} eval_cases[] = {
+    {"x y * x sin +", c_e0},
+    {"y z atan2 x exp * x 3 ^ -", c_e1},
+    {"x y / z ~ pow", c_e2},
+    {"x cosh y tanh / x y * sqrt +", c_e3},
+    {"p x 2 ^ * q y * + q z * abs -", c_e4},
+    {"x 3 / asin y 3 / acos + z atan z 2 / tan * +", c_e5},
+    {"x log y sinh * x z - cos -", c_e6},
+    {"x x * 1 - ~ y z + /", c_e7},
+};
+
+/* dag_eval and dag_eval_many agree with C at random points in [0.5, 2]^3. */
+START_TEST(test_eval)
+{
+  enum { NE = NCASES(eval_cases) };
+  const double prm[2] = {1.7, -0.3};
+  int roots[NE];
+  Dag *d = dag_new();
+  for (int i = 0; i < NE; i++)
+    roots[i] = rpn(d, eval_cases[i].e);
+  srand(SEED);
+  for (int pt = 0; pt < NPOINTS; pt++) {
+    double v[3], many[NE];
+    for (int j = 0; j < 3; j++)
+      v[j] = uniform(0.5, 2);
+    dag_eval_many(d, roots, NE, v, prm, many);
+    for (int i = 0; i < NE; i++) {
+      double c = eval_cases[i].c(v, prm), one = dag_eval(d, roots[i], v, prm);
+      ck_assert_msg(fabs(one - c) <= 1e-14 * fmax(1, fabs(c)), "'%s' = %.17g, C gives %.17g", eval_cases[i].e, one, c);
+      ck_assert_msg(many[i] == one, "'%s': dag_eval_many %.17g, dag_eval %.17g", eval_cases[i].e, many[i], one);
+    }
+  }
+}
+END_TEST
+
+/* True when node root depends on input slot. */
+static int uses_input(const Dag *d, int root, int slot)
+{
+  unsigned char *mark = calloc((size_t)d->n, 1);
+  int found = 0;
+  ck_assert_ptr_nonnull(mark);
+  dag_reach(d, &root, 1, mark);
+  for (int id = 0; id < d->n; id++)
+    found |= mark[id] && d->nodes[id].op == OP_INPUT && d->nodes[id].idx == slot;
+  free(mark);
+  return found;
+}
+
+/* dag_subst: x -> y+1 in x^2 and x*y (only slot 0 mapped), the identity map,
+ * and the swap x <-> y. */
+START_TEST(test_subst)
+{
+  Dag *d = dag_new();
+  int roots[3] = {rpn(d, "x 2 ^"), rpn(d, "x y *"), rpn(d, "y z -")}, out[3];
+  int shift[1] = {rpn(d, "y 1 +")}, ident[3], swap[2] = {dag_input(d, 1), dag_input(d, 0)};
+  dag_subst(d, roots, 3, shift, 1, out);
+  ck_assert(!uses_input(d, out[0], 0) && !uses_input(d, out[1], 0));
+  ck_assert_int_eq(out[2], roots[2]);
+  srand(SEED);
+  for (int pt = 0; pt < NPOINTS; pt++) {
+    double v[3] = {uniform(-2, 2), uniform(-2, 2), uniform(-2, 2)}, y = v[1];
+    ck_assert_double_eq_tol(dag_eval(d, out[0], v, NULL), (y + 1) * (y + 1), 1e-14 * fmax(1, (y + 1) * (y + 1)));
+    ck_assert_double_eq_tol(dag_eval(d, out[1], v, NULL), (y + 1) * y, 1e-14 * fmax(1, fabs((y + 1) * y)));
+  }
+  for (int i = 0; i < 3; i++)
+    ident[i] = dag_input(d, i);
+  dag_subst(d, roots, 3, ident, 3, out);
+  for (int i = 0; i < 3; i++)
+    ck_assert_int_eq(out[i], roots[i]);
+  dag_subst(d, roots, 3, swap, 2, out);
+  ck_assert_int_eq(out[0], rpn(d, "y 2 ^"));
+  ck_assert_int_eq(out[1], roots[1]);
+  ck_assert_int_eq(out[2], rpn(d, "x z -"));
+}
+END_TEST
+
+Suite *dag_suite(void)
+{
+  Suite *s = suite_create("dag");
+  TCase *tc = tcase_create("dag");
+  tcase_add_checked_fixture(tc, NULL, teardown);
+  tcase_add_test(tc, test_cse_identity);
+  tcase_add_test(tc, test_cse_counts);
+  tcase_add_test(tc, test_cse_growth);
+  tcase_add_test(tc, test_fold_values);
+  tcase_add_test(tc, test_fold_nonfinite);
+  tcase_add_test(tc, test_simplify);
+  tcase_add_test(tc, test_degree);
+  tcase_add_test(tc, test_auto_k);
+  tcase_add_test(tc, test_eval);
+  tcase_add_test(tc, test_subst);
+  suite_add_tcase(s, tc);
+  return s;
+}
