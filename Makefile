@@ -27,6 +27,9 @@ GEN_OBJ  := $(addprefix $(B)/gen/,$(GEN_SRC:.c=.o) parser.o lexer.o)
 RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
 SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
 SOLV_OBJ := $(addprefix $(B)/generated/,$(addsuffix .o,$(SOLVERS)))
+# test-only models (tests/models/LIST), generated at build time
+TSOLVERS := $(shell grep -v '^\#' tests/models/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
+TSOLV_OBJ:= $(addprefix $(B)/tgen/,$(addsuffix .o,$(TSOLVERS)))
 TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c tests/solvers.c
 TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
 
@@ -34,7 +37,7 @@ TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
 HBVMGEN  := gen/hbvmgen
 LIBRT    := runtime/libhbvmrt.a
 
-.PHONY: all deps check demo generated tables figures bench clean
+.PHONY: all deps check demo generated tables figures bench fuzz clean
 all: $(HBVMGEN) $(LIBRT)
 
 deps:
@@ -75,11 +78,19 @@ $(B)/generated/%.o: generated/%.c generated/%.h
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -Werror $(CFLAGS) $(SAN) -Igenerated -c -o $@ $<
 
-$(B)/tests/%.o: tests/%.c
+$(B)/tgen/stamp: tests/models/LIST $(wildcard tests/models/*.ham) $(HBVMGEN)
 	@mkdir -p $(@D)
-	$(CC) $(ALLCFLAGS) $(GSL) $(CHECK) -Igen -I$(B)/gen -Iruntime -Igenerated -Itests -c -o $@ $<
+	scripts/regen.sh $(HBVMGEN) $(B)/tgen tests/models/LIST tests/models
+	@touch $@
 
-$(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(LIBRT)
+$(B)/tgen/%.o: $(B)/tgen/stamp
+	$(CC) $(WARN) -Werror $(CFLAGS) $(SAN) -I$(B)/tgen -c -o $@ $(B)/tgen/$*.c
+
+$(B)/tests/%.o: tests/%.c $(B)/tgen/stamp
+	@mkdir -p $(@D)
+	$(CC) $(ALLCFLAGS) $(GSL) $(CHECK) -Igen -I$(B)/gen -Iruntime -Igenerated -I$(B)/tgen -Itests -c -o $@ $<
+
+$(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(TSOLV_OBJ) $(LIBRT)
 	$(CC) $(SAN) -o $@ $^ $(CHECKLIB) $(GSLLIB) -lm
 
 check: deps
@@ -102,6 +113,20 @@ tables: deps
 	$(B)/tests/tables tests/data docs/tables.md
 	@echo "tables: written to docs/tables.md"
 
+
+figures: deps
+	@scripts/deps.sh bench
+	@$(MAKE) --no-print-directory all
+	scripts/figures.sh
+
+bench: deps
+	@scripts/deps.sh bench
+	@$(MAKE) --no-print-directory all
+	bench/run.sh
+
+fuzz:
+	@scripts/deps.sh fuzz
+	tests/fuzz/run.sh $(FUZZ_SECONDS)
 
 clean:
 	rm -rf build build-san $(HBVMGEN) $(LIBRT) demo

@@ -55,11 +55,20 @@ typedef struct {
   int mass_stmt, q0_stmt, p0_stmt;
   Param *params;
   int nparams, pcap;
+  const Stmt *prog;  /* all statements, to find a name defined too late */
 } Ctx;
 
-// A new syntax tree node. Its depth is bounded so that the recursive
-// lowering below cannot overflow the stack: the first node deeper than
-// MAX_AST_DEPTH is an error (the parser goes on, nothing is lowered).
+// Give n the depth one more than its deepest child. The first node deeper
+// than MAX_AST_DEPTH is an error (the parser goes on, nothing is lowered),
+// so the recursive lowering below cannot overflow the stack.
+static void set_depth(Ast *n, int child_depth) {
+  if (child_depth + 1 <= n->depth) return;
+  n->depth = child_depth + 1;
+  if (n->depth == MAX_AST_DEPTH + 1)
+    error_at(n->loc, "expression nested too deeply (more than %d levels)", MAX_AST_DEPTH);
+}
+
+// A new syntax tree node with up to three children.
 Ast *ast_new(AstKind kind, Loc loc, Ast *a, Ast *b, Ast *c) {
   Ast *n = arena_alloc(sizeof *n);
   n->kind = kind;
@@ -71,21 +80,17 @@ Ast *ast_new(AstKind kind, Loc loc, Ast *a, Ast *b, Ast *c) {
   const Ast *kids[3] = {a, b, c};
   for (int i = 0; i < 3; i++)
     if (kids[i] && kids[i]->depth > depth) depth = kids[i]->depth;
-  n->depth = depth + 1;
-  if (n->depth == MAX_AST_DEPTH + 1) error_at(loc, "expression nested more than %d deep", MAX_AST_DEPTH);
+  set_depth(n, depth);
   return n;
 }
 
 // Attach an argument list to n, which becomes deeper than its deepest argument.
 void ast_set_args(Ast *n, Ast *args) {
   n->args = args;
-  int depth = n->depth - 1;
+  int depth = 0;
   for (const Ast *a = args; a; a = a->next)
     if (a->depth > depth) depth = a->depth;
-  if (depth + 1 > n->depth) {
-    n->depth = depth + 1;
-    if (n->depth == MAX_AST_DEPTH + 1) error_at(n->loc, "expression nested more than %d deep", MAX_AST_DEPTH);
-  }
+  set_depth(n, depth);
 }
 
 static unsigned hash_name(const char *s) {
@@ -100,11 +105,11 @@ static Sym *lookup(Ctx *cx, const char *name) {
   return NULL;
 }
 
-static const char *sym_kind_name(const Sym *s) {
+static const char *sym_kind_name(const Ctx *cx, const Sym *s) {
   switch (s->kind) {
   case SYM_COORD: return "a coordinate";
   case SYM_ARRAY: return "an array of coordinates";
-  case SYM_VALUE: return "a definition";
+  case SYM_VALUE: return cx->d->nodes[s->node].op == OP_CONST ? "a constant" : "a named subexpression";
   case SYM_PARAM: return "a parameter";
   case SYM_INDEX: return "an index variable";
   }
@@ -119,8 +124,8 @@ static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
   }
   Sym *old = lookup(cx, name);
   if (old) {
-    error_at(loc, "'%s' is already defined as %s at line %d, column %d", name, sym_kind_name(old), old->loc.line,
-             old->loc.col);
+    error_at(loc, "'%s' is defined twice (first as %s at line %d, column %d)", name, sym_kind_name(cx, old),
+             old->loc.line, old->loc.col);
     return NULL;
   }
   Sym *s = arena_alloc(sizeof *s);
@@ -142,6 +147,9 @@ static void undefine(Ctx *cx, Sym *sym) {
 
 static int lower(Ctx *cx, const Ast *e);
 
+// What a node that is not constant depends on, for messages.
+static const char *dependence(const Node *nd) { return nd->flags & DEP_INPUT ? "a coordinate" : "a parameter"; }
+
 static int is_integer(double v) { return v == floor(v) && fabs(v) <= MAX_INDEX; }
 
 // Lower e and require a constant integer (sizes, indices, ranges).
@@ -150,8 +158,7 @@ static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
   if (n < 0) return -1;
   const Node *nd = &cx->d->nodes[n];
   if (nd->op != OP_CONST) {
-    error_at(e->loc, "%s must be a constant integer, but it depends on %s", what,
-             nd->flags & DEP_INPUT ? "a coordinate" : "a parameter");
+    error_at(e->loc, "%s must be a constant integer, but it depends on %s", what, dependence(nd));
     return -1;
   }
   if (!is_integer(nd->val)) {
@@ -162,17 +169,41 @@ static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
   return 0;
 }
 
+// Where statement st defines name (a definition, param or coordinate), or NULL.
+static const Loc *defines(const Stmt *st, const char *name) {
+  if ((st->kind == S_DEF || st->kind == S_PARAM) && !strcmp(st->name, name)) return &st->name_loc;
+  if (st->kind == S_VARIABLES)
+    for (const Decl *dc = st->decls; dc; dc = dc->next)
+      if (!strcmp(dc->name, name)) return &dc->loc;
+  return NULL;
+}
+
+// Find the symbol a name refers to in the statement being analysed, or
+// report why there is none: a name defined by this statement is used in
+// its own definition, one defined by a later statement before its
+// definition; any other is unknown.
+static Sym *resolve(Ctx *cx, const char *name, Loc loc) {
+  Sym *s = lookup(cx, name);
+  if (s && s->stmt <= cx->stmt) return s;
+  const Loc *later = s ? &s->loc : NULL;
+  int i = 0;
+  for (const Stmt *st = cx->prog; st && !later; st = st->next, i++)
+    if (i >= cx->stmt && (later = defines(st, name)) != NULL && i == cx->stmt) {
+      error_at(loc, "'%s' is used in its own definition", name);
+      return NULL;
+    }
+  if (later)
+    error_at(loc, "'%s' is used before its definition (line %d, column %d)", name, later->line, later->col);
+  else
+    error_at(loc, "unknown name '%s'", name);
+  return NULL;
+}
+
 // Resolve a plain name in an expression.
 static int lower_name(Ctx *cx, const Ast *e) {
   if (!strcmp(e->name, "pi")) return dag_const(cx->d, 3.14159265358979323846);
-  Sym *s = lookup(cx, e->name);
-  if (!s || s->stmt > cx->stmt) {
-    if (s)
-      error_at(e->loc, "'%s' is used before its definition at line %d", e->name, s->loc.line);
-    else
-      error_at(e->loc, "unknown name '%s'", e->name);
-    return -1;
-  }
+  Sym *s = resolve(cx, e->name, e->loc);
+  if (!s) return -1;
   s->used = 1;
   switch (s->kind) {
   case SYM_COORD: return dag_input(cx->d, s->base);
@@ -186,14 +217,12 @@ static int lower_name(Ctx *cx, const Ast *e) {
   return -1;
 }
 
+// Lower name[i]: i must fold to an integer within the array's bounds.
 static int lower_index(Ctx *cx, const Ast *e) {
-  Sym *s = lookup(cx, e->name);
-  if (!s || s->stmt > cx->stmt) {
-    error_at(e->loc, "unknown name '%s'", e->name);
-    return -1;
-  }
+  Sym *s = resolve(cx, e->name, e->loc);
+  if (!s) return -1;
   if (s->kind != SYM_ARRAY) {
-    error_at(e->loc, "'%s' is %s, not an array, and cannot be indexed", e->name, sym_kind_name(s));
+    error_at(e->loc, "'%s' is %s, not an array, and cannot be indexed", e->name, sym_kind_name(cx, s));
     return -1;
   }
   long i;
@@ -206,17 +235,31 @@ static int lower_index(Ctx *cx, const Ast *e) {
   return dag_input(cx->d, s->base + (int)i - 1);
 }
 
+// Print a constant operand for a message; of an operator, in parentheses
+// when negative.
+static void operand(char *buf, size_t size, double v, int func) {
+  snprintf(buf, size, v < 0 && !func ? "(%.6g)" : "%.6g", v);
+}
+
 // Build op(a, b) from lowered operands; a constant result that is not a
-// finite number is an error at loc (x/0, sqrt(-1), log(0), 1e308*10, ...).
+// finite number is an error at loc (x/0, sqrt(-1), log(0), 1e308*10, ...)
+// that shows the operation with its operands. what is the function's name,
+// or the operator itself ("^") for a binary operator.
 static int build(Ctx *cx, Op op, int a, int b, Loc loc, const char *what) {
   const Node *na = &cx->d->nodes[a], *nb = b >= 0 ? &cx->d->nodes[b] : NULL;
   if (na->op == OP_CONST && (!nb || nb->op == OP_CONST)) {
     double v = op_apply(op, na->val, nb ? nb->val : 0);
-    if (!isfinite(v)) {
-      if (op == OP_DIV && nb->val == 0)
-        error_at(loc, "division by zero");
+    if (!isfinite(v) && !(op == OP_DIV && nb->val == 0)) {
+      int func = strlen(what) > 1;
+      char x[40], y[40] = "";
+      operand(x, sizeof x, na->val, func);
+      if (nb) operand(y, sizeof y, nb->val, func);
+      const char *why = isinf(v) ? "is infinite" : func ? "is not a number: the argument is outside the domain"
+                                                        : "is not a number";
+      if (func)
+        error_at(loc, "%s(%s%s%s) %s", what, x, nb ? ", " : "", y, why);
       else
-        error_at(loc, "%s of constant operands is %s", what, isnan(v) ? "not a number (outside its domain)" : "infinite");
+        error_at(loc, "%s %s %s %s", x, what, y, why);
       return -1;
     }
   }
@@ -263,10 +306,11 @@ static int for_range(Ctx *cx, const Ast *at, const char *name, const Ast *lo_e, 
   long lo, hi;
   if (lower_int(cx, lo_e, "a range bound", &lo) < 0 || lower_int(cx, hi_e, "a range bound", &hi) < 0) return -1;
   if (hi - lo + 1 > MAX_WORK - cx->work) {
-    error_at(at->loc, "range %ld..%ld expands to too many terms (the model may expand to %ld in all)", lo, hi, MAX_WORK);
+    error_at(at->loc, "range %ld..%ld has too many terms: sums and lists may expand to at most %ld terms in all", lo,
+             hi, MAX_WORK);
     return -1;
   }
-  Sym *iv = define(cx, name, at->loc, SYM_INDEX);
+  Sym *iv = define(cx, name, at->name_loc, SYM_INDEX);
   if (!iv) return -1;
   iv->used = 1;
   int rc = 0;
@@ -300,7 +344,7 @@ static int lower(Ctx *cx, const Ast *e) {
   case A_BIN: {
     int a = lower(cx, e->a), b = a < 0 ? -1 : lower(cx, e->b);
     if (a < 0 || b < 0) return -1;
-    static const char *names[] = {"addition", "subtraction", "product", "division", "power"};
+    static const char *names[] = {"+", "-", "*", "/", "^"};
     const char *ops = "+-*/^";
     static const Op bops[] = {OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW};
     int k = (int)(strchr(ops, e->op) - ops);
@@ -345,16 +389,16 @@ static int flatten(Ctx *cx, const Ast *e, List *out) {
   return 0;
 }
 
-// Flatten a list of constants (q0, p0, diag entries) into m doubles.
-static double *constant_list(Ctx *cx, const Stmt *st, const char *what, int want) {
+// Flatten a list of constants (q0, p0, diag entries, a row of M) into
+// want doubles; what names the list, whole what it is part of.
+static double *constant_list(Ctx *cx, const Stmt *st, const char *what, const char *whole, int want) {
   List l = {{0}, {0}, {0}};
   if (flatten(cx, st->expr, &l) < 0) return NULL;
   for (int i = 0; i < l.nodes.n; i++) {
     const Node *nd = &cx->d->nodes[l.nodes.v[i]];
     if (nd->op != OP_CONST) {
       Loc loc = {l.lines.v[i], l.cols.v[i]};
-      error_at(loc, "%s must be constant, but this value depends on %s", what,
-               nd->flags & DEP_INPUT ? "a coordinate" : "a parameter");
+      error_at(loc, "%s must be constant, but this value depends on %s", whole, dependence(nd));
       return NULL;
     }
   }
@@ -395,7 +439,7 @@ static void declare_variables(Ctx *cx, const Stmt *st) {
     long size = 1;
     if (dc->size && lower_int(cx, dc->size, "an array size", &size) < 0) continue;
     if (dc->size && size < 1) {
-      error_at(dc->size->loc, "array size must be at least 1, got %ld", size);
+      error_at(dc->size->loc, "an array size must be at least 1, got %ld", size);
       continue;
     }
     if (size > MAX_COORDS - mod->m) {
@@ -421,7 +465,8 @@ static void define_value(Ctx *cx, const Stmt *st) {
 static void define_param(Ctx *cx, const Stmt *st) {
   int n = lower(cx, st->expr);
   if (n >= 0 && cx->d->nodes[n].op != OP_CONST) {
-    error_at(st->expr->loc, "the default of param '%s' must be a constant number", st->name);
+    error_at(st->expr->loc, "the default of param '%s' must be constant, but it depends on %s", st->name,
+             dependence(&cx->d->nodes[n]));
     n = -1;
   }
   if (cx->nparams >= MAX_PARAMS) {
@@ -493,7 +538,7 @@ static void lower_mass(Ctx *cx) {
     Ast list = *e;
     list.kind = A_LIST;
     tmp.expr = &list;
-    double *dg = constant_list(cx, &tmp, "diag(...) of M", m);
+    double *dg = constant_list(cx, &tmp, "diag(...) of M", "M", m);
     if (!dg) return;
     double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
     if (!dense) internal_error("out of memory");
@@ -506,7 +551,7 @@ static void lower_mass(Ctx *cx) {
     int rows = 0;
     for (const Ast *r = e->args; r; r = r->next) rows++;
     if (rows != m) {
-      error_at(e->loc, "M has %d rows, expected %d (one per coordinate)", rows, m);
+      error_at(e->loc, "M has %d row%s, expected %d (one per coordinate)", rows, rows == 1 ? "" : "s", m);
       return;
     }
     double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
@@ -516,7 +561,7 @@ static void lower_mass(Ctx *cx) {
       Stmt row = *cx->mass;
       row.expr = (Ast *)r;
       row.loc = r->loc;
-      double *v = r->kind == A_LIST ? constant_list(cx, &row, "a row of M", m) : NULL;
+      double *v = r->kind == A_LIST ? constant_list(cx, &row, "a row of M", "M", m) : NULL;
       if (r->kind != A_LIST) error_at(r->loc, "M = [[...], ...] needs each row as a list");
       if (!v) {
         free(dense);
@@ -532,7 +577,11 @@ static void lower_mass(Ctx *cx) {
   if (n < 0) return;
   const Node *nd = &cx->d->nodes[n];
   if (nd->op != OP_CONST) {
-    error_at(e->loc, "M must be constant, but it depends on %s", nd->flags & DEP_INPUT ? "a coordinate" : "a parameter");
+    error_at(e->loc, "M must be constant, but it depends on %s", dependence(nd));
+    return;
+  }
+  if (!(nd->val > 0)) {
+    error_at(e->loc, "M = c (c times the identity) needs c > 0, got %g", nd->val);
     return;
   }
   double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
@@ -546,14 +595,29 @@ static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc
   if (!st) return arena_alloc((size_t)cx->mod->m * sizeof(double));
   cx->stmt = stmt;
   *loc = st->loc;
-  return constant_list(cx, st, what, cx->mod->m);
+  return constant_list(cx, st, what, what, cx->mod->m);
 }
 
+static int by_location(const void *a, const void *b) {
+  const Sym *x = *(const Sym *const *)a, *y = *(const Sym *const *)b;
+  return x->loc.line != y->loc.line ? (x->loc.line > y->loc.line) - (x->loc.line < y->loc.line)
+                                    : (x->loc.col > y->loc.col) - (x->loc.col < y->loc.col);
+}
+
+// Warn about every definition and param never used, in file order.
 static void warn_unused(Ctx *cx) {
+  int n = 0;
+  for (int b = 0; b < NBUCKETS; b++)
+    for (Sym *s = cx->buckets[b]; s; s = s->next) n++;
+  Sym **unused = arena_alloc((size_t)(n + 1) * sizeof *unused);
+  n = 0;
   for (int b = 0; b < NBUCKETS; b++)
     for (Sym *s = cx->buckets[b]; s; s = s->next)
-      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_PARAM))
-        warning_at(s->loc, "%s '%s' is never used", s->kind == SYM_PARAM ? "param" : "definition", s->name);
+      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_PARAM)) unused[n++] = s;
+  qsort(unused, (size_t)n, sizeof *unused, by_location);
+  for (int i = 0; i < n; i++)
+    warning_at(unused[i]->loc, "%s '%s' is never used", unused[i]->kind == SYM_PARAM ? "param" : "definition",
+               unused[i]->name);
 }
 
 // Analyse the statements of a model. Returns NULL if any error was reported.
@@ -564,6 +628,7 @@ Model *analyse(const char *file, Stmt *prog) {
   mod->file = file;
   cx->mod = mod;
   cx->d = mod->dag = dag_new();
+  cx->prog = prog;
   mod->U = dag_const(cx->d, 0);
   int stmt = 0;
   for (Stmt *st = prog; st && !diag_too_many(); st = st->next, stmt++) {

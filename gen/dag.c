@@ -198,6 +198,24 @@ double op_apply(Op op, double a, double b) {
 
 static int is_neg(const Dag *d, int id) { return d->nodes[id].op == OP_NEG; }
 
+// c1 * c2 when that product is exact (so merging two constant factors
+// changes no rounding), else 0.
+static double exact_product(double c1, double c2) {
+  double p = c1 * c2;
+  return isfinite(p) && p != 0 && fma(c1, c2, -p) == 0 && fabs(p) >= 0x1p-1000 ? p : 0;
+}
+
+// c * (c2 * x) -> (c * c2) * x when c * c2 is exact; -1 otherwise.
+static int merge_factors(Dag *d, int c, int prod) {
+  const Node *pn = &d->nodes[prod];
+  if (pn->op != OP_MUL) return -1;
+  int k = d->nodes[pn->a].op == OP_CONST ? pn->a : d->nodes[pn->b].op == OP_CONST ? pn->b : -1;
+  if (k < 0) return -1;
+  double p = exact_product(d->nodes[c].val, d->nodes[k].val);
+  if (p == 0) return -1;
+  return dag_op(d, OP_MUL, dag_const(d, p), k == pn->a ? pn->b : pn->a);
+}
+
 // Algebraic identities; returns the simplified node or -1 when none applies.
 static int simplify(Dag *d, Op op, int a, int b) {
   switch (op) {
@@ -222,12 +240,16 @@ static int simplify(Dag *d, Op op, int a, int b) {
     if (is_neg(d, a) && is_neg(d, b)) return dag_op(d, OP_MUL, d->nodes[a].a, d->nodes[b].a);
     if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_MUL, d->nodes[a].a, b), -1);
     if (is_neg(d, b)) return dag_op(d, OP_NEG, dag_op(d, OP_MUL, a, d->nodes[b].a), -1);
+    if (d->nodes[a].op == OP_CONST) return merge_factors(d, a, b);
+    if (d->nodes[b].op == OP_CONST) return merge_factors(d, b, a);
     return -1;
   case OP_DIV:
     if (dag_is_const(d, b, 1)) return a;
     if (dag_is_const(d, b, -1)) return dag_op(d, OP_NEG, a, -1);
     if (dag_is_zero(d, a) && !dag_is_zero(d, b)) return a;
     if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_DIV, d->nodes[a].a, b), -1);
+    if (d->nodes[b].op == OP_CONST && exact_product(1 / d->nodes[b].val, d->nodes[b].val) == 1)
+      return dag_op(d, OP_MUL, a, dag_const(d, 1 / d->nodes[b].val)); /* x/2 -> 0.5*x: exact */
     return -1;
   case OP_NEG:
     if (is_neg(d, a)) return d->nodes[a].a;

@@ -68,6 +68,7 @@ struct Ast {
   int op;            /* A_BIN: '+', '-', '*', '/', '^' */
   double num;        /* A_NUM */
   const char *name;  /* A_NAME, A_INDEX, A_CALL, A_SUM, A_FOR */
+  Loc name_loc;      /* A_SUM, A_FOR: where the index variable is named */
   Ast *a, *b, *c;    /* operands, range bounds, body */
   Ast *args;         /* A_CALL, A_LIST, A_DIAG: first of a list linked by next */
   Ast *next;
@@ -284,6 +285,8 @@ typedef struct {
   const char *name;     /* C prefix */
   const char *model_file;
   int emit_main;
+  int single;           /* --real float */
+  int compensated;      /* Kahan summation (off with --plain-sum) */
 } EmitOptions;
 
 int emit_solver(FILE *h, FILE *c, const Model *mod, const Method *meth, const Step *st, const EmitOptions *o);

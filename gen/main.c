@@ -29,6 +29,10 @@ static const char usage[] =
     "  -n NAME       C prefix of every emitted symbol (default: the model file's base name)\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k\n"
+    "  --real T      float or double (default): the type of the state, constants and\n"
+    "                arithmetic of the generated code (float: for FPUs without double)\n"
+    "  --plain-sum   update q, p, t by plain addition instead of compensated (Kahan)\n"
+    "                summation: only to measure what compensation buys\n"
     "  -h, --help    this text\n"
     "  --version     the version\n";
 
@@ -36,6 +40,7 @@ typedef struct {
   const char *model, *outdir, *name;
   int s, k; /* k = 0: auto */
   int emit_main, check_only;
+  int single, plain_sum;
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -70,6 +75,13 @@ static int parse_args(int argc, char **argv, Options *o) {
       o->emit_main = 1;
     } else if (!strcmp(a, "--check")) {
       o->check_only = 1;
+    } else if (!strcmp(a, "--plain-sum")) {
+      o->plain_sum = 1;
+    } else if (!strcmp(a, "--real")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      const char *v = argv[++i];
+      if (strcmp(v, "float") && strcmp(v, "double")) return fail("--real needs 'float' or 'double', got '%s'", v);
+      o->single = !strcmp(v, "float");
     } else if (!strcmp(a, "-s") || !strcmp(a, "-k") || !strcmp(a, "-o") || !strcmp(a, "-n")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -88,6 +100,7 @@ static int parse_args(int argc, char **argv, Options *o) {
     }
   }
   if (!o->model) return fail("%s", "no model file given (see hbvmgen --help)");
+  if (o->single && o->emit_main) return fail("%s", "--main needs double precision (the driver's CSV is in double)");
   if (o->k && o->k < o->s) {
     char buf[64];
     snprintf(buf, sizeof buf, "k=%d < s=%d", o->k, o->s);
@@ -205,7 +218,8 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
   char tmp[NFILES][4096], final[NFILES][4096];
   FILE *f[NFILES] = {NULL, NULL, NULL};
   int nfiles = o->emit_main ? 3 : 2, rc = 0;
-  EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->emit_main};
+  EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->emit_main, o->single,
+                    !o->plain_sum};
   for (int i = 0; i < nfiles && !rc; i++)
     if (!(f[i] = open_tmp(o, suffix[i], tmp[i], final[i], sizeof tmp[i]))) rc = 1;
   if (!rc) rc = emit_solver(f[H], f[C], mod, me, st, &eo) != 0;
@@ -225,7 +239,7 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0};
+  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) o.name = default_name(o.model);

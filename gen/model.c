@@ -43,7 +43,8 @@ void model_check_initial(const Model *mod) {
   const double *prm = param_defaults(mod);
   int m = mod->m;
   double U0 = dag_eval(mod->dag, mod->U, mod->q0, prm);
-  if (!isfinite(U0)) warning_at(mod->q0_loc, "U is not finite at q0 (%g)", U0);
+  if (!isfinite(U0))
+    warning_at(mod->q0_loc, "U is not finite at %s (U = %g)", mod->q0_loc.line ? "q0" : "the default q0 = 0", U0);
   double *v = malloc((size_t)m * sizeof(double));
   if (!v) internal_error("out of memory");
   for (int i = 0; i < m; i++) {

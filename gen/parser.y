@@ -4,12 +4,16 @@
  * statements whose expressions are syntax trees; all meaning (names,
  * shapes, constants) is given later by ast.c. Statements need no separator;
  * after a syntax error the parser skips to where a statement can start.
- * Nesting is bounded: the lexer refuses deeper brackets than MAX_NESTING and
- * ast_new refuses trees deeper than MAX_AST_DEPTH, so no later pass can
- * overflow the C stack. */
+ * Syntax errors name the unexpected token (with its text for names and
+ * numbers), the expected ones when there are few, and the bracket left
+ * open when its closer would fit; a reserved word where a name belongs is
+ * its own error. Nesting is bounded: the lexer refuses deeper brackets than
+ * MAX_NESTING and ast_new refuses trees deeper than MAX_AST_DEPTH, so no
+ * later pass can overflow the C stack. */
 
 %define api.pure full
-%define parse.error detailed
+%define parse.error custom
+%define parse.lac full
 %locations
 %expect 0
 %param {yyscan_t scanner}
@@ -23,8 +27,17 @@ typedef void *yyscan_t;
 #endif
 typedef struct {
   Stmt *first, *last;  /* statements in file order */
-  int depth;           /* open brackets, counted by the lexer */
   int fatal;           /* the lexer gave up (nesting too deep, too many errors) */
+  Loc end;             /* just after the last token: where end of file is reported */
+  const char *text;    /* text of the last name or number read (for messages) */
+  int after_name;      /* the token before the current one was that name ... */
+  Loc name_loc;        /* ... which is here */
+  int is_name;         /* the current token is a name */
+  long tokens;         /* tokens read, bounded by MAX_TOKENS */
+  int depth;           /* open brackets, counted by the lexer ... */
+  int pop;             /* ... which closes one when it reads the next token */
+  Loc open[MAX_NESTING];       /* where each open bracket is */
+  char open_char[MAX_NESTING]; /* and which one: '(' or '[' */
 } ParseState;
 }
 
@@ -33,6 +46,10 @@ int yylex(YYSTYPE *lval, YYLTYPE *lloc, yyscan_t scanner);
 }
 
 %code {
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
 #include "lexer.h"
 
 static Loc loc_of(YYLTYPE l) {
@@ -40,13 +57,19 @@ static Loc loc_of(YYLTYPE l) {
   return loc;
 }
 
+// Bison's own errors; only "memory exhausted" (the parser stack is full)
+// can arrive here, syntax errors go to yyreport_syntax_error.
 static void yyerror(YYLTYPE *l, yyscan_t scanner, ParseState *ps, const char *msg) {
   (void)scanner;
   if (ps->fatal || diag_too_many()) return;
   if (!strcmp(msg, "memory exhausted"))
-    error_at(loc_of(*l), "expression too deeply nested");
+    error_at(loc_of(*l), "expression nested too deeply");
   else
     error_at(loc_of(*l), "%s", msg);
+}
+
+static void reserved_name(YYLTYPE l, const char *word) {
+  error_at(loc_of(l), "'%s' is a reserved word and cannot be used as a name", word);
 }
 
 static void add_stmt(ParseState *ps, StmtKind kind, YYLTYPE l, Ast *expr) {
@@ -98,12 +121,14 @@ static Ast *list_reverse(Ast *list) {
 %token <num> NUMBER "number"
 %token <str> NAME "name"
 %token <str> FUNC "function name"
-%token VARIABLES "'variables'" PARAM "'param'" KW_M "'M'" KW_U "'U'" KW_G "'g'"
-%token Q0 "'q0'" P0 "'p0'" IDENTITY "'identity'" DIAG "'diag'" SUM "'sum'"
-%token FOR "'for'" IN "'in'" DOTDOT "'..'"
+%token <str> VARIABLES "'variables'" PARAM "'param'" KW_M "'M'" KW_U "'U'" KW_G "'g'"
+%token <str> Q0 "'q0'" P0 "'p0'" IDENTITY "'identity'" DIAG "'diag'" SUM "'sum'"
+%token <str> FOR "'for'" IN "'in'"
+%token DOTDOT "'..'"
 
 %type <ast> expr primary args arglist
 %type <decl> decls decl
+%type <str> name reserved stmt_reserved
 
 %left '+' '-'
 %left '*' '/'
@@ -116,19 +141,34 @@ model
   : %empty
   | model stmt
   | model ';'
-  | model error                 { /* resynchronise on the next statement */ }
+  | model error                 { ps->depth = ps->pop = 0; /* resynchronise on the next statement */ }
   ;
 
 stmt
   : VARIABLES decls             { add_stmt(ps, S_VARIABLES, @1, NULL); ps->last->decls = decl_reverse($2); }
   | NAME '=' expr               { add_stmt(ps, S_DEF, @1, $3); ps->last->name = $1; ps->last->name_loc = loc_of(@1); }
-  | PARAM NAME '=' expr         { add_stmt(ps, S_PARAM, @1, $4); ps->last->name = $2; ps->last->name_loc = loc_of(@2); }
+  | PARAM name '=' expr         { add_stmt(ps, S_PARAM, @1, $4); ps->last->name = $2; ps->last->name_loc = loc_of(@2); }
   | KW_M '=' expr               { add_stmt(ps, S_MASS, @1, $3); }
   | KW_U '=' expr               { add_stmt(ps, S_POTENTIAL, @1, $3); }
   | KW_G '=' expr               { add_stmt(ps, S_CONSTRAINTS, @1, $3); }
   | Q0 '=' expr                 { add_stmt(ps, S_Q0, @1, $3); }
   | P0 '=' expr                 { add_stmt(ps, S_P0, @1, $3); }
-  | FUNC '=' expr               { error_at(loc_of(@1), "'%s' is a reserved function name and cannot be defined", $1); }
+  | stmt_reserved '=' expr      { reserved_name(@1, $1); }
+  ;
+
+/* Where a name is wanted, a reserved word is an error, not a syntax error. */
+name
+  : NAME
+  | reserved                    { reserved_name(@1, $1); }
+  ;
+
+reserved
+  : stmt_reserved | VARIABLES | PARAM | KW_M | KW_U | KW_G | Q0 | P0
+  ;
+
+/* The reserved words that cannot start a statement. */
+stmt_reserved
+  : IDENTITY | DIAG | SUM | FOR | IN | FUNC
   ;
 
 decls
@@ -137,8 +177,8 @@ decls
   ;
 
 decl
-  : NAME                        { $$ = arena_alloc(sizeof(Decl)); $$->name = $1; $$->loc = loc_of(@1); }
-  | NAME '[' expr ']'           { $$ = arena_alloc(sizeof(Decl)); $$->name = $1; $$->loc = loc_of(@1); $$->size = $3; }
+  : name                        { $$ = arena_alloc(sizeof(Decl)); $$->name = $1; $$->loc = loc_of(@1); }
+  | name '[' expr ']'           { $$ = arena_alloc(sizeof(Decl)); $$->name = $1; $$->loc = loc_of(@1); $$->size = $3; }
   ;
 
 expr
@@ -158,11 +198,11 @@ primary
   | NAME '[' expr ']'           { $$ = ast_new(A_INDEX, loc_of(@1), $3, NULL, NULL); $$->name = $1; }
   | '(' expr ')'                { $$ = $2; }
   | FUNC '(' args ')'           { $$ = leaf_name(A_CALL, @1, $1); ast_set_args($$, $3); }
-  | SUM '(' NAME IN expr DOTDOT expr ',' expr ')'
-                                { $$ = ast_new(A_SUM, loc_of(@1), $5, $7, $9); $$->name = $3; }
+  | SUM '(' name IN expr DOTDOT expr ',' expr ')'
+                                { $$ = ast_new(A_SUM, loc_of(@1), $5, $7, $9); $$->name = $3; $$->name_loc = loc_of(@3); }
   | '[' args ']'                { $$ = ast_new(A_LIST, loc_of(@1), NULL, NULL, NULL); ast_set_args($$, $2); }
-  | '[' expr FOR NAME IN expr DOTDOT expr ']'
-                                { $$ = ast_new(A_FOR, loc_of(@1), $6, $8, $2); $$->name = $4; }
+  | '[' expr FOR name IN expr DOTDOT expr ']'
+                                { $$ = ast_new(A_FOR, loc_of(@1), $6, $8, $2); $$->name = $4; $$->name_loc = loc_of(@4); }
   | IDENTITY                    { $$ = ast_new(A_IDENTITY, loc_of(@1), NULL, NULL, NULL); }
   | DIAG '(' args ')'           { $$ = ast_new(A_DIAG, loc_of(@1), NULL, NULL, NULL); ast_set_args($$, $3); }
   ;
@@ -180,18 +220,126 @@ arglist
 
 %%
 
+/* Append to a message buffer of size MSG_SIZE, truncating quietly. */
+#define MSG_SIZE 512
+static void msg_add(char *msg, const char *fmt, ...) {
+  size_t n = strlen(msg);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg + n, MSG_SIZE - n, fmt, ap);
+  va_end(ap);
+}
+
+/* Whether k is a reserved word (the grammar accepts them where a name is
+ * wanted, only to report them as misused). */
+static int is_reserved(yysymbol_kind_t k) {
+  switch (k) {
+  case YYSYMBOL_FUNC: case YYSYMBOL_VARIABLES: case YYSYMBOL_PARAM: case YYSYMBOL_KW_M: case YYSYMBOL_KW_U:
+  case YYSYMBOL_KW_G: case YYSYMBOL_Q0: case YYSYMBOL_P0: case YYSYMBOL_IDENTITY: case YYSYMBOL_DIAG:
+  case YYSYMBOL_SUM: case YYSYMBOL_FOR: case YYSYMBOL_IN: return 1;
+  default: return 0;
+  }
+}
+
+/* The tokens the parser could take instead of the unexpected one, as they
+ * should be listed: where only a name fits (no statement could start
+ * there), the reserved words are left out. Returns their number. */
+static int expected_tokens(const yypcontext_t *ctx, yysymbol_kind_t *out) {
+  yysymbol_kind_t all[YYNTOKENS];
+  int n = yypcontext_expected_tokens(ctx, all, YYNTOKENS), name = 0, stmt = 0, k = 0;
+  for (int i = 0; i < n; i++) {
+    name |= all[i] == YYSYMBOL_NAME;
+    stmt |= all[i] == YYSYMBOL_YYEOF;  /* the end of a statement: the next may start */
+  }
+  for (int i = 0; i < n; i++)
+    if (!(name && !stmt && is_reserved(all[i]))) out[k++] = all[i];
+  return k;
+}
+
+/* Whether token t is one of the characters in set. */
+static int is_char(yysymbol_kind_t t, const char *set) {
+  for (; *set; set++)
+    if (t == YYTRANSLATE((unsigned char)*set)) return 1;
+  return 0;
+}
+
+/* The expected tokens as they read best: the tokens that can start an
+ * expression as "an expression", the five operators (and '[' of indexing
+ * with them) as "an operator", any other token by its name. Fills words,
+ * returns their number. */
+static int describe_expected(const yysymbol_kind_t *expected, int n, const char **words) {
+  int expr = 0, nops = 0, k = 0;
+  for (int i = 0; i < n; i++) {
+    expr |= expected[i] == YYSYMBOL_NUMBER;
+    nops += is_char(expected[i], "+-*/^");
+  }
+  if (expr) words[k++] = "an expression";
+  if (nops == 5) words[k++] = "an operator";
+  for (int i = 0; i < n; i++) {
+    yysymbol_kind_t t = expected[i];
+    int starts = t == YYSYMBOL_NUMBER || t == YYSYMBOL_NAME || t == YYSYMBOL_FUNC || t == YYSYMBOL_SUM ||
+                 t == YYSYMBOL_IDENTITY || t == YYSYMBOL_DIAG || is_char(t, "+-([");
+    if (!(expr && starts) && !(nops == 5 && is_char(t, "+-*/^["))) words[k++] = yysymbol_name(t);
+  }
+  return k;
+}
+
+/* A syntax error: "syntax error, unexpected X", the text of X when it is a
+ * name or a number, what was expected when it fits in four words, and,
+ * when the innermost open bracket's closer is expected, where that
+ * bracket was opened (the usual cause: a missing ')' or ']'). */
+static int yyreport_syntax_error(const yypcontext_t *ctx, yyscan_t scanner, ParseState *ps) {
+  (void)scanner;
+  if (ps->fatal || diag_too_many()) return 0;
+  char msg[MSG_SIZE] = "";
+  yysymbol_kind_t tok = yypcontext_token(ctx);
+  if (tok == YYTRANSLATE('(') && ps->after_name) {
+    error_at(ps->name_loc, "'%.40s' is not a function (the functions are sin cos tan asin acos atan atan2 sinh "
+             "cosh tanh exp log sqrt pow abs)", ps->text);
+    return 0;
+  }
+  msg_add(msg, "syntax error, unexpected %s", yysymbol_name(tok));
+  if (tok == YYSYMBOL_NAME || tok == YYSYMBOL_FUNC || tok == YYSYMBOL_NUMBER)
+    msg_add(msg, " '%.40s%s'", ps->text, strlen(ps->text) > 40 ? "..." : "");
+  if (is_char(tok, ")]") && ps->depth == 0) msg_add(msg, " (no bracket is open)");
+  yysymbol_kind_t expected[YYNTOKENS];
+  int nexp = expected_tokens(ctx, expected);
+  yysymbol_kind_t closer = YYSYMBOL_YYEMPTY;
+  if (ps->depth > 0) closer = YYTRANSLATE(ps->open_char[ps->depth - 1] == '(' ? ')' : ']');
+  int closes = 0;
+  for (int i = 0; i < nexp; i++) closes |= expected[i] == closer;
+  const char *words[YYNTOKENS + 2];
+  int nwords = describe_expected(expected, nexp, words);
+  if (nwords <= 4) {
+    for (int i = 0; i < nwords; i++)
+      msg_add(msg, "%s%s", i == 0 ? ", expecting " : i == nwords - 1 ? " or " : ", ", words[i]);
+  } else if (closes) {
+    msg_add(msg, ", expecting %s", yysymbol_name(closer));
+  }
+  if (closes) {
+    Loc at = ps->open[ps->depth - 1];
+    msg_add(msg, " (to close the '%c' at line %d, column %d)", ps->open_char[ps->depth - 1], at.line, at.col);
+  }
+  error_at(loc_of(*yypcontext_location(ctx)), "%s", msg);
+  return 0;
+}
+
 /* Parse src (len bytes, may contain NUL) into a statement list. Syntax
  * errors are reported and parsing goes on where it can; the caller checks
  * diag_error_count(). */
 Stmt *parse_model(const char *src, size_t len) {
   yyscan_t scanner;
-  ParseState ps = {NULL, NULL, 0, 0};
-  if (yylex_init_extra(&ps, &scanner)) internal_error("cannot start the lexer");
+  ParseState *ps = calloc(1, sizeof *ps);
+  if (!ps) internal_error("out of memory");
+  ps->end = (Loc){1, 1};
+  if (yylex_init_extra(ps, &scanner)) internal_error("cannot start the lexer");
   YY_BUFFER_STATE buf = yy_scan_bytes(src, (int)len, scanner);
   yyset_lineno(1, scanner);
   yyset_column(1, scanner);
-  yyparse(scanner, &ps);
+  yyparse(scanner, ps);
   yy_delete_buffer(buf, scanner);
   yylex_destroy(scanner);
-  return ps.first;
+  Stmt *first = ps->first;
+  free(ps);
+  return first;
 }

@@ -111,7 +111,7 @@ static void show_line(Loc loc) {
   if (col > MAX_SHOWN_LINE / 2) from = col - MAX_SHOWN_LINE / 2;
   size_t to = end - pos;
   if (to > from + MAX_SHOWN_LINE) to = from + MAX_SHOWN_LINE;
-  if (from > to) return;
+  if (from > to || (from == to && col == 0)) return; /* no text to show */
   fputs("    ", stderr);
   for (size_t i = from; i < to; i++) {
     unsigned char ch = (unsigned char)diag_src[pos + i];

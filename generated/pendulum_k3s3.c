@@ -2,17 +2,16 @@
  * HBVM(k=3, s=3): line-integral method for Hamiltonian systems with holonomic
  * constraints (Brugnano, Gurioli, Iavernaro, Weinmueller). Needs only <math.h>. */
 #include <math.h>
-#include <string.h>
 
 #include "pendulum_k3s3.h"
 
 #define M pendulum_k3s3_M
 #define NU pendulum_k3s3_NU
 #define S pendulum_k3s3_S
-#define MAXITER 100       /* fixed-point iterations before giving up */
+#define MAXITER 100  /* fixed-point iterations before giving up */
 #define TOL 4.4408920985006262e-16  /* converged: increment within 2 ulps */
-#define STAGTOL 1e-10     /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13     /* pivot / diagonal of A below this: singular */
+#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -47,132 +46,125 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   const double t11 = t9 + t10;
   const double t12 = h * t11;
   const double t13 = t12 + q0[1];
-  const double t14 = 2.0 * t13;
-  const double t15 = 2.0 * t6;
-  const double t16 = t15 * 0.27777777777777779;
-  const double t17 = t14 * 0.27777777777777779;
-  const double t18 = t15 * (-0.37267799624996495);
-  const double t19 = t14 * (-0.37267799624996495);
-  const double t20 = t15 * 0.24845199749997668;
-  const double t21 = t14 * 0.24845199749997668;
+  const double t14 = t6 * 0.55555555555555558;
+  const double t15 = t13 * 0.55555555555555558;
+  const double t16 = t6 * (-0.7453559924999299);
+  const double t17 = t13 * (-0.7453559924999299);
+  const double t18 = t6 * 0.49690399499995336;
+  const double t19 = t13 * 0.49690399499995336;
   /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t22 = gam[0] * 0.5;
-  const double t23 = gam[2] * (-0.43301270189221935);
-  const double t24 = t22 + t23;
-  const double t25 = h * t24;
-  const double t26 = q0[0] + t25;
-  const double t27 = gam[1] * 0.5;
-  const double t28 = gam[3] * (-0.43301270189221935);
-  const double t29 = t27 + t28;
-  const double t30 = h * t29;
-  const double t31 = q0[1] + t30;
-  const double t32 = 2.0 * t31;
-  const double t33 = 2.0 * t26;
-  const double t34 = t33 * 0.44444444444444442;
-  const double t35 = t16 + t34;
-  const double t36 = t32 * 0.44444444444444442;
-  const double t37 = t17 + t36;
-  const double t38 = t33 * (-0.49690399499995325);
-  const double t39 = t20 + t38;
-  const double t40 = t32 * (-0.49690399499995325);
-  const double t41 = t21 + t40;
+  const double t20 = gam[0] * 0.5;
+  const double t21 = gam[2] * (-0.43301270189221935);
+  const double t22 = t20 + t21;
+  const double t23 = h * t22;
+  const double t24 = q0[0] + t23;
+  const double t25 = gam[1] * 0.5;
+  const double t26 = gam[3] * (-0.43301270189221935);
+  const double t27 = t25 + t26;
+  const double t28 = h * t27;
+  const double t29 = q0[1] + t28;
+  const double t30 = t24 * 0.88888888888888884;
+  const double t31 = t14 + t30;
+  const double t32 = t29 * 0.88888888888888884;
+  const double t33 = t15 + t32;
+  const double t34 = t24 * (-0.99380798999990649);
+  const double t35 = t18 + t34;
+  const double t36 = t29 * (-0.99380798999990649);
+  const double t37 = t19 + t36;
   /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t42 = gam[0] * 0.8872983346207417;
-  const double t43 = t1 + t42;
-  const double t44 = gam[4] * (-0.1732050807568877);
-  const double t45 = t43 + t44;
-  const double t46 = h * t45;
-  const double t47 = q0[0] + t46;
-  const double t48 = gam[1] * 0.8872983346207417;
-  const double t49 = t8 + t48;
-  const double t50 = gam[5] * (-0.1732050807568877);
-  const double t51 = t49 + t50;
-  const double t52 = h * t51;
-  const double t53 = q0[1] + t52;
-  const double t54 = 2.0 * t53;
-  const double t55 = 2.0 * t47;
-  const double t56 = 0.27777777777777779 * t55;
-  const double t57 = t35 + t56;
-  const double t58 = 0.27777777777777779 * t54;
-  const double t59 = t37 + t58;
-  const double t60 = t55 * 0.37267799624996495;
-  const double t61 = t18 + t60;
-  const double t62 = t54 * 0.37267799624996495;
-  const double t63 = t19 + t62;
-  const double t64 = 0.24845199749997668 * t55;
-  const double t65 = t39 + t64;
-  const double t66 = 0.24845199749997668 * t54;
-  const double t67 = t41 + t66;
+  const double t38 = gam[0] * 0.8872983346207417;
+  const double t39 = t1 + t38;
+  const double t40 = gam[4] * (-0.1732050807568877);
+  const double t41 = t39 + t40;
+  const double t42 = h * t41;
+  const double t43 = q0[0] + t42;
+  const double t44 = gam[1] * 0.8872983346207417;
+  const double t45 = t8 + t44;
+  const double t46 = gam[5] * (-0.1732050807568877);
+  const double t47 = t45 + t46;
+  const double t48 = h * t47;
+  const double t49 = q0[1] + t48;
+  const double t50 = 0.55555555555555558 * t43;
+  const double t51 = t31 + t50;
+  const double t52 = 0.55555555555555558 * t49;
+  const double t53 = t33 + t52;
+  const double t54 = t43 * 0.7453559924999299;
+  const double t55 = t16 + t54;
+  const double t56 = t49 * 0.7453559924999299;
+  const double t57 = t17 + t56;
+  const double t58 = 0.49690399499995336 * t43;
+  const double t59 = t35 + t58;
+  const double t60 = 0.49690399499995336 * t49;
+  const double t61 = t37 + t60;
   /* multiplier system A lambda = r */
-  const double t68 = t57 * t57;
-  const double t69 = t59 * t59;
-  const double t70 = t68 + t69;
-  const double t71 = 0.5 * t70;
+  const double t62 = t51 * t51;
+  const double t63 = t53 * t53;
+  const double t64 = t62 + t63;
+  const double t65 = 0.5 * t64;
+  const double t66 = h * t65;
+  const double t67 = 0.5 * t53;
+  const double t68 = t57 * 0.28867513459481292;
+  const double t69 = t67 + t68;
+  const double t70 = t57 * 1.4332917616497526e-17;
+  const double t71 = t69 - t70;
   const double t72 = h * t71;
-  const double t73 = 0.5 * t59;
-  const double t74 = t63 * 0.28867513459481292;
+  const double t73 = t51 * p0[0];
+  const double t74 = t53 * p0[1];
   const double t75 = t73 + t74;
-  const double t76 = t63 * 1.1102230246251565e-16;
-  const double t77 = 0.12909944487358055 * t76;
-  const double t78 = t75 - t77;
-  const double t79 = h * t78;
-  const double t80 = t57 * p0[0];
-  const double t81 = t59 * p0[1];
-  const double t82 = t80 + t81;
-  const double t83 = t82 - t79;
-  const double t84 = g0[0] / h;
-  const double t85 = t83 + t84;
-  const double t86 = t85 / t72;
+  const double t76 = t75 - t72;
+  const double t77 = g0[0] / h;
+  const double t78 = t76 + t77;
+  const double t79 = t78 / t66;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t87 = t57 * t86;
-  const double t88 = t59 * t86;
-  const double t89 = 1.0 + t88;
-  const double t90 = t61 * t86;
-  const double t91 = t63 * t86;
-  const double t92 = t65 * t86;
-  const double t93 = t67 * t86;
-  const double t94 = 1.1102230246251565e-16 + t93;
-  const double t95 = 0.5 * t87;
-  const double t96 = 0.28867513459481292 * t90;
-  const double t97 = t95 - t96;
-  const double t98 = h * t97;
-  const double t99 = p0[0] - t98;
-  const double t100 = 0.5 * t89;
-  const double t101 = 0.28867513459481292 * t91;
-  const double t102 = t100 - t101;
-  const double t103 = h * t102;
-  const double t104 = p0[1] - t103;
-  const double t105 = 0.28867513459481292 * t87;
-  const double t106 = 0.12909944487358055 * t92;
-  const double t107 = t105 - t106;
-  const double t108 = h * t107;
-  const double t109 = -t108;
-  const double t110 = 0.28867513459481292 * t89;
-  const double t111 = 0.12909944487358055 * t94;
-  const double t112 = t110 - t111;
-  const double t113 = h * t112;
-  const double t114 = -t113;
-  const double t115 = 0.12909944487358055 * t90;
-  const double t116 = h * t115;
+  const double t80 = t51 * t79;
+  const double t81 = t53 * t79;
+  const double t82 = 1.0 + t81;
+  const double t83 = t55 * t79;
+  const double t84 = t57 * t79;
+  const double t85 = t59 * t79;
+  const double t86 = t61 * t79;
+  const double t87 = 1.1102230246251565e-16 + t86;
+  const double t88 = 0.5 * t80;
+  const double t89 = 0.28867513459481292 * t83;
+  const double t90 = t88 - t89;
+  const double t91 = h * t90;
+  const double t92 = p0[0] - t91;
+  const double t93 = 0.5 * t82;
+  const double t94 = 0.28867513459481292 * t84;
+  const double t95 = t93 - t94;
+  const double t96 = h * t95;
+  const double t97 = p0[1] - t96;
+  const double t98 = 0.28867513459481292 * t80;
+  const double t99 = 0.12909944487358055 * t85;
+  const double t100 = t98 - t99;
+  const double t101 = h * t100;
+  const double t102 = -t101;
+  const double t103 = 0.28867513459481292 * t82;
+  const double t104 = 0.12909944487358055 * t87;
+  const double t105 = t103 - t104;
+  const double t106 = h * t105;
+  const double t107 = -t106;
+  const double t108 = 0.12909944487358055 * t83;
+  const double t109 = h * t108;
+  const double t110 = -t109;
+  const double t111 = 0.12909944487358055 * t84;
+  const double t112 = h * t111;
+  const double t113 = -t112;
+  const double t114 = h * t80;
+  const double t115 = -t114;
+  const double t116 = h * t82;
   const double t117 = -t116;
-  const double t118 = 0.12909944487358055 * t91;
-  const double t119 = h * t118;
-  const double t120 = -t119;
-  const double t121 = h * t87;
-  const double t122 = -t121;
-  const double t123 = h * t89;
-  const double t124 = -t123;
-  out[0] = t99;
-  out[1] = t104;
-  out[2] = t109;
-  out[3] = t114;
-  out[4] = t117;
-  out[5] = t120;
-  out[6] = t122;
-  out[7] = t124;
-  out[8] = t86;
-  out[9] = t72;
-  out[10] = t72;
+  out[0] = t92;
+  out[1] = t97;
+  out[2] = t102;
+  out[3] = t107;
+  out[4] = t110;
+  out[5] = t113;
+  out[6] = t115;
+  out[7] = t117;
+  out[8] = t79;
+  out[9] = t66;
+  out[10] = t66;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -232,9 +224,15 @@ void pendulum_k3s3_params_default(pendulum_k3s3_params *prm)
 
 void pendulum_k3s3_init(pendulum_k3s3_state *x, const double *q0, const double *p0)
 {
-  memset(x, 0, sizeof *x);
-  memcpy(x->q, q0 ? q0 : pendulum_k3s3_q0, sizeof x->q);
-  memcpy(x->p, p0 ? p0 : pendulum_k3s3_p0, sizeof x->p);
+  int i;
+  x->t = x->tc = x->hprev = 0;
+  for (i = 0; i < M; i++) {
+    x->q[i] = q0 ? (double)q0[i] : pendulum_k3s3_q0[i];
+    x->p[i] = p0 ? (double)p0[i] : pendulum_k3s3_p0[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < S * M; i++) x->gam[i] = 0;
 }
 
 const char *pendulum_k3s3_strerror(int code)
@@ -255,20 +253,26 @@ double pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_pa
 {
   double H;
   DEFAULT_PARAMS(prm)
-  pendulum_k3s3_energy_kernel(x->q, x->p, NULL, 0, NULL, prm, &H);
+  pendulum_k3s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *g)
 {
+  double v[NU];
+  int i;
   DEFAULT_PARAMS(prm)
-  pendulum_k3s3_g(x->q, x->p, NULL, 0, NULL, prm, g);
+  pendulum_k3s3_g(x->q, x->p, 0, 0, 0, prm, v);
+  for (i = 0; i < NU; i++) g[i] = v[i];
 }
 
 void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *gp)
 {
+  double v[NU];
+  int i;
   DEFAULT_PARAMS(prm)
-  pendulum_k3s3_hidden_kernel(x->q, x->p, NULL, 0, NULL, prm, gp);
+  pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
+  for (i = 0; i < NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -276,24 +280,22 @@ void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_para
 static void pendulum_k3s3_predict(const pendulum_k3s3_state *x, double h, const pendulum_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
+  for (i = 0; i < S * M; i++) gam[i] = 0;
   if (x->hprev == 0) {
-    memset(gam, 0, S * M * sizeof *gam);
-    pendulum_k3s3_minv_p(x->q, x->p, NULL, 0, NULL, prm, gam);
+    pendulum_k3s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++) {
-    for (l = 0; l < M; l++) gam[j * M + l] = 0;
+  for (j = 0; j < S; j++)
     for (i = 0; i < S; i++) {
       double r = h / x->hprev, e = 0;
       for (d = S - 1; d >= 0; d--) e = e * r + pendulum_k3s3_E[(j * S + i) * S + d];
       if (e != 0)
         for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
     }
-  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */
-static void pendulum_k3s3_kahan(double *a, double *c, double b)
+static void pendulum_k3s3_add(double *a, double *c, double b)
 {
   double y = b - *c, t = *a + y;
   *c = (t - *a) - y;
@@ -302,24 +304,29 @@ static void pendulum_k3s3_kahan(double *a, double *c, double b)
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_k3s3_step(pendulum_k3s3_state *x, double h, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
+int pendulum_k3s3_step(pendulum_k3s3_state *x, double h_, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
+  const double h = (double)h_;
   double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_k3s3_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_k3s3_EBADSTEP;
   pendulum_k3s3_predict(x, h, prm, gam);
-  pendulum_k3s3_g(x->q, x->p, NULL, 0, NULL, prm, g0);
+  pendulum_k3s3_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     pendulum_k3s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) scale = fmax(scale, fabs(x->q[i]) + fabs(h * sw[i]));
+    for (i = 0; i < M; i++) {
+      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+      if (v > scale) scale = v;
+    }
     for (i = 0; i < S * M; i++) {
-      inc = fmax(inc, fabs(h * (sw[i] - gam[i])));
+      double v = fabs(h * (sw[i] - gam[i]));
+      if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
@@ -329,18 +336,21 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, double h, const pendulum_k3s3_par
     for (i = 0; i < NU; i++)
       if (!(fabs(sw[S * M + M + NU + i]) > SINGTOL * fabs(sw[S * M + M + 2 * NU + i]))) rc = pendulum_k3s3_ESINGULAR;
     if (rc == pendulum_k3s3_ESINGULAR) break;
+    /* converged: the increment is at round-off, or it stopped decreasing (at
+     * round-off: accept; above STAGTOL: fail). Stopping earlier on a predicted
+     * remaining error was measured to leave a drift of H (6e-15 over 5e4 steps). */
     if (inc <= TOL) { rc = pendulum_k3s3_OK; break; }
     if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? pendulum_k3s3_OK : pendulum_k3s3_ENOCONV; break; }
   }
   if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
   if (rc != pendulum_k3s3_OK) return rc;
   for (i = 0; i < M; i++) {
-    pendulum_k3s3_kahan(&x->q[i], &x->qc[i], h * sw[i]);
-    pendulum_k3s3_kahan(&x->p[i], &x->pc[i], sw[S * M + i]);
+    pendulum_k3s3_add(&x->q[i], &x->qc[i], h * sw[i]);
+    pendulum_k3s3_add(&x->p[i], &x->pc[i], sw[S * M + i]);
   }
   for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  pendulum_k3s3_kahan(&x->t, &x->tc, h);
-  memcpy(x->gam, gam, sizeof x->gam);
+  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k3s3_OK;
 }

@@ -1,12 +1,16 @@
 #!/bin/sh
-# Regenerate every solver listed in generated/LIST into DIR (default generated).
-#   scripts/regen.sh [HBVMGEN] [DIR]
+# Generate every solver of a list (default generated/LIST) into DIR.
+#   scripts/regen.sh [HBVMGEN [DIR [LIST [MODELDIR]]]]
+# A list line is "MODEL K S [FLAGS]"; the solver is named MODEL_kKsS and
+# generated from MODELDIR/MODEL.ham (MODELDIR defaults to models).
 set -eu
 gen=${1:-gen/hbvmgen}
 dir=${2:-generated}
+list=${3:-generated/LIST}
+models=${4:-models}
 mkdir -p "$dir"
-grep -v '^#' generated/LIST | while read -r model k s flags; do
+grep -v '^#' "$list" | while read -r model k s flags; do
   [ -n "$model" ] || continue
   # shellcheck disable=SC2086
-  "$gen" -k "$k" -s "$s" -n "${model}_k${k}s${s}" -o "$dir" $flags "models/$model.ham"
+  "$gen" -k "$k" -s "$s" -n "${model}_k${k}s${s}" -o "$dir" $flags "$models/$model.ham"
 done
