@@ -325,15 +325,15 @@ static void emit_step(Emitter *e) {
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
           "int $P_step($P_state *x, double h_, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
-          "  $R gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];\n"
+          "  $R gam[S * M], sw[S * M + M + 3 * NU + 1];\n"
           "  $R inc = HUGE_VAL, inc_old, scale;\n"
           "  int it, i, rc = $P_ENOCONV;\n  DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n"
           "  $P_predict(x, h, prm, gam);\n");
-  tmpl(e, e->mod->nu ? "  $P_g(x->q, x->p, 0, 0, 0, prm, g0);\n" : "  g0[0] = 0;\n");
-  tmpl(e, "  for (it = 1; it <= MAXITER; it++) {\n"
-          "    $P_sweep(x->q, x->p, gam, h, g0, prm, sw);\n"
-          "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
+  if (e->mod->nu) tmpl(e, "  $R g0[NU];\n  $P_g(x->q, x->p, 0, 0, 0, prm, g0);\n");
+  tmpl(e, "  for (it = 1; it <= MAXITER; it++) {\n");
+  tmpl(e, e->mod->nu ? "    $P_sweep(x->q, x->p, gam, h, g0, prm, sw);\n" : "    $P_sweep(x->q, x->p, gam, h, 0, prm, sw);\n");
+  tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
           "    for (i = 0; i < M; i++) {\n"
           "      $R v = fabs$f(x->q[i]) + fabs$f(h * sw[i]);\n"

@@ -239,12 +239,13 @@ static void conical_k1s1_add(double *a, double *c, double b)
 int conical_k1s1_step(conical_k1s1_state *x, double h_, const conical_k1s1_params *prm, conical_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_k1s1_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k1s1_EBADSTEP;
   conical_k1s1_predict(x, h, prm, gam);
+  double g0[NU];
   conical_k1s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     conical_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);

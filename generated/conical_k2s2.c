@@ -292,12 +292,13 @@ static void conical_k2s2_add(double *a, double *c, double b)
 int conical_k2s2_step(conical_k2s2_state *x, double h_, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_k2s2_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k2s2_EBADSTEP;
   conical_k2s2_predict(x, h, prm, gam);
+  double g0[NU];
   conical_k2s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     conical_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);

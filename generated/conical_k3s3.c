@@ -372,12 +372,13 @@ static void conical_k3s3_add(double *a, double *c, double b)
 int conical_k3s3_step(conical_k3s3_state *x, double h_, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_k3s3_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k3s3_EBADSTEP;
   conical_k3s3_predict(x, h, prm, gam);
+  double g0[NU];
   conical_k3s3_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     conical_k3s3_sweep(x->q, x->p, gam, h, g0, prm, sw);

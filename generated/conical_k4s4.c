@@ -494,12 +494,13 @@ static void conical_k4s4_add(double *a, double *c, double b)
 int conical_k4s4_step(conical_k4s4_state *x, double h_, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_k4s4_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k4s4_EBADSTEP;
   conical_k4s4_predict(x, h, prm, gam);
+  double g0[NU];
   conical_k4s4_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     conical_k4s4_sweep(x->q, x->p, gam, h, g0, prm, sw);

@@ -223,15 +223,14 @@ static void henon_heiles_k2s2_add(double *a, double *c, double b)
 int henon_heiles_k2s2_step(henon_heiles_k2s2_state *x, double h_, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = henon_heiles_k2s2_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return henon_heiles_k2s2_EBADSTEP;
   henon_heiles_k2s2_predict(x, h, prm, gam);
-  g0[0] = 0;
   for (it = 1; it <= MAXITER; it++) {
-    henon_heiles_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    henon_heiles_k2s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;

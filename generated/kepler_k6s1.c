@@ -299,15 +299,14 @@ static void kepler_k6s1_add(double *a, double *c, double b)
 int kepler_k6s1_step(kepler_k6s1_state *x, double h_, const kepler_k6s1_params *prm, kepler_k6s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = kepler_k6s1_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s1_EBADSTEP;
   kepler_k6s1_predict(x, h, prm, gam);
-  g0[0] = 0;
   for (it = 1; it <= MAXITER; it++) {
-    kepler_k6s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    kepler_k6s1_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;

@@ -465,12 +465,13 @@ static void modified_k6s2_add(double *a, double *c, double b)
 int modified_k6s2_step(modified_k6s2_state *x, double h_, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_k6s2_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k6s2_EBADSTEP;
   modified_k6s2_predict(x, h, prm, gam);
+  double g0[NU];
   modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     modified_k6s2_sweep(x->q, x->p, gam, h, g0, prm, sw);

@@ -705,12 +705,13 @@ static void modified_k9s3_add(double *a, double *c, double b)
 int modified_k9s3_step(modified_k9s3_state *x, double h_, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_k9s3_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k9s3_EBADSTEP;
   modified_k9s3_predict(x, h, prm, gam);
+  double g0[NU];
   modified_k9s3_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     modified_k9s3_sweep(x->q, x->p, gam, h, g0, prm, sw);

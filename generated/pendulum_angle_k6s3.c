@@ -244,15 +244,14 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
 int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_angle_k6s3_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_angle_k6s3_EBADSTEP;
   pendulum_angle_k6s3_predict(x, h, prm, gam);
-  g0[0] = 0;
   for (it = 1; it <= MAXITER; it++) {
-    pendulum_angle_k6s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    pendulum_angle_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;

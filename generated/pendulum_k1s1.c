@@ -215,12 +215,13 @@ static void pendulum_k1s1_add(double *a, double *c, double b)
 int pendulum_k1s1_step(pendulum_k1s1_state *x, double h_, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_k1s1_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_k1s1_EBADSTEP;
   pendulum_k1s1_predict(x, h, prm, gam);
+  double g0[NU];
   pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     pendulum_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);

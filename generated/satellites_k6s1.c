@@ -1339,12 +1339,13 @@ static void satellites_k6s1_add(double *a, double *c, double b)
 int satellites_k6s1_step(satellites_k6s1_state *x, double h_, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1], g0[NU + 1];
+  double gam[S * M], sw[S * M + M + 3 * NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = satellites_k6s1_ENOCONV;
   DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_k6s1_EBADSTEP;
   satellites_k6s1_predict(x, h, prm, gam);
+  double g0[NU];
   satellites_k6s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   for (it = 1; it <= MAXITER; it++) {
     satellites_k6s1_sweep(x->q, x->p, gam, h, g0, prm, sw);

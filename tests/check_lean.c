@@ -1,0 +1,139 @@
+/* check_lean.c - the generated code does only what the model needs: equal
+ * mass matrices written differently give the same code, no multiplier code
+ * without constraints, no force code without a potential; and the float
+ * variant keeps order and conservation at float round-off. */
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pendulum_float_k2s2.h"
+
+// Generate `text` as model NAME.ham in a fresh directory; returns the
+// generated C source (malloc'd) or NULL.
+static char *generate(const char *text, const char *flags) {
+  char dir[] = "/tmp/hbvm-lean-XXXXXX", path[256], cmd[512];
+  if (!mkdtemp(dir)) return NULL;
+  snprintf(path, sizeof path, "%s/model.ham", dir);
+  FILE *f = fopen(path, "w");
+  if (!f) return NULL;
+  fputs(text, f);
+  fclose(f);
+  snprintf(cmd, sizeof cmd, "../gen/hbvmgen %s -o %s %s", flags, dir, path);
+  char *src = NULL;
+  if (system(cmd) == 0) {
+    snprintf(path, sizeof path, "%s/model.c", dir);
+    if ((f = fopen(path, "rb"))) {
+      src = calloc(1, 1 << 20);
+      if (src) fread(src, 1, (1 << 20) - 1, f);
+      fclose(f);
+    }
+  }
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  if (system(cmd)) return src;
+  return src;
+}
+
+START_TEST(equal_mass_matrices_give_equal_code) {
+  static const char *const forms[] = {"M = [[2, 0], [0, 2]]", "M = diag(2, 2)", "M = 2", "M = diag(4/2, 2)"};
+  char *first = NULL;
+  for (size_t i = 0; i < sizeof forms / sizeof forms[0]; i++) {
+    char text[256];
+    snprintf(text, sizeof text, "variables x, y\n%s\nU = y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", forms[i]);
+    char *src = generate(text, "-s 2");
+    ck_assert_msg(src != NULL, "generation failed for %s", forms[i]);
+    if (!first) first = src;
+    else {
+      ck_assert_msg(strcmp(first, src) == 0, "'%s' gives different code from '%s'", forms[i], forms[0]);
+      free(src);
+    }
+  }
+  ck_assert_msg(strstr(first, "0.5 *") || strstr(first, "* 0.5"), "M^-1 = 0.5 I should appear as a factor 0.5");
+  free(first);
+}
+END_TEST
+
+START_TEST(no_multiplier_code_without_constraints) {
+  char *src = generate("variables x, y\nU = x^4 + y^4 + x*y\nq0 = [1, 0]\np0 = [0, 1]\n", "-s 2");
+  ck_assert_ptr_nonnull(src);
+  ck_assert_msg(!strstr(src, "A lambda = r"), "multiplier code in an unconstrained model");
+  ck_assert_msg(!strstr(src, "g0["), "g(q0) used in an unconstrained model");
+  ck_assert_msg(!strstr(src, "SINGTOL *"), "singularity test in an unconstrained model");
+  free(src);
+}
+END_TEST
+
+START_TEST(no_force_code_without_potential) {
+  /* a free particle: gamma_0 = p0, nothing to compute in the sweep */
+  char *src = generate("variables x, y, z\nq0 = [0, 0, 0]\np0 = [1, 2, 3]\n", "-s 3");
+  ck_assert_ptr_nonnull(src);
+  char *sweep = strstr(src, "_sweep(");
+  ck_assert_ptr_nonnull(sweep);
+  char *end = strstr(sweep, "\n}\n");
+  ck_assert_ptr_nonnull(end);
+  *end = 0;
+  ck_assert_msg(!strstr(sweep, "const double t"), "temporaries in the sweep of a free particle:\n%s", sweep);
+  free(src);
+}
+END_TEST
+
+START_TEST(structural_zeros_never_multiplied) {
+  /* a chain: each constraint touches 2 or 4 coordinates; the code may not
+   * multiply by a literal 0 or 1 anywhere */
+  char *src = generate("N = 6\nvariables x[N], y[N]\nU = sum(i in 1..N, y[i])\n"
+                       "g = [x[1]^2 + y[1]^2 - 1, [(x[i] - x[i-1])^2 + (y[i] - y[i-1])^2 - 1 for i in 2..N]]\n"
+                       "q0 = [[i for i in 1..N], [0 for i in 1..N]]\np0 = [0 for i in 1..2*N]\n",
+                       "-s 2");
+  ck_assert_ptr_nonnull(src);
+  ck_assert_msg(!strstr(src, "* 0.0;") && !strstr(src, " 0.0 *"), "multiplication by zero in the code");
+  ck_assert_msg(!strstr(src, "* 1.0;") && !strstr(src, " 1.0 *"), "multiplication by one in the code");
+  free(src);
+}
+END_TEST
+
+// The float pendulum after n steps to t = 2, with the largest |H - H0|, |g|.
+static void float_run(int n, double *dH, double *dg, pendulum_float_k2s2_state *out) {
+  pendulum_float_k2s2_state x;
+  pendulum_float_k2s2_init(&x, NULL, NULL);
+  double H0 = pendulum_float_k2s2_energy(&x, NULL);
+  *dH = *dg = 0;
+  for (int i = 0; i < n; i++) {
+    ck_assert_int_eq(pendulum_float_k2s2_step(&x, 2.0 / n, NULL, NULL), 0);
+    double g;
+    pendulum_float_k2s2_constraints(&x, NULL, &g);
+    *dH = fmax(*dH, fabs(pendulum_float_k2s2_energy(&x, NULL) - H0));
+    *dg = fmax(*dg, fabs(g));
+  }
+  *out = x;
+}
+
+START_TEST(float_order_and_conservation) {
+  pendulum_float_k2s2_state a, b, c;
+  double dH, dg;
+  float_run(10, &dH, &dg, &a);
+  float_run(20, &dH, &dg, &b);
+  float_run(40, &dH, &dg, &c);
+  /* Richardson: errors e(h) ~ C h^2, so (a - b) / (b - c) ~ 4 (p is of
+   * order 2; the pendulum's q converges faster, as the paper's table shows) */
+  double ratio = fabs(a.p[0] - b.p[0]) / fabs(b.p[0] - c.p[0]);
+  ck_assert_msg(fabs(log2(ratio) - 2) < 0.2, "float HBVM(2,2): observed order %.2f", log2(ratio));
+  const double eps = 1.1920928955078125e-07; /* FLT_EPSILON */
+  ck_assert_msg(dH <= 8 * eps && dg <= 8 * eps, "float: |H - H0| = %.2e, |g| = %.2e (eps %.2e)", dH, dg, eps);
+  ck_assert_msg(sizeof a.q[0] == sizeof(float), "the float solver's state is not float");
+}
+END_TEST
+
+Suite *lean_suite(void) {
+  Suite *s = suite_create("lean");
+  TCase *tc = tcase_create("structure");
+  tcase_set_timeout(tc, 60);
+  tcase_add_test(tc, equal_mass_matrices_give_equal_code);
+  tcase_add_test(tc, no_multiplier_code_without_constraints);
+  tcase_add_test(tc, no_force_code_without_potential);
+  tcase_add_test(tc, structural_zeros_never_multiplied);
+  tcase_add_test(tc, float_order_and_conservation);
+  suite_add_tcase(s, tc);
+  return s;
+}

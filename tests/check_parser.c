@@ -1,0 +1,558 @@
+/* check_parser.c - Check suite for the front end (gen/lexer.l, parser.y,
+ * ast.c, mass.c) and the command line (gen/main.c).
+ *
+ * Small models, one per statement form of SPEC section 1, go through the
+ * front end in-process (diag_begin, parse_model, analyse,
+ * model_differentiate); each test asserts what the analysed Model holds:
+ * m, nu, degrees, the kind of M and its inverse, q0 and p0, and the values
+ * of U and g at a point (dag_eval). Table-driven cases cover the fifteen
+ * functions, operator precedence and number formats.
+ * The command line is run as ../gen/hbvmgen (the suite runs from tests/):
+ * the first line of --check on each model in models/ for s = 1, 2, 3,
+ * --help, --version and bad options.
+ * The suite is exposed as parser_suite(); the project's runner calls it. */
+#define _POSIX_C_SOURCE 200809L   /* popen, pclose, dup */
+
+#include <check.h>
+#include <ctype.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "hbvmgen.h"
+
+Suite *parser_suite(void);
+
+#define GENERATOR "../gen/hbvmgen"
+#define PI 3.14159265358979323846
+#define TOL 1e-14
+#define NCASES(t) ((int)(sizeof(t) / sizeof((t)[0])))
+
+/* ---- the front end in-process ---- */
+
+/* Parse and analyse src, which must be a valid model, and differentiate
+ * it. The model lives in the arena, freed after each test. */
+static Model *load(const char *src)
+{
+  size_t len = strlen(src);
+  diag_begin("test.ham", src, len);
+  Stmt *prog = parse_model(src, len);
+  ck_assert_msg(diag_error_count() == 0, "syntax error in:\n%s", src);
+  Model *mod = analyse("test.ham", prog);
+  ck_assert_msg(mod != NULL, "analysis failed for:\n%s", src);
+  model_differentiate(mod);
+  return mod;
+}
+
+/* Whether src is refused (syntax or analysis errors); the messages, which
+ * the golden files of check_errors.c test, are discarded. */
+static int refused(const char *src)
+{
+  size_t len = strlen(src);
+  fflush(stderr);
+  int saved = dup(2), null = open("/dev/null", O_WRONLY);
+  ck_assert_msg(saved >= 0 && null >= 0 && dup2(null, 2) == 2, "cannot silence stderr");
+  close(null);
+  diag_begin("test.ham", src, len);
+  Stmt *prog = parse_model(src, len);
+  int bad = diag_error_count() > 0 || analyse("test.ham", prog) == NULL;
+  fflush(stderr);
+  dup2(saved, 2);
+  close(saved);
+  return bad;
+}
+
+/* The value of node at coordinates q, parameters at their defaults. */
+static double eval(const Model *mod, int node, const double *q)
+{
+  double prm[64] = {0};
+  ck_assert_int_le(mod->nparams, 64);
+  for (int i = 0; i < mod->nparams; i++)
+    prm[i] = mod->params[i].value;
+  return dag_eval(mod->dag, node, q, prm);
+}
+
+/* Assert |got - want| <= TOL * max(1, |want|), naming what is compared. */
+static void assert_close(double got, double want, const char *what)
+{
+  ck_assert_msg(fabs(got - want) <= TOL * fmax(1, fabs(want)), "%s = %.17g, want %.17g", what, got, want);
+}
+
+/* Assert n values of got against want, named what[i]. */
+static void assert_values(const double *got, const double *want, int n, const char *what)
+{
+  for (int i = 0; i < n; i++) {
+    char name[64];
+    snprintf(name, sizeof name, "%s[%d]", what, i);
+    assert_close(got[i], want[i], name);
+  }
+}
+
+static void teardown(void)
+{
+  arena_free_all();
+}
+
+/* ---- statements ---- */
+
+START_TEST(test_scalar_variables)
+{
+  Model *mod = load("variables x, y\nvariables z\nU = x + 2*y + 3*z\n");
+  ck_assert_int_eq(mod->m, 3);
+  ck_assert_int_eq(mod->nu, 0);
+  ck_assert_int_eq(mod->degg, 0);
+  static const char *const names[] = {"x", "y", "z"};
+  for (int i = 0; i < 3; i++)
+    ck_assert_str_eq(mod->coord_names[i], names[i]);
+  const double q[] = {1, 10, 100};
+  assert_close(eval(mod, mod->U, q), 321, "U");
+  ck_assert_int_eq(mod->degU, 1);
+}
+END_TEST
+
+/* Arrays expand in index order, sizes are constant expressions, and
+ * several variables statements append. */
+START_TEST(test_array_variables)
+{
+  Model *mod = load("n = 2\nvariables a[n + 1], b\nvariables c[n]\nU = sum(i in 1..3, i * a[i]) + 10*b + 100*c[2]\n");
+  ck_assert_int_eq(mod->m, 6);
+  static const char *const names[] = {"a[1]", "a[2]", "a[3]", "b", "c[1]", "c[2]"};
+  for (int i = 0; i < 6; i++)
+    ck_assert_str_eq(mod->coord_names[i], names[i]);
+  const double q[] = {1, 2, 3, 4, 5, 6};
+  assert_close(eval(mod, mod->U, q), 1 + 4 + 9 + 40 + 600, "U");
+}
+END_TEST
+
+/* A definition folding to a number is a constant; otherwise a named
+ * subexpression of q, shared wherever it is used. */
+START_TEST(test_definitions)
+{
+  Model *mod = load("variables x, y\nk = 2^3 - 1\nr = sqrt(x^2 + y^2)\nU = k * r + r^2\n");
+  const double q[] = {3, 4};
+  assert_close(eval(mod, mod->U, q), 7 * 5 + 25, "U");
+  ck_assert_int_eq(mod->degU, DEG_NONPOLY);
+  const double grad[] = {7 * 3 / 5.0 + 6, 7 * 4 / 5.0 + 8};
+  for (int i = 0; i < 2; i++)
+    assert_close(eval(mod, mod->gradU[i], q), grad[i], "dU/dq");
+}
+END_TEST
+
+/* A param is a run-time value: it stays a parameter in U and g, and
+ * counts as a constant in degrees. */
+START_TEST(test_param)
+{
+  Model *mod = load("param k = 2.5\nparam L = 2\nvariables x, y\nU = k * x^2\ng = x^2 + y^2 - L^2\n");
+  ck_assert_int_eq(mod->nparams, 2);
+  ck_assert_str_eq(mod->params[0].name, "k");
+  ck_assert_str_eq(mod->params[1].name, "L");
+  assert_close(mod->params[0].value, 2.5, "k");
+  assert_close(mod->params[1].value, 2, "L");
+  const double q[] = {2, 1};
+  assert_close(eval(mod, mod->U, q), 10, "U");
+  assert_close(eval(mod, mod->g[0], q), 1, "g");
+  const double prm[] = {1, 3};
+  assert_close(dag_eval(mod->dag, mod->g[0], q, prm), 5 - 9, "g with L = 3");
+  ck_assert_int_eq(mod->degU, 2);
+  ck_assert_int_eq(mod->degg, 2);
+}
+END_TEST
+
+/* Every form of M, classified by what it is, with diag(M^-1). */
+static const struct {
+  const char *mass;
+  MassKind kind;
+  double minv_diag[2];
+} mass_cases[] = {
+    {"", MASS_IDENTITY, {1, 1}},
+    {"M = identity", MASS_IDENTITY, {1, 1}},
+    {"M = 4", MASS_SCALAR, {0.25, 0.25}},
+    {"M = diag(2, 2)", MASS_SCALAR, {0.5, 0.5}},
+    {"M = diag(1, 2)", MASS_DIAG, {1, 0.5}},
+    {"M = [[1, 0], [0, 1]]", MASS_IDENTITY, {1, 1}},
+    {"M = [[2, 0], [0, 4]]", MASS_DIAG, {0.5, 0.25}},
+    {"c = 3\nM = [[2, 1], [1, c - 1]]", MASS_DENSE, {2 / 3.0, 2 / 3.0}},
+};
+
+START_TEST(test_mass)
+{
+  char src[256];
+  snprintf(src, sizeof src, "variables x, y\n%s\nU = x*y\n", mass_cases[_i].mass);
+  Model *mod = load(src);
+  ck_assert_msg(mod->mass == mass_cases[_i].kind, "'%s': mass kind %d, want %d", mass_cases[_i].mass, mod->mass,
+                mass_cases[_i].kind);
+  assert_values(mod->minv_diag, mass_cases[_i].minv_diag, 2, "diag(M^-1)");
+  if (mod->mass == MASS_DENSE) {
+    const double minv[] = {2 / 3.0, -1 / 3.0, -1 / 3.0, 2 / 3.0};
+    assert_values(mod->minv, minv, 4, "M^-1");
+  }
+}
+END_TEST
+
+START_TEST(test_potential_default)
+{
+  Model *mod = load("variables x\n");
+  const double q[] = {5};
+  assert_close(eval(mod, mod->U, q), 0, "U");
+  ck_assert_int_eq(mod->degU, 0);
+  ck_assert_int_eq(mod->nu, 0);
+  assert_close(eval(mod, mod->gradU[0], q), 0, "dU/dx");
+}
+END_TEST
+
+/* g as a scalar, a list, a nested list and a comprehension; several g
+ * statements append in order. */
+START_TEST(test_constraints)
+{
+  Model *mod = load("variables x[3]\n"
+                    "g = x[1] - 1\n"
+                    "g = [x[2] - 2, [x[3] - 3, [x[1] * x[2]]]]\n"
+                    "g = [i * x[i]^2 for i in 1..3]\n");
+  ck_assert_int_eq(mod->nu, 7);
+  const double q[] = {1, 2, 3};
+  const double want[] = {0, 0, 0, 2, 1, 8, 27};
+  for (int a = 0; a < 7; a++)
+    assert_close(eval(mod, mod->g[a], q), want[a], "g");
+  ck_assert_int_eq(mod->degg, 2);
+  ck_assert_int_eq(mod->g_loc[0].line, 2);
+  ck_assert_int_eq(mod->g_loc[4].line, 4);
+  ck_assert_int_eq(mod->jac[0].n, 1);   /* x[1] - 1 depends on x[1] only */
+  ck_assert_int_eq(mod->jac[3].n, 2);
+}
+END_TEST
+
+/* sum with index arithmetic in indices, bounds and bodies; nested sums. */
+START_TEST(test_sum_and_indexing)
+{
+  Model *mod = load("variables x[4]\n"
+                    "n = 4\n"
+                    "U = sum(i in 1..n - 1, x[i] * x[i + 1]) + sum(i in 1..2, sum(j in i..2, x[2*j - 1] * (i + j)))\n");
+  const double q[] = {1, 2, 3, 4};
+  /* 1*2 + 2*3 + 3*4; i=1: j=1 x1*2, j=2 x3*3; i=2: j=2 x3*4 */
+  assert_close(eval(mod, mod->U, q), 20 + 2 + 9 + 12, "U");
+  ck_assert_int_eq(mod->degU, 2);
+}
+END_TEST
+
+/* The fifteen functions against the C library at (x, y) = (0.3, 0.7). */
+static double fn_abs(double x, double y) { return fabs(x - y); }
+static double fn_sin(double x, double y) { (void)y; return sin(x); }
+static double fn_cos(double x, double y) { (void)y; return cos(x); }
+static double fn_tan(double x, double y) { (void)y; return tan(x); }
+static double fn_asin(double x, double y) { (void)y; return asin(x); }
+static double fn_acos(double x, double y) { (void)y; return acos(x); }
+static double fn_atan(double x, double y) { (void)y; return atan(x); }
+static double fn_sinh(double x, double y) { (void)y; return sinh(x); }
+static double fn_cosh(double x, double y) { (void)y; return cosh(x); }
+static double fn_tanh(double x, double y) { (void)y; return tanh(x); }
+static double fn_exp(double x, double y) { (void)y; return exp(x); }
+static double fn_log(double x, double y) { (void)y; return log(x); }
+static double fn_sqrt(double x, double y) { (void)y; return sqrt(x); }
+
+static const struct {
+  const char *expr;
+  double (*f)(double, double);
+} function_cases[] = {
+    {"sin(x)", fn_sin},   {"cos(x)", fn_cos},     {"tan(x)", fn_tan},   {"asin(x)", fn_asin}, {"acos(x)", fn_acos},
+    {"atan(x)", fn_atan}, {"atan2(x, y)", atan2}, {"sinh(x)", fn_sinh}, {"cosh(x)", fn_cosh}, {"tanh(x)", fn_tanh},
+    {"exp(x)", fn_exp},   {"log(x)", fn_log},     {"sqrt(x)", fn_sqrt}, {"pow(x, y)", pow},   {"abs(x - y)", fn_abs},
+};
+
+START_TEST(test_functions)
+{
+  char src[128];
+  snprintf(src, sizeof src, "variables x, y\nU = %s\n", function_cases[_i].expr);
+  Model *mod = load(src);
+  const double q[] = {0.3, 0.7};
+  assert_close(eval(mod, mod->U, q), function_cases[_i].f(0.3, 0.7), function_cases[_i].expr);
+  ck_assert_int_eq(mod->degU, DEG_NONPOLY);
+}
+END_TEST
+
+/* expr with the names x and y (not the letters of exp) replaced by the
+ * numbers 0.3 and 0.7, into out (size bytes). */
+static void substitute(const char *expr, char *out, size_t size)
+{
+  size_t n = 0;
+  for (const char *c = expr; *c && n + 4 < size; c++) {
+    int alone = (*c == 'x' || *c == 'y') && (c == expr || !isalnum((unsigned char)c[-1])) &&
+                !isalnum((unsigned char)c[1]);
+    if (alone)
+      n += (size_t)sprintf(out + n, "%s", *c == 'x' ? "0.3" : "0.7");
+    else
+      out[n++] = *c;
+  }
+  out[n] = '\0';
+}
+
+/* Every function folds to the same number on constant arguments (q0). */
+START_TEST(test_functions_fold)
+{
+  char expr[128], src[256];
+  substitute(function_cases[_i].expr, expr, sizeof expr);
+  snprintf(src, sizeof src, "variables x, y\nq0 = [%s, 0]\nU = x + y\n", expr);
+  Model *mod = load(src);
+  assert_close(mod->q0[0], function_cases[_i].f(0.3, 0.7), expr);
+}
+END_TEST
+
+/* q0 and p0 as lists with nested lists and comprehensions; without them
+ * the initial values are zero. */
+START_TEST(test_initial_values)
+{
+  Model *mod = load("variables x[2], y\nq0 = [[i / 2 for i in 1..2], 3]\np0 = [0, [1, [2]]]\n");
+  const double q0[] = {0.5, 1, 3}, p0[] = {0, 1, 2};
+  assert_values(mod->q0, q0, 3, "q0");
+  assert_values(mod->p0, p0, 3, "p0");
+  mod = load("variables x, y\n");
+  const double zero[] = {0, 0};
+  assert_values(mod->q0, zero, 2, "default q0");
+  assert_values(mod->p0, zero, 2, "default p0");
+}
+END_TEST
+
+/* Comments, optional semicolons, statements on one line, any order;
+ * non-ASCII text in comments. */
+START_TEST(test_layout)
+{
+  Model *mod = load("# a comment \xc3\xa9\xe2\x82\xac\n"
+                    ";; variables x; # trailing comment\n"
+                    "U = x^2;  q0 = [3, 5]   p0 = [1, 0];\n"
+                    "\t\r\n"
+                    "variables y g = y - x # no newline at the end");
+  ck_assert_int_eq(mod->m, 2);
+  ck_assert_int_eq(mod->nu, 1);
+  const double q[] = {3, 5};
+  assert_close(eval(mod, mod->U, q), 9, "U");
+  assert_close(eval(mod, mod->g[0], q), 2, "g");
+  assert_close(mod->q0[0], 3, "q0");
+  assert_close(mod->p0[0], 1, "p0");
+}
+END_TEST
+
+/* Every number format of SPEC section 1. */
+START_TEST(test_numbers)
+{
+  Model *mod = load("variables x[6]\nq0 = [12, 1.5, .5, 2e-3, 1.0E+10, 0.25e1]\n");
+  const double want[] = {12, 1.5, 0.5, 2e-3, 1.0E+10, 2.5};
+  ck_assert_int_eq(mod->m, 6);
+  for (int i = 0; i < 6; i++)
+    ck_assert_msg(mod->q0[i] == want[i], "number %d: %.17g, want %.17g", i, mod->q0[i], want[i]);
+}
+END_TEST
+
+/* Precedence and associativity: '^' is right-associative and binds
+ * tighter than unary minus; the others are left-associative. Each
+ * expression is evaluated at x = 3. */
+static const struct {
+  const char *expr;
+  double value;
+} precedence_cases[] = {
+    {"-x^2", -9},         {"(-x)^2", 9},         {"2^3^2", 512},        {"(2^3)^2", 64},   {"x^2^-1", 1.7320508075688772},
+    {"-2^2 * x", -12},    {"2 * 3 + 4 * x", 18}, {"2 + 3 * x", 11},     {"24 / x / 2", 4}, {"10 - x - 2", 5},
+    {"-x - -x", 0},       {"+x", 3},             {"2 * -x", -6},        {"x^-1", 1 / 3.0}, {"pi * x", 3 * PI},
+    {"(x + 1) * (x - 1)", 8},
+};
+
+START_TEST(test_precedence)
+{
+  char src[128];
+  snprintf(src, sizeof src, "variables x\nU = %s\n", precedence_cases[_i].expr);
+  Model *mod = load(src);
+  const double q[] = {3};
+  assert_close(eval(mod, mod->U, q), precedence_cases[_i].value, precedence_cases[_i].expr);
+}
+END_TEST
+
+START_TEST(test_pi)
+{
+  Model *mod = load("variables x\nq0 = [pi / 4]\nU = pi * x\n");
+  assert_close(mod->q0[0], PI / 4, "q0");
+  const double q[] = {2};
+  assert_close(eval(mod, mod->U, q), 2 * PI, "U");
+}
+END_TEST
+
+/* Polynomial degrees of U and of the largest constraint. */
+static const struct {
+  const char *body;
+  int degU, degg;
+} degree_cases[] = {
+    {"U = y", 1, 0},
+    {"U = x^2 * y^2 + 1\ng = x - 1", 4, 1},
+    {"g = [x^2 + y^2 - 1, x^3 * y^3]", 0, 6},
+    {"U = sin(x)\ng = x*y", DEG_NONPOLY, 2},
+    {"U = x^2.5", DEG_NONPOLY, 0},
+    {"U = x / 2 + y^2 / pi", 2, 0},
+    {"g = [x - 1, 1 / y]", 0, DEG_NONPOLY},
+    {"U = sum(i in 1..4, x^i)", 4, 0},
+};
+
+START_TEST(test_degrees)
+{
+  char src[128];
+  snprintf(src, sizeof src, "variables x, y\n%s\n", degree_cases[_i].body);
+  Model *mod = load(src);
+  ck_assert_msg(mod->degU == degree_cases[_i].degU && mod->degg == degree_cases[_i].degg,
+                "'%s': deg(U)=%d deg(g)=%d, want %d %d", degree_cases[_i].body, mod->degU, mod->degg,
+                degree_cases[_i].degU, degree_cases[_i].degg);
+}
+END_TEST
+
+/* The gradient of U and the Jacobian of g from model_differentiate. */
+START_TEST(test_derivatives)
+{
+  Model *mod = load("variables x, y, z\nU = x^2 * y + sin(z)\ng = [x*y - 1, z^2]\n");
+  const double q[] = {2, 3, 0.5};
+  const double grad[] = {12, 4, cos(0.5)};
+  for (int i = 0; i < 3; i++)
+    assert_close(eval(mod, mod->gradU[i], q), grad[i], "grad U");
+  ck_assert_int_eq(mod->jac[0].n, 2);
+  ck_assert_int_eq(mod->jac[1].n, 1);
+  ck_assert_int_eq(mod->jac[1].e[0].coord, 2);
+  assert_close(eval(mod, mod->jac[1].e[0].node, q), 1, "dg2/dz");
+}
+END_TEST
+
+/* A few refusals in-process: the front end reports and returns NULL. */
+START_TEST(test_refused)
+{
+  static const char *const bad[] = {
+      "variables x\nU = y\n", "variables x[2]\nU = x[3]\n", "variables x\nM = [[1, 2], [3, 4]]\n",
+      "variables x\nU = (x\n", "", "variables x\nq0 = [1, 2]\n",
+  };
+  for (int i = 0; i < NCASES(bad); i++)
+    ck_assert_msg(refused(bad[i]), "accepted:\n%s", bad[i]);
+}
+END_TEST
+
+/* ---- the command line ---- */
+
+/* Run `GENERATOR args` through the shell; return its exit status and its
+ * stdout (stderr too when merge) in out (size bytes). */
+static int run_cli(const char *args, int merge, char *out, size_t size)
+{
+  char cmd[512];
+  snprintf(cmd, sizeof cmd, "%s %s %s", GENERATOR, args, merge ? "2>&1" : "2>/dev/null");
+  FILE *p = popen(cmd, "r");
+  ck_assert_msg(p != NULL, "cannot run %s", cmd);
+  size_t n = fread(out, 1, size - 1, p);
+  out[n] = '\0';
+  int status = pclose(p);
+  ck_assert_msg(WIFEXITED(status), "%s: killed", cmd);
+  ck_assert_msg(WEXITSTATUS(status) != 127, "cannot run %s (build it with make all)", GENERATOR);
+  return WEXITSTATUS(status);
+}
+
+/* The first line of --check for each model and s (k auto). */
+static const struct {
+  const char *model;
+  int s;
+  const char *line;
+} check_cases[] = {
+    {"pendulum", 2, "model pendulum: m=2 nu=1 deg(U)=1 deg(g)=2 k=2 s=2"},
+    {"pendulum", 1, "model pendulum: m=2 nu=1 deg(U)=1 deg(g)=2 k=1 s=1"},
+    {"pendulum", 3, "model pendulum: m=2 nu=1 deg(U)=1 deg(g)=2 k=3 s=3"},
+    {"conical", 2, "model conical: m=3 nu=1 deg(U)=1 deg(g)=2 k=2 s=2"},
+    {"conical", 1, "model conical: m=3 nu=1 deg(U)=1 deg(g)=2 k=1 s=1"},
+    {"conical", 3, "model conical: m=3 nu=1 deg(U)=1 deg(g)=2 k=3 s=3"},
+    {"modified", 2, "model modified: m=3 nu=1 deg(U)=4 deg(g)=6 k=6 s=2"},
+    {"modified", 1, "model modified: m=3 nu=1 deg(U)=4 deg(g)=6 k=3 s=1"},
+    {"modified", 3, "model modified: m=3 nu=1 deg(U)=4 deg(g)=6 k=9 s=3"},
+    {"satellites", 2, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=6 s=2"},
+    {"satellites", 1, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=6 s=1"},
+    {"satellites", 3, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=6 s=3"},
+};
+
+START_TEST(test_check_models)
+{
+  char args[128], out[4096];
+  snprintf(args, sizeof args, "--check -s %d ../models/%s.ham", check_cases[_i].s, check_cases[_i].model);
+  ck_assert_int_eq(run_cli(args, 0, out, sizeof out), 0);
+  out[strcspn(out, "\n")] = '\0';
+  ck_assert_str_eq(out, check_cases[_i].line);
+}
+END_TEST
+
+/* -k given explicitly, and -n renaming the model. */
+START_TEST(test_check_options)
+{
+  char out[4096];
+  ck_assert_int_eq(run_cli("--check -k 4 -n pend ../models/pendulum.ham", 0, out, sizeof out), 0);
+  out[strcspn(out, "\n")] = '\0';
+  ck_assert_str_eq(out, "model pend: m=2 nu=1 deg(U)=1 deg(g)=2 k=4 s=2");
+  ck_assert_int_eq(run_cli("-k auto -s 3 --check ../models/modified.ham", 0, out, sizeof out), 0);
+  ck_assert_msg(strstr(out, " k=9 s=3\n") != NULL, "-k auto: %s", out);
+}
+END_TEST
+
+START_TEST(test_help)
+{
+  static const char *const options[] = {"-s S", "-k K", "auto", "-o DIR", "-n NAME", "--main", "--check", "-h",
+                                        "--help", "--version"};
+  char out[8192];
+  for (int h = 0; h < 2; h++) {
+    ck_assert_int_eq(run_cli(h ? "-h" : "--help", 0, out, sizeof out), 0);
+    for (int i = 0; i < NCASES(options); i++)
+      ck_assert_msg(strstr(out, options[i]) != NULL, "--help does not mention %s", options[i]);
+  }
+  ck_assert_int_eq(run_cli("--version", 0, out, sizeof out), 0);
+  ck_assert_msg(!strncmp(out, "hbvmgen ", 8), "--version: %s", out);
+}
+END_TEST
+
+/* Bad command lines exit 1 with "hbvmgen: error: ..." on stderr. */
+static const char *const bad_options[] = {
+    "--bogus ../models/pendulum.ham", "-s 0 ../models/pendulum.ham",   "-s x ../models/pendulum.ham",
+    "-s 2.5 ../models/pendulum.ham",  "-s 21 ../models/pendulum.ham",  "-k 1 -s 2 ../models/pendulum.ham",
+    "-k 0 ../models/pendulum.ham",    "-k many ../models/pendulum.ham", "-n 1abc ../models/pendulum.ham",
+    "-n a-b ../models/pendulum.ham",  "../models/pendulum.ham -s",     "",
+    "../models/pendulum.ham ../models/conical.ham", "no/such/model.ham",
+};
+
+START_TEST(test_bad_options)
+{
+  char args[256], out[4096];
+  snprintf(args, sizeof args, "--check %s", bad_options[_i]);
+  ck_assert_msg(run_cli(args, 1, out, sizeof out) == 1, "'%s' did not exit 1: %s", args, out);
+  ck_assert_msg(strstr(out, "hbvmgen: error: ") != NULL, "'%s': %s", args, out);
+}
+END_TEST
+
+Suite *parser_suite(void)
+{
+  Suite *s = suite_create("parser");
+  TCase *fe = tcase_create("front end");
+  tcase_add_checked_fixture(fe, NULL, teardown);
+  tcase_add_test(fe, test_scalar_variables);
+  tcase_add_test(fe, test_array_variables);
+  tcase_add_test(fe, test_definitions);
+  tcase_add_test(fe, test_param);
+  tcase_add_loop_test(fe, test_mass, 0, NCASES(mass_cases));
+  tcase_add_test(fe, test_potential_default);
+  tcase_add_test(fe, test_constraints);
+  tcase_add_test(fe, test_sum_and_indexing);
+  tcase_add_loop_test(fe, test_functions, 0, NCASES(function_cases));
+  tcase_add_loop_test(fe, test_functions_fold, 0, NCASES(function_cases));
+  tcase_add_test(fe, test_initial_values);
+  tcase_add_test(fe, test_layout);
+  tcase_add_test(fe, test_numbers);
+  tcase_add_loop_test(fe, test_precedence, 0, NCASES(precedence_cases));
+  tcase_add_test(fe, test_pi);
+  tcase_add_loop_test(fe, test_degrees, 0, NCASES(degree_cases));
+  tcase_add_test(fe, test_derivatives);
+  tcase_add_test(fe, test_refused);
+  suite_add_tcase(s, fe);
+  TCase *cli = tcase_create("command line");
+  tcase_set_timeout(cli, 60);
+  tcase_add_loop_test(cli, test_check_models, 0, NCASES(check_cases));
+  tcase_add_test(cli, test_check_options);
+  tcase_add_test(cli, test_help);
+  tcase_add_loop_test(cli, test_bad_options, 0, NCASES(bad_options));
+  suite_add_tcase(s, cli);
+  return s;
+}
