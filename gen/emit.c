@@ -184,8 +184,9 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "  int iters;         /* fixed-point iterations */\n"
           "  double increment;  /* last scaled increment of the iteration */\n"
           "} $P_stats;\n\n"
-          "/* q0, p0 NULL: the model's initial values. The multiplier starts at 0 and is\n"
-          " * the constant multiplier of the last step after each step. */\n"
+          "/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier\n"
+          " * consistent with (q0, p0) at the default parameters (0 if that is singular)\n"
+          " * and is the constant multiplier of the last step after each step. */\n"
           "void $P_init($P_state *x, const double *q0, const double *p0);\n"
           "void $P_params_default($P_params *prm);\n"
           "/* One step of size h; prm and st may be NULL. Returns $P_OK or an error code. */\n"
@@ -256,6 +257,10 @@ static void emit_kernels(Emitter *e) {
   if (nu) {
     emit_kernel(e, "g", "out = g(q0)", st->g_at_q0, nu);
     emit_kernel(e, "hidden_kernel", "out = grad g(q0)' M^-1 p0", st->hidden, nu);
+    emit_kernel(e, "lambda0",
+                "out = the multiplier consistent with (q0, p0):\n"
+                " * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0",
+                st->lambda0, nu);
   }
 }
 
@@ -276,7 +281,12 @@ static void emit_public(Emitter *e) {
           "    x->p[i] = p0 ? ($R)p0[i] : $P_p0[i];\n"
           "    x->qc[i] = x->pc[i] = 0;\n  }\n"
           "  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;\n"
-          "  for (i = 0; i < S * M; i++) x->gam[i] = 0;\n}\n\n"
+          "  for (i = 0; i < S * M; i++) x->gam[i] = 0;\n");
+  if (e->mod->nu)
+    tmpl(e, "  {\n    $P_params prm;\n    $R lam[NU];\n    $P_params_default(&prm);\n"
+            "    $P_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);\n"
+            "    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;\n  }\n");
+  tmpl(e, "}\n\n"
           "const char *$P_strerror(int code)\n{\n  switch (code) {\n"
           "  case $P_OK: return \"ok\";\n"
           "  case $P_ENOCONV: return \"fixed-point iteration did not converge\";\n"

@@ -275,6 +275,7 @@ typedef struct {
   int *g_at_q0;        /* nu: g(q0) */
   int *energy;         /* 1: H(q, p) with q = inputs q0, p = inputs p0 */
   int *hidden;         /* nu: grad g(q)' M^-1 p */
+  int *lambda0;        /* nu: the multiplier consistent with (q0, p0) */
 } Step;
 
 Step *step_build(Model *mod, const Method *meth);

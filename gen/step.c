@@ -127,8 +127,29 @@ static int skew_form(Build *b, int a, int **y) {
   return acc;
 }
 
-// Assemble A (nu x nu, dense node matrix) and r, then solve A lambda = r
-// by an LU factorisation without pivoting whose zeros fold away.
+// Solve A x = r (n x n node matrix, overwritten) by an LU factorisation
+// without pivoting, in the given order, skipping structural zeros (so fill-in
+// is only where it really happens). pivot[k] receives the k-th pivot.
+static void lu_solve(Dag *d, int *A, int *r, int n, int *x, int *pivot) {
+  for (int k = 0; k < n; k++) {
+    pivot[k] = A[k * n + k];
+    for (int i = k + 1; i < n; i++) {
+      if (dag_is_zero(d, A[i * n + k])) continue;
+      int f = dag_div(d, A[i * n + k], A[k * n + k]);
+      for (int c = k + 1; c < n; c++)
+        if (!dag_is_zero(d, A[k * n + c])) A[i * n + c] = dag_sub(d, A[i * n + c], dag_mul(d, f, A[k * n + c]));
+      r[i] = dag_sub(d, r[i], dag_mul(d, f, r[k]));
+    }
+  }
+  for (int k = n - 1; k >= 0; k--) {
+    int acc = r[k];
+    for (int c = k + 1; c < n; c++)
+      if (!dag_is_zero(d, A[k * n + c])) acc = dag_sub(d, acc, dag_mul(d, A[k * n + c], x[c]));
+    x[k] = dag_div(d, acc, A[k * n + k]);
+  }
+}
+
+// Assemble A (nu x nu, dense node matrix) and r, then solve A lambda = r.
 static void build_multipliers(Build *b) {
   Dag *d = b->d;
   int nu = b->nu, m = b->m, s = b->s;
@@ -167,22 +188,7 @@ static void build_multipliers(Build *b) {
     r[a] = dag_add(d, rhs, dag_div(d, dag_input(d, st->in_g0 + a), b->h));
     st->adiag[a] = A[a * nu + a];
   }
-  for (int k = 0; k < nu; k++) {
-    st->pivot[k] = A[k * nu + k];
-    for (int i = k + 1; i < nu; i++) {
-      if (dag_is_zero(d, A[i * nu + k])) continue;
-      int f = dag_div(d, A[i * nu + k], A[k * nu + k]);
-      for (int c = k + 1; c < nu; c++)
-        if (!dag_is_zero(d, A[k * nu + c])) A[i * nu + c] = dag_sub(d, A[i * nu + c], dag_mul(d, f, A[k * nu + c]));
-      r[i] = dag_sub(d, r[i], dag_mul(d, f, r[k]));
-    }
-  }
-  for (int k = nu - 1; k >= 0; k--) {
-    int acc = r[k];
-    for (int c = k + 1; c < nu; c++)
-      if (!dag_is_zero(d, A[k * nu + c])) acc = dag_sub(d, acc, dag_mul(d, A[k * nu + c], st->lambda[c]));
-    st->lambda[k] = dag_div(d, acc, A[k * nu + k]);
-  }
+  lu_solve(d, A, r, nu, st->lambda, st->pivot);
 }
 
 // gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i], Theta_i = psi_i + rho_i lambda;
@@ -219,6 +225,56 @@ static void build_update(Build *b) {
   for (int i = 0; i < m; i++) st->dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
 }
 
+// The multiplier consistent with (q0, p0): differentiating the hidden
+// constraint G' M^-1 p = 0 along the flow gives
+//   (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U,  v = M^-1 p,
+// where v' Hess(g_a) v is the derivative of w_a(q) = grad g_a(q)' v along v
+// (one more reverse sweep, with v held constant). For NAME_init.
+static void build_initial_multiplier(Build *b, const int *q) {
+  Dag *d = b->d;
+  Model *mod = b->mod;
+  int m = b->m, nu = b->nu;
+  Step *st = b->st;
+  dag_section(d, "consistent initial multiplier");
+  const int *v = st->predict0; /* M^-1 p0 */
+  int *dw = nodes(m), *col = nodes(m), *mcol = nodes(m), *gu = nodes(m), *mgu = nodes(m);
+  int *B = nodes(nu * nu), *r = nodes(nu), *piv = nodes(nu), z = dag_const(d, 0);
+  int **G = arena_alloc((size_t)nu * sizeof(int *)); /* dense columns of grad g at q0 */
+  for (int a = 0; a < nu; a++) {
+    G[a] = zeros(d, m);
+    for (int e = 0; e < mod->jac[a].n; e++)
+      dag_subst(d, &mod->jac[a].e[e].node, 1, q, m, &G[a][mod->jac[a].e[e].coord]);
+  }
+  dag_subst(d, mod->gradU, m, q, m, gu);
+  minv_apply(mod, d, gu, mgu);
+  IntVec *touch = arena_alloc((size_t)m * sizeof(IntVec)); /* constraints on each coordinate */
+  for (int a = 0; a < nu; a++)
+    for (int e = 0; e < mod->jac[a].n; e++) intvec_push(&touch[mod->jac[a].e[e].coord], a);
+  for (int i = 0; i < nu * nu; i++) B[i] = z;
+  for (int c = 0; c < nu; c++) { /* B[:, c] = G' M^-1 G[:, c], over structural nonzeros only */
+    minv_apply(mod, d, G[c], mcol);
+    for (int i = 0; i < m; i++)
+      for (int t = 0; !dag_is_zero(d, mcol[i]) && t < touch[i].n; t++) {
+        int a = touch[i].v[t];
+        B[a * nu + c] = dag_add(d, B[a * nu + c], dag_mul(d, G[a][i], mcol[i]));
+      }
+  }
+  for (int a = 0; a < nu; a++) {
+    int w = z, hvv = z, gmu = z;
+    for (int e = 0; e < mod->jac[a].n; e++)
+      w = dag_add(d, w, dag_mul(d, mod->jac[a].e[e].node, v[mod->jac[a].e[e].coord]));
+    ad_gradient(d, w, m, dw);
+    for (int i = 0; i < m; i++) col[i] = dw[i];
+    dag_subst(d, col, m, q, m, dw);
+    for (int i = 0; i < m; i++) {
+      hvv = dag_add(d, hvv, dag_mul(d, dw[i], v[i]));
+      gmu = dag_add(d, gmu, dag_mul(d, G[a][i], mgu[i]));
+    }
+    r[a] = dag_sub(d, hvv, gmu);
+  }
+  lu_solve(d, B, r, nu, st->lambda0, piv);
+}
+
 // Functions of the state outside the step: g(q), H(q,p), grad g(q)' M^-1 p,
 // and the first step's prediction gamma_0 = M^-1 p0.
 static void build_diagnostics(Build *b) {
@@ -251,6 +307,7 @@ static void build_diagnostics(Build *b) {
     }
     st->hidden[a] = acc;
   }
+  if (nu) build_initial_multiplier(b, q);
 }
 
 Step *step_build(Model *mod, const Method *me) {
@@ -278,6 +335,7 @@ Step *step_build(Model *mod, const Method *me) {
   st->g_at_q0 = nodes(nu);
   st->energy = nodes(1);
   st->hidden = nodes(nu);
+  st->lambda0 = nodes(nu);
   Build b = {mod, me, mod->dag, st, m, nu, s, me->k, dag_input(mod->dag, st->in_h), NULL, NULL, NULL, NULL};
   build_stages(&b);
   if (nu) {

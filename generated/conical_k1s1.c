@@ -149,6 +149,35 @@ static void conical_k1s1_hidden_kernel(const double *q0, const double *p0, const
   out[0] = t7;
 }
 
+/* out = the multiplier consistent with (q0, p0):
+ * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0 */
+static void conical_k1s1_lambda0(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const conical_k1s1_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  /* hidden constraints */
+  const double t0 = 2.0 * q0[0];
+  const double t1 = 2.0 * q0[1];
+  const double t2 = 2.0 * q0[2];
+  /* consistent initial multiplier */
+  const double t3 = t0 * t0;
+  const double t4 = t1 * t1;
+  const double t5 = t3 + t4;
+  const double t6 = t2 * t2;
+  const double t7 = t5 + t6;
+  const double t8 = 2.0 * p0[0];
+  const double t9 = 2.0 * p0[1];
+  const double t10 = 2.0 * p0[2];
+  const double t11 = p0[0] * t8;
+  const double t12 = p0[1] * t9;
+  const double t13 = t11 + t12;
+  const double t14 = p0[2] * t10;
+  const double t15 = t13 + t14;
+  const double t16 = t15 - t2;
+  const double t17 = t16 / t7;
+  out[0] = t17;
+}
+
 void conical_k1s1_params_default(conical_k1s1_params *prm)
 {
   prm->unused_ = 0;
@@ -165,6 +194,13 @@ void conical_k1s1_init(conical_k1s1_state *x, const double *q0, const double *p0
   }
   for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  {
+    conical_k1s1_params prm;
+    double lam[NU];
+    conical_k1s1_params_default(&prm);
+    conical_k1s1_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
 }
 
 const char *conical_k1s1_strerror(int code)

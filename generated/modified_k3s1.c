@@ -202,6 +202,46 @@ static void modified_k3s1_hidden_kernel(const double *q0, const double *p0, cons
   out[0] = t9;
 }
 
+/* out = the multiplier consistent with (q0, p0):
+ * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0 */
+static void modified_k3s1_lambda0(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const modified_k3s1_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  /* hidden constraints */
+  const double t0 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t1 = 6.0 * t0;
+  const double t2 = q0[1] * q0[1] * q0[1];
+  const double t3 = 4.0 * t2;
+  const double t4 = 2.0 * q0[2];
+  /* consistent initial multiplier */
+  const double t5 = q0[2] * q0[2] * q0[2];
+  const double t6 = 4.0 * t5;
+  const double t7 = t1 * t1;
+  const double t8 = t3 * t3;
+  const double t9 = t7 + t8;
+  const double t10 = t4 * t4;
+  const double t11 = t9 + t10;
+  const double t12 = 6.0 * p0[0];
+  const double t13 = 4.0 * p0[1];
+  const double t14 = 2.0 * p0[2];
+  const double t15 = (q0[0] * q0[0]) * (q0[0] * q0[0]);
+  const double t16 = 5.0 * t15;
+  const double t17 = t12 * t16;
+  const double t18 = q0[1] * q0[1];
+  const double t19 = 3.0 * t18;
+  const double t20 = t13 * t19;
+  const double t21 = p0[0] * t17;
+  const double t22 = p0[1] * t20;
+  const double t23 = t21 + t22;
+  const double t24 = p0[2] * t14;
+  const double t25 = t23 + t24;
+  const double t26 = t4 * t6;
+  const double t27 = t25 - t26;
+  const double t28 = t27 / t11;
+  out[0] = t28;
+}
+
 void modified_k3s1_params_default(modified_k3s1_params *prm)
 {
   prm->unused_ = 0;
@@ -218,6 +258,13 @@ void modified_k3s1_init(modified_k3s1_state *x, const double *q0, const double *
   }
   for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  {
+    modified_k3s1_params prm;
+    double lam[NU];
+    modified_k3s1_params_default(&prm);
+    modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
 }
 
 const char *modified_k3s1_strerror(int code)

@@ -34,8 +34,9 @@ typedef struct {
   double increment;  /* last scaled increment of the iteration */
 } pendulum_k1s1_stats;
 
-/* q0, p0 NULL: the model's initial values. The multiplier starts at 0 and is
- * the constant multiplier of the last step after each step. */
+/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
+ * consistent with (q0, p0) at the default parameters (0 if that is singular)
+ * and is the constant multiplier of the last step after each step. */
 void pendulum_k1s1_init(pendulum_k1s1_state *x, const double *q0, const double *p0);
 void pendulum_k1s1_params_default(pendulum_k1s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k1s1_OK or an error code. */

@@ -162,6 +162,29 @@ static void pendulum_k2s2_hidden_kernel(const double *q0, const double *p0, cons
   out[0] = t4;
 }
 
+/* out = the multiplier consistent with (q0, p0):
+ * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0 */
+static void pendulum_k2s2_lambda0(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const pendulum_k2s2_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  /* hidden constraints */
+  const double t0 = 2.0 * q0[0];
+  const double t1 = 2.0 * q0[1];
+  /* consistent initial multiplier */
+  const double t2 = t0 * t0;
+  const double t3 = t1 * t1;
+  const double t4 = t2 + t3;
+  const double t5 = 2.0 * p0[0];
+  const double t6 = 2.0 * p0[1];
+  const double t7 = p0[0] * t5;
+  const double t8 = p0[1] * t6;
+  const double t9 = t7 + t8;
+  const double t10 = t9 - t1;
+  const double t11 = t10 / t4;
+  out[0] = t11;
+}
+
 void pendulum_k2s2_params_default(pendulum_k2s2_params *prm)
 {
   prm->unused_ = 0;
@@ -178,6 +201,13 @@ void pendulum_k2s2_init(pendulum_k2s2_state *x, const double *q0, const double *
   }
   for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  {
+    pendulum_k2s2_params prm;
+    double lam[NU];
+    pendulum_k2s2_params_default(&prm);
+    pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
 }
 
 const char *pendulum_k2s2_strerror(int code)

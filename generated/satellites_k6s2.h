@@ -34,8 +34,9 @@ typedef struct {
   double increment;  /* last scaled increment of the iteration */
 } satellites_k6s2_stats;
 
-/* q0, p0 NULL: the model's initial values. The multiplier starts at 0 and is
- * the constant multiplier of the last step after each step. */
+/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
+ * consistent with (q0, p0) at the default parameters (0 if that is singular)
+ * and is the constant multiplier of the last step after each step. */
 void satellites_k6s2_init(satellites_k6s2_state *x, const double *q0, const double *p0);
 void satellites_k6s2_params_default(satellites_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns satellites_k6s2_OK or an error code. */

@@ -12,6 +12,7 @@
 
 #include <gsl/gsl_integration.h>
 
+#include "ref.h"
 #include "solvers.h"
 
 #define PI 3.14159265358979323846
@@ -166,6 +167,24 @@ START_TEST(failed_step_leaves_state_unchanged) {
 }
 END_TEST
 
+START_TEST(init_gives_consistent_multiplier) {
+  /* against the index-1 multiplier of tests/ref.c (hand-coded Hessians) */
+  static const char *const names[][2] = {{"pendulum_k2s2", "pendulum"}, {"conical_k2s2", "conical"},
+                                         {"modified_k6s2", "modified"}, {"satellites_k6s2", "satellites"}};
+  for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+    const Solver *sv = solver_find(names[i][0]);
+    void *x = malloc(sv->state_size);
+    double lam[3];
+    sv->init(x, NULL, NULL);
+    ck_assert_int_eq(ref_lambda(names[i][1], solver_q(sv, x), solver_p(sv, x), lam), 0);
+    for (int a = 0; a < sv->nu; a++)
+      ck_assert_msg(fabs(solver_lambda(sv, x)[a] - lam[a]) <= 1e-14 * (1 + fabs(lam[a])),
+                    "%s: lambda0[%d] = %.17g, expected %.17g", sv->name, a, solver_lambda(sv, x)[a], lam[a]);
+    free(x);
+  }
+}
+END_TEST
+
 START_TEST(generated_is_up_to_date) {
   char dir[] = "/tmp/hbvm-regen-XXXXXX", cmd[512];
   ck_assert_ptr_nonnull(mkdtemp(dir));
@@ -201,6 +220,7 @@ Suite *solver_suite(void) {
   tcase_add_test(tc, cubic_potential_k_auto_conserves_energy);
   tcase_add_test(tc, nonpolynomial_k_auto_energy_at_roundoff);
   tcase_add_test(tc, failed_step_leaves_state_unchanged);
+  tcase_add_test(tc, init_gives_consistent_multiplier);
   tcase_add_test(tc, generated_is_up_to_date);
   tcase_add_test(tc, generator_valgrind_clean);
   suite_add_tcase(s, tc);

@@ -17,6 +17,12 @@ static double rate(int table, double prev, double cur, int nprev, int n) {
   return table == 1 ? log(prev / cur) / log((double)n / nprev) : log2(prev / cur);
 }
 
+static const char *rate_str(char buf[16], double rate) {
+  if (isnan(rate)) return "--";
+  snprintf(buf, 16, "%.2f", rate);
+  return buf;
+}
+
 static double rel(double ours, double paper) { return fabs(ours - paper) / fabs(paper); }
 
 // One table as Markdown: our value / paper's value / relative difference.
@@ -42,9 +48,11 @@ static void print_table(FILE *f, int table, const PaperRow *rows, int nrows) {
     double rs = first ? NAN : rate(table, prev.e_s, e.e_s, rows[i - 1].n, r->n);
     double rl = first ? NAN : rate(table, prev.e_lambda, e.e_lambda, rows[i - 1].n, r->n);
     double rh = first ? NAN : rate(table, prev.e_hc, e.e_hc, rows[i - 1].n, r->n);
-    fprintf(f, "| %d | %d | %.4e / %.4e / %.1e | %.2f | %.4e / %.4e / %.1e | %.2f | %.1e | %.1e | %.4e / %.4e / %.1e | %.2f | %.1f |\n",
-            r->s, r->n, e.e_s, r->e_s, rel(e.e_s, r->e_s), rs, e.e_lambda, r->e_lambda, rel(e.e_lambda, r->e_lambda), rl,
-            e.e_H, e.e_g, e.e_hc, r->e_hc, rel(e.e_hc, r->e_hc), rh, e.iters_mean);
+    char srs[16], srl[16], srh[16];
+    fprintf(f, "| %d | %d | %.4e / %.4e / %.1e | %s | %.4e / %.4e / %.1e | %s | %.1e | %.1e | %.4e / %.4e / %.1e | %s | %.1f |\n",
+            r->s, r->n, e.e_s, r->e_s, rel(e.e_s, r->e_s), rate_str(srs, rs), e.e_lambda, r->e_lambda,
+            rel(e.e_lambda, r->e_lambda), rate_str(srl, rl), e.e_H, e.e_g, e.e_hc, r->e_hc, rel(e.e_hc, r->e_hc),
+            rate_str(srh, rh), e.iters_mean);
     prev = e;
   }
 }
