@@ -149,6 +149,58 @@ static void lu_solve(Dag *d, int *A, int *r, int n, int *x, int *pivot) {
   }
 }
 
+// A fill-reducing elimination order for the n x n matrix of nodes A, chosen
+// at generation time by the greedy minimum-degree rule on its (symmetric)
+// structural pattern; ties go to the lower index, so an already banded
+// order, like a chain's, is kept. perm[k] is the k-th row/column eliminated.
+static void min_degree_order(const Dag *d, const int *A, int n, int *perm) {
+  unsigned char *adj = calloc((size_t)n * (size_t)n, 1), *done = calloc((size_t)n, 1);
+  int *deg = calloc((size_t)n, sizeof(int));
+  if (!adj || !done || !deg) internal_error("out of memory in min_degree_order");
+  for (int a = 0; a < n; a++)
+    for (int c = 0; c < n; c++)
+      if (a != c && (!dag_is_zero(d, A[a * n + c]) || !dag_is_zero(d, A[c * n + a]))) adj[a * n + c] = 1;
+  for (int a = 0; a < n; a++)
+    for (int c = 0; c < n; c++) deg[a] += adj[a * n + c];
+  for (int k = 0; k < n; k++) {
+    int best = -1;
+    for (int a = 0; a < n; a++)
+      if (!done[a] && (best < 0 || deg[a] < deg[best])) best = a;
+    perm[k] = best;
+    done[best] = 1;
+    /* eliminating best joins its remaining neighbours pairwise (fill-in) */
+    for (int a = 0; a < n; a++) {
+      if (done[a] || !adj[best * n + a]) continue;
+      deg[a]--;
+      for (int c = 0; c < n; c++)
+        if (c != a && !done[c] && adj[best * n + c] && !adj[a * n + c]) {
+          adj[a * n + c] = 1;
+          deg[a]++;
+        }
+    }
+  }
+  free(adj);
+  free(done);
+  free(deg);
+}
+
+// Solve A x = r in the elimination order perm: the LU of P A P' (whose
+// symmetric part is still positive definite, so no pivoting is needed).
+// pivot[k] and diag[k] receive the k-th pivot and the diagonal entry it
+// started from.
+static void solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag) {
+  int *perm = arena_alloc((size_t)n * sizeof(int)), *PA = arena_alloc((size_t)n * n * sizeof(int));
+  int *Pr = arena_alloc((size_t)n * sizeof(int)), *Px = arena_alloc((size_t)n * sizeof(int));
+  min_degree_order(d, A, n, perm);
+  for (int i = 0; i < n; i++) {
+    Pr[i] = r[perm[i]];
+    for (int j = 0; j < n; j++) PA[i * n + j] = A[perm[i] * n + perm[j]];
+    if (diag) diag[i] = PA[i * n + i];
+  }
+  lu_solve(d, PA, Pr, n, Px, pivot);
+  for (int i = 0; i < n; i++) x[perm[i]] = Px[i];
+}
+
 // Assemble A (nu x nu, dense node matrix) and r, then solve A lambda = r.
 static void build_multipliers(Build *b) {
   Dag *d = b->d;
@@ -186,9 +238,8 @@ static void build_multipliers(Build *b) {
     for (int j = 0; j < s; j++) y[j] = b->vpsi[j];
     int rhs = dag_sub(d, dot_col(b, 0, a, minvp0), dag_mul(d, b->h, skew_form(b, a, y)));
     r[a] = dag_add(d, rhs, dag_div(d, dag_input(d, st->in_g0 + a), b->h));
-    st->adiag[a] = A[a * nu + a];
   }
-  lu_solve(d, A, r, nu, st->lambda, st->pivot);
+  solve_ordered(d, A, r, nu, st->lambda, st->pivot, st->adiag);
 }
 
 // gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i], Theta_i = psi_i + rho_i lambda;
@@ -272,7 +323,7 @@ static void build_initial_multiplier(Build *b, const int *q) {
     }
     r[a] = dag_sub(d, hvv, gmu);
   }
-  lu_solve(d, B, r, nu, st->lambda0, piv);
+  solve_ordered(d, B, r, nu, st->lambda0, piv, NULL);
 }
 
 // Functions of the state outside the step: g(q), H(q,p), grad g(q)' M^-1 p,
