@@ -24,7 +24,7 @@ static const char usage[] =
     "options:\n"
     "  -s S          degree of the polynomial approximation, S >= 1 (default 2)\n"
     "  -k K|auto     Gauss-Legendre nodes, K >= S (default auto: the smallest k that\n"
-    "                conserves H and g exactly for polynomial models; max(2s,6) otherwise)\n"
+    "                conserves H and g exactly for polynomial models; 2s+12 otherwise)\n"
     "  -o DIR        where NAME.c and NAME.h are written (default generated)\n"
     "  -n NAME       C prefix of every emitted symbol (default: the model file's base name)\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"

@@ -315,8 +315,8 @@ START_TEST(test_auto_k)
     int s, degU, degg, k;
   } cases[] = {
       {2, 1, 2, 2},           {1, 4, 6, 3}, {2, 4, 6, 6},           {3, 4, 6, 9},
-      {2, 3, 0, 3},           {1, 1, 0, 1}, {1, DEG_NONPOLY, 2, 6}, {4, DEG_NONPOLY, 2, 8},
-      {2, 2, DEG_NONPOLY, 6}, {5, 4, 6, 15},        {1, 3, 0, 2}, {3, 3, 2, 5},
+      {2, 3, 0, 3},           {1, 1, 0, 1}, {1, DEG_NONPOLY, 2, 14}, {4, DEG_NONPOLY, 2, 20},
+      {2, 2, DEG_NONPOLY, 16}, {5, 4, 6, 15},        {1, 3, 0, 2}, {3, 3, 2, 5},
       {5, 1, 3, 8},
   };
   for (int i = 0; i < NCASES(cases); i++) {

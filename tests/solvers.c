@@ -24,6 +24,7 @@
 #include "kepler_k6s1.h"
 #include "kepler_k6s2.h"
 #include "kepler_k6s3.h"
+#include "kepler_k16s2.h"
 #include "henon_heiles_k2s2.h"
 #include "henon_heiles_k3s2.h"
 
@@ -31,7 +32,7 @@
   X(pendulum_k1s1) X(pendulum_k2s2) X(pendulum_k3s3) X(conical_k1s1) X(conical_k2s2) X(conical_k3s3)       \
   X(conical_k4s4) X(modified_k3s1) X(modified_k6s2) X(modified_k9s3) X(satellites_k6s1) X(satellites_k6s2) \
   X(satellites_k6s3) X(kepler_k1s1) X(kepler_k2s2) X(kepler_k3s3) X(kepler_k6s1) X(kepler_k6s2) X(kepler_k6s3)   \
-  X(henon_heiles_k2s2) X(henon_heiles_k3s2)
+  X(kepler_k16s2) X(henon_heiles_k2s2) X(henon_heiles_k3s2)
 
 #define ADAPT(P)                                                                             \
   static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); } \

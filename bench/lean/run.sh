@@ -18,7 +18,7 @@ instr_per_step() { # prefix dir steps h
   cc -O2 -std=c99 -DP="$1" -include "$2/$1.h" -I"$2" -o "$out/$1_steps" "$2/$1.c" bench/lean/steps.c -lm
   a=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null "$out/$1_steps" 1 "$4" 2>&1 | sed -n 's/.*Collected : //p')
   b=$(valgrind --tool=callgrind --callgrind-out-file=/dev/null "$out/$1_steps" $(($3 + 1)) "$4" 2>&1 | sed -n 's/.*Collected : //p')
-  it=$("$out/$1_steps" "$3" "$4")
+  it=$("$out/$1_steps" "$3" "$4" | cut -d' ' -f1)
   echo "$(( (b - a) / $3 )),$it"
 }
 
