@@ -24,7 +24,15 @@ typedef struct {
   int *temp;       /* temporary number per node, -1 if none */
   int single;      /* float instead of double */
   int compensated; /* Kahan summation of the q, p, t updates */
+  int *chunk;      /* kernel split in parts: part of each node (NULL: one part) */
+  int *slot;       /* its place in the array w[] passing values between parts, or -1 */
+  int part;        /* the part being printed */
 } Emitter;
+
+/* A kernel with more operations than this is printed as several functions
+ * of straight-line code (values crossing parts pass through an array):
+ * compilers take time superlinear in a function's size. */
+#define PART_NODES 2000
 
 static void out(Emitter *e, const char *fmt, ...) {
   va_list ap;
@@ -73,7 +81,10 @@ static void ref(Emitter *e, int id, char *buf, size_t size) {
     else if (n->idx >= st->in_q0) snprintf(buf, size, "q0[%d]", n->idx - st->in_q0);
     else internal_error("model coordinate %d reached a kernel", n->idx);
     return;
-  default: snprintf(buf, size, "t%d", e->temp[id]); return;
+  default:
+    if (e->chunk && e->chunk[id] != e->part) snprintf(buf, size, "w[%d]", e->slot[id]);
+    else snprintf(buf, size, "t%d", e->temp[id]);
+    return;
   }
 }
 
@@ -116,30 +127,99 @@ static void emit_node(Emitter *e, int id) {
   out(e, "  const %s t%d = %s;\n", e->single ? "float" : "double", e->temp[id], rhs);
 }
 
-// Print the body of a kernel computing outs[] into out[0..nouts-1].
-static void emit_kernel(Emitter *e, const char *name, const char *what, const int *outs, int nouts) {
-  const Dag *d = e->mod->dag;
-  out(e, "\n/* %s */\n", what);
+static void kernel_signature(Emitter *e, const char *name, int part) {
   tmpl(e, "static void $P_");
-  out(e, "%s", name);
-  tmpl(e, "(const $R *q0, const $R *p0, const $R *gam, $R h,\n    const $R *g0, const $P_params *prm, $R *out)\n{\n"
-          "  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;\n");
-  int top = -1;
-  for (int i = 0; i < nouts; i++)
-    if (outs[i] > top) top = outs[i];
-  unsigned char *mark = calloc((size_t)top + 2, 1);
-  if (!mark) internal_error("out of memory");
-  dag_reach(d, outs, nouts, mark);
-  int ntemp = 0, sec = -1, shown = -1;
-  for (int id = 0; id <= top; id++) {
-    if (!mark[id] || d->nodes[id].a < 0) continue;
+  out(e, part >= 0 ? "%s_part%d" : "%s", name, part);
+  tmpl(e, "(const $R *q0, const $R *p0, const $R *gam, $R h,\n    const $R *g0, const $P_params *prm, ");
+  tmpl(e, part >= 0 ? "$R *w, $R *out)\n{\n" : "$R *out)\n{\n");
+  out(e, "  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
+}
+
+// Print the operations ops[from..to) of a kernel, one a line, with a comment
+// where a new section of the method starts; values needed by a later part
+// are also stored in w[].
+static void emit_ops(Emitter *e, const int *ops, int from, int to) {
+  const Dag *d = e->mod->dag;
+  int sec = -1, shown = -1;
+  for (int i = from; i < to; i++) {
+    int id = ops[i];
     while (sec + 1 < d->marks.n && d->marks.v[sec + 1] <= id) sec++;
     if (sec >= 0 && sec != shown) {
       out(e, "  /* %s */\n", d->labels[sec]);
       shown = sec;
     }
-    e->temp[id] = ntemp++;
+    e->temp[id] = i;
     emit_node(e, id);
+    if (e->chunk && e->slot[id] >= 0) out(e, "  w[%d] = t%d;\n", e->slot[id], i);
+  }
+}
+
+// Assign each operation its part, and a slot in w[] to every value used in
+// a later part than its own. Returns the number of slots.
+static int split_parts(Emitter *e, const int *ops, int nops) {
+  const Dag *d = e->mod->dag;
+  int nslots = 0;
+  for (int i = 0; i < nops; i++) e->chunk[ops[i]] = i / PART_NODES;
+  for (int i = 0; i < nops; i++) {
+    const Node *n = &d->nodes[ops[i]];
+    int kids[2] = {n->a, n->b};
+    for (int k = 0; k < 2; k++)
+      if (kids[k] >= 0 && d->nodes[kids[k]].a >= 0 && e->chunk[kids[k]] < e->chunk[ops[i]] && e->slot[kids[k]] < 0)
+        e->slot[kids[k]] = nslots++;
+  }
+  return nslots;
+}
+
+// Print a kernel computing outs[] into out[0..nouts-1]: straight-line code
+// from the DAG, in several parts when it is large.
+static void emit_kernel(Emitter *e, const char *name, const char *what, const int *outs, int nouts) {
+  const Dag *d = e->mod->dag;
+  int top = -1, nops = 0;
+  for (int i = 0; i < nouts; i++)
+    if (outs[i] > top) top = outs[i];
+  unsigned char *mark = calloc((size_t)top + 2, 1);
+  int *ops = malloc((size_t)(top + 2) * sizeof(int));
+  if (!mark || !ops) internal_error("out of memory");
+  dag_reach(d, outs, nouts, mark);
+  for (int id = 0; id <= top; id++)
+    if (mark[id] && d->nodes[id].a >= 0) ops[nops++] = id;
+  int nparts = (nops + PART_NODES - 1) / PART_NODES;
+  out(e, "\n/* %s */\n", what);
+  if (nparts <= 1) {
+    kernel_signature(e, name, -1);
+    emit_ops(e, ops, 0, nops);
+  } else {
+    e->chunk = malloc((size_t)(top + 1) * sizeof(int));
+    e->slot = malloc((size_t)(top + 1) * sizeof(int));
+    if (!e->chunk || !e->slot) internal_error("out of memory");
+    for (int id = 0; id <= top; id++) {
+      e->chunk[id] = nparts - 1;
+      e->slot[id] = -1;
+    }
+    int nslots = split_parts(e, ops, nops);
+    for (e->part = 0; e->part < nparts; e->part++) {
+      kernel_signature(e, name, e->part);
+      int from = e->part * PART_NODES, to = from + PART_NODES < nops ? from + PART_NODES : nops;
+      emit_ops(e, ops, from, to);
+      for (int i = 0; i < nouts; i++) /* outputs computed in this part (leaves in the last) */
+        if (e->chunk[outs[i]] == e->part) {
+          char r[128];
+          ref(e, outs[i], r, sizeof r);
+          out(e, "  out[%d] = %s;\n", i, r);
+        }
+      out(e, "}\n\n");
+    }
+    out(e, "/* %s: the %d parts above in order */\n", name, nparts);
+    kernel_signature(e, name, -1);
+    out(e, "  %s w[%d];\n", e->single ? "float" : "double", nslots);
+    for (int k = 0; k < nparts; k++) out(e, "  %s_%s_part%d(q0, p0, gam, h, g0, prm, w, out);\n", e->P, name, k);
+    out(e, "}\n");
+    free(e->chunk);
+    free(e->slot);
+    e->chunk = e->slot = NULL;
+    free(mark);
+    free(ops);
+    return;
   }
   for (int i = 0; i < nouts; i++) {
     char r[128];
@@ -148,6 +228,7 @@ static void emit_kernel(Emitter *e, const char *name, const char *what, const in
   }
   out(e, "}\n");
   free(mark);
+  free(ops);
 }
 
 /* ---- the header ---- */
@@ -376,7 +457,7 @@ static void emit_step(Emitter *e) {
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated};
+  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0};
   e.temp = malloc((size_t)mod->dag->n * sizeof(int));
   if (!e.temp) internal_error("out of memory");
   emit_header(&e, o);

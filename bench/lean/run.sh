@@ -24,10 +24,11 @@ instr_per_step() { # prefix dir steps h
 
 csv=$res/lean_instructions.csv
 [ -f "$csv" ] || echo "tag,model,k,s,h,instructions_per_step,iters_per_step" > "$csv"
-for spec in pendulum:2:0.05 conical:2:0.05 modified:2:0.05 satellites:2:0.1 kepler:2:0.03 henon_heiles:2:0.1 chain8:2:0.01; do
-  model=${spec%%:*}; rest=${spec#*:}; s=${rest%%:*}; h=${rest#*:}
-  $gen -s "$s" -n "lean_$model" -o "$out" "models/$model.ham"
-  k=$(sed -n 's/^#define lean_'"$model"'_K \([0-9]*\).*/\1/p' "$out/lean_$model.h")
+# model:k:s:h -- fixed (k, s) so that rows of different tags compare the same method
+for spec in pendulum:2:2:0.05 conical:2:2:0.05 modified:6:2:0.05 satellites:6:2:0.1 kepler:6:2:0.03 \
+            henon_heiles:3:2:0.1 chain8:2:2:0.01; do
+  model=${spec%%:*}; rest=${spec#*:}; k=${rest%%:*}; rest=${rest#*:}; s=${rest%%:*}; h=${rest#*:}
+  $gen -k "$k" -s "$s" -n "lean_$model" -o "$out" "models/$model.ham"
   echo "$tag,$model,$k,$s,$h,$(instr_per_step "lean_$model" "$out" 20 "$h")" >> "$csv"
 done
 
