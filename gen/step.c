@@ -42,8 +42,50 @@ static int *zeros(Dag *d, int n) {
   return v;
 }
 
+// sum_r X[j][r] gamma_r (coordinate i) for the s x s matrix X of METHOD.md:
+// xi_0 gamma_0 - xi_1 gamma_1 for j = 0, xi_j gamma_{j-1} - xi_{j+1} gamma_{j+1}.
+static int x_gamma(Build *b, int j, int i) {
+  Dag *d = b->d;
+  const double *xi = b->me->xi;
+  int m = b->m, in = b->st->in_gam;
+  int v = dag_mul(d, dag_const(d, xi[j]), dag_input(d, in + (j == 0 ? 0 : j - 1) * m + i));
+  if (j + 1 < b->s) v = dag_sub(d, v, dag_mul(d, dag_const(d, xi[j + 1]), dag_input(d, in + (j + 1) * m + i)));
+  return v;
+}
+
+// The projections sum_l b_l P_j(c_l) f(Q_l) of derivative entries f that are
+// affine in q, in closed form: with Q(c) = q0 + h sum_r gamma_r int_0^c P_r,
+//   sum_l b_l P_j(c_l) f(Q_l) = delta_j0 f(q0) + h sum_i (df/dq_i) (X gamma)_j,i
+// (Gauss is exact on polynomials of degree < 2k and <P_j, int_0^c P_r> = X[j][r]),
+// so they cost nothing per stage. out[j * n + r] for root r.
+static void project_affine(Build *b, const int *roots, int n, int *out) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s;
+  dag_section(d, "affine derivative entries, projected in closed form");
+  int *grad = nodes(m), *q0 = nodes(m), *xg = nodes(s * m);
+  for (int i = 0; i < m; i++) q0[i] = dag_input(d, b->st->in_q0 + i);
+  for (int j = 0; j < s; j++)
+    for (int i = 0; i < m; i++) xg[j * m + i] = -1; /* built on first use */
+  for (int r = 0; r < n; r++) {
+    int f0;
+    ad_gradient(d, roots[r], m, grad); /* constants or parameters: f is affine */
+    dag_subst(d, &roots[r], 1, q0, m, &f0);
+    for (int j = 0; j < s; j++) {
+      int acc = j == 0 ? f0 : dag_const(d, 0);
+      for (int i = 0; i < m; i++) {
+        if (dag_is_zero(d, grad[i])) continue;
+        if (xg[j * m + i] < 0) xg[j * m + i] = dag_mul(d, b->h, x_gamma(b, j, i));
+        acc = dag_add(d, acc, dag_mul(d, grad[i], xg[j * m + i]));
+      }
+      out[j * n + r] = acc;
+    }
+  }
+}
+
 // Stage points, model derivatives at each stage, and their projections
-// psi_j and rho_j onto the Legendre basis.
+// psi_j and rho_j onto the Legendre basis. Entries of grad U and grad g that
+// are affine in q are projected in closed form (project_affine); only the
+// others are evaluated at the k stages.
 static void build_stages(Build *b) {
   Dag *d = b->d;
   const Method *me = b->me;
@@ -54,14 +96,24 @@ static void build_stages(Build *b) {
   memcpy(roots, b->mod->gradU, (size_t)m * sizeof(int));
   for (int a = 0, r = m; a < b->nu; a++)
     for (int e = 0; e < b->mod->jac[a].n; e++) roots[r++] = b->mod->jac[a].e[e].node;
-  b->psi = arena_alloc((size_t)s * sizeof(int *));
-  b->rho = arena_alloc((size_t)s * sizeof(int **));
-  for (int j = 0; j < s; j++) {
-    b->psi[j] = zeros(d, m);
-    b->rho[j] = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
-    for (int a = 0; a < b->nu; a++) b->rho[j][a] = zeros(d, b->mod->jac[a].n);
+  /* split the roots: affine ones (degree 0 or 1 in q) and the rest */
+  int *affine = nodes(nroots), *curved = nodes(nroots), *where = nodes(nroots), naff = 0, ncur = 0;
+  for (int r = 0; r < nroots; r++) {
+    int deg = d->nodes[roots[r]].deg;
+    if (deg == 0 || deg == 1) {
+      where[r] = naff;
+      affine[naff++] = roots[r];
+    } else {
+      where[r] = -1 - ncur;
+      curved[ncur++] = roots[r];
+    }
   }
-  for (int l = 0; l < b->k; l++) {
+  int *proj = nodes(s * nroots); /* proj[j * nroots + r]: the projection of root r on P_j */
+  int *paff = nodes(s * naff);
+  if (naff) project_affine(b, affine, naff, paff);
+  for (int j = 0; j < s; j++)
+    for (int r = 0; r < nroots; r++) proj[j * nroots + r] = where[r] >= 0 ? paff[j * naff + where[r]] : dag_const(d, 0);
+  for (int l = 0; l < b->k && ncur; l++) {
     char *label = arena_alloc(128);
     snprintf(label, 128, "stage %d of %d: Q = q0 + h sum_j Ihat[%d][j] gamma_j, grad U(Q), grad g(Q)", l + 1, b->k, l + 1);
     dag_section(d, label);
@@ -71,13 +123,22 @@ static void build_stages(Build *b) {
         acc = dag_add(d, acc, dag_mul(d, dag_const(d, me->Ihat[l * s + j]), dag_input(d, b->st->in_gam + j * m + i)));
       Q[i] = dag_add(d, dag_input(d, b->st->in_q0 + i), dag_mul(d, b->h, acc));
     }
-    dag_subst(d, roots, nroots, Q, m, img);
+    dag_subst(d, curved, ncur, Q, m, img);
     for (int j = 0; j < s; j++) {
       int w = dag_const(d, me->W[l * s + j]);
-      for (int i = 0; i < m; i++) b->psi[j][i] = dag_add(d, b->psi[j][i], dag_mul(d, w, img[i]));
-      for (int a = 0, r = m; a < b->nu; a++)
-        for (int e = 0; e < b->mod->jac[a].n; e++, r++)
-          b->rho[j][a][e] = dag_add(d, b->rho[j][a][e], dag_mul(d, w, img[r]));
+      for (int r = 0; r < nroots; r++)
+        if (where[r] < 0) proj[j * nroots + r] = dag_add(d, proj[j * nroots + r], dag_mul(d, w, img[-1 - where[r]]));
+    }
+  }
+  b->psi = arena_alloc((size_t)s * sizeof(int *));
+  b->rho = arena_alloc((size_t)s * sizeof(int **));
+  for (int j = 0; j < s; j++) {
+    b->psi[j] = nodes(m);
+    memcpy(b->psi[j], proj + j * nroots, (size_t)m * sizeof(int));
+    b->rho[j] = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
+    for (int a = 0, r = m; a < b->nu; a++) {
+      b->rho[j][a] = nodes(b->mod->jac[a].n);
+      for (int e = 0; e < b->mod->jac[a].n; e++) b->rho[j][a][e] = proj[j * nroots + r++];
     }
   }
 }

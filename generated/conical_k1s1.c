@@ -29,66 +29,70 @@ static void conical_k1s1_sweep(const double *q0, const double *p0, const double 
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.5;
-  const double t1 = h * t0;
-  const double t2 = t1 + q0[0];
-  const double t3 = 0.5 * gam[1];
-  const double t4 = h * t3;
-  const double t5 = t4 + q0[1];
-  const double t6 = 0.5 * gam[2];
+  /* affine derivative entries, projected in closed form */
+  const double t0 = 2.0 * q0[0];
+  const double t1 = gam[0] * 0.5;
+  const double t2 = h * t1;
+  const double t3 = 2.0 * t2;
+  const double t4 = t0 + t3;
+  const double t5 = 2.0 * q0[1];
+  const double t6 = 0.5 * gam[1];
   const double t7 = h * t6;
-  const double t8 = t7 + q0[2];
-  const double t9 = 2.0 * t8;
-  const double t10 = 2.0 * t5;
-  const double t11 = 2.0 * t2;
+  const double t8 = 2.0 * t7;
+  const double t9 = t5 + t8;
+  const double t10 = 2.0 * q0[2];
+  const double t11 = 0.5 * gam[2];
+  const double t12 = h * t11;
+  const double t13 = 2.0 * t12;
+  const double t14 = t10 + t13;
   /* multiplier system A lambda = r */
-  const double t12 = t11 * t11;
-  const double t13 = t10 * t10;
-  const double t14 = t12 + t13;
-  const double t15 = t9 * t9;
-  const double t16 = t14 + t15;
-  const double t17 = 0.5 * t16;
-  const double t18 = h * t17;
-  const double t19 = h * t8;
-  const double t20 = t11 * p0[0];
-  const double t21 = t10 * p0[1];
-  const double t22 = t20 + t21;
-  const double t23 = t9 * p0[2];
-  const double t24 = t22 + t23;
-  const double t25 = t24 - t19;
-  const double t26 = g0[0] / h;
-  const double t27 = t25 + t26;
-  const double t28 = t27 / t18;
+  const double t15 = t4 * t4;
+  const double t16 = t9 * t9;
+  const double t17 = t15 + t16;
+  const double t18 = t14 * t14;
+  const double t19 = t17 + t18;
+  const double t20 = 0.5 * t19;
+  const double t21 = h * t20;
+  const double t22 = 0.5 * t14;
+  const double t23 = h * t22;
+  const double t24 = t4 * p0[0];
+  const double t25 = t9 * p0[1];
+  const double t26 = t24 + t25;
+  const double t27 = t14 * p0[2];
+  const double t28 = t26 + t27;
+  const double t29 = t28 - t23;
+  const double t30 = g0[0] / h;
+  const double t31 = t29 + t30;
+  const double t32 = t31 / t21;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t29 = t11 * t28;
-  const double t30 = t10 * t28;
-  const double t31 = t9 * t28;
-  const double t32 = 1.0 + t31;
-  const double t33 = 0.5 * t29;
-  const double t34 = h * t33;
-  const double t35 = p0[0] - t34;
-  const double t36 = 0.5 * t30;
-  const double t37 = h * t36;
-  const double t38 = p0[1] - t37;
-  const double t39 = 0.5 * t32;
-  const double t40 = h * t39;
-  const double t41 = p0[2] - t40;
-  const double t42 = h * t29;
-  const double t43 = -t42;
-  const double t44 = h * t30;
-  const double t45 = -t44;
-  const double t46 = h * t32;
+  const double t33 = t4 * t32;
+  const double t34 = t9 * t32;
+  const double t35 = t14 * t32;
+  const double t36 = 1.0 + t35;
+  const double t37 = 0.5 * t33;
+  const double t38 = h * t37;
+  const double t39 = p0[0] - t38;
+  const double t40 = 0.5 * t34;
+  const double t41 = h * t40;
+  const double t42 = p0[1] - t41;
+  const double t43 = 0.5 * t36;
+  const double t44 = h * t43;
+  const double t45 = p0[2] - t44;
+  const double t46 = h * t33;
   const double t47 = -t46;
-  out[0] = t35;
-  out[1] = t38;
-  out[2] = t41;
-  out[3] = t43;
-  out[4] = t45;
-  out[5] = t47;
-  out[6] = t28;
-  out[7] = t18;
-  out[8] = t18;
+  const double t48 = h * t34;
+  const double t49 = -t48;
+  const double t50 = h * t36;
+  const double t51 = -t50;
+  out[0] = t39;
+  out[1] = t42;
+  out[2] = t45;
+  out[3] = t47;
+  out[4] = t49;
+  out[5] = t51;
+  out[6] = t32;
+  out[7] = t21;
+  out[8] = t21;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -137,15 +141,16 @@ static void conical_k1s1_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* hidden constraints */
+  /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
-  const double t1 = p0[0] * t0;
-  const double t2 = 2.0 * q0[1];
-  const double t3 = p0[1] * t2;
-  const double t4 = t1 + t3;
-  const double t5 = 2.0 * q0[2];
-  const double t6 = p0[2] * t5;
-  const double t7 = t4 + t6;
+  const double t1 = 2.0 * q0[1];
+  const double t2 = 2.0 * q0[2];
+  /* hidden constraints */
+  const double t3 = t0 * p0[0];
+  const double t4 = t1 * p0[1];
+  const double t5 = t3 + t4;
+  const double t6 = t2 * p0[2];
+  const double t7 = t5 + t6;
   out[0] = t7;
 }
 
@@ -155,7 +160,7 @@ static void conical_k1s1_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* hidden constraints */
+  /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = 2.0 * q0[1];
   const double t2 = 2.0 * q0[2];

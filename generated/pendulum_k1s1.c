@@ -29,50 +29,53 @@ static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.5;
-  const double t1 = h * t0;
-  const double t2 = t1 + q0[0];
-  const double t3 = 0.5 * gam[1];
-  const double t4 = h * t3;
-  const double t5 = t4 + q0[1];
-  const double t6 = 2.0 * t5;
-  const double t7 = 2.0 * t2;
+  /* affine derivative entries, projected in closed form */
+  const double t0 = 2.0 * q0[0];
+  const double t1 = gam[0] * 0.5;
+  const double t2 = h * t1;
+  const double t3 = 2.0 * t2;
+  const double t4 = t0 + t3;
+  const double t5 = 2.0 * q0[1];
+  const double t6 = 0.5 * gam[1];
+  const double t7 = h * t6;
+  const double t8 = 2.0 * t7;
+  const double t9 = t5 + t8;
   /* multiplier system A lambda = r */
-  const double t8 = t7 * t7;
-  const double t9 = t6 * t6;
-  const double t10 = t8 + t9;
-  const double t11 = 0.5 * t10;
-  const double t12 = h * t11;
-  const double t13 = h * t5;
-  const double t14 = t7 * p0[0];
-  const double t15 = t6 * p0[1];
-  const double t16 = t14 + t15;
-  const double t17 = t16 - t13;
-  const double t18 = g0[0] / h;
+  const double t10 = t4 * t4;
+  const double t11 = t9 * t9;
+  const double t12 = t10 + t11;
+  const double t13 = 0.5 * t12;
+  const double t14 = h * t13;
+  const double t15 = 0.5 * t9;
+  const double t16 = h * t15;
+  const double t17 = t4 * p0[0];
+  const double t18 = t9 * p0[1];
   const double t19 = t17 + t18;
-  const double t20 = t19 / t12;
+  const double t20 = t19 - t16;
+  const double t21 = g0[0] / h;
+  const double t22 = t20 + t21;
+  const double t23 = t22 / t14;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t21 = t7 * t20;
-  const double t22 = t6 * t20;
-  const double t23 = 1.0 + t22;
-  const double t24 = 0.5 * t21;
-  const double t25 = h * t24;
-  const double t26 = p0[0] - t25;
-  const double t27 = 0.5 * t23;
+  const double t24 = t4 * t23;
+  const double t25 = t9 * t23;
+  const double t26 = 1.0 + t25;
+  const double t27 = 0.5 * t24;
   const double t28 = h * t27;
-  const double t29 = p0[1] - t28;
-  const double t30 = h * t21;
-  const double t31 = -t30;
-  const double t32 = h * t23;
-  const double t33 = -t32;
-  out[0] = t26;
-  out[1] = t29;
-  out[2] = t31;
-  out[3] = t33;
-  out[4] = t20;
-  out[5] = t12;
-  out[6] = t12;
+  const double t29 = p0[0] - t28;
+  const double t30 = 0.5 * t26;
+  const double t31 = h * t30;
+  const double t32 = p0[1] - t31;
+  const double t33 = h * t24;
+  const double t34 = -t33;
+  const double t35 = h * t26;
+  const double t36 = -t35;
+  out[0] = t29;
+  out[1] = t32;
+  out[2] = t34;
+  out[3] = t36;
+  out[4] = t23;
+  out[5] = t14;
+  out[6] = t14;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -116,12 +119,13 @@ static void pendulum_k1s1_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* hidden constraints */
+  /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
-  const double t1 = p0[0] * t0;
-  const double t2 = 2.0 * q0[1];
-  const double t3 = p0[1] * t2;
-  const double t4 = t1 + t3;
+  const double t1 = 2.0 * q0[1];
+  /* hidden constraints */
+  const double t2 = t0 * p0[0];
+  const double t3 = t1 * p0[1];
+  const double t4 = t2 + t3;
   out[0] = t4;
 }
 
@@ -131,7 +135,7 @@ static void pendulum_k1s1_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* hidden constraints */
+  /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = 2.0 * q0[1];
   /* consistent initial multiplier */

@@ -30,86 +30,79 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.21132486540518713;
-  const double t1 = gam[2] * (-0.28867513459481292);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = t3 + q0[0];
-  const double t5 = 0.21132486540518713 * gam[1];
-  const double t6 = (-0.28867513459481292) * gam[3];
-  const double t7 = t5 + t6;
+  /* affine derivative entries, projected in closed form */
+  const double t0 = 2.0 * q0[0];
+  const double t1 = gam[0] * 0.5;
+  const double t2 = gam[2] * 0.28867513459481292;
+  const double t3 = t1 - t2;
+  const double t4 = h * t3;
+  const double t5 = 2.0 * t4;
+  const double t6 = t0 + t5;
+  const double t7 = gam[0] * 0.28867513459481292;
   const double t8 = h * t7;
-  const double t9 = t8 + q0[1];
-  const double t10 = t4 * (-0.99999999999999989);
-  const double t11 = t9 * (-0.99999999999999989);
-  /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t12 = gam[0] * 0.78867513459481287;
-  const double t13 = t1 + t12;
+  const double t9 = 2.0 * t8;
+  const double t10 = 2.0 * q0[1];
+  const double t11 = 0.5 * gam[1];
+  const double t12 = 0.28867513459481292 * gam[3];
+  const double t13 = t11 - t12;
   const double t14 = h * t13;
-  const double t15 = q0[0] + t14;
-  const double t16 = gam[1] * 0.78867513459481287;
-  const double t17 = t6 + t16;
+  const double t15 = 2.0 * t14;
+  const double t16 = t10 + t15;
+  const double t17 = 0.28867513459481292 * gam[1];
   const double t18 = h * t17;
-  const double t19 = q0[1] + t18;
-  const double t20 = t4 + t15;
-  const double t21 = t9 + t19;
-  const double t22 = t15 * 0.99999999999999989;
-  const double t23 = t10 + t22;
-  const double t24 = t19 * 0.99999999999999989;
-  const double t25 = t11 + t24;
+  const double t19 = 2.0 * t18;
   /* multiplier system A lambda = r */
-  const double t26 = t20 * t20;
-  const double t27 = t21 * t21;
-  const double t28 = t26 + t27;
-  const double t29 = 0.5 * t28;
-  const double t30 = h * t29;
-  const double t31 = 0.5 * t21;
-  const double t32 = t25 * 0.28867513459481292;
-  const double t33 = t31 + t32;
-  const double t34 = h * t33;
-  const double t35 = t20 * p0[0];
-  const double t36 = t21 * p0[1];
-  const double t37 = t35 + t36;
-  const double t38 = t37 - t34;
-  const double t39 = g0[0] / h;
-  const double t40 = t38 + t39;
-  const double t41 = t40 / t30;
+  const double t20 = t6 * t6;
+  const double t21 = t16 * t16;
+  const double t22 = t20 + t21;
+  const double t23 = 0.5 * t22;
+  const double t24 = h * t23;
+  const double t25 = 0.5 * t16;
+  const double t26 = t18 * 0.57735026918962584;
+  const double t27 = t25 + t26;
+  const double t28 = h * t27;
+  const double t29 = t6 * p0[0];
+  const double t30 = t16 * p0[1];
+  const double t31 = t29 + t30;
+  const double t32 = t31 - t28;
+  const double t33 = g0[0] / h;
+  const double t34 = t32 + t33;
+  const double t35 = t34 / t24;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t42 = t20 * t41;
-  const double t43 = t21 * t41;
-  const double t44 = 1.0 + t43;
-  const double t45 = t23 * t41;
-  const double t46 = t25 * t41;
-  const double t47 = 0.5 * t42;
-  const double t48 = 0.28867513459481292 * t45;
-  const double t49 = t47 - t48;
-  const double t50 = h * t49;
-  const double t51 = p0[0] - t50;
-  const double t52 = 0.5 * t44;
-  const double t53 = 0.28867513459481292 * t46;
-  const double t54 = t52 - t53;
+  const double t36 = t6 * t35;
+  const double t37 = t16 * t35;
+  const double t38 = 1.0 + t37;
+  const double t39 = t9 * t35;
+  const double t40 = t19 * t35;
+  const double t41 = 0.5 * t36;
+  const double t42 = 0.28867513459481292 * t39;
+  const double t43 = t41 - t42;
+  const double t44 = h * t43;
+  const double t45 = p0[0] - t44;
+  const double t46 = 0.5 * t38;
+  const double t47 = 0.28867513459481292 * t40;
+  const double t48 = t46 - t47;
+  const double t49 = h * t48;
+  const double t50 = p0[1] - t49;
+  const double t51 = 0.28867513459481292 * t36;
+  const double t52 = h * t51;
+  const double t53 = -t52;
+  const double t54 = 0.28867513459481292 * t38;
   const double t55 = h * t54;
-  const double t56 = p0[1] - t55;
-  const double t57 = 0.28867513459481292 * t42;
-  const double t58 = h * t57;
-  const double t59 = -t58;
-  const double t60 = 0.28867513459481292 * t44;
-  const double t61 = h * t60;
-  const double t62 = -t61;
-  const double t63 = h * t42;
-  const double t64 = -t63;
-  const double t65 = h * t44;
-  const double t66 = -t65;
-  out[0] = t51;
-  out[1] = t56;
-  out[2] = t59;
-  out[3] = t62;
-  out[4] = t64;
-  out[5] = t66;
-  out[6] = t41;
-  out[7] = t30;
-  out[8] = t30;
+  const double t56 = -t55;
+  const double t57 = h * t36;
+  const double t58 = -t57;
+  const double t59 = h * t38;
+  const double t60 = -t59;
+  out[0] = t45;
+  out[1] = t50;
+  out[2] = t53;
+  out[3] = t56;
+  out[4] = t58;
+  out[5] = t60;
+  out[6] = t35;
+  out[7] = t24;
+  out[8] = t24;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -153,12 +146,13 @@ static void pendulum_k2s2_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* hidden constraints */
+  /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
-  const double t1 = p0[0] * t0;
-  const double t2 = 2.0 * q0[1];
-  const double t3 = p0[1] * t2;
-  const double t4 = t1 + t3;
+  const double t1 = 2.0 * q0[1];
+  /* hidden constraints */
+  const double t2 = t0 * p0[0];
+  const double t3 = t1 * p0[1];
+  const double t4 = t2 + t3;
   out[0] = t4;
 }
 
@@ -168,7 +162,7 @@ static void pendulum_k2s2_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* hidden constraints */
+  /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = 2.0 * q0[1];
   /* consistent initial multiplier */
