@@ -1,19 +1,21 @@
 /* ad.c - reverse-mode differentiation on the DAG.
  *
  * One reverse sweep visits the nodes reachable from the seeded outputs in
- * decreasing id order (a topological order, see dag.c) and accumulates each
- * node's adjoint into its operands with the local derivative. Adjoints are
- * themselves DAG nodes, so derivatives share subexpressions with the values
- * they come from (d exp(x) reuses exp(x), d sqrt(x) reuses sqrt(x)) and with
- * each other, and zeros fold away: a structural zero of a gradient is the
- * constant 0 node. */
+ * decreasing id order (a topological order, see dag.c), and only those: its
+ * scratch lives in the Dag and is reset by an epoch, so many small
+ * constraints cost their sizes, not their number times the size of the
+ * DAG. It accumulates each node's adjoint into its operands with the local
+ * derivative. Adjoints are themselves DAG nodes, so derivatives share
+ * subexpressions with the values they come from (d exp(x) reuses exp(x),
+ * d sqrt(x) reuses sqrt(x)) and with each other, and zeros fold away: a
+ * structural zero of a gradient is the constant 0 node. */
 #include <stdlib.h>
 
 #include "hbvmgen.h"
 
 typedef struct {
   Dag *d;
-  int *adj; /* adjoint node per id, -1 for zero */
+  int *adj;   /* adjoint node per id (d->sweep_adj), -1 for zero */
 } Sweep;
 
 static void accumulate(Sweep *sw, int id, int contribution) {
@@ -91,29 +93,94 @@ static void propagate(Sweep *sw, int id, int w) {
   accumulate(sw, a, dag_mul(d, w, local));
 }
 
-// Reverse sweep from roots[r] seeded with weight nodes seeds[r] (NULL: all
-// ones). grad[i], i < n, receives d(sum_r seed_r root_r)/d(input i) as a node.
-void ad_reverse(Dag *d, const int *roots, const int *seeds, int nroots, int n, int *grad) {
+static int by_decreasing_id(const void *a, const void *b) {
+  int x = *(const int *)a, y = *(const int *)b;
+  return (x < y) - (x > y);
+}
+
+// Mark the nodes reachable from the roots with a new epoch (their adjoints
+// set to zero) and list them in d->sweep_ids in decreasing id order, a
+// reverse topological order. The scratch arrays grow to the largest id.
+static void visit(Dag *d, const int *roots, int nroots) {
   int top = -1;
   for (int r = 0; r < nroots; r++)
     if (roots[r] > top) top = roots[r];
+  if (top >= d->sweep_cap) {
+    int cap = d->sweep_cap ? d->sweep_cap : 1024;
+    while (cap <= top) cap *= 2;
+    d->sweep_stamp = arena_alloc((size_t)cap * sizeof(int)); /* zeroed: no epoch yet */
+    d->sweep_adj = arena_alloc((size_t)cap * sizeof(int));
+    d->sweep_cap = cap;
+  }
+  int epoch = ++d->sweep_epoch;
+  IntVec *ids = &d->sweep_ids;
+  ids->n = 0;
+  for (int r = 0; r < nroots; r++)
+    if (roots[r] >= 0 && d->sweep_stamp[roots[r]] != epoch) {
+      d->sweep_stamp[roots[r]] = epoch;
+      intvec_push(ids, roots[r]);
+    }
+  for (int i = 0; i < ids->n; i++) { /* the list is its own work queue */
+    const Node *nd = &d->nodes[ids->v[i]];
+    int kids[2] = {nd->a, nd->b};
+    for (int k = 0; k < 2; k++)
+      if (kids[k] >= 0 && d->sweep_stamp[kids[k]] != epoch) {
+        d->sweep_stamp[kids[k]] = epoch;
+        intvec_push(ids, kids[k]);
+      }
+  }
+  for (int i = 0; i < ids->n; i++) d->sweep_adj[ids->v[i]] = -1;
+  qsort(ids->v, (size_t)ids->n, sizeof(int), by_decreasing_id);
+}
+
+// Reverse sweep from roots[r] seeded with weight nodes seeds[r] (NULL: all
+// ones), over the reachable nodes only, listed in d->sweep_ids. Returns
+// the adjoints, indexed by id (valid for the listed ids; -1 for zero).
+static int *sweep(Dag *d, const int *roots, const int *seeds, int nroots) {
+  visit(d, roots, nroots);
+  Sweep sw = {d, d->sweep_adj};
+  for (int r = 0; r < nroots; r++)
+    if (roots[r] >= 0) accumulate(&sw, roots[r], seeds ? seeds[r] : dag_const(d, 1));
+  for (int i = 0; i < d->sweep_ids.n; i++) {
+    int id = d->sweep_ids.v[i];
+    if (sw.adj[id] >= 0 && d->nodes[id].op != OP_INPUT) propagate(&sw, id, sw.adj[id]);
+  }
+  return sw.adj;
+}
+
+// grad[i], i < n, receives d(sum_r seed_r root_r)/d(input i) as a node.
+void ad_reverse(Dag *d, const int *roots, const int *seeds, int nroots, int n, int *grad) {
   int zero = dag_const(d, 0);
   for (int i = 0; i < n; i++) grad[i] = zero;
-  if (top < 0) return;
-  unsigned char *mark = calloc((size_t)top + 1, 1);
-  Sweep sw = {d, malloc((size_t)(top + 1) * sizeof(int))};
-  if (!mark || !sw.adj) internal_error("out of memory in ad_reverse");
-  for (int id = 0; id <= top; id++) sw.adj[id] = -1;
-  dag_reach(d, roots, nroots, mark);
-  for (int r = 0; r < nroots; r++) accumulate(&sw, roots[r], seeds ? seeds[r] : dag_const(d, 1));
-  for (int id = top; id >= 0; id--) {
-    if (!mark[id] || sw.adj[id] < 0) continue;
-    const Node *nd = &d->nodes[id];
-    if (nd->op == OP_INPUT && nd->idx < n) grad[nd->idx] = sw.adj[id];
-    else propagate(&sw, id, sw.adj[id]);
+  const int *adj = sweep(d, roots, seeds, nroots);
+  for (int i = 0; i < d->sweep_ids.n; i++) {
+    const Node *nd = &d->nodes[d->sweep_ids.v[i]];
+    if (nd->op == OP_INPUT && nd->idx < n && adj[d->sweep_ids.v[i]] >= 0) grad[nd->idx] = adj[d->sweep_ids.v[i]];
   }
-  free(mark);
-  free(sw.adj);
 }
 
 void ad_gradient(Dag *d, int root, int n, int *grad) { ad_reverse(d, &root, NULL, 1, n, grad); }
+
+static int by_coord(const void *a, const void *b) {
+  const Entry *x = a, *y = b;
+  return (x->coord > y->coord) - (x->coord < y->coord);
+}
+
+// The nonzero entries of the gradient of root (see hbvmgen.h).
+void ad_gradient_sparse(Dag *d, int root, int n, SparseVec *out) {
+  dag_const(d, 0); /* as ad_reverse does first: the same nodes in the same order */
+  const int *adj = sweep(d, &root, NULL, 1);
+  int nnz = 0;
+  for (int pass = 0; pass < 2; pass++) { /* count, then fill */
+    if (pass) out->e = arena_alloc((size_t)(nnz + 1) * sizeof(Entry));
+    out->n = 0;
+    for (int i = 0; i < d->sweep_ids.n; i++) {
+      int id = d->sweep_ids.v[i];
+      if (d->nodes[id].op != OP_INPUT || d->nodes[id].idx >= n || adj[id] < 0 || dag_is_zero(d, adj[id])) continue;
+      if (pass) out->e[out->n] = (Entry){d->nodes[id].idx, adj[id]};
+      out->n++;
+    }
+    nnz = out->n;
+  }
+  qsort(out->e, (size_t)out->n, sizeof(Entry), by_coord);
+}

@@ -21,7 +21,9 @@
 #define MAX_COORDS 100000
 #define MAX_CONSTRAINTS 100000
 #define MAX_PARAMS 10000
+#ifndef MAX_WORK            /* (the fuzz harness builds with a smaller limit) */
 #define MAX_WORK 20000000L   /* terms expanded by sum/for over the whole model */
+#endif
 #define MAX_INDEX 1000000000L
 
 typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_PARAM, SYM_INDEX } SymKind;
@@ -518,8 +520,8 @@ static void add_constraints(Ctx *cx, const Stmt *st) {
   }
 }
 
-// Lower M = ... into a dense matrix when written as [[...]], else into its
-// diagonal; mass_setup then checks it and finds its structure.
+// Lower M = ... into a dense matrix when written as [[...]] (mass_setup), else
+// into its diagonal (mass_setup_diag); they check it and find its structure.
 static void lower_mass(Ctx *cx) {
   Model *mod = cx->mod;
   int m = mod->m;
@@ -539,12 +541,7 @@ static void lower_mass(Ctx *cx) {
     list.kind = A_LIST;
     tmp.expr = &list;
     double *dg = constant_list(cx, &tmp, "diag(...) of M", "M", m);
-    if (!dg) return;
-    double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
-    if (!dense) internal_error("out of memory");
-    for (int i = 0; i < m; i++) dense[(size_t)i * m + i] = dg[i];
-    mass_setup(mod, dense, e->loc);
-    free(dense);
+    if (dg) mass_setup_diag(mod, dg, e->loc);
     return;
   }
   if (e->kind == A_LIST) {
@@ -554,21 +551,20 @@ static void lower_mass(Ctx *cx) {
       error_at(e->loc, "M has %d row%s, expected %d (one per coordinate)", rows, rows == 1 ? "" : "s", m);
       return;
     }
-    double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
-    if (!dense) internal_error("out of memory");
+    /* every row read and checked before the m x m matrix is allocated */
+    double **v = arena_alloc((size_t)m * sizeof *v);
     int i = 0;
     for (const Ast *r = e->args; r; r = r->next, i++) {
       Stmt row = *cx->mass;
       row.expr = (Ast *)r;
       row.loc = r->loc;
-      double *v = r->kind == A_LIST ? constant_list(cx, &row, "a row of M", "M", m) : NULL;
+      v[i] = r->kind == A_LIST ? constant_list(cx, &row, "a row of M", "M", m) : NULL;
       if (r->kind != A_LIST) error_at(r->loc, "M = [[...], ...] needs each row as a list");
-      if (!v) {
-        free(dense);
-        return;
-      }
-      memcpy(dense + (size_t)i * m, v, (size_t)m * sizeof(double));
+      if (!v[i]) return;
     }
+    double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
+    if (!dense) internal_error("out of memory");
+    for (i = 0; i < m; i++) memcpy(dense + (size_t)i * m, v[i], (size_t)m * sizeof(double));
     mass_setup(mod, dense, e->loc);
     free(dense);
     return;
@@ -584,11 +580,9 @@ static void lower_mass(Ctx *cx) {
     error_at(e->loc, "M = c (c times the identity) needs c > 0, got %g", nd->val);
     return;
   }
-  double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
-  if (!dense) internal_error("out of memory");
-  for (int i = 0; i < m; i++) dense[(size_t)i * m + i] = nd->val;
-  mass_setup(mod, dense, e->loc);
-  free(dense);
+  double *dg = arena_alloc((size_t)m * sizeof(double));
+  for (int i = 0; i < m; i++) dg[i] = nd->val;
+  mass_setup_diag(mod, dg, e->loc);
 }
 
 static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc *loc) {

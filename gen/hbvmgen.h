@@ -163,13 +163,22 @@ typedef struct {
   Node *nodes;
   int n, cap;
   int *table;          /* open-addressing hash of node ids, -1 empty */
+  int zero;            /* the constant 0 */
   int tcap;
   IntVec marks;        /* section labels for the emitter: (first id, label index) */
   const char **labels;
   int nlabels, labcap;
+  /* ad.c: scratch of reverse sweeps, so that one costs the size of the
+   * subgraph it visits, not of the whole DAG: per node id an adjoint, valid
+   * where its stamp is the sweep's epoch; the ids visited */
+  int *sweep_stamp, *sweep_adj;
+  int sweep_cap, sweep_epoch;
+  IntVec sweep_ids;
 } Dag;
 
+#ifndef MAX_NODES /* (the fuzz harness builds with smaller limits, tests/fuzz/run.sh) */
 #define MAX_NODES 4000000
+#endif
 
 Dag *dag_new(void);
 int dag_const(Dag *d, double v);
@@ -219,6 +228,11 @@ typedef struct {
   int n;
 } SparseVec;
 
+/* ad.c: the structurally nonzero entries of the gradient of root with
+ * respect to inputs 0..n-1, in input order; costs the size of root's
+ * subgraph, not of the DAG or of n. */
+void ad_gradient_sparse(Dag *d, int root, int n, SparseVec *out);
+
 typedef struct {
   const char *file;
   int m, nu;
@@ -241,6 +255,7 @@ typedef struct {
 
 Model *analyse(const char *file, Stmt *prog);      /* NULL when errors were reported */
 int mass_setup(Model *mod, const double *dense, Loc loc); /* 0 ok, else error reported */
+int mass_setup_diag(Model *mod, const double *diag, Loc loc); /* M = diag(diag[0..m-1]) */
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out); /* out = M^-1 v, nodes */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);

@@ -15,6 +15,28 @@
 
 #include "hbvmgen.h"
 
+// Record a diagonal M given by its m diagonal entries: each must be
+// positive; M is then the identity, a scalar multiple of it, or diagonal.
+// Returns 0, or -1 after reporting an error at loc. Costs O(m), so a large
+// diagonal M never becomes an m x m matrix.
+int mass_setup_diag(Model *mod, const double *diag, Loc loc) {
+  int m = mod->m;
+  mod->minv_diag = arena_alloc((size_t)m * sizeof(double));
+  mod->mass = MASS_IDENTITY;
+  if (loc.line == 0) loc = (Loc){1, 1};
+  for (int i = 0; i < m; i++) {
+    double d = diag[i];
+    if (!(d > 0)) {
+      error_at(loc, "M is not positive definite: diagonal entry %d is %.17g", i + 1, d);
+      return -1;
+    }
+    mod->minv_diag[i] = 1 / d;
+    if (d != diag[0]) mod->mass = MASS_DIAG;
+  }
+  if (mod->mass == MASS_IDENTITY && m > 0 && diag[0] != 1) mod->mass = MASS_SCALAR;
+  return 0;
+}
+
 // Check a dense M (row-major m x m; NULL means identity) and record its
 // structure and inverse in mod. Returns 0, or -1 after reporting an error.
 int mass_setup(Model *mod, const double *dense, Loc loc) {
@@ -35,17 +57,9 @@ int mass_setup(Model *mod, const double *dense, Loc loc) {
       }
     }
   if (diagonal) {
-    for (int i = 0; i < m; i++) {
-      double d = dense[(size_t)i * m + i];
-      if (!(d > 0)) {
-        error_at(loc, "M is not positive definite: diagonal entry %d is %.17g", i + 1, d);
-        return -1;
-      }
-      mod->minv_diag[i] = 1 / d;
-      if (d != dense[0]) mod->mass = MASS_DIAG;
-    }
-    if (mod->mass == MASS_IDENTITY && dense[0] != 1) mod->mass = MASS_SCALAR;
-    return 0;
+    double *diag = arena_alloc((size_t)m * sizeof(double));
+    for (int i = 0; i < m; i++) diag[i] = dense[(size_t)i * m + i];
+    return mass_setup_diag(mod, diag, loc);
   }
   gsl_error_handler_t *old = gsl_set_error_handler_off();
   gsl_matrix *a = gsl_matrix_alloc((size_t)m, (size_t)m);
@@ -66,12 +80,13 @@ int mass_setup(Model *mod, const double *dense, Loc loc) {
   return 0;
 }
 
-// out = M^-1 v for node vectors of length m (out may not alias v).
+// out = M^-1 v for node vectors of length m (out may not alias v). Zeros of
+// v cost no lookup: the columns of a sparse Jacobian are mostly zeros.
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out) {
-  int m = mod->m;
+  int m = mod->m, zero = dag_const(d, 0);
   for (int i = 0; i < m; i++) {
     if (mod->mass != MASS_DENSE) {
-      out[i] = dag_mul(d, dag_const(d, mod->minv_diag[i]), v[i]);
+      out[i] = dag_is_zero(d, v[i]) ? zero : dag_mul(d, dag_const(d, mod->minv_diag[i]), v[i]);
       continue;
     }
     int acc = dag_const(d, 0);

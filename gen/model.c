@@ -7,6 +7,8 @@
 #include "hbvmgen.h"
 
 #define CONSISTENCY_TOL 1e-10
+#define RANK_TOL 1e-8            /* a unit gradient this close to the span of the others is dependent */
+#define RANK_WORK_MAX 1e8        /* m nu^2 above this: the rank is not checked */
 
 // Fill mod->gradU and the structurally nonzero columns mod->jac.
 void model_differentiate(Model *mod) {
@@ -16,19 +18,8 @@ void model_differentiate(Model *mod) {
   dag_section(d, "gradient of U");
   ad_gradient(d, mod->U, m, mod->gradU);
   mod->jac = arena_alloc((size_t)(mod->nu + 1) * sizeof(SparseVec));
-  int *col = malloc((size_t)m * sizeof(int));
-  if (!col) internal_error("out of memory");
   if (mod->nu) dag_section(d, "Jacobian of g");
-  for (int a = 0; a < mod->nu; a++) {
-    ad_gradient(d, mod->g[a], m, col);
-    int nnz = 0;
-    for (int i = 0; i < m; i++) nnz += !dag_is_zero(d, col[i]);
-    SparseVec *sv = &mod->jac[a];
-    sv->e = arena_alloc((size_t)(nnz + 1) * sizeof(Entry));
-    for (int i = 0; i < m; i++)
-      if (!dag_is_zero(d, col[i])) sv->e[sv->n++] = (Entry){i, col[i]};
-  }
-  free(col);
+  for (int a = 0; a < mod->nu; a++) ad_gradient_sparse(d, mod->g[a], m, &mod->jac[a]);
 }
 
 static double *param_defaults(const Model *mod) {
@@ -37,16 +28,69 @@ static double *param_defaults(const Model *mod) {
   return p;
 }
 
-// Warn when q0, p0 violate g(q0) = 0 or grad g(q0)' M^-1 p0 = 0, and when
-// U or g are not finite at q0.
+// Warn about each constraint whose gradient at q0 is zero or lies in the
+// span of the gradients of the constraints before it (relative RANK_TOL,
+// after normalisation, by Gram-Schmidt with reorthogonalisation): grad g(q0)
+// has no full column rank, the multiplier system of the method is singular
+// there (dependent constraints, or a singular configuration). jac holds the
+// values of the entries of mod->jac at q0, column after column.
+static void check_rank(const Model *mod, const double *jac) {
+  int m = mod->m, nu = mod->nu;
+  if (nu == 0 || (double)m * nu * nu > RANK_WORK_MAX) return;
+  double *basis = malloc((size_t)m * nu * sizeof *basis), *v = malloc((size_t)m * sizeof *v);
+  if (!basis || !v) internal_error("out of memory");
+  for (int a = 0, r = 0, rank = 0; a < nu; a++) {
+    double norm = 0;
+    for (int i = 0; i < m; i++) v[i] = 0;
+    for (int e = 0; e < mod->jac[a].n; e++, r++) v[mod->jac[a].e[e].coord] = jac[r];
+    for (int i = 0; i < m; i++) norm = hypot(norm, v[i]);
+    if (!isfinite(norm)) continue; /* g not smooth at q0: no statement */
+    if (norm == 0) {
+      warning_at(mod->g_loc[a], "constraint %d has a zero gradient at q0: the constraints are not independent "
+                 "there and the multiplier system is singular", a + 1);
+      continue;
+    }
+    for (int i = 0; i < m; i++) v[i] /= norm;
+    for (int pass = 0; pass < 2; pass++)
+      for (int b = 0; b < rank; b++) {
+        const double *u = basis + (size_t)b * m;
+        double dot = 0;
+        for (int i = 0; i < m; i++) dot += u[i] * v[i];
+        for (int i = 0; i < m; i++) v[i] -= dot * u[i];
+      }
+    double rest = 0;
+    for (int i = 0; i < m; i++) rest = hypot(rest, v[i]);
+    if (rest <= RANK_TOL) {
+      warning_at(mod->g_loc[a], "the gradient of constraint %d at q0 is a combination of those of the constraints "
+                 "before it: the constraints are not independent there and the multiplier system is singular",
+                 a + 1);
+      continue;
+    }
+    for (int i = 0; i < m; i++) basis[(size_t)rank * m + i] = v[i] / rest;
+    rank++;
+  }
+  free(basis);
+  free(v);
+}
+
+// Warn when q0, p0 violate g(q0) = 0 or grad g(q0)' M^-1 p0 = 0, when U or g
+// are not finite at q0, and when the constraints are dependent at q0.
 void model_check_initial(const Model *mod) {
   const double *prm = param_defaults(mod);
-  int m = mod->m;
-  double U0 = dag_eval(mod->dag, mod->U, mod->q0, prm);
-  if (!isfinite(U0))
-    warning_at(mod->q0_loc, "U is not finite at %s (U = %g)", mod->q0_loc.line ? "q0" : "the default q0 = 0", U0);
-  double *v = malloc((size_t)m * sizeof(double));
-  if (!v) internal_error("out of memory");
+  int m = mod->m, nu = mod->nu, nroots = 1 + nu;
+  for (int a = 0; a < nu; a++) nroots += mod->jac[a].n;
+  /* U, g and the Jacobian's entries at q0, all in one evaluation */
+  int *roots = malloc((size_t)nroots * sizeof *roots);
+  double *val = malloc((size_t)nroots * sizeof *val), *v = malloc((size_t)m * sizeof *v);
+  if (!roots || !val || !v) internal_error("out of memory");
+  roots[0] = mod->U;
+  for (int a = 0, r = 1 + nu; a < nu; a++) {
+    roots[1 + a] = mod->g[a];
+    for (int e = 0; e < mod->jac[a].n; e++) roots[r++] = mod->jac[a].e[e].node;
+  }
+  dag_eval_many(mod->dag, roots, nroots, mod->q0, prm, val);
+  if (!isfinite(val[0]))
+    warning_at(mod->q0_loc, "U is not finite at %s (U = %g)", mod->q0_loc.line ? "q0" : "the default q0 = 0", val[0]);
   for (int i = 0; i < m; i++) {
     v[i] = mod->minv_diag[i] * mod->p0[i];
     if (mod->mass == MASS_DENSE) {
@@ -54,16 +98,18 @@ void model_check_initial(const Model *mod) {
       for (int j = 0; j < m; j++) v[i] += mod->minv[(size_t)i * m + j] * mod->p0[j];
     }
   }
-  for (int a = 0; a < mod->nu; a++) {
-    double ga = dag_eval(mod->dag, mod->g[a], mod->q0, prm);
+  const double *jac = val + 1 + nu;
+  for (int a = 0, r = 0; a < nu; a++) {
+    double ga = val[1 + a], hc = 0;
     if (!(fabs(ga) <= CONSISTENCY_TOL))
       warning_at(mod->q0_loc, "q0 violates constraint %d: g%d(q0) = %.3e", a + 1, a + 1, ga);
-    double hc = 0;
-    for (int e = 0; e < mod->jac[a].n; e++)
-      hc += dag_eval(mod->dag, mod->jac[a].e[e].node, mod->q0, prm) * v[mod->jac[a].e[e].coord];
+    for (int e = 0; e < mod->jac[a].n; e++, r++) hc += jac[r] * v[mod->jac[a].e[e].coord];
     if (!(fabs(hc) <= CONSISTENCY_TOL))
       warning_at(mod->p0_loc.line ? mod->p0_loc : mod->q0_loc,
                  "p0 violates hidden constraint %d: (grad g%d' M^-1 p0)(q0) = %.3e", a + 1, a + 1, hc);
   }
+  check_rank(mod, jac);
+  free(roots);
+  free(val);
   free(v);
 }
