@@ -34,11 +34,19 @@ TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c tests/solvers.
 TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
 
 
-HBVMGEN  := gen/hbvmgen
-LIBRT    := runtime/libhbvmrt.a
+# Each flavour (build/, build-san/) links its own generator and runtime; `all`
+# copies them to gen/hbvmgen and runtime/libhbvmrt.a, where users, scripts and
+# tests find them, whenever they differ (so switching SANITIZE never leaves a
+# stale or mismatched binary behind).
+HBVMGEN  := $(B)/hbvmgen
+LIBRT    := $(B)/libhbvmrt.a
 
 .PHONY: all deps check demo generated tables figures bench fuzz clean
 all: $(HBVMGEN) $(LIBRT)
+	@cmp -s $(HBVMGEN) gen/hbvmgen || cp $(HBVMGEN) gen/hbvmgen
+	@cmp -s $(LIBRT) runtime/libhbvmrt.a || cp $(LIBRT) runtime/libhbvmrt.a
+
+gen/hbvmgen runtime/libhbvmrt.a: all
 
 deps:
 	@scripts/deps.sh
@@ -94,11 +102,11 @@ $(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(TSOLV_OBJ) $(LIBRT)
 	$(CC) $(SAN) -o $@ $^ $(CHECKLIB) $(GSLLIB) -lm
 
 check: deps
-	@$(MAKE) --no-print-directory $(B)/tests/runner $(HBVMGEN)
-	cd tests && ../$(B)/tests/runner
+	@$(MAKE) --no-print-directory $(B)/tests/runner all
+	cd tests && HBVM_SANITIZED=$(if $(SANITIZE),1,) ../$(B)/tests/runner
 
-generated: $(HBVMGEN)
-	scripts/regen.sh $(HBVMGEN) generated
+generated: all
+	scripts/regen.sh gen/hbvmgen generated
 
 demo: deps
 	@$(MAKE) --no-print-directory all
@@ -129,6 +137,6 @@ fuzz:
 	tests/fuzz/run.sh $(FUZZ_SECONDS)
 
 clean:
-	rm -rf build build-san $(HBVMGEN) $(LIBRT) demo
+	rm -rf build build-san gen/hbvmgen runtime/libhbvmrt.a demo
 
 -include $(shell find $(B) -name '*.d' 2>/dev/null)

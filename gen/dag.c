@@ -39,6 +39,8 @@ Dag *dag_new(void) {
   d->tcap = 2048;
   d->table = arena_alloc((size_t)d->tcap * sizeof(int));
   memset(d->table, 0xff, (size_t)d->tcap * sizeof(int));
+  d->zero = -1;
+  d->zero = dag_const(d, 0);
   return d;
 }
 
@@ -144,6 +146,7 @@ static Node leaf(Op op) {
 }
 
 int dag_const(Dag *d, double v) {
+  if (v == 0 && d->zero >= 0) return d->zero; /* the most asked-for node */
   Node n = leaf(OP_CONST);
   n.val = v == 0 ? 0.0 : v; /* one zero */
   return intern(d, n);

@@ -146,11 +146,11 @@ END_TEST
 static const struct {
   const char *e;
   Op op;
-  int count, nodes; /* nodes: total size of the DAG, 0 to skip */
+  int count, nodes; /* nodes: total size of the DAG (which starts with the constant 0), 0 to skip */
 } count_cases[] = {
-    {"x y * x y * +", OP_MUL, 1, 4},
-    {"x y * y x * +", OP_MUL, 1, 4},
-    {"x sin x sin *", OP_SIN, 1, 3},
+    {"x y * x y * +", OP_MUL, 1, 5},
+    {"x y * y x * +", OP_MUL, 1, 5},
+    {"x sin x sin *", OP_SIN, 1, 4},
     {"x sin y cos * x sin y cos * -", OP_SIN, 1, 0},
     {"x y + sqrt x y + sqrt / y x + sqrt +", OP_SQRT, 1, 0},
     {"x y + sqrt x y + sqrt / y x + sqrt +", OP_ADD, 2, 0},
