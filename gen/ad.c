@@ -46,10 +46,13 @@ static void propagate(Sweep *sw, int id, int w) {
     accumulate(sw, a, dag_mul(d, w, b));
     accumulate(sw, b, dag_mul(d, w, a));
     return;
-  case OP_DIV: /* d(a/b) = da/b - (a/b) db/b */
-    accumulate(sw, a, dag_div(d, w, b));
-    accumulate(sw, b, dag_neg(d, dag_div(d, dag_mul(d, w, id), b)));
+  case OP_DIV: { /* d(a/b) = da/b - (a/b) db/b, with one reciprocal 1/b shared by both
+                  * (and with a reciprocal a/b = 1/b itself: d(1/b) = -(1/b)^2 db) */
+    int rb = dag_div(d, one, b);
+    accumulate(sw, a, dag_mul(d, w, rb));
+    accumulate(sw, b, dag_neg(d, dag_mul(d, dag_mul(d, w, id), rb)));
     return;
+  }
   case OP_NEG:
     accumulate(sw, a, dag_neg(d, w));
     return;
@@ -86,7 +89,9 @@ static void propagate(Sweep *sw, int id, int w) {
   case OP_TANH: local = dag_sub(d, one, dag_mul(d, id, id)); break;
   case OP_EXP: local = id; break;
   case OP_LOG: accumulate(sw, a, dag_div(d, w, a)); return;
-  case OP_SQRT: accumulate(sw, a, dag_div(d, w, dag_mul(d, dag_const(d, 2), id))); return;
+  case OP_SQRT: /* w / (2 sqrt a), through the reciprocal of sqrt a that 1/sqrt(a) shares */
+    accumulate(sw, a, dag_mul(d, dag_mul(d, dag_const(d, 0.5), w), dag_div(d, one, id)));
+    return;
   case OP_ABS: local = dag_op(d, OP_SIGN, a, -1); break;
   default: internal_error("no derivative for %s", op_name((Op)n.op)); return;
   }

@@ -248,6 +248,7 @@ static int simplify(Dag *d, Op op, int a, int b) {
     return -1;
   case OP_DIV:
     if (dag_is_const(d, b, 1)) return a;
+    if (dag_is_const(d, a, -1)) return dag_op(d, OP_NEG, dag_op(d, OP_DIV, dag_const(d, 1), b), -1); /* exact */
     if (dag_is_const(d, b, -1)) return dag_op(d, OP_NEG, a, -1);
     if (dag_is_zero(d, a) && !dag_is_zero(d, b)) return a;
     if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_DIV, d->nodes[a].a, b), -1);

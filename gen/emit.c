@@ -302,11 +302,13 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   if (e->single)
     tmpl(e, "#define TOL 2.4e-7f     /* an increment within 2 ulps (float) ... */\n"
             "#define STAGTOL 1e-4f   /* an increment that stops decreasing above this is divergence */\n"
-            "#define SINGTOL 1e-6f   /* pivot / diagonal of A below this: singular */\n\n");
+            "#define SINGTOL 1e-6f   /* pivot / diagonal of A below this: singular */\n"
+            "#define GTOL 7.6e-6f    /* |g| up to this (64 ulps) is round-off: not corrected */\n\n");
   else
     tmpl(e, "#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */\n"
             "#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */\n"
-            "#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */\n\n");
+            "#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */\n"
+            "#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */\n\n");
   out(e, "/* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = %d (the kernels below use\n", me->k);
   out(e, " * their products with P_j and int_0^c P_j, folded into the code):\n");
   for (int l = 0; l < me->k; l++) out(e, " *   c_%d = %.17g   b_%d = %.17g\n", l + 1, me->c[l], l + 1, me->b[l]);
@@ -421,7 +423,12 @@ static void emit_step(Emitter *e) {
           "  int it, i, rc = $P_ENOCONV;\n  DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n"
           "  $P_predict(x, h, prm, gam);\n");
-  if (e->mod->nu) tmpl(e, "  $R g0[NU];\n  $P_g(x->q, x->p, 0, 0, 0, prm, g0);\n");
+  if (e->mod->nu)
+    tmpl(e, "  $R g0[NU];\n  $P_g(x->q, x->p, 0, 0, 0, prm, g0);\n"
+            "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
+            "   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it\n"
+            "   * (eps / h a step) would only add noise, so it is left out. */\n"
+            "  for (i = 0; i < NU; i++) g0[i] = fabs$f(g0[i]) <= GTOL ? 0 : g0[i] / h;\n");
   tmpl(e, "  for (it = 1; it <= MAXITER; it++) {\n");
   tmpl(e, e->mod->nu ? "    $P_sweep(x->q, x->p, gam, h, g0, prm, sw);\n" : "    $P_sweep(x->q, x->p, gam, h, 0, prm, sw);\n");
   tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"

@@ -298,7 +298,7 @@ static void build_multipliers(Build *b) {
     }
     for (int j = 0; j < s; j++) y[j] = b->vpsi[j];
     int rhs = dag_sub(d, dot_col(b, 0, a, minvp0), dag_mul(d, b->h, skew_form(b, a, y)));
-    r[a] = dag_add(d, rhs, dag_div(d, dag_input(d, st->in_g0 + a), b->h));
+    r[a] = dag_add(d, rhs, dag_input(d, st->in_g0 + a)); /* input: g_a(q0) / h, or 0 */
   }
   solve_ordered(d, A, r, nu, st->lambda, st->pivot, st->adiag);
 }

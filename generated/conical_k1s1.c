@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 1 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -61,36 +62,35 @@ static void conical_k1s1_sweep(const double *q0, const double *p0, const double 
   const double t27 = t14 * p0[2];
   const double t28 = t26 + t27;
   const double t29 = t28 - t23;
-  const double t30 = g0[0] / h;
-  const double t31 = t29 + t30;
-  const double t32 = t31 / t21;
+  const double t30 = t29 + g0[0];
+  const double t31 = t30 / t21;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t33 = t4 * t32;
-  const double t34 = t9 * t32;
-  const double t35 = t14 * t32;
-  const double t36 = 1.0 + t35;
-  const double t37 = 0.5 * t33;
-  const double t38 = h * t37;
-  const double t39 = p0[0] - t38;
-  const double t40 = 0.5 * t34;
-  const double t41 = h * t40;
-  const double t42 = p0[1] - t41;
-  const double t43 = 0.5 * t36;
-  const double t44 = h * t43;
-  const double t45 = p0[2] - t44;
-  const double t46 = h * t33;
-  const double t47 = -t46;
-  const double t48 = h * t34;
-  const double t49 = -t48;
-  const double t50 = h * t36;
-  const double t51 = -t50;
-  out[0] = t39;
-  out[1] = t42;
-  out[2] = t45;
-  out[3] = t47;
-  out[4] = t49;
-  out[5] = t51;
-  out[6] = t32;
+  const double t32 = t4 * t31;
+  const double t33 = t9 * t31;
+  const double t34 = t14 * t31;
+  const double t35 = 1.0 + t34;
+  const double t36 = 0.5 * t32;
+  const double t37 = h * t36;
+  const double t38 = p0[0] - t37;
+  const double t39 = 0.5 * t33;
+  const double t40 = h * t39;
+  const double t41 = p0[1] - t40;
+  const double t42 = 0.5 * t35;
+  const double t43 = h * t42;
+  const double t44 = p0[2] - t43;
+  const double t45 = h * t32;
+  const double t46 = -t45;
+  const double t47 = h * t33;
+  const double t48 = -t47;
+  const double t49 = h * t35;
+  const double t50 = -t49;
+  out[0] = t38;
+  out[1] = t41;
+  out[2] = t44;
+  out[3] = t46;
+  out[4] = t48;
+  out[5] = t50;
+  out[6] = t31;
   out[7] = t21;
   out[8] = t21;
 }
@@ -288,6 +288,10 @@ int conical_k1s1_step(conical_k1s1_state *x, double h_, const conical_k1s1_param
   conical_k1s1_predict(x, h, prm, gam);
   double g0[NU];
   conical_k1s1_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     conical_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */

@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -79,57 +80,56 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t44 = t26 * p0[2];
   const double t45 = t43 + t44;
   const double t46 = t45 - t40;
-  const double t47 = g0[0] / h;
-  const double t48 = t46 + t47;
-  const double t49 = t48 / t36;
+  const double t47 = t46 + g0[0];
+  const double t48 = t47 / t36;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t50 = t6 * t49;
-  const double t51 = t16 * t49;
-  const double t52 = t26 * t49;
-  const double t53 = 1.0 + t52;
-  const double t54 = t9 * t49;
-  const double t55 = t19 * t49;
-  const double t56 = t29 * t49;
-  const double t57 = 0.5 * t50;
-  const double t58 = 0.28867513459481292 * t54;
-  const double t59 = t57 - t58;
-  const double t60 = h * t59;
-  const double t61 = p0[0] - t60;
-  const double t62 = 0.5 * t51;
-  const double t63 = 0.28867513459481292 * t55;
-  const double t64 = t62 - t63;
-  const double t65 = h * t64;
-  const double t66 = p0[1] - t65;
-  const double t67 = 0.5 * t53;
-  const double t68 = 0.28867513459481292 * t56;
-  const double t69 = t67 - t68;
-  const double t70 = h * t69;
-  const double t71 = p0[2] - t70;
-  const double t72 = 0.28867513459481292 * t50;
-  const double t73 = h * t72;
-  const double t74 = -t73;
-  const double t75 = 0.28867513459481292 * t51;
-  const double t76 = h * t75;
-  const double t77 = -t76;
-  const double t78 = 0.28867513459481292 * t53;
-  const double t79 = h * t78;
-  const double t80 = -t79;
-  const double t81 = h * t50;
-  const double t82 = -t81;
-  const double t83 = h * t51;
-  const double t84 = -t83;
-  const double t85 = h * t53;
-  const double t86 = -t85;
-  out[0] = t61;
-  out[1] = t66;
-  out[2] = t71;
-  out[3] = t74;
-  out[4] = t77;
-  out[5] = t80;
-  out[6] = t82;
-  out[7] = t84;
-  out[8] = t86;
-  out[9] = t49;
+  const double t49 = t6 * t48;
+  const double t50 = t16 * t48;
+  const double t51 = t26 * t48;
+  const double t52 = 1.0 + t51;
+  const double t53 = t9 * t48;
+  const double t54 = t19 * t48;
+  const double t55 = t29 * t48;
+  const double t56 = 0.5 * t49;
+  const double t57 = 0.28867513459481292 * t53;
+  const double t58 = t56 - t57;
+  const double t59 = h * t58;
+  const double t60 = p0[0] - t59;
+  const double t61 = 0.5 * t50;
+  const double t62 = 0.28867513459481292 * t54;
+  const double t63 = t61 - t62;
+  const double t64 = h * t63;
+  const double t65 = p0[1] - t64;
+  const double t66 = 0.5 * t52;
+  const double t67 = 0.28867513459481292 * t55;
+  const double t68 = t66 - t67;
+  const double t69 = h * t68;
+  const double t70 = p0[2] - t69;
+  const double t71 = 0.28867513459481292 * t49;
+  const double t72 = h * t71;
+  const double t73 = -t72;
+  const double t74 = 0.28867513459481292 * t50;
+  const double t75 = h * t74;
+  const double t76 = -t75;
+  const double t77 = 0.28867513459481292 * t52;
+  const double t78 = h * t77;
+  const double t79 = -t78;
+  const double t80 = h * t49;
+  const double t81 = -t80;
+  const double t82 = h * t50;
+  const double t83 = -t82;
+  const double t84 = h * t52;
+  const double t85 = -t84;
+  out[0] = t60;
+  out[1] = t65;
+  out[2] = t70;
+  out[3] = t73;
+  out[4] = t76;
+  out[5] = t79;
+  out[6] = t81;
+  out[7] = t83;
+  out[8] = t85;
+  out[9] = t48;
   out[10] = t36;
   out[11] = t36;
 }
@@ -327,6 +327,10 @@ int conical_k2s2_step(conical_k2s2_state *x, double h_, const conical_k2s2_param
   conical_k2s2_predict(x, h, prm, gam);
   double g0[NU];
   conical_k2s2_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     conical_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */

@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -95,78 +96,77 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t59 = t36 * p0[2];
   const double t60 = t58 + t59;
   const double t61 = t60 - t55;
-  const double t62 = g0[0] / h;
-  const double t63 = t61 + t62;
-  const double t64 = t63 / t51;
+  const double t62 = t61 + g0[0];
+  const double t63 = t62 / t51;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t65 = t6 * t64;
-  const double t66 = t21 * t64;
-  const double t67 = t36 * t64;
-  const double t68 = 1.0 + t67;
-  const double t69 = t11 * t64;
-  const double t70 = t26 * t64;
-  const double t71 = t41 * t64;
-  const double t72 = t14 * t64;
-  const double t73 = t29 * t64;
-  const double t74 = t44 * t64;
-  const double t75 = 0.5 * t65;
-  const double t76 = 0.28867513459481292 * t69;
-  const double t77 = t75 - t76;
-  const double t78 = h * t77;
-  const double t79 = p0[0] - t78;
-  const double t80 = 0.5 * t66;
-  const double t81 = 0.28867513459481292 * t70;
-  const double t82 = t80 - t81;
-  const double t83 = h * t82;
-  const double t84 = p0[1] - t83;
-  const double t85 = 0.5 * t68;
-  const double t86 = 0.28867513459481292 * t71;
-  const double t87 = t85 - t86;
-  const double t88 = h * t87;
-  const double t89 = p0[2] - t88;
-  const double t90 = 0.28867513459481292 * t65;
-  const double t91 = 0.12909944487358055 * t72;
-  const double t92 = t90 - t91;
-  const double t93 = h * t92;
-  const double t94 = -t93;
-  const double t95 = 0.28867513459481292 * t66;
-  const double t96 = 0.12909944487358055 * t73;
-  const double t97 = t95 - t96;
-  const double t98 = h * t97;
-  const double t99 = -t98;
-  const double t100 = 0.28867513459481292 * t68;
-  const double t101 = 0.12909944487358055 * t74;
-  const double t102 = t100 - t101;
-  const double t103 = h * t102;
-  const double t104 = -t103;
-  const double t105 = 0.12909944487358055 * t69;
-  const double t106 = h * t105;
-  const double t107 = -t106;
-  const double t108 = 0.12909944487358055 * t70;
-  const double t109 = h * t108;
-  const double t110 = -t109;
-  const double t111 = 0.12909944487358055 * t71;
-  const double t112 = h * t111;
-  const double t113 = -t112;
-  const double t114 = h * t65;
-  const double t115 = -t114;
-  const double t116 = h * t66;
-  const double t117 = -t116;
-  const double t118 = h * t68;
-  const double t119 = -t118;
-  out[0] = t79;
-  out[1] = t84;
-  out[2] = t89;
-  out[3] = t94;
-  out[4] = t99;
-  out[5] = t104;
-  out[6] = t107;
-  out[7] = t110;
-  out[8] = t113;
-  out[9] = t115;
-  out[10] = t117;
-  out[11] = t119;
-  out[12] = t64;
+  const double t64 = t6 * t63;
+  const double t65 = t21 * t63;
+  const double t66 = t36 * t63;
+  const double t67 = 1.0 + t66;
+  const double t68 = t11 * t63;
+  const double t69 = t26 * t63;
+  const double t70 = t41 * t63;
+  const double t71 = t14 * t63;
+  const double t72 = t29 * t63;
+  const double t73 = t44 * t63;
+  const double t74 = 0.5 * t64;
+  const double t75 = 0.28867513459481292 * t68;
+  const double t76 = t74 - t75;
+  const double t77 = h * t76;
+  const double t78 = p0[0] - t77;
+  const double t79 = 0.5 * t65;
+  const double t80 = 0.28867513459481292 * t69;
+  const double t81 = t79 - t80;
+  const double t82 = h * t81;
+  const double t83 = p0[1] - t82;
+  const double t84 = 0.5 * t67;
+  const double t85 = 0.28867513459481292 * t70;
+  const double t86 = t84 - t85;
+  const double t87 = h * t86;
+  const double t88 = p0[2] - t87;
+  const double t89 = 0.28867513459481292 * t64;
+  const double t90 = 0.12909944487358055 * t71;
+  const double t91 = t89 - t90;
+  const double t92 = h * t91;
+  const double t93 = -t92;
+  const double t94 = 0.28867513459481292 * t65;
+  const double t95 = 0.12909944487358055 * t72;
+  const double t96 = t94 - t95;
+  const double t97 = h * t96;
+  const double t98 = -t97;
+  const double t99 = 0.28867513459481292 * t67;
+  const double t100 = 0.12909944487358055 * t73;
+  const double t101 = t99 - t100;
+  const double t102 = h * t101;
+  const double t103 = -t102;
+  const double t104 = 0.12909944487358055 * t68;
+  const double t105 = h * t104;
+  const double t106 = -t105;
+  const double t107 = 0.12909944487358055 * t69;
+  const double t108 = h * t107;
+  const double t109 = -t108;
+  const double t110 = 0.12909944487358055 * t70;
+  const double t111 = h * t110;
+  const double t112 = -t111;
+  const double t113 = h * t64;
+  const double t114 = -t113;
+  const double t115 = h * t65;
+  const double t116 = -t115;
+  const double t117 = h * t67;
+  const double t118 = -t117;
+  out[0] = t78;
+  out[1] = t83;
+  out[2] = t88;
+  out[3] = t93;
+  out[4] = t98;
+  out[5] = t103;
+  out[6] = t106;
+  out[7] = t109;
+  out[8] = t112;
+  out[9] = t114;
+  out[10] = t116;
+  out[11] = t118;
+  out[12] = t63;
   out[13] = t51;
   out[14] = t51;
 }
@@ -364,6 +364,10 @@ int conical_k3s3_step(conical_k3s3_state *x, double h_, const conical_k3s3_param
   conical_k3s3_predict(x, h, prm, gam);
   double g0[NU];
   conical_k3s3_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     conical_k3s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */

@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):

@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 1 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -30,7 +31,7 @@ static void kepler_k1s1_sweep(const double *q0, const double *p0, const double *
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.5;
+  const double t0 = 0.5 * gam[0];
   const double t1 = h * t0;
   const double t2 = t1 + q0[0];
   const double t3 = 0.5 * gam[1];
@@ -40,10 +41,10 @@ static void kepler_k1s1_sweep(const double *q0, const double *p0, const double *
   const double t7 = t5 * t5;
   const double t8 = t6 + t7;
   const double t9 = sqrt(t8);
-  const double t10 = (-1.0) / t9;
-  const double t11 = t10 / t9;
-  const double t12 = 2.0 * t9;
-  const double t13 = t11 / t12;
+  const double t10 = 1.0 / t9;
+  const double t11 = t10 * t10;
+  const double t12 = 0.5 * t11;
+  const double t13 = t10 * t12;
   const double t14 = 2.0 * t5;
   const double t15 = t13 * t14;
   const double t16 = 2.0 * t2;
@@ -51,16 +52,18 @@ static void kepler_k1s1_sweep(const double *q0, const double *p0, const double *
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
   const double t18 = 0.5 * t17;
   const double t19 = h * t18;
-  const double t20 = t19 + p0[0];
+  const double t20 = p0[0] - t19;
   const double t21 = 0.5 * t15;
   const double t22 = h * t21;
-  const double t23 = t22 + p0[1];
+  const double t23 = p0[1] - t22;
   const double t24 = h * t17;
-  const double t25 = h * t15;
+  const double t25 = -t24;
+  const double t26 = h * t15;
+  const double t27 = -t26;
   out[0] = t20;
   out[1] = t23;
-  out[2] = t24;
-  out[3] = t25;
+  out[2] = t25;
+  out[3] = t27;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -85,9 +88,9 @@ static void kepler_k1s1_energy_kernel(const double *q0, const double *p0, const 
   const double t4 = q0[1] * q0[1];
   const double t5 = t3 + t4;
   const double t6 = sqrt(t5);
-  const double t7 = (-1.0) / t6;
+  const double t7 = 1.0 / t6;
   const double t8 = 0.5 * t2;
-  const double t9 = t7 + t8;
+  const double t9 = t8 - t7;
   out[0] = t9;
 }
 

@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -106,36 +107,35 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   const double t67 = t4 * p0[2];
   const double t68 = t66 + t67;
   const double t69 = t68 - t63;
-  const double t70 = g0[0] / h;
-  const double t71 = t69 + t70;
-  const double t72 = t71 / t60;
+  const double t70 = t69 + g0[0];
+  const double t71 = t70 / t60;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t73 = t51 * t72;
-  const double t74 = t53 * t72;
-  const double t75 = t4 * t72;
-  const double t76 = t49 + t75;
-  const double t77 = 0.5 * t73;
-  const double t78 = h * t77;
-  const double t79 = p0[0] - t78;
-  const double t80 = 0.5 * t74;
-  const double t81 = h * t80;
-  const double t82 = p0[1] - t81;
-  const double t83 = 0.5 * t76;
-  const double t84 = h * t83;
-  const double t85 = p0[2] - t84;
-  const double t86 = h * t73;
-  const double t87 = -t86;
-  const double t88 = h * t74;
-  const double t89 = -t88;
-  const double t90 = h * t76;
-  const double t91 = -t90;
-  out[0] = t79;
-  out[1] = t82;
-  out[2] = t85;
-  out[3] = t87;
-  out[4] = t89;
-  out[5] = t91;
-  out[6] = t72;
+  const double t72 = t51 * t71;
+  const double t73 = t53 * t71;
+  const double t74 = t4 * t71;
+  const double t75 = t49 + t74;
+  const double t76 = 0.5 * t72;
+  const double t77 = h * t76;
+  const double t78 = p0[0] - t77;
+  const double t79 = 0.5 * t73;
+  const double t80 = h * t79;
+  const double t81 = p0[1] - t80;
+  const double t82 = 0.5 * t75;
+  const double t83 = h * t82;
+  const double t84 = p0[2] - t83;
+  const double t85 = h * t72;
+  const double t86 = -t85;
+  const double t87 = h * t73;
+  const double t88 = -t87;
+  const double t89 = h * t75;
+  const double t90 = -t89;
+  out[0] = t78;
+  out[1] = t81;
+  out[2] = t84;
+  out[3] = t86;
+  out[4] = t88;
+  out[5] = t90;
+  out[6] = t71;
   out[7] = t60;
   out[8] = t60;
 }
@@ -348,6 +348,10 @@ int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_pa
   modified_k3s1_predict(x, h, prm, gam);
   double g0[NU];
   modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     modified_k3s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */

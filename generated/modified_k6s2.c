@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -247,58 +248,57 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t202 = t6 * p0[2];
   const double t203 = t201 + t202;
   const double t204 = t203 - t198;
-  const double t205 = g0[0] / h;
-  const double t206 = t204 + t205;
-  const double t207 = t206 / t190;
+  const double t205 = t204 + g0[0];
+  const double t206 = t205 / t190;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t208 = t175 * t207;
-  const double t209 = t177 * t207;
-  const double t210 = t6 * t207;
-  const double t211 = t173 + t210;
-  const double t212 = t181 * t207;
-  const double t213 = t183 * t207;
-  const double t214 = t9 * t207;
-  const double t215 = t179 + t214;
-  const double t216 = 0.5 * t208;
-  const double t217 = 0.28867513459481292 * t212;
-  const double t218 = t216 - t217;
-  const double t219 = h * t218;
-  const double t220 = p0[0] - t219;
-  const double t221 = 0.5 * t209;
-  const double t222 = 0.28867513459481292 * t213;
-  const double t223 = t221 - t222;
-  const double t224 = h * t223;
-  const double t225 = p0[1] - t224;
-  const double t226 = 0.5 * t211;
-  const double t227 = 0.28867513459481292 * t215;
-  const double t228 = t226 - t227;
-  const double t229 = h * t228;
-  const double t230 = p0[2] - t229;
-  const double t231 = 0.28867513459481292 * t208;
-  const double t232 = h * t231;
-  const double t233 = -t232;
-  const double t234 = 0.28867513459481292 * t209;
-  const double t235 = h * t234;
-  const double t236 = -t235;
-  const double t237 = 0.28867513459481292 * t211;
-  const double t238 = h * t237;
-  const double t239 = -t238;
-  const double t240 = h * t208;
-  const double t241 = -t240;
-  const double t242 = h * t209;
-  const double t243 = -t242;
-  const double t244 = h * t211;
-  const double t245 = -t244;
-  out[0] = t220;
-  out[1] = t225;
-  out[2] = t230;
-  out[3] = t233;
-  out[4] = t236;
-  out[5] = t239;
-  out[6] = t241;
-  out[7] = t243;
-  out[8] = t245;
-  out[9] = t207;
+  const double t207 = t175 * t206;
+  const double t208 = t177 * t206;
+  const double t209 = t6 * t206;
+  const double t210 = t173 + t209;
+  const double t211 = t181 * t206;
+  const double t212 = t183 * t206;
+  const double t213 = t9 * t206;
+  const double t214 = t179 + t213;
+  const double t215 = 0.5 * t207;
+  const double t216 = 0.28867513459481292 * t211;
+  const double t217 = t215 - t216;
+  const double t218 = h * t217;
+  const double t219 = p0[0] - t218;
+  const double t220 = 0.5 * t208;
+  const double t221 = 0.28867513459481292 * t212;
+  const double t222 = t220 - t221;
+  const double t223 = h * t222;
+  const double t224 = p0[1] - t223;
+  const double t225 = 0.5 * t210;
+  const double t226 = 0.28867513459481292 * t214;
+  const double t227 = t225 - t226;
+  const double t228 = h * t227;
+  const double t229 = p0[2] - t228;
+  const double t230 = 0.28867513459481292 * t207;
+  const double t231 = h * t230;
+  const double t232 = -t231;
+  const double t233 = 0.28867513459481292 * t208;
+  const double t234 = h * t233;
+  const double t235 = -t234;
+  const double t236 = 0.28867513459481292 * t210;
+  const double t237 = h * t236;
+  const double t238 = -t237;
+  const double t239 = h * t207;
+  const double t240 = -t239;
+  const double t241 = h * t208;
+  const double t242 = -t241;
+  const double t243 = h * t210;
+  const double t244 = -t243;
+  out[0] = t219;
+  out[1] = t224;
+  out[2] = t229;
+  out[3] = t232;
+  out[4] = t235;
+  out[5] = t238;
+  out[6] = t240;
+  out[7] = t242;
+  out[8] = t244;
+  out[9] = t206;
   out[10] = t190;
   out[11] = t190;
 }
@@ -511,6 +511,10 @@ int modified_k6s2_step(modified_k6s2_state *x, double h_, const modified_k6s2_pa
   modified_k6s2_predict(x, h, prm, gam);
   double g0[NU];
   modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     modified_k6s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */

@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 9 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -442,80 +443,79 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t391 = t6 * p0[2];
   const double t392 = t390 + t391;
   const double t393 = t392 - t387;
-  const double t394 = g0[0] / h;
-  const double t395 = t393 + t394;
-  const double t396 = t395 / t374;
+  const double t394 = t393 + g0[0];
+  const double t395 = t394 / t374;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t397 = t353 * t396;
-  const double t398 = t355 * t396;
-  const double t399 = t6 * t396;
-  const double t400 = t351 + t399;
-  const double t401 = t359 * t396;
-  const double t402 = t361 * t396;
-  const double t403 = t11 * t396;
-  const double t404 = t357 + t403;
-  const double t405 = t365 * t396;
-  const double t406 = t367 * t396;
-  const double t407 = t14 * t396;
-  const double t408 = t363 + t407;
-  const double t409 = 0.5 * t397;
-  const double t410 = 0.28867513459481292 * t401;
-  const double t411 = t409 - t410;
-  const double t412 = h * t411;
-  const double t413 = p0[0] - t412;
-  const double t414 = 0.5 * t398;
-  const double t415 = 0.28867513459481292 * t402;
-  const double t416 = t414 - t415;
-  const double t417 = h * t416;
-  const double t418 = p0[1] - t417;
-  const double t419 = 0.5 * t400;
-  const double t420 = 0.28867513459481292 * t404;
-  const double t421 = t419 - t420;
-  const double t422 = h * t421;
-  const double t423 = p0[2] - t422;
-  const double t424 = 0.28867513459481292 * t397;
-  const double t425 = 0.12909944487358055 * t405;
-  const double t426 = t424 - t425;
-  const double t427 = h * t426;
-  const double t428 = -t427;
-  const double t429 = 0.28867513459481292 * t398;
-  const double t430 = 0.12909944487358055 * t406;
-  const double t431 = t429 - t430;
-  const double t432 = h * t431;
-  const double t433 = -t432;
-  const double t434 = 0.28867513459481292 * t400;
-  const double t435 = 0.12909944487358055 * t408;
-  const double t436 = t434 - t435;
-  const double t437 = h * t436;
-  const double t438 = -t437;
-  const double t439 = 0.12909944487358055 * t401;
-  const double t440 = h * t439;
-  const double t441 = -t440;
-  const double t442 = 0.12909944487358055 * t402;
-  const double t443 = h * t442;
-  const double t444 = -t443;
-  const double t445 = 0.12909944487358055 * t404;
-  const double t446 = h * t445;
-  const double t447 = -t446;
-  const double t448 = h * t397;
-  const double t449 = -t448;
-  const double t450 = h * t398;
-  const double t451 = -t450;
-  const double t452 = h * t400;
-  const double t453 = -t452;
-  out[0] = t413;
-  out[1] = t418;
-  out[2] = t423;
-  out[3] = t428;
-  out[4] = t433;
-  out[5] = t438;
-  out[6] = t441;
-  out[7] = t444;
-  out[8] = t447;
-  out[9] = t449;
-  out[10] = t451;
-  out[11] = t453;
-  out[12] = t396;
+  const double t396 = t353 * t395;
+  const double t397 = t355 * t395;
+  const double t398 = t6 * t395;
+  const double t399 = t351 + t398;
+  const double t400 = t359 * t395;
+  const double t401 = t361 * t395;
+  const double t402 = t11 * t395;
+  const double t403 = t357 + t402;
+  const double t404 = t365 * t395;
+  const double t405 = t367 * t395;
+  const double t406 = t14 * t395;
+  const double t407 = t363 + t406;
+  const double t408 = 0.5 * t396;
+  const double t409 = 0.28867513459481292 * t400;
+  const double t410 = t408 - t409;
+  const double t411 = h * t410;
+  const double t412 = p0[0] - t411;
+  const double t413 = 0.5 * t397;
+  const double t414 = 0.28867513459481292 * t401;
+  const double t415 = t413 - t414;
+  const double t416 = h * t415;
+  const double t417 = p0[1] - t416;
+  const double t418 = 0.5 * t399;
+  const double t419 = 0.28867513459481292 * t403;
+  const double t420 = t418 - t419;
+  const double t421 = h * t420;
+  const double t422 = p0[2] - t421;
+  const double t423 = 0.28867513459481292 * t396;
+  const double t424 = 0.12909944487358055 * t404;
+  const double t425 = t423 - t424;
+  const double t426 = h * t425;
+  const double t427 = -t426;
+  const double t428 = 0.28867513459481292 * t397;
+  const double t429 = 0.12909944487358055 * t405;
+  const double t430 = t428 - t429;
+  const double t431 = h * t430;
+  const double t432 = -t431;
+  const double t433 = 0.28867513459481292 * t399;
+  const double t434 = 0.12909944487358055 * t407;
+  const double t435 = t433 - t434;
+  const double t436 = h * t435;
+  const double t437 = -t436;
+  const double t438 = 0.12909944487358055 * t400;
+  const double t439 = h * t438;
+  const double t440 = -t439;
+  const double t441 = 0.12909944487358055 * t401;
+  const double t442 = h * t441;
+  const double t443 = -t442;
+  const double t444 = 0.12909944487358055 * t403;
+  const double t445 = h * t444;
+  const double t446 = -t445;
+  const double t447 = h * t396;
+  const double t448 = -t447;
+  const double t449 = h * t397;
+  const double t450 = -t449;
+  const double t451 = h * t399;
+  const double t452 = -t451;
+  out[0] = t412;
+  out[1] = t417;
+  out[2] = t422;
+  out[3] = t427;
+  out[4] = t432;
+  out[5] = t437;
+  out[6] = t440;
+  out[7] = t443;
+  out[8] = t446;
+  out[9] = t448;
+  out[10] = t450;
+  out[11] = t452;
+  out[12] = t395;
   out[13] = t374;
   out[14] = t374;
 }
@@ -728,6 +728,10 @@ int modified_k9s3_step(modified_k9s3_state *x, double h_, const modified_k9s3_pa
   modified_k9s3_predict(x, h, prm, gam);
   double g0[NU];
   modified_k9s3_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     modified_k9s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */

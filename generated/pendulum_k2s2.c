@@ -12,6 +12,7 @@
 #define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
 #define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -65,42 +66,41 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   const double t30 = t16 * p0[1];
   const double t31 = t29 + t30;
   const double t32 = t31 - t28;
-  const double t33 = g0[0] / h;
-  const double t34 = t32 + t33;
-  const double t35 = t34 / t24;
+  const double t33 = t32 + g0[0];
+  const double t34 = t33 / t24;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t36 = t6 * t35;
-  const double t37 = t16 * t35;
-  const double t38 = 1.0 + t37;
-  const double t39 = t9 * t35;
-  const double t40 = t19 * t35;
-  const double t41 = 0.5 * t36;
-  const double t42 = 0.28867513459481292 * t39;
-  const double t43 = t41 - t42;
-  const double t44 = h * t43;
-  const double t45 = p0[0] - t44;
-  const double t46 = 0.5 * t38;
-  const double t47 = 0.28867513459481292 * t40;
-  const double t48 = t46 - t47;
-  const double t49 = h * t48;
-  const double t50 = p0[1] - t49;
-  const double t51 = 0.28867513459481292 * t36;
-  const double t52 = h * t51;
-  const double t53 = -t52;
-  const double t54 = 0.28867513459481292 * t38;
-  const double t55 = h * t54;
-  const double t56 = -t55;
-  const double t57 = h * t36;
-  const double t58 = -t57;
-  const double t59 = h * t38;
-  const double t60 = -t59;
-  out[0] = t45;
-  out[1] = t50;
-  out[2] = t53;
-  out[3] = t56;
-  out[4] = t58;
-  out[5] = t60;
-  out[6] = t35;
+  const double t35 = t6 * t34;
+  const double t36 = t16 * t34;
+  const double t37 = 1.0 + t36;
+  const double t38 = t9 * t34;
+  const double t39 = t19 * t34;
+  const double t40 = 0.5 * t35;
+  const double t41 = 0.28867513459481292 * t38;
+  const double t42 = t40 - t41;
+  const double t43 = h * t42;
+  const double t44 = p0[0] - t43;
+  const double t45 = 0.5 * t37;
+  const double t46 = 0.28867513459481292 * t39;
+  const double t47 = t45 - t46;
+  const double t48 = h * t47;
+  const double t49 = p0[1] - t48;
+  const double t50 = 0.28867513459481292 * t35;
+  const double t51 = h * t50;
+  const double t52 = -t51;
+  const double t53 = 0.28867513459481292 * t37;
+  const double t54 = h * t53;
+  const double t55 = -t54;
+  const double t56 = h * t35;
+  const double t57 = -t56;
+  const double t58 = h * t37;
+  const double t59 = -t58;
+  out[0] = t44;
+  out[1] = t49;
+  out[2] = t52;
+  out[3] = t55;
+  out[4] = t57;
+  out[5] = t59;
+  out[6] = t34;
   out[7] = t24;
   out[8] = t24;
 }
@@ -284,6 +284,10 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, double h_, const pendulum_k2s2_pa
   pendulum_k2s2_predict(x, h, prm, gam);
   double g0[NU];
   pendulum_k2s2_g(x->q, x->p, 0, 0, 0, prm, g0);
+  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
+   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * (eps / h a step) would only add noise, so it is left out. */
+  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
   for (it = 1; it <= MAXITER; it++) {
     pendulum_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
