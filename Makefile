@@ -1,6 +1,6 @@
 # hbvmgen - one flat Makefile.
 #   make            the generator gen/hbvmgen and runtime/libhbvmrt.a
-#   make check      install missing packages, build, run every test suite
+#   make check      install missing packages, build, run every test suite (plain and sanitized)
 #   make demo       generate, build and run the pendulum with HBVM(2,2)
 #   make generated  regenerate the committed solvers in generated/
 #   make tables     the paper's tables beside ours (docs/tables.md)
@@ -101,9 +101,17 @@ $(B)/tests/%.o: tests/%.c $(B)/tgen/stamp
 $(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(TSOLV_OBJ) $(LIBRT)
 	$(CC) $(SAN) -o $@ $^ $(CHECKLIB) $(GSLLIB) -lm
 
+# make check runs every suite twice: as built, then built with ASan and UBSan
+# (make SANITIZE=1 check runs only the latter); the plain binaries are put
+# back in place at the end.
 check: deps
 	@$(MAKE) --no-print-directory $(B)/tests/runner all
 	cd tests && HBVM_SANITIZED=$(if $(SANITIZE),1,) ../$(B)/tests/runner
+ifndef SANITIZE
+	@echo "== the same suites under -fsanitize=address,undefined"
+	@$(MAKE) --no-print-directory SANITIZE=1 check
+	@$(MAKE) --no-print-directory all
+endif
 
 generated: all
 	scripts/regen.sh gen/hbvmgen generated

@@ -22,8 +22,12 @@ instr_per_step() { # prefix dir steps h
   echo "$(( (b - a) / $3 )),$it"
 }
 
+# rows of an earlier run with the same tag are replaced
+retag() { [ -f "$1" ] && grep -v "^$tag," "$1" > "$1.tmp" && mv "$1.tmp" "$1" || true; }
+
 csv=$res/lean_instructions.csv
 [ -f "$csv" ] || echo "tag,model,k,s,h,instructions_per_step,iters_per_step" > "$csv"
+retag "$csv"
 # model:k:s:h -- fixed (k, s) so that rows of different tags compare the same method
 for spec in pendulum:2:2:0.05 conical:2:2:0.05 modified:6:2:0.05 satellites:6:2:0.1 kepler:6:2:0.03 \
             henon_heiles:3:2:0.1 chain8:2:2:0.01; do
@@ -34,6 +38,7 @@ done
 
 csv=$res/lean_scaling.csv
 [ -f "$csv" ] || echo "tag,N,m,nu,gen_seconds,c_bytes,cc_seconds,instructions_per_step,iters_per_step" > "$csv"
+retag "$csv"
 for N in ${LEAN_CHAIN:-8 32 128}; do
   sed "s/^N = 8$/N = $N/" models/chain8.ham > "$out/chain$N.ham"
   t0=$(now); $gen -s 2 -n "chain$N" -o "$out" "$out/chain$N.ham"; t1=$(now)

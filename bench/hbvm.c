@@ -1,0 +1,63 @@
+/* hbvm.c - the method "hbvm": a generated solver, found by problem and
+ * (k, s) among those bench/run.sh built. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench.h"
+#include "hbvm.h"
+
+const GenSolver *gen_solver_find(const char *problem, int k, int s)
+{
+  char name[128];
+  int i;
+  snprintf(name, sizeof name, "%s_k%ds%d", problem, k, s);
+  for (i = 0; gen_solvers[i]; i++)
+    if (strcmp(gen_solvers[i]->name, name) == 0) return gen_solvers[i];
+  return NULL;
+}
+
+/* The state of an open generated solver: which one, and its own state. */
+typedef struct {
+  const GenSolver *gs;
+  void *x;
+} Open;
+
+static int open_step(void *state, double h, int *iters)
+{
+  Open *o = state;
+  return o->gs->step(o->x, h, iters);
+}
+
+static void open_get(const void *state, double *q, double *p)
+{
+  const Open *o = state;
+  o->gs->get(o->x, q, p);
+}
+
+int hbvm_open(const Setting *set, Stepper *sp)
+{
+  const GenSolver *gs = gen_solver_find(set->pb->name, set->k, set->s);
+  double q0[BENCH_MAXM], p0[BENCH_MAXM];
+  Open *o;
+  if (!gs || gs->m != set->pb->m || gs->nu != set->pb->nu) return -1;
+  o = malloc(sizeof *o);
+  if (!o || !(o->x = malloc(gs->size))) {
+    free(o);
+    return -1;
+  }
+  o->gs = gs;
+  set->pb->init(q0, p0);
+  gs->init(o->x, q0, p0);
+  sp->state = o;
+  sp->step = open_step;
+  sp->get = open_get;
+  return 0;
+}
+
+void hbvm_close(Stepper *sp)
+{
+  Open *o = sp->state;
+  free(o->x);
+  free(o);
+}

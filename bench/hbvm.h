@@ -1,0 +1,27 @@
+/* hbvm.h - a generated solver behind a uniform interface.
+ *
+ * bench/run.sh generates NAME_kKsS.c/.h with gen/hbvmgen into build/bench/gen,
+ * compiles bench/hbvm_gen.c once per solver (-DSOLVER=NAME_kKsS) to get its
+ * GenSolver, and writes the table gen_solvers[] of all of them. */
+#ifndef BENCH_HBVM_H
+#define BENCH_HBVM_H
+
+#include <stddef.h>
+
+typedef struct {
+  const char *name; /* NAME_kKsS */
+  int m, nu, k, s;
+  size_t size;      /* of the solver's state */
+  void (*init)(void *x, const double *q0, const double *p0);
+  int (*step)(void *x, double h, int *iters); /* the solver's return code */
+  void (*get)(const void *x, double *q, double *p);
+} GenSolver;
+
+/* Every generated solver of the build, NULL-terminated (registry.c, written
+ * by bench/run.sh). */
+extern const GenSolver *const gen_solvers[];
+
+/* The generated solver for problem at (k, s), or NULL. */
+const GenSolver *gen_solver_find(const char *problem, int k, int s);
+
+#endif
