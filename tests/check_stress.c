@@ -65,27 +65,15 @@ enum { OK = 0, ENOCONV = 1, ENONFINITE = 2, ESINGULAR = 3, EBADSTEP = 4 };
 #define TEST_ONLY_SOLVERS(X) X(redundant_k2s2) X(viviani_k2s2) X(cliff_k6s2) X(logwall_k6s2)
 #define LOCAL_SOLVERS(X) TEST_ONLY_SOLVERS(X) X(pendulum_angle_k6s3)
 
-#define LOCAL_ADAPT(P)                                                                                      \
+#define CODES_AGREE(P)                                                                                    \
   typedef char P##_codes_agree[(P##_OK == OK && P##_ENOCONV == ENOCONV && P##_ENONFINITE == ENONFINITE &&   \
                                 P##_ESINGULAR == ESINGULAR && P##_EBADSTEP == EBADSTEP)                     \
                                    ? 1                                                                      \
-                                   : -1];                                                                   \
-  static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); }              \
-  static int P##_step_(void *x, double h, int *iters) {                                                     \
-    P##_stats st;                                                                                           \
-    int rc = P##_step(x, h, NULL, &st);                                                                     \
-    if (iters) *iters = st.iters;                                                                           \
-    return rc;                                                                                              \
-  }                                                                                                         \
-  static double P##_energy_(const void *x) { return P##_energy(x, NULL); }                                  \
-  static void P##_g_(const void *x, double *g) { P##_constraints(x, NULL, g); }                             \
-  static void P##_hc_(const void *x, double *hc) { P##_hidden(x, NULL, hc); }
+                                   : -1];
+#define LOCAL_ADAPT(P) CODES_AGREE(P) SOLVER_ADAPT(P)
 LOCAL_SOLVERS(LOCAL_ADAPT)
 
-#define LOCAL_ENTRY(P)                                                                                      \
-  {#P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), offsetof(P##_state, t), offsetof(P##_state, q),       \
-   offsetof(P##_state, p), offsetof(P##_state, lambda), P##_init_, P##_step_, P##_energy_, P##_g_, P##_hc_},
-static const Solver local_solvers[] = {LOCAL_SOLVERS(LOCAL_ENTRY)}; /* the test-only ones first */
+static const Solver local_solvers[] = {LOCAL_SOLVERS(SOLVER_ENTRY)}; /* the test-only ones first */
 #define LOCAL_NAME(P) #P,
 static const char *const test_only_names[] = {TEST_ONLY_SOLVERS(LOCAL_NAME)};
 #define NTEST_ONLY (sizeof test_only_names / sizeof test_only_names[0])

@@ -34,24 +34,9 @@
   X(satellites_k6s3) X(kepler_k1s1) X(kepler_k2s2) X(kepler_k3s3) X(kepler_k6s1) X(kepler_k6s2) X(kepler_k6s3)   \
   X(kepler_k16s2) X(henon_heiles_k2s2) X(henon_heiles_k3s2)
 
-#define ADAPT(P)                                                                             \
-  static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); } \
-  static int P##_step_(void *x, double h, int *iters) {                                      \
-    P##_stats st;                                                                            \
-    int rc = P##_step(x, h, NULL, &st);                                                      \
-    if (iters) *iters = st.iters;                                                            \
-    return rc;                                                                               \
-  }                                                                                          \
-  static double P##_energy_(const void *x) { return P##_energy(x, NULL); }                   \
-  static void P##_g_(const void *x, double *g) { P##_constraints(x, NULL, g); }              \
-  static void P##_hc_(const void *x, double *hc) { P##_hidden(x, NULL, hc); }
-SOLVERS(ADAPT)
+SOLVERS(SOLVER_ADAPT)
 
-#define ENTRY(P)                                                                                                \
-  {#P,           P##_M,       P##_NU,    P##_K,      P##_S,         sizeof(P##_state),                         \
-   offsetof(P##_state, t), offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda),          \
-   P##_init_,    P##_step_,   P##_energy_, P##_g_,   P##_hc_},
-static const Solver solvers[] = {SOLVERS(ENTRY)};
+static const Solver solvers[] = {SOLVERS(SOLVER_ENTRY)};
 
 const Solver *solver_find(const char *name) {
   for (size_t i = 0; i < sizeof solvers / sizeof solvers[0]; i++)

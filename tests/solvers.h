@@ -17,6 +17,25 @@ typedef struct {
   void (*hidden)(const void *x, double *hc);
 } Solver;
 
+/* The adapters of a generated solver with prefix P (its header included),
+ * and its Solver table entry: SOLVER_ADAPT(P) at file scope, then
+ * SOLVER_ENTRY(P) inside an initialiser. */
+#define SOLVER_ADAPT(P)                                                                      \
+  static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); } \
+  static int P##_step_(void *x, double h, int *iters) {                                      \
+    P##_stats st;                                                                            \
+    int rc = P##_step(x, h, NULL, &st);                                                      \
+    if (iters) *iters = st.iters;                                                            \
+    return rc;                                                                               \
+  }                                                                                          \
+  static double P##_energy_(const void *x) { return P##_energy(x, NULL); }                   \
+  static void P##_g_(const void *x, double *g) { P##_constraints(x, NULL, g); }              \
+  static void P##_hc_(const void *x, double *hc) { P##_hidden(x, NULL, hc); }
+#define SOLVER_ENTRY(P)                                                                                         \
+  {#P,           P##_M,       P##_NU,    P##_K,      P##_S,         sizeof(P##_state),                         \
+   offsetof(P##_state, t), offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda),          \
+   P##_init_,    P##_step_,   P##_energy_, P##_g_,   P##_hc_},
+
 /* The solver of that name, or NULL. */
 const Solver *solver_find(const char *name);
 /* The solver for model (e.g. "pendulum") at (k, s), or NULL. */
