@@ -26,6 +26,8 @@ double legendre_shifted(int j, double x) {
   return sqrt(2.0 * j + 1) * l;
 }
 
+static double xi(int j) { return 1 / (2 * sqrt(fabs(4.0 * j * j - 1))); }
+
 static double binomial(int n, int k) {
   double r = 1;
   for (int i = 1; i <= k; i++) r = r * (n - k + i) / i;
@@ -66,49 +68,6 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
-// P_j(x) in long double: the constants are computed in extended precision
-// and rounded once, so identities of the method hold to the last bit where
-// they can (b_l P_1(c_l) = 1/2 exactly for k = 2, not 0.49999999999999994).
-static long double legendre_ld(int j, long double x) {
-  long double t = 2 * x - 1, lm1 = 1, l = t;
-  if (j == 0) return 1;
-  for (int n = 1; n < j; n++) {
-    long double next = ((2 * n + 1) * t * l - n * lm1) / (n + 1);
-    lm1 = l;
-    l = next;
-  }
-  return sqrtl(2.0L * j + 1) * l;
-}
-
-static long double xi_ld(int j) { return 1 / (2 * sqrtl(fabsl(4.0L * j * j - 1))); }
-
-// Refine a Gauss-Legendre node c of [0,1] (from GSL, in double) by Newton's
-// method on L_k(2c-1) in long double, and return its weight.
-static long double refine_node(int k, long double *c) {
-  long double t = 2 * *c - 1, lk = 1, lkm1 = 0;
-  for (int it = 0; it < 4; it++) {
-    long double a = 1, b = t; /* L_0, L_1 */
-    for (int n = 1; n < k; n++) {
-      long double next = ((2 * n + 1) * t * b - n * a) / (n + 1);
-      a = b;
-      b = next;
-    }
-    lk = k == 0 ? 1 : b;
-    lkm1 = a;
-    long double d = k * (t * lk - lkm1) / (t * t - 1);
-    t -= lk / d;
-  }
-  long double a = 1, b = t;
-  for (int n = 1; n < k; n++) {
-    long double next = ((2 * n + 1) * t * b - n * a) / (n + 1);
-    a = b;
-    b = next;
-  }
-  long double d = k * (t * b - a) / (t * t - 1);
-  *c = (t + 1) / 2;
-  return 1 / ((1 - t * t) * d * d); /* 2 / ((1 - t^2) L_k'^2), halved for [0,1] */
-}
-
 // Fill the constants of HBVM(k,s).
 Method *method_new(int k, int s) {
   Method *me = arena_alloc(sizeof *me);
@@ -121,19 +80,9 @@ Method *method_new(int k, int s) {
   if (!t || !cb) internal_error("cannot build the Gauss-Legendre table for k=%d", k);
   for (int l = 0; l < k; l++) gsl_integration_glfixed_point(0, 1, (size_t)l, &cb[l][0], &cb[l][1], t);
   qsort(cb, (size_t)k, sizeof *cb, cmp_double);
-  /* nodes and weights refined in long double, and symmetric about 1/2 */
-  long double *cl = malloc((size_t)k * sizeof *cl), *bl = malloc((size_t)k * sizeof *bl);
-  if (!cl || !bl) internal_error("out of memory");
-  for (int l = 0; l < (k + 1) / 2; l++) {
-    cl[l] = cb[l][0];
-    bl[l] = refine_node(k, &cl[l]);
-    cl[k - 1 - l] = 1 - cl[l];
-    bl[k - 1 - l] = bl[l];
-  }
-  if (k % 2) cl[k / 2] = 0.5L;
   for (int l = 0; l < k; l++) {
-    me->c[l] = (double)cl[l];
-    me->b[l] = (double)bl[l];
+    me->c[l] = cb[l][0];
+    me->b[l] = cb[l][1];
   }
   free(cb);
   gsl_integration_glfixed_table_free(t);
@@ -141,16 +90,15 @@ Method *method_new(int k, int s) {
   me->Ihat = arena_alloc((size_t)k * s * sizeof(double));
   me->W = arena_alloc((size_t)k * s * sizeof(double));
   me->xi = arena_alloc((size_t)(s + 1) * sizeof(double));
-  for (int j = 0; j <= s; j++) me->xi[j] = (double)xi_ld(j);
+  for (int j = 0; j <= s; j++) me->xi[j] = xi(j);
   for (int l = 0; l < k; l++)
     for (int j = 0; j < s; j++) {
-      long double c = cl[l], p = legendre_ld(j, c);
-      me->Phat[l * s + j] = (double)p;
-      me->W[l * s + j] = (double)(bl[l] * p);
-      me->Ihat[l * s + j] = (double)(j == 0 ? c : xi_ld(j + 1) * legendre_ld(j + 1, c) - xi_ld(j) * legendre_ld(j - 1, c));
+      double c = me->c[l];
+      me->Phat[l * s + j] = legendre_shifted(j, c);
+      me->W[l * s + j] = me->b[l] * me->Phat[l * s + j];
+      me->Ihat[l * s + j] =
+          j == 0 ? c : xi(j + 1) * legendre_shifted(j + 1, c) - xi(j) * legendre_shifted(j - 1, c);
     }
-  free(cl);
-  free(bl);
   /* Warm start: gamma_j of the next step (size r*h) from this step's
    * polynomial: E_ji(r) = int_0^1 P_j(x) P_i(1 + r x) dx = sum_d E_jid r^d,
    * with E_jid = P_i^(d)(1)/d! * int_0^1 P_j(x) x^d dx (exact by Gauss). */

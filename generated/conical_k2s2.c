@@ -16,11 +16,11 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518711   b_1 = 0.5
+ *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double conical_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double conical_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double conical_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -34,32 +34,32 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = gam[0] * 0.5;
-  const double t2 = gam[3] * 0.28867513459481287;
+  const double t2 = gam[3] * 0.28867513459481292;
   const double t3 = t1 - t2;
   const double t4 = h * t3;
   const double t5 = 2.0 * t4;
   const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481287;
+  const double t7 = gam[0] * 0.28867513459481292;
   const double t8 = h * t7;
   const double t9 = 2.0 * t8;
   const double t10 = 2.0 * q0[1];
   const double t11 = 0.5 * gam[1];
-  const double t12 = 0.28867513459481287 * gam[4];
+  const double t12 = 0.28867513459481292 * gam[4];
   const double t13 = t11 - t12;
   const double t14 = h * t13;
   const double t15 = 2.0 * t14;
   const double t16 = t10 + t15;
-  const double t17 = 0.28867513459481287 * gam[1];
+  const double t17 = 0.28867513459481292 * gam[1];
   const double t18 = h * t17;
   const double t19 = 2.0 * t18;
   const double t20 = 2.0 * q0[2];
   const double t21 = 0.5 * gam[2];
-  const double t22 = 0.28867513459481287 * gam[5];
+  const double t22 = 0.28867513459481292 * gam[5];
   const double t23 = t21 - t22;
   const double t24 = h * t23;
   const double t25 = 2.0 * t24;
   const double t26 = t20 + t25;
-  const double t27 = 0.28867513459481287 * gam[2];
+  const double t27 = 0.28867513459481292 * gam[2];
   const double t28 = h * t27;
   const double t29 = 2.0 * t28;
   /* multiplier system A lambda = r */
@@ -71,7 +71,7 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t35 = 0.5 * t34;
   const double t36 = h * t35;
   const double t37 = 0.5 * t26;
-  const double t38 = t28 * 0.57735026918962573;
+  const double t38 = t28 * 0.57735026918962584;
   const double t39 = t37 + t38;
   const double t40 = h * t39;
   const double t41 = t6 * p0[0];
@@ -91,27 +91,27 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t54 = t19 * t48;
   const double t55 = t29 * t48;
   const double t56 = 0.5 * t49;
-  const double t57 = 0.28867513459481287 * t53;
+  const double t57 = 0.28867513459481292 * t53;
   const double t58 = t56 - t57;
   const double t59 = h * t58;
   const double t60 = p0[0] - t59;
   const double t61 = 0.5 * t50;
-  const double t62 = 0.28867513459481287 * t54;
+  const double t62 = 0.28867513459481292 * t54;
   const double t63 = t61 - t62;
   const double t64 = h * t63;
   const double t65 = p0[1] - t64;
   const double t66 = 0.5 * t52;
-  const double t67 = 0.28867513459481287 * t55;
+  const double t67 = 0.28867513459481292 * t55;
   const double t68 = t66 - t67;
   const double t69 = h * t68;
   const double t70 = p0[2] - t69;
-  const double t71 = 0.28867513459481287 * t49;
+  const double t71 = 0.28867513459481292 * t49;
   const double t72 = h * t71;
   const double t73 = -t72;
-  const double t74 = 0.28867513459481287 * t50;
+  const double t74 = 0.28867513459481292 * t50;
   const double t75 = h * t74;
   const double t76 = -t75;
-  const double t77 = 0.28867513459481287 * t52;
+  const double t77 = 0.28867513459481292 * t52;
   const double t78 = h * t77;
   const double t79 = -t78;
   const double t80 = h * t49;

@@ -16,12 +16,12 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
+ *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double conical_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double conical_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* Model defaults for q0 and p0. */
 static const double conical_k3s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k3s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -35,47 +35,47 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = gam[0] * 0.5;
-  const double t2 = gam[3] * 0.28867513459481287;
+  const double t2 = gam[3] * 0.28867513459481292;
   const double t3 = t1 - t2;
   const double t4 = h * t3;
   const double t5 = 2.0 * t4;
   const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481287;
-  const double t8 = gam[6] * 0.12909944487358058;
+  const double t7 = gam[0] * 0.28867513459481292;
+  const double t8 = gam[6] * 0.12909944487358055;
   const double t9 = t7 - t8;
   const double t10 = h * t9;
   const double t11 = 2.0 * t10;
-  const double t12 = gam[3] * 0.12909944487358058;
+  const double t12 = gam[3] * 0.12909944487358055;
   const double t13 = h * t12;
   const double t14 = 2.0 * t13;
   const double t15 = 2.0 * q0[1];
   const double t16 = 0.5 * gam[1];
-  const double t17 = 0.28867513459481287 * gam[4];
+  const double t17 = 0.28867513459481292 * gam[4];
   const double t18 = t16 - t17;
   const double t19 = h * t18;
   const double t20 = 2.0 * t19;
   const double t21 = t15 + t20;
-  const double t22 = 0.28867513459481287 * gam[1];
-  const double t23 = 0.12909944487358058 * gam[7];
+  const double t22 = 0.28867513459481292 * gam[1];
+  const double t23 = 0.12909944487358055 * gam[7];
   const double t24 = t22 - t23;
   const double t25 = h * t24;
   const double t26 = 2.0 * t25;
-  const double t27 = 0.12909944487358058 * gam[4];
+  const double t27 = 0.12909944487358055 * gam[4];
   const double t28 = h * t27;
   const double t29 = 2.0 * t28;
   const double t30 = 2.0 * q0[2];
   const double t31 = 0.5 * gam[2];
-  const double t32 = 0.28867513459481287 * gam[5];
+  const double t32 = 0.28867513459481292 * gam[5];
   const double t33 = t31 - t32;
   const double t34 = h * t33;
   const double t35 = 2.0 * t34;
   const double t36 = t30 + t35;
-  const double t37 = 0.28867513459481287 * gam[2];
-  const double t38 = 0.12909944487358058 * gam[8];
+  const double t37 = 0.28867513459481292 * gam[2];
+  const double t38 = 0.12909944487358055 * gam[8];
   const double t39 = t37 - t38;
   const double t40 = h * t39;
   const double t41 = 2.0 * t40;
-  const double t42 = 0.12909944487358058 * gam[5];
+  const double t42 = 0.12909944487358055 * gam[5];
   const double t43 = h * t42;
   const double t44 = 2.0 * t43;
   /* multiplier system A lambda = r */
@@ -87,7 +87,7 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t50 = 0.5 * t49;
   const double t51 = h * t50;
   const double t52 = 0.5 * t36;
-  const double t53 = t40 * 0.57735026918962573;
+  const double t53 = t40 * 0.57735026918962584;
   const double t54 = t52 + t53;
   const double t55 = h * t54;
   const double t56 = t6 * p0[0];
@@ -110,42 +110,42 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t72 = t29 * t63;
   const double t73 = t44 * t63;
   const double t74 = 0.5 * t64;
-  const double t75 = 0.28867513459481287 * t68;
+  const double t75 = 0.28867513459481292 * t68;
   const double t76 = t74 - t75;
   const double t77 = h * t76;
   const double t78 = p0[0] - t77;
   const double t79 = 0.5 * t65;
-  const double t80 = 0.28867513459481287 * t69;
+  const double t80 = 0.28867513459481292 * t69;
   const double t81 = t79 - t80;
   const double t82 = h * t81;
   const double t83 = p0[1] - t82;
   const double t84 = 0.5 * t67;
-  const double t85 = 0.28867513459481287 * t70;
+  const double t85 = 0.28867513459481292 * t70;
   const double t86 = t84 - t85;
   const double t87 = h * t86;
   const double t88 = p0[2] - t87;
-  const double t89 = 0.28867513459481287 * t64;
-  const double t90 = 0.12909944487358058 * t71;
+  const double t89 = 0.28867513459481292 * t64;
+  const double t90 = 0.12909944487358055 * t71;
   const double t91 = t89 - t90;
   const double t92 = h * t91;
   const double t93 = -t92;
-  const double t94 = 0.28867513459481287 * t65;
-  const double t95 = 0.12909944487358058 * t72;
+  const double t94 = 0.28867513459481292 * t65;
+  const double t95 = 0.12909944487358055 * t72;
   const double t96 = t94 - t95;
   const double t97 = h * t96;
   const double t98 = -t97;
-  const double t99 = 0.28867513459481287 * t67;
-  const double t100 = 0.12909944487358058 * t73;
+  const double t99 = 0.28867513459481292 * t67;
+  const double t100 = 0.12909944487358055 * t73;
   const double t101 = t99 - t100;
   const double t102 = h * t101;
   const double t103 = -t102;
-  const double t104 = 0.12909944487358058 * t68;
+  const double t104 = 0.12909944487358055 * t68;
   const double t105 = h * t104;
   const double t106 = -t105;
-  const double t107 = 0.12909944487358058 * t69;
+  const double t107 = 0.12909944487358055 * t69;
   const double t108 = h * t107;
   const double t109 = -t108;
-  const double t110 = 0.12909944487358058 * t70;
+  const double t110 = 0.12909944487358055 * t70;
   const double t111 = h * t110;
   const double t112 = -t111;
   const double t113 = h * t64;

@@ -19,10 +19,10 @@
  *   c_1 = 0.069431844202973714   b_1 = 0.17392742256872692
  *   c_2 = 0.33000947820757187   b_2 = 0.32607257743127305
  *   c_3 = 0.66999052179242813   b_3 = 0.32607257743127305
- *   c_4 = 0.93056815579702634   b_4 = 0.17392742256872692
+ *   c_4 = 0.93056815579702623   b_4 = 0.17392742256872692
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double conical_k4s4_E[64] = {1.0, 0.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995805, 0.0, 2.6457513110645934, 15.874507866387544, 26.457513110645909, 13.228756555322953, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989, 0.0, 0.0, 0.0, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 9.1651513899116814, 22.912878474779198, 13.747727084867522, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0000000000000002, 0.0, 0.0, 0.0, 5.916079783099617, 5.9160797830996179, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0000000000000013};
+static const double conical_k4s4_E[64] = {1.0, 0.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995796, 0.0, 2.6457513110645934, 15.874507866387544, 26.457513110645905, 13.228756555322951, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989, 0.0, 0.0, 0.0, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 9.1651513899116814, 22.912878474779198, 13.747727084867515, (-8.3266726846886741e-17), 0.0, 0.0, 0.0, (-1.442222014787673e-16), (-3.8459253727671276e-16), 0.0, 0.0, (-1.8619006149354548e-16), (-1.4895204919483639e-15), 0.99999999999999911, 0.0, (-2.2030305172320797e-16), (-3.5248488275713244e-15), 5.9160797830996108, 5.9160797830996108, (-1.6653345369377348e-16), 0.0, 0.0, 0.0, (-2.884444029575346e-16), (-5.7688880591506919e-16), 0.0, 0.0, (-3.7238012298709097e-16), (-2.2342807379225458e-15), (-2.4204707994160914e-15), 0.0, (-4.4060610344641594e-16), (-5.2872732413569865e-15), (-1.4319698362008503e-14), 0.99999999999999023};
 /* Model defaults for q0 and p0. */
 static const double conical_k4s4_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k4s4_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -36,17 +36,17 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = gam[0] * 0.5;
-  const double t2 = gam[3] * 0.28867513459481287;
+  const double t2 = gam[3] * 0.28867513459481292;
   const double t3 = t1 - t2;
   const double t4 = h * t3;
   const double t5 = 2.0 * t4;
   const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481287;
-  const double t8 = gam[6] * 0.12909944487358058;
+  const double t7 = gam[0] * 0.28867513459481292;
+  const double t8 = gam[6] * 0.12909944487358055;
   const double t9 = t7 - t8;
   const double t10 = h * t9;
   const double t11 = 2.0 * t10;
-  const double t12 = gam[3] * 0.12909944487358058;
+  const double t12 = gam[3] * 0.12909944487358055;
   const double t13 = gam[9] * 0.084515425472851652;
   const double t14 = t12 - t13;
   const double t15 = h * t14;
@@ -56,17 +56,17 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t19 = 2.0 * t18;
   const double t20 = 2.0 * q0[1];
   const double t21 = 0.5 * gam[1];
-  const double t22 = 0.28867513459481287 * gam[4];
+  const double t22 = 0.28867513459481292 * gam[4];
   const double t23 = t21 - t22;
   const double t24 = h * t23;
   const double t25 = 2.0 * t24;
   const double t26 = t20 + t25;
-  const double t27 = 0.28867513459481287 * gam[1];
-  const double t28 = 0.12909944487358058 * gam[7];
+  const double t27 = 0.28867513459481292 * gam[1];
+  const double t28 = 0.12909944487358055 * gam[7];
   const double t29 = t27 - t28;
   const double t30 = h * t29;
   const double t31 = 2.0 * t30;
-  const double t32 = 0.12909944487358058 * gam[4];
+  const double t32 = 0.12909944487358055 * gam[4];
   const double t33 = 0.084515425472851652 * gam[10];
   const double t34 = t32 - t33;
   const double t35 = h * t34;
@@ -76,17 +76,17 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t39 = 2.0 * t38;
   const double t40 = 2.0 * q0[2];
   const double t41 = 0.5 * gam[2];
-  const double t42 = 0.28867513459481287 * gam[5];
+  const double t42 = 0.28867513459481292 * gam[5];
   const double t43 = t41 - t42;
   const double t44 = h * t43;
   const double t45 = 2.0 * t44;
   const double t46 = t40 + t45;
-  const double t47 = 0.28867513459481287 * gam[2];
-  const double t48 = 0.12909944487358058 * gam[8];
+  const double t47 = 0.28867513459481292 * gam[2];
+  const double t48 = 0.12909944487358055 * gam[8];
   const double t49 = t47 - t48;
   const double t50 = h * t49;
   const double t51 = 2.0 * t50;
-  const double t52 = 0.12909944487358058 * gam[5];
+  const double t52 = 0.12909944487358055 * gam[5];
   const double t53 = 0.084515425472851652 * gam[11];
   const double t54 = t52 - t53;
   const double t55 = h * t54;
@@ -103,7 +103,7 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t65 = 0.5 * t64;
   const double t66 = h * t65;
   const double t67 = 0.5 * t46;
-  const double t68 = t50 * 0.57735026918962573;
+  const double t68 = t50 * 0.57735026918962584;
   const double t69 = t67 + t68;
   const double t70 = h * t69;
   const double t71 = t6 * p0[0];
@@ -129,46 +129,46 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t90 = t39 * t78;
   const double t91 = t59 * t78;
   const double t92 = 0.5 * t79;
-  const double t93 = 0.28867513459481287 * t83;
+  const double t93 = 0.28867513459481292 * t83;
   const double t94 = t92 - t93;
   const double t95 = h * t94;
   const double t96 = p0[0] - t95;
   const double t97 = 0.5 * t80;
-  const double t98 = 0.28867513459481287 * t84;
+  const double t98 = 0.28867513459481292 * t84;
   const double t99 = t97 - t98;
   const double t100 = h * t99;
   const double t101 = p0[1] - t100;
   const double t102 = 0.5 * t82;
-  const double t103 = 0.28867513459481287 * t85;
+  const double t103 = 0.28867513459481292 * t85;
   const double t104 = t102 - t103;
   const double t105 = h * t104;
   const double t106 = p0[2] - t105;
-  const double t107 = 0.28867513459481287 * t79;
-  const double t108 = 0.12909944487358058 * t86;
+  const double t107 = 0.28867513459481292 * t79;
+  const double t108 = 0.12909944487358055 * t86;
   const double t109 = t107 - t108;
   const double t110 = h * t109;
   const double t111 = -t110;
-  const double t112 = 0.28867513459481287 * t80;
-  const double t113 = 0.12909944487358058 * t87;
+  const double t112 = 0.28867513459481292 * t80;
+  const double t113 = 0.12909944487358055 * t87;
   const double t114 = t112 - t113;
   const double t115 = h * t114;
   const double t116 = -t115;
-  const double t117 = 0.28867513459481287 * t82;
-  const double t118 = 0.12909944487358058 * t88;
+  const double t117 = 0.28867513459481292 * t82;
+  const double t118 = 0.12909944487358055 * t88;
   const double t119 = t117 - t118;
   const double t120 = h * t119;
   const double t121 = -t120;
-  const double t122 = 0.12909944487358058 * t83;
+  const double t122 = 0.12909944487358055 * t83;
   const double t123 = 0.084515425472851652 * t89;
   const double t124 = t122 - t123;
   const double t125 = h * t124;
   const double t126 = -t125;
-  const double t127 = 0.12909944487358058 * t84;
+  const double t127 = 0.12909944487358055 * t84;
   const double t128 = 0.084515425472851652 * t90;
   const double t129 = t127 - t128;
   const double t130 = h * t129;
   const double t131 = -t130;
-  const double t132 = 0.12909944487358058 * t85;
+  const double t132 = 0.12909944487358055 * t85;
   const double t133 = 0.084515425472851652 * t91;
   const double t134 = t132 - t133;
   const double t135 = h * t134;

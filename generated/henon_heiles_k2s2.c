@@ -16,11 +16,11 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518711   b_1 = 0.5
+ *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double henon_heiles_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double henon_heiles_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double henon_heiles_k2s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k2s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
@@ -32,13 +32,13 @@ static void henon_heiles_k2s2_sweep(const double *q0, const double *p0, const do
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.21132486540518711;
-  const double t1 = gam[2] * (-0.28867513459481287);
+  const double t0 = gam[0] * 0.21132486540518713;
+  const double t1 = gam[2] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
   const double t4 = t3 + q0[0];
-  const double t5 = 0.21132486540518711 * gam[1];
-  const double t6 = (-0.28867513459481287) * gam[3];
+  const double t5 = 0.21132486540518713 * gam[1];
+  const double t6 = (-0.28867513459481292) * gam[3];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
   const double t9 = t8 + q0[1];
@@ -53,8 +53,8 @@ static void henon_heiles_k2s2_sweep(const double *q0, const double *p0, const do
   const double t18 = t15 * t17;
   const double t19 = 0.5 * t18;
   const double t20 = 0.5 * t16;
-  const double t21 = t18 * (-0.5);
-  const double t22 = t16 * (-0.5);
+  const double t21 = t18 * (-0.49999999999999994);
+  const double t22 = t16 * (-0.49999999999999994);
   /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t23 = gam[0] * 0.78867513459481287;
   const double t24 = t1 + t23;
@@ -77,35 +77,37 @@ static void henon_heiles_k2s2_sweep(const double *q0, const double *p0, const do
   const double t41 = t19 + t40;
   const double t42 = 0.5 * t37;
   const double t43 = t20 + t42;
-  const double t44 = t21 + t40;
-  const double t45 = t22 + t42;
+  const double t44 = t39 * 0.49999999999999994;
+  const double t45 = t21 + t44;
+  const double t46 = t37 * 0.49999999999999994;
+  const double t47 = t22 + t46;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t46 = 0.5 * t41;
-  const double t47 = t44 * 0.28867513459481287;
-  const double t48 = t46 - t47;
-  const double t49 = h * t48;
-  const double t50 = p0[0] - t49;
-  const double t51 = 0.5 * t43;
-  const double t52 = t45 * 0.28867513459481287;
-  const double t53 = t51 - t52;
-  const double t54 = h * t53;
-  const double t55 = p0[1] - t54;
-  const double t56 = t41 * 0.28867513459481287;
-  const double t57 = h * t56;
-  const double t58 = -t57;
-  const double t59 = t43 * 0.28867513459481287;
-  const double t60 = h * t59;
-  const double t61 = -t60;
-  const double t62 = h * t41;
+  const double t48 = 0.5 * t41;
+  const double t49 = t45 * 0.28867513459481292;
+  const double t50 = t48 - t49;
+  const double t51 = h * t50;
+  const double t52 = p0[0] - t51;
+  const double t53 = 0.5 * t43;
+  const double t54 = t47 * 0.28867513459481292;
+  const double t55 = t53 - t54;
+  const double t56 = h * t55;
+  const double t57 = p0[1] - t56;
+  const double t58 = t41 * 0.28867513459481292;
+  const double t59 = h * t58;
+  const double t60 = -t59;
+  const double t61 = t43 * 0.28867513459481292;
+  const double t62 = h * t61;
   const double t63 = -t62;
-  const double t64 = h * t43;
+  const double t64 = h * t41;
   const double t65 = -t64;
-  out[0] = t50;
-  out[1] = t55;
-  out[2] = t58;
-  out[3] = t61;
-  out[4] = t63;
-  out[5] = t65;
+  const double t66 = h * t43;
+  const double t67 = -t66;
+  out[0] = t52;
+  out[1] = t57;
+  out[2] = t60;
+  out[3] = t63;
+  out[4] = t65;
+  out[5] = t67;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */

@@ -16,7 +16,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
+ *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -33,13 +33,13 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.11270166537925831;
-  const double t1 = gam[2] * (-0.17320508075688773);
+  const double t0 = gam[0] * 0.1127016653792583;
+  const double t1 = gam[2] * (-0.17320508075688779);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
   const double t4 = t3 + q0[0];
-  const double t5 = 0.11270166537925831 * gam[1];
-  const double t6 = (-0.17320508075688773) * gam[3];
+  const double t5 = 0.1127016653792583 * gam[1];
+  const double t6 = (-0.17320508075688779) * gam[3];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
   const double t9 = t8 + q0[1];
@@ -58,12 +58,12 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t22 = t16 * (-0.37267799624996495);
   /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t23 = 0.5 * gam[0];
-  const double t24 = gam[2] * (-0.4330127018922193);
+  const double t24 = gam[2] * (-0.43301270189221935);
   const double t25 = t23 + t24;
   const double t26 = h * t25;
   const double t27 = q0[0] + t26;
   const double t28 = 0.5 * gam[1];
-  const double t29 = gam[3] * (-0.4330127018922193);
+  const double t29 = gam[3] * (-0.43301270189221935);
   const double t30 = t28 + t29;
   const double t31 = h * t30;
   const double t32 = q0[1] + t31;
@@ -108,19 +108,19 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t70 = t22 + t69;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
   const double t71 = 0.5 * t64;
-  const double t72 = t68 * 0.28867513459481287;
+  const double t72 = t68 * 0.28867513459481292;
   const double t73 = t71 - t72;
   const double t74 = h * t73;
   const double t75 = p0[0] - t74;
   const double t76 = 0.5 * t66;
-  const double t77 = t70 * 0.28867513459481287;
+  const double t77 = t70 * 0.28867513459481292;
   const double t78 = t76 - t77;
   const double t79 = h * t78;
   const double t80 = p0[1] - t79;
-  const double t81 = t64 * 0.28867513459481287;
+  const double t81 = t64 * 0.28867513459481292;
   const double t82 = h * t81;
   const double t83 = -t82;
-  const double t84 = t66 * 0.28867513459481287;
+  const double t84 = t66 * 0.28867513459481292;
   const double t85 = h * t84;
   const double t86 = -t85;
   const double t87 = h * t64;

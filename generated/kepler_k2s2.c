@@ -16,11 +16,11 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518711   b_1 = 0.5
+ *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double kepler_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double kepler_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double kepler_k2s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k2s2_p0[2] = {0.0, 2.0};
@@ -32,13 +32,13 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.21132486540518711;
-  const double t1 = gam[2] * (-0.28867513459481287);
+  const double t0 = gam[0] * 0.21132486540518713;
+  const double t1 = gam[2] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
   const double t4 = t3 + q0[0];
-  const double t5 = 0.21132486540518711 * gam[1];
-  const double t6 = (-0.28867513459481287) * gam[3];
+  const double t5 = 0.21132486540518713 * gam[1];
+  const double t6 = (-0.28867513459481292) * gam[3];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
   const double t9 = t8 + q0[1];
@@ -56,8 +56,8 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
   const double t21 = t17 * t20;
   const double t22 = 0.5 * t21;
   const double t23 = 0.5 * t19;
-  const double t24 = t21 * (-0.5);
-  const double t25 = t19 * (-0.5);
+  const double t24 = t21 * (-0.49999999999999994);
+  const double t25 = t19 * (-0.49999999999999994);
   /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t26 = gam[0] * 0.78867513459481287;
   const double t27 = t1 + t26;
@@ -83,35 +83,37 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
   const double t47 = t22 + t46;
   const double t48 = 0.5 * t43;
   const double t49 = t23 + t48;
-  const double t50 = t24 + t46;
-  const double t51 = t25 + t48;
+  const double t50 = t45 * 0.49999999999999994;
+  const double t51 = t24 + t50;
+  const double t52 = t43 * 0.49999999999999994;
+  const double t53 = t25 + t52;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t52 = 0.5 * t47;
-  const double t53 = t50 * 0.28867513459481287;
-  const double t54 = t52 - t53;
-  const double t55 = h * t54;
-  const double t56 = p0[0] - t55;
-  const double t57 = 0.5 * t49;
-  const double t58 = t51 * 0.28867513459481287;
-  const double t59 = t57 - t58;
-  const double t60 = h * t59;
-  const double t61 = p0[1] - t60;
-  const double t62 = t47 * 0.28867513459481287;
-  const double t63 = h * t62;
-  const double t64 = -t63;
-  const double t65 = t49 * 0.28867513459481287;
-  const double t66 = h * t65;
-  const double t67 = -t66;
-  const double t68 = h * t47;
+  const double t54 = 0.5 * t47;
+  const double t55 = t51 * 0.28867513459481292;
+  const double t56 = t54 - t55;
+  const double t57 = h * t56;
+  const double t58 = p0[0] - t57;
+  const double t59 = 0.5 * t49;
+  const double t60 = t53 * 0.28867513459481292;
+  const double t61 = t59 - t60;
+  const double t62 = h * t61;
+  const double t63 = p0[1] - t62;
+  const double t64 = t47 * 0.28867513459481292;
+  const double t65 = h * t64;
+  const double t66 = -t65;
+  const double t67 = t49 * 0.28867513459481292;
+  const double t68 = h * t67;
   const double t69 = -t68;
-  const double t70 = h * t49;
+  const double t70 = h * t47;
   const double t71 = -t70;
-  out[0] = t56;
-  out[1] = t61;
-  out[2] = t64;
-  out[3] = t67;
-  out[4] = t69;
-  out[5] = t71;
+  const double t72 = h * t49;
+  const double t73 = -t72;
+  out[0] = t58;
+  out[1] = t63;
+  out[2] = t66;
+  out[3] = t69;
+  out[4] = t71;
+  out[5] = t73;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */

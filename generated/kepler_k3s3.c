@@ -16,12 +16,12 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
+ *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double kepler_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double kepler_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* Model defaults for q0 and p0. */
 static const double kepler_k3s3_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k3s3_p0[2] = {0.0, 2.0};
@@ -33,17 +33,17 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.11270166537925831;
-  const double t1 = gam[2] * (-0.17320508075688773);
+  const double t0 = gam[0] * 0.1127016653792583;
+  const double t1 = gam[2] * (-0.17320508075688779);
   const double t2 = t0 + t1;
-  const double t3 = gam[4] * 0.17320508075688773;
+  const double t3 = gam[4] * 0.1732050807568877;
   const double t4 = t2 + t3;
   const double t5 = h * t4;
   const double t6 = t5 + q0[0];
-  const double t7 = 0.11270166537925831 * gam[1];
-  const double t8 = (-0.17320508075688773) * gam[3];
+  const double t7 = 0.1127016653792583 * gam[1];
+  const double t8 = (-0.17320508075688779) * gam[3];
   const double t9 = t7 + t8;
-  const double t10 = 0.17320508075688773 * gam[5];
+  const double t10 = 0.1732050807568877 * gam[5];
   const double t11 = t9 + t10;
   const double t12 = h * t11;
   const double t13 = t12 + q0[1];
@@ -63,16 +63,16 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t27 = t23 * 0.27777777777777779;
   const double t28 = t25 * (-0.37267799624996495);
   const double t29 = t23 * (-0.37267799624996495);
-  const double t30 = t25 * 0.24845199749997662;
-  const double t31 = t23 * 0.24845199749997662;
+  const double t30 = t25 * 0.24845199749997668;
+  const double t31 = t23 * 0.24845199749997668;
   /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t32 = 0.5 * gam[0];
-  const double t33 = gam[2] * (-0.4330127018922193);
+  const double t33 = gam[2] * (-0.43301270189221935);
   const double t34 = t32 + t33;
   const double t35 = h * t34;
   const double t36 = q0[0] + t35;
   const double t37 = 0.5 * gam[1];
-  const double t38 = gam[3] * (-0.4330127018922193);
+  const double t38 = gam[3] * (-0.43301270189221935);
   const double t39 = t37 + t38;
   const double t40 = h * t39;
   const double t41 = q0[1] + t40;
@@ -99,13 +99,13 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
   const double t62 = gam[0] * 0.8872983346207417;
   const double t63 = t1 + t62;
-  const double t64 = (-0.17320508075688773) * gam[4];
+  const double t64 = gam[4] * (-0.1732050807568877);
   const double t65 = t63 + t64;
   const double t66 = h * t65;
   const double t67 = q0[0] + t66;
   const double t68 = gam[1] * 0.8872983346207417;
   const double t69 = t8 + t68;
-  const double t70 = (-0.17320508075688773) * gam[5];
+  const double t70 = gam[5] * (-0.1732050807568877);
   const double t71 = t69 + t70;
   const double t72 = h * t71;
   const double t73 = q0[1] + t72;
@@ -129,35 +129,35 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t91 = t28 + t90;
   const double t92 = t83 * 0.37267799624996495;
   const double t93 = t29 + t92;
-  const double t94 = 0.24845199749997662 * t85;
+  const double t94 = 0.24845199749997668 * t85;
   const double t95 = t59 + t94;
-  const double t96 = 0.24845199749997662 * t83;
+  const double t96 = 0.24845199749997668 * t83;
   const double t97 = t61 + t96;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
   const double t98 = 0.5 * t87;
-  const double t99 = t91 * 0.28867513459481287;
+  const double t99 = t91 * 0.28867513459481292;
   const double t100 = t98 - t99;
   const double t101 = h * t100;
   const double t102 = p0[0] - t101;
   const double t103 = 0.5 * t89;
-  const double t104 = t93 * 0.28867513459481287;
+  const double t104 = t93 * 0.28867513459481292;
   const double t105 = t103 - t104;
   const double t106 = h * t105;
   const double t107 = p0[1] - t106;
-  const double t108 = t87 * 0.28867513459481287;
-  const double t109 = t95 * 0.12909944487358058;
+  const double t108 = t87 * 0.28867513459481292;
+  const double t109 = t95 * 0.12909944487358055;
   const double t110 = t108 - t109;
   const double t111 = h * t110;
   const double t112 = -t111;
-  const double t113 = t89 * 0.28867513459481287;
-  const double t114 = t97 * 0.12909944487358058;
+  const double t113 = t89 * 0.28867513459481292;
+  const double t114 = t97 * 0.12909944487358055;
   const double t115 = t113 - t114;
   const double t116 = h * t115;
   const double t117 = -t116;
-  const double t118 = t91 * 0.12909944487358058;
+  const double t118 = t91 * 0.12909944487358055;
   const double t119 = h * t118;
   const double t120 = -t119;
-  const double t121 = t93 * 0.12909944487358058;
+  const double t121 = t93 * 0.12909944487358055;
   const double t122 = h * t121;
   const double t123 = -t122;
   const double t124 = h * t87;

@@ -16,8 +16,8 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.033765242898423989   b_1 = 0.085662246189585178
- *   c_2 = 0.16939530676686773   b_2 = 0.1803807865240693
+ *   c_1 = 0.033765242898423975   b_1 = 0.085662246189585178
+ *   c_2 = 0.16939530676686776   b_2 = 0.1803807865240693
  *   c_3 = 0.38069040695840156   b_3 = 0.23395696728634552
  *   c_4 = 0.61930959304159849   b_4 = 0.23395696728634552
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
@@ -36,10 +36,10 @@ static void kepler_k6s1_sweep(const double *q0, const double *p0, const double *
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.033765242898423989;
+  const double t0 = gam[0] * 0.033765242898423975;
   const double t1 = h * t0;
   const double t2 = t1 + q0[0];
-  const double t3 = 0.033765242898423989 * gam[1];
+  const double t3 = 0.033765242898423975 * gam[1];
   const double t4 = h * t3;
   const double t5 = t4 + q0[1];
   const double t6 = t2 * t2;
@@ -57,10 +57,10 @@ static void kepler_k6s1_sweep(const double *q0, const double *p0, const double *
   const double t18 = t17 * 0.085662246189585178;
   const double t19 = t15 * 0.085662246189585178;
   /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t20 = gam[0] * 0.16939530676686773;
+  const double t20 = gam[0] * 0.16939530676686776;
   const double t21 = h * t20;
   const double t22 = q0[0] + t21;
-  const double t23 = gam[1] * 0.16939530676686773;
+  const double t23 = gam[1] * 0.16939530676686776;
   const double t24 = h * t23;
   const double t25 = q0[1] + t24;
   const double t26 = t22 * t22;

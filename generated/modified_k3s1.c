@@ -16,7 +16,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
+ *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -39,13 +39,13 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   const double t3 = 2.0 * t2;
   const double t4 = t0 + t3;
   /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t5 = gam[0] * 0.11270166537925831;
+  const double t5 = gam[0] * 0.1127016653792583;
   const double t6 = h * t5;
   const double t7 = q0[0] + t6;
-  const double t8 = 0.11270166537925831 * gam[1];
+  const double t8 = 0.1127016653792583 * gam[1];
   const double t9 = h * t8;
   const double t10 = q0[1] + t9;
-  const double t11 = gam[2] * 0.11270166537925831;
+  const double t11 = gam[2] * 0.1127016653792583;
   const double t12 = h * t11;
   const double t13 = q0[2] + t12;
   const double t14 = t13 * t13 * t13;

@@ -16,11 +16,11 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518711   b_1 = 0.5
+ *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double pendulum_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double pendulum_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double pendulum_k2s2_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k2s2_p0[2] = {1.0, 0.0};
@@ -34,22 +34,22 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = gam[0] * 0.5;
-  const double t2 = gam[2] * 0.28867513459481287;
+  const double t2 = gam[2] * 0.28867513459481292;
   const double t3 = t1 - t2;
   const double t4 = h * t3;
   const double t5 = 2.0 * t4;
   const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481287;
+  const double t7 = gam[0] * 0.28867513459481292;
   const double t8 = h * t7;
   const double t9 = 2.0 * t8;
   const double t10 = 2.0 * q0[1];
   const double t11 = 0.5 * gam[1];
-  const double t12 = 0.28867513459481287 * gam[3];
+  const double t12 = 0.28867513459481292 * gam[3];
   const double t13 = t11 - t12;
   const double t14 = h * t13;
   const double t15 = 2.0 * t14;
   const double t16 = t10 + t15;
-  const double t17 = 0.28867513459481287 * gam[1];
+  const double t17 = 0.28867513459481292 * gam[1];
   const double t18 = h * t17;
   const double t19 = 2.0 * t18;
   /* multiplier system A lambda = r */
@@ -59,7 +59,7 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   const double t23 = 0.5 * t22;
   const double t24 = h * t23;
   const double t25 = 0.5 * t16;
-  const double t26 = t18 * 0.57735026918962573;
+  const double t26 = t18 * 0.57735026918962584;
   const double t27 = t25 + t26;
   const double t28 = h * t27;
   const double t29 = t6 * p0[0];
@@ -75,19 +75,19 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   const double t38 = t9 * t34;
   const double t39 = t19 * t34;
   const double t40 = 0.5 * t35;
-  const double t41 = 0.28867513459481287 * t38;
+  const double t41 = 0.28867513459481292 * t38;
   const double t42 = t40 - t41;
   const double t43 = h * t42;
   const double t44 = p0[0] - t43;
   const double t45 = 0.5 * t37;
-  const double t46 = 0.28867513459481287 * t39;
+  const double t46 = 0.28867513459481292 * t39;
   const double t47 = t45 - t46;
   const double t48 = h * t47;
   const double t49 = p0[1] - t48;
-  const double t50 = 0.28867513459481287 * t35;
+  const double t50 = 0.28867513459481292 * t35;
   const double t51 = h * t50;
   const double t52 = -t51;
-  const double t53 = 0.28867513459481287 * t37;
+  const double t53 = 0.28867513459481292 * t37;
   const double t54 = h * t53;
   const double t55 = -t54;
   const double t56 = h * t35;

@@ -16,12 +16,12 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
+ *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double pendulum_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989};
+static const double pendulum_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* Model defaults for q0 and p0. */
 static const double pendulum_k3s3_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k3s3_p0[2] = {1.0, 0.0};
@@ -35,32 +35,32 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   /* affine derivative entries, projected in closed form */
   const double t0 = 2.0 * q0[0];
   const double t1 = gam[0] * 0.5;
-  const double t2 = gam[2] * 0.28867513459481287;
+  const double t2 = gam[2] * 0.28867513459481292;
   const double t3 = t1 - t2;
   const double t4 = h * t3;
   const double t5 = 2.0 * t4;
   const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481287;
-  const double t8 = gam[4] * 0.12909944487358058;
+  const double t7 = gam[0] * 0.28867513459481292;
+  const double t8 = gam[4] * 0.12909944487358055;
   const double t9 = t7 - t8;
   const double t10 = h * t9;
   const double t11 = 2.0 * t10;
-  const double t12 = gam[2] * 0.12909944487358058;
+  const double t12 = gam[2] * 0.12909944487358055;
   const double t13 = h * t12;
   const double t14 = 2.0 * t13;
   const double t15 = 2.0 * q0[1];
   const double t16 = 0.5 * gam[1];
-  const double t17 = 0.28867513459481287 * gam[3];
+  const double t17 = 0.28867513459481292 * gam[3];
   const double t18 = t16 - t17;
   const double t19 = h * t18;
   const double t20 = 2.0 * t19;
   const double t21 = t15 + t20;
-  const double t22 = 0.28867513459481287 * gam[1];
-  const double t23 = 0.12909944487358058 * gam[5];
+  const double t22 = 0.28867513459481292 * gam[1];
+  const double t23 = 0.12909944487358055 * gam[5];
   const double t24 = t22 - t23;
   const double t25 = h * t24;
   const double t26 = 2.0 * t25;
-  const double t27 = 0.12909944487358058 * gam[3];
+  const double t27 = 0.12909944487358055 * gam[3];
   const double t28 = h * t27;
   const double t29 = 2.0 * t28;
   /* multiplier system A lambda = r */
@@ -70,7 +70,7 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   const double t33 = 0.5 * t32;
   const double t34 = h * t33;
   const double t35 = 0.5 * t21;
-  const double t36 = t25 * 0.57735026918962573;
+  const double t36 = t25 * 0.57735026918962584;
   const double t37 = t35 + t36;
   const double t38 = h * t37;
   const double t39 = t6 * p0[0];
@@ -88,29 +88,29 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   const double t50 = t14 * t44;
   const double t51 = t29 * t44;
   const double t52 = 0.5 * t45;
-  const double t53 = 0.28867513459481287 * t48;
+  const double t53 = 0.28867513459481292 * t48;
   const double t54 = t52 - t53;
   const double t55 = h * t54;
   const double t56 = p0[0] - t55;
   const double t57 = 0.5 * t47;
-  const double t58 = 0.28867513459481287 * t49;
+  const double t58 = 0.28867513459481292 * t49;
   const double t59 = t57 - t58;
   const double t60 = h * t59;
   const double t61 = p0[1] - t60;
-  const double t62 = 0.28867513459481287 * t45;
-  const double t63 = 0.12909944487358058 * t50;
+  const double t62 = 0.28867513459481292 * t45;
+  const double t63 = 0.12909944487358055 * t50;
   const double t64 = t62 - t63;
   const double t65 = h * t64;
   const double t66 = -t65;
-  const double t67 = 0.28867513459481287 * t47;
-  const double t68 = 0.12909944487358058 * t51;
+  const double t67 = 0.28867513459481292 * t47;
+  const double t68 = 0.12909944487358055 * t51;
   const double t69 = t67 - t68;
   const double t70 = h * t69;
   const double t71 = -t70;
-  const double t72 = 0.12909944487358058 * t48;
+  const double t72 = 0.12909944487358055 * t48;
   const double t73 = h * t72;
   const double t74 = -t73;
-  const double t75 = 0.12909944487358058 * t49;
+  const double t75 = 0.12909944487358055 * t49;
   const double t76 = h * t75;
   const double t77 = -t76;
   const double t78 = h * t45;

@@ -16,8 +16,8 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.033765242898423989   b_1 = 0.085662246189585178
- *   c_2 = 0.16939530676686773   b_2 = 0.1803807865240693
+ *   c_1 = 0.033765242898423975   b_1 = 0.085662246189585178
+ *   c_2 = 0.16939530676686776   b_2 = 0.1803807865240693
  *   c_3 = 0.38069040695840156   b_3 = 0.23395696728634552
  *   c_4 = 0.61930959304159849   b_4 = 0.23395696728634552
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
@@ -127,31 +127,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t88 = t38 + t81;
   const double t89 = t70 + t88;
   /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t90 = gam[0] * 0.033765242898423989;
+  const double t90 = gam[0] * 0.033765242898423975;
   const double t91 = h * t90;
   const double t92 = q0[0] + t91;
-  const double t93 = gam[1] * 0.033765242898423989;
+  const double t93 = gam[1] * 0.033765242898423975;
   const double t94 = h * t93;
   const double t95 = q0[1] + t94;
-  const double t96 = gam[2] * 0.033765242898423989;
+  const double t96 = gam[2] * 0.033765242898423975;
   const double t97 = h * t96;
   const double t98 = q0[2] + t97;
-  const double t99 = gam[3] * 0.033765242898423989;
+  const double t99 = gam[3] * 0.033765242898423975;
   const double t100 = h * t99;
   const double t101 = q0[3] + t100;
-  const double t102 = gam[4] * 0.033765242898423989;
+  const double t102 = gam[4] * 0.033765242898423975;
   const double t103 = h * t102;
   const double t104 = q0[4] + t103;
-  const double t105 = gam[5] * 0.033765242898423989;
+  const double t105 = gam[5] * 0.033765242898423975;
   const double t106 = h * t105;
   const double t107 = q0[5] + t106;
-  const double t108 = gam[6] * 0.033765242898423989;
+  const double t108 = gam[6] * 0.033765242898423975;
   const double t109 = h * t108;
   const double t110 = q0[6] + t109;
-  const double t111 = gam[7] * 0.033765242898423989;
+  const double t111 = gam[7] * 0.033765242898423975;
   const double t112 = h * t111;
   const double t113 = q0[7] + t112;
-  const double t114 = gam[8] * 0.033765242898423989;
+  const double t114 = gam[8] * 0.033765242898423975;
   const double t115 = h * t114;
   const double t116 = q0[8] + t115;
   const double t117 = t92 * t92;
@@ -212,31 +212,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t172 = t144 * 0.085662246189585178;
   const double t173 = t142 * 0.085662246189585178;
   /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t174 = gam[0] * 0.16939530676686773;
+  const double t174 = gam[0] * 0.16939530676686776;
   const double t175 = h * t174;
   const double t176 = q0[0] + t175;
-  const double t177 = gam[1] * 0.16939530676686773;
+  const double t177 = gam[1] * 0.16939530676686776;
   const double t178 = h * t177;
   const double t179 = q0[1] + t178;
-  const double t180 = gam[2] * 0.16939530676686773;
+  const double t180 = gam[2] * 0.16939530676686776;
   const double t181 = h * t180;
   const double t182 = q0[2] + t181;
-  const double t183 = gam[3] * 0.16939530676686773;
+  const double t183 = gam[3] * 0.16939530676686776;
   const double t184 = h * t183;
   const double t185 = q0[3] + t184;
-  const double t186 = gam[4] * 0.16939530676686773;
+  const double t186 = gam[4] * 0.16939530676686776;
   const double t187 = h * t186;
   const double t188 = q0[4] + t187;
-  const double t189 = gam[5] * 0.16939530676686773;
+  const double t189 = gam[5] * 0.16939530676686776;
   const double t190 = h * t189;
   const double t191 = q0[5] + t190;
-  const double t192 = gam[6] * 0.16939530676686773;
+  const double t192 = gam[6] * 0.16939530676686776;
   const double t193 = h * t192;
   const double t194 = q0[6] + t193;
-  const double t195 = gam[7] * 0.16939530676686773;
+  const double t195 = gam[7] * 0.16939530676686776;
   const double t196 = h * t195;
   const double t197 = q0[7] + t196;
-  const double t198 = gam[8] * 0.16939530676686773;
+  const double t198 = gam[8] * 0.16939530676686776;
   const double t199 = h * t198;
   const double t200 = q0[8] + t199;
   const double t201 = t176 * t176;
