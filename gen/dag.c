@@ -44,8 +44,6 @@ Dag *dag_new(void) {
   return d;
 }
 
-int dag_full(const Dag *d) { return d->n >= MAX_NODES; }
-
 static uint64_t hash_node(const Node *n) {
   uint64_t bits;
   memcpy(&bits, &n->val, sizeof bits);

@@ -154,6 +154,17 @@ static void emit_ops(Emitter *e, const int *ops, int from, int to) {
   }
 }
 
+// out[i] = outs[i], for the outputs of the part being printed (all of
+// them when the kernel is one part).
+static void emit_outputs(Emitter *e, const int *outs, int nouts) {
+  for (int i = 0; i < nouts; i++) {
+    if (e->chunk && e->chunk[outs[i]] != e->part) continue;
+    char r[128];
+    ref(e, outs[i], r, sizeof r);
+    out(e, "  out[%d] = %s;\n", i, r);
+  }
+}
+
 // Assign each operation its part, and a slot in w[] to every value used in
 // a later part than its own. Returns the number of slots.
 static int split_parts(Emitter *e, const int *ops, int nops) {
@@ -201,12 +212,7 @@ static void emit_kernel(Emitter *e, const char *name, const char *what, const in
       kernel_signature(e, name, e->part);
       int from = e->part * PART_NODES, to = from + PART_NODES < nops ? from + PART_NODES : nops;
       emit_ops(e, ops, from, to);
-      for (int i = 0; i < nouts; i++) /* outputs computed in this part (leaves in the last) */
-        if (e->chunk[outs[i]] == e->part) {
-          char r[128];
-          ref(e, outs[i], r, sizeof r);
-          out(e, "  out[%d] = %s;\n", i, r);
-        }
+      emit_outputs(e, outs, nouts); /* those computed in this part (leaves in the last) */
       out(e, "}\n\n");
     }
     out(e, "/* %s: the %d parts above in order */\n", name, nparts);
@@ -221,11 +227,7 @@ static void emit_kernel(Emitter *e, const char *name, const char *what, const in
     free(ops);
     return;
   }
-  for (int i = 0; i < nouts; i++) {
-    char r[128];
-    ref(e, outs[i], r, sizeof r);
-    out(e, "  out[%d] = %s;\n", i, r);
-  }
+  emit_outputs(e, outs, nouts);
   out(e, "}\n");
   free(mark);
   free(ops);

@@ -39,7 +39,6 @@ void intvec_push(IntVec *vec, int x);
 void diag_begin(const char *file, const char *src, size_t len);
 void error_at(Loc loc, const char *fmt, ...);
 void warning_at(Loc loc, const char *fmt, ...);
-void note(const char *fmt, ...);
 int diag_error_count(void);
 int diag_too_many(void);                 /* true once the error cap is hit */
 void internal_error(const char *fmt, ...);
@@ -199,7 +198,6 @@ double dag_eval(const Dag *d, int root, const double *inputs, const double *para
 void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inputs, const double *params,
                    double *out);
 void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, int *out);
-int dag_full(const Dag *d);
 
 /* ---- ad.c: reverse-mode differentiation ---- */
 
@@ -265,7 +263,6 @@ void model_check_initial(const Model *mod);
 typedef struct {
   int k, s;
   double *c, *b;      /* k nodes and weights on [0,1] */
-  double *Phat;       /* k x s: P_j(c_l) */
   double *Ihat;       /* k x s: integral_0^{c_l} P_j */
   double *W;          /* k x s: b_l P_j(c_l) */
   double *xi;         /* s+1 values xi_0..xi_s */
@@ -274,7 +271,6 @@ typedef struct {
 
 int method_auto_k(int s, int degU, int degg, const char **why);
 Method *method_new(int k, int s);
-double legendre_shifted(int j, double x);
 
 /* ---- step.c: the step as a DAG ---- */
 

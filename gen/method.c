@@ -15,7 +15,7 @@
 #define NONPOLY_EXTRA_K 12 /* k = 2s + 12 for a non-polynomial U or g */
 
 // P_j(x) = sqrt(2j+1) L_j(2x-1): orthonormal on [0,1].
-double legendre_shifted(int j, double x) {
+static double legendre_shifted(int j, double x) {
   double t = 2 * x - 1, lm1 = 1, l = t;
   if (j == 0) return 1;
   for (int n = 1; n < j; n++) {
@@ -86,7 +86,6 @@ Method *method_new(int k, int s) {
   }
   free(cb);
   gsl_integration_glfixed_table_free(t);
-  me->Phat = arena_alloc((size_t)k * s * sizeof(double));
   me->Ihat = arena_alloc((size_t)k * s * sizeof(double));
   me->W = arena_alloc((size_t)k * s * sizeof(double));
   me->xi = arena_alloc((size_t)(s + 1) * sizeof(double));
@@ -94,8 +93,7 @@ Method *method_new(int k, int s) {
   for (int l = 0; l < k; l++)
     for (int j = 0; j < s; j++) {
       double c = me->c[l];
-      me->Phat[l * s + j] = legendre_shifted(j, c);
-      me->W[l * s + j] = me->b[l] * me->Phat[l * s + j];
+      me->W[l * s + j] = me->b[l] * legendre_shifted(j, c);
       me->Ihat[l * s + j] =
           j == 0 ? c : xi(j + 1) * legendre_shifted(j + 1, c) - xi(j) * legendre_shifted(j - 1, c);
     }

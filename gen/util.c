@@ -151,15 +151,6 @@ void warning_at(Loc loc, const char *fmt, ...) {
   va_end(ap);
 }
 
-void note(const char *fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  fputs("hbvmgen: ", stderr);
-  vfprintf(stderr, fmt, ap);
-  fputc('\n', stderr);
-  va_end(ap);
-}
-
 void internal_error(const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
