@@ -27,6 +27,8 @@ typedef struct {
   int *chunk;      /* kernel split in parts: part of each node (NULL: one part) */
   int *slot;       /* its place in the array w[] passing values between parts, or -1 */
   int part;        /* the part being printed */
+  int wide_sweep;  /* --wide-sweep */
+  int wide;        /* the kernel being printed computes one precision wider */
 } Emitter;
 
 /* A kernel with more operations than this is printed as several functions
@@ -56,20 +58,43 @@ static void tmpl(Emitter *e, const char *text) {
   }
 }
 
+// The type of a kernel's temporaries, and the suffix of its math functions:
+// the real type, or the next wider one in a wide kernel (--wide-sweep).
+static const char *work_type(const Emitter *e) {
+  if (e->wide) return e->single ? "double" : "long double";
+  return e->single ? "float" : "double";
+}
+
+static const char *work_suffix(const Emitter *e) {
+  if (e->wide) return e->single ? "" : "l";
+  return e->single ? "f" : "";
+}
+
 // A literal that reads back exactly in the real type and is a C floating
 // constant: 17 significant digits for double, 9 and an f suffix for float.
 static void format_real(const Emitter *e, char *buf, size_t size, double v) {
   char tmp[40];
-  snprintf(tmp, sizeof tmp, e->single ? "%.9g" : "%.17g", e->single ? (double)(float)v : v);
+  int single = e->single && !e->wide; /* a wide kernel of a float solver computes in double */
+  snprintf(tmp, sizeof tmp, single ? "%.9g" : "%.17g", single ? (double)(float)v : v);
   if (!strpbrk(tmp, ".eEn")) strcat(tmp, ".0");
-  if (e->single) strcat(tmp, "f");
+  if (single) strcat(tmp, "f");
   snprintf(buf, size, v < 0 ? "(%s)" : "%s", tmp);
 }
 
-// The C expression that names node id inside a kernel.
+// The C expression that names node id inside a kernel. In a wide kernel
+// the leaves (constants, params, inputs) are cast to the wider type, so that
+// no operation is done in the narrower one.
 static void ref(Emitter *e, int id, char *buf, size_t size) {
   const Node *n = &e->mod->dag->nodes[id];
   const Step *st = e->st;
+  int cast = e->wide && (n->op == OP_CONST || n->op == OP_PARAM || n->op == OP_INPUT);
+  if (cast) {
+    int len = snprintf(buf, size, "(%s)", work_type(e));
+    e->wide = 0;
+    ref(e, id, buf + len, size - (size_t)len);
+    e->wide = 1;
+    return;
+  }
   switch ((Op)n->op) {
   case OP_CONST: format_real(e, buf, size, n->val); return;
   case OP_PARAM: snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name); return;
@@ -117,21 +142,22 @@ static void emit_node(Emitter *e, int id) {
   case OP_POW: {
     const Node *ex = &e->mod->dag->nodes[n->b];
     if (ex->op == OP_CONST && power_expr(rhs, sizeof rhs, a, ex->val)) break;
-    snprintf(rhs, sizeof rhs, "pow%s(%s, %s)", e->single ? "f" : "", a, b);
+    snprintf(rhs, sizeof rhs, "pow%s(%s, %s)", work_suffix(e), a, b);
     break;
   }
   default:
-    if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), e->single ? "f" : "", a, b);
-    else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), e->single ? "f" : "", a);
+    if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), work_suffix(e), a, b);
+    else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), work_suffix(e), a);
   }
-  out(e, "  const %s t%d = %s;\n", e->single ? "float" : "double", e->temp[id], rhs);
+  out(e, "  const %s t%d = %s;\n", work_type(e), e->temp[id], rhs);
 }
 
 static void kernel_signature(Emitter *e, const char *name, int part) {
   tmpl(e, "static void $P_");
   out(e, part >= 0 ? "%s_part%d" : "%s", name, part);
   tmpl(e, "(const $R *q0, const $R *p0, const $R *gam, $R h,\n    const $R *g0, const $P_params *prm, ");
-  tmpl(e, part >= 0 ? "$R *w, $R *out)\n{\n" : "$R *out)\n{\n");
+  if (part >= 0) out(e, "%s *w, ", work_type(e));
+  tmpl(e, "$R *out)\n{\n");
   out(e, "  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
 }
 
@@ -217,7 +243,7 @@ static void emit_kernel(Emitter *e, const char *name, const char *what, const in
     }
     out(e, "/* %s: the %d parts above in order */\n", name, nparts);
     kernel_signature(e, name, -1);
-    out(e, "  %s w[%d];\n", e->single ? "float" : "double", nslots);
+    out(e, "  %s w[%d];\n", work_type(e), nslots);
     for (int k = 0; k < nparts; k++) out(e, "  %s_%s_part%d(q0, p0, gam, h, g0, prm, w, out);\n", e->P, name, k);
     out(e, "}\n");
     free(e->chunk);
@@ -324,7 +350,7 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
 static void emit_kernels(Emitter *e) {
   const Step *st = e->st;
   int m = e->mod->m, nu = e->mod->nu, s = e->me->s;
-  int nsweep = s * m + m + 3 * nu;
+  int nsweep = s * m + m + 3 * nu, wide = e->wide_sweep;
   int *sweep = malloc((size_t)nsweep * sizeof(int));
   if (!sweep) internal_error("out of memory");
   memcpy(sweep, st->gam_new, (size_t)(s * m) * sizeof(int));
@@ -332,10 +358,15 @@ static void emit_kernels(Emitter *e) {
   memcpy(sweep + s * m + m, st->lambda, (size_t)nu * sizeof(int));
   memcpy(sweep + s * m + m + nu, st->pivot, (size_t)nu * sizeof(int));
   memcpy(sweep + s * m + m + 2 * nu, st->adiag, (size_t)nu * sizeof(int));
+  e->wide = wide;
   emit_kernel(e, "sweep",
-              "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
-              " * pivots of the LU of A (NU), diagonal of A (NU).",
+              wide ? "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
+                     " * pivots of the LU of A (NU), diagonal of A (NU); computed one precision\n"
+                     " * wider than the state (--wide-sweep) and rounded once, into out."
+                   : "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
+                     " * pivots of the LU of A (NU), diagonal of A (NU).",
               sweep, nsweep);
+  e->wide = 0;
   free(sweep);
   emit_kernel(e, "minv_p", "out = M^-1 p0: the first step's prediction of gamma_0", st->predict0, m);
   emit_kernel(e, "energy_kernel", "out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0)", st->energy, 1);
@@ -472,7 +503,7 @@ static void emit_step(Emitter *e) {
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0};
+  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_sweep, 0};
   e.temp = malloc((size_t)mod->dag->n * sizeof(int));
   if (!e.temp) internal_error("out of memory");
   emit_header(&e, o);
