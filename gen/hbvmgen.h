@@ -299,7 +299,7 @@ typedef struct {
   int emit_main;
   int single;           /* --real float */
   int compensated;      /* Kahan summation (off with --plain-sum) */
-  int wide_sweep;       /* --wide-sweep: the sweep one precision wider */
+  int wide_step;        /* --wide-step: iterate and update one precision wider */
 } EmitOptions;
 
 int emit_solver(FILE *h, FILE *c, const Model *mod, const Method *meth, const Step *st, const EmitOptions *o);

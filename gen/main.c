@@ -33,19 +33,19 @@ static const char usage[] =
     "                arithmetic of the generated code (float: for FPUs without double)\n"
     "  --plain-sum   update q, p, t by plain addition instead of compensated (Kahan)\n"
     "                summation: only to measure what compensation buys\n"
-    "  --wide-sweep  compute the fixed-point sweep one precision wider than the state\n"
-    "                (long double, 80-bit on x86-64, for double; double for float):\n"
-    "                for runs of millions of steps, where the double sweep's round-off\n"
-    "                has a small bias that makes |H - H0| drift (bench/README.md);\n"
-    "                costs 2-3x the step time, and nothing where long double is double\n"
-    "  -h, --help    this text\n"
+    "  --wide-step   iterate and update in the next wider type (long double, 80-bit on\n"
+    "                x86-64, for double; double for float), from the compensated state,\n"
+    "                rounding once into q, p: for runs of millions of steps, where the\n"
+    "                round-off of a double step has a small bias that makes |H - H0|\n"
+    "                drift (bench/README.md); 4-5x the step time, and no gain where\n"
+    "                long double is double\n"    "  -h, --help    this text\n"
     "  --version     the version\n";
 
 typedef struct {
   const char *model, *outdir, *name;
   int s, k; /* k = 0: auto */
   int emit_main, check_only;
-  int single, plain_sum, wide_sweep;
+  int single, plain_sum, wide_step;
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -82,8 +82,8 @@ static int parse_args(int argc, char **argv, Options *o) {
       o->check_only = 1;
     } else if (!strcmp(a, "--plain-sum")) {
       o->plain_sum = 1;
-    } else if (!strcmp(a, "--wide-sweep")) {
-      o->wide_sweep = 1;
+    } else if (!strcmp(a, "--wide-step")) {
+      o->wide_step = 1;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -226,7 +226,7 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
   FILE *f[NFILES] = {NULL, NULL, NULL};
   int nfiles = o->emit_main ? 3 : 2, rc = 0;
   EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->emit_main, o->single,
-                    !o->plain_sum, o->wide_sweep};
+                    !o->plain_sum, o->wide_step};
   for (int i = 0; i < nfiles && !rc; i++)
     if (!(f[i] = open_tmp(o, suffix[i], tmp[i], final[i], sizeof tmp[i]))) rc = 1;
   if (!rc) rc = emit_solver(f[H], f[C], mod, me, st, &eo) != 0;

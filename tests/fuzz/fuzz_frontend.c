@@ -124,7 +124,7 @@ void __wrap_free(void *p) {
 
 /* Build the step of a small analysed model and emit it to /dev/null, with
  * the options variant selects: bit 0 single precision (no driver then, as
- * gen/main.c requires), bit 1 plain summation. */
+ * gen/main.c requires), bit 1 plain summation, bit 2 the wide step. */
 static void build_and_emit(Model *mod, int s, int variant) {
   static FILE *sink;
   const char *why;
@@ -135,7 +135,7 @@ static void build_and_emit(Model *mod, int s, int variant) {
   if (!st) return;
   if (!sink && !(sink = fopen("/dev/null", "w"))) abort();
   int single = variant & 1;
-  EmitOptions eo = {"fuzz", "fuzz.ham", !single, single, !(variant & 2)};
+  EmitOptions eo = {"fuzz", "fuzz.ham", !single, single, !(variant & 2), (variant & 4) != 0};
   emit_solver(sink, sink, mod, me, st, &eo);
   if (eo.emit_main) emit_driver(sink, mod, me, &eo);
 }
@@ -148,7 +148,7 @@ static void run_model(const char *src, size_t len) {
   if (!mod) return;
   model_differentiate(mod);
   model_check_initial(mod);
-  build_and_emit(mod, 1 + (int)(len % 3), (int)(len / 3 % 4));
+  build_and_emit(mod, 1 + (int)(len % 3), (int)(len / 3 % 8));
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
