@@ -24,8 +24,12 @@
 
 #include "kepler_comp.h"
 #include "kepler_plain.h"
+#include "kepler_wide.h"
+#include "oscillator_comp.h"
+#include "oscillator_wide.h"
 #include "pendulum_comp.h"
 #include "pendulum_plain.h"
+#include "pendulum_wide.h"
 
 #define REL_PERTURBATION 1e-12
 #define FIT_FROM 1000L     /* the slope is fitted from this step on */
@@ -35,7 +39,7 @@
 
 /* ---- the models: their perturbed initial values ---- */
 
-typedef enum { KEPLER, PENDULUM } ModelKind;
+typedef enum { FREE, PENDULUM } ModelKind; /* FREE: unconstrained, m = 2 */
 
 /* A uniform number in [-1, 1) from a 64-bit xorshift generator. */
 static double uniform(unsigned long long *s) {
@@ -46,13 +50,13 @@ static double uniform(unsigned long long *s) {
 }
 
 /* Perturbed initial values of run r (r = 0: exactly the model's). Kepler
- * (unconstrained): every component times 1 + 1e-12 u. The pendulum: the
+ * and the oscillator (unconstrained): every component times 1 + 1e-12 u. The pendulum: the
  * angle and the angular velocity, so that q0 stays on the circle and p0
  * tangent to it (x = sin th, y = -cos th, p = w (cos th, sin th)). */
 static void perturbed(ModelKind kind, const double *q, const double *p, int r, double *q0, double *p0) {
   unsigned long long s = 0x9E3779B97F4A7C15ull * (unsigned long long)(r + 1);
   double d = r ? REL_PERTURBATION : 0;
-  if (kind == KEPLER) {
+  if (kind == FREE) {
     for (int i = 0; i < 2; i++) {
       q0[i] = q[i] * (1 + d * uniform(&s));
       p0[i] = p[i] * (1 + d * uniform(&s));
@@ -92,7 +96,9 @@ typedef struct {
   static const double *P##_qp_(const void *x, int which) {                                           \
     return which ? ((const P##_state *)x)->p : ((const P##_state *)x)->q;                            \
   }
-#define SOLVERS(X) X(kepler_comp, KEPLER) X(kepler_plain, KEPLER) X(pendulum_comp, PENDULUM) X(pendulum_plain, PENDULUM)
+#define SOLVERS(X)                                                                                         \
+  X(kepler_comp, FREE) X(kepler_plain, FREE) X(kepler_wide, FREE) X(pendulum_comp, PENDULUM)                \
+  X(pendulum_plain, PENDULUM) X(pendulum_wide, PENDULUM) X(oscillator_comp, FREE) X(oscillator_wide, FREE)
 #define ADAPT2(P, K) ADAPT(P)
 SOLVERS(ADAPT2)
 #define ENTRY(P, K) {#P, K, P##_K, P##_S, P##_NU, sizeof(P##_state), P##_init_, P##_step_, P##_energy_, P##_g_, P##_qp_},
@@ -190,7 +196,7 @@ int main(int argc, char **argv) {
   long steps = strtol(argv[3], NULL, 10);
   int runs = atoi(argv[4]);
   if (!sv || !(h > 0) || steps < 1 || runs < 1) {
-    fprintf(stderr, "longrun: bad arguments (solvers: kepler_comp kepler_plain pendulum_comp pendulum_plain)\n");
+    fprintf(stderr, "longrun: bad arguments (solvers: kepler_comp kepler_plain kepler_wide pendulum_comp pendulum_plain pendulum_wide oscillator_comp oscillator_wide)\n");
     return 1;
   }
   static Grid gr;
