@@ -7,7 +7,8 @@
 # warning-free, and its undefined symbols must be <math.h> functions or the
 # compiler's run-time helpers (__aeabi_*): no malloc, memcpy, printf, ...
 # One model generated with --real float must moreover call no
-# double-precision math function (sqrtf, not sqrt).
+# double-precision math function (sqrtf, not sqrt), and models generated with
+# --wide-step (long double, which is double on this target) must compile too.
 # Exit status: 0 pass, 1 fail, 77 when arm-none-eabi-gcc is not installed
 # (scripts/deps.sh embedded).
 set -u
@@ -79,6 +80,26 @@ for model in kepler pendulum_angle satellites; do
     fail=1
   else
     echo "arm_build.sh: --real float $model.ham: only single-precision math (" $("$NM" -u "$obj" | awk '{print $NF}') ")"
+  fi
+done
+
+# --wide-step: long double arithmetic and the long-double math names.
+LMATH=$(for f in $MATH; do printf '%s %sl ' "$f" "$f"; done)
+for model in kepler satellites; do
+  mkdir -p "$tmp/w$model"
+  if ! "$GEN" --wide-step -s 2 -n "${model}_w" -o "$tmp/w$model" "../models/$model.ham" 2>"$tmp/log"; then
+    echo "arm_build.sh: hbvmgen --wide-step failed on $model.ham:"
+    cat "$tmp/log"
+    fail=1
+    continue
+  fi
+  compile "$tmp/w$model/${model}_w.c" || continue
+  bad=$(forbidden "$obj" "$LMATH")
+  if [ -n "$bad" ]; then
+    echo "arm_build.sh: --wide-step $model.ham needs symbols beyond <math.h>:" $bad
+    fail=1
+  else
+    echo "arm_build.sh: --wide-step $model.ham: compiled (" $("$NM" -u "$obj" | awk '$NF !~ /^__aeabi_/ {print $NF}') ")"
   fi
 done
 exit $fail
