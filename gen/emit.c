@@ -43,35 +43,36 @@ static void out(Emitter *e, const char *fmt, ...) {
   va_end(ap);
 }
 
+// The name of a real type of the generated code, and the suffix of its
+// math functions (sqrt, sqrtf, sqrtl): the solver's real type, or with wide
+// the next wider one (--wide-step: long double for double, double for float).
+static const char *real_type(const Emitter *e, int wide) {
+  if (wide) return e->single ? "double" : "long double";
+  return e->single ? "float" : "double";
+}
+
+static const char *math_suffix(const Emitter *e, int wide) {
+  if (wide) return e->single ? "" : "l";
+  return e->single ? "f" : "";
+}
+
 // Print text, replacing $P by the prefix, $R by the real type name, $f by
-// the suffix of its math functions (sqrt, sqrtf), $W by the type the step
-// iterates in (the real type, or the next wider one with --wide-step) and $g
-// by the suffix of that type's math functions.
+// the suffix of its math functions, $W by the type the step iterates in (the
+// real type, or the next wider one with --wide-step) and $g by the suffix of
+// that type's math functions.
 static void tmpl(Emitter *e, const char *text) {
   for (const char *p = text; *p; p++) {
     if (*p == '$' && p[1] == 'P') fputs(e->P, e->f);
-    else if (*p == '$' && p[1] == 'R') fputs(e->single ? "float" : "double", e->f);
-    else if (*p == '$' && p[1] == 'f') fputs(e->single ? "f" : "", e->f);
-    else if (*p == '$' && p[1] == 'W') fputs(!e->wide_step ? (e->single ? "float" : "double") : e->single ? "double" : "long double", e->f);
-    else if (*p == '$' && p[1] == 'g') fputs(!e->wide_step ? (e->single ? "f" : "") : e->single ? "" : "l", e->f);
+    else if (*p == '$' && p[1] == 'R') fputs(real_type(e, 0), e->f);
+    else if (*p == '$' && p[1] == 'f') fputs(math_suffix(e, 0), e->f);
+    else if (*p == '$' && p[1] == 'W') fputs(real_type(e, e->wide_step), e->f);
+    else if (*p == '$' && p[1] == 'g') fputs(math_suffix(e, e->wide_step), e->f);
     else {
       fputc(*p, e->f);
       continue;
     }
     p++;
   }
-}
-
-// The type of a kernel's temporaries, and the suffix of its math functions:
-// the real type, or the next wider one in a wide kernel (--wide-step).
-static const char *work_type(const Emitter *e) {
-  if (e->wide) return e->single ? "double" : "long double";
-  return e->single ? "float" : "double";
-}
-
-static const char *work_suffix(const Emitter *e) {
-  if (e->wide) return e->single ? "" : "l";
-  return e->single ? "f" : "";
 }
 
 // A literal that reads back exactly in the real type and is a C floating
@@ -93,7 +94,7 @@ static void ref(Emitter *e, int id, char *buf, size_t size) {
   const Step *st = e->st;
   int cast = e->wide && (n->op == OP_CONST || n->op == OP_PARAM || n->op == OP_INPUT);
   if (cast) {
-    int len = snprintf(buf, size, "(%s)", work_type(e));
+    int len = snprintf(buf, size, "(%s)", real_type(e, e->wide));
     e->wide = 0;
     ref(e, id, buf + len, size - (size_t)len);
     e->wide = 1;
@@ -146,25 +147,24 @@ static void emit_node(Emitter *e, int id) {
   case OP_POW: {
     const Node *ex = &e->mod->dag->nodes[n->b];
     if (ex->op == OP_CONST && power_expr(rhs, sizeof rhs, a, ex->val)) break;
-    snprintf(rhs, sizeof rhs, "pow%s(%s, %s)", work_suffix(e), a, b);
+    snprintf(rhs, sizeof rhs, "pow%s(%s, %s)", math_suffix(e, e->wide), a, b);
     break;
   }
   default:
-    if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), work_suffix(e), a, b);
-    else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), work_suffix(e), a);
+    if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a, b);
+    else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a);
   }
-  out(e, "  const %s t%d = %s;\n", work_type(e), e->temp[id], rhs);
+  out(e, "  const %s t%d = %s;\n", real_type(e, e->wide), e->temp[id], rhs);
 }
 
 static void kernel_signature(Emitter *e, const char *name, int part) {
   tmpl(e, "static void $P_");
   out(e, part >= 0 ? "%s_part%d" : "%s", name, part);
-  if (e->wide) /* the sweep of --wide-step: state, gamma and results in the wider type */
-    tmpl(e, "(const $W *q0, const $W *p0, const $W *gam, $R h,\n    const $R *g0, const $P_params *prm, ");
-  else
-    tmpl(e, "(const $R *q0, const $R *p0, const $R *gam, $R h,\n    const $R *g0, const $P_params *prm, ");
-  if (part >= 0) out(e, "%s *w, ", work_type(e));
-  tmpl(e, e->wide ? "$W *out)\n{\n" : "$R *out)\n{\n");
+  const char *t = real_type(e, e->wide); /* the sweep of --wide-step: state, gamma, results wider */
+  out(e, "(const %s *q0, const %s *p0, const %s *gam, ", t, t, t);
+  tmpl(e, "$R h,\n    const $R *g0, const $P_params *prm, ");
+  if (part >= 0) out(e, "%s *w, ", t);
+  out(e, "%s *out)\n{\n", t);
   out(e, "  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
 }
 
@@ -250,7 +250,7 @@ static void emit_kernel(Emitter *e, const char *name, const char *what, const in
     }
     out(e, "/* %s: the %d parts above in order */\n", name, nparts);
     kernel_signature(e, name, -1);
-    out(e, "  %s w[%d];\n", work_type(e), nslots);
+    out(e, "  %s w[%d];\n", real_type(e, e->wide), nslots);
     for (int k = 0; k < nparts; k++) out(e, "  %s_%s_part%d(q0, p0, gam, h, g0, prm, w, out);\n", e->P, name, k);
     out(e, "}\n");
     free(e->chunk);
@@ -274,7 +274,7 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "/* %s.h - generated by hbvmgen %s from %s: do not edit.\n", e->P, HBVMGEN_VERSION, o->model_file);
   out(e, " * HBVM(k=%d, s=%d) for a Hamiltonian system with %d coordinates and %d constraints,\n", e->me->k, s, m, nu);
   out(e, " * in %s precision%s%s. */\n", e->single ? "single" : "double", o->wide_step ? ", the step computed in " : "",
-      o->wide_step ? (e->single ? "double" : "long double") : "");
+      o->wide_step ? real_type(e, 1) : "");
   tmpl(e, "#ifndef $P_H\n#define $P_H\n\n");
   out(e, "#define %s_M %d      /* coordinates */\n#define %s_NU %d     /* constraints */\n", e->P, m, e->P, nu);
   out(e, "#define %s_K %d      /* Gauss-Legendre nodes */\n#define %s_S %d      /* polynomial degree */\n", e->P, e->me->k,
@@ -318,7 +318,7 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
 /* ---- the source ---- */
 
 static void emit_array(Emitter *e, const char *name, const double *v, int n) {
-  out(e, "static const %s %s_%s[%d] = {", e->single ? "float" : "double", e->P, name, n > 0 ? n : 1);
+  out(e, "static const %s %s_%s[%d] = {", real_type(e, 0), e->P, name, n > 0 ? n : 1);
   for (int i = 0; i < n; i++) {
     char b[40];
     format_real(e, b, sizeof b, v[i]);
@@ -367,7 +367,7 @@ static void emit_kernels(Emitter *e) {
   memcpy(sweep + s * m + m + nu, st->pivot, (size_t)nu * sizeof(int));
   memcpy(sweep + s * m + m + 2 * nu, st->adiag, (size_t)nu * sizeof(int));
   e->wide = wide;
-  if (wide) out(e, "\n/* --wide-step: the sweep below computes in %s. */", work_type(e));
+  if (wide) out(e, "\n/* --wide-step: the sweep below computes in %s. */", real_type(e, e->wide));
   emit_kernel(e, "sweep",
               "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
               " * pivots of the LU of A (NU), diagonal of A (NU).",
