@@ -86,20 +86,11 @@ static void format_real(const Emitter *e, char *buf, size_t size, double v) {
   snprintf(buf, size, v < 0 ? "(%s)" : "%s", tmp);
 }
 
-// The C expression that names node id inside a kernel. In a wide kernel
-// the leaves (constants, params, inputs) are cast to the wider type, so that
-// no operation is done in the narrower one.
-static void ref(Emitter *e, int id, char *buf, size_t size) {
+// The C expression that names node id inside a kernel: a literal, a
+// parameter, an input or a temporary.
+static void name_of(Emitter *e, int id, char *buf, size_t size) {
   const Node *n = &e->mod->dag->nodes[id];
   const Step *st = e->st;
-  int cast = e->wide && (n->op == OP_CONST || n->op == OP_PARAM || n->op == OP_INPUT);
-  if (cast) {
-    int len = snprintf(buf, size, "(%s)", real_type(e, e->wide));
-    e->wide = 0;
-    ref(e, id, buf + len, size - (size_t)len);
-    e->wide = 1;
-    return;
-  }
   switch ((Op)n->op) {
   case OP_CONST: format_real(e, buf, size, n->val); return;
   case OP_PARAM: snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name); return;
@@ -116,6 +107,19 @@ static void ref(Emitter *e, int id, char *buf, size_t size) {
     else snprintf(buf, size, "t%d", e->temp[id]);
     return;
   }
+}
+
+// name_of, with the leaves (constants, params, inputs) of a wide kernel cast
+// to the wider type, so that no operation is done in the narrower one.
+static void ref(Emitter *e, int id, char *buf, size_t size) {
+  const Node *n = &e->mod->dag->nodes[id];
+  if (!(e->wide && (n->op == OP_CONST || n->op == OP_PARAM || n->op == OP_INPUT))) {
+    name_of(e, id, buf, size);
+    return;
+  }
+  char leaf[96];
+  name_of(e, id, leaf, sizeof leaf);
+  snprintf(buf, size, "(%s)%s", real_type(e, 1), leaf);
 }
 
 // x^n for a small integer n as products, so no pow() call is needed.

@@ -167,8 +167,9 @@ START_TEST(float_order_and_conservation) {
 }
 END_TEST
 
-// --wide-step: every temporary of the sweep, and nothing else, is one
-// precision wider than the state (long double for double, double for float).
+// --wide-step: every temporary and literal of the sweep, and no temporary
+// elsewhere, is one precision wider than the state (long double for double,
+// double for float).
 START_TEST(wide_step_widens_only_the_sweep) {
   static const char *const flags[2] = {"--wide-step", "--wide-step --real float"};
   static const char *const wide[2] = {"const long double t", "const double t"};
@@ -184,6 +185,8 @@ START_TEST(wide_step_widens_only_the_sweep) {
     ck_assert_msg(first_wide && first_wide > sweep && first_wide < end, "%s: no %s in the sweep", flags[v], wide[v]);
     ck_assert_msg(first_narrow && first_narrow > end, "%s: a %s inside the sweep", flags[v], narrow[v]);
     ck_assert_msg(!strstr(end, wide[v]), "%s: a wide temporary outside the sweep", flags[v]);
+    for (const char *c = sweep; c + 1 < end; c++) /* and its literals are wide too: no 0.5f */
+      ck_assert_msg(!(c[0] >= '0' && c[0] <= '9' && c[1] == 'f'), "%s: a float literal in the sweep", flags[v]);
     free(src);
   }
 }
