@@ -28,7 +28,7 @@ RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
 SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
 SOLV_OBJ := $(addprefix $(B)/generated/,$(addsuffix .o,$(SOLVERS)))
 # test-only models (tests/models/LIST), generated at build time
-TSOLVERS := $(shell grep -v '^\#' tests/models/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
+TSOLVERS := $(shell grep -v '^\#' tests/models/LIST | awk 'NF {sub(/:.*/, "", $$1); print $$1 "_k" $$2 "s" $$3}')
 TSOLV_OBJ:= $(addprefix $(B)/tgen/,$(addsuffix .o,$(TSOLVERS)))
 TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c tests/solvers.c
 TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
@@ -86,7 +86,7 @@ $(B)/generated/%.o: generated/%.c generated/%.h
 	@mkdir -p $(@D)
 	$(CC) $(WARN) -Werror $(CFLAGS) $(SAN) -Igenerated -c -o $@ $<
 
-$(B)/tgen/stamp: tests/models/LIST $(wildcard tests/models/*.ham) $(HBVMGEN)
+$(B)/tgen/stamp: tests/models/LIST $(wildcard tests/models/*.ham) $(wildcard models/*.ham) $(HBVMGEN)
 	@mkdir -p $(@D)
 	scripts/regen.sh $(HBVMGEN) $(B)/tgen tests/models/LIST tests/models
 	@touch $@
