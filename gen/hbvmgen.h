@@ -260,43 +260,79 @@ void model_check_initial(const Model *mod);
 
 /* ---- method.c: HBVM(k,s) constants and the choice of k ---- */
 
+/* How the multiplier varies over a step: the method family. */
+typedef enum {
+  MULT_CONST, /* constant over the step: the paper's method, order 2 (step_const.c) */
+  MULT_POLY   /* a polynomial of degree s-1, then projection and rescale: order 2s (step_poly.c) */
+} MultFamily;
+
 typedef struct {
   int k, s;
+  MultFamily family;
   double *c, *b;      /* k nodes and weights on [0,1] */
   double *Ihat;       /* k x s: integral_0^{c_l} P_j */
   double *W;          /* k x s: b_l P_j(c_l) */
+  double *Phat;       /* k x s: P_j(c_l) */
   double *xi;         /* s+1 values xi_0..xi_s */
   double *E;          /* s x s x s: warm start, E[j][i] = sum_d E[(j*s+i)*s+d] r^d */
 } Method;
 
 int method_auto_k(int s, int degU, int degg, const char **why);
-Method *method_new(int k, int s);
+Method *method_new(int k, int s, MultFamily family);
 
-/* ---- step.c: the step as a DAG ---- */
+/* ---- step.c, step_const.c, step_poly.c, lu.c: the step as a DAG ---- */
+
+/* The size macros of the generated solver a block's length is written in. */
+typedef enum { SZ_SM, SZ_M, SZ_NU, SZ_SNU, SZ_ONE, SZ_COUNT } SizeSym;
+
+/* A run of consecutive slots: one input of every kernel (the DAG inputs
+ * first .. first+len-1, a C array argument or a scalar), or one result of
+ * a kernel (out[first .. first+len-1]). */
+typedef struct {
+  const char *name;   /* the C name of an input; how templates name a result */
+  SizeSym sym;        /* len = coef * (the value of sym), as the C text writes it */
+  int coef;
+  int first, len;
+  int scalar;         /* input passed by value (h) */
+  int narrow;         /* input in the solver's real type even in a wide kernel */
+  int wrap;           /* the kernel signature breaks the line after it */
+  int *nodes;         /* a result's DAG nodes, len of them */
+} Slots;
+
+/* The inputs every kernel takes, in signature order. */
+enum { IN_Q0, IN_P0, IN_GAM, IN_H, IN_G0, IN_LAM, IN_LU, IN_COUNT };
+
+/* The kernels of a solver, in the order they are printed. */
+typedef enum { K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_LAMBDA0, K_PROJECT, K_COUNT } KernelId;
+
+#define MAX_BLOCKS 8
+
+/* A straight-line function of the generated solver: its results are
+ * consecutive blocks of out[]. A kernel with no blocks is not emitted. */
+typedef struct {
+  const char *name;   /* the C name after the prefix */
+  const char *what;   /* its comment */
+  int wide;           /* computed one precision wider under --wide-step */
+  Slots out[MAX_BLOCKS];
+  int nout;
+} Kernel;
 
 typedef struct {
   int m, nu, s;
-  int in_q0, in_p0, in_gam, in_h, in_g0;  /* first input slot of each */
-  int ninputs;
-  int *gam_new;        /* s*m */
-  int *dp;             /* m: p1 - p0 */
-  int *lambda;         /* nu */
-  int *pivot, *adiag;  /* nu: pivots of the LU of A, and diag of A */
-  int *predict0;       /* m: M^-1 p0, the first step's gamma_0 */
-  int *g_at_q0;        /* nu: g(q0) */
-  int *energy;         /* 1: H(q, p) with q = inputs q0, p = inputs p0 */
-  int *hidden;         /* nu: grad g(q)' M^-1 p */
-  int *lambda0;        /* nu: the multiplier consistent with (q0, p0) */
+  Slots in[IN_COUNT];
+  Kernel kern[K_COUNT];
 } Step;
 
 Step *step_build(Model *mod, const Method *meth);
+/* The block of kernel k named name; NULL if there is none. */
+const Slots *step_block(const Step *st, KernelId k, const char *name);
+int kernel_size(const Kernel *k);   /* slots of out[] */
 
-/* ---- emit.c, emit_main.c ---- */
+/* ---- emit_kernel.c, emit_step.c, emit_main.c ---- */
 
 typedef struct {
   const char *name;     /* C prefix */
   const char *model_file;
-  int emit_main;
   int single;           /* --real float */
   int compensated;      /* Kahan summation (off with --plain-sum) */
   int wide_step;        /* --wide-step: iterate and update one precision wider */

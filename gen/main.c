@@ -225,7 +225,7 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
   char tmp[NFILES][4096], final[NFILES][4096];
   FILE *f[NFILES] = {NULL, NULL, NULL};
   int nfiles = o->emit_main ? 3 : 2, rc = 0;
-  EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->emit_main, o->single,
+  EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
                     !o->plain_sum, o->wide_step};
   for (int i = 0; i < nfiles && !rc; i++)
     if (!(f[i] = open_tmp(o, suffix[i], tmp[i], final[i], sizeof tmp[i]))) rc = 1;
@@ -271,7 +271,7 @@ int main(int argc, char **argv) {
   } else if (o.check_only) {
     print_check(mod, &o, k, why);
   } else {
-    const Method *me = method_new(k, o.s);
+    const Method *me = method_new(k, o.s, MULT_CONST);
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }

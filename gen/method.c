@@ -69,10 +69,11 @@ static int cmp_double(const void *a, const void *b) {
 }
 
 // Fill the constants of HBVM(k,s).
-Method *method_new(int k, int s) {
+Method *method_new(int k, int s, MultFamily family) {
   Method *me = arena_alloc(sizeof *me);
   me->k = k;
   me->s = s;
+  me->family = family;
   me->c = arena_alloc((size_t)k * sizeof(double));
   me->b = arena_alloc((size_t)k * sizeof(double));
   gsl_integration_glfixed_table *t = gsl_integration_glfixed_table_alloc((size_t)k);
@@ -88,12 +89,14 @@ Method *method_new(int k, int s) {
   gsl_integration_glfixed_table_free(t);
   me->Ihat = arena_alloc((size_t)k * s * sizeof(double));
   me->W = arena_alloc((size_t)k * s * sizeof(double));
+  me->Phat = arena_alloc((size_t)k * s * sizeof(double));
   me->xi = arena_alloc((size_t)(s + 1) * sizeof(double));
   for (int j = 0; j <= s; j++) me->xi[j] = xi(j);
   for (int l = 0; l < k; l++)
     for (int j = 0; j < s; j++) {
       double c = me->c[l];
-      me->W[l * s + j] = me->b[l] * legendre_shifted(j, c);
+      me->Phat[l * s + j] = legendre_shifted(j, c);
+      me->W[l * s + j] = me->b[l] * me->Phat[l * s + j];
       me->Ihat[l * s + j] =
           j == 0 ? c : xi(j + 1) * legendre_shifted(j + 1, c) - xi(j) * legendre_shifted(j - 1, c);
     }

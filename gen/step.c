@@ -1,55 +1,58 @@
 /* step.c - one fixed-point sweep of HBVM(k,s), built as a DAG.
  *
- * The sweep maps (q0, p0, gamma, h, g(q0)) to the new gamma, lambda and
- * p1 - p0 exactly as METHOD.md writes it:
- *   Q_l     = q0 + h sum_j Ihat[l][j] gamma_j                  stage points
+ * The sweep maps (q0, p0, gamma, h, g(q0)) to the new gamma and p1 - p0
+ * exactly as METHOD.md writes it:
+ *   Q_l      = q0 + h sum_j Ihat[l][j] gamma_j                 stage points
  *   F_l, G_l = grad U(Q_l), grad g(Q_l)                         model derivatives
- *   psi_j   = sum_l b_l P_j(c_l) F_l,  rho_j likewise with G_l
- *   A lambda = r                                                the multiplier system
- *   gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)]
- * Building it in the DAG (rather than printing loops) lets folding and
- * sharing do the structural work: zero Jacobian entries, constant
- * gradients, an identity M, and the zeros of A and of its LU factors never
- * reach the emitted code. A is factored without pivoting, in the order of
- * the constraints: its symmetric part h xi_0 rho_0' M^-1 rho_0 is positive
- * definite when the constraints are independent, so no pivot vanishes, and
- * a banded A (a chain) keeps its band. */
+ *   psi_j    = sum_l b_l P_j(c_l) F_l,  rho_j likewise with G_l
+ *   Theta_j  = psi_j + (the multiplier's force, projected on P_j)
+ *   gamma_j  = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i]
+ * How the multiplier is fixed is the method family's: step_const.c (the
+ * paper's constant multiplier) or step_poly.c (a polynomial one). Building
+ * the step in the DAG (rather than printing loops) lets folding and sharing
+ * do the structural work: zero Jacobian entries, constant gradients, an
+ * identity M, and the zeros of the multiplier system and of its factors
+ * never reach the emitted code.
+ *
+ * The results are laid out as named blocks of the kernels' out[] arrays
+ * (Step.kern), and the inputs as named blocks of DAG input slots
+ * (Step.in): the emitter prints both from this description. */
 #include <stdlib.h>
 #include <string.h>
 
-#include "hbvmgen.h"
+#include "step.h"
 
 #define MAX_DENSE_NU 4096
 
-typedef struct {
-  Model *mod;
-  const Method *me;
-  Dag *d;
-  Step *st;
-  int m, nu, s, k;
-  int h;          /* node of the step size */
-  int **psi;      /* s x m */
-  int ***rho;     /* s x nu x (entries of jac[a]) */
-  int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
-  int **vpsi;     /* s x m: M^-1 psi_j */
-} Build;
-
-static int *nodes(int n) { return arena_alloc((size_t)(n > 0 ? n : 1) * sizeof(int)); }
+int *step_nodes(int n) { return arena_alloc((size_t)(n > 0 ? n : 1) * sizeof(int)); }
 
 static int *zeros(Dag *d, int n) {
-  int *v = nodes(n), z = dag_const(d, 0);
+  int *v = step_nodes(n), z = dag_const(d, 0);
   for (int i = 0; i < n; i++) v[i] = z;
   return v;
 }
 
-// sum_r X[j][r] gamma_r (coordinate i) for the s x s matrix X of METHOD.md:
-// xi_0 gamma_0 - xi_1 gamma_1 for j = 0, xi_j gamma_{j-1} - xi_{j+1} gamma_{j+1}.
-static int x_gamma(Build *b, int j, int i) {
+int step_in(Build *b, int block, int i) { return dag_input(b->d, b->st->in[block].first + i); }
+
+// Coefficient j, coordinate i of gamma (the sweep's input) or of Theta.
+static int gamma_coef(Build *b, const void *ctx, int j, int i) {
+  (void)ctx;
+  return step_in(b, IN_GAM, j * b->m + i);
+}
+
+static int theta_coef(Build *b, const void *ctx, int j, int i) {
+  (void)b;
+  return ((int *const *)ctx)[j][i];
+}
+
+// Row j of the s x s matrix X of METHOD.md applied to coordinate i of the
+// coefficients coef(j): xi_0 v_0 - xi_1 v_1 for j = 0, else
+// xi_j v_{j-1} - xi_{j+1} v_{j+1} (the last term absent for j = s-1).
+static int apply_x(Build *b, int j, int i, int (*coef)(Build *, const void *, int, int), const void *ctx) {
   Dag *d = b->d;
   const double *xi = b->me->xi;
-  int m = b->m, in = b->st->in_gam;
-  int v = dag_mul(d, dag_const(d, xi[j]), dag_input(d, in + (j == 0 ? 0 : j - 1) * m + i));
-  if (j + 1 < b->s) v = dag_sub(d, v, dag_mul(d, dag_const(d, xi[j + 1]), dag_input(d, in + (j + 1) * m + i)));
+  int v = dag_mul(d, dag_const(d, xi[j]), coef(b, ctx, j == 0 ? 0 : j - 1, i));
+  if (j + 1 < b->s) v = dag_sub(d, v, dag_mul(d, dag_const(d, xi[j + 1]), coef(b, ctx, j + 1, i)));
   return v;
 }
 
@@ -62,8 +65,8 @@ static void project_affine(Build *b, const int *roots, int n, int *out) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
   dag_section(d, "affine derivative entries, projected in closed form");
-  int *grad = nodes(m), *q0 = nodes(m), *xg = nodes(s * m);
-  for (int i = 0; i < m; i++) q0[i] = dag_input(d, b->st->in_q0 + i);
+  int *grad = step_nodes(m), *q0 = step_nodes(m), *xg = step_nodes(s * m);
+  for (int i = 0; i < m; i++) q0[i] = step_in(b, IN_Q0, i);
   for (int j = 0; j < s; j++)
     for (int i = 0; i < m; i++) xg[j * m + i] = -1; /* built on first use */
   for (int r = 0; r < n; r++) {
@@ -74,7 +77,7 @@ static void project_affine(Build *b, const int *roots, int n, int *out) {
       int acc = j == 0 ? f0 : dag_const(d, 0);
       for (int i = 0; i < m; i++) {
         if (dag_is_zero(d, grad[i])) continue;
-        if (xg[j * m + i] < 0) xg[j * m + i] = dag_mul(d, b->h, x_gamma(b, j, i));
+        if (xg[j * m + i] < 0) xg[j * m + i] = dag_mul(d, b->h, apply_x(b, j, i, gamma_coef, NULL));
         acc = dag_add(d, acc, dag_mul(d, grad[i], xg[j * m + i]));
       }
       out[j * n + r] = acc;
@@ -92,12 +95,12 @@ static void build_stages(Build *b) {
   int m = b->m, s = b->s;
   int nroots = m;
   for (int a = 0; a < b->nu; a++) nroots += b->mod->jac[a].n;
-  int *roots = nodes(nroots), *img = nodes(nroots), *Q = nodes(m);
+  int *roots = step_nodes(nroots), *img = step_nodes(nroots), *Q = step_nodes(m);
   memcpy(roots, b->mod->gradU, (size_t)m * sizeof(int));
   for (int a = 0, r = m; a < b->nu; a++)
     for (int e = 0; e < b->mod->jac[a].n; e++) roots[r++] = b->mod->jac[a].e[e].node;
   /* split the roots: affine ones (degree 0 or 1 in q) and the rest */
-  int *affine = nodes(nroots), *curved = nodes(nroots), *where = nodes(nroots), naff = 0, ncur = 0;
+  int *affine = step_nodes(nroots), *curved = step_nodes(nroots), *where = step_nodes(nroots), naff = 0, ncur = 0;
   for (int r = 0; r < nroots; r++) {
     int deg = d->nodes[roots[r]].deg;
     if (deg == 0 || deg == 1) {
@@ -108,8 +111,8 @@ static void build_stages(Build *b) {
       curved[ncur++] = roots[r];
     }
   }
-  int *proj = nodes(s * nroots); /* proj[j * nroots + r]: the projection of root r on P_j */
-  int *paff = nodes(s * naff);
+  int *proj = step_nodes(s * nroots); /* proj[j * nroots + r]: the projection of root r on P_j */
+  int *paff = step_nodes(s * naff);
   if (naff) project_affine(b, affine, naff, paff);
   for (int j = 0; j < s; j++)
     for (int r = 0; r < nroots; r++) proj[j * nroots + r] = where[r] >= 0 ? paff[j * naff + where[r]] : dag_const(d, 0);
@@ -120,8 +123,8 @@ static void build_stages(Build *b) {
     for (int i = 0; i < m; i++) {
       int acc = dag_const(d, 0);
       for (int j = 0; j < s; j++)
-        acc = dag_add(d, acc, dag_mul(d, dag_const(d, me->Ihat[l * s + j]), dag_input(d, b->st->in_gam + j * m + i)));
-      Q[i] = dag_add(d, dag_input(d, b->st->in_q0 + i), dag_mul(d, b->h, acc));
+        acc = dag_add(d, acc, dag_mul(d, dag_const(d, me->Ihat[l * s + j]), step_in(b, IN_GAM, j * m + i)));
+      Q[i] = dag_add(d, step_in(b, IN_Q0, i), dag_mul(d, b->h, acc));
     }
     dag_subst(d, curved, ncur, Q, m, img);
     for (int j = 0; j < s; j++) {
@@ -133,18 +136,18 @@ static void build_stages(Build *b) {
   b->psi = arena_alloc((size_t)s * sizeof(int *));
   b->rho = arena_alloc((size_t)s * sizeof(int **));
   for (int j = 0; j < s; j++) {
-    b->psi[j] = nodes(m);
+    b->psi[j] = step_nodes(m);
     memcpy(b->psi[j], proj + j * nroots, (size_t)m * sizeof(int));
     b->rho[j] = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
     for (int a = 0, r = m; a < b->nu; a++) {
-      b->rho[j][a] = nodes(b->mod->jac[a].n);
+      b->rho[j][a] = step_nodes(b->mod->jac[a].n);
       for (int e = 0; e < b->mod->jac[a].n; e++) b->rho[j][a][e] = proj[j * nroots + r++];
     }
   }
 }
 
 // <rho_j[:, a], v> over the structural nonzeros of column a.
-static int dot_col(Build *b, int j, int a, const int *v) {
+int step_dot_col(Build *b, int j, int a, const int *v) {
   Dag *d = b->d;
   const SparseVec *col = &b->mod->jac[a];
   int acc = dag_const(d, 0);
@@ -157,11 +160,11 @@ static void build_minv_products(Build *b) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
   dag_section(d, "M^-1 psi_j and M^-1 rho_j");
-  int *dense = nodes(m);
+  int *dense = step_nodes(m);
   b->vpsi = arena_alloc((size_t)s * sizeof(int *));
   b->vrho = arena_alloc((size_t)s * sizeof(int **));
   for (int j = 0; j < s; j++) {
-    b->vpsi[j] = nodes(m);
+    b->vpsi[j] = step_nodes(m);
     minv_apply(b->mod, d, b->psi[j], b->vpsi[j]);
     b->vrho[j] = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
     for (int a = 0; a < b->nu; a++) {
@@ -169,172 +172,28 @@ static void build_minv_products(Build *b) {
       int z = dag_const(d, 0);
       for (int i = 0; i < m; i++) dense[i] = z;
       for (int e = 0; e < col->n; e++) dense[col->e[e].coord] = b->rho[j][a][e];
-      b->vrho[j][a] = nodes(m);
+      b->vrho[j][a] = step_nodes(m);
       minv_apply(b->mod, d, dense, b->vrho[j][a]);
     }
   }
 }
 
-// The combination xi_0 <x_0, y_0> + sum_j xi_j (<x_j, y_{j-1}> - <x_{j-1}, y_j>)
-// with x = rho[:, a] and y_j given by yj(j).
-static int skew_form(Build *b, int a, int **y) {
-  Dag *d = b->d;
-  const double *xi = b->me->xi;
-  int acc = dag_mul(d, dag_const(d, xi[0]), dot_col(b, 0, a, y[0]));
-  for (int j = 1; j < b->s; j++) {
-    int t = dag_sub(d, dot_col(b, j, a, y[j - 1]), dot_col(b, j - 1, a, y[j]));
-    acc = dag_add(d, acc, dag_mul(d, dag_const(d, xi[j]), t));
-  }
-  return acc;
-}
-
-// Solve A x = r (n x n node matrix, overwritten) by an LU factorisation
-// without pivoting, in the given order, skipping structural zeros (so fill-in
-// is only where it really happens). pivot[k] receives the k-th pivot.
-static void lu_solve(Dag *d, int *A, int *r, int n, int *x, int *pivot) {
-  for (int k = 0; k < n; k++) {
-    pivot[k] = A[k * n + k];
-    for (int i = k + 1; i < n; i++) {
-      if (dag_is_zero(d, A[i * n + k])) continue;
-      int f = dag_div(d, A[i * n + k], A[k * n + k]);
-      for (int c = k + 1; c < n; c++)
-        if (!dag_is_zero(d, A[k * n + c])) A[i * n + c] = dag_sub(d, A[i * n + c], dag_mul(d, f, A[k * n + c]));
-      r[i] = dag_sub(d, r[i], dag_mul(d, f, r[k]));
-    }
-  }
-  for (int k = n - 1; k >= 0; k--) {
-    int acc = r[k];
-    for (int c = k + 1; c < n; c++)
-      if (!dag_is_zero(d, A[k * n + c])) acc = dag_sub(d, acc, dag_mul(d, A[k * n + c], x[c]));
-    x[k] = dag_div(d, acc, A[k * n + k]);
-  }
-}
-
-// A fill-reducing elimination order for the n x n matrix of nodes A, chosen
-// at generation time by the greedy minimum-degree rule on its (symmetric)
-// structural pattern; ties go to the lower index, so an already banded
-// order, like a chain's, is kept. perm[k] is the k-th row/column eliminated.
-static void min_degree_order(const Dag *d, const int *A, int n, int *perm) {
-  unsigned char *adj = calloc((size_t)n * (size_t)n, 1), *done = calloc((size_t)n, 1);
-  int *deg = calloc((size_t)n, sizeof(int));
-  if (!adj || !done || !deg) internal_error("out of memory in min_degree_order");
-  for (int a = 0; a < n; a++)
-    for (int c = 0; c < n; c++)
-      if (a != c && (!dag_is_zero(d, A[a * n + c]) || !dag_is_zero(d, A[c * n + a]))) adj[a * n + c] = 1;
-  for (int a = 0; a < n; a++)
-    for (int c = 0; c < n; c++) deg[a] += adj[a * n + c];
-  for (int k = 0; k < n; k++) {
-    int best = -1;
-    for (int a = 0; a < n; a++)
-      if (!done[a] && (best < 0 || deg[a] < deg[best])) best = a;
-    perm[k] = best;
-    done[best] = 1;
-    /* eliminating best joins its remaining neighbours pairwise (fill-in) */
-    for (int a = 0; a < n; a++) {
-      if (done[a] || !adj[best * n + a]) continue;
-      deg[a]--;
-      for (int c = 0; c < n; c++)
-        if (c != a && !done[c] && adj[best * n + c] && !adj[a * n + c]) {
-          adj[a * n + c] = 1;
-          deg[a]++;
-        }
-    }
-  }
-  free(adj);
-  free(done);
-  free(deg);
-}
-
-// Solve A x = r in the elimination order perm: the LU of P A P' (whose
-// symmetric part is still positive definite, so no pivoting is needed).
-// pivot[k] and diag[k] receive the k-th pivot and the diagonal entry it
-// started from.
-static void solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag) {
-  int *perm = arena_alloc((size_t)n * sizeof(int)), *PA = arena_alloc((size_t)n * n * sizeof(int));
-  int *Pr = arena_alloc((size_t)n * sizeof(int)), *Px = arena_alloc((size_t)n * sizeof(int));
-  min_degree_order(d, A, n, perm);
-  for (int i = 0; i < n; i++) {
-    Pr[i] = r[perm[i]];
-    for (int j = 0; j < n; j++) PA[i * n + j] = A[perm[i] * n + perm[j]];
-    if (diag) diag[i] = PA[i * n + i];
-  }
-  lu_solve(d, PA, Pr, n, Px, pivot);
-  for (int i = 0; i < n; i++) x[perm[i]] = Px[i];
-}
-
-// Assemble A (nu x nu, dense node matrix) and r, then solve A lambda = r.
-static void build_multipliers(Build *b) {
-  Dag *d = b->d;
-  int nu = b->nu, m = b->m, s = b->s;
-  Step *st = b->st;
-  dag_section(d, "multiplier system A lambda = r");
-  int *A = nodes(nu * nu), *r = nodes(nu);
-  int **y = arena_alloc((size_t)s * sizeof(int *));
-  /* which constraints touch each coordinate through M^-1 rho */
-  IntVec *touch = arena_alloc((size_t)m * sizeof(IntVec));
-  for (int a = 0; a < nu; a++)
-    for (int i = 0; i < m; i++) {
-      int any = 0;
-      for (int j = 0; j < s; j++) any |= !dag_is_zero(d, b->vrho[j][a][i]);
-      if (any) intvec_push(&touch[i], a);
-    }
-  int *pair = nodes(nu);
-  for (int a = 0; a < nu; a++) pair[a] = -1;
-  int *minvp0 = nodes(m), *p0 = nodes(m);
-  for (int i = 0; i < m; i++) p0[i] = dag_input(d, st->in_p0 + i);
-  minv_apply(b->mod, d, p0, minvp0);
-  for (int a = 0; a < nu; a++) {
-    for (int c = 0; c < nu; c++) A[a * nu + c] = dag_const(d, 0);
-    const SparseVec *col = &b->mod->jac[a];
-    for (int e = 0; e < col->n; e++) {
-      IntVec *t = &touch[col->e[e].coord];
-      for (int q = 0; q < t->n; q++) {
-        int c = t->v[q];
-        if (pair[c] == a) continue;
-        pair[c] = a;
-        for (int j = 0; j < s; j++) y[j] = b->vrho[j][c];
-        A[a * nu + c] = dag_mul(d, b->h, skew_form(b, a, y));
-      }
-    }
-    for (int j = 0; j < s; j++) y[j] = b->vpsi[j];
-    int rhs = dag_sub(d, dot_col(b, 0, a, minvp0), dag_mul(d, b->h, skew_form(b, a, y)));
-    r[a] = dag_add(d, rhs, dag_input(d, st->in_g0 + a)); /* input: g_a(q0) / h, or 0 */
-  }
-  solve_ordered(d, A, r, nu, st->lambda, st->pivot, st->adiag);
-}
-
-// gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i], Theta_i = psi_i + rho_i lambda;
-// and p1 - p0 = -h Theta_0.
-static void build_update(Build *b) {
+// gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i] and p1 - p0 = -h Theta_0:
+// the sweep's results "gam" and "dp".
+void step_gamma_update(Build *b, int **theta) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
-  const double *xi = b->me->xi;
-  Step *st = b->st;
-  dag_section(d, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)]");
-  int **theta = arena_alloc((size_t)s * sizeof(int *));
-  for (int j = 0; j < s; j++) {
-    theta[j] = nodes(m);
-    memcpy(theta[j], b->psi[j], (size_t)m * sizeof(int));
-    for (int a = 0; a < b->nu; a++) {
-      const SparseVec *col = &b->mod->jac[a];
-      for (int e = 0; e < col->n; e++) {
-        int i = col->e[e].coord;
-        theta[j][i] = dag_add(d, theta[j][i], dag_mul(d, b->rho[j][a][e], st->lambda[a]));
-      }
-    }
-  }
-  int *v = nodes(m);
+  int *v = step_nodes(m), *gam = step_nodes(s * m), *dp = step_nodes(m);
   for (int j = 0; j < s; j++) {
     for (int i = 0; i < m; i++) {
-      int x = j == 0 ? dag_mul(d, dag_const(d, xi[0]), theta[0][i])
-                     : dag_mul(d, dag_const(d, xi[j]), theta[j - 1][i]);
-      if (j + 1 < s) x = dag_sub(d, x, dag_mul(d, dag_const(d, xi[j + 1]), theta[j + 1][i]));
-      x = dag_mul(d, b->h, x);
-      v[i] = j == 0 ? dag_sub(d, dag_input(d, st->in_p0 + i), x) : dag_neg(d, x);
+      int x = dag_mul(d, b->h, apply_x(b, j, i, theta_coef, theta));
+      v[i] = j == 0 ? dag_sub(d, step_in(b, IN_P0, i), x) : dag_neg(d, x);
     }
-    minv_apply(b->mod, d, v, st->gam_new + j * m);
+    minv_apply(b->mod, d, v, gam + j * m);
   }
-  for (int i = 0; i < m; i++) st->dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
+  for (int i = 0; i < m; i++) dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
+  step_result(b->st, K_SWEEP, "gam", SZ_SM, 1, s * m, gam);
+  step_result(b->st, K_SWEEP, "dp", SZ_M, 1, m, dp);
 }
 
 // The multiplier consistent with (q0, p0): differentiating the hidden
@@ -342,15 +201,14 @@ static void build_update(Build *b) {
 //   (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U,  v = M^-1 p,
 // where v' Hess(g_a) v is the derivative of w_a(q) = grad g_a(q)' v along v
 // (one more reverse sweep, with v held constant). For NAME_init.
-static void build_initial_multiplier(Build *b, const int *q) {
+static void build_initial_multiplier(Build *b, const int *q, const int *v) {
   Dag *d = b->d;
   Model *mod = b->mod;
   int m = b->m, nu = b->nu;
-  Step *st = b->st;
   dag_section(d, "consistent initial multiplier");
-  const int *v = st->predict0; /* M^-1 p0 */
-  int *dw = nodes(m), *col = nodes(m), *mcol = nodes(m), *gu = nodes(m), *mgu = nodes(m);
-  int *B = nodes(nu * nu), *r = nodes(nu), *piv = nodes(nu), z = dag_const(d, 0);
+  int *dw = step_nodes(m), *col = step_nodes(m), *mcol = step_nodes(m), *gu = step_nodes(m), *mgu = step_nodes(m);
+  int *B = step_nodes(nu * nu), *r = step_nodes(nu), *piv = step_nodes(nu), *lambda0 = step_nodes(nu);
+  int z = dag_const(d, 0);
   int **G = arena_alloc((size_t)nu * sizeof(int *)); /* dense columns of grad g at q0 */
   for (int a = 0; a < nu; a++) {
     G[a] = zeros(d, m);
@@ -384,30 +242,30 @@ static void build_initial_multiplier(Build *b, const int *q) {
     }
     r[a] = dag_sub(d, hvv, gmu);
   }
-  solve_ordered(d, B, r, nu, st->lambda0, piv, NULL);
+  lu_solve_ordered(d, B, r, nu, lambda0, piv, NULL);
+  step_result(b->st, K_LAMBDA0, "lambda", SZ_NU, 1, nu, lambda0);
 }
 
 // Functions of the state outside the step: g(q), H(q,p), grad g(q)' M^-1 p,
-// and the first step's prediction gamma_0 = M^-1 p0.
+// the first step's prediction gamma_0 = M^-1 p0, and the consistent multiplier.
 static void build_diagnostics(Build *b) {
   Dag *d = b->d;
   Model *mod = b->mod;
   int m = b->m, nu = b->nu;
-  Step *st = b->st;
-  int *q = nodes(m), *p = nodes(m);
+  int *q = step_nodes(m), *p = step_nodes(m), *g = step_nodes(nu), *v = step_nodes(m), *hidden = step_nodes(nu);
   for (int i = 0; i < m; i++) {
-    q[i] = dag_input(d, st->in_q0 + i);
-    p[i] = dag_input(d, st->in_p0 + i);
+    q[i] = step_in(b, IN_Q0, i);
+    p[i] = step_in(b, IN_P0, i);
   }
   dag_section(d, "g(q0)");
-  dag_subst(d, mod->g, nu, q, m, st->g_at_q0);
-  minv_apply(mod, d, p, st->predict0);
+  dag_subst(d, mod->g, nu, q, m, g);
+  minv_apply(mod, d, p, v);
   dag_section(d, "energy");
   int kin = dag_const(d, 0);
-  for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, p[i], st->predict0[i]));
+  for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, p[i], v[i]));
   int U;
   dag_subst(d, &mod->U, 1, q, m, &U);
-  st->energy[0] = dag_add(d, dag_mul(d, dag_const(d, 0.5), kin), U);
+  int H = dag_add(d, dag_mul(d, dag_const(d, 0.5), kin), U);
   dag_section(d, "hidden constraints");
   for (int a = 0; a < nu; a++) {
     const SparseVec *col = &mod->jac[a];
@@ -415,12 +273,83 @@ static void build_diagnostics(Build *b) {
     for (int e = 0; e < col->n; e++) {
       int ga;
       dag_subst(d, &col->e[e].node, 1, q, m, &ga);
-      acc = dag_add(d, acc, dag_mul(d, ga, st->predict0[col->e[e].coord]));
+      acc = dag_add(d, acc, dag_mul(d, ga, v[col->e[e].coord]));
     }
-    st->hidden[a] = acc;
+    hidden[a] = acc;
   }
-  if (nu) build_initial_multiplier(b, q);
+  step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);
+  step_result(b->st, K_ENERGY, "H", SZ_ONE, 1, 1, &H);
+  if (!nu) return;
+  step_result(b->st, K_G, "g", SZ_NU, 1, nu, g);
+  step_result(b->st, K_HIDDEN, "hidden", SZ_NU, 1, nu, hidden);
+  build_initial_multiplier(b, q, v);
 }
+
+// Append the result block name (len nodes, len = coef * sym) to kernel k.
+void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes) {
+  Kernel *kn = &st->kern[k];
+  ASSERT(kn->nout < MAX_BLOCKS);
+  Slots *bl = &kn->out[kn->nout++];
+  bl->name = name;
+  bl->sym = sym;
+  bl->coef = coef;
+  bl->first = kn->nout > 1 ? bl[-1].first + bl[-1].len : 0;
+  bl->len = len;
+  bl->nodes = step_nodes(len);
+  memcpy(bl->nodes, nodes, (size_t)len * sizeof(int));
+}
+
+const Slots *step_block(const Step *st, KernelId k, const char *name) {
+  for (int i = 0; i < st->kern[k].nout; i++)
+    if (!strcmp(st->kern[k].out[i].name, name)) return &st->kern[k].out[i];
+  return NULL;
+}
+
+int kernel_size(const Kernel *k) { return k->nout ? k->out[k->nout - 1].first + k->out[k->nout - 1].len : 0; }
+
+// Lay out the input blocks: DAG inputs 0..m-1 are the model's coordinates,
+// the kernels' inputs follow in signature order.
+static void layout_inputs(Step *st, int m, int nu, int s, int nlam, int nlu) {
+  static const struct {
+    const char *name;
+    SizeSym sym;
+    int scalar, narrow, wrap;
+  } spec[IN_COUNT] = {
+      [IN_Q0] = {"q0", SZ_M, 0, 0, 0},  [IN_P0] = {"p0", SZ_M, 0, 0, 0},  [IN_GAM] = {"gam", SZ_SM, 0, 0, 0},
+      [IN_H] = {"h", SZ_ONE, 1, 1, 1},  [IN_G0] = {"g0", SZ_NU, 0, 1, 0}, [IN_LAM] = {"lam", SZ_SNU, 0, 0, 0},
+      [IN_LU] = {"lu", SZ_ONE, 0, 0, 0},
+  };
+  int len[IN_COUNT] = {[IN_Q0] = m, [IN_P0] = m, [IN_GAM] = s * m, [IN_H] = 1, [IN_G0] = nu, [IN_LAM] = nlam, [IN_LU] = nlu};
+  for (int i = 0, first = m; i < IN_COUNT; i++) {
+    Slots *bl = &st->in[i];
+    bl->name = spec[i].name;
+    bl->sym = spec[i].sym;
+    bl->coef = spec[i].sym == SZ_ONE ? len[i] : 1;
+    bl->scalar = spec[i].scalar;
+    bl->narrow = spec[i].narrow;
+    bl->wrap = spec[i].wrap;
+    bl->first = first;
+    bl->len = len[i];
+    first += len[i];
+  }
+}
+
+static const struct {
+  const char *name, *what;
+  int wide;
+} kernel_spec[K_COUNT] = {
+    [K_SWEEP] = {"sweep", NULL, 1},
+    [K_FACTOR] = {"factor", NULL, 1},
+    [K_MINV_P] = {"minv_p", "out = M^-1 p0: the first step's prediction of gamma_0", 0},
+    [K_ENERGY] = {"energy_kernel", "out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0)", 0},
+    [K_G] = {"g", "out = g(q0)", 0},
+    [K_HIDDEN] = {"hidden_kernel", "out = grad g(q0)' M^-1 p0", 0},
+    [K_LAMBDA0] = {"lambda0",
+                   "out = the multiplier consistent with (q0, p0):\n"
+                   " * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0",
+                   0},
+    [K_PROJECT] = {"project", NULL, 0},
+};
 
 Step *step_build(Model *mod, const Method *me) {
   Step *st = arena_alloc(sizeof *st);
@@ -432,29 +361,17 @@ Step *step_build(Model *mod, const Method *me) {
   st->m = m;
   st->nu = nu;
   st->s = s;
-  st->in_q0 = m;
-  st->in_p0 = 2 * m;
-  st->in_gam = 3 * m;
-  st->in_h = 3 * m + s * m;
-  st->in_g0 = st->in_h + 1;
-  st->ninputs = st->in_g0 + nu;
-  st->gam_new = nodes(s * m);
-  st->dp = nodes(m);
-  st->lambda = nodes(nu);
-  st->pivot = nodes(nu);
-  st->adiag = nodes(nu);
-  st->predict0 = nodes(m);
-  st->g_at_q0 = nodes(nu);
-  st->energy = nodes(1);
-  st->hidden = nodes(nu);
-  st->lambda0 = nodes(nu);
-  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, dag_input(mod->dag, st->in_h), NULL, NULL, NULL, NULL};
-  build_stages(&b);
-  if (nu) {
-    build_minv_products(&b);
-    build_multipliers(&b);
+  for (int k = 0; k < K_COUNT; k++) {
+    st->kern[k].name = kernel_spec[k].name;
+    st->kern[k].what = kernel_spec[k].what;
+    st->kern[k].wide = kernel_spec[k].wide;
   }
-  build_update(&b);
+  layout_inputs(st, m, nu, s, 0, 0);
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, NULL, NULL, NULL, NULL, NULL};
+  b.h = step_in(&b, IN_H, 0);
+  build_stages(&b);
+  if (nu) build_minv_products(&b);
+  build_const_multiplier(&b);
   build_diagnostics(&b);
   return st;
 }

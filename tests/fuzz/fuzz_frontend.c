@@ -130,14 +130,14 @@ static void build_and_emit(Model *mod, int s, int variant) {
   const char *why;
   int k = method_auto_k(s, mod->degU, mod->degg, &why);
   if (mod->m > FUZZ_MAX_M || mod->nu > FUZZ_MAX_NU || k > FUZZ_MAX_K || mod->dag->n > FUZZ_MAX_NODES) return;
-  const Method *me = method_new(k, s);
+  const Method *me = method_new(k, s, MULT_CONST);
   Step *st = step_build(mod, me);
   if (!st) return;
   if (!sink && !(sink = fopen("/dev/null", "w"))) abort();
   int single = variant & 1;
-  EmitOptions eo = {"fuzz", "fuzz.ham", !single, single, !(variant & 2), (variant & 4) != 0};
+  EmitOptions eo = {"fuzz", "fuzz.ham", single, !(variant & 2), (variant & 4) != 0};
   emit_solver(sink, sink, mod, me, st, &eo);
-  if (eo.emit_main) emit_driver(sink, mod, me, &eo);
+  if (!single) emit_driver(sink, mod, me, &eo);
 }
 
 /* One model: the passes of gen/main.c, then everything freed. */

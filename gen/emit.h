@@ -1,0 +1,36 @@
+/* emit.h - what the two halves of the emitter share.
+ *
+ * emit_kernel.c prints kernels: straight-line C from the DAG, addressing
+ * inputs and results through the blocks of the Step. emit_step.c prints
+ * everything around them (header, constants, the public functions and the
+ * step's predict / iterate / commit templates), naming the kernels' inputs
+ * and results only through those blocks. */
+#ifndef EMIT_H
+#define EMIT_H
+
+#include "hbvmgen.h"
+
+typedef struct {
+  FILE *f;
+  const Model *mod;
+  const Method *me;
+  const Step *st;
+  const char *P;   /* prefix */
+  int *temp;       /* temporary number per node, -1 if none */
+  int single;      /* float instead of double */
+  int compensated; /* Kahan summation of the q, p, t updates */
+  int *chunk;      /* kernel split in parts: part of each node (NULL: one part) */
+  int *slot;       /* its place in the array w[] passing values between parts, or -1 */
+  int part;        /* the part being printed */
+  int wide_step;   /* --wide-step: the step iterates one precision wider */
+  int wide;        /* the kernel being printed computes one precision wider */
+} Emitter;
+
+void out(Emitter *e, const char *fmt, ...);
+const char *real_type(const Emitter *e, int wide);
+const char *math_suffix(const Emitter *e, int wide);
+void format_real(const Emitter *e, char *buf, size_t size, double v);
+void tmpl(Emitter *e, const char *text);
+void emit_kernel(Emitter *e, KernelId k);
+
+#endif

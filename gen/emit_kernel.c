@@ -1,0 +1,382 @@
+/* emit_kernel.c - kernels: straight-line C from the DAG.
+ *
+ * Every computation of the generated solver is a "kernel": a static
+ * function printed from the result blocks of a Kernel as straight-line
+ * code, one operation a line, each intermediate a named const temporary, a
+ * comment where a new section of the method starts, constants with 17
+ * significant digits. All kernels share one signature, printed from the
+ * Step's input blocks (q0, p0, gamma, h, g0, ..., params -> out[]), so that
+ * the input slots of the DAG map to the same C names everywhere. This file
+ * also holds the small printing helpers emit_step.c uses: out, tmpl (the
+ * template expander, which also names kernel calls and result offsets from
+ * the blocks) and format_real. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "emit.h"
+
+/* A kernel with more operations than this is printed as several functions
+ * of straight-line code (values crossing parts pass through an array):
+ * compilers take time superlinear in a function's size. */
+#define PART_NODES 2000
+
+void out(Emitter *e, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  vfprintf(e->f, fmt, ap);
+  va_end(ap);
+}
+
+// The name of a real type of the generated code, and the suffix of its
+// math functions (sqrt, sqrtf, sqrtl): the solver's real type, or with wide
+// the next wider one (--wide-step: long double for double, double for float).
+const char *real_type(const Emitter *e, int wide) {
+  if (wide) return e->single ? "double" : "long double";
+  return e->single ? "float" : "double";
+}
+
+const char *math_suffix(const Emitter *e, int wide) {
+  if (wide) return e->single ? "" : "l";
+  return e->single ? "f" : "";
+}
+
+
+// The C expression of the total length of blocks[0..n): the sum of their
+// symbolic lengths, equal symbols merged ("S * M + M + 2 * NU"); "" for none.
+static void size_expr(const Slots *blocks, int n, char *buf, size_t size) {
+  static const char *const sym[SZ_COUNT] = {[SZ_SM] = "S * M", [SZ_M] = "M", [SZ_NU] = "NU", [SZ_SNU] = "S * NU"};
+  int coef[SZ_COUNT] = {0}, order[SZ_COUNT], norder = 0;
+  for (int i = 0; i < n; i++) {
+    if (!blocks[i].coef) continue;
+    if (!coef[blocks[i].sym]) order[norder++] = blocks[i].sym;
+    coef[blocks[i].sym] += blocks[i].coef;
+  }
+  size_t len = 0;
+  buf[0] = 0;
+  for (int i = 0; i < norder && len < size; i++) {
+    int c = coef[order[i]];
+    const char *sep = i ? " + " : "";
+    if (order[i] == SZ_ONE) len += (size_t)snprintf(buf + len, size - len, "%s%d", sep, c);
+    else if (c == 1) len += (size_t)snprintf(buf + len, size - len, "%s%s", sep, sym[order[i]]);
+    else len += (size_t)snprintf(buf + len, size - len, "%s%d * %s", sep, c, sym[order[i]]);
+  }
+}
+
+// The kernel named name (up to the first character not in a C name).
+static KernelId kernel_named(const Emitter *e, const char *name, size_t n) {
+  for (int k = 0; k < K_COUNT; k++)
+    if (strlen(e->st->kern[k].name) == n && !strncmp(e->st->kern[k].name, name, n)) return (KernelId)k;
+  internal_error("template names an unknown kernel '%.*s'", (int)n, name);
+  return K_COUNT;
+}
+
+// Expand "kernel.block" or "kernel" (text up to end) into the C expression
+// of that block's offset in the kernel's out[] (of its total length without
+// a block): "" when it is zero. With plus, "OFFSET + " so that
+// "sw[$[sweep.dp]i]" reads sw[S * M + i] or sw[i].
+static void offset_of(const Emitter *e, const char *text, const char *end, int plus) {
+  const char *dot = memchr(text, '.', (size_t)(end - text));
+  const Kernel *k = &e->st->kern[kernel_named(e, text, (size_t)((dot ? dot : end) - text))];
+  int upto = k->nout;
+  if (dot) {
+    for (upto = 0; upto < k->nout; upto++)
+      if (strlen(k->out[upto].name) == (size_t)(end - dot - 1) && !strncmp(k->out[upto].name, dot + 1, (size_t)(end - dot - 1)))
+        break;
+    if (upto == k->nout) internal_error("template names an unknown result '%.*s'", (int)(end - text), text);
+  }
+  char buf[256];
+  size_expr(k->out, upto, buf, sizeof buf);
+  if (plus && buf[0]) fprintf(e->f, "%s + ", buf);
+  else if (!plus) fputs(buf[0] ? buf : "0", e->f);
+}
+
+// Print a call of a kernel from "name arg=value ...": the arguments in
+// signature order, 0 for an input not given, prm unless given, out= last.
+static void kernel_call(Emitter *e, const char *text, const char *end) {
+  size_t n = strcspn(text, " )");
+  KernelId k = kernel_named(e, text, n);
+  const char *val[IN_COUNT + 2] = {0}; /* the inputs, then prm and out */
+  size_t vlen[IN_COUNT + 2] = {0};
+  for (const char *p = text + n; p < end;) {
+    while (*p == ' ') p++;
+    size_t nl = strcspn(p, "="), vl = strcspn(p + nl + 1, " )");
+    int slot = -1;
+    for (int i = 0; i < IN_COUNT; i++)
+      if (strlen(e->st->in[i].name) == nl && !strncmp(e->st->in[i].name, p, nl)) slot = i;
+    if (nl == 3 && !strncmp(p, "prm", 3)) slot = IN_COUNT;
+    if (nl == 3 && !strncmp(p, "out", 3)) slot = IN_COUNT + 1;
+    if (slot < 0) internal_error("template passes an unknown argument '%.*s'", (int)nl, p);
+    val[slot] = p + nl + 1;
+    vlen[slot] = vl;
+    p += nl + 1 + vl;
+  }
+  fprintf(e->f, "%s_%s(", e->P, e->st->kern[k].name);
+  for (int i = 0; i < IN_COUNT; i++)
+    if (e->st->in[i].len || i < IN_LAM) fprintf(e->f, "%.*s, ", val[i] ? (int)vlen[i] : 1, val[i] ? val[i] : "0");
+  fprintf(e->f, "%.*s, %.*s)", val[IN_COUNT] ? (int)vlen[IN_COUNT] : 3, val[IN_COUNT] ? val[IN_COUNT] : "prm",
+          (int)vlen[IN_COUNT + 1], val[IN_COUNT + 1] ? val[IN_COUNT + 1] : "");
+}
+
+// Print text, replacing $P by the prefix, $R by the real type name, $f by
+// the suffix of its math functions, $W by the type the step iterates in (the
+// real type, or the next wider one with --wide-step) and $g by the suffix of
+// that type's math functions. Kernels are named through the Step, never by
+// position: $(kernel arg=value ...) prints a call, $[kernel.result] the
+// offset of a result block followed by " + " (nothing for the first),
+// $<kernel.result> the offset alone and $<kernel> the length of out[].
+void tmpl(Emitter *e, const char *text) {
+  for (const char *p = text; *p; p++) {
+    if (*p != '$' || !p[1]) {
+      fputc(*p, e->f);
+      continue;
+    }
+    const char *close = NULL;
+    switch (p[1]) {
+    case 'P': fputs(e->P, e->f); break;
+    case 'R': fputs(real_type(e, 0), e->f); break;
+    case 'f': fputs(math_suffix(e, 0), e->f); break;
+    case 'W': fputs(real_type(e, e->wide_step), e->f); break;
+    case 'g': fputs(math_suffix(e, e->wide_step), e->f); break;
+    case '(':
+      close = strchr(p, ')');
+      kernel_call(e, p + 2, close);
+      break;
+    case '[':
+      close = strchr(p, ']');
+      offset_of(e, p + 2, close, 1);
+      break;
+    case '<':
+      close = strchr(p, '>');
+      offset_of(e, p + 2, close, 0);
+      break;
+    default: fputc(*p, e->f); continue;
+    }
+    p = close ? close : p + 1;
+  }
+}
+// A literal that reads back exactly in the real type and is a C floating
+// constant: 17 significant digits for double, 9 and an f suffix for float.
+void format_real(const Emitter *e, char *buf, size_t size, double v) {
+  char tmp[40];
+  int single = e->single && !e->wide; /* a wide kernel of a float solver computes in double */
+  snprintf(tmp, sizeof tmp, single ? "%.9g" : "%.17g", single ? (double)(float)v : v);
+  if (!strpbrk(tmp, ".eEn")) strcat(tmp, ".0");
+  if (single) strcat(tmp, "f");
+  snprintf(buf, size, v < 0 ? "(%s)" : "%s", tmp);
+}
+
+// The C expression that names node id inside a kernel: a literal, a
+// parameter, an input or a temporary.
+static void name_of(Emitter *e, int id, char *buf, size_t size) {
+  const Node *n = &e->mod->dag->nodes[id];
+  const Step *st = e->st;
+  switch ((Op)n->op) {
+  case OP_CONST: format_real(e, buf, size, n->val); return;
+  case OP_PARAM: snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name); return;
+  case OP_INPUT:
+    for (int i = 0; i < IN_COUNT; i++) {
+      const Slots *in = &st->in[i];
+      if (n->idx < in->first || n->idx >= in->first + in->len) continue;
+      if (in->scalar) snprintf(buf, size, "%s", in->name);
+      else snprintf(buf, size, "%s[%d]", in->name, n->idx - in->first);
+      return;
+    }
+    internal_error("model coordinate %d reached a kernel", n->idx);
+    return;
+  default:
+    if (e->chunk && e->chunk[id] != e->part) snprintf(buf, size, "w[%d]", e->slot[id]);
+    else snprintf(buf, size, "t%d", e->temp[id]);
+    return;
+  }
+}
+
+// name_of, with the leaves (constants, params, inputs) of a wide kernel cast
+// to the wider type, so that no operation is done in the narrower one.
+static void ref(Emitter *e, int id, char *buf, size_t size) {
+  const Node *n = &e->mod->dag->nodes[id];
+  if (!(e->wide && (n->op == OP_CONST || n->op == OP_PARAM || n->op == OP_INPUT))) {
+    name_of(e, id, buf, size);
+    return;
+  }
+  char leaf[96];
+  name_of(e, id, leaf, sizeof leaf);
+  snprintf(buf, size, "(%s)%s", real_type(e, 1), leaf);
+}
+
+// x^n for a small integer n as products, so no pow() call is needed.
+static int power_expr(char *buf, size_t size, const char *x, double n) {
+  static const char *const forms[] = {NULL, "%s", "%s * %s", "%s * %s * %s", "(%s * %s) * (%s * %s)",
+                                      "(%s * %s) * (%s * %s) * %s", "(%s * %s * %s) * (%s * %s * %s)"};
+  if (n != floor(n) || fabs(n) < 2 || fabs(n) > 6) return 0; /* (int) of 1e40 would be undefined */
+  int k = (int)fabs(n);
+  char prod[512];
+  snprintf(prod, sizeof prod, forms[k], x, x, x, x, x, x);
+  if (n < 0) snprintf(buf, size, "1 / (%s)", prod);
+  else snprintf(buf, size, "%s", prod);
+  return 1;
+}
+
+// One line computing node id into its temporary.
+static void emit_node(Emitter *e, int id) {
+  const Node *n = &e->mod->dag->nodes[id];
+  char a[128], b[128], rhs[640];
+  ref(e, n->a, a, sizeof a);
+  if (n->b >= 0) ref(e, n->b, b, sizeof b);
+  switch ((Op)n->op) {
+  case OP_ADD: snprintf(rhs, sizeof rhs, "%s + %s", a, b); break;
+  case OP_SUB: snprintf(rhs, sizeof rhs, "%s - %s", a, b); break;
+  case OP_MUL: snprintf(rhs, sizeof rhs, "%s * %s", a, b); break;
+  case OP_DIV: snprintf(rhs, sizeof rhs, "%s / %s", a, b); break;
+  case OP_NEG: snprintf(rhs, sizeof rhs, "-%s", a); break;
+  case OP_SIGN: snprintf(rhs, sizeof rhs, "(%s > 0) - (%s < 0)", a, a); break;
+  case OP_POW: {
+    const Node *ex = &e->mod->dag->nodes[n->b];
+    if (ex->op == OP_CONST && power_expr(rhs, sizeof rhs, a, ex->val)) break;
+    snprintf(rhs, sizeof rhs, "pow%s(%s, %s)", math_suffix(e, e->wide), a, b);
+    break;
+  }
+  default:
+    if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a, b);
+    else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a);
+  }
+  out(e, "  const %s t%d = %s;\n", real_type(e, e->wide), e->temp[id], rhs);
+}
+
+// The signature of kernel k (of its part-th part when part >= 0): one
+// argument per input block of the Step, then the parameters and out[].
+static void kernel_signature(Emitter *e, const Kernel *k, int part) {
+  const Step *st = e->st;
+  const char *t = real_type(e, e->wide); /* the sweep of --wide-step: state, gamma, results wider */
+  tmpl(e, "static void $P_");
+  out(e, part >= 0 ? "%s_part%d(" : "%s(", k->name, part);
+  for (int i = 0; i < IN_COUNT; i++) {
+    const Slots *in = &st->in[i];
+    if (!in->len && i >= IN_LAM) continue; /* the inputs of one family only */
+    const char *ty = in->narrow ? real_type(e, 0) : t;
+    out(e, in->scalar ? "%s %s,%s" : "const %s *%s,%s", ty, in->name, in->wrap ? "\n    " : " ");
+  }
+  tmpl(e, "const $P_params *prm, ");
+  if (part >= 0) out(e, "%s *w, ", t);
+  out(e, "%s *out)\n{\n ", t);
+  for (int i = 0; i < IN_COUNT; i++)
+    if (st->in[i].len || i < IN_LAM) out(e, " (void)%s;", st->in[i].name);
+  out(e, " (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
+}
+
+// Print the operations ops[from..to) of a kernel, one a line, with a comment
+// where a new section of the method starts; values needed by a later part
+// are also stored in w[].
+static void emit_ops(Emitter *e, const int *ops, int from, int to) {
+  const Dag *d = e->mod->dag;
+  int sec = -1, shown = -1;
+  for (int i = from; i < to; i++) {
+    int id = ops[i];
+    while (sec + 1 < d->marks.n && d->marks.v[sec + 1] <= id) sec++;
+    if (sec >= 0 && sec != shown) {
+      out(e, "  /* %s */\n", d->labels[sec]);
+      shown = sec;
+    }
+    e->temp[id] = i;
+    emit_node(e, id);
+    if (e->chunk && e->slot[id] >= 0) out(e, "  w[%d] = t%d;\n", e->slot[id], i);
+  }
+}
+
+// out[i] = outs[i], for the outputs of the part being printed (all of
+// them when the kernel is one part).
+static void emit_outputs(Emitter *e, const int *outs, int nouts) {
+  for (int i = 0; i < nouts; i++) {
+    if (e->chunk && e->chunk[outs[i]] != e->part) continue;
+    char r[128];
+    ref(e, outs[i], r, sizeof r);
+    out(e, "  out[%d] = %s;\n", i, r);
+  }
+}
+
+// Assign each operation its part, and a slot in w[] to every value used in
+// a later part than its own. Returns the number of slots.
+static int split_parts(Emitter *e, const int *ops, int nops) {
+  const Dag *d = e->mod->dag;
+  int nslots = 0;
+  for (int i = 0; i < nops; i++) e->chunk[ops[i]] = i / PART_NODES;
+  for (int i = 0; i < nops; i++) {
+    const Node *n = &d->nodes[ops[i]];
+    int kids[2] = {n->a, n->b};
+    for (int k = 0; k < 2; k++)
+      if (kids[k] >= 0 && d->nodes[kids[k]].a >= 0 && e->chunk[kids[k]] < e->chunk[ops[i]] && e->slot[kids[k]] < 0)
+        e->slot[kids[k]] = nslots++;
+  }
+  return nslots;
+}
+
+// Print the kernel k's parts, each a function of straight-line code over
+// ops[] (ops in DAG order), and the kernel calling them in order.
+static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, const int *outs, int nouts, int top) {
+  int nparts = (nops + PART_NODES - 1) / PART_NODES;
+  e->chunk = malloc((size_t)(top + 1) * sizeof(int));
+  e->slot = malloc((size_t)(top + 1) * sizeof(int));
+  if (!e->chunk || !e->slot) internal_error("out of memory");
+  for (int id = 0; id <= top; id++) {
+    e->chunk[id] = nparts - 1;
+    e->slot[id] = -1;
+  }
+  int nslots = split_parts(e, ops, nops);
+  for (e->part = 0; e->part < nparts; e->part++) {
+    kernel_signature(e, k, e->part);
+    int from = e->part * PART_NODES, to = from + PART_NODES < nops ? from + PART_NODES : nops;
+    emit_ops(e, ops, from, to);
+    emit_outputs(e, outs, nouts); /* those computed in this part (leaves in the last) */
+    out(e, "}\n\n");
+  }
+  out(e, "/* %s: the %d parts above in order */\n", k->name, nparts);
+  kernel_signature(e, k, -1);
+  out(e, "  %s w[%d];\n", real_type(e, e->wide), nslots);
+  for (int p = 0; p < nparts; p++) {
+    out(e, "  %s_%s_part%d(", e->P, k->name, p);
+    for (int i = 0; i < IN_COUNT; i++)
+      if (e->st->in[i].len || i < IN_LAM) out(e, "%s, ", e->st->in[i].name);
+    out(e, "prm, w, out);\n");
+  }
+  out(e, "}\n");
+  free(e->chunk);
+  free(e->slot);
+  e->chunk = e->slot = NULL;
+}
+
+// Print kernel k, computing its result blocks into out[]: straight-line
+// code from the DAG, in several parts when it is large. Kernels marked wide
+// compute one precision wider under --wide-step.
+void emit_kernel(Emitter *e, KernelId id) {
+  const Kernel *k = &e->st->kern[id];
+  const Dag *d = e->mod->dag;
+  int nouts = kernel_size(k), top = -1, nops = 0;
+  int *outs = malloc((size_t)(nouts + 1) * sizeof(int));
+  if (!outs) internal_error("out of memory");
+  for (int b = 0; b < k->nout; b++)
+    memcpy(outs + k->out[b].first, k->out[b].nodes, (size_t)k->out[b].len * sizeof(int));
+  for (int i = 0; i < nouts; i++)
+    if (outs[i] > top) top = outs[i];
+  unsigned char *mark = calloc((size_t)top + 2, 1);
+  int *ops = malloc((size_t)(top + 2) * sizeof(int));
+  if (!mark || !ops) internal_error("out of memory");
+  dag_reach(d, outs, nouts, mark);
+  for (int i = 0; i <= top; i++)
+    if (mark[i] && d->nodes[i].a >= 0) ops[nops++] = i;
+  e->wide = e->wide_step && k->wide;
+  if (e->wide) out(e, "\n/* --wide-step: the %s below computes in %s. */", k->name, real_type(e, 1));
+  out(e, "\n/* %s */\n", k->what);
+  if (nops > PART_NODES) {
+    emit_parts(e, k, ops, nops, outs, nouts, top);
+  } else {
+    kernel_signature(e, k, -1);
+    emit_ops(e, ops, 0, nops);
+    emit_outputs(e, outs, nouts);
+    out(e, "}\n");
+  }
+  e->wide = 0;
+  free(outs);
+  free(mark);
+  free(ops);
+}

@@ -1,0 +1,40 @@
+/* step.h - what the step builders share (step.c, step_const.c, step_poly.c, lu.c).
+ *
+ * step.c builds what every method family has: the stage points, the model
+ * derivatives at the stages and their Legendre projections, the update of
+ * gamma, and the functions of the state outside the step. The family's
+ * file builds the multiplier: build_const_multiplier (the paper's constant
+ * one) or build_poly_multiplier (a polynomial of degree s-1). */
+#ifndef STEP_H
+#define STEP_H
+
+#include "hbvmgen.h"
+
+typedef struct {
+  Model *mod;
+  const Method *me;
+  Dag *d;
+  Step *st;
+  int m, nu, s, k;
+  int h;          /* node of the step size */
+  int **psi;      /* s x m: sum_l b_l P_j(c_l) grad U(Q_l) */
+  int ***rho;     /* s x nu x (entries of jac[a]): the same with grad g_a */
+  int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
+  int **vpsi;     /* s x m: M^-1 psi_j */
+  int *minvp0;    /* m: M^-1 p0 */
+} Build;
+
+int *step_nodes(int n);
+int step_in(Build *b, int block, int i);              /* input node i of an input block */
+int step_apply_x(Build *b, int j, const int *v);      /* sum_i X[j][i] v[i], v one node per i */
+void step_gamma_update(Build *b, int **theta);        /* gamma_j and p1 - p0 from Theta_i */
+int step_dot_col(Build *b, int j, int a, const int *v);
+void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
+
+void build_const_multiplier(Build *b);
+void build_poly_multiplier(Build *b);
+
+/* lu.c: linear systems of DAG nodes, solved at generation time in structure */
+void lu_solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag);
+
+#endif
