@@ -35,7 +35,10 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "typedef $R $P_real;\n\n");
   out(e, "typedef struct {\n  %s_real t, q[%d], p[%d], lambda[%d];\n", e->P, m, m, nu ? nu : 1);
   out(e, "  /* private: compensated-summation errors and the last step's polynomial */\n");
-  out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n} %s_state;\n\ntypedef struct {\n", e->P, m, m, s * m, e->P);
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
+  if (poly) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+  out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
     char v[40];
     format_real(e, v, sizeof v, mod->params[i].value);
@@ -48,9 +51,10 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "  double increment;  /* last scaled increment of the iteration */\n"
           "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier\n"
-          " * consistent with (q0, p0) at the default parameters (0 if that is singular)\n"
-          " * and is the constant multiplier of the last step after each step. */\n"
-          "void $P_init($P_state *x, const double *q0, const double *p0);\n"
+          " * consistent with (q0, p0) at the default parameters (0 if that is singular)\n");
+  tmpl(e, poly ? " * and after each step is the multiplier consistent with the new (q, p), of order 2s. */\n"
+               : " * and is the constant multiplier of the last step after each step. */\n");
+  tmpl(e, "void $P_init($P_state *x, const double *q0, const double *p0);\n"
           "void $P_params_default($P_params *prm);\n"
           "/* One step of size h; prm and st may be NULL. Returns $P_OK or an error code. */\n"
           "int $P_step($P_state *x, double h, const $P_params *prm, $P_stats *st);\n"
@@ -125,6 +129,7 @@ static void emit_public(Emitter *e) {
           "    x->qc[i] = x->pc[i] = 0;\n  }\n"
           "  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;\n"
           "  for (i = 0; i < S * M; i++) x->gam[i] = 0;\n");
+  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
   if (e->mod->nu)
     tmpl(e, "  {\n    $P_params prm;\n    $R lam[NU];\n    $P_params_default(&prm);\n"
             "    $(lambda0 q0=x->q p0=x->p prm=&prm out=lam);\n"
@@ -154,12 +159,62 @@ static void emit_public(Emitter *e) {
             "  (void)x; (void)prm; (void)gp;\n}\n");
 }
 
+// The end of a step of the polynomial family: q1 and p1 as the state will
+// hold them (compensated sums, or the wide sums with --wide-step), p1
+// projected onto the hidden constraint at q1 and rescaled to the energy H0
+// of the run, the multiplier consistent with (q1, p1), then the commit.
+static void emit_end_poly(Emitter *e) {
+  int wide = e->wide_step;
+  tmpl(e, "  $W q1[M], p1[M], pr[$<project> + 1], K, U1, beta = 1;\n  $R H0, Hn = $P_energy(x, prm);\n");
+  if (wide)
+    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+            "    q1[i] = q0w[i] + h * sw[$[sweep.gam]i];\n    p1[i] = p0w[i] + sw[$[sweep.dp]i];\n  }\n");
+  else
+    tmpl(e, "  $R qc1[M], pc1[M];\n"
+            "  for (i = 0; i < M; i++) {\n"
+            "    q1[i] = x->q[i];\n    qc1[i] = x->qc[i];\n    p1[i] = x->p[i];\n    pc1[i] = x->pc[i];\n"
+            "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
+            "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
+  tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
+          "  $(project q0=q1 p0=p1 out=pr);\n"
+          "  for (i = 0; i < NU; i++) {\n"
+          "    $W piv = pr[$[project.pivot]i], dia = pr[$[project.adiag]i];\n"
+          "    if (isfinite(piv) && isfinite(dia) && !(fabs$g(piv) > SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n"
+          "  for (i = 0; i < $<project>; i++)\n    if (!isfinite(pr[i])) return $P_ENONFINITE;\n"
+          "  /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:\n"
+          "   * taken anew on the first step, or when the state or parameters were changed\n"
+          "   * since the last step (H(q0, p0) differs from H0 by more than round-off). No\n"
+          "   * rescale at rest (K = 0) or where H0 < U(q1). */\n"
+          "  K = pr[$[project.kin]0];\n  U1 = pr[$[project.U]0];\n"
+          "  H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * TOL * (K + fabs$g(U1)) ? x->H0 : Hn;\n"
+          "  if (K > 0 && H0 - U1 > 0) beta = sqrt$g((H0 - U1) / K);\n");
+  if (wide)
+    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+            "    p1[i] = beta * (p1[i] + pr[$[project.dp]i]);\n"
+            "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
+            "  /* q1, p1 rounded once into q, p; what the rounding lost is the new qc, pc */\n"
+            "  for (i = 0; i < M; i++) {\n    x->q[i] = ($R)q1[i];\n    x->p[i] = ($R)p1[i];\n");
+  else
+    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+            "    $P_add(&p1[i], &pc1[i], pr[$[project.dp]i] + (beta - 1) * (p1[i] + pr[$[project.dp]i]));\n"
+            "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
+            "  for (i = 0; i < M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
+            "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
+  if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
+  tmpl(e, "  }\n"
+          "  for (i = 0; i < S * M; i++) x->gam[i] = ($R)gam[i];\n"
+          "  x->H0 = H0;\n"
+          "  {\n    $R lam0[NU];\n    $(lambda0 q0=x->q p0=x->p out=lam0);\n"
+          "    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;\n  }\n"
+          "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
+}
+
 // The warm start, iteration and compensated update around the sweep kernel.
 // With --wide-step the iteration (gamma, the sweep's results) is in the wider
 // type, starts from the compensated state q - qc, p - pc, and the new q, p
 // and their compensations come from rounding the wide sums once.
 static void emit_step(Emitter *e) {
-  int wide = e->wide_step;
+  int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "\n/* gamma for a step of size h: extrapolated from the previous step's polynomial,\n"
           " * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */\n"
           "static void $P_predict(const $P_state *x, $R h, const $P_params *prm, $R *gam)\n{\n"
@@ -202,10 +257,24 @@ static void emit_step(Emitter *e) {
             "   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it\n"
             "   * (eps / h a step) would only add noise, so it is left out. */\n"
             "  for (i = 0; i < NU; i++) g0[i] = fabs$f(g0[i]) <= GTOL ? 0 : g0[i] / h;\n");
+  if (poly)
+    tmpl(e, wide ? "  $W fa[$<factor> + 1], lam[S * NU];\n"
+                              "  for (i = 0; i < S * NU; i++) lam[i] = 0;\n"
+                              "  /* the multiplier matrix at the predicted stages, factored once for all sweeps */\n"
+                              "  $(factor q0=q0w gam=gam h=h out=fa);\n"
+                            : "  $W fa[$<factor> + 1], lam[S * NU];\n"
+                              "  for (i = 0; i < S * NU; i++) lam[i] = 0;\n"
+                              "  /* the multiplier matrix at the predicted stages, factored once for all sweeps */\n"
+                              "  $(factor q0=x->q gam=gam h=h out=fa);\n");
+  if (poly)
+    tmpl(e, "  for (i = 0; i < S * NU; i++) {\n"
+            "    $W piv = fa[$[factor.pivot]i], dia = fa[$[factor.adiag]i];\n"
+            "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
+            "    if (!(fabs$g(piv) > SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n");
   tmpl(e, "  for (it = 1; it <= MAXITER; it++) {\n");
   char call[128];
-  snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s out=sw);\n", wide ? "q0w" : "x->q",
-           wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "");
+  snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s%s out=sw);\n", wide ? "q0w" : "x->q",
+           wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "", poly ? " lam=lam lu=fa" : "");
   tmpl(e, call);
   tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
@@ -217,14 +286,17 @@ static void emit_step(Emitter *e) {
           "      if (v > inc) inc = v;\n"
           "      gam[i] = sw[$[sweep.gam]i];\n    }\n"
           "    if (scale > 0) inc /= scale;\n");
-  if (e->mod->nu) /* before the finiteness test: a zero pivot makes lambda 0/0 */
+  if (poly)
+    tmpl(e, "    for (i = 0; i < S * NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
+            "    for (i = 0; i < $<sweep>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+  else if (e->mod->nu) /* before the finiteness test: a zero pivot makes lambda 0/0 */
     tmpl(e, "    for (i = 0; i < NU; i++) {\n"
             "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
             "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
             "    }\n"
             "    if (rc == $P_ESINGULAR) break;\n");
-  tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
-          "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
+  if (!poly) tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+  tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
           "    /* converged: the increment is far below an ulp of the state (TOL / 256), or\n"
           "     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it\n"
           "     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating\n"
@@ -233,8 +305,12 @@ static void emit_step(Emitter *e) {
           "    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = $P_OK; break; }\n"
           "    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? $P_OK : $P_ENOCONV; break; }\n  }\n"
           "  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }\n"
-          "  if (rc != $P_OK) return rc;\n"
-          "  for (i = 0; i < M; i++) /* the new state must be finite too */\n"
+          "  if (rc != $P_OK) return rc;\n");
+  if (poly) {
+    emit_end_poly(e);
+    return;
+  }
+  tmpl(e, "  for (i = 0; i < M; i++) /* the new state must be finite too */\n"
           "    if (!isfinite(x->q[i] + h * sw[$[sweep.gam]i]) || !isfinite(x->p[i] + sw[$[sweep.dp]i])) return $P_ENONFINITE;\n");
   if (!wide)
     tmpl(e, "  for (i = 0; i < M; i++) {\n"

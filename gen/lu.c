@@ -83,3 +83,49 @@ void lu_solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pi
   lu_solve(d, PA, Pr, n, Px, pivot);
   for (int i = 0; i < n; i++) x[perm[i]] = Px[i];
 }
+
+// Factor A (n x n node matrix) once, for solves whose right-hand sides
+// come later (the frozen multiplier matrix of step_poly.c): P A P' = L U in
+// the minimum-degree order, no pivoting. f->F holds the multipliers of L
+// below the diagonal, U above it and the reciprocals of U's pivots on it,
+// so that a solve needs no division; structural zeros stay the DAG's zero.
+// pivot[k] and diag[k] receive the k-th pivot and its starting diagonal.
+void lu_factor(Dag *d, const int *A, int n, LuFactor *f, int *pivot, int *diag) {
+  f->n = n;
+  f->perm = step_nodes(n);
+  f->F = step_nodes(n * n);
+  min_degree_order(d, A, n, f->perm);
+  int *F = f->F;
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) F[i * n + j] = A[f->perm[i] * n + f->perm[j]];
+  for (int k = 0; k < n; k++) diag[k] = F[k * n + k];
+  for (int k = 0; k < n; k++) {
+    pivot[k] = F[k * n + k];
+    for (int i = k + 1; i < n; i++) {
+      if (dag_is_zero(d, F[i * n + k])) continue;
+      F[i * n + k] = dag_div(d, F[i * n + k], F[k * n + k]);
+      for (int c = k + 1; c < n; c++)
+        if (!dag_is_zero(d, F[k * n + c]))
+          F[i * n + c] = dag_sub(d, F[i * n + c], dag_mul(d, F[i * n + k], F[k * n + c]));
+    }
+    F[k * n + k] = dag_div(d, dag_const(d, 1), F[k * n + k]);
+  }
+}
+
+// Solve with a factor: x = A^-1 r, where f->F may hold the factor's own
+// nodes or, in a later kernel, inputs standing for them at the same places.
+void lu_apply(Dag *d, const LuFactor *f, const int *r, int *x) {
+  int n = f->n, *y = step_nodes(n);
+  const int *F = f->F;
+  for (int i = 0; i < n; i++) y[i] = r[f->perm[i]];
+  for (int k = 0; k < n; k++)
+    for (int i = k + 1; i < n; i++)
+      if (!dag_is_zero(d, F[i * n + k])) y[i] = dag_sub(d, y[i], dag_mul(d, F[i * n + k], y[k]));
+  for (int k = n - 1; k >= 0; k--) {
+    int acc = y[k];
+    for (int c = k + 1; c < n; c++)
+      if (!dag_is_zero(d, F[k * n + c])) acc = dag_sub(d, acc, dag_mul(d, F[k * n + c], y[c]));
+    y[k] = dag_mul(d, acc, F[k * n + k]);
+  }
+  for (int i = 0; i < n; i++) x[f->perm[i]] = y[i];
+}

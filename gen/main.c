@@ -27,6 +27,11 @@ static const char usage[] =
     "                conserves H and g exactly for polynomial models; 2s+12 otherwise)\n"
     "  -o DIR        where NAME.c and NAME.h are written (default generated)\n"
     "  -n NAME       C prefix of every emitted symbol (default: the model file's base name)\n"
+    "  --multiplier F  const or poly: how the Lagrange multiplier varies over a step.\n"
+    "                const: constant, the paper's method, order 2 with constraints\n"
+    "                (2s where the true multiplier is constant); poly: a polynomial of\n"
+    "                degree s-1, then p projected onto the hidden constraint and rescaled\n"
+    "                to the energy: order 2s. Default: poly for s >= 2 with constraints\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k\n"
     "  --real T      float or double (default): the type of the state, constants and\n"
@@ -46,6 +51,7 @@ typedef struct {
   int s, k; /* k = 0: auto */
   int emit_main, check_only;
   int single, plain_sum, wide_step;
+  int multiplier; /* -1: default for s and the model; else a MultFamily */
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -84,6 +90,11 @@ static int parse_args(int argc, char **argv, Options *o) {
       o->plain_sum = 1;
     } else if (!strcmp(a, "--wide-step")) {
       o->wide_step = 1;
+    } else if (!strcmp(a, "--multiplier")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      const char *v = argv[++i];
+      if (strcmp(v, "const") && strcmp(v, "poly")) return fail("--multiplier needs 'const' or 'poly', got '%s'", v);
+      o->multiplier = !strcmp(v, "poly") ? MULT_POLY : MULT_CONST;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -192,11 +203,19 @@ static const char *mass_str(MassKind k) {
   return "?";
 }
 
-static void print_check(const Model *mod, const Options *o, int k, const char *why) {
+static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam) {
   char a[16], b[16];
   printf("model %s: m=%d nu=%d deg(U)=%s deg(g)=%s k=%d s=%d\n", o->name, mod->m, mod->nu, deg_str(mod->degU, a),
          deg_str(mod->degg, b), k, o->s);
   printf("k: %s\n", o->k ? "given with -k" : why);
+  if (!mod->nu)
+    printf("multiplier: none (no constraints): order %d\n", 2 * o->s);
+  else if (fam == MULT_POLY)
+    printf("multiplier: poly (degree %d, projection and energy rescale): order %d in q, p and lambda\n", o->s - 1,
+           o->s >= 2 ? 2 * o->s : 2);
+  else
+    printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda (%d where the true multiplier is "
+           "constant)\n", 2 * o->s);
   printf("M: %s\n", mass_str(mod->mass));
   long nnz = 0;
   for (int a2 = 0; a2 < mod->nu; a2++) nnz += mod->jac[a2].n;
@@ -246,7 +265,7 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0};
+  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) o.name = default_name(o.model);
@@ -265,13 +284,14 @@ int main(int argc, char **argv) {
   model_check_initial(mod);
   const char *why = "given with -k";
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, &why);
+  MultFamily fam = o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 && mod->nu ? MULT_POLY : MULT_CONST;
   if (k > MAX_K) {
     fprintf(stderr, "hbvmgen: error: the degrees of U and g need k=%d > %d nodes; pass -k\n", k, MAX_K);
     rc = 1;
   } else if (o.check_only) {
-    print_check(mod, &o, k, why);
+    print_check(mod, &o, k, why, fam);
   } else {
-    const Method *me = method_new(k, o.s, MULT_CONST);
+    const Method *me = method_new(k, o.s, fam);
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }

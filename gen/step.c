@@ -40,7 +40,7 @@ static int gamma_coef(Build *b, const void *ctx, int j, int i) {
   return step_in(b, IN_GAM, j * b->m + i);
 }
 
-static int theta_coef(Build *b, const void *ctx, int j, int i) {
+static int vector_coef(Build *b, const void *ctx, int j, int i) {
   (void)b;
   return ((int *const *)ctx)[j][i];
 }
@@ -55,6 +55,9 @@ static int apply_x(Build *b, int j, int i, int (*coef)(Build *, const void *, in
   if (j + 1 < b->s) v = dag_sub(d, v, dag_mul(d, dag_const(d, xi[j + 1]), coef(b, ctx, j + 1, i)));
   return v;
 }
+
+// Row j of X applied to coordinate i of the vectors v[0..s-1].
+int step_apply_x(Build *b, int j, int i, int **v) { return apply_x(b, j, i, vector_coef, v); }
 
 // The projections sum_l b_l P_j(c_l) f(Q_l) of derivative entries f that are
 // affine in q, in closed form: with Q(c) = q0 + h sum_r gamma_r int_0^c P_r,
@@ -82,6 +85,18 @@ static void project_affine(Build *b, const int *roots, int n, int *out) {
       }
       out[j * n + r] = acc;
     }
+  }
+}
+
+// Stage point l: Q[i] = q0[i] + h sum_j Ihat[l][j] gamma_j[i].
+void step_stage_point(Build *b, int l, int *Q) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s;
+  for (int i = 0; i < m; i++) {
+    int acc = dag_const(d, 0);
+    for (int j = 0; j < s; j++)
+      acc = dag_add(d, acc, dag_mul(d, dag_const(d, b->me->Ihat[l * s + j]), step_in(b, IN_GAM, j * m + i)));
+    Q[i] = dag_add(d, step_in(b, IN_Q0, i), dag_mul(d, b->h, acc));
   }
 }
 
@@ -120,12 +135,7 @@ static void build_stages(Build *b) {
     char *label = arena_alloc(128);
     snprintf(label, 128, "stage %d of %d: Q = q0 + h sum_j Ihat[%d][j] gamma_j, grad U(Q), grad g(Q)", l + 1, b->k, l + 1);
     dag_section(d, label);
-    for (int i = 0; i < m; i++) {
-      int acc = dag_const(d, 0);
-      for (int j = 0; j < s; j++)
-        acc = dag_add(d, acc, dag_mul(d, dag_const(d, me->Ihat[l * s + j]), step_in(b, IN_GAM, j * m + i)));
-      Q[i] = dag_add(d, step_in(b, IN_Q0, i), dag_mul(d, b->h, acc));
-    }
+    step_stage_point(b, l, Q);
     dag_subst(d, curved, ncur, Q, m, img);
     for (int j = 0; j < s; j++) {
       int w = dag_const(d, me->W[l * s + j]);
@@ -178,22 +188,60 @@ static void build_minv_products(Build *b) {
   }
 }
 
-// gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i] and p1 - p0 = -h Theta_0:
-// the sweep's results "gam" and "dp".
-void step_gamma_update(Build *b, int **theta) {
+// gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i] (s*m nodes in gam)
+// and p1 - p0 = -h Theta_0 (m nodes in dp).
+void step_gamma(Build *b, int **theta, int *gam, int *dp) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
-  int *v = step_nodes(m), *gam = step_nodes(s * m), *dp = step_nodes(m);
+  int *v = step_nodes(m);
   for (int j = 0; j < s; j++) {
     for (int i = 0; i < m; i++) {
-      int x = dag_mul(d, b->h, apply_x(b, j, i, theta_coef, theta));
+      int x = dag_mul(d, b->h, apply_x(b, j, i, vector_coef, theta));
       v[i] = j == 0 ? dag_sub(d, step_in(b, IN_P0, i), x) : dag_neg(d, x);
     }
     minv_apply(b->mod, d, v, gam + j * m);
   }
   for (int i = 0; i < m; i++) dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
-  step_result(b->st, K_SWEEP, "gam", SZ_SM, 1, s * m, gam);
-  step_result(b->st, K_SWEEP, "dp", SZ_M, 1, m, dp);
+}
+
+// step_gamma, as the sweep's results "gam" and "dp".
+void step_gamma_update(Build *b, int **theta) {
+  int *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->m);
+  step_gamma(b, theta, gam, dp);
+  step_result(b->st, K_SWEEP, "gam", SZ_SM, 1, b->s * b->m, gam);
+  step_result(b->st, K_SWEEP, "dp", SZ_M, 1, b->m, dp);
+}
+
+// The dense columns G[a] (m nodes each) of grad g at the point q.
+int **step_jacobian_at(Build *b, const int *q) {
+  Model *mod = b->mod;
+  int **G = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
+  for (int a = 0; a < b->nu; a++) {
+    G[a] = zeros(b->d, b->m);
+    for (int e = 0; e < mod->jac[a].n; e++)
+      dag_subst(b->d, &mod->jac[a].e[e].node, 1, q, b->m, &G[a][mod->jac[a].e[e].coord]);
+  }
+  return G;
+}
+
+// B = G' M^-1 G (nu x nu) for the dense columns G, over the structural
+// nonzeros of the Jacobian only.
+void step_gram(Build *b, int **G, int *B) {
+  Dag *d = b->d;
+  Model *mod = b->mod;
+  int m = b->m, nu = b->nu, z = dag_const(d, 0), *mcol = step_nodes(m);
+  IntVec *touch = arena_alloc((size_t)m * sizeof(IntVec)); /* constraints on each coordinate */
+  for (int a = 0; a < nu; a++)
+    for (int e = 0; e < mod->jac[a].n; e++) intvec_push(&touch[mod->jac[a].e[e].coord], a);
+  for (int i = 0; i < nu * nu; i++) B[i] = z;
+  for (int c = 0; c < nu; c++) { /* B[:, c] = G' M^-1 G[:, c] */
+    minv_apply(mod, d, G[c], mcol);
+    for (int i = 0; i < m; i++)
+      for (int t = 0; !dag_is_zero(d, mcol[i]) && t < touch[i].n; t++) {
+        int a = touch[i].v[t];
+        B[a * nu + c] = dag_add(d, B[a * nu + c], dag_mul(d, G[a][i], mcol[i]));
+      }
+  }
 }
 
 // The multiplier consistent with (q0, p0): differentiating the hidden
@@ -206,29 +254,13 @@ static void build_initial_multiplier(Build *b, const int *q, const int *v) {
   Model *mod = b->mod;
   int m = b->m, nu = b->nu;
   dag_section(d, "consistent initial multiplier");
-  int *dw = step_nodes(m), *col = step_nodes(m), *mcol = step_nodes(m), *gu = step_nodes(m), *mgu = step_nodes(m);
+  int *dw = step_nodes(m), *col = step_nodes(m), *gu = step_nodes(m), *mgu = step_nodes(m);
   int *B = step_nodes(nu * nu), *r = step_nodes(nu), *piv = step_nodes(nu), *lambda0 = step_nodes(nu);
   int z = dag_const(d, 0);
-  int **G = arena_alloc((size_t)nu * sizeof(int *)); /* dense columns of grad g at q0 */
-  for (int a = 0; a < nu; a++) {
-    G[a] = zeros(d, m);
-    for (int e = 0; e < mod->jac[a].n; e++)
-      dag_subst(d, &mod->jac[a].e[e].node, 1, q, m, &G[a][mod->jac[a].e[e].coord]);
-  }
+  int **G = step_jacobian_at(b, q);
   dag_subst(d, mod->gradU, m, q, m, gu);
   minv_apply(mod, d, gu, mgu);
-  IntVec *touch = arena_alloc((size_t)m * sizeof(IntVec)); /* constraints on each coordinate */
-  for (int a = 0; a < nu; a++)
-    for (int e = 0; e < mod->jac[a].n; e++) intvec_push(&touch[mod->jac[a].e[e].coord], a);
-  for (int i = 0; i < nu * nu; i++) B[i] = z;
-  for (int c = 0; c < nu; c++) { /* B[:, c] = G' M^-1 G[:, c], over structural nonzeros only */
-    minv_apply(mod, d, G[c], mcol);
-    for (int i = 0; i < m; i++)
-      for (int t = 0; !dag_is_zero(d, mcol[i]) && t < touch[i].n; t++) {
-        int a = touch[i].v[t];
-        B[a * nu + c] = dag_add(d, B[a * nu + c], dag_mul(d, G[a][i], mcol[i]));
-      }
-  }
+  step_gram(b, G, B);
   for (int a = 0; a < nu; a++) {
     int w = z, hvv = z, gmu = z;
     for (int e = 0; e < mod->jac[a].n; e++)
@@ -348,7 +380,7 @@ static const struct {
                    "out = the multiplier consistent with (q0, p0):\n"
                    " * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0",
                    0},
-    [K_PROJECT] = {"project", NULL, 0},
+    [K_PROJECT] = {"project", NULL, 1},
 };
 
 Step *step_build(Model *mod, const Method *me) {
@@ -356,6 +388,11 @@ Step *step_build(Model *mod, const Method *me) {
   int m = mod->m, nu = mod->nu, s = me->s;
   if (nu > MAX_DENSE_NU) {
     error_at((Loc){0, 0}, "%d constraints: at most %d are supported", nu, MAX_DENSE_NU);
+    return NULL;
+  }
+  if (me->family == MULT_POLY && s * nu > MAX_DENSE_NU) {
+    error_at((Loc){0, 0}, "%d constraints at s=%d: the polynomial multiplier has at most %d coefficients; "
+             "pass --multiplier const", nu, s, MAX_DENSE_NU);
     return NULL;
   }
   st->m = m;
@@ -367,11 +404,17 @@ Step *step_build(Model *mod, const Method *me) {
     st->kern[k].wide = kernel_spec[k].wide;
   }
   layout_inputs(st, m, nu, s, 0, 0);
-  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, NULL, NULL, NULL, NULL, NULL};
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, NULL, NULL, NULL, NULL};
   b.h = step_in(&b, IN_H, 0);
+  int poly = me->family == MULT_POLY && nu;
+  if (poly) layout_inputs(st, m, nu, s, s * nu, 0); /* the factor's length is known once it is built */
   build_stages(&b);
-  if (nu) build_minv_products(&b);
-  build_const_multiplier(&b);
+  if (poly) {
+    build_poly_multiplier(&b);
+  } else {
+    if (nu) build_minv_products(&b);
+    build_const_multiplier(&b);
+  }
   build_diagnostics(&b);
   return st;
 }

@@ -21,13 +21,16 @@ typedef struct {
   int ***rho;     /* s x nu x (entries of jac[a]): the same with grad g_a */
   int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
   int **vpsi;     /* s x m: M^-1 psi_j */
-  int *minvp0;    /* m: M^-1 p0 */
 } Build;
 
 int *step_nodes(int n);
 int step_in(Build *b, int block, int i);              /* input node i of an input block */
-int step_apply_x(Build *b, int j, const int *v);      /* sum_i X[j][i] v[i], v one node per i */
-void step_gamma_update(Build *b, int **theta);        /* gamma_j and p1 - p0 from Theta_i */
+int step_apply_x(Build *b, int j, int i, int **v);     /* sum_r X[j][r] v[r][i] */
+void step_stage_point(Build *b, int l, int *Q);       /* Q_l, m nodes */
+void step_gamma(Build *b, int **theta, int *gam, int *dp); /* gamma_j and p1 - p0 from Theta_i */
+void step_gamma_update(Build *b, int **theta);        /* the same, as the sweep's results */
+int **step_jacobian_at(Build *b, const int *q);       /* dense columns of grad g at q */
+void step_gram(Build *b, int **G, int *B);            /* B = G' M^-1 G */
 int step_dot_col(Build *b, int j, int a, const int *v);
 void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
 
@@ -36,5 +39,14 @@ void build_poly_multiplier(Build *b);
 
 /* lu.c: linear systems of DAG nodes, solved at generation time in structure */
 void lu_solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag);
+
+typedef struct {
+  int n;
+  int *perm;  /* the elimination order */
+  int *F;     /* n x n: L's multipliers below the diagonal, U above, 1 / U's pivots on it */
+} LuFactor;
+
+void lu_factor(Dag *d, const int *A, int n, LuFactor *f, int *pivot, int *diag);
+void lu_apply(Dag *d, const LuFactor *f, const int *r, int *x);
 
 #endif

@@ -1,0 +1,273 @@
+/* step_poly.c - the order-2s method family: a polynomial multiplier.
+ *
+ * The multiplier is a polynomial of degree s-1 on the step,
+ *   lambda(t0 + c h) = sum_r P_r(c) lambda_r,
+ * fixed by s Legendre conditions on d/dt g along the step:
+ *   C_i = sum_l b_l P_i(c_l) G_l' V_l + delta_i0 g(q0)/h = 0,  i = 0..s-1,
+ * with V_l = sum_j P_j(c_l) gamma_j the velocity at stage l. The force
+ * coefficients become Theta_j = psi_j + sum_l b_l P_j(c_l) G_l Lambda_l,
+ * Lambda_l = sum_r P_r(c_l) lambda_r. C is affine in the lambda_r, with the
+ * (s nu) x (s nu) matrix
+ *   A[(i,a),(r,c)] = h sum_{j,l} X[j][l] (R_ij' M^-1 R_lr)_ac,
+ *   R_jr = sum_l b_l P_j(c_l) P_r(c_l) G_l,
+ * which the kernel "factor" builds from the predicted stage data and
+ * factors once per step (lu.c, minimum-degree order: a chain's blocks keep
+ * their band). Each sweep then updates lambda <- lambda + A^-1 C(lambda)
+ * with that frozen factor and recomputes Theta and gamma (METHOD-HO.md
+ * section 5: as few sweeps as re-solving A every sweep).
+ *
+ * After the iteration the step projects p1 onto the hidden constraint at
+ * q1 and rescales it so that H keeps its value; the kernel "project" gives
+ * the correction -G1 mu (mu = (G1' M^-1 G1)^-1 G1' M^-1 p1), the kinetic
+ * energy after it and U(q1), and the step template applies them. With the
+ * projection the step has order 2s (section 8: without it, s or s+1). */
+#include "step.h"
+
+// grad g at every stage point, over the structural nonzeros:
+// G[l][a][e] is entry e of column a at Q_l.
+static int ***stage_jacobians(Build *b) {
+  Dag *d = b->d;
+  const Model *mod = b->mod;
+  int m = b->m, nu = b->nu, nroots = 0;
+  for (int a = 0; a < nu; a++) nroots += mod->jac[a].n;
+  int *roots = step_nodes(nroots), *img = step_nodes(nroots), *Q = step_nodes(m);
+  for (int a = 0, r = 0; a < nu; a++)
+    for (int e = 0; e < mod->jac[a].n; e++) roots[r++] = mod->jac[a].e[e].node;
+  int ***G = arena_alloc((size_t)b->k * sizeof(int **));
+  for (int l = 0; l < b->k; l++) {
+    step_stage_point(b, l, Q);
+    dag_subst(d, roots, nroots, Q, m, img);
+    G[l] = arena_alloc((size_t)nu * sizeof(int *));
+    for (int a = 0, r = 0; a < nu; a++) {
+      G[l][a] = step_nodes(mod->jac[a].n);
+      for (int e = 0; e < mod->jac[a].n; e++) G[l][a][e] = img[r++];
+    }
+  }
+  return G;
+}
+
+// sum_e col[e] v[coord of entry e of column a]: a sparse column dotted with v.
+static int dot_sparse(Build *b, int a, const int *col, const int *v) {
+  Dag *d = b->d;
+  const SparseVec *jc = &b->mod->jac[a];
+  int acc = dag_const(d, 0);
+  for (int e = 0; e < jc->n; e++) acc = dag_add(d, acc, dag_mul(d, col[e], v[jc->e[e].coord]));
+  return acc;
+}
+
+// The multiplier matrix A of the header, assembled from the stage
+// Jacobians: (s nu) x (s nu) nodes, row (i,a) = i*nu + a.
+static int *multiplier_matrix(Build *b, int ***G) {
+  Dag *d = b->d;
+  const Method *me = b->me;
+  int m = b->m, nu = b->nu, s = b->s, n = s * nu, z = dag_const(d, 0);
+  /* R[i][r][a][e] = sum_l b_l P_i(c_l) P_r(c_l) G_l[a][e], symmetric in (i, r) */
+  int ****R = arena_alloc((size_t)s * sizeof(int ***));
+  for (int i = 0; i < s; i++) {
+    R[i] = arena_alloc((size_t)s * sizeof(int **));
+    for (int r = 0; r < s; r++) {
+      if (r < i) {
+        R[i][r] = R[r][i];
+        continue;
+      }
+      R[i][r] = arena_alloc((size_t)nu * sizeof(int *));
+      for (int a = 0; a < nu; a++) {
+        R[i][r][a] = step_nodes(b->mod->jac[a].n);
+        for (int e = 0; e < b->mod->jac[a].n; e++) {
+          int acc = z;
+          for (int l = 0; l < b->k; l++) {
+            double w = me->W[l * s + i] * me->Phat[l * s + r];
+            acc = dag_add(d, acc, dag_mul(d, dag_const(d, w), G[l][a][e]));
+          }
+          R[i][r][a][e] = acc;
+        }
+      }
+    }
+  }
+  /* vR[r][c][l] = M^-1 R_lr[:, c], dense */
+  int *dense = step_nodes(m);
+  int ****vR = arena_alloc((size_t)s * sizeof(int ***));
+  for (int r = 0; r < s; r++) {
+    vR[r] = arena_alloc((size_t)nu * sizeof(int **));
+    for (int c = 0; c < nu; c++) {
+      vR[r][c] = arena_alloc((size_t)s * sizeof(int *));
+      for (int l = 0; l < s; l++) {
+        for (int i = 0; i < m; i++) dense[i] = z;
+        for (int e = 0; e < b->mod->jac[c].n; e++) dense[b->mod->jac[c].e[e].coord] = R[l][r][c][e];
+        vR[r][c][l] = step_nodes(m);
+        minv_apply(b->mod, d, dense, vR[r][c][l]);
+      }
+    }
+  }
+  /* which constraints c reach each coordinate through M^-1: only those
+   * pairs (a, c) sharing a coordinate give a nonzero block */
+  IntVec *touch = arena_alloc((size_t)m * sizeof(IntVec));
+  for (int c = 0; c < nu; c++)
+    for (int i = 0; i < m; i++) {
+      int any = 0;
+      for (int r = 0; r < s; r++)
+        for (int l = 0; l < s; l++) any |= !dag_is_zero(d, vR[r][c][l][i]);
+      if (any) intvec_push(&touch[i], c);
+    }
+  int *A = step_nodes(n * n), *pair = step_nodes(nu), *xv = step_nodes(m);
+  for (int t = 0; t < n * n; t++) A[t] = z;
+  for (int a = 0; a < nu; a++) pair[a] = -1;
+  for (int a = 0; a < nu; a++) {
+    const SparseVec *col = &b->mod->jac[a];
+    for (int e = 0; e < col->n; e++) {
+      IntVec *t = &touch[col->e[e].coord];
+      for (int q = 0; q < t->n; q++) {
+        int c = t->v[q];
+        if (pair[c] == a) continue;
+        pair[c] = a;
+        for (int i = 0; i < s; i++)
+          for (int r = 0; r < s; r++) {
+            int acc = z;
+            for (int j = 0; j < s; j++) {
+              for (int f = 0; f < col->n; f++) xv[col->e[f].coord] = step_apply_x(b, j, col->e[f].coord, vR[r][c]);
+              acc = dag_add(d, acc, dot_sparse(b, a, R[i][j][a], xv));
+            }
+            A[(i * nu + a) * n + r * nu + c] = dag_mul(d, b->h, acc);
+          }
+      }
+    }
+  }
+  return A;
+}
+
+// Theta_j = psi_j + sum_l b_l P_j(c_l) G_l Lambda_l for the coefficients
+// lam[r*nu + a] of the multiplier.
+static int **force_coefficients(Build *b, int ***G, const int *lam) {
+  Dag *d = b->d;
+  const Method *me = b->me;
+  int m = b->m, nu = b->nu, s = b->s, z = dag_const(d, 0);
+  int **theta = arena_alloc((size_t)s * sizeof(int *)), *f = step_nodes(m);
+  for (int j = 0; j < s; j++) {
+    theta[j] = step_nodes(m);
+    for (int i = 0; i < m; i++) theta[j][i] = b->psi[j][i];
+  }
+  for (int l = 0; l < b->k; l++) {
+    for (int i = 0; i < m; i++) f[i] = z;
+    for (int a = 0; a < nu; a++) {
+      int Lam = z; /* the multiplier at stage l */
+      for (int r = 0; r < s; r++) Lam = dag_add(d, Lam, dag_mul(d, dag_const(d, me->Phat[l * s + r]), lam[r * nu + a]));
+      const SparseVec *col = &b->mod->jac[a];
+      for (int e = 0; e < col->n; e++)
+        f[col->e[e].coord] = dag_add(d, f[col->e[e].coord], dag_mul(d, G[l][a][e], Lam));
+    }
+    for (int j = 0; j < s; j++) {
+      int w = dag_const(d, me->W[l * s + j]);
+      for (int i = 0; i < m; i++) theta[j][i] = dag_add(d, theta[j][i], dag_mul(d, w, f[i]));
+    }
+  }
+  return theta;
+}
+
+// The conditions C[i*nu + a] = sum_l b_l P_i(c_l) G_l[:, a]' V_l (+ g_a(q0)/h
+// for i = 0) for the velocity coefficients gam (s*m nodes).
+static int *conditions(Build *b, int ***G, const int *gam) {
+  Dag *d = b->d;
+  const Method *me = b->me;
+  int m = b->m, nu = b->nu, s = b->s, z = dag_const(d, 0);
+  int *C = step_nodes(s * nu), *V = step_nodes(m);
+  for (int t = 0; t < s * nu; t++) C[t] = z;
+  for (int l = 0; l < b->k; l++) {
+    for (int i = 0; i < m; i++) {
+      V[i] = z;
+      for (int j = 0; j < s; j++) V[i] = dag_add(d, V[i], dag_mul(d, dag_const(d, me->Phat[l * s + j]), gam[j * m + i]));
+    }
+    for (int a = 0; a < nu; a++) {
+      int gv = dot_sparse(b, a, G[l][a], V);
+      for (int i = 0; i < s; i++) C[i * nu + a] = dag_add(d, C[i * nu + a], dag_mul(d, dag_const(d, me->W[l * s + i]), gv));
+    }
+  }
+  for (int a = 0; a < nu; a++) C[a] = dag_add(d, C[a], step_in(b, IN_G0, a)); /* input: g_a(q0) / h, or 0 */
+  return C;
+}
+
+// The kernel "project": at (q, p) = inputs (q0, p0), which the step sets to
+// (q1, p1), the correction dp = -G1 mu onto grad g(q1)' M^-1 p = 0, the
+// kinetic energy after it, U(q1), and the pivots of G1' M^-1 G1.
+static void build_projection(Build *b) {
+  Dag *d = b->d;
+  Model *mod = b->mod;
+  int m = b->m, nu = b->nu, z = dag_const(d, 0);
+  dag_section(d, "projection onto the hidden constraint at q1, kinetic energy after it, U(q1)");
+  int *q = step_nodes(m), *p = step_nodes(m), *v = step_nodes(m), *B = step_nodes(nu * nu), *rhs = step_nodes(nu);
+  int *mu = step_nodes(nu), *pivot = step_nodes(nu), *adiag = step_nodes(nu), *dp = step_nodes(m), *pt = step_nodes(m);
+  for (int i = 0; i < m; i++) {
+    q[i] = step_in(b, IN_Q0, i);
+    p[i] = step_in(b, IN_P0, i);
+  }
+  int **G = step_jacobian_at(b, q);
+  step_gram(b, G, B);
+  minv_apply(mod, d, p, v);
+  for (int a = 0; a < nu; a++) {
+    rhs[a] = z;
+    for (int i = 0; i < m; i++) rhs[a] = dag_add(d, rhs[a], dag_mul(d, G[a][i], v[i]));
+  }
+  lu_solve_ordered(d, B, rhs, nu, mu, pivot, adiag);
+  for (int i = 0; i < m; i++) {
+    dp[i] = z;
+    for (int a = 0; a < nu; a++) dp[i] = dag_sub(d, dp[i], dag_mul(d, G[a][i], mu[a]));
+    pt[i] = dag_add(d, p[i], dp[i]);
+  }
+  minv_apply(mod, d, pt, v);
+  int kin = z, U;
+  for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, pt[i], v[i]));
+  kin = dag_mul(d, dag_const(d, 0.5), kin);
+  dag_subst(d, &mod->U, 1, q, m, &U);
+  Step *st = b->st;
+  step_result(st, K_PROJECT, "dp", SZ_M, 1, m, dp);
+  step_result(st, K_PROJECT, "kin", SZ_ONE, 1, 1, &kin);
+  step_result(st, K_PROJECT, "U", SZ_ONE, 1, 1, &U);
+  step_result(st, K_PROJECT, "pivot", SZ_NU, 1, nu, pivot);
+  step_result(st, K_PROJECT, "adiag", SZ_NU, 1, nu, adiag);
+  st->kern[K_PROJECT].what = "The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the\n"
+                             " * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)\n"
+                             " * and diagonal (NU) of G1' M^-1 G1.";
+}
+
+// The kernels of the polynomial family: "factor" (the frozen multiplier
+// matrix, once per step), "sweep" (with the factor's entries as the input
+// lu) and "project".
+void build_poly_multiplier(Build *b) {
+  Dag *d = b->d;
+  Step *st = b->st;
+  int m = b->m, nu = b->nu, s = b->s, n = s * nu;
+  dag_section(d, "grad g at the stages");
+  int ***G = stage_jacobians(b);
+  dag_section(d, "the multiplier matrix A, factored once per step");
+  int *A = multiplier_matrix(b, G), *pivot = step_nodes(n), *adiag = step_nodes(n);
+  LuFactor f;
+  lu_factor(d, A, n, &f, pivot, adiag);
+  /* the factor's structural nonzeros are its results, and the sweep's input lu */
+  int nlu = 0, *lu = step_nodes(n * n);
+  LuFactor in = {n, f.perm, step_nodes(n * n)};
+  for (int t = 0; t < n * n; t++) {
+    in.F[t] = f.F[t];
+    if (dag_is_zero(d, f.F[t])) continue;
+    lu[nlu] = f.F[t];
+    in.F[t] = dag_input(d, st->in[IN_LU].first + nlu);
+    nlu++;
+  }
+  st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
+  step_result(st, K_FACTOR, "lu", SZ_ONE, nlu, nlu, lu);
+  step_result(st, K_FACTOR, "pivot", SZ_SNU, 1, n, pivot);
+  step_result(st, K_FACTOR, "adiag", SZ_SNU, 1, n, adiag);
+  st->kern[K_FACTOR].what = "The multiplier matrix A at the predicted stages, factored once per step: out = its\n"
+                            " * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU).";
+  dag_section(d, "the multiplier coefficients: lambda += A^-1 C(lambda)");
+  int *lam = step_nodes(n), *delta = step_nodes(n), *lam1 = step_nodes(n);
+  for (int t = 0; t < n; t++) lam[t] = step_in(b, IN_LAM, t);
+  int *gam = step_nodes(s * m), *dp = step_nodes(m);
+  step_gamma(b, force_coefficients(b, G, lam), gam, dp);
+  lu_apply(d, &in, conditions(b, G, gam), delta);
+  for (int t = 0; t < n; t++) lam1[t] = dag_add(d, lam[t], delta[t]);
+  dag_section(d, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)]");
+  step_gamma_update(b, force_coefficients(b, G, lam1));
+  step_result(st, K_SWEEP, "lam", SZ_SNU, 1, n, lam1);
+  st->kern[K_SWEEP].what = "One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),\n"
+                           " * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU).";
+  build_projection(b);
+}
