@@ -9,6 +9,9 @@
  *             phi''   = -2 cot th theta' phi';
  *             q = (sin th cos phi, sin th sin phi, -cos th)
  *   kepler    Cartesian, already unconstrained: q'' = -q / |q|^3
+ *   double_pendulum  the angles th1, th2 of the rods from the downward
+ *             vertical (Euler-Lagrange equations below);
+ *             q = (sin th1, -cos th1, sin th1 + sin th2, -cos th1 - cos th2)
  *
  * with p = q' mapped back, so errors, energy and constraints are measured
  * on (q, p) exactly as for the other methods. Absolute and relative
@@ -168,12 +171,81 @@ static void kep_to_qp(const double *y, double *q, double *p)
   memcpy(p, y + 2, 2 * sizeof *p);
 }
 
+/* --------------------------------------- double pendulum, rod angles
+ * y = (th1, th2, w1, w2), w = th'. With D = th1 - th2, c = cos D,
+ * s = sin D the Euler-Lagrange equations of
+ *     L = w1^2 + w2^2/2 + w1 w2 c + 2 cos th1 + cos th2
+ * are [[2, c], [c, 1]] (w1', w2') = (r1, r2) with
+ *     r1 = -s w2^2 - 2 sin th1,   r2 = s w1^2 - sin th2,
+ * so w1' = (r1 - c r2)/det, w2' = (2 r2 - c r1)/det, det = 2 - c^2. */
+
+static int dpend_f(double t, const double y[], double f[], void *params)
+{
+  double c = cos(y[0] - y[1]), s = sin(y[0] - y[1]), det = 2 - c * c;
+  double r1 = -s * y[3] * y[3] - 2 * sin(y[0]), r2 = s * y[2] * y[2] - sin(y[1]);
+  (void)t;
+  (void)params;
+  f[0] = y[2];
+  f[1] = y[3];
+  f[2] = (r1 - c * r2) / det;
+  f[3] = (2 * r2 - c * r1) / det;
+  return GSL_SUCCESS;
+}
+
+/* Column j of the Jacobian of (w1', w2') from the derivatives of D, r1 and
+ * r2 along y_j: d(n/det) = (dn - (n/det) ddet)/det, dc = -s dD,
+ * ddet = 2 c s dD. */
+static int dpend_jac(double t, const double y[], double *J, double dfdt[], void *params)
+{
+  double c = cos(y[0] - y[1]), s = sin(y[0] - y[1]), det = 2 - c * c;
+  double r1 = -s * y[3] * y[3] - 2 * sin(y[0]), r2 = s * y[2] * y[2] - sin(y[1]);
+  double a1 = (r1 - c * r2) / det, a2 = (2 * r2 - c * r1) / det;
+  /* dD, dr1, dr2 along th1, th2, w1, w2 */
+  const double dD[4] = {1, -1, 0, 0};
+  const double dr1[4] = {-c * y[3] * y[3] - 2 * cos(y[0]), c * y[3] * y[3], 0, -2 * s * y[3]};
+  const double dr2[4] = {c * y[2] * y[2], -c * y[2] * y[2] - cos(y[1]), 2 * s * y[2], 0};
+  int j;
+  (void)t;
+  (void)params;
+  for (j = 0; j < 4; j++) {
+    double dc = -s * dD[j], ddet = 2 * c * s * dD[j];
+    J[0 * 4 + j] = j == 2;
+    J[1 * 4 + j] = j == 3;
+    J[2 * 4 + j] = (dr1[j] - c * dr2[j] - dc * r2 - a1 * ddet) / det;
+    J[3 * 4 + j] = (2 * dr2[j] - c * dr1[j] - dc * r1 - a2 * ddet) / det;
+    dfdt[j] = 0;
+  }
+  return GSL_SUCCESS;
+}
+
+/* At rest at th1 = 0.5, th2 = -0.3: models/double_pendulum.ham's q0, p0. */
+static void dpend_init(double *y)
+{
+  y[0] = 0.5;
+  y[1] = -0.3;
+  y[2] = y[3] = 0;
+}
+
+static void dpend_to_qp(const double *y, double *q, double *p)
+{
+  double s1 = sin(y[0]), c1 = cos(y[0]), s2 = sin(y[1]), c2 = cos(y[1]);
+  q[0] = s1;
+  q[1] = -c1;
+  q[2] = s1 + s2;
+  q[3] = -c1 - c2;
+  p[0] = c1 * y[2];
+  p[1] = s1 * y[2];
+  p[2] = c1 * y[2] + c2 * y[3];
+  p[3] = s1 * y[2] + s2 * y[3];
+}
+
 /* -------------------------------------------------------------- the runs */
 
 static const MinimalForm forms[] = {
     {"pendulum", 2, pend_f, pend_jac, pend_init, pend_to_qp},
     {"conical", 4, con_f, con_jac, con_init, con_to_qp},
     {"kepler", 4, kep_f, kep_jac, kep_init, kep_to_qp},
+    {"double_pendulum", 4, dpend_f, dpend_jac, dpend_init, dpend_to_qp},
 };
 
 /* Integrate the minimal form of set->pb from 0 to set->T with the stepper

@@ -14,7 +14,7 @@ set key outside right top samplen 2 spacing 1.1
 
 
 if (mode eq "wp") {
-  set title prob.": CPU time to reach an error at the final time (lower left is better)"
+  set title prob.": CPU time to reach an error at the final time (lower left is better)" noenhanced
   set xlabel "err_q = max-norm error of (q, p) at T"
   set ylabel "CPU seconds (median of 5)"
   plot for [i=1:words(files)] word(files, i) using 3:2 with linespoints lw 1.5 ps 0.9 \
@@ -23,7 +23,7 @@ if (mode eq "wp") {
 
 if (mode eq "inv") {
   cols = has_g ? 2 : 1
-  set multiplot layout 1, cols title prob.": invariants over the run against CPU time"
+  set multiplot layout 1, cols title prob.": invariants over the run against CPU time" noenhanced
   set xlabel "CPU seconds"
   set ylabel "max |H - H0|"
   set key inside top right font ",8" samplen 1 spacing 0.9
@@ -38,7 +38,9 @@ if (mode eq "inv") {
 }
 
 if (mode eq "iters") {
-  set multiplot layout 2, 3 title "mean fixed-point iterations per step against h (generated solid, generic dashed)"
+  # three panels a row, as many rows as needed (problem names may hold "_",
+  # hence noenhanced titles)
+  set multiplot layout (words(probs) + 2) / 3, 3 title "mean fixed-point iterations per step against h (generated solid, generic dashed)"
   unset logscale y
   set format y "%g"
   set xlabel "h"
@@ -50,7 +52,7 @@ if (mode eq "iters") {
     colors = value("colors_".p)
     dts = value("dts_".p)
     pts = value("pts_".p)
-    set title p
+    set title p noenhanced
     plot for [i=1:words(files)] word(files, i) using 1:2 with linespoints lw 1.2 ps 0.6 \
          lc rgb word(colors, i) dt int(word(dts, i)) pt int(word(pts, i)) title word(titles, i)
   }

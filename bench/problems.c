@@ -1,4 +1,4 @@
-/* problems.c - the six benchmark problems, written by hand from
+/* problems.c - the seven benchmark problems, written by hand from
  * models/NAME.ham (the same functions hbvmgen differentiates), and the
  * helpers every peer shares: energy, constraint residual, the index-1
  * multiplier and the observer of invariants. */
@@ -305,6 +305,58 @@ static void chain_hessq(const double *q, const double *v, double *hq)
   }
 }
 
+/* --------------------------------------------------------- double_pendulum
+ * m=4, nu=2: two unit masses on rods of unit length, the first hinged at the
+ * origin; q = (x1, y1, x2, y2), U = y1 + y2, g_1 = x1^2 + y1^2 - 1,
+ * g_2 = (x2 - x1)^2 + (y2 - y1)^2 - 1; released from rest at angles 0.5
+ * and -0.3 from the downward vertical. */
+
+static void dpend_init(double *q0, double *p0)
+{
+  q0[0] = sin(0.5);
+  q0[1] = -cos(0.5);
+  q0[2] = q0[0] + sin(-0.3);
+  q0[3] = q0[1] - cos(-0.3);
+  p0[0] = p0[1] = p0[2] = p0[3] = 0;
+}
+
+static double dpend_pot(const double *q) { return q[1] + q[3]; }
+
+static void dpend_grad(const double *q, double *gu)
+{
+  (void)q;
+  gu[0] = gu[2] = 0;
+  gu[1] = gu[3] = 1;
+}
+
+static void dpend_cons(const double *q, double *g)
+{
+  double dx = q[2] - q[0], dy = q[3] - q[1];
+  g[0] = q[0] * q[0] + q[1] * q[1] - 1;
+  g[1] = dx * dx + dy * dy - 1;
+}
+
+static void dpend_jac(const double *q, double *G)
+{
+  double dx = q[2] - q[0], dy = q[3] - q[1];
+  G[0 * 2 + 0] = 2 * q[0];
+  G[1 * 2 + 0] = 2 * q[1];
+  G[2 * 2 + 0] = G[3 * 2 + 0] = 0;
+  G[0 * 2 + 1] = -2 * dx;
+  G[1 * 2 + 1] = -2 * dy;
+  G[2 * 2 + 1] = 2 * dx;
+  G[3 * 2 + 1] = 2 * dy;
+}
+
+/* v' Hess(g_1) v = 2 |v_1|^2, v' Hess(g_2) v = 2 |v_2 - v_1|^2. */
+static void dpend_hessq(const double *q, const double *v, double *hq)
+{
+  double dx = v[2] - v[0], dy = v[3] - v[1];
+  (void)q;
+  hq[0] = 2 * (v[0] * v[0] + v[1] * v[1]);
+  hq[1] = 2 * (dx * dx + dy * dy);
+}
+
 /* ------------------------------------------------------------------- table */
 
 static const Problem problems[] = {
@@ -315,6 +367,8 @@ static const Problem problems[] = {
     {"kepler", 2, 0, 20 * 3.14159265358979323846, unit_minv, kep_init, kep_pot, kep_grad, NULL, NULL, NULL},
     {"chain8", 2 * CHAIN, CHAIN, 5, unit_minv, chain_init, chain_pot, chain_grad, chain_cons, chain_jac,
      chain_hessq},
+    {"double_pendulum", 4, 2, 10, unit_minv, dpend_init, dpend_pot, dpend_grad, dpend_cons, dpend_jac,
+     dpend_hessq},
 };
 
 const Problem *problem_find(const char *name)

@@ -3,15 +3,17 @@
  *   kepler      exact: whole periods bring the orbit back to (q0, p0)
  *   conical     exact: uniform circular motion (tests/ref.c, closed form)
  *   pendulum    tests/ref.c: theta'' = -sin theta by GSL rk8pd
- *   modified,   tests/ref.c: the index-1 formulation by GSL rk8pd
- *   satellites
+ *   double_pendulum  tests/ref.c: the equations of the rod angles by GSL
+ *               rk8pd
+ *   modified,   tests/ref.c: the index-1 formulation by GSL rk8pd (the
+ *   satellites  satellites' state as q - q0)
  *   chain8      here: the index-1 formulation by GSL rk8pd, with the
  *               hand-coded gradient, Jacobian and contracted Hessians of
  *               problems.c
  *
  * tests/ref.c is compiled into the benchmark as it is (not copied). The
- * index-1 integrator below is run on modified and satellites as well, by
- * `bench ref`, to check it (and problems.c) against tests/ref.c. */
+ * index-1 integrator below is run on every problem by `bench refcheck`,
+ * to check it (and problems.c) against tests/ref.c. */
 #include "reference.h"
 
 #include <math.h>
@@ -94,6 +96,8 @@ int reference_final(const Problem *pb, double T, double tol, double *q, double *
     snprintf(how, (size_t)n, "exact: uniform circular motion (tests/ref.c)");
   else if (strcmp(pb->name, "pendulum") == 0)
     snprintf(how, (size_t)n, "theta'' = -sin theta, GSL rk8pd, tol %g (tests/ref.c)", tol);
+  else if (strcmp(pb->name, "double_pendulum") == 0)
+    snprintf(how, (size_t)n, "rod angles' Euler-Lagrange equations, GSL rk8pd, tol %g (tests/ref.c)", tol);
   else
     snprintf(how, (size_t)n, "index-1 formulation, GSL rk8pd, tol %g (tests/ref.c)", tol);
   if (ref_solve_tol(pb->name, T, 1, tol, qq, pp, ll) != 0) return -2;

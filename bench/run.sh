@@ -21,7 +21,7 @@ BUDGET=${BENCH_BUDGET:-540} # seconds; callgrind is skipped past this
 start=$(date +%s)
 elapsed() { echo $(($(date +%s) - start)); }
 
-PROBLEMS="pendulum conical modified satellites kepler chain8"
+PROBLEMS="pendulum conical modified satellites kepler chain8 double_pendulum"
 
 # Step sizes FROM:TO:FACTOR (h = T/N, N from ceil(T/FROM) doubling), the
 # error at which a line stops (the reference's accuracy), and the h of the
@@ -34,6 +34,7 @@ hrange() {
   satellites) echo 2:1e-3:2 ;;
   kepler) echo 0.2:1e-4:2 ;;
   chain8) echo 0.02:1e-5:2 ;;
+  double_pendulum) echo 0.2:1e-5:2 ;;
   esac
 }
 floor() {
@@ -52,7 +53,7 @@ count_h() {
 }
 IDA_TOLS=1e-3:1e-10:10
 GSL_TOLS=1e-3:1e-14:10
-GSL_PROBLEMS="pendulum conical kepler"
+GSL_PROBLEMS="pendulum conical kepler double_pendulum"
 
 # The k that `hbvmgen -k auto` picks for model $1 at s = $2.
 auto_k() {

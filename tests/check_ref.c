@@ -9,8 +9,13 @@
  *     ~1e-12), and lambda agrees with the h = 0.1 run;
  *   - grad U and grad g against central differences of U and g;
  *   - an error estimate from independent runs (other tolerance, finer output
- *     grid, and for pendulum and conical the generic index-1 integrator
- *     against the theta formulation / the closed form).
+ *     grid, and for pendulum, double pendulum and conical the generic
+ *     index-1 integrator against the angle formulation / the closed form);
+ *   - the double pendulum's angle run against that integrator at every
+ *     step point of the order tests' grids, its invariants at round-off,
+ *     and its initial angles; the satellites' reference independent of
+ *     the output grid to 3e-14;
+ *   - ref_max_error against ref_solve and a known perturbation.
  * The suite is exposed as ref_suite(); the project's runner calls it. */
 #include "ref.h"
 
@@ -26,7 +31,8 @@
 Suite *ref_suite(void);
 
 static const char *const prob_names[] = {"pendulum", "conical", "modified",
-                                         "satellites"};
+                                         "satellites", "double_pendulum"};
+#define NPROB 5
 
 /* A reference run: sizes and the trajectory arrays. */
 typedef struct {
@@ -86,10 +92,20 @@ static void run_diff(const run *a, const run *b, long stride, double *dqp,
   }
 }
 
+/* Points n of a and n*stride of b agree within lim in q, p and lambda. */
+static void assert_agree(const run *a, const run *b, long stride, double lim)
+{
+  double dqp, dl;
+  run_diff(a, b, stride, &dqp, &dl);
+  ck_assert_double_lt(dqp, lim);
+  ck_assert_double_lt(dl, lim);
+}
+
 START_TEST(test_dims)
 {
   int m = 0, nu = 0;
-  static const int want[4][2] = {{2, 1}, {3, 1}, {3, 1}, {9, 3}};
+  static const int want[NPROB][2] = {{2, 1}, {3, 1}, {3, 1}, {9, 3},
+                                     {4, 2}};
   ck_assert_int_eq(ref_dims(prob_names[_i], &m, &nu), 0);
   ck_assert_int_eq(m, want[_i][0]);
   ck_assert_int_eq(nu, want[_i][1]);
@@ -215,17 +231,12 @@ END_TEST
 START_TEST(test_error_estimate)
 {
   const char *name = prob_names[_i];
-  const double lim = _i <= 1 ? 1e-12 : 1e-11;
+  const double lim = (_i <= 1 || _i == 4) ? 1e-12 : 1e-11;
   run r = make_run(name, HSTEP, NSTEP, 0, 0.0);
   run a = make_run(name, HSTEP, NSTEP, 1, 1e-13);
   run b = make_run(name, HSTEP / 4, 4 * NSTEP, 0, 0.0);
-  double dqp, dl;
-  run_diff(&r, &a, 1, &dqp, &dl);
-  ck_assert_double_lt(dqp, lim);
-  ck_assert_double_lt(dl, lim);
-  run_diff(&r, &b, 4, &dqp, &dl);
-  ck_assert_double_lt(dqp, lim);
-  ck_assert_double_lt(dl, lim);
+  assert_agree(&r, &a, 1, lim);
+  assert_agree(&r, &b, 4, lim);
   free_run(&r);
   free_run(&a);
   free_run(&b);
@@ -265,20 +276,6 @@ START_TEST(test_gradients)
 }
 END_TEST
 
-/* Pendulum: the generic index-1 integrator against the theta formulation. */
-START_TEST(test_pendulum_index1)
-{
-  run r = make_run("pendulum", HSTEP, NSTEP, 0, 0.0);
-  run a = make_run("pendulum", HSTEP, NSTEP, 2, 1e-15);
-  double dqp, dl;
-  run_diff(&r, &a, 1, &dqp, &dl);
-  ck_assert_double_lt(dqp, 1e-12);
-  ck_assert_double_lt(dl, 1e-12);
-  free_run(&r);
-  free_run(&a);
-}
-END_TEST
-
 /* Conical pendulum: closed form checked directly (radius, plane, speed,
  * period), and the generic index-1 integrator against it over 10 periods. */
 START_TEST(test_conical)
@@ -287,7 +284,6 @@ START_TEST(test_conical)
   const double r0 = sqrt(0.5), w = pow(2.0, 0.25);
   run c = make_run("conical", T / 10.0, 100, 0, 0.0);
   run a = make_run("conical", T / 10.0, 100, 2, 1e-15);
-  double dqp, dl;
   long n;
   for (n = 0; n <= c.N; n++) {
     const double *q = c.q + 3 * n, *p = c.p + 3 * n;
@@ -301,11 +297,121 @@ START_TEST(test_conical)
       ck_assert_double_eq_tol(q[1], 0.0, 1e-13);
     }
   }
-  run_diff(&c, &a, 1, &dqp, &dl);
-  ck_assert_double_lt(dqp, 1e-11);
-  ck_assert_double_lt(dl, 1e-11);
+  assert_agree(&c, &a, 1, 1e-11);
   free_run(&c);
   free_run(&a);
+}
+END_TEST
+
+/* The angle formulations of the pendulum and the double pendulum
+ * (ref_solve) against the generic index-1 integrator in Cartesian
+ * coordinates, at every point t_n = n h on [0,10]; for the double pendulum
+ * on each of the order tests' grids h = 0.1 .. 0.0125 (measured: 1.6e-14
+ * at h = 0.1, 2.7e-15 at 0.0125; lambda 3e-14). A wrong sign or factor in
+ * the angle equations, or in the Jacobian or Hessians, shows as O(1). */
+START_TEST(test_angles_index1)
+{
+  const char *name = _i == 0 ? "pendulum" : "double_pendulum";
+  const int halvings = _i == 0 ? 0 : _i - 1;
+  const double h = HSTEP / (double)(1 << halvings);
+  const long N = (long)NSTEP << halvings;
+  run r = make_run(name, h, N, 0, 0.0);
+  run a = make_run(name, h, N, 2, 1e-15);
+  assert_agree(&r, &a, 1, 1e-12);
+  free_run(&r);
+  free_run(&a);
+}
+END_TEST
+
+/* Double pendulum: energy, constraints and hidden constraints along the
+ * reference at round-off (measured 8.9e-16, 4.4e-16, 2.2e-16), the start
+ * at rest at angles 0.5 and -0.3, and the motion not trivial: the second
+ * mass swings to the other side (x2 changes sign) and both multipliers
+ * vary by more than 0.1. */
+START_TEST(test_double_pendulum)
+{
+  run r = make_run("double_pendulum", 0.0125, 800, 0, 0.0);
+  double H0, H, g[2], hc[2], eH = 0.0, eg = 0.0, ehc = 0.0;
+  double x2min = 0.0, x2max = 0.0, lmin[2] = {1e300, 1e300}, lmax[2] = {0, 0};
+  long n;
+  int j;
+  ck_assert_double_eq_tol(r.q[0], sin(0.5), 1e-16);
+  ck_assert_double_eq_tol(r.q[1], -cos(0.5), 1e-16);
+  ck_assert_double_eq_tol(r.q[2] - r.q[0], sin(-0.3), 1e-16);
+  ck_assert_double_eq_tol(r.q[3] - r.q[1], -cos(-0.3), 1e-16);
+  for (j = 0; j < 4; j++)
+    ck_assert_double_eq(r.p[j], 0.0);
+  ck_assert_int_eq(ref_invariants("double_pendulum", r.q, r.p, &H0, NULL,
+                                  NULL), 0);
+  ck_assert_double_eq_tol(H0, -2.0 * cos(0.5) - cos(0.3), 1e-15);
+  for (n = 0; n <= r.N; n++) {
+    ref_invariants("double_pendulum", r.q + 4 * n, r.p + 4 * n, &H, g, hc);
+    eH = fmax(eH, fabs(H - H0));
+    x2min = fmin(x2min, r.q[4 * n + 2]);
+    x2max = fmax(x2max, r.q[4 * n + 2]);
+    for (j = 0; j < 2; j++) {
+      eg = fmax(eg, fabs(g[j]));
+      ehc = fmax(ehc, fabs(hc[j]));
+      lmin[j] = fmin(lmin[j], r.lambda[2 * n + j]);
+      lmax[j] = fmax(lmax[j], r.lambda[2 * n + j]);
+    }
+  }
+  ck_assert_double_le(eH, 4e-15);
+  ck_assert_double_le(eg, 2e-15);
+  ck_assert_double_le(ehc, 2e-15);
+  ck_assert_double_lt(x2min, -0.1);
+  ck_assert_double_gt(x2max, 0.1);
+  ck_assert_double_gt(lmax[0] - lmin[0], 0.1);
+  ck_assert_double_gt(lmax[1] - lmin[1], 0.1);
+  free_run(&r);
+}
+END_TEST
+
+/* Satellites at tolerance 1e-15 for max-over-run errors: the reference at
+ * the points of h = 0.1 and of h = 0.0125 agree at every common point to
+ * 3e-14 (measured 7e-15; integrating q rather than q - q0 gave 1.1e-13,
+ * round-off at |z| = 20), and against tolerance 1e-14 on the fine grid. */
+START_TEST(test_satellites_grid)
+{
+  run r = make_run("satellites", 0.1, 100, 1, 1e-15);
+  run f = make_run("satellites", 0.0125, 800, 1, 1e-15);
+  run g = make_run("satellites", 0.0125, 800, 1, 1e-14);
+  assert_agree(&r, &f, 8, 3e-14);
+  assert_agree(&f, &g, 1, 3e-14);
+  free_run(&r);
+  free_run(&f);
+  free_run(&g);
+}
+END_TEST
+
+/* ref_max_error: zero against ref_solve's own run, the size of a planted
+ * perturbation otherwise, NaN for a NaN, and -1 for bad arguments. */
+START_TEST(test_max_error)
+{
+  const char *name = prob_names[_i];
+  run r = make_run(name, 0.05, 200, 0, 0.0);
+  double eqp = -1.0, el = -1.0;
+  ck_assert_int_eq(ref_max_error(name, 0.05, 200, r.q, r.p, r.lambda, &eqp,
+                                 &el), 0);
+  ck_assert_double_eq(eqp, 0.0);
+  ck_assert_double_eq(el, 0.0);
+  r.p[137 * r.m + r.m - 1] += 3e-9;
+  r.lambda[200 * r.nu] -= 2e-7;
+  ck_assert_int_eq(ref_max_error(name, 0.05, 200, r.q, r.p, r.lambda, &eqp,
+                                 &el), 0);
+  ck_assert_double_eq_tol(eqp, 3e-9, 1e-15);
+  ck_assert_double_eq_tol(el, 2e-7, 1e-15);
+  el = -1.0;
+  r.q[5] = NAN;
+  ck_assert_int_eq(ref_max_error(name, 0.05, 200, r.q, r.p, NULL, &eqp,
+                                 &el), 0);
+  ck_assert(isnan(eqp));
+  ck_assert_double_eq(el, -1.0);
+  ck_assert_int_eq(ref_max_error("nosuch", 0.05, 200, r.q, r.p, NULL, &eqp,
+                                 NULL), -1);
+  ck_assert_int_eq(ref_max_error(name, 0.0, 200, r.q, r.p, NULL, &eqp,
+                                 NULL), -1);
+  free_run(&r);
 }
 END_TEST
 
@@ -314,16 +420,19 @@ Suite *ref_suite(void)
   Suite *s = suite_create("ref");
   TCase *tc = tcase_create("reference");
   tcase_set_timeout(tc, 60);
-  tcase_add_loop_test(tc, test_dims, 0, 4);
+  tcase_add_loop_test(tc, test_dims, 0, NPROB);
   tcase_add_test(tc, test_unknown);
-  tcase_add_loop_test(tc, test_initial, 0, 4);
-  tcase_add_loop_test(tc, test_invariants, 0, 4);
-  tcase_add_loop_test(tc, test_lambda_motion, 0, 4);
-  tcase_add_loop_test(tc, test_lambda_formula, 0, 4);
-  tcase_add_loop_test(tc, test_error_estimate, 0, 4);
-  tcase_add_loop_test(tc, test_gradients, 0, 4);
-  tcase_add_test(tc, test_pendulum_index1);
+  tcase_add_loop_test(tc, test_initial, 0, NPROB);
+  tcase_add_loop_test(tc, test_invariants, 0, NPROB);
+  tcase_add_loop_test(tc, test_lambda_motion, 0, NPROB);
+  tcase_add_loop_test(tc, test_lambda_formula, 0, NPROB);
+  tcase_add_loop_test(tc, test_error_estimate, 0, NPROB);
+  tcase_add_loop_test(tc, test_gradients, 0, NPROB);
+  tcase_add_loop_test(tc, test_angles_index1, 0, 5);
   tcase_add_test(tc, test_conical);
+  tcase_add_test(tc, test_double_pendulum);
+  tcase_add_test(tc, test_satellites_grid);
+  tcase_add_loop_test(tc, test_max_error, 0, NPROB);
   suite_add_tcase(s, tc);
   return s;
 }
