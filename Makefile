@@ -25,7 +25,7 @@ ALLCFLAGS = $(WARN) $(CFLAGS) $(SAN) -MMD -MP
 GEN_SRC  := util.c ast.c dag.c ad.c mass.c model.c method.c lu.c step.c step_const.c step_poly.c emit_kernel.c emit_step.c emit_main.c
 GEN_OBJ  := $(addprefix $(B)/gen/,$(GEN_SRC:.c=.o) parser.o lexer.o)
 RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
-SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {print $$1 "_k" $$2 "s" $$3}')
+SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {sub(/:.*/, "", $$1); print $$1 "_k" $$2 "s" $$3}')
 SOLV_OBJ := $(addprefix $(B)/generated/,$(addsuffix .o,$(SOLVERS)))
 # test-only models (tests/models/LIST), generated at build time
 TSOLVERS := $(shell grep -v '^\#' tests/models/LIST | awk 'NF {sub(/:.*/, "", $$1); print $$1 "_k" $$2 "s" $$3}')

@@ -167,26 +167,36 @@ START_TEST(float_order_and_conservation) {
 }
 END_TEST
 
-// --wide-step: every temporary and literal of the sweep, and no temporary
-// elsewhere, is one precision wider than the state (long double for double,
-// double for float).
-START_TEST(wide_step_widens_only_the_sweep) {
-  static const char *const flags[2] = {"--wide-step", "--wide-step --real float"};
+// --wide-step: every temporary and literal of the iteration's kernels (the
+// sweep; with the polynomial multiplier also factor and project, which the
+// iteration and the end of the step use), and no temporary elsewhere, is
+// one precision wider than the state (long double for double, double for
+// float). _i: 0 const, 1 poly; v: double, float.
+START_TEST(wide_step_widens_only_the_iteration) {
+  static const char *const flags[2][2] = {{"--wide-step --multiplier const", "--wide-step --real float --multiplier const"},
+                                          {"--wide-step -s 3", "--wide-step --real float -s 3"}};
   static const char *const wide[2] = {"const long double t", "const double t"};
   static const char *const narrow[2] = {"const double t", "const float t"};
+  static const char *const kernels[] = {"_sweep(", "_factor(", "_project(", "_minv_p(", "_energy_kernel(", "_g(",
+                                        "_hidden_kernel(", "_lambda0("};
+  int nwide = _i ? 3 : 1;
   for (int v = 0; v < 2; v++) {
-    char *src = generate("variables x, y\nU = x^2 * y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", flags[v]);
+    char *src = generate("variables x, y\nU = x^2 * y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", flags[_i][v]);
     ck_assert_ptr_nonnull(src);
-    const char *sweep = strstr(src, "_sweep(");
-    ck_assert_ptr_nonnull(sweep);
-    const char *end = strstr(sweep, "\n}\n");
-    ck_assert_ptr_nonnull(end);
-    const char *first_wide = strstr(src, wide[v]), *first_narrow = strstr(sweep, narrow[v]);
-    ck_assert_msg(first_wide && first_wide > sweep && first_wide < end, "%s: no %s in the sweep", flags[v], wide[v]);
-    ck_assert_msg(first_narrow && first_narrow > end, "%s: a %s inside the sweep", flags[v], narrow[v]);
-    ck_assert_msg(!strstr(end, wide[v]), "%s: a wide temporary outside the sweep", flags[v]);
-    for (const char *c = sweep; c + 1 < end; c++) /* and its literals are wide too: no 0.5f */
-      ck_assert_msg(!(c[0] >= '0' && c[0] <= '9' && c[1] == 'f'), "%s: a float literal in the sweep", flags[v]);
+    for (size_t k = 0; k < sizeof kernels / sizeof kernels[0]; k++) {
+      const char *start = strstr(src, kernels[k]);
+      ck_assert_msg(start || (!_i && k == 1) || (!_i && k == 2), "%s: no kernel %s", flags[_i][v], kernels[k]);
+      if (!start) continue;
+      const char *end = strstr(start, "\n}\n"), *w = strstr(start, wide[v]), *n = strstr(start, narrow[v]);
+      ck_assert_ptr_nonnull(end);
+      int is_wide = k < (size_t)nwide;
+      ck_assert_msg(is_wide ? w && w < end : !w || w > end, "%s: %s %s", flags[_i][v], kernels[k],
+                    is_wide ? "is not wide" : "has a wide temporary");
+      ck_assert_msg(is_wide ? !n || n > end : 1, "%s: a %s inside %s", flags[_i][v], narrow[v], kernels[k]);
+      for (const char *c = start; is_wide && c + 1 < end; c++) /* and its literals are wide too: no 0.5f */
+        ck_assert_msg(!(c[0] >= '0' && c[0] <= '9' && c[1] == 'f'), "%s: a float literal in %s", flags[_i][v],
+                      kernels[k]);
+    }
     free(src);
   }
 }
@@ -264,7 +274,7 @@ Suite *lean_suite(void) {
   tcase_add_test(tc, structural_zeros_never_multiplied);
   tcase_add_test(tc, elimination_order_keeps_sparsity);
   tcase_add_test(tc, float_order_and_conservation);
-  tcase_add_test(tc, wide_step_widens_only_the_sweep);
+  tcase_add_loop_test(tc, wide_step_widens_only_the_iteration, 0, 2);
   tcase_add_test(tc, wide_step_same_steps);
   tcase_add_test(tc, wide_step_holds_H_at_roundoff);
   tcase_add_test(tc, float_wide_step_holds_H);

@@ -48,6 +48,10 @@
 #include "pendulum_angle_k6s3.h"
 #include "redundant_k2s2.h"
 #include "viviani_k2s2.h"
+#include "viviani_const_k2s2.h"
+#include "polywide_k3s3.h"
+#include "polyplain_k3s3.h"
+#include "chain_poly_k2s2.h"
 
 Suite *stress_suite(void);
 
@@ -62,7 +66,9 @@ enum { OK = 0, ENOCONV = 1, ENONFINITE = 2, ESINGULAR = 3, EBADSTEP = 4 };
 /* ---- solvers not in tests/solvers.c: the test-only models and the
  * committed solver that only the driver tests use ---- */
 
-#define TEST_ONLY_SOLVERS(X) X(redundant_k2s2) X(viviani_k2s2) X(cliff_k6s2) X(logwall_k6s2)
+#define TEST_ONLY_SOLVERS(X)                                                                          \
+  X(redundant_k2s2) X(viviani_k2s2) X(viviani_const_k2s2) X(cliff_k6s2) X(logwall_k6s2) X(polywide_k3s3) \
+  X(polyplain_k3s3) X(chain_poly_k2s2)
 #define LOCAL_SOLVERS(X) TEST_ONLY_SOLVERS(X) X(pendulum_angle_k6s3)
 
 #define CODES_AGREE(P)                                                                                    \
@@ -97,6 +103,7 @@ static int read_list(const char *path, char names[][NAME_SIZE], int max) {
   while (fgets(line, sizeof line, f))
     if (line[0] != '#' && sscanf(line, "%63s %d %d", model, &k, &s) == 3) {
       ck_assert_msg(n < max, "%s: more than %d solvers", path, max);
+      model[strcspn(model, ":")] = 0; /* NAME:FILE names the solver NAME */
       snprintf(names[n++], NAME_SIZE, "%s_k%ds%d", model, k, s);
     }
   fclose(f);
@@ -306,7 +313,11 @@ static double from_double_point(const double *q) { return sqrt((q[0] - 1) * (q[0
  * there, cleanly; halving h on failure (a caller's usual strategy) must
  * carry it through with g, the hidden constraints and H = 1/2 conserved. */
 START_TEST(rank_loss_at_double_point) {
-  const Solver *sv = find_solver("viviani_k2s2");
+  /* both families: the polynomial one's (s nu) x (s nu) system, nearly
+   * singular there, passes on a little more round-off to g */
+  static const char *const names[2] = {"viviani_const_k2s2", "viviani_k2s2"};
+  static const double g_tol[2] = {1e-13, 4e-13};
+  const Solver *sv = find_solver(names[_i]);
   const double H_BIG = 0.01, T_END = 12.0;
   Run r = run_new(sv, NULL, NULL);
   double h = H_BIG, g[2], hc[2], worst_g = 0, worst_hc = 0, worst_H = 0;
@@ -331,12 +342,12 @@ START_TEST(rank_loss_at_double_point) {
     }
     worst_H = fmax(worst_H, fabs(sv->energy(r.x) - 0.5));
   }
-  printf("stress: viviani_k2s2 through the double point: %d failed steps (%d near it), max |g| = %.2e, "
-         "max |hc| = %.2e, max |H - H0| = %.2e\n", failures, near, worst_g, worst_hc, worst_H);
+  printf("stress: %s through the double point: %d failed steps (%d near it), max |g| = %.2e, "
+         "max |hc| = %.2e, max |H - H0| = %.2e\n", names[_i], failures, near, worst_g, worst_hc, worst_H);
   fflush(stdout);
   ck_assert_msg(near >= 1, "Viviani: no step failed at the double point (rank of grad g drops there)");
   ck_assert_msg(near == failures, "Viviani: %d of %d failures away from the double point", failures - near, failures);
-  ck_assert_msg(worst_g <= 1e-13, "Viviani: |g| = %.2e", worst_g);
+  ck_assert_msg(worst_g <= g_tol[_i], "Viviani: |g| = %.2e", worst_g);
   ck_assert_msg(worst_hc <= 1e-3, "Viviani: hidden constraint %.2e", worst_hc);
   ck_assert_msg(worst_H <= 1e-13, "Viviani: |H - H0| = %.2e", worst_H); /* H = |p|^2/2 is quadratic: exact */
   run_free(&r);
@@ -441,7 +452,7 @@ Suite *stress_suite(void) {
   tcase_add_test(tc, sweep_committed_solvers);
   tcase_add_test(tc, sweep_test_only_solvers);
   tcase_add_test(tc, redundant_constraints_fail_cleanly);
-  tcase_add_test(tc, rank_loss_at_double_point);
+  tcase_add_loop_test(tc, rank_loss_at_double_point, 0, 2);
   tcase_add_test(tc, leaving_domain_gives_enonfinite);
   tcase_add_test(tc, singularity_fails_cleanly);
   tcase_add_test(tc, overflow_fails_cleanly);
