@@ -3,7 +3,8 @@
  *   - the embedding examples of docs/embedding.md (docs/examples/embed.c
  *     and embed.cpp) are compiled with gcc and g++ against a pendulum
  *     generated into a temporary directory, run, and their printed state
- *     compared with an independent RK4 solution of the pendulum;
+ *     compared with an independent RK4 solution of the pendulum, and
+ *     docs/embedding.md shows both files verbatim;
  *   - `make install PREFIX=TMP` installs what docs/hbvmgen.1 lists, and the
  *     C example and a standalone driver build with `pkg-config --cflags
  *     --libs hbvmrt` (PKG_CONFIG_PATH=TMP/lib/pkgconfig) and nothing else
@@ -124,6 +125,33 @@ START_TEST(embedding_examples_c_and_cpp)
   snprintf(cmd, sizeof cmd, "%s/embed_cpp", d);
   check_example_output(cmd);
   remove_dir(d);
+}
+END_TEST
+
+/* The whole of a file, malloc'd. */
+static char *slurp(const char *path)
+{
+  FILE *f = fopen(path, "rb");
+  ck_assert_msg(f != NULL, "cannot read %s", path);
+  char *buf = calloc(1, 1 << 17);
+  ck_assert_ptr_nonnull(buf);
+  size_t n = fread(buf, 1, (1 << 17) - 1, f);
+  ck_assert_msg(n < (1 << 17) - 1, "%s is too large", path);
+  fclose(f);
+  return buf;
+}
+
+/* docs/embedding.md shows the example files verbatim. */
+START_TEST(embedding_doc_shows_the_examples)
+{
+  static const char *const files[] = {"../docs/examples/embed.c", "../docs/examples/embed.cpp"};
+  char *doc = slurp("../docs/embedding.md");
+  for (size_t i = 0; i < 2; i++) {
+    char *src = slurp(files[i]);
+    ck_assert_msg(strstr(doc, src) != NULL, "docs/embedding.md does not show %s as it is", files[i]);
+    free(src);
+  }
+  free(doc);
 }
 END_TEST
 
@@ -289,6 +317,7 @@ Suite *docs_suite(void)
   TCase *tc = tcase_create("docs");
   tcase_set_timeout(tc, 300);
   tcase_add_test(tc, embedding_examples_c_and_cpp);
+  tcase_add_test(tc, embedding_doc_shows_the_examples);
   tcase_add_test(tc, install_and_pkg_config);
   tcase_add_test(tc, man_page_covers_help);
   tcase_add_test(tc, stack_bound_holds);
