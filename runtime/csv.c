@@ -36,34 +36,33 @@ static const double *at(const void *x, size_t off)
   return (const double *)(const void *)((const char *)x + off);
 }
 
-/* ",PREFIXname" for each of the m coordinate names */
-static void coords(FILE *f, const char *prefix, const char *const *name, int m)
+/* ",PREFIXname" for each coordinate name, or ",PREFIXn" n = 1..m without names */
+static void coords(FILE *f, const char *prefix, const hbvmrt_model *md)
 {
   int i;
 
-  for (i = 0; i < m; i++)
-    fprintf(f, ",%s%s", prefix, name[i]);
+  if (!md->names) {
+    names(f, prefix, md->m);
+    return;
+  }
+  for (i = 0; i < md->m; i++)
+    fprintf(f, ",%s%s", prefix, md->names[i]);
 }
 
 int hbvmrt_csv_header(FILE *f, const hbvmrt_model *md)
 {
+  /* prefixes of the q, p, lambda, g and hc columns: with names, numbered */
+  static const char *const named[] = {"", "p_", "lambda_", "g_", "hc_"};
+  static const char *const numbered[] = {"q", "p", "lam", "g", "hc"};
+  const char *const *pre = md->names ? named : numbered;
+
   fputc('t', f);
-  if (md->names) {
-    coords(f, "", md->names, md->m);
-    coords(f, "p_", md->names, md->m);
-    names(f, "lambda_", md->nu);
-    fputs(",H", f);
-    names(f, "g_", md->nu);
-    names(f, "hc_", md->nu);
-    fputc('\n', f);
-    return ferror(f) ? -1 : 0;
-  }
-  names(f, "q", md->m);
-  names(f, "p", md->m);
-  names(f, "lam", md->nu);
+  coords(f, pre[0], md);
+  coords(f, pre[1], md);
+  names(f, pre[2], md->nu);
   fputs(",H", f);
-  names(f, "g", md->nu);
-  names(f, "hc", md->nu);
+  names(f, pre[3], md->nu);
+  names(f, pre[4], md->nu);
   fputc('\n', f);
   return ferror(f) ? -1 : 0;
 }
