@@ -4,6 +4,8 @@
 #   make demo       generate, build and run the pendulum with HBVM(2,2)
 #   make generated  regenerate the committed solvers in generated/
 #   make tables     the paper's tables beside ours (docs/tables.md)
+#   make install    hbvmgen, libhbvmrt.a, hbvmrt.h, hbvmgen.1, hbvmrt.pc under
+#                   $(DESTDIR)$(PREFIX) (PREFIX=/usr/local); make uninstall
 #   make SANITIZE=1 ...   everything with -fsanitize=address,undefined
 
 CC      ?= cc
@@ -41,7 +43,7 @@ TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
 HBVMGEN  := $(B)/hbvmgen
 LIBRT    := $(B)/libhbvmrt.a
 
-.PHONY: all deps check demo generated tables figures bench fuzz clean
+.PHONY: all deps check demo generated tables figures bench fuzz clean install uninstall
 all: $(HBVMGEN) $(LIBRT)
 	@cmp -s $(HBVMGEN) gen/hbvmgen || cp $(HBVMGEN) gen/hbvmgen
 	@cmp -s $(LIBRT) runtime/libhbvmrt.a || cp $(LIBRT) runtime/libhbvmrt.a
@@ -139,6 +141,36 @@ bench: deps
 	@scripts/deps.sh bench
 	@$(MAKE) --no-print-directory all
 	bench/run.sh
+
+# Installation. The pkg-config file is made from runtime/hbvmrt.pc.in with
+# the prefix and directories of this install, so a program finds the
+# runtime with `pkg-config --cflags --libs hbvmrt` alone.
+PREFIX     ?= /usr/local
+BINDIR     ?= $(PREFIX)/bin
+LIBDIR     ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+MANDIR     ?= $(PREFIX)/share/man
+PCDIR      ?= $(LIBDIR)/pkgconfig
+VERSION    := $(shell sed -n 's/^\#define HBVMGEN_VERSION "\(.*\)"/\1/p' gen/hbvmgen.h)
+
+$(B)/hbvmrt.pc: runtime/hbvmrt.pc.in gen/hbvmgen.h FORCE
+	@mkdir -p $(@D)
+	sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@LIBDIR@|$(LIBDIR)|g' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|g' \
+	    -e 's|@VERSION@|$(VERSION)|g' runtime/hbvmrt.pc.in > $@
+
+install: all $(B)/hbvmrt.pc
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PCDIR)
+	install -m 755 gen/hbvmgen $(DESTDIR)$(BINDIR)/hbvmgen
+	install -m 644 runtime/libhbvmrt.a $(DESTDIR)$(LIBDIR)/libhbvmrt.a
+	install -m 644 runtime/hbvmrt.h $(DESTDIR)$(INCLUDEDIR)/hbvmrt.h
+	install -m 644 docs/hbvmgen.1 $(DESTDIR)$(MANDIR)/man1/hbvmgen.1
+	install -m 644 $(B)/hbvmrt.pc $(DESTDIR)$(PCDIR)/hbvmrt.pc
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/hbvmgen $(DESTDIR)$(LIBDIR)/libhbvmrt.a $(DESTDIR)$(INCLUDEDIR)/hbvmrt.h \
+	      $(DESTDIR)$(MANDIR)/man1/hbvmgen.1 $(DESTDIR)$(PCDIR)/hbvmrt.pc
+
+FORCE:
 
 fuzz:
 	@scripts/deps.sh fuzz

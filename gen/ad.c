@@ -8,7 +8,14 @@
  * derivative. Adjoints are themselves DAG nodes, so derivatives share
  * subexpressions with the values they come from (d exp(x) reuses exp(x),
  * d sqrt(x) reuses sqrt(x)) and with each other, and zeros fold away: a
- * structural zero of a gradient is the constant 0 node. */
+ * structural zero of a gradient is the constant 0 node.
+ *
+ * Where a function has a kink the sweep takes a subgradient, the same at
+ * every tie: d abs(a) = sign(a), 0 at a = 0; d sign(a) = 0 everywhere (the
+ * jump at 0 has no derivative); min and max pass the adjoint to the
+ * operand they select, and half to each when a = b, through
+ * (1 -+ sign(a - b)) / 2, so at a tie the derivative is the mean of the
+ * two one-sided ones. */
 #include <stdlib.h>
 
 #include "hbvmgen.h"
@@ -67,6 +74,15 @@ static void propagate(Sweep *sw, int id, int w) {
       accumulate(sw, b, dag_mul(d, w, dag_mul(d, dag_op(d, OP_LOG, a, -1), id)));
     }
     return;
+  case OP_MIN:
+  case OP_MAX: { /* the selected operand gets w, each half of w at a tie */
+    int sg = dag_op(d, OP_SIGN, dag_sub(d, a, b), -1), half = dag_const(d, 0.5);
+    int to_a = dag_mul(d, half, n.op == OP_MAX ? dag_add(d, one, sg) : dag_sub(d, one, sg));
+    int to_b = dag_sub(d, one, to_a);
+    accumulate(sw, a, dag_mul(d, w, to_a));
+    accumulate(sw, b, dag_mul(d, w, to_b));
+    return;
+  }
   case OP_ATAN2: { /* atan2(y, x): dy x/(x^2+y^2), dx -y/(x^2+y^2) */
     int r2 = dag_add(d, dag_mul(d, a, a), dag_mul(d, b, b));
     accumulate(sw, a, dag_div(d, dag_mul(d, w, b), r2));

@@ -26,7 +26,7 @@
 #endif
 #define MAX_INDEX 1000000000L
 
-typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_PARAM, SYM_INDEX } SymKind;
+typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_VALUES, SYM_PARAM, SYM_INDEX } SymKind;
 
 typedef struct Sym Sym;
 struct Sym {
@@ -35,8 +35,9 @@ struct Sym {
   Loc loc;
   int stmt;      /* statement that defines it (file order) */
   int base;      /* COORD, ARRAY: first input slot; PARAM: parameter number */
-  int size;      /* ARRAY */
+  int size;      /* ARRAY, VALUES */
   int node;      /* VALUE */
+  int *nodes;    /* VALUES: size nodes, the array defined by name = [...] */
   long ival;     /* INDEX */
   int used;
   Sym *next;     /* hash chain */
@@ -112,6 +113,7 @@ static const char *sym_kind_name(const Ctx *cx, const Sym *s) {
   case SYM_COORD: return "a coordinate";
   case SYM_ARRAY: return "an array of coordinates";
   case SYM_VALUE: return cx->d->nodes[s->node].op == OP_CONST ? "a constant" : "a named subexpression";
+  case SYM_VALUES: return "an array of values";
   case SYM_PARAM: return "a parameter";
   case SYM_INDEX: return "an index variable";
   }
@@ -213,28 +215,34 @@ static int lower_name(Ctx *cx, const Ast *e) {
     error_at(e->loc, "'%s' is an array of %d coordinates: index it, as in %s[1]", e->name, s->size, e->name);
     return -1;
   case SYM_VALUE: return s->node;
+  case SYM_VALUES:
+    if (s->size == 0) return -1;
+    error_at(e->loc, "'%s' is an array of %d values: index it, as in %s[1]", e->name, s->size, e->name);
+    return -1;
   case SYM_PARAM: return dag_param(cx->d, s->base);
   case SYM_INDEX: return dag_const(cx->d, (double)s->ival);
   }
   return -1;
 }
 
-// Lower name[i]: i must fold to an integer within the array's bounds.
+// Lower name[i], of coordinates or of values: i must fold to an integer
+// within the array's bounds.
 static int lower_index(Ctx *cx, const Ast *e) {
   Sym *s = resolve(cx, e->name, e->loc);
   if (!s) return -1;
-  if (s->kind != SYM_ARRAY) {
+  if (s->kind != SYM_ARRAY && s->kind != SYM_VALUES) {
     error_at(e->loc, "'%s' is %s, not an array, and cannot be indexed", e->name, sym_kind_name(cx, s));
     return -1;
   }
   long i;
+  if (s->kind == SYM_VALUES && s->size == 0) return -1;
   if (lower_int(cx, e->a, "an index", &i) < 0) return -1;
   if (i < 1 || i > s->size) {
     error_at(e->a->loc, "index %ld out of range: '%s' has indices 1..%d", i, e->name, s->size);
     return -1;
   }
   s->used = 1;
-  return dag_input(cx->d, s->base + (int)i - 1);
+  return s->kind == SYM_VALUES ? s->nodes[i - 1] : dag_input(cx->d, s->base + (int)i - 1);
 }
 
 // Print a constant operand for a message; of an operator, in parentheses
@@ -279,6 +287,7 @@ static const struct {
     {"sin", OP_SIN},   {"cos", OP_COS},   {"tan", OP_TAN},     {"asin", OP_ASIN}, {"acos", OP_ACOS},
     {"atan", OP_ATAN}, {"atan2", OP_ATAN2}, {"sinh", OP_SINH}, {"cosh", OP_COSH}, {"tanh", OP_TANH},
     {"exp", OP_EXP},   {"log", OP_LOG},   {"sqrt", OP_SQRT},   {"pow", OP_POW},   {"abs", OP_ABS},
+    {"sign", OP_SIGN}, {"min", OP_MIN},   {"max", OP_MAX},
 };
 
 static int lower_call(Ctx *cx, const Ast *e) {
@@ -458,7 +467,26 @@ static void declare_variables(Ctx *cx, const Stmt *st) {
   }
 }
 
+// name = [e1, e2, ...] or [e for i in a..b]: an array of values, each
+// lowered once here (constants, or subexpressions of q and params).
+static void define_values(Ctx *cx, const Stmt *st) {
+  List l = {{0}, {0}, {0}};
+  int ok = flatten(cx, st->expr, &l) == 0;
+  if (ok && l.nodes.n == 0) {
+    error_at(st->expr->loc, "the array '%s' has no values", st->name);
+    ok = 0;
+  }
+  Sym *s = define(cx, st->name, st->name_loc, SYM_VALUES);
+  if (!s) return;
+  s->size = ok ? l.nodes.n : 0; /* 0: in error, its uses say nothing more */
+  s->nodes = l.nodes.v;
+}
+
 static void define_value(Ctx *cx, const Stmt *st) {
+  if (st->expr->kind == A_LIST || st->expr->kind == A_FOR) {
+    define_values(cx, st);
+    return;
+  }
   int n = lower(cx, st->expr);
   Sym *s = define(cx, st->name, st->name_loc, SYM_VALUE);
   if (s) s->node = n < 0 ? dag_const(cx->d, 0) : n;
@@ -607,7 +635,7 @@ static void warn_unused(Ctx *cx) {
   n = 0;
   for (int b = 0; b < NBUCKETS; b++)
     for (Sym *s = cx->buckets[b]; s; s = s->next)
-      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_PARAM)) unused[n++] = s;
+      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_VALUES || s->kind == SYM_PARAM)) unused[n++] = s;
   qsort(unused, (size_t)n, sizeof *unused, by_location);
   for (int i = 0; i < n; i++)
     warning_at(unused[i]->loc, "%s '%s' is never used", unused[i]->kind == SYM_PARAM ? "param" : "definition",

@@ -6,7 +6,7 @@
  * by construction. As each node is built it is folded when all operands are
  * constants (unless the result would be NaN, an infinity or -0.0, which are
  * left for run time and reported by the caller) and simplified by the
- * algebraic identities x+0, x*1, x*0, x-x, -(-x), x^1, x^0.
+ * algebraic identities x+0, x*1, x*0, x-x, -(-x), x^1, x^0, min(x,x), max(x,x).
  *
  * Nodes are numbered in creation order and an operand is always created
  * before its user, so id order is a topological order: evaluation, degree
@@ -192,6 +192,8 @@ double op_apply(Op op, double a, double b) {
   case OP_SQRT: return sqrt(a);
   case OP_ABS: return fabs(a);
   case OP_SIGN: return (a > 0) - (a < 0);
+  case OP_MIN: return fmin(a, b);
+  case OP_MAX: return fmax(a, b);
   default: internal_error("op_apply on %s", op_name(op));
   }
   return 0;
@@ -257,6 +259,9 @@ static int simplify(Dag *d, Op op, int a, int b) {
     if (is_neg(d, a)) return d->nodes[a].a;
     if (dag_is_zero(d, a)) return a;
     return -1;
+  case OP_MIN:
+  case OP_MAX:
+    return a == b ? a : -1;
   case OP_POW:
     if (dag_is_const(d, b, 1)) return a;
     if (dag_is_zero(d, b) || dag_is_const(d, a, 1)) return dag_const(d, 1);
@@ -277,7 +282,7 @@ int dag_op(Dag *d, Op op, int a, int b) {
   }
   int s = simplify(d, op, a, b);
   if (s >= 0) return s;
-  if ((op == OP_ADD || op == OP_MUL) && a > b) {
+  if ((op == OP_ADD || op == OP_MUL || op == OP_MIN || op == OP_MAX) && a > b) {
     int t = a;
     a = b;
     b = t;

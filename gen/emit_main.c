@@ -33,6 +33,9 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
     fprintf(f, "  {\"%s\", offsetof(%s_params, %s)},\n", mod->params[i].name, P, mod->params[i].name);
   if (!mod->nparams) fprintf(f, "  {NULL, 0},\n");
   fprintf(f, "};\n");
+  fprintf(f, "static const char *const names[] = {");
+  for (int i = 0; i < mod->m; i++) fprintf(f, "%s\"%s\"", i ? ", " : "", mod->coord_names[i]);
+  fprintf(f, "};\n");
   emit_values(f, "q0", mod->q0, mod->m);
   emit_values(f, "p0", mod->p0, mod->m);
   fprintf(f, "\nint main(int argc, char **argv)\n{\n  static const hbvmrt_model model = {\n");
@@ -41,7 +44,7 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    offsetof(%s_state, t), offsetof(%s_state, q), offsetof(%s_state, p), offsetof(%s_state, lambda),\n",
           P, P, P, P);
   fprintf(f, "    %d, params, q0, p0,\n", mod->nparams);
-  fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden,\n  };\n", P);
+  fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n  };\n", P);
   fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");
   (void)me;
   return ferror(f) ? -1 : 0;

@@ -104,7 +104,9 @@ Stmt *parse_model(const char *src, size_t len);   /* NULL only on a fatal error 
 
 /* ---- dag.c: the expression DAG ---- */
 
-/* X-macro of operations: name, arity, C function (NULL for operators). */
+/* X-macro of operations: name, arity, C function (NULL for operators).
+ * The emitter prints an op with a C function as that function with the
+ * real type's suffix (fmin, fminf, fminl); the others it prints itself. */
 #define OPS(X)                   \
   X(CONST, 0, NULL)              \
   X(INPUT, 0, NULL)              \
@@ -129,7 +131,9 @@ Stmt *parse_model(const char *src, size_t len);   /* NULL only on a fatal error 
   X(LOG, 1, "log")               \
   X(SQRT, 1, "sqrt")             \
   X(ABS, 1, "fabs")              \
-  X(SIGN, 1, NULL)
+  X(SIGN, 1, NULL)               \
+  X(MIN, 2, "fmin")              \
+  X(MAX, 2, "fmax")
 
 typedef enum {
 #define X(name, arity, cfun) OP_##name,

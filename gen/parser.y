@@ -295,7 +295,7 @@ static int yyreport_syntax_error(const yypcontext_t *ctx, yyscan_t scanner, Pars
   yysymbol_kind_t tok = yypcontext_token(ctx);
   if (tok == YYTRANSLATE('(') && ps->after_name) {
     error_at(ps->name_loc, "'%.40s' is not a function (the functions are sin cos tan asin acos atan atan2 sinh "
-             "cosh tanh exp log sqrt pow abs)", ps->text);
+             "cosh tanh exp log sqrt pow abs sign min max)", ps->text);
     return 0;
   }
   msg_add(msg, "syntax error, unexpected %s", yysymbol_name(tok));

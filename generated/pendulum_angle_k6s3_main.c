@@ -24,6 +24,7 @@ static int step(void *x, double h, const void *prm, hbvmrt_stats *st)
 static const hbvmrt_param params[] = {
   {NULL, 0},
 };
+static const char *const names[] = {"theta"};
 static const double q0[1] = {0};
 static const double p0[1] = {1};
 
@@ -34,7 +35,7 @@ int main(int argc, char **argv)
     sizeof(pendulum_angle_k6s3_state), sizeof(pendulum_angle_k6s3_params),
     offsetof(pendulum_angle_k6s3_state, t), offsetof(pendulum_angle_k6s3_state, q), offsetof(pendulum_angle_k6s3_state, p), offsetof(pendulum_angle_k6s3_state, lambda),
     0, params, q0, p0,
-    init, params_default, step, pendulum_angle_k6s3_strerror, energy, constraints, hidden,
+    init, params_default, step, pendulum_angle_k6s3_strerror, energy, constraints, hidden, names,
   };
   return hbvmrt_main(&model, argc, argv);
 }

@@ -24,6 +24,7 @@ static int step(void *x, double h, const void *prm, hbvmrt_stats *st)
 static const hbvmrt_param params[] = {
   {NULL, 0},
 };
+static const char *const names[] = {"x", "y"};
 static const double q0[2] = {0, -1};
 static const double p0[2] = {1, 0};
 
@@ -34,7 +35,7 @@ int main(int argc, char **argv)
     sizeof(pendulum_k2s2_state), sizeof(pendulum_k2s2_params),
     offsetof(pendulum_k2s2_state, t), offsetof(pendulum_k2s2_state, q), offsetof(pendulum_k2s2_state, p), offsetof(pendulum_k2s2_state, lambda),
     0, params, q0, p0,
-    init, params_default, step, pendulum_k2s2_strerror, energy, constraints, hidden,
+    init, params_default, step, pendulum_k2s2_strerror, energy, constraints, hidden, names,
   };
   return hbvmrt_main(&model, argc, argv);
 }

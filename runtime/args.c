@@ -255,7 +255,7 @@ static int print_help(const hbvmrt_model *md, FILE *out)
   print_vector(out, md->p0, md->m);
   fputs(")\n"
     "  --param name=value set a run-time parameter (repeatable)\n"
-    "  --csv FILE         write the rows t,q1..,p1..,lam1..,H,g1..,hc1.. to\n"
+    "  --csv FILE         write the rows t,x..,p_x..,lambda_1..,H,g_1..,hc_1.. to\n"
     "                     FILE ('-' for stdout); no CSV without it\n"
     "  --quiet            no progress line on a terminal\n"
     "  --help             this text\n", out);

@@ -1,8 +1,12 @@
 /* csv.c - the driver's CSV output.
  *
- * Header  t,q1..qm,p1..pm,lam1..lamnu,H,g1..gnu,hc1..hcnu  (the lam, g and hc
- * columns are absent when nu = 0), then one row per written step with every
- * value printed "%.17g", so a row reads back to the same doubles.  Errors are
+ * Header  t,x,y,p_x,p_y,lambda_1,H,g_1,hc_1: the model's coordinate names
+ * (an array element as x[3]), p_ and the name for its momentum, then
+ * lambda_a, H, g_a, hc_a for a = 1..nu (absent when nu = 0).  A model
+ * description without names (md->names NULL: drivers from hbvmgen 0.1)
+ * keeps the old header t,q1..qm,p1..pm,lam1..lamnu,H,g1..gnu,hc1..hcnu.
+ * Then one row per written step with every value printed "%.17g", so a row
+ * reads back to the same doubles.  Errors are
  * not reported here: the functions return -1 once the stream is in error and
  * the caller says what failed. */
 #include <stdio.h>
@@ -32,15 +36,33 @@ static const double *at(const void *x, size_t off)
   return (const double *)(const void *)((const char *)x + off);
 }
 
+/* ",PREFIXname" for each coordinate name, or ",PREFIXn" n = 1..m without names */
+static void coords(FILE *f, const char *prefix, const hbvmrt_model *md)
+{
+  int i;
+
+  if (!md->names) {
+    names(f, prefix, md->m);
+    return;
+  }
+  for (i = 0; i < md->m; i++)
+    fprintf(f, ",%s%s", prefix, md->names[i]);
+}
+
 int hbvmrt_csv_header(FILE *f, const hbvmrt_model *md)
 {
+  /* prefixes of the q, p, lambda, g and hc columns: with names, numbered */
+  static const char *const named[] = {"", "p_", "lambda_", "g_", "hc_"};
+  static const char *const numbered[] = {"q", "p", "lam", "g", "hc"};
+  const char *const *pre = md->names ? named : numbered;
+
   fputc('t', f);
-  names(f, "q", md->m);
-  names(f, "p", md->m);
-  names(f, "lam", md->nu);
+  coords(f, pre[0], md);
+  coords(f, pre[1], md);
+  names(f, pre[2], md->nu);
   fputs(",H", f);
-  names(f, "g", md->nu);
-  names(f, "hc", md->nu);
+  names(f, pre[3], md->nu);
+  names(f, pre[4], md->nu);
   fputc('\n', f);
   return ferror(f) ? -1 : 0;
 }

@@ -3,13 +3,17 @@
  * A generated NAME_main.c describes its model with an hbvmrt_model (sizes,
  * parameter names, and adapter functions that call NAME_step and friends on
  * opaque state and parameter blocks) and hands argc/argv to hbvmrt_main.
- * The runtime parses the driver options of SPEC section 4, runs the loop,
+ * The runtime parses the driver options (docs/api.md, "The driver"), runs the loop,
  * writes the CSV, keeps the running maxima and prints the summary line.
  * The generated step never needs this library. */
 #ifndef HBVMRT_H
 #define HBVMRT_H
 
 #include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
 
 /* What one step reports back to the driver. */
 typedef struct {
@@ -41,10 +45,18 @@ typedef struct {
   double (*energy)(const void *x, const void *prm);
   void (*constraints)(const void *x, const void *prm, double *g);
   void (*hidden)(const void *x, const void *prm, double *gp);
+  /* The m coordinate names ("x", "x[3]") for the CSV header; NULL (as in
+   * drivers from hbvmgen 0.1, which end before this field) gives the
+   * numbered header q1..qm.  Add new fields after this one. */
+  const char *const *names;
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status
  * (0 success, 1 bad arguments, 2 a failed step). */
 int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

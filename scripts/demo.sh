@@ -35,4 +35,4 @@ for h in 0.1 0.05 0.025 0.0125; do
 done
 echo "   err(q,p): max over t = 0, 0.1, ..., 10 of the largest error in x, y, px, py."
 echo "   Order 2 in q, p and the hidden constraint; H and g conserved to round-off (paper, table tab0)."
-echo "== CSV (t,q1,q2,p1,p2,lam1,H,g1,hc1) in $out/pendulum_h*.csv; run $out/pendulum --help for options"
+echo "== CSV (t,x,y,p_x,p_y,lambda_1,H,g_1,hc_1) in $out/pendulum_h*.csv; run $out/pendulum --help for options"

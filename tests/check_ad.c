@@ -157,6 +157,11 @@ static const OpCase op_cases[] = {
     {"sqrt", OP_SQRT, 1.6, 1.4, B_NONE, 0, 0},
     {"abs, a > 0", OP_ABS, 0.6, 0.4, B_NONE, 0, 0},
     {"abs, a < 0", OP_ABS, -0.6, 0.4, B_NONE, 0, 0},
+    {"min, a < b", OP_MIN, -0.6, 0.4, B_VAR, 0.65, 0.35},
+    {"min, a > b", OP_MIN, 0.6, 0.4, B_VAR, -0.65, 0.35},
+    {"max, a < b", OP_MAX, -0.6, 0.4, B_VAR, 0.65, 0.35},
+    {"max, a > b", OP_MAX, 0.6, 0.4, B_VAR, -0.65, 0.35},
+    {"sign, a > 0", OP_SIGN, 0.6, 0.4, B_NONE, 0, 0},
 };
 
 /* Build the operation of case c on inputs xa, xb (see OpCase). */
@@ -181,6 +186,30 @@ START_TEST(test_op_gradient)
   int root = dag_add(d, f, dag_mul(d, dag_input(d, 2), f));
   ck_assert_msg(reaches(d, root, c->op, -1), "%s was simplified away", c->name);
   check_fd(d, root, 4, -1, 1, c->name);
+}
+END_TEST
+
+/* At a kink the sweep takes the documented subgradient (ad.c): d abs = 0
+ * and d sign = 0 at 0; min and max give half to each operand at a tie. */
+START_TEST(test_subgradients_at_ties)
+{
+  static const struct {
+    Op op;
+    double x, y, dx, dy;
+  } cases[] = {
+      {OP_ABS, 0, 0, 0, 0},      {OP_SIGN, 0, 0, 0, 0},      {OP_MIN, 1.5, 1.5, 0.5, 0.5},
+      {OP_MAX, -2, -2, 0.5, 0.5}, {OP_MIN, 1, 2, 1, 0},       {OP_MAX, 1, 2, 0, 1},
+  };
+  for (int i = 0; i < NCASES(cases); i++) {
+    Dag *d = dag_new();
+    int x = dag_input(d, 0), y = dag_input(d, 1), grad[2];
+    int f = dag_op(d, cases[i].op, x, op_arity(cases[i].op) == 2 ? y : -1);
+    ad_gradient(d, f, 2, grad);
+    double q[2] = {cases[i].x, cases[i].y};
+    double dx = dag_eval(d, grad[0], q, NULL), dy = dag_eval(d, grad[1], q, NULL);
+    ck_assert_msg(dx == cases[i].dx && dy == cases[i].dy, "%s at (%g, %g): gradient (%g, %g), want (%g, %g)",
+                  op_name(cases[i].op), q[0], q[1], dx, dy, cases[i].dx, cases[i].dy);
+  }
 }
 END_TEST
 
@@ -453,6 +482,7 @@ Suite *ad_suite(void)
   TCase *tc = tcase_create("ad");
   tcase_add_checked_fixture(tc, NULL, teardown);
   tcase_add_loop_test(tc, test_op_gradient, 0, NCASES(op_cases));
+  tcase_add_test(tc, test_subgradients_at_ties);
   tcase_add_test(tc, test_rosenbrock);
   tcase_add_test(tc, test_dot_product);
   tcase_add_loop_test(tc, test_model, 0, NCASES(model_cases));

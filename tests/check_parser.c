@@ -238,7 +238,7 @@ START_TEST(test_sum_and_indexing)
 }
 END_TEST
 
-/* The fifteen functions against the C library at (x, y) = (0.3, 0.7). */
+/* The eighteen functions against the C library at (x, y) = (0.3, 0.7). */
 static double fn_abs(double x, double y) { return fabs(x - y); }
 static double fn_sin(double x, double y) { (void)y; return sin(x); }
 static double fn_cos(double x, double y) { (void)y; return cos(x); }
@@ -252,6 +252,7 @@ static double fn_tanh(double x, double y) { (void)y; return tanh(x); }
 static double fn_exp(double x, double y) { (void)y; return exp(x); }
 static double fn_log(double x, double y) { (void)y; return log(x); }
 static double fn_sqrt(double x, double y) { (void)y; return sqrt(x); }
+static double fn_sign(double x, double y) { return (x - y > 0) - (x - y < 0); }
 
 static const struct {
   const char *expr;
@@ -260,6 +261,7 @@ static const struct {
     {"sin(x)", fn_sin},   {"cos(x)", fn_cos},     {"tan(x)", fn_tan},   {"asin(x)", fn_asin}, {"acos(x)", fn_acos},
     {"atan(x)", fn_atan}, {"atan2(x, y)", atan2}, {"sinh(x)", fn_sinh}, {"cosh(x)", fn_cosh}, {"tanh(x)", fn_tanh},
     {"exp(x)", fn_exp},   {"log(x)", fn_log},     {"sqrt(x)", fn_sqrt}, {"pow(x, y)", pow},   {"abs(x - y)", fn_abs},
+    {"sign(x - y)", fn_sign}, {"min(x, y)", fmin}, {"max(x, y)", fmax},
 };
 
 START_TEST(test_functions)
@@ -297,6 +299,58 @@ START_TEST(test_functions_fold)
   snprintf(src, sizeof src, "variables x, y\nq0 = [%s, 0]\nU = x + y\n", expr);
   Model *mod = load(src);
   assert_close(mod->q0[0], function_cases[_i].f(0.3, 0.7), expr);
+}
+END_TEST
+
+/* name = [...] defines an array of values (constants or expressions),
+ * flattened like g; name[i] takes a constant index or a sum/for index
+ * variable, and constant entries work wherever constants are required. */
+START_TEST(test_value_arrays)
+{
+  Model *mod = load("variables x[3]\n"
+                    "mass = [1, 2, 0.5]\n"
+                    "k = [[10 * i for i in 1..2], 30]\n"
+                    "d = [x[i + 1] - x[i] for i in 1..2]\n"
+                    "M = diag(mass[1], mass[2], mass[3])\n"
+                    "U = sum(i in 1..3, k[i] * x[i]^2) + d[2]^2\n"
+                    "g = sum(i in 1..2, mass[i + 1] * x[i]) - 1\n"
+                    "q0 = [mass[3], 0, k[1]]\n");
+  const double q[] = {1, 2, 5}, minv[] = {1, 0.5, 2}, q0[] = {0.5, 0, 10};
+  assert_close(eval(mod, mod->U, q), 10 + 20 * 4 + 30 * 25 + 9, "U");
+  assert_close(eval(mod, mod->g[0], q), 2 * 1 + 0.5 * 2 - 1, "g");
+  assert_values(mod->minv_diag, minv, 3, "diag M^-1");
+  assert_values(mod->q0, q0, 3, "q0");
+  ck_assert_int_eq(mod->degU, 2);
+  ck_assert_int_eq(mod->degg, 1);
+  ck_assert(refused("variables x\na = [1, 2]\nU = a[3] * x\n"));
+  ck_assert(refused("variables x\na = [1, 2]\nU = a * x\n"));
+  ck_assert(refused("variables x\na = [1, 2]\nU = a[x] * x\n"));
+  ck_assert(refused("variables x\na = []\nU = x\n"));
+}
+END_TEST
+
+/* min, max and sign: values on both sides and at a tie, derivatives the
+ * subgradients of ad.c (half to each operand of min/max at a tie). */
+START_TEST(test_min_max_sign)
+{
+  Model *mod = load("variables x, y\nU = 3 * min(x, y) + 5 * max(x, 2*y) + 7 * sign(x) * x\n");
+  static const struct {
+    double q[2], U, dx, dy;
+  } pts[] = {
+      {{1, 2}, 3 * 1 + 5 * 4 + 7, 3 + 7, 10},
+      {{3, 1}, 3 * 1 + 5 * 3 + 21, 5 + 7, 3},
+      {{2, 1}, 3 * 1 + 5 * 2 + 14, 2.5 + 7, 3 + 5},    /* tie of max: half each */
+      {{-1, -1}, -3 - 5 - 7 * -1, 1.5 + 5 - 7, 1.5},   /* tie of min: half each */
+      {{0, 1}, 0 + 10 + 0, 3 + 0, 10},                 /* sign(0) = 0, d sign = 0 */
+  };
+  for (int i = 0; i < NCASES(pts); i++) {
+    assert_close(eval(mod, mod->U, pts[i].q), pts[i].U, "U");
+    assert_close(eval(mod, mod->gradU[0], pts[i].q), pts[i].dx, "dU/dx");
+    assert_close(eval(mod, mod->gradU[1], pts[i].q), pts[i].dy, "dU/dy");
+  }
+  ck_assert_int_eq(mod->degU, DEG_NONPOLY);
+  ck_assert(refused("variables x\nU = min(x)\n"));
+  ck_assert(refused("variables x\nU = sign(x, 1)\n"));
 }
 END_TEST
 
@@ -538,6 +592,8 @@ Suite *parser_suite(void)
   tcase_add_test(fe, test_sum_and_indexing);
   tcase_add_loop_test(fe, test_functions, 0, NCASES(function_cases));
   tcase_add_loop_test(fe, test_functions_fold, 0, NCASES(function_cases));
+  tcase_add_test(fe, test_value_arrays);
+  tcase_add_test(fe, test_min_max_sign);
   tcase_add_test(fe, test_initial_values);
   tcase_add_test(fe, test_layout);
   tcase_add_test(fe, test_numbers);

@@ -102,7 +102,8 @@ static const hbvmrt_model osc = {
   0, NULL,
   osc_q0, osc_p0,
   osc_init, osc_params_default, osc_step, osc_strerror, osc_energy,
-  NULL, NULL                    /* nu = 0: never called */
+  NULL, NULL,                   /* nu = 0: never called */
+  NULL                          /* no names: the numbered CSV header */
 };
 
 /* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
@@ -198,7 +199,8 @@ static const hbvmrt_model ring = {
   1, ring_params,
   ring_q0, ring_p0,
   ring_init, ring_params_default, ring_step, ring_strerror, ring_energy,
-  ring_constraints, ring_hidden
+  ring_constraints, ring_hidden,
+  NULL
 };
 
 /* --- running the driver ---------------------------------------------------- */
@@ -432,6 +434,22 @@ START_TEST(header_nu1)
 
   ck_assert_int_eq(r.status, 0);
   ck_assert_int_eq(strncmp(r.csv, "t,q1,q2,p1,p2,lam1,H,g1,hc1\n", 28), 0);
+  done(&r);
+}
+END_TEST
+
+/* with the model's coordinate names, as generated drivers give them */
+START_TEST(header_names)
+{
+  static const char *const names[] = {"x", "r[2]"};
+  static const char want[] = "t,x,r[2],p_x,p_r[2],lambda_1,H,g_1,hc_1\n0,1,0,";
+  hbvmrt_model named = ring;
+  Result r;
+
+  named.names = names;
+  r = run(&named, "-N 1 --csv @");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_msg(strncmp(r.csv, want, strlen(want)) == 0, "header and first row: %.60s", r.csv);
   done(&r);
 }
 END_TEST
@@ -861,6 +879,7 @@ Suite *runtime_suite(void)
 
   tcase_add_test(csv, header_nu0);
   tcase_add_test(csv, header_nu1);
+  tcase_add_test(csv, header_names);
   tcase_add_loop_test(csv, rows, 0,
                       (int)(sizeof row_cases / sizeof row_cases[0]));
   tcase_add_test(csv, values_read_back);
