@@ -179,33 +179,59 @@ static void check_message(const char *err, const char *want)
   ck_assert_msg(strstr(err, "/.") == NULL && strstr(err, "XXXXXX") == NULL, "a temporary is named: %s", err);
 }
 
+/* root/name, in buf (of PATH_SIZE bytes). */
+#define PATH_SIZE 160
+static const char *in_root(char *buf, const char *name)
+{
+  snprintf(buf, PATH_SIZE, "%s/%s", root, name);
+  return buf;
+}
+
+/* A failed run: exit status 1 and an error naming want. */
+static void expect_failure(const char *const *args, long fsize, const char *want)
+{
+  char *err;
+  ck_assert_int_eq(generate(args, fsize, &err), 1);
+  check_message(err, want);
+  free(err);
+}
+
+static void assert_content(const char *path, const char *want)
+{
+  char *s = get(path);
+  ck_assert_msg(s && !strcmp(s, want), "%s holds '%s', want '%s'", path, s ? s : "(nothing)", want);
+  free(s);
+}
+
+static void assert_entries(const char *dir, const char *want)
+{
+  char list[1024];
+  entries(dir, list, sizeof list);
+  ck_assert_str_eq(list, want);
+}
+
 /* ---- output ---- */
 
 START_TEST(test_output_dir_created)
 {
   make_root();
-  char dir[128], list[512];
-  snprintf(dir, sizeof dir, "%s/a/b/c", root);
-  const char *args[] = {"-o", dir, PENDULUM, NULL};
+  char dir[PATH_SIZE];
+  const char *args[] = {"-o", in_root(dir, "a/b/c"), PENDULUM, NULL};
   ck_assert_int_eq(generate(args, 0, NULL), 0);
-  entries(dir, list, sizeof list);
-  ck_assert_str_eq(list, "pendulum.c pendulum.h");
+  assert_entries(dir, "pendulum.c pendulum.h");
   /* a file where the directory should be: refused, naming the user's path */
-  char file[128], *err;
-  snprintf(file, sizeof file, "%s/file", root);
-  put(file, "x");
+  char file[PATH_SIZE], want[PATH_SIZE + 32];
+  put(in_root(file, "file"), "x");
   const char *args2[] = {"-o", file, PENDULUM, NULL};
-  ck_assert_int_eq(generate(args2, 0, &err), 1);
-  check_message(err, "'");
-  ck_assert_msg(strstr(err, file) != NULL, "the path is not named: %s", err);
-  free(err);
+  snprintf(want, sizeof want, "'%s' is not a directory", file);
+  expect_failure(args2, 0, want);
 }
 END_TEST
 
 START_TEST(test_planted_symlink)
 {
   make_root();
-  char victim[128], link1[160], link2[160], list[512];
+  char victim[128], link1[160], link2[160];
   snprintf(victim, sizeof victim, "%s/victim", root);
   put(victim, "precious\n");
   /* the temporaries' names of old: a symlink there used to be written through */
@@ -215,53 +241,35 @@ START_TEST(test_planted_symlink)
   ck_assert_int_eq(symlink(victim, link2), 0);
   const char *args[] = {"-o", root, PENDULUM, NULL};
   ck_assert_int_eq(generate(args, 0, NULL), 0);
-  char *v = get(victim);
-  ck_assert_str_eq(v, "precious\n");
-  free(v);
-  entries(root, list, sizeof list);
-  ck_assert_str_eq(list, ".pendulum.c.tmp .pendulum.h.tmp pendulum.c pendulum.h victim");
+  assert_content(victim, "precious\n");
+  assert_entries(root, ".pendulum.c.tmp .pendulum.h.tmp pendulum.c pendulum.h victim");
 }
 END_TEST
 
 START_TEST(test_failed_rename_restores)
 {
   make_root();
-  char h[128], c[128], list[512], *err;
-  snprintf(h, sizeof h, "%s/pendulum.h", root);
-  snprintf(c, sizeof c, "%s/pendulum.c", root);
-  put(h, "old header\n");
-  ck_assert_int_eq(mkdir(c, 0700), 0); /* NAME.c cannot be replaced */
+  char path[PATH_SIZE];
+  put(in_root(path, "pendulum.h"), "old header\n");
+  ck_assert_int_eq(mkdir(in_root(path, "pendulum.c"), 0700), 0); /* NAME.c cannot be replaced */
   const char *args[] = {"-o", root, PENDULUM, NULL};
-  ck_assert_int_eq(generate(args, 0, &err), 1);
-  check_message(err, "pendulum.c': it is a directory");
-  free(err);
-  char *old = get(h);
-  ck_assert_str_eq(old, "old header\n"); /* put back after it was replaced */
-  free(old);
-  entries(root, list, sizeof list);
-  ck_assert_str_eq(list, "pendulum.c pendulum.h");
+  expect_failure(args, 0, "pendulum.c': it is a directory");
+  assert_content(in_root(path, "pendulum.h"), "old header\n"); /* put back after it was replaced */
+  assert_entries(root, "pendulum.c pendulum.h");
 }
 END_TEST
 
 START_TEST(test_file_size_limit)
 {
   make_root();
-  char h[128], c[128], list[512], *err;
-  snprintf(h, sizeof h, "%s/conical.h", root);
-  snprintf(c, sizeof c, "%s/conical.c", root);
-  put(h, "old header\n");
-  put(c, "old code\n");
+  char h[PATH_SIZE], c[PATH_SIZE];
+  put(in_root(h, "conical.h"), "old header\n");
+  put(in_root(c, "conical.c"), "old code\n");
   const char *args[] = {"-o", root, CONICAL, NULL};
-  ck_assert_int_eq(generate(args, 4096, &err), 1); /* ulimit -f: the .c is larger */
-  check_message(err, "conical.c': File too large");
-  free(err);
-  char *a = get(h), *b = get(c);
-  ck_assert_str_eq(a, "old header\n");
-  ck_assert_str_eq(b, "old code\n");
-  free(a);
-  free(b);
-  entries(root, list, sizeof list);
-  ck_assert_str_eq(list, "conical.c conical.h");
+  expect_failure(args, 4096, "conical.c': File too large"); /* ulimit -f: the .c is larger */
+  assert_content(h, "old header\n");
+  assert_content(c, "old code\n");
+  assert_entries(root, "conical.c conical.h");
 }
 END_TEST
 
@@ -273,13 +281,9 @@ START_TEST(test_long_path)
   size_t n = strlen(dir);
   memset(dir + n, 'd', 5000);
   dir[n + 5000] = '\0';
-  char *err, list[512];
   const char *args[] = {"-o", dir, PENDULUM, NULL};
-  ck_assert_int_eq(generate(args, 0, &err), 1);
-  check_message(err, "too long");
-  free(err);
-  entries(root, list, sizeof list);
-  ck_assert_str_eq(list, "");
+  expect_failure(args, 0, "too long");
+  assert_entries(root, "");
 }
 END_TEST
 
@@ -288,9 +292,9 @@ END_TEST
 START_TEST(test_concurrent_runs)
 {
   make_root();
-  char h[128], c[128], list[512];
-  snprintf(h, sizeof h, "%s/twin.h", root);
-  snprintf(c, sizeof c, "%s/twin.c", root);
+  char h[PATH_SIZE], c[PATH_SIZE];
+  in_root(h, "twin.h");
+  in_root(c, "twin.c");
   for (int round = 0; round < 10; round++) {
     pid_t pids[2];
     for (int i = 0; i < 2; i++) {
@@ -318,8 +322,7 @@ START_TEST(test_concurrent_runs)
                   ca ? "pendulum" : "conical");
     free(a);
     free(b);
-    entries(root, list, sizeof list);
-    ck_assert_str_eq(list, "twin.c twin.h");
+    assert_entries(root, "twin.c twin.h");
   }
 }
 END_TEST
@@ -362,17 +365,15 @@ END_TEST
 START_TEST(test_many_warnings_capped)
 {
   make_root();
-  char model[128], out[128];
-  snprintf(model, sizeof model, "%s/many.ham", root);
-  snprintf(out, sizeof out, "%s/out", root);
-  FILE *f = fopen(model, "w");
+  char model[PATH_SIZE], out[PATH_SIZE];
+  FILE *f = fopen(in_root(model, "many.ham"), "w");
   ck_assert(f != NULL);
   fputs("variables x\nU = x^2\n", f);
   for (int i = 0; i < 100000; i++)
     fprintf(f, "d%d = %d\n", i, i);
   ck_assert(fclose(f) == 0);
   char *err;
-  const char *args[] = {"-o", out, model, NULL};
+  const char *args[] = {"-o", in_root(out, "out"), model, NULL};
   ck_assert_int_eq(generate(args, 0, &err), 0);
   int warnings = 0;
   for (const char *p = err; (p = strstr(p, ": warning: ")) != NULL; p++)
@@ -409,27 +410,29 @@ START_TEST(test_driver_short_span)
 }
 END_TEST
 
+/* A test case of s that cleans up root after each test. */
+static TCase *tcase_in(Suite *s, const char *name)
+{
+  TCase *tc = tcase_create(name);
+  tcase_add_checked_fixture(tc, NULL, teardown);
+  tcase_set_timeout(tc, 120);
+  suite_add_tcase(s, tc);
+  return tc;
+}
+
 Suite *files_suite(void)
 {
   Suite *s = suite_create("files");
-  TCase *out = tcase_create("output");
-  tcase_add_checked_fixture(out, NULL, teardown);
-  tcase_set_timeout(out, 120);
+  TCase *out = tcase_in(s, "output");
   tcase_add_test(out, test_output_dir_created);
   tcase_add_test(out, test_planted_symlink);
   tcase_add_test(out, test_failed_rename_restores);
   tcase_add_test(out, test_file_size_limit);
   tcase_add_test(out, test_long_path);
   tcase_add_test(out, test_concurrent_runs);
-  suite_add_tcase(s, out);
-  TCase *cost = tcase_create("cost");
-  tcase_add_checked_fixture(cost, NULL, teardown);
-  tcase_set_timeout(cost, 120);
+  TCase *cost = tcase_in(s, "cost");
   tcase_add_test(cost, test_diagnostics_linear);
   tcase_add_test(cost, test_many_warnings_capped);
-  suite_add_tcase(s, cost);
-  TCase *drv = tcase_create("driver");
-  tcase_add_test(drv, test_driver_short_span);
-  suite_add_tcase(s, drv);
+  tcase_add_test(tcase_in(s, "driver"), test_driver_short_span);
   return s;
 }
