@@ -285,7 +285,7 @@ static int make_dir(const char *dir) {
   char *path = xmalloc(strlen(dir) + 1);
   strcpy(path, dir);
   int rc = 0;
-  for (char *p = path + 1;; p++) {
+  for (char *p = path + (path[0] == '/');; p++) {
     if (*p != '/' && *p) continue;
     char saved = *p;
     *p = '\0';
@@ -299,9 +299,11 @@ static int make_dir(const char *dir) {
     if (!saved) break;
   }
   struct stat st;
-  if (!rc && (stat(dir, &st) || !S_ISDIR(st.st_mode))) {
-    fprintf(stderr, "hbvmgen: error: the output directory '%s' %s\n", dir,
-            errno == 0 || !stat(dir, &st) ? "is not a directory" : strerror(errno));
+  if (!rc && stat(dir, &st)) {
+    fprintf(stderr, "hbvmgen: error: cannot use the output directory '%s': %s\n", dir, strerror(errno));
+    rc = 1;
+  } else if (!rc && !S_ISDIR(st.st_mode)) {
+    fprintf(stderr, "hbvmgen: error: the output directory '%s' is not a directory\n", dir);
     rc = 1;
   }
   free(path);
