@@ -59,7 +59,10 @@ char *arena_strndup(const char *s, size_t n) {
   return p;
 }
 
+static void forget_lines(void);
+
 void arena_free_all(void) {
+  forget_lines(); /* the line index lives in the arena */
   while (arena_head) {
     Block *next = arena_head->next;
     free(arena_head);
@@ -195,7 +198,7 @@ void internal_error(const char *fmt, ...) {
 static const char *diag_src;
 static size_t diag_len;
 static int nerrors;
-static size_t *line_start; /* line_start[i]: offset of line i+1, once indexed */
+static size_t *line_start; /* line_start[i]: offset of line i+1, once indexed (arena) */
 static int nlines;
 static long scanned;       /* bytes looked at to index lines (tests: linear) */
 static struct {
@@ -210,10 +213,13 @@ void diag_begin(const char *file, const char *src, size_t len) {
   diag_src = src;
   diag_len = len;
   nerrors = 0;
-  free(line_start);
+  forget_lines();
+  nkinds = 0;
+}
+
+static void forget_lines(void) {
   line_start = NULL;
   nlines = 0;
-  nkinds = 0;
 }
 
 int diag_error_count(void) { return nerrors; }
@@ -225,7 +231,7 @@ static void index_lines(void) {
   long cap = 1;
   for (size_t i = 0; i < diag_len; i++) cap += diag_src[i] == '\n' || diag_src[i] == '\r';
   scanned += (long)diag_len;
-  line_start = xmalloc((size_t)cap * sizeof *line_start);
+  line_start = arena_alloc((size_t)cap * sizeof *line_start);
   line_start[nlines++] = 0;
   for (size_t i = 0; i < diag_len; i++) {
     scanned++;
