@@ -63,7 +63,7 @@ $(B)/gen/lexer.c $(B)/gen/lexer.h &: gen/lexer.l $(B)/gen/parser.h
 
 # flex's output is not pedantic-clean; it gets the same warnings minus that one.
 $(B)/gen/lexer.o: $(B)/gen/lexer.c
-	$(CC) $(WARN) -Wno-unused-function $(CFLAGS) $(SAN) -Igen -I$(B)/gen -c -o $@ $<
+	$(CC) $(WARN) -Wno-unused-function $(CFLAGS) $(SAN) -MMD -MP -Igen -I$(B)/gen -c -o $@ $<
 
 $(B)/gen/parser.o: $(B)/gen/parser.c $(B)/gen/lexer.h
 	$(CC) $(ALLCFLAGS) -Igen -I$(B)/gen -c -o $@ $<

@@ -19,7 +19,7 @@
 #include "hbvmgen.h"
 
 #define MAX_COORDS 100000
-#define MAX_CONSTRAINTS 100000
+#define MAX_CONSTRAINTS 4096  /* the step factors a dense nu x nu system at worst */
 #define MAX_PARAMS 10000
 #ifndef MAX_WORK            /* (the fuzz harness builds with a smaller limit) */
 #define MAX_WORK 20000000L   /* terms expanded by sum/for over the whole model */
@@ -43,12 +43,11 @@ struct Sym {
   Sym *next;     /* hash chain */
 };
 
-#define NBUCKETS 4096
-
 typedef struct {
   Model *mod;
   Dag *d;
-  Sym *buckets[NBUCKETS];
+  Sym **buckets;   /* hash chains of the names, grown with their number */
+  int nbuckets, nsyms;
   int stmt;        /* index of the statement being analysed */
   long work;
   IntVec g, g_line, g_col;
@@ -96,14 +95,29 @@ void ast_set_args(Ast *n, Ast *args) {
   set_depth(n, depth);
 }
 
-static unsigned hash_name(const char *s) {
+static unsigned hash_name(const Ctx *cx, const char *s) {
   unsigned h = 2166136261u;
   for (; *s; s++) h = (h ^ (unsigned char)*s) * 16777619u;
-  return h % NBUCKETS;
+  return h & (unsigned)(cx->nbuckets - 1);
+}
+
+// Double the hash table when it holds twice as many names as chains.
+static void grow_table(Ctx *cx) {
+  Sym **old = cx->buckets;
+  int nold = cx->nbuckets;
+  cx->nbuckets = nold ? 2 * nold : 256;
+  cx->buckets = arena_alloc((size_t)cx->nbuckets * sizeof *cx->buckets);
+  for (int b = 0; b < nold; b++)
+    for (Sym *s = old[b], *next; s; s = next) {
+      next = s->next;
+      unsigned h = hash_name(cx, s->name);
+      s->next = cx->buckets[h];
+      cx->buckets[h] = s;
+    }
 }
 
 static Sym *lookup(Ctx *cx, const char *name) {
-  for (Sym *s = cx->buckets[hash_name(name)]; s; s = s->next)
+  for (Sym *s = cx->buckets[hash_name(cx, name)]; s; s = s->next)
     if (!strcmp(s->name, name)) return s;
   return NULL;
 }
@@ -132,29 +146,35 @@ static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
              old->loc.line, old->loc.col);
     return NULL;
   }
+  const char *problem = kind == SYM_VALUE || kind == SYM_PARAM ? c_name_problem(name) : NULL;
+  if (problem) {
+    error_at(loc, "'%s' cannot name a %s: it is %s, which the generated C cannot use", name,
+             kind == SYM_PARAM ? "param" : "definition", problem);
+    return NULL;
+  }
   Sym *s = arena_alloc(sizeof *s);
   s->kind = kind;
   s->name = name;
   s->loc = loc;
   s->stmt = cx->stmt;
-  unsigned h = hash_name(name);
+  if (++cx->nsyms > 2 * cx->nbuckets) grow_table(cx);
+  unsigned h = hash_name(cx, name);
   s->next = cx->buckets[h];
   cx->buckets[h] = s;
   return s;
 }
 
 static void undefine(Ctx *cx, Sym *sym) {
-  Sym **p = &cx->buckets[hash_name(sym->name)];
+  Sym **p = &cx->buckets[hash_name(cx, sym->name)];
   while (*p != sym) p = &(*p)->next;
   *p = sym->next;
+  cx->nsyms--;
 }
 
 static int lower(Ctx *cx, const Ast *e);
 
 // What a node that is not constant depends on, for messages.
 static const char *dependence(const Node *nd) { return nd->flags & DEP_INPUT ? "a coordinate" : "a parameter"; }
-
-static int is_integer(double v) { return v == floor(v) && fabs(v) <= MAX_INDEX; }
 
 // Lower e and require a constant integer (sizes, indices, ranges).
 static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
@@ -165,8 +185,12 @@ static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
     error_at(e->loc, "%s must be a constant integer, but it depends on %s", what, dependence(nd));
     return -1;
   }
-  if (!is_integer(nd->val)) {
+  if (nd->val != floor(nd->val)) {
     error_at(e->loc, "%s must be an integer, got %.17g", what, nd->val);
+    return -1;
+  }
+  if (fabs(nd->val) > MAX_INDEX) {
+    error_at(e->loc, "%s is %.17g, beyond the largest allowed magnitude, %ld", what, nd->val, MAX_INDEX);
     return -1;
   }
   *out = (long)nd->val;
@@ -427,14 +451,7 @@ static double *constant_list(Ctx *cx, const Stmt *st, const char *what, const ch
 
 // Name coordinate slot for comments in the emitted code: "x" or "x[3]".
 static void name_coord(Ctx *cx, const char *name, long index) {
-  if (cx->mod->m > cx->ncap) {
-    int cap = cx->ncap ? 2 * cx->ncap : 64;
-    while (cap < cx->mod->m) cap *= 2;
-    const char **names = arena_alloc((size_t)cap * sizeof *names);
-    if (cx->nnamed) memcpy(names, cx->names, (size_t)cx->nnamed * sizeof *names);
-    cx->names = names;
-    cx->ncap = cap;
-  }
+  VEC_RESERVE(cx->names, cx->nnamed, cx->ncap, cx->nnamed + 1);
   char buf[32] = "";
   if (index > 0) snprintf(buf, sizeof buf, "[%ld]", index);
   size_t len = strlen(name);
@@ -505,13 +522,7 @@ static void define_param(Ctx *cx, const Stmt *st) {
   }
   Sym *s = define(cx, st->name, st->name_loc, SYM_PARAM);
   if (!s) return;
-  if (cx->nparams == cx->pcap) {
-    int cap = cx->pcap ? 2 * cx->pcap : 8;
-    Param *p = arena_alloc((size_t)cap * sizeof *p);
-    if (cx->nparams) memcpy(p, cx->params, (size_t)cx->nparams * sizeof *p);
-    cx->params = p;
-    cx->pcap = cap;
-  }
+  VEC_RESERVE(cx->params, cx->nparams, cx->pcap, cx->nparams + 1);
   s->base = cx->nparams;
   Param *p = &cx->params[cx->nparams++];
   p->name = st->name;
@@ -539,7 +550,8 @@ static void add_constraints(Ctx *cx, const Stmt *st) {
       continue;
     }
     if (cx->g.n >= MAX_CONSTRAINTS) {
-      error_at(loc, "too many constraints (at most %d)", MAX_CONSTRAINTS);
+      error_at(loc, "too many constraints: this is constraint %d, at most %d are supported", cx->g.n + 1,
+               MAX_CONSTRAINTS);
       return;
     }
     intvec_push(&cx->g, l.nodes.v[i]);
@@ -558,6 +570,7 @@ static void lower_mass(Ctx *cx) {
     return;
   }
   cx->stmt = cx->mass_stmt;
+  cx->d->where = cx->mass->loc;
   const Ast *e = cx->mass->expr;
   if (e->kind == A_IDENTITY) {
     mass_setup(mod, NULL, e->loc);
@@ -590,8 +603,7 @@ static void lower_mass(Ctx *cx) {
       if (r->kind != A_LIST) error_at(r->loc, "M = [[...], ...] needs each row as a list");
       if (!v[i]) return;
     }
-    double *dense = calloc((size_t)m * (size_t)m, sizeof(double));
-    if (!dense) internal_error("out of memory");
+    double *dense = xcalloc((size_t)m * (size_t)m, sizeof(double));
     for (i = 0; i < m; i++) memcpy(dense + (size_t)i * m, v[i], (size_t)m * sizeof(double));
     mass_setup(mod, dense, e->loc);
     free(dense);
@@ -616,7 +628,7 @@ static void lower_mass(Ctx *cx) {
 static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc *loc) {
   if (!st) return arena_alloc((size_t)cx->mod->m * sizeof(double));
   cx->stmt = stmt;
-  *loc = st->loc;
+  cx->d->where = *loc = st->loc;
   return constant_list(cx, st, what, what, cx->mod->m);
 }
 
@@ -628,12 +640,9 @@ static int by_location(const void *a, const void *b) {
 
 // Warn about every definition and param never used, in file order.
 static void warn_unused(Ctx *cx) {
+  Sym **unused = arena_alloc((size_t)(cx->nsyms + 1) * sizeof *unused);
   int n = 0;
-  for (int b = 0; b < NBUCKETS; b++)
-    for (Sym *s = cx->buckets[b]; s; s = s->next) n++;
-  Sym **unused = arena_alloc((size_t)(n + 1) * sizeof *unused);
-  n = 0;
-  for (int b = 0; b < NBUCKETS; b++)
+  for (int b = 0; b < cx->nbuckets; b++)
     for (Sym *s = cx->buckets[b]; s; s = s->next)
       if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_VALUES || s->kind == SYM_PARAM)) unused[n++] = s;
   qsort(unused, (size_t)n, sizeof *unused, by_location);
@@ -644,8 +653,8 @@ static void warn_unused(Ctx *cx) {
 
 // Analyse the statements of a model. Returns NULL if any error was reported.
 Model *analyse(const char *file, Stmt *prog) {
-  Ctx *cx = calloc(1, sizeof *cx);
-  if (!cx) internal_error("out of memory");
+  Ctx *cx = xcalloc(1, sizeof *cx);
+  grow_table(cx);
   Model *mod = arena_alloc(sizeof *mod);
   mod->file = file;
   cx->mod = mod;
@@ -655,6 +664,7 @@ Model *analyse(const char *file, Stmt *prog) {
   int stmt = 0;
   for (Stmt *st = prog; st && !diag_too_many(); st = st->next, stmt++) {
     cx->stmt = stmt;
+    cx->d->where = st->loc;
     switch (st->kind) {
     case S_VARIABLES: declare_variables(cx, st); break;
     case S_DEF: define_value(cx, st); break;
@@ -663,6 +673,7 @@ Model *analyse(const char *file, Stmt *prog) {
       if (once(&cx->pot, NULL, st, stmt, "U")) {
         int n = lower(cx, st->expr);
         if (n >= 0) mod->U = n;
+        mod->U_loc = st->loc;
       }
       break;
     case S_CONSTRAINTS: add_constraints(cx, st); break;
@@ -681,6 +692,9 @@ Model *analyse(const char *file, Stmt *prog) {
   mod->g = cx->g.v;
   mod->g_loc = arena_alloc((size_t)(mod->nu + 1) * sizeof(Loc));
   for (int a = 0; a < mod->nu; a++) mod->g_loc[a] = (Loc){cx->g_line.v[a], cx->g_col.v[a]};
+  if (mod->m > 0 && mod->nu > mod->m && !diag_error_count())
+    error_at(mod->g_loc[mod->m], "more constraints than coordinates: constraint %d of %d, with %d coordinate%s (the "
+             "constraints cannot be independent)", mod->m + 1, mod->nu, mod->m, mod->m == 1 ? "" : "s");
   mod->coord_names = cx->names;
   mod->params = cx->params;
   mod->nparams = cx->nparams;

@@ -114,19 +114,12 @@ static int intern(Dag *d, Node proto) {
     if (same_node(&d->nodes[d->table[h]], &proto)) return d->table[h];
     h = (h + 1) & (uint64_t)(d->tcap - 1);
   }
-  if (d->n >= MAX_NODES) {
-    fprintf(stderr, "hbvmgen: error: the model needs more than %d expression nodes\n", MAX_NODES);
-    exit(1);
-  }
-  if (d->n == d->cap) {
-    Node *nodes = arena_alloc((size_t)d->cap * 2 * sizeof(Node));
-    memcpy(nodes, d->nodes, (size_t)d->n * sizeof(Node));
-    d->nodes = nodes;
-    d->cap *= 2;
-  }
+  if (d->n >= MAX_NODES)
+    fatal_at(d->where, "the model needs more than %d expression nodes%s", MAX_NODES,
+             d->where.line ? " (the limit was reached building this statement)" : "");
+  VEC_RESERVE(d->nodes, d->n, d->cap, d->n + 1);
   proto.flags = (unsigned char)((proto.a >= 0 ? d->nodes[proto.a].flags : 0) |
-                                (proto.b >= 0 ? d->nodes[proto.b].flags : 0) |
-                                (proto.op == OP_INPUT ? DEP_INPUT : 0) | (proto.op == OP_PARAM ? DEP_PARAM : 0));
+                                (proto.b >= 0 ? d->nodes[proto.b].flags : 0) | (proto.op == OP_INPUT ? DEP_INPUT : 0));
   proto.deg = node_degree(d, &proto);
   int id = d->n++;
   d->nodes[id] = proto;
@@ -302,13 +295,7 @@ int dag_neg(Dag *d, int a) { return dag_op(d, OP_NEG, a, -1); }
 // Start a labelled section: nodes created from now on belong to it (for
 // the comments of the emitted code).
 void dag_section(Dag *d, const char *label) {
-  if (d->nlabels == d->labcap) {
-    int cap = d->labcap ? 2 * d->labcap : 16;
-    const char **labels = arena_alloc((size_t)cap * sizeof *labels);
-    if (d->nlabels) memcpy(labels, d->labels, (size_t)d->nlabels * sizeof *labels);
-    d->labels = labels;
-    d->labcap = cap;
-  }
+  VEC_RESERVE(d->labels, d->nlabels, d->labcap, d->nlabels + 1);
   intvec_push(&d->marks, d->n);
   d->labels[d->nlabels++] = label;
 }
@@ -339,9 +326,8 @@ void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inp
   for (int i = 0; i < nroots; i++)
     if (roots[i] > top) top = roots[i];
   if (top < 0) return;
-  double *v = malloc((size_t)(top + 1) * sizeof *v);
-  unsigned char *mark = calloc((size_t)top + 1, 1);
-  if (!v || !mark) internal_error("out of memory in dag_eval");
+  double *v = xmalloc((size_t)(top + 1) * sizeof *v);
+  unsigned char *mark = xcalloc((size_t)top + 1, 1);
   dag_reach(d, roots, nroots, mark);
   for (int id = 0; id <= top; id++) {
     if (!mark[id]) continue;
@@ -371,9 +357,8 @@ void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, i
   for (int i = 0; i < nroots; i++)
     if (roots[i] > top) top = roots[i];
   if (top < 0) return;
-  unsigned char *mark = calloc((size_t)top + 1, 1);
-  int *img = malloc((size_t)(top + 1) * sizeof *img);
-  if (!mark || !img) internal_error("out of memory in dag_subst");
+  unsigned char *mark = xcalloc((size_t)top + 1, 1);
+  int *img = xmalloc((size_t)(top + 1) * sizeof *img);
   dag_reach(d, roots, nroots, mark);
   for (int id = 0; id <= top; id++) {
     if (!mark[id]) continue;

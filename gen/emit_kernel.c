@@ -315,9 +315,8 @@ static int split_parts(Emitter *e, const int *ops, int nops) {
 // ops[] (ops in DAG order), and the kernel calling them in order.
 static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, const int *outs, int nouts, int top) {
   int nparts = (nops + PART_NODES - 1) / PART_NODES;
-  e->chunk = malloc((size_t)(top + 1) * sizeof(int));
-  e->slot = malloc((size_t)(top + 1) * sizeof(int));
-  if (!e->chunk || !e->slot) internal_error("out of memory");
+  e->chunk = xmalloc((size_t)(top + 1) * sizeof(int));
+  e->slot = xmalloc((size_t)(top + 1) * sizeof(int));
   for (int id = 0; id <= top; id++) {
     e->chunk[id] = nparts - 1;
     e->slot[id] = -1;
@@ -352,15 +351,13 @@ void emit_kernel(Emitter *e, KernelId id) {
   const Kernel *k = &e->st->kern[id];
   const Dag *d = e->mod->dag;
   int nouts = kernel_size(k), top = -1, nops = 0;
-  int *outs = malloc((size_t)(nouts + 1) * sizeof(int));
-  if (!outs) internal_error("out of memory");
+  int *outs = xmalloc((size_t)(nouts + 1) * sizeof(int));
   for (int b = 0; b < k->nout; b++)
     memcpy(outs + k->out[b].first, k->out[b].nodes, (size_t)k->out[b].len * sizeof(int));
   for (int i = 0; i < nouts; i++)
     if (outs[i] > top) top = outs[i];
-  unsigned char *mark = calloc((size_t)top + 2, 1);
-  int *ops = malloc((size_t)(top + 2) * sizeof(int));
-  if (!mark || !ops) internal_error("out of memory");
+  unsigned char *mark = xcalloc((size_t)top + 2, 1);
+  int *ops = xmalloc((size_t)(top + 2) * sizeof(int));
   dag_reach(d, outs, nouts, mark);
   for (int i = 0; i <= top; i++)
     if (mark[i] && d->nodes[i].a >= 0) ops[nops++] = i;

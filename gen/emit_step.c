@@ -335,8 +335,7 @@ static void emit_step(Emitter *e) {
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0};
-  e.temp = malloc((size_t)mod->dag->n * sizeof(int));
-  if (!e.temp) internal_error("out of memory");
+  e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;
   emit_prelude(&e, o);

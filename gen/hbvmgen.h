@@ -6,11 +6,18 @@
  *   dag.c               hash-consed expression DAG: CSE, folding, degrees
  *   ad.c                reverse-mode gradients and Jacobians on the DAG
  *   mass.c              the mass matrix: SPD check and structure of M^-1
+ *   model.c             gradient of U, Jacobian of g, checks of q0 and p0
  *   method.c            HBVM(k,s) constants and the choice of k
- *   step.c              the step of the method, built as one more DAG
- *   emit.c, emit_main.c C text for NAME.h / NAME.c / NAME_main.c
+ *   step.c              the step of the method, built as one more DAG (step.h):
+ *     step_const.c      the multiplier family of the paper (constant over a step)
+ *     step_poly.c       the order-2s family (polynomial multiplier, projection)
+ *     lu.c              linear systems of DAG nodes, factored at generation time
+ *   emit_kernel.c       C text of the kernels: straight-line code from the DAG (emit.h)
+ *   emit_step.c         C text of NAME.h / NAME.c around them: types, step templates
+ *   emit_main.c         C text of NAME_main.c, the standalone driver
  *   main.c              the command line
- * util.c holds the arena and the diagnostics every pass uses. */
+ * util.c holds the arena, growable arrays, the fatal-error path and the
+ * diagnostics every pass uses. */
 #ifndef HBVMGEN_H
 #define HBVMGEN_H
 
@@ -19,7 +26,7 @@
 
 #define HBVMGEN_VERSION "0.1.0"
 
-/* ---- util.c: arena, growable arrays, diagnostics ---- */
+/* ---- util.c: arena, growable arrays, dying, diagnostics ---- */
 
 typedef struct {
   int line, col;
@@ -29,20 +36,36 @@ void *arena_alloc(size_t size);          /* zeroed; dies cleanly on exhaustion *
 char *arena_strndup(const char *s, size_t n);
 void arena_free_all(void);
 
-/* A growable array of ints living in the arena. */
+/* The one growable array: v, n in use, cap allocated, in the arena. */
+void *vec_reserve(void *v, int n, int *cap, long need, size_t elem);
+#define VEC_RESERVE(v, n, cap, need) ((v) = vec_reserve((v), (n), &(cap), (need), sizeof *(v)))
+
 typedef struct {
   int *v;
   int n, cap;
 } IntVec;
 void intvec_push(IntVec *vec, int x);
 
+void *xmalloc(size_t size);              /* malloc, calloc, realloc that die cleanly */
+void *xcalloc(size_t n, size_t size);
+void *xrealloc(void *p, size_t size);
+
+/* The generator's one exit path on a failure: an error (at loc when it has a
+ * line), "out of memory", or an internal error (abort). */
+void fatal_at(Loc loc, const char *fmt, ...);
+void out_of_memory(void);
+void internal_error(const char *fmt, ...);
+#define ASSERT(c) ((c) ? (void)0 : internal_error("%s:%d: %s", __FILE__, __LINE__, #c))
+
+const char *c_name_problem(const char *name); /* why name cannot be a C identifier here, or NULL */
+
 void diag_begin(const char *file, const char *src, size_t len);
 void error_at(Loc loc, const char *fmt, ...);
 void warning_at(Loc loc, const char *fmt, ...);
+void diag_end(void);                     /* prints the counts of warnings not shown */
 int diag_error_count(void);
 int diag_too_many(void);                 /* true once the error cap is hit */
-void internal_error(const char *fmt, ...);
-#define ASSERT(c) ((c) ? (void)0 : internal_error("%s:%d: %s", __FILE__, __LINE__, #c))
+long diag_scanned(void);                 /* bytes read to index lines (for tests) */
 
 /* ---- parser.y / lexer.l: the syntax tree ---- */
 
@@ -100,7 +123,7 @@ struct Stmt {
 
 Ast *ast_new(AstKind kind, Loc loc, Ast *a, Ast *b, Ast *c);
 void ast_set_args(Ast *n, Ast *args);
-Stmt *parse_model(const char *src, size_t len);   /* NULL only on a fatal error */
+Stmt *parse_model(const char *src, size_t len);   /* NULL for no statements; check diag_error_count() */
 
 /* ---- dag.c: the expression DAG ---- */
 
@@ -146,8 +169,8 @@ int op_arity(Op op);
 const char *op_cfun(Op op);
 const char *op_name(Op op);
 
-/* Node flags: what a node depends on. */
-enum { DEP_INPUT = 1, DEP_PARAM = 2 };
+/* Node flags: whether a node depends on a coordinate. */
+enum { DEP_INPUT = 1 };
 
 #define DEG_NONPOLY (-1)
 
@@ -168,6 +191,7 @@ typedef struct {
   int *table;          /* open-addressing hash of node ids, -1 empty */
   int zero;            /* the constant 0 */
   int tcap;
+  Loc where;           /* what is being built, where the node limit is reported */
   IntVec marks;        /* section labels for the emitter: (first id, label index) */
   const char **labels;
   int nlabels, labcap;
@@ -251,7 +275,7 @@ typedef struct {
   double *minv;               /* m*m row-major inverse mass (dense only), else NULL */
   double *minv_diag;          /* m entries of diag(M^-1) */
   double *q0, *p0;            /* m each */
-  Loc q0_loc, p0_loc, stmt_loc_end;
+  Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
   int degU, degg;             /* DEG_NONPOLY or degree; degg = 0 without constraints */
 } Model;
 

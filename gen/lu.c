@@ -38,9 +38,8 @@ static void lu_solve(Dag *d, int *A, int *r, int n, int *x, int *pivot) {
 // structural pattern; ties go to the lower index, so an already banded
 // order, like a chain's, is kept. perm[k] is the k-th row/column eliminated.
 static void min_degree_order(const Dag *d, const int *A, int n, int *perm) {
-  unsigned char *adj = calloc((size_t)n * (size_t)n, 1), *done = calloc((size_t)n, 1);
-  int *deg = calloc((size_t)n, sizeof(int));
-  if (!adj || !done || !deg) internal_error("out of memory in min_degree_order");
+  unsigned char *adj = xcalloc((size_t)n * (size_t)n, 1), *done = xcalloc((size_t)n, 1);
+  int *deg = xcalloc((size_t)n, sizeof(int));
   for (int a = 0; a < n; a++)
     for (int c = 0; c < n; c++)
       if (a != c && (!dag_is_zero(d, A[a * n + c]) || !dag_is_zero(d, A[c * n + a]))) adj[a * n + c] = 1;

@@ -3,17 +3,28 @@
  * Reads the model, runs the passes in order (parse, analyse, differentiate,
  * choose k, build the step, emit) and writes NAME.h, NAME.c and optionally
  * NAME_main.c. Files are written under temporary names and renamed only
- * when everything succeeded, so an error never leaves a partial output. */
+ * when everything succeeded, so an error never leaves a partial output
+ * (see "writing the output" below). */
 #define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* flock */
 #include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "hbvmgen.h"
 
 #define MAX_MODEL_BYTES (64L << 20)
 #define MAX_S 20
 #define MAX_K 200
+#ifndef PATH_MAX
+#define PATH_MAX 4096
+#endif
 
 static const char usage[] =
     "usage: hbvmgen [options] MODEL.ham\n"
@@ -70,6 +81,26 @@ static int parse_count(const char *s, int lo, int hi, int *out) {
   return 0;
 }
 
+// Whether name cannot prefix the emitted symbols (said why, with the model
+// file it comes from when it was not given with -n).
+static int bad_name(const char *name, const char *file) {
+  int ok = ((name[0] | 32) >= 'a' && (name[0] | 32) <= 'z') || name[0] == '_';
+  for (const char *p = name; *p; p++)
+    ok &= *p == '_' || (*p >= '0' && *p <= '9') || ((*p | 32) >= 'a' && (*p | 32) <= 'z');
+  const char *why = !ok ? "is not a C identifier"
+                    : name[0] == '_' ? "starts with '_' (such names are reserved in C)"
+                    : !strcmp(name, "hbvmrt") || !strncmp(name, "hbvmrt_", 7) ? "is the prefix of the driver library"
+                    : c_name_problem(name) ? c_name_problem(name) : NULL;
+  if (!why) return 0;
+  if (file)
+    fprintf(stderr, "hbvmgen: error: the file name '%s' gives the C prefix '%s', which %s%s; pass -n NAME\n", file, name,
+            ok && name[0] != '_' && strncmp(name, "hbvmrt", 6) ? "is " : "", why);
+  else
+    fprintf(stderr, "hbvmgen: error: -n needs a C prefix, but '%s' %s%s\n", name,
+            ok && name[0] != '_' && strncmp(name, "hbvmrt", 6) ? "is " : "", why);
+  return 1;
+}
+
 // Parse argv into o. Returns -1 to exit 0 (help, version), 1 on a usage
 // error (already reported), 0 to go on.
 static int parse_args(int argc, char **argv, Options *o) {
@@ -124,12 +155,7 @@ static int parse_args(int argc, char **argv, Options *o) {
     snprintf(buf, sizeof buf, "k=%d < s=%d", o->k, o->s);
     return fail("-k must be at least -s (%s)", buf);
   }
-  if (o->name) {
-    int ok = o->name[0] == '_' || ((o->name[0] | 32) >= 'a' && (o->name[0] | 32) <= 'z');
-    for (const char *p = o->name; *p; p++)
-      ok &= *p == '_' || (*p >= '0' && *p <= '9') || ((*p | 32) >= 'a' && (*p | 32) <= 'z');
-    if (!ok) return fail("-n needs a C identifier, got '%s'", o->name);
-  }
+  if (o->name && bad_name(o->name, NULL)) return 1;
   return 0;
 }
 
@@ -140,9 +166,10 @@ static const char *default_name(const char *path) {
   base = base ? base + 1 : path;
   size_t n = strlen(base);
   if (n > 4 && !strcmp(base + n - 4, ".ham")) n -= 4;
-  char *name = arena_alloc(n + 2);
+  char *name = arena_alloc(n + 6);
   size_t j = 0;
-  if (n == 0 || (base[0] >= '0' && base[0] <= '9')) name[j++] = '_';
+  if (n == 0) strcpy(name, "model"), j = 5;
+  else if (base[0] >= '0' && base[0] <= '9') name[j++] = 'm';
   for (size_t i = 0; i < n; i++) {
     char c = base[i];
     int ok = c == '_' || (c >= '0' && c <= '9') || ((c | 32) >= 'a' && (c | 32) <= 'z');
@@ -168,9 +195,7 @@ static char *read_file(const char *path, size_t *len) {
         fclose(f);
         return NULL;
       }
-      char *nb = realloc(buf, cap);
-      if (!nb) internal_error("out of memory reading the model");
-      buf = nb;
+      buf = xrealloc(buf, cap);
     }
     size_t got = fread(buf + n, 1, cap - n, f);
     n += got;
@@ -228,54 +253,227 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   for (int i = 0; i < mod->nparams; i++) printf("param %s = %.17g\n", mod->params[i].name, mod->params[i].value);
 }
 
-// Open DIR/NAME+suffix under a temporary name.
-static FILE *open_tmp(const Options *o, const char *suffix, char *tmp, char *final, size_t size) {
-  snprintf(final, size, "%s/%s%s", o->outdir, o->name, suffix);
-  snprintf(tmp, size, "%s/.%s%s.tmp", o->outdir, o->name, suffix);
-  FILE *f = fopen(tmp, "w");
-  if (!f) fprintf(stderr, "hbvmgen: error: cannot write '%s': %s\n", tmp, strerror(errno));
-  return f;
+/* ---- writing the output ----
+ *
+ * Each file is first written to a temporary DIR/.NAME.h.XXXXXX created by
+ * mkstemp (exclusively, with an unpredictable name: a planted symlink is
+ * never followed). Only when all are complete are they renamed into place,
+ * under an exclusive lock on DIR so that two runs cannot interleave; an
+ * existing file is first moved to a backup, and if any rename fails, the
+ * files already replaced are put back, so DIR holds either the old set or
+ * the new one, never a mix. Every temporary is registered and removed on
+ * every exit path (atexit covers the fatal ones). Messages name the user's
+ * paths, never a temporary. */
+
+enum { H, C, MAIN, NFILES };
+
+static char *tmp_path[2 * NFILES]; /* temporaries and backups to remove at exit */
+
+static void remove_temporaries(void) {
+  for (int i = 0; i < 2 * NFILES; i++)
+    if (tmp_path[i]) {
+      unlink(tmp_path[i]);
+      free(tmp_path[i]);
+      tmp_path[i] = NULL;
+    }
+}
+
+// Keep path (a temporary that is no longer ours to remove).
+static void forget(int slot) {
+  free(tmp_path[slot]);
+  tmp_path[slot] = NULL;
+}
+
+// DIR/NAME+suffix, or NULL after an error naming it when it (or its
+// temporary, 8 bytes longer) would be longer than the system allows.
+static char *output_path(const char *dir, const char *name, const char *suffix) {
+  size_t n = strlen(dir) + 1 + strlen(name) + strlen(suffix);
+  char *p = xmalloc(n + 1);
+  snprintf(p, n + 1, "%s/%s%s", dir, name, suffix);
+  if (n + 8 >= PATH_MAX) {
+    fprintf(stderr, "hbvmgen: error: cannot write '%s': the path is too long (%zu bytes, at most %d)\n", p, n,
+            PATH_MAX - 9);
+    free(p);
+    return NULL;
+  }
+  return p;
+}
+
+// mkdir -p dir. Returns 0, or 1 after an error naming dir.
+static int make_dir(const char *dir) {
+  char *path = xmalloc(strlen(dir) + 1);
+  strcpy(path, dir);
+  int rc = 0;
+  for (char *p = path + (path[0] == '/');; p++) {
+    if (*p != '/' && *p) continue;
+    char saved = *p;
+    *p = '\0';
+    if (mkdir(path, 0777) && errno != EEXIST) {
+      fprintf(stderr, "hbvmgen: error: cannot create the output directory '%s'%s%s%s: %s\n", dir,
+              saved ? " ('" : "", saved ? path : "", saved ? "')" : "", strerror(errno));
+      rc = 1;
+      break;
+    }
+    *p = saved;
+    if (!saved) break;
+  }
+  struct stat st;
+  if (!rc && stat(dir, &st)) {
+    fprintf(stderr, "hbvmgen: error: cannot use the output directory '%s': %s\n", dir, strerror(errno));
+    rc = 1;
+  } else if (!rc && !S_ISDIR(st.st_mode)) {
+    fprintf(stderr, "hbvmgen: error: the output directory '%s' is not a directory\n", dir);
+    rc = 1;
+  }
+  free(path);
+  return rc;
+}
+
+// A new empty file DIR/.NAME+suffix.XXXXXX beside final, registered in
+// slot. Returns its descriptor, or -1 after an error naming final.
+static int make_temporary(const char *dir, const char *name, const char *suffix, const char *final, int slot) {
+  size_t n = strlen(dir) + strlen(name) + strlen(suffix) + 10;
+  char *path = xmalloc(n);
+  snprintf(path, n, "%s/.%s%s.XXXXXX", dir, name, suffix);
+  int fd = mkstemp(path);
+  if (fd < 0) {
+    fprintf(stderr, "hbvmgen: error: cannot write '%s': %s\n", final, strerror(errno));
+    free(path);
+    return -1;
+  }
+  tmp_path[slot] = path;
+  return fd;
+}
+
+// Move each of the n new files tmp_path[i] to final[i], backing up what was
+// there; on a failure put everything back. Returns 0; 1 when nothing was
+// changed; 2 when the old files could not all be restored (said how).
+static int install(const char *dir, const char *name, char *const *final, const char *const *suffix, int n) {
+  struct stat st;
+  int dfd = open(dir, O_RDONLY);
+  if (dfd >= 0) flock(dfd, LOCK_EX); /* serialises concurrent runs into dir */
+  int placed = 0, rc = 0;
+  char *bak[NFILES] = {NULL, NULL, NULL};
+  for (; placed < n; placed++) {
+    if (!lstat(final[placed], &st)) {
+      if (S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "hbvmgen: error: cannot write '%s': it is a directory\n", final[placed]);
+        rc = 1;
+        break;
+      }
+      int fd = make_temporary(dir, name, suffix[placed], final[placed], NFILES + placed);
+      if (fd < 0) {
+        rc = 1;
+        break;
+      }
+      close(fd);
+      if (rename(final[placed], tmp_path[NFILES + placed])) {
+        fprintf(stderr, "hbvmgen: error: cannot replace '%s': %s\n", final[placed], strerror(errno));
+        rc = 1;
+        break;
+      }
+      bak[placed] = tmp_path[NFILES + placed];
+      tmp_path[NFILES + placed] = NULL; /* the user's file now: removed only once replaced */
+    }
+    if (rename(tmp_path[placed], final[placed])) {
+      fprintf(stderr, "hbvmgen: error: cannot write '%s': %s\n", final[placed], strerror(errno));
+      rc = 1;
+      placed++; /* its backup, if any, is restored below */
+      break;
+    }
+    forget(placed);
+  }
+  for (int i = placed - 1; rc && i >= 0; i--) { /* put back what was there, newest first */
+    if (tmp_path[i] && !bak[i]) continue; /* never placed, nothing moved */
+    if (bak[i] ? rename(bak[i], final[i]) : unlink(final[i])) {
+      fprintf(stderr, "hbvmgen: error: cannot restore '%s'%s%s%s: %s\n", final[i],
+              bak[i] ? " (the old file is kept as '" : "", bak[i] ? bak[i] : "", bak[i] ? "')" : "", strerror(errno));
+      rc = 2;
+    }
+    free(bak[i]);
+    bak[i] = NULL;
+  }
+  for (int i = 0; i < NFILES; i++)
+    if (bak[i]) {
+      unlink(bak[i]);
+      free(bak[i]);
+    }
+  if (dfd >= 0) close(dfd); /* releases the lock */
+  return rc;
 }
 
 // Emit the solver files; all or nothing.
 static int write_outputs(const Options *o, const Model *mod, const Method *me, const Step *st) {
-  enum { H, C, MAIN, NFILES };
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
-  char tmp[NFILES][4096], final[NFILES][4096];
+  char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
-  int nfiles = o->emit_main ? 3 : 2, rc = 0;
+  int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
                     !o->plain_sum, o->wide_step};
-  for (int i = 0; i < nfiles && !rc; i++)
-    if (!(f[i] = open_tmp(o, suffix[i], tmp[i], final[i], sizeof tmp[i]))) rc = 1;
-  if (!rc) rc = emit_solver(f[H], f[C], mod, me, st, &eo) != 0;
-  if (!rc && o->emit_main) rc = emit_driver(f[MAIN], mod, me, &eo) != 0;
-  for (int i = 0; i < nfiles; i++)
-    if (f[i] && fclose(f[i])) rc = 1;
-  for (int i = 0; i < nfiles; i++) {
-    if (!f[i]) continue;
-    if (rc) remove(tmp[i]);
-    else if (rename(tmp[i], final[i])) {
+  atexit(remove_temporaries);
+  mode_t mask = umask(0);
+  umask(mask);
+  for (int i = 0; i < nfiles && !rc; i++) {
+    int fd = -1;
+    if (!(final[i] = output_path(o->outdir, o->name, suffix[i])) ||
+        (fd = make_temporary(o->outdir, o->name, suffix[i], final[i], i)) < 0) {
+      rc = 1;
+    } else if (fchmod(fd, 0666 & ~mask) || !(f[i] = fdopen(fd, "w"))) {
       fprintf(stderr, "hbvmgen: error: cannot write '%s': %s\n", final[i], strerror(errno));
+      close(fd);
       rc = 1;
     }
   }
-  if (rc) fprintf(stderr, "hbvmgen: error: writing the output failed; nothing was written\n");
-  return rc;
+  int emitted = rc ? 0 : emit_solver(f[H], f[C], mod, me, st, &eo) == 0;
+  if (emitted && o->emit_main) emitted = emit_driver(f[MAIN], mod, me, &eo) == 0;
+  for (int i = 0; i < nfiles; i++) {
+    if (!f[i]) continue;
+    int bad = ferror(f[i]), err = errno;
+    if (fclose(f[i])) bad = 1, err = errno;
+    if (bad && !rc) {
+      fprintf(stderr, "hbvmgen: error: cannot write '%s': %s\n", final[i], strerror(err));
+      rc = 1;
+    }
+  }
+  if (!rc && !emitted) {
+    fprintf(stderr, "hbvmgen: error: cannot write the output\n");
+    rc = 1;
+  }
+  if (!rc) rc = install(o->outdir, o->name, final, suffix, nfiles);
+  remove_temporaries();
+  for (int i = 0; i < nfiles; i++) free(final[i]);
+  if (rc == 1) fprintf(stderr, "hbvmgen: error: writing the output failed; no file in '%s' was changed\n", o->outdir);
+  return rc != 0;
+}
+
+// Report that the degree of U or of a constraint needs k > MAX_K, at the
+// statement (U) or list element (g) that has it.
+static void report_degree(const Model *mod, int s, int k) {
+  const char *why;
+  int best = -1;
+  if (mod->degU == DEG_NONPOLY || method_auto_k(s, mod->degU, 0, &why) <= MAX_K)
+    for (int a = 0; a < mod->nu; a++)
+      if (best < 0 || mod->dag->nodes[mod->g[a]].deg > mod->dag->nodes[mod->g[best]].deg) best = a;
+  error_at(best < 0 ? mod->U_loc : mod->g_loc[best],
+           "%s has degree %d: the quadrature exact for it needs k=%d > %d Gauss nodes; pass -k",
+           best < 0 ? "U" : "this constraint", best < 0 ? mod->degU : mod->degg, k, MAX_K);
 }
 
 int main(int argc, char **argv) {
   Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
-  if (!o.name) o.name = default_name(o.model);
+  if (!o.name && bad_name(o.name = default_name(o.model), o.model)) return 1;
+  signal(SIGXFSZ, SIG_IGN); /* past ulimit -f, a write fails (and is reported) instead of killing us */
   size_t len;
   char *src = read_file(o.model, &len);
   if (!src) return 1;
-  diag_begin(o.model, src, len);
-  Stmt *prog = parse_model(src, len);
+  size_t bom = len >= 3 && !memcmp(src, "\xef\xbb\xbf", 3) ? 3 : 0; /* a UTF-8 byte-order mark */
+  diag_begin(o.model, src + bom, len - bom);
+  Stmt *prog = parse_model(src + bom, len - bom);
   Model *mod = diag_error_count() ? NULL : analyse(o.model, prog);
   if (!mod) {
+    diag_end();
     free(src);
     arena_free_all();
     return 1;
@@ -286,7 +484,7 @@ int main(int argc, char **argv) {
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, &why);
   MultFamily fam = o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 && mod->nu ? MULT_POLY : MULT_CONST;
   if (k > MAX_K) {
-    fprintf(stderr, "hbvmgen: error: the degrees of U and g need k=%d > %d nodes; pass -k\n", k, MAX_K);
+    report_degree(mod, o.s, k);
     rc = 1;
   } else if (o.check_only) {
     print_check(mod, &o, k, why, fam);
@@ -295,6 +493,7 @@ int main(int argc, char **argv) {
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }
+  diag_end();
   free(src);
   arena_free_all();
   return rc;

@@ -16,10 +16,14 @@ void model_differentiate(Model *mod) {
   int m = mod->m;
   mod->gradU = arena_alloc((size_t)m * sizeof(int));
   dag_section(d, "gradient of U");
+  d->where = mod->U_loc;
   ad_gradient(d, mod->U, m, mod->gradU);
   mod->jac = arena_alloc((size_t)(mod->nu + 1) * sizeof(SparseVec));
   if (mod->nu) dag_section(d, "Jacobian of g");
-  for (int a = 0; a < mod->nu; a++) ad_gradient_sparse(d, mod->g[a], m, &mod->jac[a]);
+  for (int a = 0; a < mod->nu; a++) {
+    d->where = mod->g_loc[a];
+    ad_gradient_sparse(d, mod->g[a], m, &mod->jac[a]);
+  }
 }
 
 static double *param_defaults(const Model *mod) {
@@ -37,8 +41,7 @@ static double *param_defaults(const Model *mod) {
 static void check_rank(const Model *mod, const double *jac) {
   int m = mod->m, nu = mod->nu;
   if (nu == 0 || (double)m * nu * nu > RANK_WORK_MAX) return;
-  double *basis = malloc((size_t)m * nu * sizeof *basis), *v = malloc((size_t)m * sizeof *v);
-  if (!basis || !v) internal_error("out of memory");
+  double *basis = xmalloc((size_t)m * nu * sizeof *basis), *v = xmalloc((size_t)m * sizeof *v);
   for (int a = 0, r = 0, rank = 0; a < nu; a++) {
     double norm = 0;
     for (int i = 0; i < m; i++) v[i] = 0;
@@ -80,9 +83,8 @@ void model_check_initial(const Model *mod) {
   int m = mod->m, nu = mod->nu, nroots = 1 + nu;
   for (int a = 0; a < nu; a++) nroots += mod->jac[a].n;
   /* U, g and the Jacobian's entries at q0, all in one evaluation */
-  int *roots = malloc((size_t)nroots * sizeof *roots);
-  double *val = malloc((size_t)nroots * sizeof *val), *v = malloc((size_t)m * sizeof *v);
-  if (!roots || !val || !v) internal_error("out of memory");
+  int *roots = xmalloc((size_t)nroots * sizeof *roots);
+  double *val = xmalloc((size_t)nroots * sizeof *val), *v = xmalloc((size_t)m * sizeof *v);
   roots[0] = mod->U;
   for (int a = 0, r = 1 + nu; a < nu; a++) {
     roots[1 + a] = mod->g[a];

@@ -324,13 +324,12 @@ static int yyreport_syntax_error(const yypcontext_t *ctx, yyscan_t scanner, Pars
   return 0;
 }
 
-/* Parse src (len bytes, may contain NUL) into a statement list. Syntax
- * errors are reported and parsing goes on where it can; the caller checks
- * diag_error_count(). */
+/* Parse src (len bytes, may contain NUL) into a statement list, NULL when
+ * there is none. Syntax errors are reported and parsing goes on where it
+ * can; the caller checks diag_error_count(). */
 Stmt *parse_model(const char *src, size_t len) {
   yyscan_t scanner;
-  ParseState *ps = calloc(1, sizeof *ps);
-  if (!ps) internal_error("out of memory");
+  ParseState *ps = xcalloc(1, sizeof *ps);
   ps->end = (Loc){1, 1};
   if (yylex_init_extra(ps, &scanner)) internal_error("cannot start the lexer");
   YY_BUFFER_STATE buf = yy_scan_bytes(src, (int)len, scanner);

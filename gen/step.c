@@ -22,7 +22,7 @@
 
 #include "step.h"
 
-#define MAX_DENSE_NU 4096
+#define MAX_POLY_COEFS 4096 /* s nu: the polynomial multiplier's (s nu)^2 matrix */
 
 int *step_nodes(int n) { return arena_alloc((size_t)(n > 0 ? n : 1) * sizeof(int)); }
 
@@ -386,15 +386,12 @@ static const struct {
 Step *step_build(Model *mod, const Method *me) {
   Step *st = arena_alloc(sizeof *st);
   int m = mod->m, nu = mod->nu, s = me->s;
-  if (nu > MAX_DENSE_NU) {
-    error_at((Loc){0, 0}, "%d constraints: at most %d are supported", nu, MAX_DENSE_NU);
+  if (me->family == MULT_POLY && s * nu > MAX_POLY_COEFS) { /* (the analysis caps nu itself) */
+    error_at(mod->g_loc[0], "%d constraints at s=%d: the polynomial multiplier has at most %d coefficients "
+             "(s nu); pass --multiplier const or a smaller -s", nu, s, MAX_POLY_COEFS);
     return NULL;
   }
-  if (me->family == MULT_POLY && s * nu > MAX_DENSE_NU) {
-    error_at((Loc){0, 0}, "%d constraints at s=%d: the polynomial multiplier has at most %d coefficients; "
-             "pass --multiplier const", nu, s, MAX_DENSE_NU);
-    return NULL;
-  }
+  mod->dag->where = (Loc){0, 0}; /* a node limit hit here is the step's, not a statement's */
   st->m = m;
   st->nu = nu;
   st->s = s;

@@ -208,12 +208,12 @@ END_TEST
  * statements append in order. */
 START_TEST(test_constraints)
 {
-  Model *mod = load("variables x[3]\n"
+  Model *mod = load("variables x[7]\n" /* no more constraints than coordinates */
                     "g = x[1] - 1\n"
                     "g = [x[2] - 2, [x[3] - 3, [x[1] * x[2]]]]\n"
                     "g = [i * x[i]^2 for i in 1..3]\n");
   ck_assert_int_eq(mod->nu, 7);
-  const double q[] = {1, 2, 3};
+  const double q[] = {1, 2, 3, 0, 0, 0, 0};
   const double want[] = {0, 0, 0, 2, 1, 8, 27};
   for (int a = 0; a < 7; a++)
     assert_close(eval(mod, mod->g[a], q), want[a], "g");
@@ -566,6 +566,10 @@ static const char *const bad_options[] = {
     "-k 0 ../models/pendulum.ham",    "-k many ../models/pendulum.ham", "-n 1abc ../models/pendulum.ham",
     "-n a-b ../models/pendulum.ham",  "../models/pendulum.ham -s",     "",
     "../models/pendulum.ham ../models/conical.ham", "no/such/model.ham",
+    /* prefixes the emitted C cannot use: the runtime's, reserved, keywords */
+    "-n hbvmrt ../models/pendulum.ham", "-n hbvmrt_x ../models/pendulum.ham", "-n _MATH ../models/pendulum.ham",
+    "-n _ ../models/pendulum.ham",     "-n _x ../models/pendulum.ham",     "-n int ../models/pendulum.ham",
+    "-n class ../models/pendulum.ham", "-n NAN ../models/pendulum.ham",
 };
 
 START_TEST(test_bad_options)
