@@ -14,6 +14,7 @@ Suite *lean_suite(void);
 Suite *stress_suite(void);
 Suite *docs_suite(void);
 Suite *files_suite(void);
+Suite *poly_suite(void);
 
 int main(void) {
   SRunner *sr = srunner_create(parser_suite());
@@ -28,6 +29,7 @@ int main(void) {
   srunner_add_suite(sr, stress_suite());
   srunner_add_suite(sr, docs_suite());
   srunner_add_suite(sr, files_suite());
+  srunner_add_suite(sr, poly_suite());
   srunner_run_all(sr, CK_NORMAL);
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);
