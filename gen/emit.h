@@ -24,6 +24,7 @@ typedef struct {
   int part;        /* the part being printed */
   int wide_step;   /* --wide-step: the step iterates one precision wider */
   int wide;        /* the kernel being printed computes one precision wider */
+  KernelId kid;    /* the kernel being printed */
 } Emitter;
 
 void out(Emitter *e, const char *fmt, ...);

@@ -22,6 +22,10 @@
  * compilers take time superlinear in a function's size. */
 #define PART_NODES 2000
 
+/* Room for the C name of one value: a temporary, a literal, an input with
+ * its coordinate's name, or prm->NAME. */
+#define NAME_SIZE 1024
+
 void out(Emitter *e, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
@@ -44,9 +48,11 @@ const char *math_suffix(const Emitter *e, int wide) {
 
 
 // The C expression of the total length of blocks[0..n): the sum of their
-// symbolic lengths, equal symbols merged ("S * M + M + 2 * NU"); "" for none.
-static void size_expr(const Slots *blocks, int n, char *buf, size_t size) {
-  static const char *const sym[SZ_COUNT] = {[SZ_SM] = "S * M", [SZ_M] = "M", [SZ_NU] = "NU", [SZ_SNU] = "S * NU"};
+// symbolic lengths in the solver's size macros, equal ones merged
+// ("P_S * P_M + P_M + 2 * P_NU"); "" for none.
+static void size_expr(const char *P, const Slots *blocks, int n, char *buf, size_t size) {
+  static const char *const sym[SZ_COUNT][2] = {[SZ_SM] = {"S", "M"}, [SZ_M] = {"M", NULL}, [SZ_NU] = {"NU", NULL},
+                                               [SZ_SNU] = {"S", "NU"}};
   int coef[SZ_COUNT] = {0}, order[SZ_COUNT], norder = 0;
   for (int i = 0; i < n; i++) {
     if (!blocks[i].coef) continue;
@@ -58,9 +64,11 @@ static void size_expr(const Slots *blocks, int n, char *buf, size_t size) {
   for (int i = 0; i < norder && len < size; i++) {
     int c = coef[order[i]];
     const char *sep = i ? " + " : "";
+    const char *const *y = sym[order[i]];
     if (order[i] == SZ_ONE) len += (size_t)snprintf(buf + len, size - len, "%s%d", sep, c);
-    else if (c == 1) len += (size_t)snprintf(buf + len, size - len, "%s%s", sep, sym[order[i]]);
-    else len += (size_t)snprintf(buf + len, size - len, "%s%d * %s", sep, c, sym[order[i]]);
+    else if (c == 1) len += (size_t)snprintf(buf + len, size - len, "%s%s_%s", sep, P, y[0]);
+    else len += (size_t)snprintf(buf + len, size - len, "%s%d * %s_%s", sep, c, P, y[0]);
+    if (order[i] != SZ_ONE && y[1] && len < size) len += (size_t)snprintf(buf + len, size - len, " * %s_%s", P, y[1]);
   }
 }
 
@@ -86,8 +94,8 @@ static void offset_of(const Emitter *e, const char *text, const char *end, int p
         break;
     if (upto == k->nout) internal_error("template names an unknown result '%.*s'", (int)(end - text), text);
   }
-  char buf[256];
-  size_expr(k->out, upto, buf, sizeof buf);
+  char buf[1024];
+  size_expr(e->P, k->out, upto, buf, sizeof buf);
   if (plus && buf[0]) fprintf(e->f, "%s + ", buf);
   else if (!plus) fputs(buf[0] ? buf : "0", e->f);
 }
@@ -179,8 +187,11 @@ static void name_of(Emitter *e, int id, char *buf, size_t size) {
     for (int i = 0; i < IN_COUNT; i++) {
       const Slots *in = &st->in[i];
       if (n->idx < in->first || n->idx >= in->first + in->len) continue;
+      int i = n->idx - in->first;
       if (in->scalar) snprintf(buf, size, "%s", in->name);
-      else snprintf(buf, size, "%s[%d]", in->name, n->idx - in->first);
+      else if (i < e->mod->m && (in == &st->in[IN_Q0] || in == &st->in[IN_P0])) /* name the coordinate */
+        snprintf(buf, size, "%s[%d] /* %s%s */", in->name, i, in == &st->in[IN_P0] ? "p_" : "", e->mod->coord_names[i]);
+      else snprintf(buf, size, "%s[%d]", in->name, i);
       return;
     }
     internal_error("model coordinate %d reached a kernel", n->idx);
@@ -200,7 +211,7 @@ static void ref(Emitter *e, int id, char *buf, size_t size) {
     name_of(e, id, buf, size);
     return;
   }
-  char leaf[96];
+  char leaf[NAME_SIZE - 16]; /* room for the cast */
   name_of(e, id, leaf, sizeof leaf);
   snprintf(buf, size, "(%s)%s", real_type(e, 1), leaf);
 }
@@ -211,7 +222,7 @@ static int power_expr(char *buf, size_t size, const char *x, double n) {
                                       "(%s * %s) * (%s * %s) * %s", "(%s * %s * %s) * (%s * %s * %s)"};
   if (n != floor(n) || fabs(n) < 2 || fabs(n) > 6) return 0; /* (int) of 1e40 would be undefined */
   int k = (int)fabs(n);
-  char prod[512];
+  char prod[7 * NAME_SIZE];
   snprintf(prod, sizeof prod, forms[k], x, x, x, x, x, x);
   if (n < 0) snprintf(buf, size, "1 / (%s)", prod);
   else snprintf(buf, size, "%s", prod);
@@ -221,7 +232,7 @@ static int power_expr(char *buf, size_t size, const char *x, double n) {
 // One line computing node id into its temporary.
 static void emit_node(Emitter *e, int id) {
   const Node *n = &e->mod->dag->nodes[id];
-  char a[128], b[128], rhs[640];
+  char a[NAME_SIZE], b[NAME_SIZE], rhs[8 * NAME_SIZE];
   ref(e, n->a, a, sizeof a);
   if (n->b >= 0) ref(e, n->b, b, sizeof b);
   switch ((Op)n->op) {
@@ -265,9 +276,17 @@ static void kernel_signature(Emitter *e, const Kernel *k, int part) {
   out(e, " (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
 }
 
+// Whether section sec of the DAG was built for the kernel being printed.
+// Its nodes reused by another kernel (shared subexpressions) are not
+// labelled there, so a label never names what that kernel does not do.
+static int section_here(const Emitter *e, int sec) {
+  const IntVec *own = &e->st->sec_owner;
+  return sec < own->n && ((unsigned)own->v[sec] >> e->kid & 1u);
+}
+
 // Print the operations ops[from..to) of a kernel, one a line, with a comment
-// where a new section of the method starts; values needed by a later part
-// are also stored in w[].
+// where a new section of the method that belongs to it starts; values
+// needed by a later part are also stored in w[].
 static void emit_ops(Emitter *e, const int *ops, int from, int to) {
   const Dag *d = e->mod->dag;
   int sec = -1, shown = -1;
@@ -275,7 +294,7 @@ static void emit_ops(Emitter *e, const int *ops, int from, int to) {
     int id = ops[i];
     while (sec + 1 < d->marks.n && d->marks.v[sec + 1] <= id) sec++;
     if (sec >= 0 && sec != shown) {
-      out(e, "  /* %s */\n", d->labels[sec]);
+      if (section_here(e, sec)) out(e, "  /* %s */\n", d->labels[sec]);
       shown = sec;
     }
     e->temp[id] = i;
@@ -285,11 +304,14 @@ static void emit_ops(Emitter *e, const int *ops, int from, int to) {
 }
 
 // out[i] = outs[i], for the outputs of the part being printed (all of
-// them when the kernel is one part).
-static void emit_outputs(Emitter *e, const int *outs, int nouts) {
-  for (int i = 0; i < nouts; i++) {
+// them when the kernel is one part), each result block under its name.
+static void emit_outputs(Emitter *e, const Kernel *k, const int *outs, int nouts) {
+  for (int i = 0, b = 0; i < nouts; i++) {
     if (e->chunk && e->chunk[outs[i]] != e->part) continue;
-    char r[128];
+    while (b + 1 < k->nout && k->out[b + 1].first <= i) b++;
+    if (i == k->out[b].first || (e->chunk && i > 0 && e->chunk[outs[i - 1]] != e->part))
+      out(e, "  /* %s */\n", k->out[b].name);
+    char r[NAME_SIZE];
     ref(e, outs[i], r, sizeof r);
     out(e, "  out[%d] = %s;\n", i, r);
   }
@@ -326,7 +348,7 @@ static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, co
     kernel_signature(e, k, e->part);
     int from = e->part * PART_NODES, to = from + PART_NODES < nops ? from + PART_NODES : nops;
     emit_ops(e, ops, from, to);
-    emit_outputs(e, outs, nouts); /* those computed in this part (leaves in the last) */
+    emit_outputs(e, k, outs, nouts); /* those computed in this part (leaves in the last) */
     out(e, "}\n\n");
   }
   out(e, "/* %s: the %d parts above in order */\n", k->name, nparts);
@@ -359,6 +381,7 @@ void emit_kernel(Emitter *e, KernelId id) {
   unsigned char *mark = xcalloc((size_t)top + 2, 1);
   int *ops = xmalloc((size_t)(top + 2) * sizeof(int));
   dag_reach(d, outs, nouts, mark);
+  e->kid = id;
   for (int i = 0; i <= top; i++)
     if (mark[i] && d->nodes[i].a >= 0) ops[nops++] = i;
   e->wide = e->wide_step && k->wide;
@@ -369,7 +392,7 @@ void emit_kernel(Emitter *e, KernelId id) {
   } else {
     kernel_signature(e, k, -1);
     emit_ops(e, ops, 0, nops);
-    emit_outputs(e, outs, nouts);
+    emit_outputs(e, k, outs, nouts);
     out(e, "}\n");
   }
   e->wide = 0;

@@ -21,7 +21,7 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, " * HBVM(k=%d, s=%d) for a Hamiltonian system with %d coordinates and %d constraints,\n", e->me->k, s, m, nu);
   out(e, " * in %s precision%s%s. */\n", e->single ? "single" : "double", o->wide_step ? ", the step computed in " : "",
       o->wide_step ? real_type(e, 1) : "");
-  tmpl(e, "#ifndef $P_H\n#define $P_H\n\n");
+  tmpl(e, "#ifndef $P_H\n#define $P_H\n\n#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n");
   out(e, "#define %s_M %d      /* coordinates */\n#define %s_NU %d     /* constraints */\n", e->P, m, e->P, nu);
   out(e, "#define %s_K %d      /* Gauss-Legendre nodes */\n#define %s_S %d      /* polynomial degree */\n", e->P, e->me->k,
       e->P, s);
@@ -60,9 +60,9 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "int $P_step($P_state *x, double h, const $P_params *prm, $P_stats *st);\n"
           "const char *$P_strerror(int code);\n"
           "double $P_energy(const $P_state *x, const $P_params *prm);\n"
-          "void $P_constraints(const $P_state *x, const $P_params *prm, double *g);   /* NU values */\n"
+          "void $P_constraints(const $P_state *x, const $P_params *prm, double *g);   /* $P_NU values */\n"
           "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp);       /* grad g' M^-1 p */\n"
-          "\n#endif\n");
+          "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
 }
 
 /* ---- the source ---- */
@@ -83,18 +83,25 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   out(e, " * HBVM(k=%d, s=%d): line-integral method for Hamiltonian systems with holonomic\n", me->k, me->s);
   tmpl(e, " * constraints (Brugnano, Gurioli, Iavernaro, Weinmueller). Needs only <math.h>. */\n"
           "#include <math.h>\n\n#include \"$P.h\"\n\n"
-          "#define M $P_M\n#define NU $P_NU\n#define S $P_S\n"
-          "#define MAXITER 100  /* fixed-point iterations before giving up */\n");
-  if (e->single)
-    tmpl(e, "#define TOL 2.4e-7f     /* an increment within 2 ulps (float) ... */\n"
-            "#define STAGTOL 1e-4f   /* an increment that stops decreasing above this is divergence */\n"
-            "#define SINGTOL 1e-6f   /* pivot / diagonal of A below this: singular */\n"
-            "#define GTOL 7.6e-6f    /* |g| up to this (64 ulps) is round-off: not corrected */\n\n");
-  else
-    tmpl(e, "#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */\n"
-            "#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */\n"
-            "#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */\n"
-            "#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */\n\n");
+          "#if defined(__FAST_MATH__) && !defined($P_ALLOW_FAST_MATH)\n"
+          "/* -ffast-math would remove the finiteness checks and undo the compensated sums */\n"
+          "#error \"compile without -ffast-math (docs/api.md), or define $P_ALLOW_FAST_MATH\"\n"
+          "#endif\n\n"
+          "/* Limits of the iteration; each can be set with -D (docs/api.md). */\n"
+          "#ifndef $P_MAXITER\n#define $P_MAXITER 100  /* fixed-point iterations before giving up */\n#endif\n");
+  static const char *const limits[2][4][2] = {
+      {{"TOL", "4.4408920985006262e-16  /* an increment within 2 ulps ... */"},
+       {"STAGTOL", "1e-10  /* an increment that stops decreasing above this is divergence */"},
+       {"SINGTOL", "1e-13  /* pivot / diagonal of A below this: singular */"},
+       {"GTOL", "1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */"}},
+      {{"TOL", "2.4e-7f     /* an increment within 2 ulps (float) ... */"},
+       {"STAGTOL", "1e-4f   /* an increment that stops decreasing above this is divergence */"},
+       {"SINGTOL", "1e-6f   /* pivot / diagonal of A below this: singular */"},
+       {"GTOL", "7.6e-6f    /* |g| up to this (64 ulps) is round-off: not corrected */"}}};
+  for (int i = 0; i < 4; i++)
+    out(e, "#ifndef %s_%s\n#define %s_%s %s\n#endif\n", e->P, limits[e->single][i][0], e->P, limits[e->single][i][0],
+        limits[e->single][i][1]);
+  out(e, "\n");
   out(e, "/* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = %d (the kernels below use\n", me->k);
   out(e, " * their products with P_j and int_0^c P_j, folded into the code):\n");
   for (int l = 0; l < me->k; l++) out(e, " *   c_%d = %.17g   b_%d = %.17g\n", l + 1, me->c[l], l + 1, me->b[l]);
@@ -123,17 +130,17 @@ static void emit_public(Emitter *e) {
           "void $P_init($P_state *x, const double *q0, const double *p0)\n{\n"
           "  int i;\n"
           "  x->t = x->tc = x->hprev = 0;\n"
-          "  for (i = 0; i < M; i++) {\n"
+          "  for (i = 0; i < $P_M; i++) {\n"
           "    x->q[i] = q0 ? ($R)q0[i] : $P_q0[i];\n"
           "    x->p[i] = p0 ? ($R)p0[i] : $P_p0[i];\n"
           "    x->qc[i] = x->pc[i] = 0;\n  }\n"
-          "  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;\n"
-          "  for (i = 0; i < S * M; i++) x->gam[i] = 0;\n");
+          "  for (i = 0; i < ($P_NU ? $P_NU : 1); i++) x->lambda[i] = 0;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n");
   if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
   if (e->mod->nu)
-    tmpl(e, "  {\n    $P_params prm;\n    $R lam[NU];\n    $P_params_default(&prm);\n"
+    tmpl(e, "  {\n    $P_params prm;\n    $R lam[$P_NU];\n    $P_params_default(&prm);\n"
             "    $(lambda0 q0=x->q p0=x->p prm=&prm out=lam);\n"
-            "    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;\n  }\n");
+            "    for (i = 0; i < $P_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;\n  }\n");
   tmpl(e, "}\n\n"
           "const char *$P_strerror(int code)\n{\n  switch (code) {\n"
           "  case $P_OK: return \"ok\";\n"
@@ -142,16 +149,16 @@ static void emit_public(Emitter *e) {
           "  case $P_ESINGULAR: return \"singular multiplier system\";\n"
           "  case $P_EBADSTEP: return \"step size zero or not finite\";\n"
           "  }\n  return \"unknown error\";\n}\n\n"
-          "#define DEFAULT_PARAMS(prm) $P_params dflt_; if (!prm) { $P_params_default(&dflt_); prm = &dflt_; }\n\n"
-          "double $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  DEFAULT_PARAMS(prm)\n"
+          "#define $P_DEFAULT_PARAMS(prm) $P_params dflt_; if (!prm) { $P_params_default(&dflt_); prm = &dflt_; }\n\n"
+          "double $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  $(energy_kernel q0=x->q p0=x->p out=&H);\n  return H;\n}\n\n");
   if (e->mod->nu)
     tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, double *g)\n{\n"
-            "  $R v[NU];\n  int i;\n  DEFAULT_PARAMS(prm)\n"
-            "  $(g q0=x->q p0=x->p out=v);\n  for (i = 0; i < NU; i++) g[i] = v[i];\n}\n\n"
+            "  $R v[$P_NU];\n  int i;\n  $P_DEFAULT_PARAMS(prm)\n"
+            "  $(g q0=x->q p0=x->p out=v);\n  for (i = 0; i < $P_NU; i++) g[i] = v[i];\n}\n\n"
             "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp)\n{\n"
-            "  $R v[NU];\n  int i;\n  DEFAULT_PARAMS(prm)\n"
-            "  $(hidden_kernel q0=x->q p0=x->p out=v);\n  for (i = 0; i < NU; i++) gp[i] = v[i];\n}\n");
+            "  $R v[$P_NU];\n  int i;\n  $P_DEFAULT_PARAMS(prm)\n"
+            "  $(hidden_kernel q0=x->q p0=x->p out=v);\n  for (i = 0; i < $P_NU; i++) gp[i] = v[i];\n}\n");
   else
     tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, double *g)\n{\n"
             "  (void)x; (void)prm; (void)g;\n}\n\n"
@@ -165,47 +172,47 @@ static void emit_public(Emitter *e) {
 // of the run, the multiplier consistent with (q1, p1), then the commit.
 static void emit_end_poly(Emitter *e) {
   int wide = e->wide_step;
-  tmpl(e, "  $W q1[M], p1[M], pr[$<project> + 1], K, U1, beta = 1;\n  $R H0, Hn = $P_energy(x, prm);\n");
+  tmpl(e, "  $W q1[$P_M], p1[$P_M], pr[$<project> + 1], K, U1, beta = 1;\n  $R H0, Hn = $P_energy(x, prm);\n");
   if (wide)
-    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+    tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    q1[i] = q0w[i] + h * sw[$[sweep.gam]i];\n    p1[i] = p0w[i] + sw[$[sweep.dp]i];\n  }\n");
   else
-    tmpl(e, "  $R qc1[M], pc1[M];\n"
-            "  for (i = 0; i < M; i++) {\n"
+    tmpl(e, "  $R qc1[$P_M], pc1[$P_M];\n"
+            "  for (i = 0; i < $P_M; i++) {\n"
             "    q1[i] = x->q[i];\n    qc1[i] = x->qc[i];\n    p1[i] = x->p[i];\n    pc1[i] = x->pc[i];\n"
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
   tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
           "  $(project q0=q1 p0=p1 out=pr);\n"
-          "  for (i = 0; i < NU; i++) {\n"
+          "  for (i = 0; i < $P_NU; i++) {\n"
           "    $W piv = pr[$[project.pivot]i], dia = pr[$[project.adiag]i];\n"
-          "    if (isfinite(piv) && isfinite(dia) && !(fabs$g(piv) > SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n"
+          "    if (isfinite(piv) && isfinite(dia) && !(fabs$g(piv) > $P_SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n"
           "  for (i = 0; i < $<project>; i++)\n    if (!isfinite(pr[i])) return $P_ENONFINITE;\n"
           "  /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:\n"
           "   * taken anew on the first step, or when the state or parameters were changed\n"
           "   * since the last step (H(q0, p0) differs from H0 by more than round-off). No\n"
           "   * rescale at rest (K = 0) or where H0 < U(q1). */\n"
           "  K = pr[$[project.kin]0];\n  U1 = pr[$[project.U]0];\n"
-          "  H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * TOL * (K + fabs$g(U1)) ? x->H0 : Hn;\n"
+          "  H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$g(U1)) ? x->H0 : Hn;\n"
           "  if (K > 0 && H0 - U1 > 0) beta = sqrt$g((H0 - U1) / K);\n");
   if (wide)
-    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+    tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    p1[i] = beta * (p1[i] + pr[$[project.dp]i]);\n"
             "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
             "  /* q1, p1 rounded once into q, p; what the rounding lost is the new qc, pc */\n"
-            "  for (i = 0; i < M; i++) {\n    x->q[i] = ($R)q1[i];\n    x->p[i] = ($R)p1[i];\n");
+            "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = ($R)q1[i];\n    x->p[i] = ($R)p1[i];\n");
   else
-    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+    tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    $P_add(&p1[i], &pc1[i], pr[$[project.dp]i] + (beta - 1) * (p1[i] + pr[$[project.dp]i]));\n"
             "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
-            "  for (i = 0; i < M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
+            "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
   tmpl(e, "  }\n"
-          "  for (i = 0; i < S * M; i++) x->gam[i] = ($R)gam[i];\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
           "  x->H0 = H0;\n"
-          "  {\n    $R lam0[NU];\n    $(lambda0 q0=x->q p0=x->p out=lam0);\n"
-          "    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;\n  }\n"
+          "  {\n    $R lam0[$P_NU];\n    $(lambda0 q0=x->q p0=x->p out=lam0);\n"
+          "    for (i = 0; i < $P_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;\n  }\n"
           "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
@@ -219,12 +226,12 @@ static void emit_step(Emitter *e) {
           " * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */\n"
           "static void $P_predict(const $P_state *x, $R h, const $P_params *prm, $R *gam)\n{\n"
           "  int i, j, l, d;\n"
-          "  for (i = 0; i < S * M; i++) gam[i] = 0;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n"
           "  if (x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n"
-          "  for (j = 0; j < S; j++)\n    for (i = 0; i < S; i++) {\n"
+          "  for (j = 0; j < $P_S; j++)\n    for (i = 0; i < $P_S; i++) {\n"
           "      $R r = h / x->hprev, e = 0;\n"
-          "      for (d = S - 1; d >= 0; d--) e = e * r + $P_E[(j * S + i) * S + d];\n"
-          "      if (e != 0)\n        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];\n"
+          "      for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
+          "      if (e != 0)\n        for (l = 0; l < $P_M; l++) gam[j * $P_M + l] += e * x->gam[i * $P_M + l];\n"
           "    }\n}\n\n");
   if (e->compensated)
     tmpl(e, "/* a += b with the rounding error carried in *c (Kahan). */\n"
@@ -237,104 +244,106 @@ static void emit_step(Emitter *e) {
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
           "int $P_step($P_state *x, double h_, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
-          "  $W gam[S * M], sw[$<sweep> + 1];\n"
+          "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
           "  $R inc = HUGE_VAL, inc_old, scale;\n"
-          "  int it, i, rc = $P_ENOCONV;\n  DEFAULT_PARAMS(prm)\n"
+          "  int it, i, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
   if (wide)
-    tmpl(e, "  $W q0w[M], p0w[M];\n"
-            "  {\n    $R guess[S * M];\n    $P_predict(x, h, prm, guess);\n"
-            "    for (i = 0; i < S * M; i++) gam[i] = guess[i];\n  }\n"
+    tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
+            "  {\n    $R guess[$P_S * $P_M];\n    $P_predict(x, h, prm, guess);\n"
+            "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
             "  /* the sweep starts from the compensated state q - qc, p - pc, in $W */\n"
-            "  for (i = 0; i < M; i++) {\n"
+            "  for (i = 0; i < $P_M; i++) {\n"
             "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
             "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
   else
     tmpl(e, "  $P_predict(x, h, prm, gam);\n");
   if (e->mod->nu)
-    tmpl(e, "  $R g0[NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
+    tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
             "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
-            "   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it\n"
+            "   * cannot drift; below $P_GTOL, g(q0) is round-off, and kicking the momenta by it\n"
             "   * (eps / h a step) would only add noise, so it is left out. */\n"
-            "  for (i = 0; i < NU; i++) g0[i] = fabs$f(g0[i]) <= GTOL ? 0 : g0[i] / h;\n");
+            "  for (i = 0; i < $P_NU; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
   if (poly)
-    tmpl(e, wide ? "  $W fa[$<factor> + 1], lam[S * NU];\n"
-                              "  for (i = 0; i < S * NU; i++) lam[i] = 0;\n"
+    tmpl(e, wide ? "  $W fa[$<factor> + 1], lam[$P_S * $P_NU];\n"
+                              "  for (i = 0; i < $P_S * $P_NU; i++) lam[i] = 0;\n"
                               "  /* the multiplier matrix at the predicted stages, factored once for all sweeps */\n"
                               "  $(factor q0=q0w gam=gam h=h out=fa);\n"
-                            : "  $W fa[$<factor> + 1], lam[S * NU];\n"
-                              "  for (i = 0; i < S * NU; i++) lam[i] = 0;\n"
+                            : "  $W fa[$<factor> + 1], lam[$P_S * $P_NU];\n"
+                              "  for (i = 0; i < $P_S * $P_NU; i++) lam[i] = 0;\n"
                               "  /* the multiplier matrix at the predicted stages, factored once for all sweeps */\n"
                               "  $(factor q0=x->q gam=gam h=h out=fa);\n");
   if (poly)
-    tmpl(e, "  for (i = 0; i < S * NU; i++) {\n"
+    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++) {\n"
             "    $W piv = fa[$[factor.pivot]i], dia = fa[$[factor.adiag]i];\n"
             "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
-            "    if (!(fabs$g(piv) > SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n");
-  tmpl(e, "  for (it = 1; it <= MAXITER; it++) {\n");
+            "    if (!(fabs$g(piv) > $P_SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n");
+  tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
   char call[128];
   snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s%s out=sw);\n", wide ? "q0w" : "x->q",
            wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "", poly ? " lam=lam lu=fa" : "");
   tmpl(e, call);
   tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
-          "    for (i = 0; i < M; i++) {\n"
+          "    for (i = 0; i < $P_M; i++) {\n"
           "      $R v = fabs$f(x->q[i]) + fabs$g(h * sw[$[sweep.gam]i]);\n"
           "      if (v > scale) scale = v;\n    }\n"
-          "    for (i = 0; i < S * M; i++) {\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) {\n"
           "      $R v = fabs$g(h * (sw[$[sweep.gam]i] - gam[i]));\n"
           "      if (v > inc) inc = v;\n"
           "      gam[i] = sw[$[sweep.gam]i];\n    }\n"
           "    if (scale > 0) inc /= scale;\n");
   if (poly)
-    tmpl(e, "    for (i = 0; i < S * NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
+    tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
             "    for (i = 0; i < $<sweep>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
   else if (e->mod->nu) /* before the finiteness test: a zero pivot makes lambda 0/0 */
-    tmpl(e, "    for (i = 0; i < NU; i++) {\n"
+    tmpl(e, "    for (i = 0; i < $P_NU; i++) {\n"
             "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
-            "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
+            "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
             "    }\n"
             "    if (rc == $P_ESINGULAR) break;\n");
   if (!poly) tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
-          "    /* converged: the increment is far below an ulp of the state (TOL / 256), or\n"
-          "     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it\n"
-          "     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating\n"
+          "    /* converged: the increment is far below an ulp of the state ($P_TOL / 256), or\n"
+          "     * within 2 ulps ($P_TOL) and falling by less than 4x (round-off noise), or it\n"
+          "     * stopped decreasing (at round-off: accept; above $P_STAGTOL: fail). Iterating\n"
           "     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a\n"
           "     * random walk over millions of steps (bench/results/longrun.txt). */\n"
-          "    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = $P_OK; break; }\n"
-          "    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? $P_OK : $P_ENOCONV; break; }\n  }\n"
-          "  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }\n"
-          "  if (rc != $P_OK) return rc;\n");
+          "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) { rc = $P_OK; break; }\n"
+          "    if (it > 1 && inc >= inc_old) { rc = inc <= $P_STAGTOL ? $P_OK : $P_ENOCONV; break; }\n  }\n"
+          "  if (st) { st->iters = it > $P_MAXITER ? $P_MAXITER : it; st->increment = inc; }\n"
+          "  if (rc != $P_OK) return rc;\n"
+          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
   if (poly) {
     emit_end_poly(e);
     return;
   }
-  tmpl(e, "  for (i = 0; i < M; i++) /* the new state must be finite too */\n"
-          "    if (!isfinite(x->q[i] + h * sw[$[sweep.gam]i]) || !isfinite(x->p[i] + sw[$[sweep.dp]i])) return $P_ENONFINITE;\n");
+  tmpl(e, "  for (i = 0; i < $P_M; i++) /* the new state must be finite too, compensations included */\n"
+          "    if (!isfinite(x->q[i] + h * sw[$[sweep.gam]i]) || !isfinite(x->p[i] + sw[$[sweep.dp]i]) ||\n"
+          "        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))\n      return $P_ENONFINITE;\n");
   if (!wide)
-    tmpl(e, "  for (i = 0; i < M; i++) {\n"
+    tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    $P_add(&x->q[i], &x->qc[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&x->p[i], &x->pc[i], sw[$[sweep.dp]i]);\n  }\n"
-            "  for (i = 0; i < NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];\n");
+            "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n"
+            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = gam[i];\n");
   else {
     tmpl(e, "  /* q1 = (q - qc) + h gamma_0 and p1 = (p - pc) + (p1 - p0) in $W, rounded once into\n"
             "   * q, p; what the rounding lost is the new qc, pc */\n"
-            "  for (i = 0; i < M; i++) {\n"
+            "  for (i = 0; i < $P_M; i++) {\n"
             "    $W q1 = q0w[i] + h * sw[$[sweep.gam]i], p1 = p0w[i] + sw[$[sweep.dp]i];\n"
             "    x->q[i] = ($R)q1;\n    x->p[i] = ($R)p1;\n");
     if (e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1);\n    x->pc[i] = ($R)(x->p[i] - p1);\n");
     tmpl(e, "  }\n"
-            "  for (i = 0; i < NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < S * M; i++) x->gam[i] = ($R)gam[i];\n");
+            "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n"
+            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n");
   }
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0};
+  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP};
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;

@@ -349,6 +349,7 @@ typedef struct {
   int m, nu, s;
   Slots in[IN_COUNT];
   Kernel kern[K_COUNT];
+  IntVec sec_owner;   /* per DAG section label: the kernels (1 << KernelId) built in it */
 } Step;
 
 Step *step_build(Model *mod, const Method *meth);

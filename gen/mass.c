@@ -31,6 +31,10 @@ int mass_setup_diag(Model *mod, const double *diag, Loc loc) {
       return -1;
     }
     mod->minv_diag[i] = 1 / d;
+    if (!isfinite(mod->minv_diag[i])) {
+      error_at(loc, "M^-1 is not finite in double: diagonal entry %d of M is %.17g (below 1/DBL_MAX)", i + 1, d);
+      return -1;
+    }
     if (d != diag[0]) mod->mass = MASS_DIAG;
   }
   if (mod->mass == MASS_IDENTITY && m > 0 && diag[0] != 1) mod->mass = MASS_SCALAR;
@@ -72,6 +76,12 @@ int mass_setup(Model *mod, const double *dense, Loc loc) {
     error_at(loc, "M is not positive definite (its Cholesky factorisation fails)");
     return -1;
   }
+  for (size_t i = 0; i < (size_t)m * m; i++)
+    if (!isfinite(a->data[i])) {
+      gsl_matrix_free(a);
+      error_at(loc, "M^-1 is not finite in double: M is too close to singular");
+      return -1;
+    }
   mod->mass = MASS_DENSE;
   mod->minv = arena_alloc((size_t)m * (size_t)m * sizeof(double));
   memcpy(mod->minv, a->data, (size_t)m * (size_t)m * sizeof(double));

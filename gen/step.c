@@ -32,6 +32,14 @@ static int *zeros(Dag *d, int n) {
   return v;
 }
 
+// Start a section of the DAG called label, made for the kernels b->owners:
+// the emitter labels it in those kernels only.
+void step_section(Build *b, const char *label) {
+  dag_section(b->d, label);
+  while (b->st->sec_owner.n < b->d->nlabels - 1) intvec_push(&b->st->sec_owner, 0);
+  intvec_push(&b->st->sec_owner, (int)b->owners);
+}
+
 int step_in(Build *b, int block, int i) { return dag_input(b->d, b->st->in[block].first + i); }
 
 // Coefficient j, coordinate i of gamma (the sweep's input) or of Theta.
@@ -67,7 +75,7 @@ int step_apply_x(Build *b, int j, int i, int **v) { return apply_x(b, j, i, vect
 static void project_affine(Build *b, const int *roots, int n, int *out) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
-  dag_section(d, "affine derivative entries, projected in closed form");
+  step_section(b, "affine derivative entries, projected in closed form");
   int *grad = step_nodes(m), *q0 = step_nodes(m), *xg = step_nodes(s * m);
   for (int i = 0; i < m; i++) q0[i] = step_in(b, IN_Q0, i);
   for (int j = 0; j < s; j++)
@@ -134,7 +142,7 @@ static void build_stages(Build *b) {
   for (int l = 0; l < b->k && ncur; l++) {
     char *label = arena_alloc(128);
     snprintf(label, 128, "stage %d of %d: Q = q0 + h sum_j Ihat[%d][j] gamma_j, grad U(Q), grad g(Q)", l + 1, b->k, l + 1);
-    dag_section(d, label);
+    step_section(b, label);
     step_stage_point(b, l, Q);
     dag_subst(d, curved, ncur, Q, m, img);
     for (int j = 0; j < s; j++) {
@@ -169,7 +177,8 @@ int step_dot_col(Build *b, int j, int a, const int *v) {
 static void build_minv_products(Build *b) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
-  dag_section(d, "M^-1 psi_j and M^-1 rho_j");
+  b->owners = 1u << K_SWEEP;
+  step_section(b, "M^-1 psi_j and M^-1 rho_j");
   int *dense = step_nodes(m);
   b->vpsi = arena_alloc((size_t)s * sizeof(int *));
   b->vrho = arena_alloc((size_t)s * sizeof(int **));
@@ -253,7 +262,8 @@ static void build_initial_multiplier(Build *b, const int *q, const int *v) {
   Dag *d = b->d;
   Model *mod = b->mod;
   int m = b->m, nu = b->nu;
-  dag_section(d, "consistent initial multiplier");
+  b->owners = 1u << K_LAMBDA0;
+  step_section(b, "consistent initial multiplier");
   int *dw = step_nodes(m), *col = step_nodes(m), *gu = step_nodes(m), *mgu = step_nodes(m);
   int *B = step_nodes(nu * nu), *r = step_nodes(nu), *piv = step_nodes(nu), *lambda0 = step_nodes(nu);
   int z = dag_const(d, 0);
@@ -289,16 +299,21 @@ static void build_diagnostics(Build *b) {
     q[i] = step_in(b, IN_Q0, i);
     p[i] = step_in(b, IN_P0, i);
   }
-  dag_section(d, "g(q0)");
+  b->owners = 1u << K_G;
+  step_section(b, "g(q0)");
   dag_subst(d, mod->g, nu, q, m, g);
+  b->owners = 1u << K_MINV_P | 1u << K_ENERGY | 1u << K_HIDDEN | 1u << K_LAMBDA0;
+  step_section(b, "M^-1 p0");
   minv_apply(mod, d, p, v);
-  dag_section(d, "energy");
+  b->owners = 1u << K_ENERGY;
+  step_section(b, "energy");
   int kin = dag_const(d, 0);
   for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, p[i], v[i]));
   int U;
   dag_subst(d, &mod->U, 1, q, m, &U);
   int H = dag_add(d, dag_mul(d, dag_const(d, 0.5), kin), U);
-  dag_section(d, "hidden constraints");
+  b->owners = 1u << K_HIDDEN;
+  step_section(b, "hidden constraints");
   for (int a = 0; a < nu; a++) {
     const SparseVec *col = &mod->jac[a];
     int acc = dag_const(d, 0);
@@ -401,7 +416,7 @@ Step *step_build(Model *mod, const Method *me) {
     st->kern[k].wide = kernel_spec[k].wide;
   }
   layout_inputs(st, m, nu, s, 0, 0);
-  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, NULL, NULL, NULL, NULL};
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL};
   b.h = step_in(&b, IN_H, 0);
   int poly = me->family == MULT_POLY && nu;
   if (poly) layout_inputs(st, m, nu, s, s * nu, 0); /* the factor's length is known once it is built */

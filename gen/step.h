@@ -17,6 +17,7 @@ typedef struct {
   Step *st;
   int m, nu, s, k;
   int h;          /* node of the step size */
+  unsigned owners; /* the kernels (1 << KernelId) the nodes being built are for */
   int **psi;      /* s x m: sum_l b_l P_j(c_l) grad U(Q_l) */
   int ***rho;     /* s x nu x (entries of jac[a]): the same with grad g_a */
   int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
@@ -24,6 +25,7 @@ typedef struct {
 } Build;
 
 int *step_nodes(int n);
+void step_section(Build *b, const char *label);       /* dag_section, labelled for b->owners */
 int step_in(Build *b, int block, int i);              /* input node i of an input block */
 int step_apply_x(Build *b, int j, int i, int **v);     /* sum_r X[j][r] v[r][i] */
 void step_stage_point(Build *b, int l, int *Q);       /* Q_l, m nodes */

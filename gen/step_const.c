@@ -31,7 +31,8 @@ static int skew_form(Build *b, int a, int **y) {
 static void build_system(Build *b, int *lambda, int *pivot, int *adiag) {
   Dag *d = b->d;
   int nu = b->nu, m = b->m, s = b->s;
-  dag_section(d, "multiplier system A lambda = r");
+  b->owners = 1u << K_SWEEP;
+  step_section(b, "multiplier system A lambda = r");
   int *A = step_nodes(nu * nu), *r = step_nodes(nu);
   int **y = arena_alloc((size_t)s * sizeof(int *));
   /* which constraints touch each coordinate through M^-1 rho */
@@ -75,7 +76,7 @@ void build_const_multiplier(Build *b) {
   int m = b->m, s = b->s, nu = b->nu;
   int *lambda = step_nodes(nu), *pivot = step_nodes(nu), *adiag = step_nodes(nu);
   if (nu) build_system(b, lambda, pivot, adiag);
-  dag_section(d, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)]");
+  step_section(b, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)]");
   int **theta = arena_alloc((size_t)s * sizeof(int *));
   for (int j = 0; j < s; j++) {
     theta[j] = step_nodes(m);

@@ -192,7 +192,8 @@ static void build_projection(Build *b) {
   Dag *d = b->d;
   Model *mod = b->mod;
   int m = b->m, nu = b->nu, z = dag_const(d, 0);
-  dag_section(d, "projection onto the hidden constraint at q1, kinetic energy after it, U(q1)");
+  b->owners = 1u << K_PROJECT;
+  step_section(b, "projection onto the hidden constraint at q1, kinetic energy after it, U(q1)");
   int *q = step_nodes(m), *p = step_nodes(m), *v = step_nodes(m), *B = step_nodes(nu * nu), *rhs = step_nodes(nu);
   int *mu = step_nodes(nu), *pivot = step_nodes(nu), *adiag = step_nodes(nu), *dp = step_nodes(m), *pt = step_nodes(m);
   for (int i = 0; i < m; i++) {
@@ -235,9 +236,10 @@ void build_poly_multiplier(Build *b) {
   Dag *d = b->d;
   Step *st = b->st;
   int m = b->m, nu = b->nu, s = b->s, n = s * nu;
-  dag_section(d, "grad g at the stages");
+  step_section(b, "grad g at the stages");
   int ***G = stage_jacobians(b);
-  dag_section(d, "the multiplier matrix A, factored once per step");
+  b->owners = 1u << K_FACTOR;
+  step_section(b, "the multiplier matrix A, factored once per step");
   int *A = multiplier_matrix(b, G), *pivot = step_nodes(n), *adiag = step_nodes(n);
   LuFactor f;
   lu_factor(d, A, n, &f, pivot, adiag);
@@ -257,14 +259,15 @@ void build_poly_multiplier(Build *b) {
   step_result(st, K_FACTOR, "adiag", SZ_SNU, 1, n, adiag);
   st->kern[K_FACTOR].what = "The multiplier matrix A at the predicted stages, factored once per step: out = its\n"
                             " * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU).";
-  dag_section(d, "the multiplier coefficients: lambda += A^-1 C(lambda)");
+  b->owners = 1u << K_SWEEP;
+  step_section(b, "the multiplier coefficients: lambda += A^-1 C(lambda)");
   int *lam = step_nodes(n), *delta = step_nodes(n), *lam1 = step_nodes(n);
   for (int t = 0; t < n; t++) lam[t] = step_in(b, IN_LAM, t);
   int *gam = step_nodes(s * m), *dp = step_nodes(m);
   step_gamma(b, force_coefficients(b, G, lam), gam, dp);
   lu_apply(d, &in, conditions(b, G, gam), delta);
   for (int t = 0; t < n; t++) lam1[t] = dag_add(d, lam[t], delta[t]);
-  dag_section(d, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)]");
+  step_section(b, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)]");
   step_gamma_update(b, force_coefficients(b, G, lam1));
   step_result(st, K_SWEEP, "lam", SZ_SNU, 1, n, lam1);
   st->kern[K_SWEEP].what = "One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),\n"

@@ -4,6 +4,10 @@
 #ifndef conical_k1s1_H
 #define conical_k1s1_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define conical_k1s1_M 3      /* coordinates */
 #define conical_k1s1_NU 1     /* constraints */
 #define conical_k1s1_K 1      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void conical_k1s1_params_default(conical_k1s1_params *prm);
 int conical_k1s1_step(conical_k1s1_state *x, double h, const conical_k1s1_params *prm, conical_k1s1_stats *st);
 const char *conical_k1s1_strerror(int code);
 double conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm);
-void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *g);   /* NU values */
+void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *g);   /* conical_k1s1_NU values */
 void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

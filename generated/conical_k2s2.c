@@ -5,14 +5,27 @@
 
 #include "conical_k2s2.h"
 
-#define M conical_k2s2_M
-#define NU conical_k2s2_NU
-#define S conical_k2s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(conical_k2s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define conical_k2s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef conical_k2s2_MAXITER
+#define conical_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef conical_k2s2_TOL
+#define conical_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef conical_k2s2_STAGTOL
+#define conical_k2s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef conical_k2s2_SINGTOL
+#define conical_k2s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef conical_k2s2_GTOL
+#define conical_k2s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -32,7 +45,7 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
+  const double t0 = 2.0 * q0[0] /* x */;
   const double t1 = gam[0] * 0.5;
   const double t2 = gam[3] * 0.28867513459481292;
   const double t3 = t1 - t2;
@@ -42,7 +55,7 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t7 = gam[0] * 0.28867513459481292;
   const double t8 = h * t7;
   const double t9 = 2.0 * t8;
-  const double t10 = 2.0 * q0[1];
+  const double t10 = 2.0 * q0[1] /* y */;
   const double t11 = 0.5 * gam[1];
   const double t12 = 0.28867513459481292 * gam[4];
   const double t13 = t11 - t12;
@@ -52,7 +65,7 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t17 = 0.28867513459481292 * gam[1];
   const double t18 = h * t17;
   const double t19 = 2.0 * t18;
-  const double t20 = 2.0 * q0[2];
+  const double t20 = 2.0 * q0[2] /* z */;
   const double t21 = 0.5 * gam[2];
   const double t22 = 0.28867513459481292 * gam[5];
   const double t23 = t21 - t22;
@@ -74,10 +87,10 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t38 = t28 * 0.57735026918962584;
   const double t39 = t37 + t38;
   const double t40 = h * t39;
-  const double t41 = t6 * p0[0];
-  const double t42 = t16 * p0[1];
+  const double t41 = t6 * p0[0] /* p_x */;
+  const double t42 = t16 * p0[1] /* p_y */;
   const double t43 = t41 + t42;
-  const double t44 = t26 * p0[2];
+  const double t44 = t26 * p0[2] /* p_z */;
   const double t45 = t43 + t44;
   const double t46 = t45 - t40;
   const double t47 = t46 + g0[0];
@@ -94,17 +107,17 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t57 = 0.28867513459481292 * t53;
   const double t58 = t56 - t57;
   const double t59 = h * t58;
-  const double t60 = p0[0] - t59;
+  const double t60 = p0[0] /* p_x */ - t59;
   const double t61 = 0.5 * t50;
   const double t62 = 0.28867513459481292 * t54;
   const double t63 = t61 - t62;
   const double t64 = h * t63;
-  const double t65 = p0[1] - t64;
+  const double t65 = p0[1] /* p_y */ - t64;
   const double t66 = 0.5 * t52;
   const double t67 = 0.28867513459481292 * t55;
   const double t68 = t66 - t67;
   const double t69 = h * t68;
-  const double t70 = p0[2] - t69;
+  const double t70 = p0[2] /* p_z */ - t69;
   const double t71 = 0.28867513459481292 * t49;
   const double t72 = h * t71;
   const double t73 = -t72;
@@ -120,17 +133,22 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t83 = -t82;
   const double t84 = h * t52;
   const double t85 = -t84;
+  /* gam */
   out[0] = t60;
   out[1] = t65;
   out[2] = t70;
   out[3] = t73;
   out[4] = t76;
   out[5] = t79;
+  /* dp */
   out[6] = t81;
   out[7] = t83;
   out[8] = t85;
+  /* lambda */
   out[9] = t48;
+  /* pivot */
   out[10] = t36;
+  /* adiag */
   out[11] = t36;
 }
 
@@ -139,9 +157,10 @@ static void conical_k2s2_minv_p(const double *q0, const double *p0, const double
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
+  out[2] = p0[2] /* p_z */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -150,13 +169,14 @@ static void conical_k2s2_energy_kernel(const double *q0, const double *p0, const
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_z */ * p0[2] /* p_z */;
   const double t4 = t2 + t3;
   const double t5 = 0.5 * t4;
-  const double t6 = q0[2] + t5;
+  const double t6 = q0[2] /* z */ + t5;
+  /* H */
   out[0] = t6;
 }
 
@@ -166,12 +186,13 @@ static void conical_k2s2_g(const double *q0, const double *p0, const double *gam
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* g(q0) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* z */ * q0[2] /* z */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 1.0;
+  /* g */
   out[0] = t5;
 }
 
@@ -180,16 +201,16 @@ static void conical_k2s2_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[2] /* z */;
   /* hidden constraints */
-  const double t3 = t0 * p0[0];
-  const double t4 = t1 * p0[1];
+  const double t3 = t0 * p0[0] /* p_x */;
+  const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2];
+  const double t6 = t2 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
+  /* hidden */
   out[0] = t7;
 }
 
@@ -199,26 +220,26 @@ static void conical_k2s2_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[2] /* z */;
   /* consistent initial multiplier */
   const double t3 = t0 * t0;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
   const double t6 = t2 * t2;
   const double t7 = t5 + t6;
-  const double t8 = 2.0 * p0[0];
-  const double t9 = 2.0 * p0[1];
-  const double t10 = 2.0 * p0[2];
-  const double t11 = p0[0] * t8;
-  const double t12 = p0[1] * t9;
+  const double t8 = 2.0 * p0[0] /* p_x */;
+  const double t9 = 2.0 * p0[1] /* p_y */;
+  const double t10 = 2.0 * p0[2] /* p_z */;
+  const double t11 = p0[0] /* p_x */ * t8;
+  const double t12 = p0[1] /* p_y */ * t9;
   const double t13 = t11 + t12;
-  const double t14 = p0[2] * t10;
+  const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
   const double t16 = t15 - t2;
   const double t17 = t16 / t7;
+  /* lambda */
   out[0] = t17;
 }
 
@@ -231,19 +252,19 @@ void conical_k2s2_init(conical_k2s2_state *x, const double *q0, const double *p0
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < conical_k2s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : conical_k2s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : conical_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (conical_k2s2_NU ? conical_k2s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
   {
     conical_k2s2_params prm;
-    double lam[NU];
+    double lam[conical_k2s2_NU];
     conical_k2s2_params_default(&prm);
     conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -259,32 +280,32 @@ const char *conical_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) conical_k2s2_params dflt_; if (!prm) { conical_k2s2_params_default(&dflt_); prm = &dflt_; }
+#define conical_k2s2_DEFAULT_PARAMS(prm) conical_k2s2_params dflt_; if (!prm) { conical_k2s2_params_default(&dflt_); prm = &dflt_; }
 
 double conical_k2s2_energy(const conical_k2s2_state *x, const conical_k2s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  conical_k2s2_DEFAULT_PARAMS(prm)
   conical_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void conical_k2s2_constraints(const conical_k2s2_state *x, const conical_k2s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[conical_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  conical_k2s2_DEFAULT_PARAMS(prm)
   conical_k2s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < conical_k2s2_NU; i++) g[i] = v[i];
 }
 
 void conical_k2s2_hidden(const conical_k2s2_state *x, const conical_k2s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[conical_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  conical_k2s2_DEFAULT_PARAMS(prm)
   conical_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < conical_k2s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -292,17 +313,17 @@ void conical_k2s2_hidden(const conical_k2s2_state *x, const conical_k2s2_params 
 static void conical_k2s2_predict(const conical_k2s2_state *x, double h, const conical_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     conical_k2s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < conical_k2s2_S; j++)
+    for (i = 0; i < conical_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + conical_k2s2_E[(j * S + i) * S + d];
+      for (d = conical_k2s2_S - 1; d >= 0; d--) e = e * r + conical_k2s2_E[(j * conical_k2s2_S + i) * conical_k2s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < conical_k2s2_M; l++) gam[j * conical_k2s2_M + l] += e * x->gam[i * conical_k2s2_M + l];
     }
 }
 
@@ -319,60 +340,63 @@ static void conical_k2s2_add(double *a, double *c, double b)
 int conical_k2s2_step(conical_k2s2_state *x, double h_, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_k2s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  conical_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k2s2_EBADSTEP;
   conical_k2s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[conical_k2s2_NU];
   conical_k2s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below conical_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < conical_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= conical_k2s2_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= conical_k2s2_MAXITER; it++) {
     conical_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < conical_k2s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = conical_k2s2_ESINGULAR;
+    for (i = 0; i < conical_k2s2_NU; i++) {
+      double piv = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU + i], dia = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 2 * conical_k2s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k2s2_SINGTOL * fabs(dia))) rc = conical_k2s2_ESINGULAR;
     }
     if (rc == conical_k2s2_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k2s2_ENONFINITE;
     if (rc == conical_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (conical_k2s2_TOL / 256), or
+     * within 2 ulps (conical_k2s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above conical_k2s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = conical_k2s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? conical_k2s2_OK : conical_k2s2_ENOCONV; break; }
+    if (inc <= conical_k2s2_TOL / 256 || (inc <= conical_k2s2_TOL && 4 * inc > inc_old)) { rc = conical_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= conical_k2s2_STAGTOL ? conical_k2s2_OK : conical_k2s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > conical_k2s2_MAXITER ? conical_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != conical_k2s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return conical_k2s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k2s2_ENONFINITE;
+  for (i = 0; i < conical_k2s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k2s2_S * conical_k2s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return conical_k2s2_ENONFINITE;
+  for (i = 0; i < conical_k2s2_M; i++) {
     conical_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    conical_k2s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    conical_k2s2_add(&x->p[i], &x->pc[i], sw[conical_k2s2_S * conical_k2s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + i];
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k2s2_OK;

@@ -4,6 +4,10 @@
 #ifndef conical_k3s3_H
 #define conical_k3s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define conical_k3s3_M 3      /* coordinates */
 #define conical_k3s3_NU 1     /* constraints */
 #define conical_k3s3_K 3      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void conical_k3s3_params_default(conical_k3s3_params *prm);
 int conical_k3s3_step(conical_k3s3_state *x, double h, const conical_k3s3_params *prm, conical_k3s3_stats *st);
 const char *conical_k3s3_strerror(int code);
 double conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm);
-void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *g);   /* NU values */
+void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *g);   /* conical_k3s3_NU values */
 void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

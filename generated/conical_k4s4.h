@@ -4,6 +4,10 @@
 #ifndef conical_k4s4_H
 #define conical_k4s4_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define conical_k4s4_M 3      /* coordinates */
 #define conical_k4s4_NU 1     /* constraints */
 #define conical_k4s4_K 4      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void conical_k4s4_params_default(conical_k4s4_params *prm);
 int conical_k4s4_step(conical_k4s4_state *x, double h, const conical_k4s4_params *prm, conical_k4s4_stats *st);
 const char *conical_k4s4_strerror(int code);
 double conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm);
-void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *g);   /* NU values */
+void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *g);   /* conical_k4s4_NU values */
 void conical_k4s4_hidden(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "conical_poly_k2s2.h"
 
-#define M conical_poly_k2s2_M
-#define NU conical_poly_k2s2_NU
-#define S conical_poly_k2s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(conical_poly_k2s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define conical_poly_k2s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef conical_poly_k2s2_MAXITER
+#define conical_poly_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef conical_poly_k2s2_TOL
+#define conical_poly_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef conical_poly_k2s2_STAGTOL
+#define conical_poly_k2s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef conical_poly_k2s2_SINGTOL
+#define conical_poly_k2s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef conical_poly_k2s2_GTOL
+#define conical_poly_k2s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,32 +49,32 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   const double t1 = gam[3] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x */ + t3;
   const double t5 = gam[1] * 0.21132486540518713;
   const double t6 = gam[4] * (-0.28867513459481292);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y */ + t8;
   const double t10 = gam[2] * 0.21132486540518713;
   const double t11 = gam[5] * (-0.28867513459481292);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* z */ + t13;
   const double t15 = 2.0 * t14;
   const double t16 = 2.0 * t9;
   const double t17 = 2.0 * t4;
   const double t18 = gam[0] * 0.78867513459481287;
   const double t19 = t1 + t18;
   const double t20 = h * t19;
-  const double t21 = q0[0] + t20;
+  const double t21 = q0[0] /* x */ + t20;
   const double t22 = gam[1] * 0.78867513459481287;
   const double t23 = t6 + t22;
   const double t24 = h * t23;
-  const double t25 = q0[1] + t24;
+  const double t25 = q0[1] /* y */ + t24;
   const double t26 = gam[2] * 0.78867513459481287;
   const double t27 = t11 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[2] + t28;
+  const double t29 = q0[2] /* z */ + t28;
   const double t30 = 2.0 * t29;
   const double t31 = 2.0 * t25;
   const double t32 = 2.0 * t21;
@@ -99,17 +112,17 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   const double t63 = 0.28867513459481292 * t57;
   const double t64 = t62 - t63;
   const double t65 = h * t64;
-  const double t66 = p0[0] - t65;
+  const double t66 = p0[0] /* p_x */ - t65;
   const double t67 = 0.5 * t53;
   const double t68 = 0.28867513459481292 * t59;
   const double t69 = t67 - t68;
   const double t70 = h * t69;
-  const double t71 = p0[1] - t70;
+  const double t71 = p0[1] /* p_y */ - t70;
   const double t72 = 0.5 * t55;
   const double t73 = 0.28867513459481292 * t61;
   const double t74 = t72 - t73;
   const double t75 = h * t74;
-  const double t76 = p0[2] - t75;
+  const double t76 = p0[2] /* p_z */ - t75;
   const double t77 = 0.28867513459481292 * t51;
   const double t78 = h * t77;
   const double t79 = 0.28867513459481292 * t53;
@@ -187,17 +200,17 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   const double t150 = 0.28867513459481292 * t144;
   const double t151 = t149 - t150;
   const double t152 = h * t151;
-  const double t153 = p0[0] - t152;
+  const double t153 = p0[0] /* p_x */ - t152;
   const double t154 = 0.5 * t140;
   const double t155 = 0.28867513459481292 * t146;
   const double t156 = t154 - t155;
   const double t157 = h * t156;
-  const double t158 = p0[1] - t157;
+  const double t158 = p0[1] /* p_y */ - t157;
   const double t159 = 0.5 * t142;
   const double t160 = 0.28867513459481292 * t148;
   const double t161 = t159 - t160;
   const double t162 = h * t161;
-  const double t163 = p0[2] - t162;
+  const double t163 = p0[2] /* p_z */ - t162;
   const double t164 = 0.28867513459481292 * t138;
   const double t165 = h * t164;
   const double t166 = -t165;
@@ -213,15 +226,18 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   const double t176 = -t175;
   const double t177 = h * t142;
   const double t178 = -t177;
+  /* gam */
   out[0] = t153;
   out[1] = t158;
   out[2] = t163;
   out[3] = t166;
   out[4] = t169;
   out[5] = t172;
+  /* dp */
   out[6] = t174;
   out[7] = t176;
   out[8] = t178;
+  /* lam */
   out[9] = t118;
   out[10] = t119;
 }
@@ -237,29 +253,29 @@ static void conical_poly_k2s2_factor(const double *q0, const double *p0, const d
   const double t1 = gam[3] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x */ + t3;
   const double t5 = gam[1] * 0.21132486540518713;
   const double t6 = gam[4] * (-0.28867513459481292);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y */ + t8;
   const double t10 = gam[2] * 0.21132486540518713;
   const double t11 = gam[5] * (-0.28867513459481292);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* z */ + t13;
   const double t15 = gam[0] * 0.78867513459481287;
   const double t16 = t1 + t15;
   const double t17 = h * t16;
-  const double t18 = q0[0] + t17;
+  const double t18 = q0[0] /* x */ + t17;
   const double t19 = gam[1] * 0.78867513459481287;
   const double t20 = t6 + t19;
   const double t21 = h * t20;
-  const double t22 = q0[1] + t21;
+  const double t22 = q0[1] /* y */ + t21;
   const double t23 = gam[2] * 0.78867513459481287;
   const double t24 = t11 + t23;
   const double t25 = h * t24;
-  const double t26 = q0[2] + t25;
+  const double t26 = q0[2] /* z */ + t25;
   /* the multiplier matrix A, factored once per step */
   const double t27 = t4 + t18;
   const double t28 = t9 + t22;
@@ -356,12 +372,15 @@ static void conical_poly_k2s2_factor(const double *q0, const double *p0, const d
   const double t119 = t116 - t118;
   const double t120 = 1.0 / t71;
   const double t121 = 1.0 / t119;
+  /* lu */
   out[0] = t120;
   out[1] = t92;
   out[2] = t117;
   out[3] = t121;
+  /* pivot */
   out[4] = t71;
   out[5] = t119;
+  /* adiag */
   out[6] = t71;
   out[7] = t116;
 }
@@ -371,9 +390,10 @@ static void conical_poly_k2s2_minv_p(const double *q0, const double *p0, const d
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
+  out[2] = p0[2] /* p_z */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -382,13 +402,14 @@ static void conical_poly_k2s2_energy_kernel(const double *q0, const double *p0, 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_z */ * p0[2] /* p_z */;
   const double t4 = t2 + t3;
   const double t5 = 0.5 * t4;
-  const double t6 = q0[2] + t5;
+  const double t6 = q0[2] /* z */ + t5;
+  /* H */
   out[0] = t6;
 }
 
@@ -398,12 +419,13 @@ static void conical_poly_k2s2_g(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* g(q0) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* z */ * q0[2] /* z */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 1.0;
+  /* g */
   out[0] = t5;
 }
 
@@ -412,16 +434,15 @@ static void conical_poly_k2s2_hidden_kernel(const double *q0, const double *p0, 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = 2.0 * q0[2];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t3 = t0 * p0[0];
-  const double t4 = t1 * p0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[2] /* z */;
+  const double t3 = t0 * p0[0] /* p_x */;
+  const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2];
+  const double t6 = t2 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
+  /* hidden */
   out[0] = t7;
 }
 
@@ -431,27 +452,26 @@ static void conical_poly_k2s2_lambda0(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = 2.0 * q0[2];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[2] /* z */;
   const double t3 = t0 * t0;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
   const double t6 = t2 * t2;
   const double t7 = t5 + t6;
   /* consistent initial multiplier */
-  const double t8 = 2.0 * p0[0];
-  const double t9 = 2.0 * p0[1];
-  const double t10 = 2.0 * p0[2];
-  const double t11 = p0[0] * t8;
-  const double t12 = p0[1] * t9;
+  const double t8 = 2.0 * p0[0] /* p_x */;
+  const double t9 = 2.0 * p0[1] /* p_y */;
+  const double t10 = 2.0 * p0[2] /* p_z */;
+  const double t11 = p0[0] /* p_x */ * t8;
+  const double t12 = p0[1] /* p_y */ * t9;
   const double t13 = t11 + t12;
-  const double t14 = p0[2] * t10;
+  const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
   const double t16 = t15 - t2;
   const double t17 = t16 / t7;
+  /* lambda */
   out[0] = t17;
 }
 
@@ -462,43 +482,47 @@ static void conical_poly_k2s2_project(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[2] /* z */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t3 = t0 * t0;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
   const double t6 = t2 * t2;
   const double t7 = t5 + t6;
-  const double t8 = t0 * p0[0];
-  const double t9 = t1 * p0[1];
+  const double t8 = t0 * p0[0] /* p_x */;
+  const double t9 = t1 * p0[1] /* p_y */;
   const double t10 = t8 + t9;
-  const double t11 = t2 * p0[2];
+  const double t11 = t2 * p0[2] /* p_z */;
   const double t12 = t10 + t11;
   const double t13 = t12 / t7;
   const double t14 = t0 * t13;
   const double t15 = -t14;
-  const double t16 = p0[0] - t14;
+  const double t16 = p0[0] /* p_x */ - t14;
   const double t17 = t1 * t13;
   const double t18 = -t17;
-  const double t19 = p0[1] - t17;
+  const double t19 = p0[1] /* p_y */ - t17;
   const double t20 = t2 * t13;
   const double t21 = -t20;
-  const double t22 = p0[2] - t20;
+  const double t22 = p0[2] /* p_z */ - t20;
   const double t23 = t16 * t16;
   const double t24 = t19 * t19;
   const double t25 = t23 + t24;
   const double t26 = t22 * t22;
   const double t27 = t25 + t26;
   const double t28 = 0.5 * t27;
+  /* dp */
   out[0] = t15;
   out[1] = t18;
   out[2] = t21;
+  /* kin */
   out[3] = t28;
-  out[4] = q0[2];
+  /* U */
+  out[4] = q0[2] /* z */;
+  /* pivot */
   out[5] = t7;
+  /* adiag */
   out[6] = t7;
 }
 
@@ -511,20 +535,20 @@ void conical_poly_k2s2_init(conical_poly_k2s2_state *x, const double *q0, const 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : conical_poly_k2s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : conical_poly_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (conical_poly_k2s2_NU ? conical_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     conical_poly_k2s2_params prm;
-    double lam[NU];
+    double lam[conical_poly_k2s2_NU];
     conical_poly_k2s2_params_default(&prm);
     conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -540,32 +564,32 @@ const char *conical_poly_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) conical_poly_k2s2_params dflt_; if (!prm) { conical_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
+#define conical_poly_k2s2_DEFAULT_PARAMS(prm) conical_poly_k2s2_params dflt_; if (!prm) { conical_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
 
 double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  conical_poly_k2s2_DEFAULT_PARAMS(prm)
   conical_poly_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[conical_poly_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  conical_poly_k2s2_DEFAULT_PARAMS(prm)
   conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < conical_poly_k2s2_NU; i++) g[i] = v[i];
 }
 
 void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[conical_poly_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  conical_poly_k2s2_DEFAULT_PARAMS(prm)
   conical_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < conical_poly_k2s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -573,17 +597,17 @@ void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_po
 static void conical_poly_k2s2_predict(const conical_poly_k2s2_state *x, double h, const conical_poly_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     conical_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < conical_poly_k2s2_S; j++)
+    for (i = 0; i < conical_poly_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + conical_poly_k2s2_E[(j * S + i) * S + d];
+      for (d = conical_poly_k2s2_S - 1; d >= 0; d--) e = e * r + conical_poly_k2s2_E[(j * conical_poly_k2s2_S + i) * conical_poly_k2s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < conical_poly_k2s2_M; l++) gam[j * conical_poly_k2s2_M + l] += e * x->gam[i * conical_poly_k2s2_M + l];
     }
 }
 
@@ -600,100 +624,101 @@ static void conical_poly_k2s2_add(double *a, double *c, double b)
 int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h_, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = conical_poly_k2s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  conical_poly_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_poly_k2s2_EBADSTEP;
   conical_poly_k2s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[conical_poly_k2s2_NU];
   conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below conical_poly_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[4 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= conical_poly_k2s2_GTOL ? 0 : g0[i] / h;
+  double fa[4 + 2 * conical_poly_k2s2_S * conical_poly_k2s2_NU + 1], lam[conical_poly_k2s2_S * conical_poly_k2s2_NU];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   conical_poly_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[4 + i], dia = fa[4 + S * NU + i];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) {
+    double piv = fa[4 + i], dia = fa[4 + conical_poly_k2s2_S * conical_poly_k2s2_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return conical_poly_k2s2_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
+    if (!(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= conical_poly_k2s2_MAXITER; it++) {
     conical_poly_k2s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < conical_poly_k2s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + i];
+    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = conical_poly_k2s2_ENONFINITE;
     if (rc == conical_poly_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_poly_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (conical_poly_k2s2_TOL / 256), or
+     * within 2 ulps (conical_poly_k2s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above conical_poly_k2s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = conical_poly_k2s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? conical_poly_k2s2_OK : conical_poly_k2s2_ENOCONV; break; }
+    if (inc <= conical_poly_k2s2_TOL / 256 || (inc <= conical_poly_k2s2_TOL && 4 * inc > inc_old)) { rc = conical_poly_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= conical_poly_k2s2_STAGTOL ? conical_poly_k2s2_OK : conical_poly_k2s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > conical_poly_k2s2_MAXITER ? conical_poly_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != conical_poly_k2s2_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_poly_k2s2_ENONFINITE;
+  double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 2 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = conical_poly_k2s2_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[conical_poly_k2s2_M], pc1[conical_poly_k2s2_M];
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     conical_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
-    conical_poly_k2s2_add(&p1[i], &pc1[i], sw[S * M + i]);
+    conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   conical_poly_k2s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
+  for (i = 0; i < conical_poly_k2s2_NU; i++) {
+    double piv = pr[conical_poly_k2s2_M + 2 + i], dia = pr[conical_poly_k2s2_M + 2 + conical_poly_k2s2_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < conical_poly_k2s2_M + 2 + 2 * conical_poly_k2s2_NU; i++)
     if (!isfinite(pr[i])) return conical_poly_k2s2_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[conical_poly_k2s2_M + 0];
+  U1 = pr[conical_poly_k2s2_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * conical_poly_k2s2_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
     conical_poly_k2s2_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return conical_poly_k2s2_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[conical_poly_k2s2_NU];
     conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   conical_poly_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;

@@ -4,6 +4,10 @@
 #ifndef conical_poly_k2s2_H
 #define conical_poly_k2s2_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define conical_poly_k2s2_M 3      /* coordinates */
 #define conical_poly_k2s2_NU 1     /* constraints */
 #define conical_poly_k2s2_K 2      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void conical_poly_k2s2_params_default(conical_poly_k2s2_params *prm);
 int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
 const char *conical_poly_k2s2_strerror(int code);
 double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
-void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g);   /* NU values */
+void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g);   /* conical_poly_k2s2_NU values */
 void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

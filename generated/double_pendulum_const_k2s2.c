@@ -5,14 +5,27 @@
 
 #include "double_pendulum_const_k2s2.h"
 
-#define M double_pendulum_const_k2s2_M
-#define NU double_pendulum_const_k2s2_NU
-#define S double_pendulum_const_k2s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(double_pendulum_const_k2s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define double_pendulum_const_k2s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef double_pendulum_const_k2s2_MAXITER
+#define double_pendulum_const_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef double_pendulum_const_k2s2_TOL
+#define double_pendulum_const_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef double_pendulum_const_k2s2_STAGTOL
+#define double_pendulum_const_k2s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef double_pendulum_const_k2s2_SINGTOL
+#define double_pendulum_const_k2s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef double_pendulum_const_k2s2_GTOL
+#define double_pendulum_const_k2s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -32,7 +45,7 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
   const double t1 = 0.5 * gam[0];
   const double t2 = gam[4] * 0.28867513459481292;
   const double t3 = t1 - t2;
@@ -42,7 +55,7 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t7 = gam[0] * 0.28867513459481292;
   const double t8 = h * t7;
   const double t9 = 2.0 * t8;
-  const double t10 = 2.0 * q0[1];
+  const double t10 = 2.0 * q0[1] /* y1 */;
   const double t11 = 0.5 * gam[1];
   const double t12 = 0.28867513459481292 * gam[5];
   const double t13 = t11 - t12;
@@ -52,7 +65,7 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t17 = 0.28867513459481292 * gam[1];
   const double t18 = h * t17;
   const double t19 = 2.0 * t18;
-  const double t20 = q0[2] - q0[0];
+  const double t20 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t21 = 2.0 * t20;
   const double t22 = t5 - t21;
   const double t23 = 0.5 * gam[2];
@@ -65,7 +78,7 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t30 = h * t29;
   const double t31 = (-2.0) * t30;
   const double t32 = t9 + t31;
-  const double t33 = q0[3] - q0[1];
+  const double t33 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t34 = 2.0 * t33;
   const double t35 = t15 - t34;
   const double t36 = 0.5 * gam[3];
@@ -116,8 +129,8 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t80 = t18 * 0.57735026918962584;
   const double t81 = t79 + t80;
   const double t82 = h * t81;
-  const double t83 = t6 * p0[0];
-  const double t84 = t16 * p0[1];
+  const double t83 = t6 * p0[0] /* p_x1 */;
+  const double t84 = t16 * p0[1] /* p_y1 */;
   const double t85 = t83 + t84;
   const double t86 = t85 - t82;
   const double t87 = t86 + g0[0];
@@ -140,12 +153,12 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t104 = 0.28867513459481292 * t103;
   const double t105 = t102 + t104;
   const double t106 = h * t105;
-  const double t107 = t28 * p0[0];
-  const double t108 = t41 * p0[1];
+  const double t107 = t28 * p0[0] /* p_x1 */;
+  const double t108 = t41 * p0[1] /* p_y1 */;
   const double t109 = t107 + t108;
-  const double t110 = t49 * p0[2];
+  const double t110 = t49 * p0[2] /* p_x2 */;
   const double t111 = t109 + t110;
-  const double t112 = t56 * p0[3];
+  const double t112 = t56 * p0[3] /* p_y2 */;
   const double t113 = t111 + t112;
   const double t114 = t113 - t106;
   const double t115 = t114 + g0[1];
@@ -181,22 +194,22 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t144 = 0.28867513459481292 * t138;
   const double t145 = t143 - t144;
   const double t146 = h * t145;
-  const double t147 = p0[0] - t146;
+  const double t147 = p0[0] /* p_x1 */ - t146;
   const double t148 = 0.5 * t131;
   const double t149 = 0.28867513459481292 * t140;
   const double t150 = t148 - t149;
   const double t151 = h * t150;
-  const double t152 = p0[1] - t151;
+  const double t152 = p0[1] /* p_y1 */ - t151;
   const double t153 = 0.5 * t132;
   const double t154 = 0.28867513459481292 * t141;
   const double t155 = t153 - t154;
   const double t156 = h * t155;
-  const double t157 = p0[2] - t156;
+  const double t157 = p0[2] /* p_x2 */ - t156;
   const double t158 = 0.5 * t134;
   const double t159 = 0.28867513459481292 * t142;
   const double t160 = t158 - t159;
   const double t161 = h * t160;
-  const double t162 = p0[3] - t161;
+  const double t162 = p0[3] /* p_y2 */ - t161;
   const double t163 = 0.28867513459481292 * t129;
   const double t164 = h * t163;
   const double t165 = -t164;
@@ -217,6 +230,7 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t180 = -t179;
   const double t181 = h * t134;
   const double t182 = -t181;
+  /* gam */
   out[0] = t147;
   out[1] = t152;
   out[2] = t157;
@@ -225,14 +239,18 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   out[5] = t168;
   out[6] = t171;
   out[7] = t174;
+  /* dp */
   out[8] = t176;
   out[9] = t178;
   out[10] = t180;
   out[11] = t182;
+  /* lambda */
   out[12] = t124;
   out[13] = t121;
+  /* pivot */
   out[14] = t64;
   out[15] = t118;
+  /* adiag */
   out[16] = t64;
   out[17] = t100;
 }
@@ -242,10 +260,11 @@ static void double_pendulum_const_k2s2_minv_p(const double *q0, const double *p0
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_x2 */;
+  out[3] = p0[3] /* p_y2 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -254,16 +273,17 @@ static void double_pendulum_const_k2s2_energy_kernel(const double *q0, const dou
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t1 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_x2 */ * p0[2] /* p_x2 */;
   const double t4 = t2 + t3;
-  const double t5 = p0[3] * p0[3];
+  const double t5 = p0[3] /* p_y2 */ * p0[3] /* p_y2 */;
   const double t6 = t4 + t5;
-  const double t7 = q0[1] + q0[3];
+  const double t7 = q0[1] /* y1 */ + q0[3] /* y2 */;
   const double t8 = 0.5 * t6;
   const double t9 = t7 + t8;
+  /* H */
   out[0] = t9;
 }
 
@@ -272,18 +292,18 @@ static void double_pendulum_const_k2s2_g(const double *q0, const double *p0, con
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[2] - q0[0];
-  const double t1 = q0[3] - q0[1];
+  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
+  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
   /* g(q0) */
-  const double t2 = q0[0] * q0[0];
-  const double t3 = q0[1] * q0[1];
+  const double t2 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t3 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 1.0;
   const double t6 = t0 * t0;
   const double t7 = t1 * t1;
   const double t8 = t6 + t7;
   const double t9 = t8 - 1.0;
+  /* g */
   out[0] = t5;
   out[1] = t9;
 }
@@ -293,25 +313,25 @@ static void double_pendulum_const_k2s2_hidden_kernel(const double *q0, const dou
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
   /* hidden constraints */
-  const double t6 = t0 * p0[0];
-  const double t7 = t1 * p0[1];
+  const double t6 = t0 * p0[0] /* p_x1 */;
+  const double t7 = t1 * p0[1] /* p_y1 */;
   const double t8 = t6 + t7;
-  const double t9 = t3 * p0[0];
+  const double t9 = t3 * p0[0] /* p_x1 */;
   const double t10 = -t9;
-  const double t11 = t5 * p0[1];
+  const double t11 = t5 * p0[1] /* p_y1 */;
   const double t12 = t10 - t11;
-  const double t13 = t3 * p0[2];
+  const double t13 = t3 * p0[2] /* p_x2 */;
   const double t14 = t12 + t13;
-  const double t15 = t5 * p0[3];
+  const double t15 = t5 * p0[3] /* p_y2 */;
   const double t16 = t14 + t15;
+  /* hidden */
   out[0] = t8;
   out[1] = t16;
 }
@@ -322,12 +342,11 @@ static void double_pendulum_const_k2s2_lambda0(const double *q0, const double *p
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
   /* consistent initial multiplier */
   const double t6 = t0 * t0;
@@ -342,23 +361,23 @@ static void double_pendulum_const_k2s2_lambda0(const double *q0, const double *p
   const double t15 = t13 + t14;
   const double t16 = t13 + t15;
   const double t17 = t14 + t16;
-  const double t18 = 2.0 * p0[0];
-  const double t19 = 2.0 * p0[1];
-  const double t20 = p0[0] * t18;
-  const double t21 = p0[1] * t19;
+  const double t18 = 2.0 * p0[0] /* p_x1 */;
+  const double t19 = 2.0 * p0[1] /* p_y1 */;
+  const double t20 = p0[0] /* p_x1 */ * t18;
+  const double t21 = p0[1] /* p_y1 */ * t19;
   const double t22 = t20 + t21;
   const double t23 = t22 - t1;
-  const double t24 = p0[3] - p0[1];
-  const double t25 = p0[2] - p0[0];
+  const double t24 = p0[3] /* p_y2 */ - p0[1] /* p_y1 */;
+  const double t25 = p0[2] /* p_x2 */ - p0[0] /* p_x1 */;
   const double t26 = 2.0 * t25;
   const double t27 = 2.0 * t24;
-  const double t28 = p0[0] * t26;
+  const double t28 = p0[0] /* p_x1 */ * t26;
   const double t29 = -t28;
-  const double t30 = p0[1] * t27;
+  const double t30 = p0[1] /* p_y1 */ * t27;
   const double t31 = t29 - t30;
-  const double t32 = p0[2] * t26;
+  const double t32 = p0[2] /* p_x2 */ * t26;
   const double t33 = t31 + t32;
-  const double t34 = p0[3] * t27;
+  const double t34 = p0[3] /* p_y2 */ * t27;
   const double t35 = t33 + t34;
   const double t36 = t12 / t10;
   const double t37 = t12 * t36;
@@ -369,6 +388,7 @@ static void double_pendulum_const_k2s2_lambda0(const double *q0, const double *p
   const double t42 = t12 * t41;
   const double t43 = t23 - t42;
   const double t44 = t43 / t10;
+  /* lambda */
   out[0] = t44;
   out[1] = t41;
 }
@@ -382,19 +402,19 @@ void double_pendulum_const_k2s2_init(double_pendulum_const_k2s2_state *x, const 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : double_pendulum_const_k2s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : double_pendulum_const_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (double_pendulum_const_k2s2_NU ? double_pendulum_const_k2s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = 0;
   {
     double_pendulum_const_k2s2_params prm;
-    double lam[NU];
+    double lam[double_pendulum_const_k2s2_NU];
     double_pendulum_const_k2s2_params_default(&prm);
     double_pendulum_const_k2s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -410,32 +430,32 @@ const char *double_pendulum_const_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) double_pendulum_const_k2s2_params dflt_; if (!prm) { double_pendulum_const_k2s2_params_default(&dflt_); prm = &dflt_; }
+#define double_pendulum_const_k2s2_DEFAULT_PARAMS(prm) double_pendulum_const_k2s2_params dflt_; if (!prm) { double_pendulum_const_k2s2_params_default(&dflt_); prm = &dflt_; }
 
 double double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
   double_pendulum_const_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void double_pendulum_const_k2s2_constraints(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[double_pendulum_const_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
   double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) g[i] = v[i];
 }
 
 void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[double_pendulum_const_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
   double_pendulum_const_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -443,17 +463,17 @@ void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x
 static void double_pendulum_const_k2s2_predict(const double_pendulum_const_k2s2_state *x, double h, const double_pendulum_const_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     double_pendulum_const_k2s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < double_pendulum_const_k2s2_S; j++)
+    for (i = 0; i < double_pendulum_const_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + double_pendulum_const_k2s2_E[(j * S + i) * S + d];
+      for (d = double_pendulum_const_k2s2_S - 1; d >= 0; d--) e = e * r + double_pendulum_const_k2s2_E[(j * double_pendulum_const_k2s2_S + i) * double_pendulum_const_k2s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[j * double_pendulum_const_k2s2_M + l] += e * x->gam[i * double_pendulum_const_k2s2_M + l];
     }
 }
 
@@ -470,60 +490,63 @@ static void double_pendulum_const_k2s2_add(double *a, double *c, double b)
 int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double h_, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = double_pendulum_const_k2s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_const_k2s2_EBADSTEP;
   double_pendulum_const_k2s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[double_pendulum_const_k2s2_NU];
   double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below double_pendulum_const_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= double_pendulum_const_k2s2_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= double_pendulum_const_k2s2_MAXITER; it++) {
     double_pendulum_const_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
+    for (i = 0; i < double_pendulum_const_k2s2_NU; i++) {
+      double piv = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_const_k2s2_SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
     }
     if (rc == double_pendulum_const_k2s2_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_const_k2s2_ENONFINITE;
     if (rc == double_pendulum_const_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_const_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (double_pendulum_const_k2s2_TOL / 256), or
+     * within 2 ulps (double_pendulum_const_k2s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above double_pendulum_const_k2s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = double_pendulum_const_k2s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? double_pendulum_const_k2s2_OK : double_pendulum_const_k2s2_ENOCONV; break; }
+    if (inc <= double_pendulum_const_k2s2_TOL / 256 || (inc <= double_pendulum_const_k2s2_TOL && 4 * inc > inc_old)) { rc = double_pendulum_const_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= double_pendulum_const_k2s2_STAGTOL ? double_pendulum_const_k2s2_OK : double_pendulum_const_k2s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > double_pendulum_const_k2s2_MAXITER ? double_pendulum_const_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_const_k2s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return double_pendulum_const_k2s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_const_k2s2_ENONFINITE;
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return double_pendulum_const_k2s2_ENONFINITE;
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
     double_pendulum_const_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + i];
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return double_pendulum_const_k2s2_OK;

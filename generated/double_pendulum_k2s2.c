@@ -5,14 +5,27 @@
 
 #include "double_pendulum_k2s2.h"
 
-#define M double_pendulum_k2s2_M
-#define NU double_pendulum_k2s2_NU
-#define S double_pendulum_k2s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(double_pendulum_k2s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define double_pendulum_k2s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef double_pendulum_k2s2_MAXITER
+#define double_pendulum_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef double_pendulum_k2s2_TOL
+#define double_pendulum_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef double_pendulum_k2s2_STAGTOL
+#define double_pendulum_k2s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef double_pendulum_k2s2_SINGTOL
+#define double_pendulum_k2s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef double_pendulum_k2s2_GTOL
+#define double_pendulum_k2s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,22 +49,22 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t1 = gam[4] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x1 */ + t3;
   const double t5 = gam[1] * 0.21132486540518713;
   const double t6 = gam[5] * (-0.28867513459481292);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y1 */ + t8;
   const double t10 = gam[2] * 0.21132486540518713;
   const double t11 = gam[6] * (-0.28867513459481292);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* x2 */ + t13;
   const double t15 = gam[3] * 0.21132486540518713;
   const double t16 = gam[7] * (-0.28867513459481292);
   const double t17 = t15 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[3] + t18;
+  const double t19 = q0[3] /* y2 */ + t18;
   const double t20 = t14 - t4;
   const double t21 = t19 - t9;
   const double t22 = 2.0 * t9;
@@ -61,19 +74,19 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t26 = gam[0] * 0.78867513459481287;
   const double t27 = t1 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[0] + t28;
+  const double t29 = q0[0] /* x1 */ + t28;
   const double t30 = gam[1] * 0.78867513459481287;
   const double t31 = t6 + t30;
   const double t32 = h * t31;
-  const double t33 = q0[1] + t32;
+  const double t33 = q0[1] /* y1 */ + t32;
   const double t34 = gam[2] * 0.78867513459481287;
   const double t35 = t11 + t34;
   const double t36 = h * t35;
-  const double t37 = q0[2] + t36;
+  const double t37 = q0[2] /* x2 */ + t36;
   const double t38 = gam[3] * 0.78867513459481287;
   const double t39 = t16 + t38;
   const double t40 = h * t39;
-  const double t41 = q0[3] + t40;
+  const double t41 = q0[3] /* y2 */ + t40;
   const double t42 = t37 - t29;
   const double t43 = t41 - t33;
   const double t44 = 2.0 * t33;
@@ -131,22 +144,22 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t95 = 0.28867513459481292 * t87;
   const double t96 = t94 - t95;
   const double t97 = h * t96;
-  const double t98 = p0[0] - t97;
+  const double t98 = p0[0] /* p_x1 */ - t97;
   const double t99 = 0.5 * t81;
   const double t100 = 0.28867513459481292 * t89;
   const double t101 = t99 - t100;
   const double t102 = h * t101;
-  const double t103 = p0[1] - t102;
+  const double t103 = p0[1] /* p_y1 */ - t102;
   const double t104 = 0.5 * t83;
   const double t105 = 0.28867513459481292 * t91;
   const double t106 = t104 - t105;
   const double t107 = h * t106;
-  const double t108 = p0[2] - t107;
+  const double t108 = p0[2] /* p_x2 */ - t107;
   const double t109 = 0.5 * t85;
   const double t110 = 0.28867513459481292 * t93;
   const double t111 = t109 - t110;
   const double t112 = h * t111;
-  const double t113 = p0[3] - t112;
+  const double t113 = p0[3] /* p_y2 */ - t112;
   const double t114 = 0.28867513459481292 * t79;
   const double t115 = h * t114;
   const double t116 = 0.28867513459481292 * t81;
@@ -290,22 +303,22 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t253 = 0.28867513459481292 * t245;
   const double t254 = t252 - t253;
   const double t255 = h * t254;
-  const double t256 = p0[0] - t255;
+  const double t256 = p0[0] /* p_x1 */ - t255;
   const double t257 = 0.5 * t239;
   const double t258 = 0.28867513459481292 * t247;
   const double t259 = t257 - t258;
   const double t260 = h * t259;
-  const double t261 = p0[1] - t260;
+  const double t261 = p0[1] /* p_y1 */ - t260;
   const double t262 = 0.5 * t241;
   const double t263 = 0.28867513459481292 * t249;
   const double t264 = t262 - t263;
   const double t265 = h * t264;
-  const double t266 = p0[2] - t265;
+  const double t266 = p0[2] /* p_x2 */ - t265;
   const double t267 = 0.5 * t243;
   const double t268 = 0.28867513459481292 * t251;
   const double t269 = t267 - t268;
   const double t270 = h * t269;
-  const double t271 = p0[3] - t270;
+  const double t271 = p0[3] /* p_y2 */ - t270;
   const double t272 = 0.28867513459481292 * t237;
   const double t273 = h * t272;
   const double t274 = -t273;
@@ -326,6 +339,7 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t289 = -t288;
   const double t290 = h * t243;
   const double t291 = -t290;
+  /* gam */
   out[0] = t256;
   out[1] = t261;
   out[2] = t266;
@@ -334,10 +348,12 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   out[5] = t277;
   out[6] = t280;
   out[7] = t283;
+  /* dp */
   out[8] = t285;
   out[9] = t287;
   out[10] = t289;
   out[11] = t291;
+  /* lam */
   out[12] = t202;
   out[13] = t203;
   out[14] = t204;
@@ -355,40 +371,40 @@ static void double_pendulum_k2s2_factor(const double *q0, const double *p0, cons
   const double t1 = gam[4] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x1 */ + t3;
   const double t5 = gam[1] * 0.21132486540518713;
   const double t6 = gam[5] * (-0.28867513459481292);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y1 */ + t8;
   const double t10 = gam[2] * 0.21132486540518713;
   const double t11 = gam[6] * (-0.28867513459481292);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* x2 */ + t13;
   const double t15 = gam[3] * 0.21132486540518713;
   const double t16 = gam[7] * (-0.28867513459481292);
   const double t17 = t15 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[3] + t18;
+  const double t19 = q0[3] /* y2 */ + t18;
   const double t20 = t14 - t4;
   const double t21 = t19 - t9;
   const double t22 = gam[0] * 0.78867513459481287;
   const double t23 = t1 + t22;
   const double t24 = h * t23;
-  const double t25 = q0[0] + t24;
+  const double t25 = q0[0] /* x1 */ + t24;
   const double t26 = gam[1] * 0.78867513459481287;
   const double t27 = t6 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[1] + t28;
+  const double t29 = q0[1] /* y1 */ + t28;
   const double t30 = gam[2] * 0.78867513459481287;
   const double t31 = t11 + t30;
   const double t32 = h * t31;
-  const double t33 = q0[2] + t32;
+  const double t33 = q0[2] /* x2 */ + t32;
   const double t34 = gam[3] * 0.78867513459481287;
   const double t35 = t16 + t34;
   const double t36 = h * t35;
-  const double t37 = q0[3] + t36;
+  const double t37 = q0[3] /* y2 */ + t36;
   const double t38 = t33 - t25;
   const double t39 = t37 - t29;
   /* the multiplier matrix A, factored once per step */
@@ -672,6 +688,7 @@ static void double_pendulum_k2s2_factor(const double *q0, const double *p0, cons
   const double t317 = t313 - t316;
   const double t318 = 1.0 / t306;
   const double t319 = 1.0 / t317;
+  /* lu */
   out[0] = t303;
   out[1] = t141;
   out[2] = t109;
@@ -688,10 +705,12 @@ static void double_pendulum_k2s2_factor(const double *q0, const double *p0, cons
   out[13] = t309;
   out[14] = t315;
   out[15] = t319;
+  /* pivot */
   out[16] = t95;
   out[17] = t284;
   out[18] = t306;
   out[19] = t317;
+  /* adiag */
   out[20] = t95;
   out[21] = t227;
   out[22] = t125;
@@ -703,10 +722,11 @@ static void double_pendulum_k2s2_minv_p(const double *q0, const double *p0, cons
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_x2 */;
+  out[3] = p0[3] /* p_y2 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -714,18 +734,18 @@ static void double_pendulum_k2s2_energy_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[1] + q0[3];
+  const double t0 = q0[1] /* y1 */ + q0[3] /* y2 */;
   /* energy */
-  const double t1 = p0[0] * p0[0];
-  const double t2 = p0[1] * p0[1];
+  const double t1 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t2 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t3 = t1 + t2;
-  const double t4 = p0[2] * p0[2];
+  const double t4 = p0[2] /* p_x2 */ * p0[2] /* p_x2 */;
   const double t5 = t3 + t4;
-  const double t6 = p0[3] * p0[3];
+  const double t6 = p0[3] /* p_y2 */ * p0[3] /* p_y2 */;
   const double t7 = t5 + t6;
   const double t8 = 0.5 * t7;
   const double t9 = t0 + t8;
+  /* H */
   out[0] = t9;
 }
 
@@ -734,18 +754,18 @@ static void double_pendulum_k2s2_g(const double *q0, const double *p0, const dou
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[2] - q0[0];
-  const double t1 = q0[3] - q0[1];
+  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
+  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
   /* g(q0) */
-  const double t2 = q0[0] * q0[0];
-  const double t3 = q0[1] * q0[1];
+  const double t2 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t3 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 1.0;
   const double t6 = t0 * t0;
   const double t7 = t1 * t1;
   const double t8 = t6 + t7;
   const double t9 = t8 - 1.0;
+  /* g */
   out[0] = t5;
   out[1] = t9;
 }
@@ -755,25 +775,24 @@ static void double_pendulum_k2s2_hidden_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t6 = t0 * p0[0];
-  const double t7 = t1 * p0[1];
+  const double t6 = t0 * p0[0] /* p_x1 */;
+  const double t7 = t1 * p0[1] /* p_y1 */;
   const double t8 = t6 + t7;
-  const double t9 = t3 * p0[0];
+  const double t9 = t3 * p0[0] /* p_x1 */;
   const double t10 = -t9;
-  const double t11 = t5 * p0[1];
+  const double t11 = t5 * p0[1] /* p_y1 */;
   const double t12 = t10 - t11;
-  const double t13 = t3 * p0[2];
+  const double t13 = t3 * p0[2] /* p_x2 */;
   const double t14 = t12 + t13;
-  const double t15 = t5 * p0[3];
+  const double t15 = t5 * p0[3] /* p_y2 */;
   const double t16 = t14 + t15;
+  /* hidden */
   out[0] = t8;
   out[1] = t16;
 }
@@ -784,14 +803,12 @@ static void double_pendulum_k2s2_lambda0(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t6 = t0 * t0;
   const double t7 = t0 * t3;
   const double t8 = -t7;
@@ -808,23 +825,23 @@ static void double_pendulum_k2s2_lambda0(const double *q0, const double *p0, con
   const double t19 = t12 * t18;
   const double t20 = t17 - t19;
   /* consistent initial multiplier */
-  const double t21 = 2.0 * p0[0];
-  const double t22 = 2.0 * p0[1];
-  const double t23 = p0[0] * t21;
-  const double t24 = p0[1] * t22;
+  const double t21 = 2.0 * p0[0] /* p_x1 */;
+  const double t22 = 2.0 * p0[1] /* p_y1 */;
+  const double t23 = p0[0] /* p_x1 */ * t21;
+  const double t24 = p0[1] /* p_y1 */ * t22;
   const double t25 = t23 + t24;
   const double t26 = t25 - t1;
-  const double t27 = p0[3] - p0[1];
-  const double t28 = p0[2] - p0[0];
+  const double t27 = p0[3] /* p_y2 */ - p0[1] /* p_y1 */;
+  const double t28 = p0[2] /* p_x2 */ - p0[0] /* p_x1 */;
   const double t29 = 2.0 * t28;
   const double t30 = 2.0 * t27;
-  const double t31 = p0[0] * t29;
+  const double t31 = p0[0] /* p_x1 */ * t29;
   const double t32 = -t31;
-  const double t33 = p0[1] * t30;
+  const double t33 = p0[1] /* p_y1 */ * t30;
   const double t34 = t32 - t33;
-  const double t35 = p0[2] * t29;
+  const double t35 = p0[2] /* p_x2 */ * t29;
   const double t36 = t34 + t35;
-  const double t37 = p0[3] * t30;
+  const double t37 = p0[3] /* p_y2 */ * t30;
   const double t38 = t36 + t37;
   const double t39 = t18 * t26;
   const double t40 = t38 - t39;
@@ -832,6 +849,7 @@ static void double_pendulum_k2s2_lambda0(const double *q0, const double *p0, con
   const double t42 = t12 * t41;
   const double t43 = t26 - t42;
   const double t44 = t43 / t10;
+  /* lambda */
   out[0] = t44;
   out[1] = t41;
 }
@@ -843,12 +861,11 @@ static void double_pendulum_k2s2_project(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t6 = t0 * t0;
@@ -863,16 +880,16 @@ static void double_pendulum_k2s2_project(const double *q0, const double *p0, con
   const double t15 = t13 + t14;
   const double t16 = t13 + t15;
   const double t17 = t14 + t16;
-  const double t18 = t0 * p0[0];
-  const double t19 = t1 * p0[1];
+  const double t18 = t0 * p0[0] /* p_x1 */;
+  const double t19 = t1 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t3 * p0[0];
+  const double t21 = t3 * p0[0] /* p_x1 */;
   const double t22 = -t21;
-  const double t23 = t5 * p0[1];
+  const double t23 = t5 * p0[1] /* p_y1 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[2];
+  const double t25 = t3 * p0[2] /* p_x2 */;
   const double t26 = t24 + t25;
-  const double t27 = t5 * p0[3];
+  const double t27 = t5 * p0[3] /* p_y2 */;
   const double t28 = t26 + t27;
   const double t29 = t12 / t10;
   const double t30 = t12 * t29;
@@ -887,14 +904,14 @@ static void double_pendulum_k2s2_project(const double *q0, const double *p0, con
   const double t39 = t3 * t34;
   const double t40 = -t39;
   const double t41 = t39 - t38;
-  const double t42 = p0[0] + t41;
+  const double t42 = p0[0] /* p_x1 */ + t41;
   const double t43 = t1 * t37;
   const double t44 = t5 * t34;
   const double t45 = -t44;
   const double t46 = t44 - t43;
-  const double t47 = p0[1] + t46;
-  const double t48 = p0[2] - t39;
-  const double t49 = p0[3] - t44;
+  const double t47 = p0[1] /* p_y1 */ + t46;
+  const double t48 = p0[2] /* p_x2 */ - t39;
+  const double t49 = p0[3] /* p_y2 */ - t44;
   const double t50 = t42 * t42;
   const double t51 = t47 * t47;
   const double t52 = t50 + t51;
@@ -903,15 +920,20 @@ static void double_pendulum_k2s2_project(const double *q0, const double *p0, con
   const double t55 = t49 * t49;
   const double t56 = t54 + t55;
   const double t57 = 0.5 * t56;
-  const double t58 = q0[1] + q0[3];
+  const double t58 = q0[1] /* y1 */ + q0[3] /* y2 */;
+  /* dp */
   out[0] = t41;
   out[1] = t46;
   out[2] = t40;
   out[3] = t45;
+  /* kin */
   out[4] = t57;
+  /* U */
   out[5] = t58;
+  /* pivot */
   out[6] = t10;
   out[7] = t31;
+  /* adiag */
   out[8] = t10;
   out[9] = t17;
 }
@@ -925,20 +947,20 @@ void double_pendulum_k2s2_init(double_pendulum_k2s2_state *x, const double *q0, 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k2s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : double_pendulum_k2s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : double_pendulum_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (double_pendulum_k2s2_NU ? double_pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double_pendulum_k2s2_params prm;
-    double lam[NU];
+    double lam[double_pendulum_k2s2_NU];
     double_pendulum_k2s2_params_default(&prm);
     double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < double_pendulum_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -954,32 +976,32 @@ const char *double_pendulum_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) double_pendulum_k2s2_params dflt_; if (!prm) { double_pendulum_k2s2_params_default(&dflt_); prm = &dflt_; }
+#define double_pendulum_k2s2_DEFAULT_PARAMS(prm) double_pendulum_k2s2_params dflt_; if (!prm) { double_pendulum_k2s2_params_default(&dflt_); prm = &dflt_; }
 
 double double_pendulum_k2s2_energy(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k2s2_DEFAULT_PARAMS(prm)
   double_pendulum_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void double_pendulum_k2s2_constraints(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[double_pendulum_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k2s2_DEFAULT_PARAMS(prm)
   double_pendulum_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < double_pendulum_k2s2_NU; i++) g[i] = v[i];
 }
 
 void double_pendulum_k2s2_hidden(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[double_pendulum_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k2s2_DEFAULT_PARAMS(prm)
   double_pendulum_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < double_pendulum_k2s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -987,17 +1009,17 @@ void double_pendulum_k2s2_hidden(const double_pendulum_k2s2_state *x, const doub
 static void double_pendulum_k2s2_predict(const double_pendulum_k2s2_state *x, double h, const double_pendulum_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     double_pendulum_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < double_pendulum_k2s2_S; j++)
+    for (i = 0; i < double_pendulum_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + double_pendulum_k2s2_E[(j * S + i) * S + d];
+      for (d = double_pendulum_k2s2_S - 1; d >= 0; d--) e = e * r + double_pendulum_k2s2_E[(j * double_pendulum_k2s2_S + i) * double_pendulum_k2s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < double_pendulum_k2s2_M; l++) gam[j * double_pendulum_k2s2_M + l] += e * x->gam[i * double_pendulum_k2s2_M + l];
     }
 }
 
@@ -1014,100 +1036,101 @@ static void double_pendulum_k2s2_add(double *a, double *c, double b)
 int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double h_, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = double_pendulum_k2s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k2s2_EBADSTEP;
   double_pendulum_k2s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[double_pendulum_k2s2_NU];
   double_pendulum_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below double_pendulum_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[16 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= double_pendulum_k2s2_GTOL ? 0 : g0[i] / h;
+  double fa[16 + 2 * double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1], lam[double_pendulum_k2s2_S * double_pendulum_k2s2_NU];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   double_pendulum_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[16 + i], dia = fa[16 + S * NU + i];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) {
+    double piv = fa[16 + i], dia = fa[16 + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return double_pendulum_k2s2_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
+    if (!(fabs(piv) > double_pendulum_k2s2_SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= double_pendulum_k2s2_MAXITER; it++) {
     double_pendulum_k2s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < double_pendulum_k2s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + i];
+    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k2s2_ENONFINITE;
     if (rc == double_pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (double_pendulum_k2s2_TOL / 256), or
+     * within 2 ulps (double_pendulum_k2s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above double_pendulum_k2s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = double_pendulum_k2s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? double_pendulum_k2s2_OK : double_pendulum_k2s2_ENOCONV; break; }
+    if (inc <= double_pendulum_k2s2_TOL / 256 || (inc <= double_pendulum_k2s2_TOL && 4 * inc > inc_old)) { rc = double_pendulum_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= double_pendulum_k2s2_STAGTOL ? double_pendulum_k2s2_OK : double_pendulum_k2s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_k2s2_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
+  double q1[double_pendulum_k2s2_M], p1[double_pendulum_k2s2_M], pr[double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k2s2_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[double_pendulum_k2s2_M], pc1[double_pendulum_k2s2_M];
+  for (i = 0; i < double_pendulum_k2s2_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     double_pendulum_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
-    double_pendulum_k2s2_add(&p1[i], &pc1[i], sw[S * M + i]);
+    double_pendulum_k2s2_add(&p1[i], &pc1[i], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k2s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
+  for (i = 0; i < double_pendulum_k2s2_NU; i++) {
+    double piv = pr[double_pendulum_k2s2_M + 2 + i], dia = pr[double_pendulum_k2s2_M + 2 + double_pendulum_k2s2_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k2s2_SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU; i++)
     if (!isfinite(pr[i])) return double_pendulum_k2s2_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[double_pendulum_k2s2_M + 0];
+  U1 = pr[double_pendulum_k2s2_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * double_pendulum_k2s2_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k2s2_M; i++) {
     double_pendulum_k2s2_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return double_pendulum_k2s2_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k2s2_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[double_pendulum_k2s2_NU];
     double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < double_pendulum_k2s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   double_pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;

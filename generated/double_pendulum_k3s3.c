@@ -5,14 +5,27 @@
 
 #include "double_pendulum_k3s3.h"
 
-#define M double_pendulum_k3s3_M
-#define NU double_pendulum_k3s3_NU
-#define S double_pendulum_k3s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(double_pendulum_k3s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define double_pendulum_k3s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef double_pendulum_k3s3_MAXITER
+#define double_pendulum_k3s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef double_pendulum_k3s3_TOL
+#define double_pendulum_k3s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef double_pendulum_k3s3_STAGTOL
+#define double_pendulum_k3s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef double_pendulum_k3s3_SINGTOL
+#define double_pendulum_k3s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef double_pendulum_k3s3_GTOL
+#define double_pendulum_k3s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -44,28 +57,28 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t7 = gam[8] * 0.1732050807568877;
   const double t8 = t6 + t7;
   const double t9 = h * t8;
-  const double t10 = q0[0] + t9;
+  const double t10 = q0[0] /* x1 */ + t9;
   const double t11 = gam[1] * 0.1127016653792583;
   const double t12 = gam[5] * (-0.17320508075688779);
   const double t13 = t11 + t12;
   const double t14 = gam[9] * 0.1732050807568877;
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y1 */ + t16;
   const double t18 = gam[2] * 0.1127016653792583;
   const double t19 = gam[6] * (-0.17320508075688779);
   const double t20 = t18 + t19;
   const double t21 = gam[10] * 0.1732050807568877;
   const double t22 = t20 + t21;
   const double t23 = h * t22;
-  const double t24 = q0[2] + t23;
+  const double t24 = q0[2] /* x2 */ + t23;
   const double t25 = gam[3] * 0.1127016653792583;
   const double t26 = gam[7] * (-0.17320508075688779);
   const double t27 = t25 + t26;
   const double t28 = gam[11] * 0.1732050807568877;
   const double t29 = t27 + t28;
   const double t30 = h * t29;
-  const double t31 = q0[3] + t30;
+  const double t31 = q0[3] /* y2 */ + t30;
   const double t32 = t24 - t10;
   const double t33 = t31 - t17;
   const double t34 = 2.0 * t17;
@@ -75,19 +88,19 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t38 = gam[4] * (-0.43301270189221935);
   const double t39 = t0 + t38;
   const double t40 = h * t39;
-  const double t41 = q0[0] + t40;
+  const double t41 = q0[0] /* x1 */ + t40;
   const double t42 = gam[5] * (-0.43301270189221935);
   const double t43 = t1 + t42;
   const double t44 = h * t43;
-  const double t45 = q0[1] + t44;
+  const double t45 = q0[1] /* y1 */ + t44;
   const double t46 = gam[6] * (-0.43301270189221935);
   const double t47 = t2 + t46;
   const double t48 = h * t47;
-  const double t49 = q0[2] + t48;
+  const double t49 = q0[2] /* x2 */ + t48;
   const double t50 = gam[7] * (-0.43301270189221935);
   const double t51 = t3 + t50;
   const double t52 = h * t51;
-  const double t53 = q0[3] + t52;
+  const double t53 = q0[3] /* y2 */ + t52;
   const double t54 = t49 - t41;
   const double t55 = t53 - t45;
   const double t56 = 2.0 * t45;
@@ -99,25 +112,25 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t62 = gam[8] * (-0.1732050807568877);
   const double t63 = t61 + t62;
   const double t64 = h * t63;
-  const double t65 = q0[0] + t64;
+  const double t65 = q0[0] /* x1 */ + t64;
   const double t66 = gam[1] * 0.8872983346207417;
   const double t67 = t12 + t66;
   const double t68 = gam[9] * (-0.1732050807568877);
   const double t69 = t67 + t68;
   const double t70 = h * t69;
-  const double t71 = q0[1] + t70;
+  const double t71 = q0[1] /* y1 */ + t70;
   const double t72 = gam[2] * 0.8872983346207417;
   const double t73 = t19 + t72;
   const double t74 = gam[10] * (-0.1732050807568877);
   const double t75 = t73 + t74;
   const double t76 = h * t75;
-  const double t77 = q0[2] + t76;
+  const double t77 = q0[2] /* x2 */ + t76;
   const double t78 = gam[3] * 0.8872983346207417;
   const double t79 = t26 + t78;
   const double t80 = gam[11] * (-0.1732050807568877);
   const double t81 = t79 + t80;
   const double t82 = h * t81;
-  const double t83 = q0[3] + t82;
+  const double t83 = q0[3] /* y2 */ + t82;
   const double t84 = t77 - t65;
   const double t85 = t83 - t71;
   const double t86 = 2.0 * t71;
@@ -219,22 +232,22 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t181 = 0.28867513459481292 * t165;
   const double t182 = t180 - t181;
   const double t183 = h * t182;
-  const double t184 = p0[0] - t183;
+  const double t184 = p0[0] /* p_x1 */ - t183;
   const double t185 = 0.5 * t159;
   const double t186 = 0.28867513459481292 * t167;
   const double t187 = t185 - t186;
   const double t188 = h * t187;
-  const double t189 = p0[1] - t188;
+  const double t189 = p0[1] /* p_y1 */ - t188;
   const double t190 = 0.5 * t161;
   const double t191 = 0.28867513459481292 * t169;
   const double t192 = t190 - t191;
   const double t193 = h * t192;
-  const double t194 = p0[2] - t193;
+  const double t194 = p0[2] /* p_x2 */ - t193;
   const double t195 = 0.5 * t163;
   const double t196 = 0.28867513459481292 * t171;
   const double t197 = t195 - t196;
   const double t198 = h * t197;
-  const double t199 = p0[3] - t198;
+  const double t199 = p0[3] /* p_y2 */ - t198;
   const double t200 = 0.28867513459481292 * t157;
   const double t201 = 0.12909944487358055 * t173;
   const double t202 = t200 - t201;
@@ -523,22 +536,22 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t484 = 0.28867513459481292 * t468;
   const double t485 = t483 - t484;
   const double t486 = h * t485;
-  const double t487 = p0[0] - t486;
+  const double t487 = p0[0] /* p_x1 */ - t486;
   const double t488 = 0.5 * t462;
   const double t489 = 0.28867513459481292 * t470;
   const double t490 = t488 - t489;
   const double t491 = h * t490;
-  const double t492 = p0[1] - t491;
+  const double t492 = p0[1] /* p_y1 */ - t491;
   const double t493 = 0.5 * t464;
   const double t494 = 0.28867513459481292 * t472;
   const double t495 = t493 - t494;
   const double t496 = h * t495;
-  const double t497 = p0[2] - t496;
+  const double t497 = p0[2] /* p_x2 */ - t496;
   const double t498 = 0.5 * t466;
   const double t499 = 0.28867513459481292 * t474;
   const double t500 = t498 - t499;
   const double t501 = h * t500;
-  const double t502 = p0[3] - t501;
+  const double t502 = p0[3] /* p_y2 */ - t501;
   const double t503 = 0.28867513459481292 * t460;
   const double t504 = 0.12909944487358055 * t476;
   const double t505 = t503 - t504;
@@ -579,6 +592,7 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t540 = -t539;
   const double t541 = h * t466;
   const double t542 = -t541;
+  /* gam */
   out[0] = t487;
   out[1] = t492;
   out[2] = t497;
@@ -591,10 +605,12 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   out[9] = t528;
   out[10] = t531;
   out[11] = t534;
+  /* dp */
   out[12] = t536;
   out[13] = t538;
   out[14] = t540;
   out[15] = t542;
+  /* lam */
   out[16] = t387;
   out[17] = t388;
   out[18] = t389;
@@ -621,46 +637,46 @@ static void double_pendulum_k3s3_factor(const double *q0, const double *p0, cons
   const double t7 = gam[8] * 0.1732050807568877;
   const double t8 = t6 + t7;
   const double t9 = h * t8;
-  const double t10 = q0[0] + t9;
+  const double t10 = q0[0] /* x1 */ + t9;
   const double t11 = gam[1] * 0.1127016653792583;
   const double t12 = gam[5] * (-0.17320508075688779);
   const double t13 = t11 + t12;
   const double t14 = gam[9] * 0.1732050807568877;
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y1 */ + t16;
   const double t18 = gam[2] * 0.1127016653792583;
   const double t19 = gam[6] * (-0.17320508075688779);
   const double t20 = t18 + t19;
   const double t21 = gam[10] * 0.1732050807568877;
   const double t22 = t20 + t21;
   const double t23 = h * t22;
-  const double t24 = q0[2] + t23;
+  const double t24 = q0[2] /* x2 */ + t23;
   const double t25 = gam[3] * 0.1127016653792583;
   const double t26 = gam[7] * (-0.17320508075688779);
   const double t27 = t25 + t26;
   const double t28 = gam[11] * 0.1732050807568877;
   const double t29 = t27 + t28;
   const double t30 = h * t29;
-  const double t31 = q0[3] + t30;
+  const double t31 = q0[3] /* y2 */ + t30;
   const double t32 = t24 - t10;
   const double t33 = t31 - t17;
   const double t34 = gam[4] * (-0.43301270189221935);
   const double t35 = t0 + t34;
   const double t36 = h * t35;
-  const double t37 = q0[0] + t36;
+  const double t37 = q0[0] /* x1 */ + t36;
   const double t38 = gam[5] * (-0.43301270189221935);
   const double t39 = t1 + t38;
   const double t40 = h * t39;
-  const double t41 = q0[1] + t40;
+  const double t41 = q0[1] /* y1 */ + t40;
   const double t42 = gam[6] * (-0.43301270189221935);
   const double t43 = t2 + t42;
   const double t44 = h * t43;
-  const double t45 = q0[2] + t44;
+  const double t45 = q0[2] /* x2 */ + t44;
   const double t46 = gam[7] * (-0.43301270189221935);
   const double t47 = t3 + t46;
   const double t48 = h * t47;
-  const double t49 = q0[3] + t48;
+  const double t49 = q0[3] /* y2 */ + t48;
   const double t50 = t45 - t37;
   const double t51 = t49 - t41;
   const double t52 = gam[0] * 0.8872983346207417;
@@ -668,25 +684,25 @@ static void double_pendulum_k3s3_factor(const double *q0, const double *p0, cons
   const double t54 = gam[8] * (-0.1732050807568877);
   const double t55 = t53 + t54;
   const double t56 = h * t55;
-  const double t57 = q0[0] + t56;
+  const double t57 = q0[0] /* x1 */ + t56;
   const double t58 = gam[1] * 0.8872983346207417;
   const double t59 = t12 + t58;
   const double t60 = gam[9] * (-0.1732050807568877);
   const double t61 = t59 + t60;
   const double t62 = h * t61;
-  const double t63 = q0[1] + t62;
+  const double t63 = q0[1] /* y1 */ + t62;
   const double t64 = gam[2] * 0.8872983346207417;
   const double t65 = t19 + t64;
   const double t66 = gam[10] * (-0.1732050807568877);
   const double t67 = t65 + t66;
   const double t68 = h * t67;
-  const double t69 = q0[2] + t68;
+  const double t69 = q0[2] /* x2 */ + t68;
   const double t70 = gam[3] * 0.8872983346207417;
   const double t71 = t26 + t70;
   const double t72 = gam[11] * (-0.1732050807568877);
   const double t73 = t71 + t72;
   const double t74 = h * t73;
-  const double t75 = q0[3] + t74;
+  const double t75 = q0[3] /* y2 */ + t74;
   const double t76 = t69 - t57;
   const double t77 = t75 - t63;
   /* the multiplier matrix A, factored once per step */
@@ -1593,6 +1609,7 @@ static void double_pendulum_k3s3_factor(const double *q0, const double *p0, cons
   const double t978 = t974 - t977;
   const double t979 = 1.0 / t967;
   const double t980 = 1.0 / t978;
+  /* lu */
   out[0] = t905;
   out[1] = t367;
   out[2] = t245;
@@ -1629,12 +1646,14 @@ static void double_pendulum_k3s3_factor(const double *q0, const double *p0, cons
   out[33] = t970;
   out[34] = t976;
   out[35] = t980;
+  /* pivot */
   out[36] = t221;
   out[37] = t852;
   out[38] = t908;
   out[39] = t945;
   out[40] = t967;
   out[41] = t978;
+  /* adiag */
   out[42] = t221;
   out[43] = t633;
   out[44] = t293;
@@ -1648,10 +1667,11 @@ static void double_pendulum_k3s3_minv_p(const double *q0, const double *p0, cons
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_x2 */;
+  out[3] = p0[3] /* p_y2 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -1659,18 +1679,18 @@ static void double_pendulum_k3s3_energy_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[1] + q0[3];
+  const double t0 = q0[1] /* y1 */ + q0[3] /* y2 */;
   /* energy */
-  const double t1 = p0[0] * p0[0];
-  const double t2 = p0[1] * p0[1];
+  const double t1 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t2 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t3 = t1 + t2;
-  const double t4 = p0[2] * p0[2];
+  const double t4 = p0[2] /* p_x2 */ * p0[2] /* p_x2 */;
   const double t5 = t3 + t4;
-  const double t6 = p0[3] * p0[3];
+  const double t6 = p0[3] /* p_y2 */ * p0[3] /* p_y2 */;
   const double t7 = t5 + t6;
   const double t8 = 0.5 * t7;
   const double t9 = t0 + t8;
+  /* H */
   out[0] = t9;
 }
 
@@ -1679,18 +1699,18 @@ static void double_pendulum_k3s3_g(const double *q0, const double *p0, const dou
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[2] - q0[0];
-  const double t1 = q0[3] - q0[1];
+  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
+  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
   /* g(q0) */
-  const double t2 = q0[0] * q0[0];
-  const double t3 = q0[1] * q0[1];
+  const double t2 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t3 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 1.0;
   const double t6 = t0 * t0;
   const double t7 = t1 * t1;
   const double t8 = t6 + t7;
   const double t9 = t8 - 1.0;
+  /* g */
   out[0] = t5;
   out[1] = t9;
 }
@@ -1700,25 +1720,24 @@ static void double_pendulum_k3s3_hidden_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t6 = t0 * p0[0];
-  const double t7 = t1 * p0[1];
+  const double t6 = t0 * p0[0] /* p_x1 */;
+  const double t7 = t1 * p0[1] /* p_y1 */;
   const double t8 = t6 + t7;
-  const double t9 = t3 * p0[0];
+  const double t9 = t3 * p0[0] /* p_x1 */;
   const double t10 = -t9;
-  const double t11 = t5 * p0[1];
+  const double t11 = t5 * p0[1] /* p_y1 */;
   const double t12 = t10 - t11;
-  const double t13 = t3 * p0[2];
+  const double t13 = t3 * p0[2] /* p_x2 */;
   const double t14 = t12 + t13;
-  const double t15 = t5 * p0[3];
+  const double t15 = t5 * p0[3] /* p_y2 */;
   const double t16 = t14 + t15;
+  /* hidden */
   out[0] = t8;
   out[1] = t16;
 }
@@ -1729,14 +1748,12 @@ static void double_pendulum_k3s3_lambda0(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t6 = t0 * t0;
   const double t7 = t0 * t3;
   const double t8 = -t7;
@@ -1753,23 +1770,23 @@ static void double_pendulum_k3s3_lambda0(const double *q0, const double *p0, con
   const double t19 = t12 * t18;
   const double t20 = t17 - t19;
   /* consistent initial multiplier */
-  const double t21 = 2.0 * p0[0];
-  const double t22 = 2.0 * p0[1];
-  const double t23 = p0[0] * t21;
-  const double t24 = p0[1] * t22;
+  const double t21 = 2.0 * p0[0] /* p_x1 */;
+  const double t22 = 2.0 * p0[1] /* p_y1 */;
+  const double t23 = p0[0] /* p_x1 */ * t21;
+  const double t24 = p0[1] /* p_y1 */ * t22;
   const double t25 = t23 + t24;
   const double t26 = t25 - t1;
-  const double t27 = p0[3] - p0[1];
-  const double t28 = p0[2] - p0[0];
+  const double t27 = p0[3] /* p_y2 */ - p0[1] /* p_y1 */;
+  const double t28 = p0[2] /* p_x2 */ - p0[0] /* p_x1 */;
   const double t29 = 2.0 * t28;
   const double t30 = 2.0 * t27;
-  const double t31 = p0[0] * t29;
+  const double t31 = p0[0] /* p_x1 */ * t29;
   const double t32 = -t31;
-  const double t33 = p0[1] * t30;
+  const double t33 = p0[1] /* p_y1 */ * t30;
   const double t34 = t32 - t33;
-  const double t35 = p0[2] * t29;
+  const double t35 = p0[2] /* p_x2 */ * t29;
   const double t36 = t34 + t35;
-  const double t37 = p0[3] * t30;
+  const double t37 = p0[3] /* p_y2 */ * t30;
   const double t38 = t36 + t37;
   const double t39 = t18 * t26;
   const double t40 = t38 - t39;
@@ -1777,6 +1794,7 @@ static void double_pendulum_k3s3_lambda0(const double *q0, const double *p0, con
   const double t42 = t12 * t41;
   const double t43 = t26 - t42;
   const double t44 = t43 / t10;
+  /* lambda */
   out[0] = t44;
   out[1] = t41;
 }
@@ -1788,12 +1806,11 @@ static void double_pendulum_k3s3_project(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t6 = t0 * t0;
@@ -1808,16 +1825,16 @@ static void double_pendulum_k3s3_project(const double *q0, const double *p0, con
   const double t15 = t13 + t14;
   const double t16 = t13 + t15;
   const double t17 = t14 + t16;
-  const double t18 = t0 * p0[0];
-  const double t19 = t1 * p0[1];
+  const double t18 = t0 * p0[0] /* p_x1 */;
+  const double t19 = t1 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t3 * p0[0];
+  const double t21 = t3 * p0[0] /* p_x1 */;
   const double t22 = -t21;
-  const double t23 = t5 * p0[1];
+  const double t23 = t5 * p0[1] /* p_y1 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[2];
+  const double t25 = t3 * p0[2] /* p_x2 */;
   const double t26 = t24 + t25;
-  const double t27 = t5 * p0[3];
+  const double t27 = t5 * p0[3] /* p_y2 */;
   const double t28 = t26 + t27;
   const double t29 = t12 / t10;
   const double t30 = t12 * t29;
@@ -1832,14 +1849,14 @@ static void double_pendulum_k3s3_project(const double *q0, const double *p0, con
   const double t39 = t3 * t34;
   const double t40 = -t39;
   const double t41 = t39 - t38;
-  const double t42 = p0[0] + t41;
+  const double t42 = p0[0] /* p_x1 */ + t41;
   const double t43 = t1 * t37;
   const double t44 = t5 * t34;
   const double t45 = -t44;
   const double t46 = t44 - t43;
-  const double t47 = p0[1] + t46;
-  const double t48 = p0[2] - t39;
-  const double t49 = p0[3] - t44;
+  const double t47 = p0[1] /* p_y1 */ + t46;
+  const double t48 = p0[2] /* p_x2 */ - t39;
+  const double t49 = p0[3] /* p_y2 */ - t44;
   const double t50 = t42 * t42;
   const double t51 = t47 * t47;
   const double t52 = t50 + t51;
@@ -1848,15 +1865,20 @@ static void double_pendulum_k3s3_project(const double *q0, const double *p0, con
   const double t55 = t49 * t49;
   const double t56 = t54 + t55;
   const double t57 = 0.5 * t56;
-  const double t58 = q0[1] + q0[3];
+  const double t58 = q0[1] /* y1 */ + q0[3] /* y2 */;
+  /* dp */
   out[0] = t41;
   out[1] = t46;
   out[2] = t40;
   out[3] = t45;
+  /* kin */
   out[4] = t57;
+  /* U */
   out[5] = t58;
+  /* pivot */
   out[6] = t10;
   out[7] = t31;
+  /* adiag */
   out[8] = t10;
   out[9] = t17;
 }
@@ -1870,20 +1892,20 @@ void double_pendulum_k3s3_init(double_pendulum_k3s3_state *x, const double *q0, 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k3s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : double_pendulum_k3s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : double_pendulum_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (double_pendulum_k3s3_NU ? double_pendulum_k3s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double_pendulum_k3s3_params prm;
-    double lam[NU];
+    double lam[double_pendulum_k3s3_NU];
     double_pendulum_k3s3_params_default(&prm);
     double_pendulum_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < double_pendulum_k3s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -1899,32 +1921,32 @@ const char *double_pendulum_k3s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) double_pendulum_k3s3_params dflt_; if (!prm) { double_pendulum_k3s3_params_default(&dflt_); prm = &dflt_; }
+#define double_pendulum_k3s3_DEFAULT_PARAMS(prm) double_pendulum_k3s3_params dflt_; if (!prm) { double_pendulum_k3s3_params_default(&dflt_); prm = &dflt_; }
 
 double double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k3s3_DEFAULT_PARAMS(prm)
   double_pendulum_k3s3_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *g)
 {
-  double v[NU];
+  double v[double_pendulum_k3s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k3s3_DEFAULT_PARAMS(prm)
   double_pendulum_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < double_pendulum_k3s3_NU; i++) g[i] = v[i];
 }
 
 void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *gp)
 {
-  double v[NU];
+  double v[double_pendulum_k3s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k3s3_DEFAULT_PARAMS(prm)
   double_pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < double_pendulum_k3s3_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1932,17 +1954,17 @@ void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const doub
 static void double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, const double_pendulum_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     double_pendulum_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < double_pendulum_k3s3_S; j++)
+    for (i = 0; i < double_pendulum_k3s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + double_pendulum_k3s3_E[(j * S + i) * S + d];
+      for (d = double_pendulum_k3s3_S - 1; d >= 0; d--) e = e * r + double_pendulum_k3s3_E[(j * double_pendulum_k3s3_S + i) * double_pendulum_k3s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < double_pendulum_k3s3_M; l++) gam[j * double_pendulum_k3s3_M + l] += e * x->gam[i * double_pendulum_k3s3_M + l];
     }
 }
 
@@ -1959,100 +1981,101 @@ static void double_pendulum_k3s3_add(double *a, double *c, double b)
 int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double h_, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = double_pendulum_k3s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k3s3_EBADSTEP;
   double_pendulum_k3s3_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[double_pendulum_k3s3_NU];
   double_pendulum_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below double_pendulum_k3s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[36 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < double_pendulum_k3s3_NU; i++) g0[i] = fabs(g0[i]) <= double_pendulum_k3s3_GTOL ? 0 : g0[i] / h;
+  double fa[36 + 2 * double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1], lam[double_pendulum_k3s3_S * double_pendulum_k3s3_NU];
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   double_pendulum_k3s3_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[36 + i], dia = fa[36 + S * NU + i];
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++) {
+    double piv = fa[36 + i], dia = fa[36 + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return double_pendulum_k3s3_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return double_pendulum_k3s3_ESINGULAR;
+    if (!(fabs(piv) > double_pendulum_k3s3_SINGTOL * fabs(dia))) return double_pendulum_k3s3_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= double_pendulum_k3s3_MAXITER; it++) {
     double_pendulum_k3s3_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < double_pendulum_k3s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++) lam[i] = sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + i];
+    for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k3s3_ENONFINITE;
     if (rc == double_pendulum_k3s3_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k3s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (double_pendulum_k3s3_TOL / 256), or
+     * within 2 ulps (double_pendulum_k3s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above double_pendulum_k3s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = double_pendulum_k3s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? double_pendulum_k3s3_OK : double_pendulum_k3s3_ENOCONV; break; }
+    if (inc <= double_pendulum_k3s3_TOL / 256 || (inc <= double_pendulum_k3s3_TOL && 4 * inc > inc_old)) { rc = double_pendulum_k3s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= double_pendulum_k3s3_STAGTOL ? double_pendulum_k3s3_OK : double_pendulum_k3s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > double_pendulum_k3s3_MAXITER ? double_pendulum_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_k3s3_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k3s3_ENONFINITE;
+  double q1[double_pendulum_k3s3_M], p1[double_pendulum_k3s3_M], pr[double_pendulum_k3s3_M + 2 + 2 * double_pendulum_k3s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k3s3_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[double_pendulum_k3s3_M], pc1[double_pendulum_k3s3_M];
+  for (i = 0; i < double_pendulum_k3s3_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     double_pendulum_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
-    double_pendulum_k3s3_add(&p1[i], &pc1[i], sw[S * M + i]);
+    double_pendulum_k3s3_add(&p1[i], &pc1[i], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k3s3_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return double_pendulum_k3s3_ESINGULAR;
+  for (i = 0; i < double_pendulum_k3s3_NU; i++) {
+    double piv = pr[double_pendulum_k3s3_M + 2 + i], dia = pr[double_pendulum_k3s3_M + 2 + double_pendulum_k3s3_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k3s3_SINGTOL * fabs(dia))) return double_pendulum_k3s3_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < double_pendulum_k3s3_M + 2 + 2 * double_pendulum_k3s3_NU; i++)
     if (!isfinite(pr[i])) return double_pendulum_k3s3_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[double_pendulum_k3s3_M + 0];
+  U1 = pr[double_pendulum_k3s3_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * double_pendulum_k3s3_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k3s3_M; i++) {
     double_pendulum_k3s3_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return double_pendulum_k3s3_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k3s3_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[double_pendulum_k3s3_NU];
     double_pendulum_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < double_pendulum_k3s3_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   double_pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;

@@ -4,6 +4,10 @@
 #ifndef double_pendulum_k3s3_H
 #define double_pendulum_k3s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define double_pendulum_k3s3_M 4      /* coordinates */
 #define double_pendulum_k3s3_NU 2     /* constraints */
 #define double_pendulum_k3s3_K 3      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void double_pendulum_k3s3_params_default(double_pendulum_k3s3_params *prm);
 int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double h, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
 const char *double_pendulum_k3s3_strerror(int code);
 double double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm);
-void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *g);   /* NU values */
+void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *g);   /* double_pendulum_k3s3_NU values */
 void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "double_pendulum_k4s4.h"
 
-#define M double_pendulum_k4s4_M
-#define NU double_pendulum_k4s4_NU
-#define S double_pendulum_k4s4_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(double_pendulum_k4s4_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define double_pendulum_k4s4_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef double_pendulum_k4s4_MAXITER
+#define double_pendulum_k4s4_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef double_pendulum_k4s4_TOL
+#define double_pendulum_k4s4_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef double_pendulum_k4s4_STAGTOL
+#define double_pendulum_k4s4_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef double_pendulum_k4s4_SINGTOL
+#define double_pendulum_k4s4_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef double_pendulum_k4s4_GTOL
+#define double_pendulum_k4s4_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 4 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -42,7 +55,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t5 = gam[12] * (-0.11572017713039036);
   const double t6 = t4 + t5;
   const double t7 = h * t6;
-  const double t8 = q0[0] + t7;
+  const double t8 = q0[0] /* x1 */ + t7;
   const double t9 = gam[1] * 0.069431844202973714;
   const double t10 = gam[5] * (-0.11190964421690913);
   const double t11 = t9 + t10;
@@ -51,7 +64,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t14 = gam[13] * (-0.11572017713039036);
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y1 */ + t16;
   const double t18 = gam[2] * 0.069431844202973714;
   const double t19 = gam[6] * (-0.11190964421690913);
   const double t20 = t18 + t19;
@@ -60,7 +73,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t23 = gam[14] * (-0.11572017713039036);
   const double t24 = t22 + t23;
   const double t25 = h * t24;
-  const double t26 = q0[2] + t25;
+  const double t26 = q0[2] /* x2 */ + t25;
   const double t27 = gam[3] * 0.069431844202973714;
   const double t28 = gam[7] * (-0.11190964421690913);
   const double t29 = t27 + t28;
@@ -69,7 +82,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t32 = gam[15] * (-0.11572017713039036);
   const double t33 = t31 + t32;
   const double t34 = h * t33;
-  const double t35 = q0[3] + t34;
+  const double t35 = q0[3] /* y2 */ + t34;
   const double t36 = t26 - t8;
   const double t37 = t35 - t17;
   const double t38 = 2.0 * t17;
@@ -84,7 +97,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t47 = gam[12] * 0.06172525241478647;
   const double t48 = t46 + t47;
   const double t49 = h * t48;
-  const double t50 = q0[0] + t49;
+  const double t50 = q0[0] /* x1 */ + t49;
   const double t51 = gam[1] * 0.33000947820757187;
   const double t52 = gam[5] * (-0.38296201508848449);
   const double t53 = t51 + t52;
@@ -93,7 +106,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t56 = gam[13] * 0.06172525241478647;
   const double t57 = t55 + t56;
   const double t58 = h * t57;
-  const double t59 = q0[1] + t58;
+  const double t59 = q0[1] /* y1 */ + t58;
   const double t60 = gam[2] * 0.33000947820757187;
   const double t61 = gam[6] * (-0.38296201508848449);
   const double t62 = t60 + t61;
@@ -102,7 +115,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t65 = gam[14] * 0.06172525241478647;
   const double t66 = t64 + t65;
   const double t67 = h * t66;
-  const double t68 = q0[2] + t67;
+  const double t68 = q0[2] /* x2 */ + t67;
   const double t69 = gam[3] * 0.33000947820757187;
   const double t70 = gam[7] * (-0.38296201508848449);
   const double t71 = t69 + t70;
@@ -111,7 +124,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t74 = gam[15] * 0.06172525241478647;
   const double t75 = t73 + t74;
   const double t76 = h * t75;
-  const double t77 = q0[3] + t76;
+  const double t77 = q0[3] /* y2 */ + t76;
   const double t78 = t68 - t50;
   const double t79 = t77 - t59;
   const double t80 = 2.0 * t59;
@@ -124,28 +137,28 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t87 = t85 + t86;
   const double t88 = t47 + t87;
   const double t89 = h * t88;
-  const double t90 = q0[0] + t89;
+  const double t90 = q0[0] /* x1 */ + t89;
   const double t91 = gam[1] * 0.66999052179242813;
   const double t92 = t52 + t91;
   const double t93 = gam[9] * (-0.16808725200256719);
   const double t94 = t92 + t93;
   const double t95 = t56 + t94;
   const double t96 = h * t95;
-  const double t97 = q0[1] + t96;
+  const double t97 = q0[1] /* y1 */ + t96;
   const double t98 = gam[2] * 0.66999052179242813;
   const double t99 = t61 + t98;
   const double t100 = gam[10] * (-0.16808725200256719);
   const double t101 = t99 + t100;
   const double t102 = t65 + t101;
   const double t103 = h * t102;
-  const double t104 = q0[2] + t103;
+  const double t104 = q0[2] /* x2 */ + t103;
   const double t105 = gam[3] * 0.66999052179242813;
   const double t106 = t70 + t105;
   const double t107 = gam[11] * (-0.16808725200256719);
   const double t108 = t106 + t107;
   const double t109 = t74 + t108;
   const double t110 = h * t109;
-  const double t111 = q0[3] + t110;
+  const double t111 = q0[3] /* y2 */ + t110;
   const double t112 = t104 - t90;
   const double t113 = t111 - t97;
   const double t114 = 2.0 * t97;
@@ -160,7 +173,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t123 = gam[12] * (-0.11572017713039039);
   const double t124 = t122 + t123;
   const double t125 = h * t124;
-  const double t126 = q0[0] + t125;
+  const double t126 = q0[0] /* x1 */ + t125;
   const double t127 = gam[1] * 0.93056815579702623;
   const double t128 = gam[5] * (-0.11190964421690919);
   const double t129 = t127 + t128;
@@ -169,7 +182,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t132 = gam[13] * (-0.11572017713039039);
   const double t133 = t131 + t132;
   const double t134 = h * t133;
-  const double t135 = q0[1] + t134;
+  const double t135 = q0[1] /* y1 */ + t134;
   const double t136 = gam[2] * 0.93056815579702623;
   const double t137 = gam[6] * (-0.11190964421690919);
   const double t138 = t136 + t137;
@@ -178,7 +191,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t141 = gam[14] * (-0.11572017713039039);
   const double t142 = t140 + t141;
   const double t143 = h * t142;
-  const double t144 = q0[2] + t143;
+  const double t144 = q0[2] /* x2 */ + t143;
   const double t145 = gam[3] * 0.93056815579702623;
   const double t146 = gam[7] * (-0.11190964421690919);
   const double t147 = t145 + t146;
@@ -187,7 +200,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t150 = gam[15] * (-0.11572017713039039);
   const double t151 = t149 + t150;
   const double t152 = h * t151;
-  const double t153 = q0[3] + t152;
+  const double t153 = q0[3] /* y2 */ + t152;
   const double t154 = t144 - t126;
   const double t155 = t153 - t135;
   const double t156 = 2.0 * t135;
@@ -383,22 +396,22 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t345 = 0.28867513459481292 * t321;
   const double t346 = t344 - t345;
   const double t347 = h * t346;
-  const double t348 = p0[0] - t347;
+  const double t348 = p0[0] /* p_x1 */ - t347;
   const double t349 = 0.5 * t315;
   const double t350 = 0.28867513459481292 * t323;
   const double t351 = t349 - t350;
   const double t352 = h * t351;
-  const double t353 = p0[1] - t352;
+  const double t353 = p0[1] /* p_y1 */ - t352;
   const double t354 = 0.5 * t317;
   const double t355 = 0.28867513459481292 * t325;
   const double t356 = t354 - t355;
   const double t357 = h * t356;
-  const double t358 = p0[2] - t357;
+  const double t358 = p0[2] /* p_x2 */ - t357;
   const double t359 = 0.5 * t319;
   const double t360 = 0.28867513459481292 * t327;
   const double t361 = t359 - t360;
   const double t362 = h * t361;
-  const double t363 = p0[3] - t362;
+  const double t363 = p0[3] /* p_y2 */ - t362;
   const double t364 = 0.28867513459481292 * t313;
   const double t365 = 0.12909944487358055 * t329;
   const double t366 = t364 - t365;
@@ -950,22 +963,22 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t911 = 0.28867513459481292 * t887;
   const double t912 = t910 - t911;
   const double t913 = h * t912;
-  const double t914 = p0[0] - t913;
+  const double t914 = p0[0] /* p_x1 */ - t913;
   const double t915 = 0.5 * t881;
   const double t916 = 0.28867513459481292 * t889;
   const double t917 = t915 - t916;
   const double t918 = h * t917;
-  const double t919 = p0[1] - t918;
+  const double t919 = p0[1] /* p_y1 */ - t918;
   const double t920 = 0.5 * t883;
   const double t921 = 0.28867513459481292 * t891;
   const double t922 = t920 - t921;
   const double t923 = h * t922;
-  const double t924 = p0[2] - t923;
+  const double t924 = p0[2] /* p_x2 */ - t923;
   const double t925 = 0.5 * t885;
   const double t926 = 0.28867513459481292 * t893;
   const double t927 = t925 - t926;
   const double t928 = h * t927;
-  const double t929 = p0[3] - t928;
+  const double t929 = p0[3] /* p_y2 */ - t928;
   const double t930 = 0.28867513459481292 * t879;
   const double t931 = 0.12909944487358055 * t895;
   const double t932 = t930 - t931;
@@ -1026,6 +1039,7 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t987 = -t986;
   const double t988 = h * t885;
   const double t989 = -t988;
+  /* gam */
   out[0] = t914;
   out[1] = t919;
   out[2] = t924;
@@ -1042,10 +1056,12 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   out[13] = t975;
   out[14] = t978;
   out[15] = t981;
+  /* dp */
   out[16] = t983;
   out[17] = t985;
   out[18] = t987;
   out[19] = t989;
+  /* lam */
   out[20] = t718;
   out[21] = t719;
   out[22] = t720;
@@ -1071,7 +1087,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t5 = gam[12] * (-0.11572017713039036);
   const double t6 = t4 + t5;
   const double t7 = h * t6;
-  const double t8 = q0[0] + t7;
+  const double t8 = q0[0] /* x1 */ + t7;
   const double t9 = gam[1] * 0.069431844202973714;
   const double t10 = gam[5] * (-0.11190964421690913);
   const double t11 = t9 + t10;
@@ -1080,7 +1096,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t14 = gam[13] * (-0.11572017713039036);
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y1 */ + t16;
   const double t18 = gam[2] * 0.069431844202973714;
   const double t19 = gam[6] * (-0.11190964421690913);
   const double t20 = t18 + t19;
@@ -1089,7 +1105,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t23 = gam[14] * (-0.11572017713039036);
   const double t24 = t22 + t23;
   const double t25 = h * t24;
-  const double t26 = q0[2] + t25;
+  const double t26 = q0[2] /* x2 */ + t25;
   const double t27 = gam[3] * 0.069431844202973714;
   const double t28 = gam[7] * (-0.11190964421690913);
   const double t29 = t27 + t28;
@@ -1098,7 +1114,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t32 = gam[15] * (-0.11572017713039036);
   const double t33 = t31 + t32;
   const double t34 = h * t33;
-  const double t35 = q0[3] + t34;
+  const double t35 = q0[3] /* y2 */ + t34;
   const double t36 = t26 - t8;
   const double t37 = t35 - t17;
   const double t38 = gam[0] * 0.33000947820757187;
@@ -1109,7 +1125,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t43 = gam[12] * 0.06172525241478647;
   const double t44 = t42 + t43;
   const double t45 = h * t44;
-  const double t46 = q0[0] + t45;
+  const double t46 = q0[0] /* x1 */ + t45;
   const double t47 = gam[1] * 0.33000947820757187;
   const double t48 = gam[5] * (-0.38296201508848449);
   const double t49 = t47 + t48;
@@ -1118,7 +1134,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t52 = gam[13] * 0.06172525241478647;
   const double t53 = t51 + t52;
   const double t54 = h * t53;
-  const double t55 = q0[1] + t54;
+  const double t55 = q0[1] /* y1 */ + t54;
   const double t56 = gam[2] * 0.33000947820757187;
   const double t57 = gam[6] * (-0.38296201508848449);
   const double t58 = t56 + t57;
@@ -1127,7 +1143,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t61 = gam[14] * 0.06172525241478647;
   const double t62 = t60 + t61;
   const double t63 = h * t62;
-  const double t64 = q0[2] + t63;
+  const double t64 = q0[2] /* x2 */ + t63;
   const double t65 = gam[3] * 0.33000947820757187;
   const double t66 = gam[7] * (-0.38296201508848449);
   const double t67 = t65 + t66;
@@ -1136,7 +1152,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t70 = gam[15] * 0.06172525241478647;
   const double t71 = t69 + t70;
   const double t72 = h * t71;
-  const double t73 = q0[3] + t72;
+  const double t73 = q0[3] /* y2 */ + t72;
   const double t74 = t64 - t46;
   const double t75 = t73 - t55;
   const double t76 = gam[0] * 0.66999052179242813;
@@ -1145,28 +1161,28 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t79 = t77 + t78;
   const double t80 = t43 + t79;
   const double t81 = h * t80;
-  const double t82 = q0[0] + t81;
+  const double t82 = q0[0] /* x1 */ + t81;
   const double t83 = gam[1] * 0.66999052179242813;
   const double t84 = t48 + t83;
   const double t85 = gam[9] * (-0.16808725200256719);
   const double t86 = t84 + t85;
   const double t87 = t52 + t86;
   const double t88 = h * t87;
-  const double t89 = q0[1] + t88;
+  const double t89 = q0[1] /* y1 */ + t88;
   const double t90 = gam[2] * 0.66999052179242813;
   const double t91 = t57 + t90;
   const double t92 = gam[10] * (-0.16808725200256719);
   const double t93 = t91 + t92;
   const double t94 = t61 + t93;
   const double t95 = h * t94;
-  const double t96 = q0[2] + t95;
+  const double t96 = q0[2] /* x2 */ + t95;
   const double t97 = gam[3] * 0.66999052179242813;
   const double t98 = t66 + t97;
   const double t99 = gam[11] * (-0.16808725200256719);
   const double t100 = t98 + t99;
   const double t101 = t70 + t100;
   const double t102 = h * t101;
-  const double t103 = q0[3] + t102;
+  const double t103 = q0[3] /* y2 */ + t102;
   const double t104 = t96 - t82;
   const double t105 = t103 - t89;
   const double t106 = gam[0] * 0.93056815579702623;
@@ -1177,7 +1193,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t111 = gam[12] * (-0.11572017713039039);
   const double t112 = t110 + t111;
   const double t113 = h * t112;
-  const double t114 = q0[0] + t113;
+  const double t114 = q0[0] /* x1 */ + t113;
   const double t115 = gam[1] * 0.93056815579702623;
   const double t116 = gam[5] * (-0.11190964421690919);
   const double t117 = t115 + t116;
@@ -1186,7 +1202,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t120 = gam[13] * (-0.11572017713039039);
   const double t121 = t119 + t120;
   const double t122 = h * t121;
-  const double t123 = q0[1] + t122;
+  const double t123 = q0[1] /* y1 */ + t122;
   const double t124 = gam[2] * 0.93056815579702623;
   const double t125 = gam[6] * (-0.11190964421690919);
   const double t126 = t124 + t125;
@@ -1195,7 +1211,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t129 = gam[14] * (-0.11572017713039039);
   const double t130 = t128 + t129;
   const double t131 = h * t130;
-  const double t132 = q0[2] + t131;
+  const double t132 = q0[2] /* x2 */ + t131;
   const double t133 = gam[3] * 0.93056815579702623;
   const double t134 = gam[7] * (-0.11190964421690919);
   const double t135 = t133 + t134;
@@ -1204,7 +1220,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t138 = gam[15] * (-0.11572017713039039);
   const double t139 = t137 + t138;
   const double t140 = h * t139;
-  const double t141 = q0[3] + t140;
+  const double t141 = q0[3] /* y2 */ + t140;
   const double t142 = t132 - t114;
   const double t143 = t141 - t123;
   /* the multiplier matrix A, factored once per step */
@@ -3133,6 +3149,7 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   const double t1998 = t497 * t925;
   const double t1999 = t1997 + t1998;
   w[2] = t1999;
+  /* lu */
   out[1] = t869;
   out[2] = t573;
   out[3] = t903;
@@ -3140,7 +3157,9 @@ static void double_pendulum_k4s4_factor_part0(const double *q0, const double *p0
   out[5] = t937;
   out[6] = t641;
   out[7] = t971;
+  /* pivot */
   out[64] = t539;
+  /* adiag */
   out[72] = t539;
   out[73] = t1471;
   out[74] = t673;
@@ -3477,7 +3496,9 @@ static void double_pendulum_k4s4_factor_part1(const double *q0, const double *p0
   const double t2319 = t2315 - t2318;
   const double t2320 = 1.0 / t2308;
   const double t2321 = 1.0 / t2319;
+  /* lu */
   out[0] = t2111;
+  /* lu */
   out[8] = t2006;
   out[9] = t2190;
   out[10] = t2010;
@@ -3534,6 +3555,7 @@ static void double_pendulum_k4s4_factor_part1(const double *q0, const double *p0
   out[61] = t2311;
   out[62] = t2317;
   out[63] = t2321;
+  /* pivot */
   out[65] = t2008;
   out[66] = t2114;
   out[67] = t2193;
@@ -3541,6 +3563,7 @@ static void double_pendulum_k4s4_factor_part1(const double *q0, const double *p0
   out[69] = t2286;
   out[70] = t2308;
   out[71] = t2319;
+  /* adiag */
   out[79] = t2005;
 }
 
@@ -3559,10 +3582,11 @@ static void double_pendulum_k4s4_minv_p(const double *q0, const double *p0, cons
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_x2 */;
+  out[3] = p0[3] /* p_y2 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -3570,18 +3594,18 @@ static void double_pendulum_k4s4_energy_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[1] + q0[3];
+  const double t0 = q0[1] /* y1 */ + q0[3] /* y2 */;
   /* energy */
-  const double t1 = p0[0] * p0[0];
-  const double t2 = p0[1] * p0[1];
+  const double t1 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t2 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t3 = t1 + t2;
-  const double t4 = p0[2] * p0[2];
+  const double t4 = p0[2] /* p_x2 */ * p0[2] /* p_x2 */;
   const double t5 = t3 + t4;
-  const double t6 = p0[3] * p0[3];
+  const double t6 = p0[3] /* p_y2 */ * p0[3] /* p_y2 */;
   const double t7 = t5 + t6;
   const double t8 = 0.5 * t7;
   const double t9 = t0 + t8;
+  /* H */
   out[0] = t9;
 }
 
@@ -3590,18 +3614,18 @@ static void double_pendulum_k4s4_g(const double *q0, const double *p0, const dou
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[2] - q0[0];
-  const double t1 = q0[3] - q0[1];
+  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
+  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
   /* g(q0) */
-  const double t2 = q0[0] * q0[0];
-  const double t3 = q0[1] * q0[1];
+  const double t2 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t3 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 1.0;
   const double t6 = t0 * t0;
   const double t7 = t1 * t1;
   const double t8 = t6 + t7;
   const double t9 = t8 - 1.0;
+  /* g */
   out[0] = t5;
   out[1] = t9;
 }
@@ -3611,25 +3635,24 @@ static void double_pendulum_k4s4_hidden_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t6 = t0 * p0[0];
-  const double t7 = t1 * p0[1];
+  const double t6 = t0 * p0[0] /* p_x1 */;
+  const double t7 = t1 * p0[1] /* p_y1 */;
   const double t8 = t6 + t7;
-  const double t9 = t3 * p0[0];
+  const double t9 = t3 * p0[0] /* p_x1 */;
   const double t10 = -t9;
-  const double t11 = t5 * p0[1];
+  const double t11 = t5 * p0[1] /* p_y1 */;
   const double t12 = t10 - t11;
-  const double t13 = t3 * p0[2];
+  const double t13 = t3 * p0[2] /* p_x2 */;
   const double t14 = t12 + t13;
-  const double t15 = t5 * p0[3];
+  const double t15 = t5 * p0[3] /* p_y2 */;
   const double t16 = t14 + t15;
+  /* hidden */
   out[0] = t8;
   out[1] = t16;
 }
@@ -3640,14 +3663,12 @@ static void double_pendulum_k4s4_lambda0(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t6 = t0 * t0;
   const double t7 = t0 * t3;
   const double t8 = -t7;
@@ -3664,23 +3685,23 @@ static void double_pendulum_k4s4_lambda0(const double *q0, const double *p0, con
   const double t19 = t12 * t18;
   const double t20 = t17 - t19;
   /* consistent initial multiplier */
-  const double t21 = 2.0 * p0[0];
-  const double t22 = 2.0 * p0[1];
-  const double t23 = p0[0] * t21;
-  const double t24 = p0[1] * t22;
+  const double t21 = 2.0 * p0[0] /* p_x1 */;
+  const double t22 = 2.0 * p0[1] /* p_y1 */;
+  const double t23 = p0[0] /* p_x1 */ * t21;
+  const double t24 = p0[1] /* p_y1 */ * t22;
   const double t25 = t23 + t24;
   const double t26 = t25 - t1;
-  const double t27 = p0[3] - p0[1];
-  const double t28 = p0[2] - p0[0];
+  const double t27 = p0[3] /* p_y2 */ - p0[1] /* p_y1 */;
+  const double t28 = p0[2] /* p_x2 */ - p0[0] /* p_x1 */;
   const double t29 = 2.0 * t28;
   const double t30 = 2.0 * t27;
-  const double t31 = p0[0] * t29;
+  const double t31 = p0[0] /* p_x1 */ * t29;
   const double t32 = -t31;
-  const double t33 = p0[1] * t30;
+  const double t33 = p0[1] /* p_y1 */ * t30;
   const double t34 = t32 - t33;
-  const double t35 = p0[2] * t29;
+  const double t35 = p0[2] /* p_x2 */ * t29;
   const double t36 = t34 + t35;
-  const double t37 = p0[3] * t30;
+  const double t37 = p0[3] /* p_y2 */ * t30;
   const double t38 = t36 + t37;
   const double t39 = t18 * t26;
   const double t40 = t38 - t39;
@@ -3688,6 +3709,7 @@ static void double_pendulum_k4s4_lambda0(const double *q0, const double *p0, con
   const double t42 = t12 * t41;
   const double t43 = t26 - t42;
   const double t44 = t43 / t10;
+  /* lambda */
   out[0] = t44;
   out[1] = t41;
 }
@@ -3699,12 +3721,11 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  const double t2 = q0[2] - q0[0];
+  const double t0 = 2.0 * q0[0] /* x1 */;
+  const double t1 = 2.0 * q0[1] /* y1 */;
+  const double t2 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[3] - q0[1];
+  const double t4 = q0[3] /* y2 */ - q0[1] /* y1 */;
   const double t5 = 2.0 * t4;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t6 = t0 * t0;
@@ -3719,16 +3740,16 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
   const double t15 = t13 + t14;
   const double t16 = t13 + t15;
   const double t17 = t14 + t16;
-  const double t18 = t0 * p0[0];
-  const double t19 = t1 * p0[1];
+  const double t18 = t0 * p0[0] /* p_x1 */;
+  const double t19 = t1 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t3 * p0[0];
+  const double t21 = t3 * p0[0] /* p_x1 */;
   const double t22 = -t21;
-  const double t23 = t5 * p0[1];
+  const double t23 = t5 * p0[1] /* p_y1 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[2];
+  const double t25 = t3 * p0[2] /* p_x2 */;
   const double t26 = t24 + t25;
-  const double t27 = t5 * p0[3];
+  const double t27 = t5 * p0[3] /* p_y2 */;
   const double t28 = t26 + t27;
   const double t29 = t12 / t10;
   const double t30 = t12 * t29;
@@ -3743,14 +3764,14 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
   const double t39 = t3 * t34;
   const double t40 = -t39;
   const double t41 = t39 - t38;
-  const double t42 = p0[0] + t41;
+  const double t42 = p0[0] /* p_x1 */ + t41;
   const double t43 = t1 * t37;
   const double t44 = t5 * t34;
   const double t45 = -t44;
   const double t46 = t44 - t43;
-  const double t47 = p0[1] + t46;
-  const double t48 = p0[2] - t39;
-  const double t49 = p0[3] - t44;
+  const double t47 = p0[1] /* p_y1 */ + t46;
+  const double t48 = p0[2] /* p_x2 */ - t39;
+  const double t49 = p0[3] /* p_y2 */ - t44;
   const double t50 = t42 * t42;
   const double t51 = t47 * t47;
   const double t52 = t50 + t51;
@@ -3759,15 +3780,20 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
   const double t55 = t49 * t49;
   const double t56 = t54 + t55;
   const double t57 = 0.5 * t56;
-  const double t58 = q0[1] + q0[3];
+  const double t58 = q0[1] /* y1 */ + q0[3] /* y2 */;
+  /* dp */
   out[0] = t41;
   out[1] = t46;
   out[2] = t40;
   out[3] = t45;
+  /* kin */
   out[4] = t57;
+  /* U */
   out[5] = t58;
+  /* pivot */
   out[6] = t10;
   out[7] = t31;
+  /* adiag */
   out[8] = t10;
   out[9] = t17;
 }
@@ -3781,20 +3807,20 @@ void double_pendulum_k4s4_init(double_pendulum_k4s4_state *x, const double *q0, 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : double_pendulum_k4s4_q0[i];
     x->p[i] = p0 ? (double)p0[i] : double_pendulum_k4s4_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (double_pendulum_k4s4_NU ? double_pendulum_k4s4_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double_pendulum_k4s4_params prm;
-    double lam[NU];
+    double lam[double_pendulum_k4s4_NU];
     double_pendulum_k4s4_params_default(&prm);
     double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < double_pendulum_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -3810,32 +3836,32 @@ const char *double_pendulum_k4s4_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) double_pendulum_k4s4_params dflt_; if (!prm) { double_pendulum_k4s4_params_default(&dflt_); prm = &dflt_; }
+#define double_pendulum_k4s4_DEFAULT_PARAMS(prm) double_pendulum_k4s4_params dflt_; if (!prm) { double_pendulum_k4s4_params_default(&dflt_); prm = &dflt_; }
 
 double double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   double_pendulum_k4s4_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *g)
 {
-  double v[NU];
+  double v[double_pendulum_k4s4_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < double_pendulum_k4s4_NU; i++) g[i] = v[i];
 }
 
 void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *gp)
 {
-  double v[NU];
+  double v[double_pendulum_k4s4_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   double_pendulum_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < double_pendulum_k4s4_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -3843,17 +3869,17 @@ void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const doub
 static void double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, double h, const double_pendulum_k4s4_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     double_pendulum_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < double_pendulum_k4s4_S; j++)
+    for (i = 0; i < double_pendulum_k4s4_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + double_pendulum_k4s4_E[(j * S + i) * S + d];
+      for (d = double_pendulum_k4s4_S - 1; d >= 0; d--) e = e * r + double_pendulum_k4s4_E[(j * double_pendulum_k4s4_S + i) * double_pendulum_k4s4_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < double_pendulum_k4s4_M; l++) gam[j * double_pendulum_k4s4_M + l] += e * x->gam[i * double_pendulum_k4s4_M + l];
     }
 }
 
@@ -3870,100 +3896,101 @@ static void double_pendulum_k4s4_add(double *a, double *c, double b)
 int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double h_, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = double_pendulum_k4s4_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k4s4_EBADSTEP;
   double_pendulum_k4s4_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[double_pendulum_k4s4_NU];
   double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below double_pendulum_k4s4_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[64 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_NU; i++) g0[i] = fabs(g0[i]) <= double_pendulum_k4s4_GTOL ? 0 : g0[i] / h;
+  double fa[64 + 2 * double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1], lam[double_pendulum_k4s4_S * double_pendulum_k4s4_NU];
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   double_pendulum_k4s4_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[64 + i], dia = fa[64 + S * NU + i];
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) {
+    double piv = fa[64 + i], dia = fa[64 + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return double_pendulum_k4s4_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return double_pendulum_k4s4_ESINGULAR;
+    if (!(fabs(piv) > double_pendulum_k4s4_SINGTOL * fabs(dia))) return double_pendulum_k4s4_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= double_pendulum_k4s4_MAXITER; it++) {
     double_pendulum_k4s4_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < double_pendulum_k4s4_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + i];
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k4s4_ENONFINITE;
     if (rc == double_pendulum_k4s4_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k4s4_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (double_pendulum_k4s4_TOL / 256), or
+     * within 2 ulps (double_pendulum_k4s4_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above double_pendulum_k4s4_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = double_pendulum_k4s4_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? double_pendulum_k4s4_OK : double_pendulum_k4s4_ENOCONV; break; }
+    if (inc <= double_pendulum_k4s4_TOL / 256 || (inc <= double_pendulum_k4s4_TOL && 4 * inc > inc_old)) { rc = double_pendulum_k4s4_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= double_pendulum_k4s4_STAGTOL ? double_pendulum_k4s4_OK : double_pendulum_k4s4_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > double_pendulum_k4s4_MAXITER ? double_pendulum_k4s4_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_k4s4_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k4s4_ENONFINITE;
+  double q1[double_pendulum_k4s4_M], p1[double_pendulum_k4s4_M], pr[double_pendulum_k4s4_M + 2 + 2 * double_pendulum_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k4s4_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[double_pendulum_k4s4_M], pc1[double_pendulum_k4s4_M];
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     double_pendulum_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
-    double_pendulum_k4s4_add(&p1[i], &pc1[i], sw[S * M + i]);
+    double_pendulum_k4s4_add(&p1[i], &pc1[i], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k4s4_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return double_pendulum_k4s4_ESINGULAR;
+  for (i = 0; i < double_pendulum_k4s4_NU; i++) {
+    double piv = pr[double_pendulum_k4s4_M + 2 + i], dia = pr[double_pendulum_k4s4_M + 2 + double_pendulum_k4s4_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k4s4_SINGTOL * fabs(dia))) return double_pendulum_k4s4_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < double_pendulum_k4s4_M + 2 + 2 * double_pendulum_k4s4_NU; i++)
     if (!isfinite(pr[i])) return double_pendulum_k4s4_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[double_pendulum_k4s4_M + 0];
+  U1 = pr[double_pendulum_k4s4_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * double_pendulum_k4s4_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
     double_pendulum_k4s4_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return double_pendulum_k4s4_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[double_pendulum_k4s4_NU];
     double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < double_pendulum_k4s4_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   double_pendulum_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;

@@ -4,6 +4,10 @@
 #ifndef double_pendulum_k4s4_H
 #define double_pendulum_k4s4_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define double_pendulum_k4s4_M 4      /* coordinates */
 #define double_pendulum_k4s4_NU 2     /* constraints */
 #define double_pendulum_k4s4_K 4      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void double_pendulum_k4s4_params_default(double_pendulum_k4s4_params *prm);
 int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double h, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st);
 const char *double_pendulum_k4s4_strerror(int code);
 double double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm);
-void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *g);   /* NU values */
+void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *g);   /* double_pendulum_k4s4_NU values */
 void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

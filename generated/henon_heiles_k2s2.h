@@ -4,6 +4,10 @@
 #ifndef henon_heiles_k2s2_H
 #define henon_heiles_k2s2_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define henon_heiles_k2s2_M 2      /* coordinates */
 #define henon_heiles_k2s2_NU 0     /* constraints */
 #define henon_heiles_k2s2_K 2      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void henon_heiles_k2s2_params_default(henon_heiles_k2s2_params *prm);
 int henon_heiles_k2s2_step(henon_heiles_k2s2_state *x, double h, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_stats *st);
 const char *henon_heiles_k2s2_strerror(int code);
 double henon_heiles_k2s2_energy(const henon_heiles_k2s2_state *x, const henon_heiles_k2s2_params *prm);
-void henon_heiles_k2s2_constraints(const henon_heiles_k2s2_state *x, const henon_heiles_k2s2_params *prm, double *g);   /* NU values */
+void henon_heiles_k2s2_constraints(const henon_heiles_k2s2_state *x, const henon_heiles_k2s2_params *prm, double *g);   /* henon_heiles_k2s2_NU values */
 void henon_heiles_k2s2_hidden(const henon_heiles_k2s2_state *x, const henon_heiles_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

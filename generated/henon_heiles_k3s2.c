@@ -5,14 +5,27 @@
 
 #include "henon_heiles_k3s2.h"
 
-#define M henon_heiles_k3s2_M
-#define NU henon_heiles_k3s2_NU
-#define S henon_heiles_k3s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(henon_heiles_k3s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define henon_heiles_k3s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef henon_heiles_k3s2_MAXITER
+#define henon_heiles_k3s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef henon_heiles_k3s2_TOL
+#define henon_heiles_k3s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef henon_heiles_k3s2_STAGTOL
+#define henon_heiles_k3s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef henon_heiles_k3s2_SINGTOL
+#define henon_heiles_k3s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef henon_heiles_k3s2_GTOL
+#define henon_heiles_k3s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -37,12 +50,12 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t1 = gam[2] * (-0.17320508075688779);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = t3 + q0[0];
+  const double t4 = t3 + q0[0] /* x */;
   const double t5 = 0.1127016653792583 * gam[1];
   const double t6 = (-0.17320508075688779) * gam[3];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = t8 + q0[1];
+  const double t9 = t8 + q0[1] /* y */;
   const double t10 = t4 * t4;
   const double t11 = t9 * t9;
   const double t12 = 3.0 * t11;
@@ -61,12 +74,12 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t24 = gam[2] * (-0.43301270189221935);
   const double t25 = t23 + t24;
   const double t26 = h * t25;
-  const double t27 = q0[0] + t26;
+  const double t27 = q0[0] /* x */ + t26;
   const double t28 = 0.5 * gam[1];
   const double t29 = gam[3] * (-0.43301270189221935);
   const double t30 = t28 + t29;
   const double t31 = h * t30;
-  const double t32 = q0[1] + t31;
+  const double t32 = q0[1] /* y */ + t31;
   const double t33 = t27 * t27;
   const double t34 = t32 * t32;
   const double t35 = 3.0 * t34;
@@ -84,11 +97,11 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t46 = gam[0] * 0.8872983346207417;
   const double t47 = t1 + t46;
   const double t48 = h * t47;
-  const double t49 = q0[0] + t48;
+  const double t49 = q0[0] /* x */ + t48;
   const double t50 = gam[1] * 0.8872983346207417;
   const double t51 = t6 + t50;
   const double t52 = h * t51;
-  const double t53 = q0[1] + t52;
+  const double t53 = q0[1] /* y */ + t52;
   const double t54 = t49 * t49;
   const double t55 = t53 * t53;
   const double t56 = 3.0 * t55;
@@ -111,12 +124,12 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t72 = t68 * 0.28867513459481292;
   const double t73 = t71 - t72;
   const double t74 = h * t73;
-  const double t75 = p0[0] - t74;
+  const double t75 = p0[0] /* p_x */ - t74;
   const double t76 = 0.5 * t66;
   const double t77 = t70 * 0.28867513459481292;
   const double t78 = t76 - t77;
   const double t79 = h * t78;
-  const double t80 = p0[1] - t79;
+  const double t80 = p0[1] /* p_y */ - t79;
   const double t81 = t64 * 0.28867513459481292;
   const double t82 = h * t81;
   const double t83 = -t82;
@@ -127,10 +140,12 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t88 = -t87;
   const double t89 = h * t66;
   const double t90 = -t89;
+  /* gam */
   out[0] = t75;
   out[1] = t80;
   out[2] = t83;
   out[3] = t86;
+  /* dp */
   out[4] = t88;
   out[5] = t90;
 }
@@ -140,8 +155,9 @@ static void henon_heiles_k3s2_minv_p(const double *q0, const double *p0, const d
     const double *g0, const henon_heiles_k3s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -150,20 +166,21 @@ static void henon_heiles_k3s2_energy_kernel(const double *q0, const double *p0, 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[0] * q0[0];
-  const double t4 = q0[1] * q0[1];
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
   const double t5 = t3 + t4;
   const double t6 = 0.5 * t5;
-  const double t7 = q0[1] * t3;
+  const double t7 = q0[1] /* y */ * t3;
   const double t8 = t6 + t7;
-  const double t9 = q0[1] * q0[1] * q0[1];
+  const double t9 = q0[1] /* y */ * q0[1] /* y */ * q0[1] /* y */;
   const double t10 = t9 / 3.0;
   const double t11 = t8 - t10;
   const double t12 = 0.5 * t2;
   const double t13 = t11 + t12;
+  /* H */
   out[0] = t13;
 }
 
@@ -176,13 +193,13 @@ void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const double *q0, const 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < henon_heiles_k3s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : henon_heiles_k3s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : henon_heiles_k3s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (henon_heiles_k3s2_NU ? henon_heiles_k3s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = 0;
 }
 
 const char *henon_heiles_k3s2_strerror(int code)
@@ -197,12 +214,12 @@ const char *henon_heiles_k3s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) henon_heiles_k3s2_params dflt_; if (!prm) { henon_heiles_k3s2_params_default(&dflt_); prm = &dflt_; }
+#define henon_heiles_k3s2_DEFAULT_PARAMS(prm) henon_heiles_k3s2_params dflt_; if (!prm) { henon_heiles_k3s2_params_default(&dflt_); prm = &dflt_; }
 
 double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  henon_heiles_k3s2_DEFAULT_PARAMS(prm)
   henon_heiles_k3s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -222,17 +239,17 @@ void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heil
 static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, const henon_heiles_k3s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     henon_heiles_k3s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < henon_heiles_k3s2_S; j++)
+    for (i = 0; i < henon_heiles_k3s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + henon_heiles_k3s2_E[(j * S + i) * S + d];
+      for (d = henon_heiles_k3s2_S - 1; d >= 0; d--) e = e * r + henon_heiles_k3s2_E[(j * henon_heiles_k3s2_S + i) * henon_heiles_k3s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < henon_heiles_k3s2_M; l++) gam[j * henon_heiles_k3s2_M + l] += e * x->gam[i * henon_heiles_k3s2_M + l];
     }
 }
 
@@ -249,49 +266,52 @@ static void henon_heiles_k3s2_add(double *a, double *c, double b)
 int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, double h_, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = henon_heiles_k3s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  henon_heiles_k3s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return henon_heiles_k3s2_EBADSTEP;
   henon_heiles_k3s2_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= henon_heiles_k3s2_MAXITER; it++) {
     henon_heiles_k3s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < henon_heiles_k3s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + henon_heiles_k3s2_NU; i++)
       if (!isfinite(sw[i])) rc = henon_heiles_k3s2_ENONFINITE;
     if (rc == henon_heiles_k3s2_ENONFINITE || !isfinite(inc)) { rc = henon_heiles_k3s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (henon_heiles_k3s2_TOL / 256), or
+     * within 2 ulps (henon_heiles_k3s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above henon_heiles_k3s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = henon_heiles_k3s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? henon_heiles_k3s2_OK : henon_heiles_k3s2_ENOCONV; break; }
+    if (inc <= henon_heiles_k3s2_TOL / 256 || (inc <= henon_heiles_k3s2_TOL && 4 * inc > inc_old)) { rc = henon_heiles_k3s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= henon_heiles_k3s2_STAGTOL ? henon_heiles_k3s2_OK : henon_heiles_k3s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it; st->increment = inc; }
   if (rc != henon_heiles_k3s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return henon_heiles_k3s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return henon_heiles_k3s2_ENONFINITE;
+  for (i = 0; i < henon_heiles_k3s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return henon_heiles_k3s2_ENONFINITE;
+  for (i = 0; i < henon_heiles_k3s2_M; i++) {
     henon_heiles_k3s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    henon_heiles_k3s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    henon_heiles_k3s2_add(&x->p[i], &x->pc[i], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < henon_heiles_k3s2_NU; i++) x->lambda[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + i];
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = gam[i];
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return henon_heiles_k3s2_OK;

@@ -5,14 +5,27 @@
 
 #include "kepler_k16s2.h"
 
-#define M kepler_k16s2_M
-#define NU kepler_k16s2_NU
-#define S kepler_k16s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(kepler_k16s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define kepler_k16s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef kepler_k16s2_MAXITER
+#define kepler_k16s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef kepler_k16s2_TOL
+#define kepler_k16s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef kepler_k16s2_STAGTOL
+#define kepler_k16s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef kepler_k16s2_SINGTOL
+#define kepler_k16s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef kepler_k16s2_GTOL
+#define kepler_k16s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 16 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -50,12 +63,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t1 = gam[2] * (-0.0091304148291319609);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = t3 + q0[0];
+  const double t4 = t3 + q0[0] /* x */;
   const double t5 = 0.0052995325041750307 * gam[1];
   const double t6 = (-0.0091304148291319609) * gam[3];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = t8 + q0[1];
+  const double t9 = t8 + q0[1] /* y */;
   const double t10 = t4 * t4;
   const double t11 = t9 * t9;
   const double t12 = t10 + t11;
@@ -77,12 +90,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t27 = gam[2] * (-0.046669254150292716);
   const double t28 = t26 + t27;
   const double t29 = h * t28;
-  const double t30 = q0[0] + t29;
+  const double t30 = q0[0] /* x */ + t29;
   const double t31 = gam[1] * 0.0277124884633837;
   const double t32 = gam[3] * (-0.046669254150292716);
   const double t33 = t31 + t32;
   const double t34 = h * t33;
-  const double t35 = q0[1] + t34;
+  const double t35 = q0[1] /* y */ + t34;
   const double t36 = t30 * t30;
   const double t37 = t35 * t35;
   const double t38 = t36 + t37;
@@ -108,12 +121,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t57 = gam[2] * (-0.10854875923261334);
   const double t58 = t56 + t57;
   const double t59 = h * t58;
-  const double t60 = q0[0] + t59;
+  const double t60 = q0[0] /* x */ + t59;
   const double t61 = gam[1] * 0.067184398806084122;
   const double t62 = gam[3] * (-0.10854875923261334);
   const double t63 = t61 + t62;
   const double t64 = h * t63;
-  const double t65 = q0[1] + t64;
+  const double t65 = q0[1] /* y */ + t64;
   const double t66 = t60 * t60;
   const double t67 = t65 * t65;
   const double t68 = t66 + t67;
@@ -139,12 +152,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t87 = gam[2] * (-0.18592014360731468);
   const double t88 = t86 + t87;
   const double t89 = h * t88;
-  const double t90 = q0[0] + t89;
+  const double t90 = q0[0] /* x */ + t89;
   const double t91 = gam[1] * 0.1222977958224985;
   const double t92 = gam[3] * (-0.18592014360731468);
   const double t93 = t91 + t92;
   const double t94 = h * t93;
-  const double t95 = q0[1] + t94;
+  const double t95 = q0[1] /* y */ + t94;
   const double t96 = t90 * t90;
   const double t97 = t95 * t95;
   const double t98 = t96 + t97;
@@ -170,12 +183,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t117 = gam[2] * (-0.2677009865564956);
   const double t118 = t116 + t117;
   const double t119 = h * t118;
-  const double t120 = q0[0] + t119;
+  const double t120 = q0[0] /* x */ + t119;
   const double t121 = gam[1] * 0.19106187779867811;
   const double t122 = gam[3] * (-0.2677009865564956);
   const double t123 = t121 + t122;
   const double t124 = h * t123;
-  const double t125 = q0[1] + t124;
+  const double t125 = q0[1] /* y */ + t124;
   const double t126 = t120 * t120;
   const double t127 = t125 * t125;
   const double t128 = t126 + t127;
@@ -201,12 +214,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t147 = gam[2] * (-0.34217557068677351);
   const double t148 = t146 + t147;
   const double t149 = h * t148;
-  const double t150 = q0[0] + t149;
+  const double t150 = q0[0] /* x */ + t149;
   const double t151 = gam[1] * 0.27099161117138632;
   const double t152 = gam[3] * (-0.34217557068677351);
   const double t153 = t151 + t152;
   const double t154 = h * t153;
-  const double t155 = q0[1] + t154;
+  const double t155 = q0[1] /* y */ + t154;
   const double t156 = t150 * t150;
   const double t157 = t155 * t155;
   const double t158 = t156 + t157;
@@ -232,12 +245,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t177 = gam[2] * (-0.39867455222668197);
   const double t178 = t176 + t177;
   const double t179 = h * t178;
-  const double t180 = q0[0] + t179;
+  const double t180 = q0[0] /* x */ + t179;
   const double t181 = gam[1] * 0.35919822461037054;
   const double t182 = gam[3] * (-0.39867455222668197);
   const double t183 = t181 + t182;
   const double t184 = h * t183;
-  const double t185 = q0[1] + t184;
+  const double t185 = q0[1] /* y */ + t184;
   const double t186 = t180 * t180;
   const double t187 = t185 * t185;
   const double t188 = t186 + t187;
@@ -263,12 +276,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t207 = gam[2] * (-0.4291037329753441);
   const double t208 = t206 + t207;
   const double t209 = h * t208;
-  const double t210 = q0[0] + t209;
+  const double t210 = q0[0] /* x */ + t209;
   const double t211 = gam[1] * 0.45249374508118129;
   const double t212 = gam[3] * (-0.4291037329753441);
   const double t213 = t211 + t212;
   const double t214 = h * t213;
-  const double t215 = q0[1] + t214;
+  const double t215 = q0[1] /* y */ + t214;
   const double t216 = t210 * t210;
   const double t217 = t215 * t215;
   const double t218 = t216 + t217;
@@ -293,11 +306,11 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t236 = gam[0] * 0.54750625491881877;
   const double t237 = t207 + t236;
   const double t238 = h * t237;
-  const double t239 = q0[0] + t238;
+  const double t239 = q0[0] /* x */ + t238;
   const double t240 = gam[1] * 0.54750625491881877;
   const double t241 = t212 + t240;
   const double t242 = h * t241;
-  const double t243 = q0[1] + t242;
+  const double t243 = q0[1] /* y */ + t242;
   const double t244 = t239 * t239;
   const double t245 = t243 * t243;
   const double t246 = t244 + t245;
@@ -322,11 +335,11 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t264 = gam[0] * 0.64080177538962946;
   const double t265 = t177 + t264;
   const double t266 = h * t265;
-  const double t267 = q0[0] + t266;
+  const double t267 = q0[0] /* x */ + t266;
   const double t268 = gam[1] * 0.64080177538962946;
   const double t269 = t182 + t268;
   const double t270 = h * t269;
-  const double t271 = q0[1] + t270;
+  const double t271 = q0[1] /* y */ + t270;
   const double t272 = t267 * t267;
   const double t273 = t271 * t271;
   const double t274 = t272 + t273;
@@ -352,12 +365,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t293 = gam[2] * (-0.34217557068677357);
   const double t294 = t292 + t293;
   const double t295 = h * t294;
-  const double t296 = q0[0] + t295;
+  const double t296 = q0[0] /* x */ + t295;
   const double t297 = gam[1] * 0.72900838882861363;
   const double t298 = gam[3] * (-0.34217557068677357);
   const double t299 = t297 + t298;
   const double t300 = h * t299;
-  const double t301 = q0[1] + t300;
+  const double t301 = q0[1] /* y */ + t300;
   const double t302 = t296 * t296;
   const double t303 = t301 * t301;
   const double t304 = t302 + t303;
@@ -382,11 +395,11 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t322 = gam[0] * 0.80893812220132189;
   const double t323 = t117 + t322;
   const double t324 = h * t323;
-  const double t325 = q0[0] + t324;
+  const double t325 = q0[0] /* x */ + t324;
   const double t326 = gam[1] * 0.80893812220132189;
   const double t327 = t122 + t326;
   const double t328 = h * t327;
-  const double t329 = q0[1] + t328;
+  const double t329 = q0[1] /* y */ + t328;
   const double t330 = t325 * t325;
   const double t331 = t329 * t329;
   const double t332 = t330 + t331;
@@ -412,12 +425,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t351 = gam[2] * (-0.18592014360731457);
   const double t352 = t350 + t351;
   const double t353 = h * t352;
-  const double t354 = q0[0] + t353;
+  const double t354 = q0[0] /* x */ + t353;
   const double t355 = gam[1] * 0.87770220417750155;
   const double t356 = gam[3] * (-0.18592014360731457);
   const double t357 = t355 + t356;
   const double t358 = h * t357;
-  const double t359 = q0[1] + t358;
+  const double t359 = q0[1] /* y */ + t358;
   const double t360 = t354 * t354;
   const double t361 = t359 * t359;
   const double t362 = t360 + t361;
@@ -443,12 +456,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t381 = gam[2] * (-0.10854875923261328);
   const double t382 = t380 + t381;
   const double t383 = h * t382;
-  const double t384 = q0[0] + t383;
+  const double t384 = q0[0] /* x */ + t383;
   const double t385 = gam[1] * 0.93281560119391593;
   const double t386 = gam[3] * (-0.10854875923261328);
   const double t387 = t385 + t386;
   const double t388 = h * t387;
-  const double t389 = q0[1] + t388;
+  const double t389 = q0[1] /* y */ + t388;
   const double t390 = t384 * t384;
   const double t391 = t389 * t389;
   const double t392 = t390 + t391;
@@ -473,11 +486,11 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t410 = gam[0] * 0.9722875115366163;
   const double t411 = t27 + t410;
   const double t412 = h * t411;
-  const double t413 = q0[0] + t412;
+  const double t413 = q0[0] /* x */ + t412;
   const double t414 = gam[1] * 0.9722875115366163;
   const double t415 = t32 + t414;
   const double t416 = h * t415;
-  const double t417 = q0[1] + t416;
+  const double t417 = q0[1] /* y */ + t416;
   const double t418 = t413 * t413;
   const double t419 = t417 * t417;
   const double t420 = t418 + t419;
@@ -502,11 +515,11 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t438 = gam[0] * 0.99470046749582497;
   const double t439 = t1 + t438;
   const double t440 = h * t439;
-  const double t441 = q0[0] + t440;
+  const double t441 = q0[0] /* x */ + t440;
   const double t442 = gam[1] * 0.99470046749582497;
   const double t443 = t6 + t442;
   const double t444 = h * t443;
-  const double t445 = q0[1] + t444;
+  const double t445 = q0[1] /* y */ + t444;
   const double t446 = t441 * t441;
   const double t447 = t445 * t445;
   const double t448 = t446 + t447;
@@ -532,12 +545,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t467 = t463 * 0.28867513459481292;
   const double t468 = t466 - t467;
   const double t469 = h * t468;
-  const double t470 = p0[0] - t469;
+  const double t470 = p0[0] /* p_x */ - t469;
   const double t471 = 0.5 * t461;
   const double t472 = t465 * 0.28867513459481292;
   const double t473 = t471 - t472;
   const double t474 = h * t473;
-  const double t475 = p0[1] - t474;
+  const double t475 = p0[1] /* p_y */ - t474;
   const double t476 = t459 * 0.28867513459481292;
   const double t477 = h * t476;
   const double t478 = -t477;
@@ -548,10 +561,12 @@ static void kepler_k16s2_sweep(const double *q0, const double *p0, const double 
   const double t483 = -t482;
   const double t484 = h * t461;
   const double t485 = -t484;
+  /* gam */
   out[0] = t470;
   out[1] = t475;
   out[2] = t478;
   out[3] = t481;
+  /* dp */
   out[4] = t483;
   out[5] = t485;
 }
@@ -561,8 +576,9 @@ static void kepler_k16s2_minv_p(const double *q0, const double *p0, const double
     const double *g0, const kepler_k16s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -571,16 +587,17 @@ static void kepler_k16s2_energy_kernel(const double *q0, const double *p0, const
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[0] * q0[0];
-  const double t4 = q0[1] * q0[1];
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
   const double t5 = t3 + t4;
   const double t6 = sqrt(t5);
   const double t7 = 1.0 / t6;
   const double t8 = 0.5 * t2;
   const double t9 = t8 - t7;
+  /* H */
   out[0] = t9;
 }
 
@@ -593,13 +610,13 @@ void kepler_k16s2_init(kepler_k16s2_state *x, const double *q0, const double *p0
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < kepler_k16s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : kepler_k16s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : kepler_k16s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (kepler_k16s2_NU ? kepler_k16s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) x->gam[i] = 0;
 }
 
 const char *kepler_k16s2_strerror(int code)
@@ -614,12 +631,12 @@ const char *kepler_k16s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) kepler_k16s2_params dflt_; if (!prm) { kepler_k16s2_params_default(&dflt_); prm = &dflt_; }
+#define kepler_k16s2_DEFAULT_PARAMS(prm) kepler_k16s2_params dflt_; if (!prm) { kepler_k16s2_params_default(&dflt_); prm = &dflt_; }
 
 double kepler_k16s2_energy(const kepler_k16s2_state *x, const kepler_k16s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  kepler_k16s2_DEFAULT_PARAMS(prm)
   kepler_k16s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -639,17 +656,17 @@ void kepler_k16s2_hidden(const kepler_k16s2_state *x, const kepler_k16s2_params 
 static void kepler_k16s2_predict(const kepler_k16s2_state *x, double h, const kepler_k16s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k16s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < kepler_k16s2_S; j++)
+    for (i = 0; i < kepler_k16s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + kepler_k16s2_E[(j * S + i) * S + d];
+      for (d = kepler_k16s2_S - 1; d >= 0; d--) e = e * r + kepler_k16s2_E[(j * kepler_k16s2_S + i) * kepler_k16s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < kepler_k16s2_M; l++) gam[j * kepler_k16s2_M + l] += e * x->gam[i * kepler_k16s2_M + l];
     }
 }
 
@@ -666,49 +683,52 @@ static void kepler_k16s2_add(double *a, double *c, double b)
 int kepler_k16s2_step(kepler_k16s2_state *x, double h_, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[kepler_k16s2_S * kepler_k16s2_M], sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + 3 * kepler_k16s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = kepler_k16s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  kepler_k16s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k16s2_EBADSTEP;
   kepler_k16s2_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= kepler_k16s2_MAXITER; it++) {
     kepler_k16s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < kepler_k16s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + kepler_k16s2_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k16s2_ENONFINITE;
     if (rc == kepler_k16s2_ENONFINITE || !isfinite(inc)) { rc = kepler_k16s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (kepler_k16s2_TOL / 256), or
+     * within 2 ulps (kepler_k16s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above kepler_k16s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = kepler_k16s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? kepler_k16s2_OK : kepler_k16s2_ENOCONV; break; }
+    if (inc <= kepler_k16s2_TOL / 256 || (inc <= kepler_k16s2_TOL && 4 * inc > inc_old)) { rc = kepler_k16s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= kepler_k16s2_STAGTOL ? kepler_k16s2_OK : kepler_k16s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k16s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return kepler_k16s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k16s2_ENONFINITE;
+  for (i = 0; i < kepler_k16s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k16s2_S * kepler_k16s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return kepler_k16s2_ENONFINITE;
+  for (i = 0; i < kepler_k16s2_M; i++) {
     kepler_k16s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    kepler_k16s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    kepler_k16s2_add(&x->p[i], &x->pc[i], sw[kepler_k16s2_S * kepler_k16s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k16s2_NU; i++) x->lambda[i] = sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + i];
+  for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) x->gam[i] = gam[i];
   kepler_k16s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k16s2_OK;

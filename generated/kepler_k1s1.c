@@ -5,14 +5,27 @@
 
 #include "kepler_k1s1.h"
 
-#define M kepler_k1s1_M
-#define NU kepler_k1s1_NU
-#define S kepler_k1s1_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(kepler_k1s1_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define kepler_k1s1_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef kepler_k1s1_MAXITER
+#define kepler_k1s1_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef kepler_k1s1_TOL
+#define kepler_k1s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef kepler_k1s1_STAGTOL
+#define kepler_k1s1_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef kepler_k1s1_SINGTOL
+#define kepler_k1s1_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef kepler_k1s1_GTOL
+#define kepler_k1s1_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 1 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -33,10 +46,10 @@ static void kepler_k1s1_sweep(const double *q0, const double *p0, const double *
   /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
   const double t0 = 0.5 * gam[0];
   const double t1 = h * t0;
-  const double t2 = t1 + q0[0];
+  const double t2 = t1 + q0[0] /* x */;
   const double t3 = 0.5 * gam[1];
   const double t4 = h * t3;
-  const double t5 = t4 + q0[1];
+  const double t5 = t4 + q0[1] /* y */;
   const double t6 = t2 * t2;
   const double t7 = t5 * t5;
   const double t8 = t6 + t7;
@@ -52,16 +65,18 @@ static void kepler_k1s1_sweep(const double *q0, const double *p0, const double *
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
   const double t18 = 0.5 * t17;
   const double t19 = h * t18;
-  const double t20 = p0[0] - t19;
+  const double t20 = p0[0] /* p_x */ - t19;
   const double t21 = 0.5 * t15;
   const double t22 = h * t21;
-  const double t23 = p0[1] - t22;
+  const double t23 = p0[1] /* p_y */ - t22;
   const double t24 = h * t17;
   const double t25 = -t24;
   const double t26 = h * t15;
   const double t27 = -t26;
+  /* gam */
   out[0] = t20;
   out[1] = t23;
+  /* dp */
   out[2] = t25;
   out[3] = t27;
 }
@@ -71,8 +86,9 @@ static void kepler_k1s1_minv_p(const double *q0, const double *p0, const double 
     const double *g0, const kepler_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -81,16 +97,17 @@ static void kepler_k1s1_energy_kernel(const double *q0, const double *p0, const 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[0] * q0[0];
-  const double t4 = q0[1] * q0[1];
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
   const double t5 = t3 + t4;
   const double t6 = sqrt(t5);
   const double t7 = 1.0 / t6;
   const double t8 = 0.5 * t2;
   const double t9 = t8 - t7;
+  /* H */
   out[0] = t9;
 }
 
@@ -103,13 +120,13 @@ void kepler_k1s1_init(kepler_k1s1_state *x, const double *q0, const double *p0)
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < kepler_k1s1_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : kepler_k1s1_q0[i];
     x->p[i] = p0 ? (double)p0[i] : kepler_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (kepler_k1s1_NU ? kepler_k1s1_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = 0;
 }
 
 const char *kepler_k1s1_strerror(int code)
@@ -124,12 +141,12 @@ const char *kepler_k1s1_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) kepler_k1s1_params dflt_; if (!prm) { kepler_k1s1_params_default(&dflt_); prm = &dflt_; }
+#define kepler_k1s1_DEFAULT_PARAMS(prm) kepler_k1s1_params dflt_; if (!prm) { kepler_k1s1_params_default(&dflt_); prm = &dflt_; }
 
 double kepler_k1s1_energy(const kepler_k1s1_state *x, const kepler_k1s1_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  kepler_k1s1_DEFAULT_PARAMS(prm)
   kepler_k1s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -149,17 +166,17 @@ void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *pr
 static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, const kepler_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < kepler_k1s1_S; j++)
+    for (i = 0; i < kepler_k1s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + kepler_k1s1_E[(j * S + i) * S + d];
+      for (d = kepler_k1s1_S - 1; d >= 0; d--) e = e * r + kepler_k1s1_E[(j * kepler_k1s1_S + i) * kepler_k1s1_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < kepler_k1s1_M; l++) gam[j * kepler_k1s1_M + l] += e * x->gam[i * kepler_k1s1_M + l];
     }
 }
 
@@ -176,49 +193,52 @@ static void kepler_k1s1_add(double *a, double *c, double b)
 int kepler_k1s1_step(kepler_k1s1_state *x, double h_, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[kepler_k1s1_S * kepler_k1s1_M], sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + 3 * kepler_k1s1_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = kepler_k1s1_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  kepler_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k1s1_EBADSTEP;
   kepler_k1s1_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= kepler_k1s1_MAXITER; it++) {
     kepler_k1s1_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < kepler_k1s1_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + kepler_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k1s1_ENONFINITE;
     if (rc == kepler_k1s1_ENONFINITE || !isfinite(inc)) { rc = kepler_k1s1_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (kepler_k1s1_TOL / 256), or
+     * within 2 ulps (kepler_k1s1_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above kepler_k1s1_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = kepler_k1s1_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? kepler_k1s1_OK : kepler_k1s1_ENOCONV; break; }
+    if (inc <= kepler_k1s1_TOL / 256 || (inc <= kepler_k1s1_TOL && 4 * inc > inc_old)) { rc = kepler_k1s1_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= kepler_k1s1_STAGTOL ? kepler_k1s1_OK : kepler_k1s1_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > kepler_k1s1_MAXITER ? kepler_k1s1_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k1s1_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return kepler_k1s1_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k1s1_ENONFINITE;
+  for (i = 0; i < kepler_k1s1_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k1s1_S * kepler_k1s1_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return kepler_k1s1_ENONFINITE;
+  for (i = 0; i < kepler_k1s1_M; i++) {
     kepler_k1s1_add(&x->q[i], &x->qc[i], h * sw[i]);
-    kepler_k1s1_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    kepler_k1s1_add(&x->p[i], &x->pc[i], sw[kepler_k1s1_S * kepler_k1s1_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k1s1_NU; i++) x->lambda[i] = sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + i];
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = gam[i];
   kepler_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k1s1_OK;

@@ -5,14 +5,27 @@
 
 #include "kepler_k2s2.h"
 
-#define M kepler_k2s2_M
-#define NU kepler_k2s2_NU
-#define S kepler_k2s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(kepler_k2s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define kepler_k2s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef kepler_k2s2_MAXITER
+#define kepler_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef kepler_k2s2_TOL
+#define kepler_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef kepler_k2s2_STAGTOL
+#define kepler_k2s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef kepler_k2s2_SINGTOL
+#define kepler_k2s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef kepler_k2s2_GTOL
+#define kepler_k2s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,12 +49,12 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
   const double t1 = gam[2] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = t3 + q0[0];
+  const double t4 = t3 + q0[0] /* x */;
   const double t5 = 0.21132486540518713 * gam[1];
   const double t6 = (-0.28867513459481292) * gam[3];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = t8 + q0[1];
+  const double t9 = t8 + q0[1] /* y */;
   const double t10 = t4 * t4;
   const double t11 = t9 * t9;
   const double t12 = t10 + t11;
@@ -62,11 +75,11 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
   const double t26 = gam[0] * 0.78867513459481287;
   const double t27 = t1 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[0] + t28;
+  const double t29 = q0[0] /* x */ + t28;
   const double t30 = gam[1] * 0.78867513459481287;
   const double t31 = t6 + t30;
   const double t32 = h * t31;
-  const double t33 = q0[1] + t32;
+  const double t33 = q0[1] /* y */ + t32;
   const double t34 = t29 * t29;
   const double t35 = t33 * t33;
   const double t36 = t34 + t35;
@@ -92,12 +105,12 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
   const double t55 = t51 * 0.28867513459481292;
   const double t56 = t54 - t55;
   const double t57 = h * t56;
-  const double t58 = p0[0] - t57;
+  const double t58 = p0[0] /* p_x */ - t57;
   const double t59 = 0.5 * t49;
   const double t60 = t53 * 0.28867513459481292;
   const double t61 = t59 - t60;
   const double t62 = h * t61;
-  const double t63 = p0[1] - t62;
+  const double t63 = p0[1] /* p_y */ - t62;
   const double t64 = t47 * 0.28867513459481292;
   const double t65 = h * t64;
   const double t66 = -t65;
@@ -108,10 +121,12 @@ static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *
   const double t71 = -t70;
   const double t72 = h * t49;
   const double t73 = -t72;
+  /* gam */
   out[0] = t58;
   out[1] = t63;
   out[2] = t66;
   out[3] = t69;
+  /* dp */
   out[4] = t71;
   out[5] = t73;
 }
@@ -121,8 +136,9 @@ static void kepler_k2s2_minv_p(const double *q0, const double *p0, const double 
     const double *g0, const kepler_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -131,16 +147,17 @@ static void kepler_k2s2_energy_kernel(const double *q0, const double *p0, const 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[0] * q0[0];
-  const double t4 = q0[1] * q0[1];
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
   const double t5 = t3 + t4;
   const double t6 = sqrt(t5);
   const double t7 = 1.0 / t6;
   const double t8 = 0.5 * t2;
   const double t9 = t8 - t7;
+  /* H */
   out[0] = t9;
 }
 
@@ -153,13 +170,13 @@ void kepler_k2s2_init(kepler_k2s2_state *x, const double *q0, const double *p0)
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < kepler_k2s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : kepler_k2s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : kepler_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (kepler_k2s2_NU ? kepler_k2s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = 0;
 }
 
 const char *kepler_k2s2_strerror(int code)
@@ -174,12 +191,12 @@ const char *kepler_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) kepler_k2s2_params dflt_; if (!prm) { kepler_k2s2_params_default(&dflt_); prm = &dflt_; }
+#define kepler_k2s2_DEFAULT_PARAMS(prm) kepler_k2s2_params dflt_; if (!prm) { kepler_k2s2_params_default(&dflt_); prm = &dflt_; }
 
 double kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  kepler_k2s2_DEFAULT_PARAMS(prm)
   kepler_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -199,17 +216,17 @@ void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *pr
 static void kepler_k2s2_predict(const kepler_k2s2_state *x, double h, const kepler_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k2s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < kepler_k2s2_S; j++)
+    for (i = 0; i < kepler_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + kepler_k2s2_E[(j * S + i) * S + d];
+      for (d = kepler_k2s2_S - 1; d >= 0; d--) e = e * r + kepler_k2s2_E[(j * kepler_k2s2_S + i) * kepler_k2s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < kepler_k2s2_M; l++) gam[j * kepler_k2s2_M + l] += e * x->gam[i * kepler_k2s2_M + l];
     }
 }
 
@@ -226,49 +243,52 @@ static void kepler_k2s2_add(double *a, double *c, double b)
 int kepler_k2s2_step(kepler_k2s2_state *x, double h_, const kepler_k2s2_params *prm, kepler_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[kepler_k2s2_S * kepler_k2s2_M], sw[kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + 3 * kepler_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = kepler_k2s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  kepler_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k2s2_EBADSTEP;
   kepler_k2s2_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= kepler_k2s2_MAXITER; it++) {
     kepler_k2s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < kepler_k2s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + kepler_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k2s2_ENONFINITE;
     if (rc == kepler_k2s2_ENONFINITE || !isfinite(inc)) { rc = kepler_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (kepler_k2s2_TOL / 256), or
+     * within 2 ulps (kepler_k2s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above kepler_k2s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = kepler_k2s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? kepler_k2s2_OK : kepler_k2s2_ENOCONV; break; }
+    if (inc <= kepler_k2s2_TOL / 256 || (inc <= kepler_k2s2_TOL && 4 * inc > inc_old)) { rc = kepler_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= kepler_k2s2_STAGTOL ? kepler_k2s2_OK : kepler_k2s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > kepler_k2s2_MAXITER ? kepler_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k2s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return kepler_k2s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k2s2_ENONFINITE;
+  for (i = 0; i < kepler_k2s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k2s2_S * kepler_k2s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return kepler_k2s2_ENONFINITE;
+  for (i = 0; i < kepler_k2s2_M; i++) {
     kepler_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    kepler_k2s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    kepler_k2s2_add(&x->p[i], &x->pc[i], sw[kepler_k2s2_S * kepler_k2s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k2s2_NU; i++) x->lambda[i] = sw[kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + i];
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = gam[i];
   kepler_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k2s2_OK;

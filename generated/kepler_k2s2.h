@@ -4,6 +4,10 @@
 #ifndef kepler_k2s2_H
 #define kepler_k2s2_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define kepler_k2s2_M 2      /* coordinates */
 #define kepler_k2s2_NU 0     /* constraints */
 #define kepler_k2s2_K 2      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void kepler_k2s2_params_default(kepler_k2s2_params *prm);
 int kepler_k2s2_step(kepler_k2s2_state *x, double h, const kepler_k2s2_params *prm, kepler_k2s2_stats *st);
 const char *kepler_k2s2_strerror(int code);
 double kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *prm);
-void kepler_k2s2_constraints(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *g);   /* NU values */
+void kepler_k2s2_constraints(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *g);   /* kepler_k2s2_NU values */
 void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "kepler_k3s3.h"
 
-#define M kepler_k3s3_M
-#define NU kepler_k3s3_NU
-#define S kepler_k3s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(kepler_k3s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define kepler_k3s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef kepler_k3s3_MAXITER
+#define kepler_k3s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef kepler_k3s3_TOL
+#define kepler_k3s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef kepler_k3s3_STAGTOL
+#define kepler_k3s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef kepler_k3s3_SINGTOL
+#define kepler_k3s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef kepler_k3s3_GTOL
+#define kepler_k3s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -39,14 +52,14 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t3 = gam[4] * 0.1732050807568877;
   const double t4 = t2 + t3;
   const double t5 = h * t4;
-  const double t6 = t5 + q0[0];
+  const double t6 = t5 + q0[0] /* x */;
   const double t7 = 0.1127016653792583 * gam[1];
   const double t8 = (-0.17320508075688779) * gam[3];
   const double t9 = t7 + t8;
   const double t10 = 0.1732050807568877 * gam[5];
   const double t11 = t9 + t10;
   const double t12 = h * t11;
-  const double t13 = t12 + q0[1];
+  const double t13 = t12 + q0[1] /* y */;
   const double t14 = t6 * t6;
   const double t15 = t13 * t13;
   const double t16 = t14 + t15;
@@ -70,12 +83,12 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t33 = gam[2] * (-0.43301270189221935);
   const double t34 = t32 + t33;
   const double t35 = h * t34;
-  const double t36 = q0[0] + t35;
+  const double t36 = q0[0] /* x */ + t35;
   const double t37 = 0.5 * gam[1];
   const double t38 = gam[3] * (-0.43301270189221935);
   const double t39 = t37 + t38;
   const double t40 = h * t39;
-  const double t41 = q0[1] + t40;
+  const double t41 = q0[1] /* y */ + t40;
   const double t42 = t36 * t36;
   const double t43 = t41 * t41;
   const double t44 = t42 + t43;
@@ -102,13 +115,13 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t64 = gam[4] * (-0.1732050807568877);
   const double t65 = t63 + t64;
   const double t66 = h * t65;
-  const double t67 = q0[0] + t66;
+  const double t67 = q0[0] /* x */ + t66;
   const double t68 = gam[1] * 0.8872983346207417;
   const double t69 = t8 + t68;
   const double t70 = gam[5] * (-0.1732050807568877);
   const double t71 = t69 + t70;
   const double t72 = h * t71;
-  const double t73 = q0[1] + t72;
+  const double t73 = q0[1] /* y */ + t72;
   const double t74 = t67 * t67;
   const double t75 = t73 * t73;
   const double t76 = t74 + t75;
@@ -138,12 +151,12 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t99 = t91 * 0.28867513459481292;
   const double t100 = t98 - t99;
   const double t101 = h * t100;
-  const double t102 = p0[0] - t101;
+  const double t102 = p0[0] /* p_x */ - t101;
   const double t103 = 0.5 * t89;
   const double t104 = t93 * 0.28867513459481292;
   const double t105 = t103 - t104;
   const double t106 = h * t105;
-  const double t107 = p0[1] - t106;
+  const double t107 = p0[1] /* p_y */ - t106;
   const double t108 = t87 * 0.28867513459481292;
   const double t109 = t95 * 0.12909944487358055;
   const double t110 = t108 - t109;
@@ -164,12 +177,14 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t125 = -t124;
   const double t126 = h * t89;
   const double t127 = -t126;
+  /* gam */
   out[0] = t102;
   out[1] = t107;
   out[2] = t112;
   out[3] = t117;
   out[4] = t120;
   out[5] = t123;
+  /* dp */
   out[6] = t125;
   out[7] = t127;
 }
@@ -179,8 +194,9 @@ static void kepler_k3s3_minv_p(const double *q0, const double *p0, const double 
     const double *g0, const kepler_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -189,16 +205,17 @@ static void kepler_k3s3_energy_kernel(const double *q0, const double *p0, const 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[0] * q0[0];
-  const double t4 = q0[1] * q0[1];
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
   const double t5 = t3 + t4;
   const double t6 = sqrt(t5);
   const double t7 = 1.0 / t6;
   const double t8 = 0.5 * t2;
   const double t9 = t8 - t7;
+  /* H */
   out[0] = t9;
 }
 
@@ -211,13 +228,13 @@ void kepler_k3s3_init(kepler_k3s3_state *x, const double *q0, const double *p0)
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < kepler_k3s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : kepler_k3s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : kepler_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (kepler_k3s3_NU ? kepler_k3s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = 0;
 }
 
 const char *kepler_k3s3_strerror(int code)
@@ -232,12 +249,12 @@ const char *kepler_k3s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) kepler_k3s3_params dflt_; if (!prm) { kepler_k3s3_params_default(&dflt_); prm = &dflt_; }
+#define kepler_k3s3_DEFAULT_PARAMS(prm) kepler_k3s3_params dflt_; if (!prm) { kepler_k3s3_params_default(&dflt_); prm = &dflt_; }
 
 double kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  kepler_k3s3_DEFAULT_PARAMS(prm)
   kepler_k3s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -257,17 +274,17 @@ void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *pr
 static void kepler_k3s3_predict(const kepler_k3s3_state *x, double h, const kepler_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k3s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < kepler_k3s3_S; j++)
+    for (i = 0; i < kepler_k3s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + kepler_k3s3_E[(j * S + i) * S + d];
+      for (d = kepler_k3s3_S - 1; d >= 0; d--) e = e * r + kepler_k3s3_E[(j * kepler_k3s3_S + i) * kepler_k3s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < kepler_k3s3_M; l++) gam[j * kepler_k3s3_M + l] += e * x->gam[i * kepler_k3s3_M + l];
     }
 }
 
@@ -284,49 +301,52 @@ static void kepler_k3s3_add(double *a, double *c, double b)
 int kepler_k3s3_step(kepler_k3s3_state *x, double h_, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[kepler_k3s3_S * kepler_k3s3_M], sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + 3 * kepler_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = kepler_k3s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  kepler_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k3s3_EBADSTEP;
   kepler_k3s3_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= kepler_k3s3_MAXITER; it++) {
     kepler_k3s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < kepler_k3s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + kepler_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k3s3_ENONFINITE;
     if (rc == kepler_k3s3_ENONFINITE || !isfinite(inc)) { rc = kepler_k3s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (kepler_k3s3_TOL / 256), or
+     * within 2 ulps (kepler_k3s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above kepler_k3s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = kepler_k3s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? kepler_k3s3_OK : kepler_k3s3_ENOCONV; break; }
+    if (inc <= kepler_k3s3_TOL / 256 || (inc <= kepler_k3s3_TOL && 4 * inc > inc_old)) { rc = kepler_k3s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= kepler_k3s3_STAGTOL ? kepler_k3s3_OK : kepler_k3s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > kepler_k3s3_MAXITER ? kepler_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k3s3_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return kepler_k3s3_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k3s3_ENONFINITE;
+  for (i = 0; i < kepler_k3s3_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k3s3_S * kepler_k3s3_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return kepler_k3s3_ENONFINITE;
+  for (i = 0; i < kepler_k3s3_M; i++) {
     kepler_k3s3_add(&x->q[i], &x->qc[i], h * sw[i]);
-    kepler_k3s3_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    kepler_k3s3_add(&x->p[i], &x->pc[i], sw[kepler_k3s3_S * kepler_k3s3_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k3s3_NU; i++) x->lambda[i] = sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + i];
+  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = gam[i];
   kepler_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k3s3_OK;

@@ -4,6 +4,10 @@
 #ifndef kepler_k3s3_H
 #define kepler_k3s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define kepler_k3s3_M 2      /* coordinates */
 #define kepler_k3s3_NU 0     /* constraints */
 #define kepler_k3s3_K 3      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void kepler_k3s3_params_default(kepler_k3s3_params *prm);
 int kepler_k3s3_step(kepler_k3s3_state *x, double h, const kepler_k3s3_params *prm, kepler_k3s3_stats *st);
 const char *kepler_k3s3_strerror(int code);
 double kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm);
-void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *g);   /* NU values */
+void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *g);   /* kepler_k3s3_NU values */
 void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

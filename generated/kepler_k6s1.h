@@ -4,6 +4,10 @@
 #ifndef kepler_k6s1_H
 #define kepler_k6s1_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define kepler_k6s1_M 2      /* coordinates */
 #define kepler_k6s1_NU 0     /* constraints */
 #define kepler_k6s1_K 6      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void kepler_k6s1_params_default(kepler_k6s1_params *prm);
 int kepler_k6s1_step(kepler_k6s1_state *x, double h, const kepler_k6s1_params *prm, kepler_k6s1_stats *st);
 const char *kepler_k6s1_strerror(int code);
 double kepler_k6s1_energy(const kepler_k6s1_state *x, const kepler_k6s1_params *prm);
-void kepler_k6s1_constraints(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *g);   /* NU values */
+void kepler_k6s1_constraints(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *g);   /* kepler_k6s1_NU values */
 void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "kepler_k6s3.h"
 
-#define M kepler_k6s3_M
-#define NU kepler_k6s3_NU
-#define S kepler_k6s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(kepler_k6s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define kepler_k6s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef kepler_k6s3_MAXITER
+#define kepler_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef kepler_k6s3_TOL
+#define kepler_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef kepler_k6s3_STAGTOL
+#define kepler_k6s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef kepler_k6s3_SINGTOL
+#define kepler_k6s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef kepler_k6s3_GTOL
+#define kepler_k6s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -42,14 +55,14 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t3 = gam[4] * 0.068025568234204442;
   const double t4 = t2 + t3;
   const double t5 = h * t4;
-  const double t6 = t5 + q0[0];
+  const double t6 = t5 + q0[0] /* x */;
   const double t7 = 0.033765242898423975 * gam[1];
   const double t8 = (-0.056508419605012766) * gam[3];
   const double t9 = t7 + t8;
   const double t10 = 0.068025568234204442 * gam[5];
   const double t11 = t9 + t10;
   const double t12 = h * t11;
-  const double t13 = t12 + q0[1];
+  const double t13 = t12 + q0[1] /* y */;
   const double t14 = t6 * t6;
   const double t15 = t13 * t13;
   const double t16 = t14 + t15;
@@ -75,14 +88,14 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t35 = gam[4] * 0.20802702904656017;
   const double t36 = t34 + t35;
   const double t37 = h * t36;
-  const double t38 = q0[0] + t37;
+  const double t38 = q0[0] /* x */ + t37;
   const double t39 = gam[1] * 0.16939530676686776;
   const double t40 = gam[3] * (-0.24370047841099157);
   const double t41 = t39 + t40;
   const double t42 = gam[5] * 0.20802702904656017;
   const double t43 = t41 + t42;
   const double t44 = h * t43;
-  const double t45 = q0[1] + t44;
+  const double t45 = q0[1] /* y */ + t44;
   const double t46 = t38 * t38;
   const double t47 = t45 * t45;
   const double t48 = t46 + t47;
@@ -114,14 +127,14 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t73 = gam[4] * 0.1257969473866733;
   const double t74 = t72 + t73;
   const double t75 = h * t74;
-  const double t76 = q0[0] + t75;
+  const double t76 = q0[0] /* x */ + t75;
   const double t77 = gam[1] * 0.38069040695840156;
   const double t78 = gam[3] * (-0.40835734144399111);
   const double t79 = t77 + t78;
   const double t80 = gam[5] * 0.1257969473866733;
   const double t81 = t79 + t80;
   const double t82 = h * t81;
-  const double t83 = q0[1] + t82;
+  const double t83 = q0[1] /* y */ + t82;
   const double t84 = t76 * t76;
   const double t85 = t83 * t83;
   const double t86 = t84 + t85;
@@ -153,14 +166,14 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t111 = gam[4] * (-0.12579694738667335);
   const double t112 = t110 + t111;
   const double t113 = h * t112;
-  const double t114 = q0[0] + t113;
+  const double t114 = q0[0] /* x */ + t113;
   const double t115 = gam[1] * 0.61930959304159849;
   const double t116 = gam[3] * (-0.40835734144399105);
   const double t117 = t115 + t116;
   const double t118 = gam[5] * (-0.12579694738667335);
   const double t119 = t117 + t118;
   const double t120 = h * t119;
-  const double t121 = q0[1] + t120;
+  const double t121 = q0[1] /* y */ + t120;
   const double t122 = t114 * t114;
   const double t123 = t121 * t121;
   const double t124 = t122 + t123;
@@ -191,13 +204,13 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t148 = gam[4] * (-0.20802702904656017);
   const double t149 = t147 + t148;
   const double t150 = h * t149;
-  const double t151 = q0[0] + t150;
+  const double t151 = q0[0] /* x */ + t150;
   const double t152 = gam[1] * 0.83060469323313224;
   const double t153 = t40 + t152;
   const double t154 = gam[5] * (-0.20802702904656017);
   const double t155 = t153 + t154;
   const double t156 = h * t155;
-  const double t157 = q0[1] + t156;
+  const double t157 = q0[1] /* y */ + t156;
   const double t158 = t151 * t151;
   const double t159 = t157 * t157;
   const double t160 = t158 + t159;
@@ -228,13 +241,13 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t184 = gam[4] * (-0.068025568234204442);
   const double t185 = t183 + t184;
   const double t186 = h * t185;
-  const double t187 = q0[0] + t186;
+  const double t187 = q0[0] /* x */ + t186;
   const double t188 = gam[1] * 0.96623475710157603;
   const double t189 = t8 + t188;
   const double t190 = gam[5] * (-0.068025568234204442);
   const double t191 = t189 + t190;
   const double t192 = h * t191;
-  const double t193 = q0[1] + t192;
+  const double t193 = q0[1] /* y */ + t192;
   const double t194 = t187 * t187;
   const double t195 = t193 * t193;
   const double t196 = t194 + t195;
@@ -264,12 +277,12 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t219 = t211 * 0.28867513459481292;
   const double t220 = t218 - t219;
   const double t221 = h * t220;
-  const double t222 = p0[0] - t221;
+  const double t222 = p0[0] /* p_x */ - t221;
   const double t223 = 0.5 * t209;
   const double t224 = t213 * 0.28867513459481292;
   const double t225 = t223 - t224;
   const double t226 = h * t225;
-  const double t227 = p0[1] - t226;
+  const double t227 = p0[1] /* p_y */ - t226;
   const double t228 = t207 * 0.28867513459481292;
   const double t229 = t215 * 0.12909944487358055;
   const double t230 = t228 - t229;
@@ -290,12 +303,14 @@ static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *
   const double t245 = -t244;
   const double t246 = h * t209;
   const double t247 = -t246;
+  /* gam */
   out[0] = t222;
   out[1] = t227;
   out[2] = t232;
   out[3] = t237;
   out[4] = t240;
   out[5] = t243;
+  /* dp */
   out[6] = t245;
   out[7] = t247;
 }
@@ -305,8 +320,9 @@ static void kepler_k6s3_minv_p(const double *q0, const double *p0, const double 
     const double *g0, const kepler_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -315,16 +331,17 @@ static void kepler_k6s3_energy_kernel(const double *q0, const double *p0, const 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
-  const double t3 = q0[0] * q0[0];
-  const double t4 = q0[1] * q0[1];
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
   const double t5 = t3 + t4;
   const double t6 = sqrt(t5);
   const double t7 = 1.0 / t6;
   const double t8 = 0.5 * t2;
   const double t9 = t8 - t7;
+  /* H */
   out[0] = t9;
 }
 
@@ -337,13 +354,13 @@ void kepler_k6s3_init(kepler_k6s3_state *x, const double *q0, const double *p0)
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < kepler_k6s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : kepler_k6s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : kepler_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (kepler_k6s3_NU ? kepler_k6s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = 0;
 }
 
 const char *kepler_k6s3_strerror(int code)
@@ -358,12 +375,12 @@ const char *kepler_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) kepler_k6s3_params dflt_; if (!prm) { kepler_k6s3_params_default(&dflt_); prm = &dflt_; }
+#define kepler_k6s3_DEFAULT_PARAMS(prm) kepler_k6s3_params dflt_; if (!prm) { kepler_k6s3_params_default(&dflt_); prm = &dflt_; }
 
 double kepler_k6s3_energy(const kepler_k6s3_state *x, const kepler_k6s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  kepler_k6s3_DEFAULT_PARAMS(prm)
   kepler_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -383,17 +400,17 @@ void kepler_k6s3_hidden(const kepler_k6s3_state *x, const kepler_k6s3_params *pr
 static void kepler_k6s3_predict(const kepler_k6s3_state *x, double h, const kepler_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k6s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < kepler_k6s3_S; j++)
+    for (i = 0; i < kepler_k6s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + kepler_k6s3_E[(j * S + i) * S + d];
+      for (d = kepler_k6s3_S - 1; d >= 0; d--) e = e * r + kepler_k6s3_E[(j * kepler_k6s3_S + i) * kepler_k6s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < kepler_k6s3_M; l++) gam[j * kepler_k6s3_M + l] += e * x->gam[i * kepler_k6s3_M + l];
     }
 }
 
@@ -410,49 +427,52 @@ static void kepler_k6s3_add(double *a, double *c, double b)
 int kepler_k6s3_step(kepler_k6s3_state *x, double h_, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[kepler_k6s3_S * kepler_k6s3_M], sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + 3 * kepler_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = kepler_k6s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  kepler_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s3_EBADSTEP;
   kepler_k6s3_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= kepler_k6s3_MAXITER; it++) {
     kepler_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < kepler_k6s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + kepler_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k6s3_ENONFINITE;
     if (rc == kepler_k6s3_ENONFINITE || !isfinite(inc)) { rc = kepler_k6s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (kepler_k6s3_TOL / 256), or
+     * within 2 ulps (kepler_k6s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above kepler_k6s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = kepler_k6s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? kepler_k6s3_OK : kepler_k6s3_ENOCONV; break; }
+    if (inc <= kepler_k6s3_TOL / 256 || (inc <= kepler_k6s3_TOL && 4 * inc > inc_old)) { rc = kepler_k6s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= kepler_k6s3_STAGTOL ? kepler_k6s3_OK : kepler_k6s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k6s3_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return kepler_k6s3_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s3_ENONFINITE;
+  for (i = 0; i < kepler_k6s3_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k6s3_S * kepler_k6s3_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return kepler_k6s3_ENONFINITE;
+  for (i = 0; i < kepler_k6s3_M; i++) {
     kepler_k6s3_add(&x->q[i], &x->qc[i], h * sw[i]);
-    kepler_k6s3_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    kepler_k6s3_add(&x->p[i], &x->pc[i], sw[kepler_k6s3_S * kepler_k6s3_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k6s3_NU; i++) x->lambda[i] = sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + i];
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = gam[i];
   kepler_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k6s3_OK;

@@ -5,14 +5,27 @@
 
 #include "modified_k3s1.h"
 
-#define M modified_k3s1_M
-#define NU modified_k3s1_NU
-#define S modified_k3s1_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(modified_k3s1_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define modified_k3s1_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef modified_k3s1_MAXITER
+#define modified_k3s1_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef modified_k3s1_TOL
+#define modified_k3s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef modified_k3s1_STAGTOL
+#define modified_k3s1_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef modified_k3s1_SINGTOL
+#define modified_k3s1_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef modified_k3s1_GTOL
+#define modified_k3s1_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -33,7 +46,7 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   const double t1 = gam[2] * 0.5;
   const double t2 = h * t1;
   const double t3 = 2.0 * t2;
@@ -41,13 +54,13 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
   const double t5 = gam[0] * 0.1127016653792583;
   const double t6 = h * t5;
-  const double t7 = q0[0] + t6;
+  const double t7 = q0[0] /* q[1] */ + t6;
   const double t8 = 0.1127016653792583 * gam[1];
   const double t9 = h * t8;
-  const double t10 = q0[1] + t9;
+  const double t10 = q0[1] /* q[2] */ + t9;
   const double t11 = gam[2] * 0.1127016653792583;
   const double t12 = h * t11;
-  const double t13 = q0[2] + t12;
+  const double t13 = q0[2] /* q[3] */ + t12;
   const double t14 = t13 * t13 * t13;
   const double t15 = t10 * t10 * t10;
   const double t16 = (t7 * t7) * (t7 * t7) * t7;
@@ -57,11 +70,11 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t20 = 0.5 * gam[0];
   const double t21 = h * t20;
-  const double t22 = q0[0] + t21;
+  const double t22 = q0[0] /* q[1] */ + t21;
   const double t23 = 0.5 * gam[1];
   const double t24 = h * t23;
-  const double t25 = q0[1] + t24;
-  const double t26 = q0[2] + t2;
+  const double t25 = q0[1] /* q[2] */ + t24;
+  const double t26 = q0[2] /* q[3] */ + t2;
   const double t27 = t26 * t26 * t26;
   const double t28 = t25 * t25 * t25;
   const double t29 = (t22 * t22) * (t22 * t22) * t22;
@@ -74,13 +87,13 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
   const double t36 = gam[0] * 0.8872983346207417;
   const double t37 = h * t36;
-  const double t38 = q0[0] + t37;
+  const double t38 = q0[0] /* q[1] */ + t37;
   const double t39 = gam[1] * 0.8872983346207417;
   const double t40 = h * t39;
-  const double t41 = q0[1] + t40;
+  const double t41 = q0[1] /* q[2] */ + t40;
   const double t42 = gam[2] * 0.8872983346207417;
   const double t43 = h * t42;
-  const double t44 = q0[2] + t43;
+  const double t44 = q0[2] /* q[3] */ + t43;
   const double t45 = t44 * t44 * t44;
   const double t46 = t41 * t41 * t41;
   const double t47 = (t38 * t38) * (t38 * t38) * t38;
@@ -101,10 +114,10 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   const double t61 = t4 * t49;
   const double t62 = 0.5 * t61;
   const double t63 = h * t62;
-  const double t64 = t51 * p0[0];
-  const double t65 = t53 * p0[1];
+  const double t64 = t51 * p0[0] /* p_q[1] */;
+  const double t65 = t53 * p0[1] /* p_q[2] */;
   const double t66 = t64 + t65;
-  const double t67 = t4 * p0[2];
+  const double t67 = t4 * p0[2] /* p_q[3] */;
   const double t68 = t66 + t67;
   const double t69 = t68 - t63;
   const double t70 = t69 + g0[0];
@@ -116,27 +129,32 @@ static void modified_k3s1_sweep(const double *q0, const double *p0, const double
   const double t75 = t49 + t74;
   const double t76 = 0.5 * t72;
   const double t77 = h * t76;
-  const double t78 = p0[0] - t77;
+  const double t78 = p0[0] /* p_q[1] */ - t77;
   const double t79 = 0.5 * t73;
   const double t80 = h * t79;
-  const double t81 = p0[1] - t80;
+  const double t81 = p0[1] /* p_q[2] */ - t80;
   const double t82 = 0.5 * t75;
   const double t83 = h * t82;
-  const double t84 = p0[2] - t83;
+  const double t84 = p0[2] /* p_q[3] */ - t83;
   const double t85 = h * t72;
   const double t86 = -t85;
   const double t87 = h * t73;
   const double t88 = -t87;
   const double t89 = h * t75;
   const double t90 = -t89;
+  /* gam */
   out[0] = t78;
   out[1] = t81;
   out[2] = t84;
+  /* dp */
   out[3] = t86;
   out[4] = t88;
   out[5] = t90;
+  /* lambda */
   out[6] = t71;
+  /* pivot */
   out[7] = t60;
+  /* adiag */
   out[8] = t60;
 }
 
@@ -145,9 +163,10 @@ static void modified_k3s1_minv_p(const double *q0, const double *p0, const doubl
     const double *g0, const modified_k3s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_q[1] */;
+  out[1] = p0[1] /* p_q[2] */;
+  out[2] = p0[2] /* p_q[3] */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -156,14 +175,15 @@ static void modified_k3s1_energy_kernel(const double *q0, const double *p0, cons
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
+  const double t1 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
   const double t4 = t2 + t3;
-  const double t5 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t5 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
   const double t6 = 0.5 * t4;
   const double t7 = t5 + t6;
+  /* H */
   out[0] = t7;
 }
 
@@ -173,12 +193,13 @@ static void modified_k3s1_g(const double *q0, const double *p0, const double *ga
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* g(q0) */
-  const double t0 = (q0[0] * q0[0] * q0[0]) * (q0[0] * q0[0] * q0[0]);
-  const double t1 = (q0[1] * q0[1]) * (q0[1] * q0[1]);
+  const double t0 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t1 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 0.625;
+  /* g */
   out[0] = t5;
 }
 
@@ -187,18 +208,18 @@ static void modified_k3s1_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const modified_k3s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   /* hidden constraints */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = p0[0] * t2;
-  const double t4 = q0[1] * q0[1] * q0[1];
+  const double t3 = p0[0] /* p_q[1] */ * t2;
+  const double t4 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t5 = 4.0 * t4;
-  const double t6 = p0[1] * t5;
+  const double t6 = p0[1] /* p_q[2] */ * t5;
   const double t7 = t3 + t6;
-  const double t8 = t0 * p0[2];
+  const double t8 = t0 * p0[2] /* p_q[3] */;
   const double t9 = t7 + t8;
+  /* hidden */
   out[0] = t9;
 }
 
@@ -208,38 +229,37 @@ static void modified_k3s1_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const modified_k3s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* hidden constraints */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   /* consistent initial multiplier */
-  const double t5 = q0[2] * q0[2] * q0[2];
+  const double t5 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t6 = 4.0 * t5;
   const double t7 = t2 * t2;
   const double t8 = t4 * t4;
   const double t9 = t7 + t8;
   const double t10 = t0 * t0;
   const double t11 = t9 + t10;
-  const double t12 = 6.0 * p0[0];
-  const double t13 = 4.0 * p0[1];
-  const double t14 = 2.0 * p0[2];
-  const double t15 = (q0[0] * q0[0]) * (q0[0] * q0[0]);
+  const double t12 = 6.0 * p0[0] /* p_q[1] */;
+  const double t13 = 4.0 * p0[1] /* p_q[2] */;
+  const double t14 = 2.0 * p0[2] /* p_q[3] */;
+  const double t15 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
   const double t16 = 5.0 * t15;
   const double t17 = t12 * t16;
-  const double t18 = q0[1] * q0[1];
+  const double t18 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t19 = 3.0 * t18;
   const double t20 = t13 * t19;
-  const double t21 = p0[0] * t17;
-  const double t22 = p0[1] * t20;
+  const double t21 = p0[0] /* p_q[1] */ * t17;
+  const double t22 = p0[1] /* p_q[2] */ * t20;
   const double t23 = t21 + t22;
-  const double t24 = p0[2] * t14;
+  const double t24 = p0[2] /* p_q[3] */ * t14;
   const double t25 = t23 + t24;
   const double t26 = t0 * t6;
   const double t27 = t25 - t26;
   const double t28 = t27 / t11;
+  /* lambda */
   out[0] = t28;
 }
 
@@ -252,19 +272,19 @@ void modified_k3s1_init(modified_k3s1_state *x, const double *q0, const double *
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_k3s1_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : modified_k3s1_q0[i];
     x->p[i] = p0 ? (double)p0[i] : modified_k3s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (modified_k3s1_NU ? modified_k3s1_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
   {
     modified_k3s1_params prm;
-    double lam[NU];
+    double lam[modified_k3s1_NU];
     modified_k3s1_params_default(&prm);
     modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -280,32 +300,32 @@ const char *modified_k3s1_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) modified_k3s1_params dflt_; if (!prm) { modified_k3s1_params_default(&dflt_); prm = &dflt_; }
+#define modified_k3s1_DEFAULT_PARAMS(prm) modified_k3s1_params dflt_; if (!prm) { modified_k3s1_params_default(&dflt_); prm = &dflt_; }
 
 double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  modified_k3s1_DEFAULT_PARAMS(prm)
   modified_k3s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *g)
 {
-  double v[NU];
+  double v[modified_k3s1_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_k3s1_DEFAULT_PARAMS(prm)
   modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < modified_k3s1_NU; i++) g[i] = v[i];
 }
 
 void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *gp)
 {
-  double v[NU];
+  double v[modified_k3s1_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_k3s1_DEFAULT_PARAMS(prm)
   modified_k3s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < modified_k3s1_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -313,17 +333,17 @@ void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_para
 static void modified_k3s1_predict(const modified_k3s1_state *x, double h, const modified_k3s1_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_k3s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < modified_k3s1_S; j++)
+    for (i = 0; i < modified_k3s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + modified_k3s1_E[(j * S + i) * S + d];
+      for (d = modified_k3s1_S - 1; d >= 0; d--) e = e * r + modified_k3s1_E[(j * modified_k3s1_S + i) * modified_k3s1_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < modified_k3s1_M; l++) gam[j * modified_k3s1_M + l] += e * x->gam[i * modified_k3s1_M + l];
     }
 }
 
@@ -340,60 +360,63 @@ static void modified_k3s1_add(double *a, double *c, double b)
 int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_k3s1_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  modified_k3s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k3s1_EBADSTEP;
   modified_k3s1_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[modified_k3s1_NU];
   modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below modified_k3s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < modified_k3s1_NU; i++) g0[i] = fabs(g0[i]) <= modified_k3s1_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= modified_k3s1_MAXITER; it++) {
     modified_k3s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < modified_k3s1_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = modified_k3s1_ESINGULAR;
+    for (i = 0; i < modified_k3s1_NU; i++) {
+      double piv = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU + i], dia = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 2 * modified_k3s1_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k3s1_SINGTOL * fabs(dia))) rc = modified_k3s1_ESINGULAR;
     }
     if (rc == modified_k3s1_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k3s1_ENONFINITE;
     if (rc == modified_k3s1_ENONFINITE || !isfinite(inc)) { rc = modified_k3s1_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (modified_k3s1_TOL / 256), or
+     * within 2 ulps (modified_k3s1_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above modified_k3s1_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = modified_k3s1_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? modified_k3s1_OK : modified_k3s1_ENOCONV; break; }
+    if (inc <= modified_k3s1_TOL / 256 || (inc <= modified_k3s1_TOL && 4 * inc > inc_old)) { rc = modified_k3s1_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= modified_k3s1_STAGTOL ? modified_k3s1_OK : modified_k3s1_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it; st->increment = inc; }
   if (rc != modified_k3s1_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return modified_k3s1_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k3s1_ENONFINITE;
+  for (i = 0; i < modified_k3s1_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k3s1_S * modified_k3s1_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return modified_k3s1_ENONFINITE;
+  for (i = 0; i < modified_k3s1_M; i++) {
     modified_k3s1_add(&x->q[i], &x->qc[i], h * sw[i]);
-    modified_k3s1_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    modified_k3s1_add(&x->p[i], &x->pc[i], sw[modified_k3s1_S * modified_k3s1_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + i];
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k3s1_OK;

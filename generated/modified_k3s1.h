@@ -4,6 +4,10 @@
 #ifndef modified_k3s1_H
 #define modified_k3s1_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define modified_k3s1_M 3      /* coordinates */
 #define modified_k3s1_NU 1     /* constraints */
 #define modified_k3s1_K 3      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void modified_k3s1_params_default(modified_k3s1_params *prm);
 int modified_k3s1_step(modified_k3s1_state *x, double h, const modified_k3s1_params *prm, modified_k3s1_stats *st);
 const char *modified_k3s1_strerror(int code);
 double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm);
-void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *g);   /* NU values */
+void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *g);   /* modified_k3s1_NU values */
 void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "modified_k6s2.h"
 
-#define M modified_k6s2_M
-#define NU modified_k6s2_NU
-#define S modified_k6s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(modified_k6s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define modified_k6s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef modified_k6s2_MAXITER
+#define modified_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef modified_k6s2_TOL
+#define modified_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef modified_k6s2_STAGTOL
+#define modified_k6s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef modified_k6s2_SINGTOL
+#define modified_k6s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef modified_k6s2_GTOL
+#define modified_k6s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,7 +49,7 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   const double t1 = gam[2] * 0.5;
   const double t2 = gam[5] * 0.28867513459481292;
   const double t3 = t1 - t2;
@@ -51,17 +64,17 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t11 = gam[3] * (-0.056508419605012766);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[0] + t13;
+  const double t14 = q0[0] /* q[1] */ + t13;
   const double t15 = 0.033765242898423975 * gam[1];
   const double t16 = (-0.056508419605012766) * gam[4];
   const double t17 = t15 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[1] + t18;
+  const double t19 = q0[1] /* q[2] */ + t18;
   const double t20 = gam[2] * 0.033765242898423975;
   const double t21 = gam[5] * (-0.056508419605012766);
   const double t22 = t20 + t21;
   const double t23 = h * t22;
-  const double t24 = q0[2] + t23;
+  const double t24 = q0[2] /* q[3] */ + t23;
   const double t25 = t24 * t24 * t24;
   const double t26 = t19 * t19 * t19;
   const double t27 = (t14 * t14) * (t14 * t14) * t14;
@@ -77,17 +90,17 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t36 = gam[3] * (-0.24370047841099157);
   const double t37 = t35 + t36;
   const double t38 = h * t37;
-  const double t39 = q0[0] + t38;
+  const double t39 = q0[0] /* q[1] */ + t38;
   const double t40 = gam[1] * 0.16939530676686776;
   const double t41 = gam[4] * (-0.24370047841099157);
   const double t42 = t40 + t41;
   const double t43 = h * t42;
-  const double t44 = q0[1] + t43;
+  const double t44 = q0[1] /* q[2] */ + t43;
   const double t45 = gam[2] * 0.16939530676686776;
   const double t46 = gam[5] * (-0.24370047841099157);
   const double t47 = t45 + t46;
   const double t48 = h * t47;
-  const double t49 = q0[2] + t48;
+  const double t49 = q0[2] /* q[3] */ + t48;
   const double t50 = t49 * t49 * t49;
   const double t51 = t44 * t44 * t44;
   const double t52 = (t39 * t39) * (t39 * t39) * t39;
@@ -109,17 +122,17 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t67 = gam[3] * (-0.40835734144399111);
   const double t68 = t66 + t67;
   const double t69 = h * t68;
-  const double t70 = q0[0] + t69;
+  const double t70 = q0[0] /* q[1] */ + t69;
   const double t71 = gam[1] * 0.38069040695840156;
   const double t72 = gam[4] * (-0.40835734144399111);
   const double t73 = t71 + t72;
   const double t74 = h * t73;
-  const double t75 = q0[1] + t74;
+  const double t75 = q0[1] /* q[2] */ + t74;
   const double t76 = gam[2] * 0.38069040695840156;
   const double t77 = gam[5] * (-0.40835734144399111);
   const double t78 = t76 + t77;
   const double t79 = h * t78;
-  const double t80 = q0[2] + t79;
+  const double t80 = q0[2] /* q[3] */ + t79;
   const double t81 = t80 * t80 * t80;
   const double t82 = t75 * t75 * t75;
   const double t83 = (t70 * t70) * (t70 * t70) * t70;
@@ -141,17 +154,17 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t98 = gam[3] * (-0.40835734144399105);
   const double t99 = t97 + t98;
   const double t100 = h * t99;
-  const double t101 = q0[0] + t100;
+  const double t101 = q0[0] /* q[1] */ + t100;
   const double t102 = gam[1] * 0.61930959304159849;
   const double t103 = gam[4] * (-0.40835734144399105);
   const double t104 = t102 + t103;
   const double t105 = h * t104;
-  const double t106 = q0[1] + t105;
+  const double t106 = q0[1] /* q[2] */ + t105;
   const double t107 = gam[2] * 0.61930959304159849;
   const double t108 = gam[5] * (-0.40835734144399105);
   const double t109 = t107 + t108;
   const double t110 = h * t109;
-  const double t111 = q0[2] + t110;
+  const double t111 = q0[2] /* q[3] */ + t110;
   const double t112 = t111 * t111 * t111;
   const double t113 = t106 * t106 * t106;
   const double t114 = (t101 * t101) * (t101 * t101) * t101;
@@ -172,15 +185,15 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t128 = gam[0] * 0.83060469323313224;
   const double t129 = t36 + t128;
   const double t130 = h * t129;
-  const double t131 = q0[0] + t130;
+  const double t131 = q0[0] /* q[1] */ + t130;
   const double t132 = gam[1] * 0.83060469323313224;
   const double t133 = t41 + t132;
   const double t134 = h * t133;
-  const double t135 = q0[1] + t134;
+  const double t135 = q0[1] /* q[2] */ + t134;
   const double t136 = gam[2] * 0.83060469323313224;
   const double t137 = t46 + t136;
   const double t138 = h * t137;
-  const double t139 = q0[2] + t138;
+  const double t139 = q0[2] /* q[3] */ + t138;
   const double t140 = t139 * t139 * t139;
   const double t141 = t135 * t135 * t135;
   const double t142 = (t131 * t131) * (t131 * t131) * t131;
@@ -201,15 +214,15 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t156 = gam[0] * 0.96623475710157603;
   const double t157 = t11 + t156;
   const double t158 = h * t157;
-  const double t159 = q0[0] + t158;
+  const double t159 = q0[0] /* q[1] */ + t158;
   const double t160 = gam[1] * 0.96623475710157603;
   const double t161 = t16 + t160;
   const double t162 = h * t161;
-  const double t163 = q0[1] + t162;
+  const double t163 = q0[1] /* q[2] */ + t162;
   const double t164 = gam[2] * 0.96623475710157603;
   const double t165 = t21 + t164;
   const double t166 = h * t165;
-  const double t167 = q0[2] + t166;
+  const double t167 = q0[2] /* q[3] */ + t166;
   const double t168 = t167 * t167 * t167;
   const double t169 = t163 * t163 * t163;
   const double t170 = (t159 * t159) * (t159 * t159) * t159;
@@ -242,10 +255,10 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t196 = 0.28867513459481292 * t195;
   const double t197 = t192 + t196;
   const double t198 = h * t197;
-  const double t199 = t175 * p0[0];
-  const double t200 = t177 * p0[1];
+  const double t199 = t175 * p0[0] /* p_q[1] */;
+  const double t200 = t177 * p0[1] /* p_q[2] */;
   const double t201 = t199 + t200;
-  const double t202 = t6 * p0[2];
+  const double t202 = t6 * p0[2] /* p_q[3] */;
   const double t203 = t201 + t202;
   const double t204 = t203 - t198;
   const double t205 = t204 + g0[0];
@@ -263,17 +276,17 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t216 = 0.28867513459481292 * t211;
   const double t217 = t215 - t216;
   const double t218 = h * t217;
-  const double t219 = p0[0] - t218;
+  const double t219 = p0[0] /* p_q[1] */ - t218;
   const double t220 = 0.5 * t208;
   const double t221 = 0.28867513459481292 * t212;
   const double t222 = t220 - t221;
   const double t223 = h * t222;
-  const double t224 = p0[1] - t223;
+  const double t224 = p0[1] /* p_q[2] */ - t223;
   const double t225 = 0.5 * t210;
   const double t226 = 0.28867513459481292 * t214;
   const double t227 = t225 - t226;
   const double t228 = h * t227;
-  const double t229 = p0[2] - t228;
+  const double t229 = p0[2] /* p_q[3] */ - t228;
   const double t230 = 0.28867513459481292 * t207;
   const double t231 = h * t230;
   const double t232 = -t231;
@@ -289,17 +302,22 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t242 = -t241;
   const double t243 = h * t210;
   const double t244 = -t243;
+  /* gam */
   out[0] = t219;
   out[1] = t224;
   out[2] = t229;
   out[3] = t232;
   out[4] = t235;
   out[5] = t238;
+  /* dp */
   out[6] = t240;
   out[7] = t242;
   out[8] = t244;
+  /* lambda */
   out[9] = t206;
+  /* pivot */
   out[10] = t190;
+  /* adiag */
   out[11] = t190;
 }
 
@@ -308,9 +326,10 @@ static void modified_k6s2_minv_p(const double *q0, const double *p0, const doubl
     const double *g0, const modified_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_q[1] */;
+  out[1] = p0[1] /* p_q[2] */;
+  out[2] = p0[2] /* p_q[3] */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -319,14 +338,15 @@ static void modified_k6s2_energy_kernel(const double *q0, const double *p0, cons
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
+  const double t1 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
   const double t4 = t2 + t3;
-  const double t5 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t5 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
   const double t6 = 0.5 * t4;
   const double t7 = t5 + t6;
+  /* H */
   out[0] = t7;
 }
 
@@ -336,12 +356,13 @@ static void modified_k6s2_g(const double *q0, const double *p0, const double *ga
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* g(q0) */
-  const double t0 = (q0[0] * q0[0] * q0[0]) * (q0[0] * q0[0] * q0[0]);
-  const double t1 = (q0[1] * q0[1]) * (q0[1] * q0[1]);
+  const double t0 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t1 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 0.625;
+  /* g */
   out[0] = t5;
 }
 
@@ -350,18 +371,18 @@ static void modified_k6s2_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const modified_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   /* hidden constraints */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = p0[0] * t2;
-  const double t4 = q0[1] * q0[1] * q0[1];
+  const double t3 = p0[0] /* p_q[1] */ * t2;
+  const double t4 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t5 = 4.0 * t4;
-  const double t6 = p0[1] * t5;
+  const double t6 = p0[1] /* p_q[2] */ * t5;
   const double t7 = t3 + t6;
-  const double t8 = t0 * p0[2];
+  const double t8 = t0 * p0[2] /* p_q[3] */;
   const double t9 = t7 + t8;
+  /* hidden */
   out[0] = t9;
 }
 
@@ -371,38 +392,37 @@ static void modified_k6s2_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const modified_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* hidden constraints */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   /* consistent initial multiplier */
-  const double t5 = q0[2] * q0[2] * q0[2];
+  const double t5 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t6 = 4.0 * t5;
   const double t7 = t2 * t2;
   const double t8 = t4 * t4;
   const double t9 = t7 + t8;
   const double t10 = t0 * t0;
   const double t11 = t9 + t10;
-  const double t12 = 6.0 * p0[0];
-  const double t13 = 4.0 * p0[1];
-  const double t14 = 2.0 * p0[2];
-  const double t15 = (q0[0] * q0[0]) * (q0[0] * q0[0]);
+  const double t12 = 6.0 * p0[0] /* p_q[1] */;
+  const double t13 = 4.0 * p0[1] /* p_q[2] */;
+  const double t14 = 2.0 * p0[2] /* p_q[3] */;
+  const double t15 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
   const double t16 = 5.0 * t15;
   const double t17 = t12 * t16;
-  const double t18 = q0[1] * q0[1];
+  const double t18 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t19 = 3.0 * t18;
   const double t20 = t13 * t19;
-  const double t21 = p0[0] * t17;
-  const double t22 = p0[1] * t20;
+  const double t21 = p0[0] /* p_q[1] */ * t17;
+  const double t22 = p0[1] /* p_q[2] */ * t20;
   const double t23 = t21 + t22;
-  const double t24 = p0[2] * t14;
+  const double t24 = p0[2] /* p_q[3] */ * t14;
   const double t25 = t23 + t24;
   const double t26 = t0 * t6;
   const double t27 = t25 - t26;
   const double t28 = t27 / t11;
+  /* lambda */
   out[0] = t28;
 }
 
@@ -415,19 +435,19 @@ void modified_k6s2_init(modified_k6s2_state *x, const double *q0, const double *
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_k6s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : modified_k6s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : modified_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (modified_k6s2_NU ? modified_k6s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = 0;
   {
     modified_k6s2_params prm;
-    double lam[NU];
+    double lam[modified_k6s2_NU];
     modified_k6s2_params_default(&prm);
     modified_k6s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -443,32 +463,32 @@ const char *modified_k6s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) modified_k6s2_params dflt_; if (!prm) { modified_k6s2_params_default(&dflt_); prm = &dflt_; }
+#define modified_k6s2_DEFAULT_PARAMS(prm) modified_k6s2_params dflt_; if (!prm) { modified_k6s2_params_default(&dflt_); prm = &dflt_; }
 
 double modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  modified_k6s2_DEFAULT_PARAMS(prm)
   modified_k6s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[modified_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_k6s2_DEFAULT_PARAMS(prm)
   modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < modified_k6s2_NU; i++) g[i] = v[i];
 }
 
 void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[modified_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_k6s2_DEFAULT_PARAMS(prm)
   modified_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < modified_k6s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -476,17 +496,17 @@ void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_para
 static void modified_k6s2_predict(const modified_k6s2_state *x, double h, const modified_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < modified_k6s2_S; j++)
+    for (i = 0; i < modified_k6s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + modified_k6s2_E[(j * S + i) * S + d];
+      for (d = modified_k6s2_S - 1; d >= 0; d--) e = e * r + modified_k6s2_E[(j * modified_k6s2_S + i) * modified_k6s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < modified_k6s2_M; l++) gam[j * modified_k6s2_M + l] += e * x->gam[i * modified_k6s2_M + l];
     }
 }
 
@@ -503,60 +523,63 @@ static void modified_k6s2_add(double *a, double *c, double b)
 int modified_k6s2_step(modified_k6s2_state *x, double h_, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_k6s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  modified_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k6s2_EBADSTEP;
   modified_k6s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[modified_k6s2_NU];
   modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below modified_k6s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < modified_k6s2_NU; i++) g0[i] = fabs(g0[i]) <= modified_k6s2_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= modified_k6s2_MAXITER; it++) {
     modified_k6s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < modified_k6s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = modified_k6s2_ESINGULAR;
+    for (i = 0; i < modified_k6s2_NU; i++) {
+      double piv = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU + i], dia = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 2 * modified_k6s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k6s2_SINGTOL * fabs(dia))) rc = modified_k6s2_ESINGULAR;
     }
     if (rc == modified_k6s2_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k6s2_ENONFINITE;
     if (rc == modified_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_k6s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (modified_k6s2_TOL / 256), or
+     * within 2 ulps (modified_k6s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above modified_k6s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = modified_k6s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? modified_k6s2_OK : modified_k6s2_ENOCONV; break; }
+    if (inc <= modified_k6s2_TOL / 256 || (inc <= modified_k6s2_TOL && 4 * inc > inc_old)) { rc = modified_k6s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= modified_k6s2_STAGTOL ? modified_k6s2_OK : modified_k6s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > modified_k6s2_MAXITER ? modified_k6s2_MAXITER : it; st->increment = inc; }
   if (rc != modified_k6s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return modified_k6s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k6s2_ENONFINITE;
+  for (i = 0; i < modified_k6s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k6s2_S * modified_k6s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return modified_k6s2_ENONFINITE;
+  for (i = 0; i < modified_k6s2_M; i++) {
     modified_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    modified_k6s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    modified_k6s2_add(&x->p[i], &x->pc[i], sw[modified_k6s2_S * modified_k6s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + i];
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = gam[i];
   modified_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k6s2_OK;

@@ -4,6 +4,10 @@
 #ifndef modified_k6s2_H
 #define modified_k6s2_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define modified_k6s2_M 3      /* coordinates */
 #define modified_k6s2_NU 1     /* constraints */
 #define modified_k6s2_K 6      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void modified_k6s2_params_default(modified_k6s2_params *prm);
 int modified_k6s2_step(modified_k6s2_state *x, double h, const modified_k6s2_params *prm, modified_k6s2_stats *st);
 const char *modified_k6s2_strerror(int code);
 double modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm);
-void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *g);   /* NU values */
+void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *g);   /* modified_k6s2_NU values */
 void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

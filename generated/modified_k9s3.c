@@ -5,14 +5,27 @@
 
 #include "modified_k9s3.h"
 
-#define M modified_k9s3_M
-#define NU modified_k9s3_NU
-#define S modified_k9s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(modified_k9s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define modified_k9s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef modified_k9s3_MAXITER
+#define modified_k9s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef modified_k9s3_TOL
+#define modified_k9s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef modified_k9s3_STAGTOL
+#define modified_k9s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef modified_k9s3_SINGTOL
+#define modified_k9s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef modified_k9s3_GTOL
+#define modified_k9s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 9 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -39,7 +52,7 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   const double t1 = gam[2] * 0.5;
   const double t2 = gam[5] * 0.28867513459481292;
   const double t3 = t1 - t2;
@@ -61,21 +74,21 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t18 = gam[6] * 0.033915833930187211;
   const double t19 = t17 + t18;
   const double t20 = h * t19;
-  const double t21 = q0[0] + t20;
+  const double t21 = q0[0] /* q[1] */ + t20;
   const double t22 = 0.015919880246186957 * gam[1];
   const double t23 = (-0.027135065999230656) * gam[4];
   const double t24 = t22 + t23;
   const double t25 = 0.033915833930187211 * gam[7];
   const double t26 = t24 + t25;
   const double t27 = h * t26;
-  const double t28 = q0[1] + t27;
+  const double t28 = q0[1] /* q[2] */ + t27;
   const double t29 = gam[2] * 0.015919880246186957;
   const double t30 = gam[5] * (-0.027135065999230656);
   const double t31 = t29 + t30;
   const double t32 = gam[8] * 0.033915833930187211;
   const double t33 = t31 + t32;
   const double t34 = h * t33;
-  const double t35 = q0[2] + t34;
+  const double t35 = q0[2] /* q[3] */ + t34;
   const double t36 = t35 * t35 * t35;
   const double t37 = t28 * t28 * t28;
   const double t38 = (t21 * t21) * (t21 * t21) * t21;
@@ -95,21 +108,21 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t51 = gam[6] * 0.1406983313308362;
   const double t52 = t50 + t51;
   const double t53 = h * t52;
-  const double t54 = q0[0] + t53;
+  const double t54 = q0[0] /* q[1] */ + t53;
   const double t55 = gam[1] * 0.081984446336682115;
   const double t56 = gam[4] * (-0.13035933455299098);
   const double t57 = t55 + t56;
   const double t58 = gam[7] * 0.1406983313308362;
   const double t59 = t57 + t58;
   const double t60 = h * t59;
-  const double t61 = q0[1] + t60;
+  const double t61 = q0[1] /* q[2] */ + t60;
   const double t62 = gam[2] * 0.081984446336682115;
   const double t63 = gam[5] * (-0.13035933455299098);
   const double t64 = t62 + t63;
   const double t65 = gam[8] * 0.1406983313308362;
   const double t66 = t64 + t65;
   const double t67 = h * t66;
-  const double t68 = q0[2] + t67;
+  const double t68 = q0[2] /* q[3] */ + t67;
   const double t69 = t68 * t68 * t68;
   const double t70 = t61 * t61 * t61;
   const double t71 = (t54 * t54) * (t54 * t54) * t54;
@@ -139,21 +152,21 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t94 = gam[6] * 0.21388329150952573;
   const double t95 = t93 + t94;
   const double t96 = h * t95;
-  const double t97 = q0[0] + t96;
+  const double t97 = q0[0] /* q[1] */ + t96;
   const double t98 = gam[1] * 0.19331428364970482;
   const double t99 = gam[4] * (-0.27010270837076178);
   const double t100 = t98 + t99;
   const double t101 = gam[7] * 0.21388329150952573;
   const double t102 = t100 + t101;
   const double t103 = h * t102;
-  const double t104 = q0[1] + t103;
+  const double t104 = q0[1] /* q[2] */ + t103;
   const double t105 = gam[2] * 0.19331428364970482;
   const double t106 = gam[5] * (-0.27010270837076178);
   const double t107 = t105 + t106;
   const double t108 = gam[8] * 0.21388329150952573;
   const double t109 = t107 + t108;
   const double t110 = h * t109;
-  const double t111 = q0[2] + t110;
+  const double t111 = q0[2] /* q[3] */ + t110;
   const double t112 = t111 * t111 * t111;
   const double t113 = t104 * t104 * t104;
   const double t114 = (t97 * t97) * (t97 * t97) * t97;
@@ -183,21 +196,21 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t137 = gam[6] * 0.16220511281207234;
   const double t138 = t136 + t137;
   const double t139 = h * t138;
-  const double t140 = q0[0] + t139;
+  const double t140 = q0[0] /* q[1] */ + t139;
   const double t141 = gam[1] * 0.33787328829809554;
   const double t142 = gam[4] * (-0.38748562405060616);
   const double t143 = t141 + t142;
   const double t144 = gam[7] * 0.16220511281207234;
   const double t145 = t143 + t144;
   const double t146 = h * t145;
-  const double t147 = q0[1] + t146;
+  const double t147 = q0[1] /* q[2] */ + t146;
   const double t148 = gam[2] * 0.33787328829809554;
   const double t149 = gam[5] * (-0.38748562405060616);
   const double t150 = t148 + t149;
   const double t151 = gam[8] * 0.16220511281207234;
   const double t152 = t150 + t151;
   const double t153 = h * t152;
-  const double t154 = q0[2] + t153;
+  const double t154 = q0[2] /* q[3] */ + t153;
   const double t155 = t154 * t154 * t154;
   const double t156 = t147 * t147 * t147;
   const double t157 = (t140 * t140) * (t140 * t140) * t140;
@@ -225,16 +238,16 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t178 = gam[3] * (-0.43301270189221935);
   const double t179 = t177 + t178;
   const double t180 = h * t179;
-  const double t181 = q0[0] + t180;
+  const double t181 = q0[0] /* q[1] */ + t180;
   const double t182 = 0.5 * gam[1];
   const double t183 = gam[4] * (-0.43301270189221935);
   const double t184 = t182 + t183;
   const double t185 = h * t184;
-  const double t186 = q0[1] + t185;
+  const double t186 = q0[1] /* q[2] */ + t185;
   const double t187 = gam[5] * (-0.43301270189221935);
   const double t188 = t1 + t187;
   const double t189 = h * t188;
-  const double t190 = q0[2] + t189;
+  const double t190 = q0[2] /* q[3] */ + t189;
   const double t191 = t190 * t190 * t190;
   const double t192 = t186 * t186 * t186;
   const double t193 = (t181 * t181) * (t181 * t181) * t181;
@@ -257,21 +270,21 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t209 = gam[6] * (-0.16220511281207237);
   const double t210 = t208 + t209;
   const double t211 = h * t210;
-  const double t212 = q0[0] + t211;
+  const double t212 = q0[0] /* q[1] */ + t211;
   const double t213 = gam[1] * 0.66212671170190451;
   const double t214 = gam[4] * (-0.3874856240506061);
   const double t215 = t213 + t214;
   const double t216 = gam[7] * (-0.16220511281207237);
   const double t217 = t215 + t216;
   const double t218 = h * t217;
-  const double t219 = q0[1] + t218;
+  const double t219 = q0[1] /* q[2] */ + t218;
   const double t220 = gam[2] * 0.66212671170190451;
   const double t221 = gam[5] * (-0.3874856240506061);
   const double t222 = t220 + t221;
   const double t223 = gam[8] * (-0.16220511281207237);
   const double t224 = t222 + t223;
   const double t225 = h * t224;
-  const double t226 = q0[2] + t225;
+  const double t226 = q0[2] /* q[3] */ + t225;
   const double t227 = t226 * t226 * t226;
   const double t228 = t219 * t219 * t219;
   const double t229 = (t212 * t212) * (t212 * t212) * t212;
@@ -300,19 +313,19 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t251 = gam[6] * (-0.21388329150952573);
   const double t252 = t250 + t251;
   const double t253 = h * t252;
-  const double t254 = q0[0] + t253;
+  const double t254 = q0[0] /* q[1] */ + t253;
   const double t255 = gam[1] * 0.80668571635029518;
   const double t256 = t99 + t255;
   const double t257 = gam[7] * (-0.21388329150952573);
   const double t258 = t256 + t257;
   const double t259 = h * t258;
-  const double t260 = q0[1] + t259;
+  const double t260 = q0[1] /* q[2] */ + t259;
   const double t261 = gam[2] * 0.80668571635029518;
   const double t262 = t106 + t261;
   const double t263 = gam[8] * (-0.21388329150952573);
   const double t264 = t262 + t263;
   const double t265 = h * t264;
-  const double t266 = q0[2] + t265;
+  const double t266 = q0[2] /* q[3] */ + t265;
   const double t267 = t266 * t266 * t266;
   const double t268 = t260 * t260 * t260;
   const double t269 = (t254 * t254) * (t254 * t254) * t254;
@@ -341,19 +354,19 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t291 = gam[6] * (-0.1406983313308362);
   const double t292 = t290 + t291;
   const double t293 = h * t292;
-  const double t294 = q0[0] + t293;
+  const double t294 = q0[0] /* q[1] */ + t293;
   const double t295 = gam[1] * 0.91801555366331788;
   const double t296 = t56 + t295;
   const double t297 = gam[7] * (-0.1406983313308362);
   const double t298 = t296 + t297;
   const double t299 = h * t298;
-  const double t300 = q0[1] + t299;
+  const double t300 = q0[1] /* q[2] */ + t299;
   const double t301 = gam[2] * 0.91801555366331788;
   const double t302 = t63 + t301;
   const double t303 = gam[8] * (-0.1406983313308362);
   const double t304 = t302 + t303;
   const double t305 = h * t304;
-  const double t306 = q0[2] + t305;
+  const double t306 = q0[2] /* q[3] */ + t305;
   const double t307 = t306 * t306 * t306;
   const double t308 = t300 * t300 * t300;
   const double t309 = (t294 * t294) * (t294 * t294) * t294;
@@ -382,19 +395,19 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t331 = gam[6] * (-0.033915833930187211);
   const double t332 = t330 + t331;
   const double t333 = h * t332;
-  const double t334 = q0[0] + t333;
+  const double t334 = q0[0] /* q[1] */ + t333;
   const double t335 = gam[1] * 0.98408011975381304;
   const double t336 = t23 + t335;
   const double t337 = gam[7] * (-0.033915833930187211);
   const double t338 = t336 + t337;
   const double t339 = h * t338;
-  const double t340 = q0[1] + t339;
+  const double t340 = q0[1] /* q[2] */ + t339;
   const double t341 = gam[2] * 0.98408011975381304;
   const double t342 = t30 + t341;
   const double t343 = gam[8] * (-0.033915833930187211);
   const double t344 = t342 + t343;
   const double t345 = h * t344;
-  const double t346 = q0[2] + t345;
+  const double t346 = q0[2] /* q[3] */ + t345;
   const double t347 = t346 * t346 * t346;
   const double t348 = t340 * t340 * t340;
   const double t349 = (t334 * t334) * (t334 * t334) * t334;
@@ -437,10 +450,10 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t385 = 0.12909944487358055 * t384;
   const double t386 = t381 + t385;
   const double t387 = h * t386;
-  const double t388 = t353 * p0[0];
-  const double t389 = t355 * p0[1];
+  const double t388 = t353 * p0[0] /* p_q[1] */;
+  const double t389 = t355 * p0[1] /* p_q[2] */;
   const double t390 = t388 + t389;
-  const double t391 = t6 * p0[2];
+  const double t391 = t6 * p0[2] /* p_q[3] */;
   const double t392 = t390 + t391;
   const double t393 = t392 - t387;
   const double t394 = t393 + g0[0];
@@ -462,17 +475,17 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t409 = 0.28867513459481292 * t400;
   const double t410 = t408 - t409;
   const double t411 = h * t410;
-  const double t412 = p0[0] - t411;
+  const double t412 = p0[0] /* p_q[1] */ - t411;
   const double t413 = 0.5 * t397;
   const double t414 = 0.28867513459481292 * t401;
   const double t415 = t413 - t414;
   const double t416 = h * t415;
-  const double t417 = p0[1] - t416;
+  const double t417 = p0[1] /* p_q[2] */ - t416;
   const double t418 = 0.5 * t399;
   const double t419 = 0.28867513459481292 * t403;
   const double t420 = t418 - t419;
   const double t421 = h * t420;
-  const double t422 = p0[2] - t421;
+  const double t422 = p0[2] /* p_q[3] */ - t421;
   const double t423 = 0.28867513459481292 * t396;
   const double t424 = 0.12909944487358055 * t404;
   const double t425 = t423 - t424;
@@ -503,6 +516,7 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t450 = -t449;
   const double t451 = h * t399;
   const double t452 = -t451;
+  /* gam */
   out[0] = t412;
   out[1] = t417;
   out[2] = t422;
@@ -512,11 +526,15 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   out[6] = t440;
   out[7] = t443;
   out[8] = t446;
+  /* dp */
   out[9] = t448;
   out[10] = t450;
   out[11] = t452;
+  /* lambda */
   out[12] = t395;
+  /* pivot */
   out[13] = t374;
+  /* adiag */
   out[14] = t374;
 }
 
@@ -525,9 +543,10 @@ static void modified_k9s3_minv_p(const double *q0, const double *p0, const doubl
     const double *g0, const modified_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_q[1] */;
+  out[1] = p0[1] /* p_q[2] */;
+  out[2] = p0[2] /* p_q[3] */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -536,14 +555,15 @@ static void modified_k9s3_energy_kernel(const double *q0, const double *p0, cons
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
+  const double t1 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
   const double t4 = t2 + t3;
-  const double t5 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t5 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
   const double t6 = 0.5 * t4;
   const double t7 = t5 + t6;
+  /* H */
   out[0] = t7;
 }
 
@@ -553,12 +573,13 @@ static void modified_k9s3_g(const double *q0, const double *p0, const double *ga
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* g(q0) */
-  const double t0 = (q0[0] * q0[0] * q0[0]) * (q0[0] * q0[0] * q0[0]);
-  const double t1 = (q0[1] * q0[1]) * (q0[1] * q0[1]);
+  const double t0 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t1 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 0.625;
+  /* g */
   out[0] = t5;
 }
 
@@ -567,18 +588,18 @@ static void modified_k9s3_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const modified_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   /* hidden constraints */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = p0[0] * t2;
-  const double t4 = q0[1] * q0[1] * q0[1];
+  const double t3 = p0[0] /* p_q[1] */ * t2;
+  const double t4 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t5 = 4.0 * t4;
-  const double t6 = p0[1] * t5;
+  const double t6 = p0[1] /* p_q[2] */ * t5;
   const double t7 = t3 + t6;
-  const double t8 = t0 * p0[2];
+  const double t8 = t0 * p0[2] /* p_q[3] */;
   const double t9 = t7 + t8;
+  /* hidden */
   out[0] = t9;
 }
 
@@ -588,38 +609,37 @@ static void modified_k9s3_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const modified_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* hidden constraints */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   /* consistent initial multiplier */
-  const double t5 = q0[2] * q0[2] * q0[2];
+  const double t5 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t6 = 4.0 * t5;
   const double t7 = t2 * t2;
   const double t8 = t4 * t4;
   const double t9 = t7 + t8;
   const double t10 = t0 * t0;
   const double t11 = t9 + t10;
-  const double t12 = 6.0 * p0[0];
-  const double t13 = 4.0 * p0[1];
-  const double t14 = 2.0 * p0[2];
-  const double t15 = (q0[0] * q0[0]) * (q0[0] * q0[0]);
+  const double t12 = 6.0 * p0[0] /* p_q[1] */;
+  const double t13 = 4.0 * p0[1] /* p_q[2] */;
+  const double t14 = 2.0 * p0[2] /* p_q[3] */;
+  const double t15 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
   const double t16 = 5.0 * t15;
   const double t17 = t12 * t16;
-  const double t18 = q0[1] * q0[1];
+  const double t18 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t19 = 3.0 * t18;
   const double t20 = t13 * t19;
-  const double t21 = p0[0] * t17;
-  const double t22 = p0[1] * t20;
+  const double t21 = p0[0] /* p_q[1] */ * t17;
+  const double t22 = p0[1] /* p_q[2] */ * t20;
   const double t23 = t21 + t22;
-  const double t24 = p0[2] * t14;
+  const double t24 = p0[2] /* p_q[3] */ * t14;
   const double t25 = t23 + t24;
   const double t26 = t0 * t6;
   const double t27 = t25 - t26;
   const double t28 = t27 / t11;
+  /* lambda */
   out[0] = t28;
 }
 
@@ -632,19 +652,19 @@ void modified_k9s3_init(modified_k9s3_state *x, const double *q0, const double *
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_k9s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : modified_k9s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : modified_k9s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (modified_k9s3_NU ? modified_k9s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = 0;
   {
     modified_k9s3_params prm;
-    double lam[NU];
+    double lam[modified_k9s3_NU];
     modified_k9s3_params_default(&prm);
     modified_k9s3_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -660,32 +680,32 @@ const char *modified_k9s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) modified_k9s3_params dflt_; if (!prm) { modified_k9s3_params_default(&dflt_); prm = &dflt_; }
+#define modified_k9s3_DEFAULT_PARAMS(prm) modified_k9s3_params dflt_; if (!prm) { modified_k9s3_params_default(&dflt_); prm = &dflt_; }
 
 double modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  modified_k9s3_DEFAULT_PARAMS(prm)
   modified_k9s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, double *g)
 {
-  double v[NU];
+  double v[modified_k9s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_k9s3_DEFAULT_PARAMS(prm)
   modified_k9s3_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < modified_k9s3_NU; i++) g[i] = v[i];
 }
 
 void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_params *prm, double *gp)
 {
-  double v[NU];
+  double v[modified_k9s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_k9s3_DEFAULT_PARAMS(prm)
   modified_k9s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < modified_k9s3_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -693,17 +713,17 @@ void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_para
 static void modified_k9s3_predict(const modified_k9s3_state *x, double h, const modified_k9s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_k9s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < modified_k9s3_S; j++)
+    for (i = 0; i < modified_k9s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + modified_k9s3_E[(j * S + i) * S + d];
+      for (d = modified_k9s3_S - 1; d >= 0; d--) e = e * r + modified_k9s3_E[(j * modified_k9s3_S + i) * modified_k9s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < modified_k9s3_M; l++) gam[j * modified_k9s3_M + l] += e * x->gam[i * modified_k9s3_M + l];
     }
 }
 
@@ -720,60 +740,63 @@ static void modified_k9s3_add(double *a, double *c, double b)
 int modified_k9s3_step(modified_k9s3_state *x, double h_, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[modified_k9s3_S * modified_k9s3_M], sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 3 * modified_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_k9s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  modified_k9s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k9s3_EBADSTEP;
   modified_k9s3_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[modified_k9s3_NU];
   modified_k9s3_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below modified_k9s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < modified_k9s3_NU; i++) g0[i] = fabs(g0[i]) <= modified_k9s3_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= modified_k9s3_MAXITER; it++) {
     modified_k9s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < modified_k9s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = modified_k9s3_ESINGULAR;
+    for (i = 0; i < modified_k9s3_NU; i++) {
+      double piv = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU + i], dia = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 2 * modified_k9s3_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k9s3_SINGTOL * fabs(dia))) rc = modified_k9s3_ESINGULAR;
     }
     if (rc == modified_k9s3_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k9s3_ENONFINITE;
     if (rc == modified_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_k9s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (modified_k9s3_TOL / 256), or
+     * within 2 ulps (modified_k9s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above modified_k9s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = modified_k9s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? modified_k9s3_OK : modified_k9s3_ENOCONV; break; }
+    if (inc <= modified_k9s3_TOL / 256 || (inc <= modified_k9s3_TOL && 4 * inc > inc_old)) { rc = modified_k9s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= modified_k9s3_STAGTOL ? modified_k9s3_OK : modified_k9s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > modified_k9s3_MAXITER ? modified_k9s3_MAXITER : it; st->increment = inc; }
   if (rc != modified_k9s3_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return modified_k9s3_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k9s3_ENONFINITE;
+  for (i = 0; i < modified_k9s3_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k9s3_S * modified_k9s3_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return modified_k9s3_ENONFINITE;
+  for (i = 0; i < modified_k9s3_M; i++) {
     modified_k9s3_add(&x->q[i], &x->qc[i], h * sw[i]);
-    modified_k9s3_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    modified_k9s3_add(&x->p[i], &x->pc[i], sw[modified_k9s3_S * modified_k9s3_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + i];
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = gam[i];
   modified_k9s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k9s3_OK;

@@ -5,14 +5,27 @@
 
 #include "modified_poly_k6s2.h"
 
-#define M modified_poly_k6s2_M
-#define NU modified_poly_k6s2_NU
-#define S modified_poly_k6s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(modified_poly_k6s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define modified_poly_k6s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef modified_poly_k6s2_MAXITER
+#define modified_poly_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef modified_poly_k6s2_TOL
+#define modified_poly_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef modified_poly_k6s2_STAGTOL
+#define modified_poly_k6s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef modified_poly_k6s2_SINGTOL
+#define modified_poly_k6s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef modified_poly_k6s2_GTOL
+#define modified_poly_k6s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -40,17 +53,17 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t1 = gam[3] * (-0.056508419605012766);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* q[1] */ + t3;
   const double t5 = 0.033765242898423975 * gam[1];
   const double t6 = (-0.056508419605012766) * gam[4];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* q[2] */ + t8;
   const double t10 = gam[2] * 0.033765242898423975;
   const double t11 = gam[5] * (-0.056508419605012766);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* q[3] */ + t13;
   const double t15 = t14 * t14 * t14;
   const double t16 = t9 * t9 * t9;
   const double t17 = 4.0 * t16;
@@ -63,17 +76,17 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t23 = gam[3] * (-0.24370047841099157);
   const double t24 = t22 + t23;
   const double t25 = h * t24;
-  const double t26 = q0[0] + t25;
+  const double t26 = q0[0] /* q[1] */ + t25;
   const double t27 = gam[1] * 0.16939530676686776;
   const double t28 = gam[4] * (-0.24370047841099157);
   const double t29 = t27 + t28;
   const double t30 = h * t29;
-  const double t31 = q0[1] + t30;
+  const double t31 = q0[1] /* q[2] */ + t30;
   const double t32 = gam[2] * 0.16939530676686776;
   const double t33 = gam[5] * (-0.24370047841099157);
   const double t34 = t32 + t33;
   const double t35 = h * t34;
-  const double t36 = q0[2] + t35;
+  const double t36 = q0[2] /* q[3] */ + t35;
   const double t37 = t36 * t36 * t36;
   const double t38 = t31 * t31 * t31;
   const double t39 = 4.0 * t38;
@@ -88,17 +101,17 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t47 = gam[3] * (-0.40835734144399111);
   const double t48 = t46 + t47;
   const double t49 = h * t48;
-  const double t50 = q0[0] + t49;
+  const double t50 = q0[0] /* q[1] */ + t49;
   const double t51 = gam[1] * 0.38069040695840156;
   const double t52 = gam[4] * (-0.40835734144399111);
   const double t53 = t51 + t52;
   const double t54 = h * t53;
-  const double t55 = q0[1] + t54;
+  const double t55 = q0[1] /* q[2] */ + t54;
   const double t56 = gam[2] * 0.38069040695840156;
   const double t57 = gam[5] * (-0.40835734144399111);
   const double t58 = t56 + t57;
   const double t59 = h * t58;
-  const double t60 = q0[2] + t59;
+  const double t60 = q0[2] /* q[3] */ + t59;
   const double t61 = t60 * t60 * t60;
   const double t62 = t55 * t55 * t55;
   const double t63 = 4.0 * t62;
@@ -113,17 +126,17 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t71 = gam[3] * (-0.40835734144399105);
   const double t72 = t70 + t71;
   const double t73 = h * t72;
-  const double t74 = q0[0] + t73;
+  const double t74 = q0[0] /* q[1] */ + t73;
   const double t75 = gam[1] * 0.61930959304159849;
   const double t76 = gam[4] * (-0.40835734144399105);
   const double t77 = t75 + t76;
   const double t78 = h * t77;
-  const double t79 = q0[1] + t78;
+  const double t79 = q0[1] /* q[2] */ + t78;
   const double t80 = gam[2] * 0.61930959304159849;
   const double t81 = gam[5] * (-0.40835734144399105);
   const double t82 = t80 + t81;
   const double t83 = h * t82;
-  const double t84 = q0[2] + t83;
+  const double t84 = q0[2] /* q[3] */ + t83;
   const double t85 = t84 * t84 * t84;
   const double t86 = t79 * t79 * t79;
   const double t87 = 4.0 * t86;
@@ -137,15 +150,15 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t94 = gam[0] * 0.83060469323313224;
   const double t95 = t23 + t94;
   const double t96 = h * t95;
-  const double t97 = q0[0] + t96;
+  const double t97 = q0[0] /* q[1] */ + t96;
   const double t98 = gam[1] * 0.83060469323313224;
   const double t99 = t28 + t98;
   const double t100 = h * t99;
-  const double t101 = q0[1] + t100;
+  const double t101 = q0[1] /* q[2] */ + t100;
   const double t102 = gam[2] * 0.83060469323313224;
   const double t103 = t33 + t102;
   const double t104 = h * t103;
-  const double t105 = q0[2] + t104;
+  const double t105 = q0[2] /* q[3] */ + t104;
   const double t106 = t105 * t105 * t105;
   const double t107 = t101 * t101 * t101;
   const double t108 = 4.0 * t107;
@@ -159,15 +172,15 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t115 = gam[0] * 0.96623475710157603;
   const double t116 = t1 + t115;
   const double t117 = h * t116;
-  const double t118 = q0[0] + t117;
+  const double t118 = q0[0] /* q[1] */ + t117;
   const double t119 = gam[1] * 0.96623475710157603;
   const double t120 = t6 + t119;
   const double t121 = h * t120;
-  const double t122 = q0[1] + t121;
+  const double t122 = q0[1] /* q[2] */ + t121;
   const double t123 = gam[2] * 0.96623475710157603;
   const double t124 = t11 + t123;
   const double t125 = h * t124;
-  const double t126 = q0[2] + t125;
+  const double t126 = q0[2] /* q[3] */ + t125;
   const double t127 = t126 * t126 * t126;
   const double t128 = t122 * t122 * t122;
   const double t129 = 4.0 * t128;
@@ -287,17 +300,17 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t241 = 0.28867513459481292 * t235;
   const double t242 = t240 - t241;
   const double t243 = h * t242;
-  const double t244 = p0[0] - t243;
+  const double t244 = p0[0] /* p_q[1] */ - t243;
   const double t245 = 0.5 * t231;
   const double t246 = 0.28867513459481292 * t237;
   const double t247 = t245 - t246;
   const double t248 = h * t247;
-  const double t249 = p0[1] - t248;
+  const double t249 = p0[1] /* p_q[2] */ - t248;
   const double t250 = 0.5 * t233;
   const double t251 = 0.28867513459481292 * t239;
   const double t252 = t250 - t251;
   const double t253 = h * t252;
-  const double t254 = p0[2] - t253;
+  const double t254 = p0[2] /* p_q[3] */ - t253;
   const double t255 = 0.28867513459481292 * t229;
   const double t256 = h * t255;
   const double t257 = 0.28867513459481292 * t231;
@@ -504,17 +517,17 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t457 = 0.28867513459481292 * t451;
   const double t458 = t456 - t457;
   const double t459 = h * t458;
-  const double t460 = p0[0] - t459;
+  const double t460 = p0[0] /* p_q[1] */ - t459;
   const double t461 = 0.5 * t447;
   const double t462 = 0.28867513459481292 * t453;
   const double t463 = t461 - t462;
   const double t464 = h * t463;
-  const double t465 = p0[1] - t464;
+  const double t465 = p0[1] /* p_q[2] */ - t464;
   const double t466 = 0.5 * t449;
   const double t467 = 0.28867513459481292 * t455;
   const double t468 = t466 - t467;
   const double t469 = h * t468;
-  const double t470 = p0[2] - t469;
+  const double t470 = p0[2] /* p_q[3] */ - t469;
   const double t471 = 0.28867513459481292 * t445;
   const double t472 = h * t471;
   const double t473 = -t472;
@@ -530,15 +543,18 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t483 = -t482;
   const double t484 = h * t449;
   const double t485 = -t484;
+  /* gam */
   out[0] = t460;
   out[1] = t465;
   out[2] = t470;
   out[3] = t473;
   out[4] = t476;
   out[5] = t479;
+  /* dp */
   out[6] = t481;
   out[7] = t483;
   out[8] = t485;
+  /* lam */
   out[9] = t356;
   out[10] = t357;
 }
@@ -554,17 +570,17 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t1 = gam[3] * (-0.056508419605012766);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* q[1] */ + t3;
   const double t5 = 0.033765242898423975 * gam[1];
   const double t6 = (-0.056508419605012766) * gam[4];
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* q[2] */ + t8;
   const double t10 = gam[2] * 0.033765242898423975;
   const double t11 = gam[5] * (-0.056508419605012766);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* q[3] */ + t13;
   const double t15 = t9 * t9 * t9;
   const double t16 = (t4 * t4) * (t4 * t4) * t4;
   const double t17 = 6.0 * t16;
@@ -577,17 +593,17 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t23 = gam[3] * (-0.24370047841099157);
   const double t24 = t22 + t23;
   const double t25 = h * t24;
-  const double t26 = q0[0] + t25;
+  const double t26 = q0[0] /* q[1] */ + t25;
   const double t27 = gam[1] * 0.16939530676686776;
   const double t28 = gam[4] * (-0.24370047841099157);
   const double t29 = t27 + t28;
   const double t30 = h * t29;
-  const double t31 = q0[1] + t30;
+  const double t31 = q0[1] /* q[2] */ + t30;
   const double t32 = gam[2] * 0.16939530676686776;
   const double t33 = gam[5] * (-0.24370047841099157);
   const double t34 = t32 + t33;
   const double t35 = h * t34;
-  const double t36 = q0[2] + t35;
+  const double t36 = q0[2] /* q[3] */ + t35;
   const double t37 = t31 * t31 * t31;
   const double t38 = (t26 * t26) * (t26 * t26) * t26;
   const double t39 = 6.0 * t38;
@@ -604,17 +620,17 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t49 = gam[3] * (-0.40835734144399111);
   const double t50 = t48 + t49;
   const double t51 = h * t50;
-  const double t52 = q0[0] + t51;
+  const double t52 = q0[0] /* q[1] */ + t51;
   const double t53 = gam[1] * 0.38069040695840156;
   const double t54 = gam[4] * (-0.40835734144399111);
   const double t55 = t53 + t54;
   const double t56 = h * t55;
-  const double t57 = q0[1] + t56;
+  const double t57 = q0[1] /* q[2] */ + t56;
   const double t58 = gam[2] * 0.38069040695840156;
   const double t59 = gam[5] * (-0.40835734144399111);
   const double t60 = t58 + t59;
   const double t61 = h * t60;
-  const double t62 = q0[2] + t61;
+  const double t62 = q0[2] /* q[3] */ + t61;
   const double t63 = t57 * t57 * t57;
   const double t64 = (t52 * t52) * (t52 * t52) * t52;
   const double t65 = 6.0 * t64;
@@ -631,17 +647,17 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t75 = gam[3] * (-0.40835734144399105);
   const double t76 = t74 + t75;
   const double t77 = h * t76;
-  const double t78 = q0[0] + t77;
+  const double t78 = q0[0] /* q[1] */ + t77;
   const double t79 = gam[1] * 0.61930959304159849;
   const double t80 = gam[4] * (-0.40835734144399105);
   const double t81 = t79 + t80;
   const double t82 = h * t81;
-  const double t83 = q0[1] + t82;
+  const double t83 = q0[1] /* q[2] */ + t82;
   const double t84 = gam[2] * 0.61930959304159849;
   const double t85 = gam[5] * (-0.40835734144399105);
   const double t86 = t84 + t85;
   const double t87 = h * t86;
-  const double t88 = q0[2] + t87;
+  const double t88 = q0[2] /* q[3] */ + t87;
   const double t89 = t83 * t83 * t83;
   const double t90 = (t78 * t78) * (t78 * t78) * t78;
   const double t91 = 6.0 * t90;
@@ -657,15 +673,15 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t100 = gam[0] * 0.83060469323313224;
   const double t101 = t23 + t100;
   const double t102 = h * t101;
-  const double t103 = q0[0] + t102;
+  const double t103 = q0[0] /* q[1] */ + t102;
   const double t104 = gam[1] * 0.83060469323313224;
   const double t105 = t28 + t104;
   const double t106 = h * t105;
-  const double t107 = q0[1] + t106;
+  const double t107 = q0[1] /* q[2] */ + t106;
   const double t108 = gam[2] * 0.83060469323313224;
   const double t109 = t33 + t108;
   const double t110 = h * t109;
-  const double t111 = q0[2] + t110;
+  const double t111 = q0[2] /* q[3] */ + t110;
   const double t112 = t107 * t107 * t107;
   const double t113 = (t103 * t103) * (t103 * t103) * t103;
   const double t114 = 6.0 * t113;
@@ -681,15 +697,15 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t123 = gam[0] * 0.96623475710157603;
   const double t124 = t1 + t123;
   const double t125 = h * t124;
-  const double t126 = q0[0] + t125;
+  const double t126 = q0[0] /* q[1] */ + t125;
   const double t127 = gam[1] * 0.96623475710157603;
   const double t128 = t6 + t127;
   const double t129 = h * t128;
-  const double t130 = q0[1] + t129;
+  const double t130 = q0[1] /* q[2] */ + t129;
   const double t131 = gam[2] * 0.96623475710157603;
   const double t132 = t11 + t131;
   const double t133 = h * t132;
-  const double t134 = q0[2] + t133;
+  const double t134 = q0[2] /* q[3] */ + t133;
   const double t135 = t130 * t130 * t130;
   const double t136 = (t126 * t126) * (t126 * t126) * t126;
   const double t137 = 6.0 * t136;
@@ -831,12 +847,15 @@ static void modified_poly_k6s2_factor(const double *q0, const double *p0, const 
   const double t272 = t269 - t271;
   const double t273 = 1.0 / t224;
   const double t274 = 1.0 / t272;
+  /* lu */
   out[0] = t273;
   out[1] = t245;
   out[2] = t270;
   out[3] = t274;
+  /* pivot */
   out[4] = t224;
   out[5] = t272;
+  /* adiag */
   out[6] = t224;
   out[7] = t269;
 }
@@ -846,9 +865,10 @@ static void modified_poly_k6s2_minv_p(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_q[1] */;
+  out[1] = p0[1] /* p_q[2] */;
+  out[2] = p0[2] /* p_q[3] */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -856,16 +876,16 @@ static void modified_poly_k6s2_energy_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t0 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
   /* energy */
-  const double t1 = p0[0] * p0[0];
-  const double t2 = p0[1] * p0[1];
+  const double t1 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
+  const double t2 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
   const double t3 = t1 + t2;
-  const double t4 = p0[2] * p0[2];
+  const double t4 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
   const double t5 = t3 + t4;
   const double t6 = 0.5 * t5;
   const double t7 = t0 + t6;
+  /* H */
   out[0] = t7;
 }
 
@@ -875,12 +895,13 @@ static void modified_poly_k6s2_g(const double *q0, const double *p0, const doubl
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* g(q0) */
-  const double t0 = (q0[0] * q0[0] * q0[0]) * (q0[0] * q0[0] * q0[0]);
-  const double t1 = (q0[1] * q0[1]) * (q0[1] * q0[1]);
+  const double t0 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t1 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 0.625;
+  /* g */
   out[0] = t5;
 }
 
@@ -889,18 +910,17 @@ static void modified_poly_k6s2_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
-  const double t5 = p0[0] * t2;
-  const double t6 = p0[1] * t4;
+  const double t5 = p0[0] /* p_q[1] */ * t2;
+  const double t6 = p0[1] /* p_q[2] */ * t4;
   const double t7 = t5 + t6;
-  const double t8 = t0 * p0[2];
+  const double t8 = t0 * p0[2] /* p_q[3] */;
   const double t9 = t7 + t8;
+  /* hidden */
   out[0] = t9;
 }
 
@@ -910,12 +930,10 @@ static void modified_poly_k6s2_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   const double t5 = t2 * t2;
   const double t6 = t4 * t4;
@@ -923,25 +941,26 @@ static void modified_poly_k6s2_lambda0(const double *q0, const double *p0, const
   const double t8 = t0 * t0;
   const double t9 = t7 + t8;
   /* consistent initial multiplier */
-  const double t10 = q0[2] * q0[2] * q0[2];
+  const double t10 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t11 = 4.0 * t10;
-  const double t12 = 6.0 * p0[0];
-  const double t13 = 4.0 * p0[1];
-  const double t14 = 2.0 * p0[2];
-  const double t15 = (q0[0] * q0[0]) * (q0[0] * q0[0]);
+  const double t12 = 6.0 * p0[0] /* p_q[1] */;
+  const double t13 = 4.0 * p0[1] /* p_q[2] */;
+  const double t14 = 2.0 * p0[2] /* p_q[3] */;
+  const double t15 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
   const double t16 = 5.0 * t15;
   const double t17 = t12 * t16;
-  const double t18 = q0[1] * q0[1];
+  const double t18 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t19 = 3.0 * t18;
   const double t20 = t13 * t19;
-  const double t21 = p0[0] * t17;
-  const double t22 = p0[1] * t20;
+  const double t21 = p0[0] /* p_q[1] */ * t17;
+  const double t22 = p0[1] /* p_q[2] */ * t20;
   const double t23 = t21 + t22;
-  const double t24 = p0[2] * t14;
+  const double t24 = p0[2] /* p_q[3] */ * t14;
   const double t25 = t23 + t24;
   const double t26 = t0 * t11;
   const double t27 = t25 - t26;
   const double t28 = t27 / t9;
+  /* lambda */
   out[0] = t28;
 }
 
@@ -952,46 +971,50 @@ static void modified_poly_k6s2_project(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   const double t5 = t2 * t2;
   const double t6 = t4 * t4;
   const double t7 = t5 + t6;
   const double t8 = t0 * t0;
   const double t9 = t7 + t8;
-  const double t10 = p0[0] * t2;
-  const double t11 = p0[1] * t4;
+  const double t10 = p0[0] /* p_q[1] */ * t2;
+  const double t11 = p0[1] /* p_q[2] */ * t4;
   const double t12 = t10 + t11;
-  const double t13 = t0 * p0[2];
+  const double t13 = t0 * p0[2] /* p_q[3] */;
   const double t14 = t12 + t13;
   const double t15 = t14 / t9;
   const double t16 = t2 * t15;
   const double t17 = -t16;
-  const double t18 = p0[0] - t16;
+  const double t18 = p0[0] /* p_q[1] */ - t16;
   const double t19 = t4 * t15;
   const double t20 = -t19;
-  const double t21 = p0[1] - t19;
+  const double t21 = p0[1] /* p_q[2] */ - t19;
   const double t22 = t0 * t15;
   const double t23 = -t22;
-  const double t24 = p0[2] - t22;
+  const double t24 = p0[2] /* p_q[3] */ - t22;
   const double t25 = t18 * t18;
   const double t26 = t21 * t21;
   const double t27 = t25 + t26;
   const double t28 = t24 * t24;
   const double t29 = t27 + t28;
   const double t30 = 0.5 * t29;
-  const double t31 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t31 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
+  /* dp */
   out[0] = t17;
   out[1] = t20;
   out[2] = t23;
+  /* kin */
   out[3] = t30;
+  /* U */
   out[4] = t31;
+  /* pivot */
   out[5] = t9;
+  /* adiag */
   out[6] = t9;
 }
 
@@ -1004,20 +1027,20 @@ void modified_poly_k6s2_init(modified_poly_k6s2_state *x, const double *q0, cons
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : modified_poly_k6s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : modified_poly_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (modified_poly_k6s2_NU ? modified_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     modified_poly_k6s2_params prm;
-    double lam[NU];
+    double lam[modified_poly_k6s2_NU];
     modified_poly_k6s2_params_default(&prm);
     modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -1033,32 +1056,32 @@ const char *modified_poly_k6s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) modified_poly_k6s2_params dflt_; if (!prm) { modified_poly_k6s2_params_default(&dflt_); prm = &dflt_; }
+#define modified_poly_k6s2_DEFAULT_PARAMS(prm) modified_poly_k6s2_params dflt_; if (!prm) { modified_poly_k6s2_params_default(&dflt_); prm = &dflt_; }
 
 double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k6s2_DEFAULT_PARAMS(prm)
   modified_poly_k6s2_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[modified_poly_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k6s2_DEFAULT_PARAMS(prm)
   modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < modified_poly_k6s2_NU; i++) g[i] = v[i];
 }
 
 void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[modified_poly_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k6s2_DEFAULT_PARAMS(prm)
   modified_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < modified_poly_k6s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1066,17 +1089,17 @@ void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified
 static void modified_poly_k6s2_predict(const modified_poly_k6s2_state *x, double h, const modified_poly_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < modified_poly_k6s2_S; j++)
+    for (i = 0; i < modified_poly_k6s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + modified_poly_k6s2_E[(j * S + i) * S + d];
+      for (d = modified_poly_k6s2_S - 1; d >= 0; d--) e = e * r + modified_poly_k6s2_E[(j * modified_poly_k6s2_S + i) * modified_poly_k6s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < modified_poly_k6s2_M; l++) gam[j * modified_poly_k6s2_M + l] += e * x->gam[i * modified_poly_k6s2_M + l];
     }
 }
 
@@ -1093,100 +1116,101 @@ static void modified_poly_k6s2_add(double *a, double *c, double b)
 int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h_, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_poly_k6s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_poly_k6s2_EBADSTEP;
   modified_poly_k6s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[modified_poly_k6s2_NU];
   modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below modified_poly_k6s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[4 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_NU; i++) g0[i] = fabs(g0[i]) <= modified_poly_k6s2_GTOL ? 0 : g0[i] / h;
+  double fa[4 + 2 * modified_poly_k6s2_S * modified_poly_k6s2_NU + 1], lam[modified_poly_k6s2_S * modified_poly_k6s2_NU];
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   modified_poly_k6s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[4 + i], dia = fa[4 + S * NU + i];
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) {
+    double piv = fa[4 + i], dia = fa[4 + modified_poly_k6s2_S * modified_poly_k6s2_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return modified_poly_k6s2_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return modified_poly_k6s2_ESINGULAR;
+    if (!(fabs(piv) > modified_poly_k6s2_SINGTOL * fabs(dia))) return modified_poly_k6s2_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= modified_poly_k6s2_MAXITER; it++) {
     modified_poly_k6s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < modified_poly_k6s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) lam[i] = sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + i];
+    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = modified_poly_k6s2_ENONFINITE;
     if (rc == modified_poly_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_poly_k6s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (modified_poly_k6s2_TOL / 256), or
+     * within 2 ulps (modified_poly_k6s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above modified_poly_k6s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = modified_poly_k6s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? modified_poly_k6s2_OK : modified_poly_k6s2_ENOCONV; break; }
+    if (inc <= modified_poly_k6s2_TOL / 256 || (inc <= modified_poly_k6s2_TOL && 4 * inc > inc_old)) { rc = modified_poly_k6s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= modified_poly_k6s2_STAGTOL ? modified_poly_k6s2_OK : modified_poly_k6s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > modified_poly_k6s2_MAXITER ? modified_poly_k6s2_MAXITER : it; st->increment = inc; }
   if (rc != modified_poly_k6s2_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k6s2_ENONFINITE;
+  double q1[modified_poly_k6s2_M], p1[modified_poly_k6s2_M], pr[modified_poly_k6s2_M + 2 + 2 * modified_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k6s2_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[modified_poly_k6s2_M], pc1[modified_poly_k6s2_M];
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     modified_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
-    modified_poly_k6s2_add(&p1[i], &pc1[i], sw[S * M + i]);
+    modified_poly_k6s2_add(&p1[i], &pc1[i], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   modified_poly_k6s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return modified_poly_k6s2_ESINGULAR;
+  for (i = 0; i < modified_poly_k6s2_NU; i++) {
+    double piv = pr[modified_poly_k6s2_M + 2 + i], dia = pr[modified_poly_k6s2_M + 2 + modified_poly_k6s2_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_poly_k6s2_SINGTOL * fabs(dia))) return modified_poly_k6s2_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < modified_poly_k6s2_M + 2 + 2 * modified_poly_k6s2_NU; i++)
     if (!isfinite(pr[i])) return modified_poly_k6s2_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[modified_poly_k6s2_M + 0];
+  U1 = pr[modified_poly_k6s2_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * modified_poly_k6s2_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
     modified_poly_k6s2_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return modified_poly_k6s2_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[modified_poly_k6s2_NU];
     modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   modified_poly_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;

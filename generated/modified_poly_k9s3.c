@@ -5,14 +5,27 @@
 
 #include "modified_poly_k9s3.h"
 
-#define M modified_poly_k9s3_M
-#define NU modified_poly_k9s3_NU
-#define S modified_poly_k9s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(modified_poly_k9s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define modified_poly_k9s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef modified_poly_k9s3_MAXITER
+#define modified_poly_k9s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef modified_poly_k9s3_TOL
+#define modified_poly_k9s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef modified_poly_k9s3_STAGTOL
+#define modified_poly_k9s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef modified_poly_k9s3_SINGTOL
+#define modified_poly_k9s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef modified_poly_k9s3_GTOL
+#define modified_poly_k9s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 9 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -47,21 +60,21 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t4 = gam[6] * 0.033915833930187211;
   const double t5 = t3 + t4;
   const double t6 = h * t5;
-  const double t7 = q0[0] + t6;
+  const double t7 = q0[0] /* q[1] */ + t6;
   const double t8 = 0.015919880246186957 * gam[1];
   const double t9 = (-0.027135065999230656) * gam[4];
   const double t10 = t8 + t9;
   const double t11 = 0.033915833930187211 * gam[7];
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[1] + t13;
+  const double t14 = q0[1] /* q[2] */ + t13;
   const double t15 = gam[2] * 0.015919880246186957;
   const double t16 = gam[5] * (-0.027135065999230656);
   const double t17 = t15 + t16;
   const double t18 = gam[8] * 0.033915833930187211;
   const double t19 = t17 + t18;
   const double t20 = h * t19;
-  const double t21 = q0[2] + t20;
+  const double t21 = q0[2] /* q[3] */ + t20;
   const double t22 = t21 * t21 * t21;
   const double t23 = t14 * t14 * t14;
   const double t24 = 4.0 * t23;
@@ -77,21 +90,21 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t33 = gam[6] * 0.1406983313308362;
   const double t34 = t32 + t33;
   const double t35 = h * t34;
-  const double t36 = q0[0] + t35;
+  const double t36 = q0[0] /* q[1] */ + t35;
   const double t37 = gam[1] * 0.081984446336682115;
   const double t38 = gam[4] * (-0.13035933455299098);
   const double t39 = t37 + t38;
   const double t40 = gam[7] * 0.1406983313308362;
   const double t41 = t39 + t40;
   const double t42 = h * t41;
-  const double t43 = q0[1] + t42;
+  const double t43 = q0[1] /* q[2] */ + t42;
   const double t44 = gam[2] * 0.081984446336682115;
   const double t45 = gam[5] * (-0.13035933455299098);
   const double t46 = t44 + t45;
   const double t47 = gam[8] * 0.1406983313308362;
   const double t48 = t46 + t47;
   const double t49 = h * t48;
-  const double t50 = q0[2] + t49;
+  const double t50 = q0[2] /* q[3] */ + t49;
   const double t51 = t50 * t50 * t50;
   const double t52 = t43 * t43 * t43;
   const double t53 = 4.0 * t52;
@@ -110,21 +123,21 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t65 = gam[6] * 0.21388329150952573;
   const double t66 = t64 + t65;
   const double t67 = h * t66;
-  const double t68 = q0[0] + t67;
+  const double t68 = q0[0] /* q[1] */ + t67;
   const double t69 = gam[1] * 0.19331428364970482;
   const double t70 = gam[4] * (-0.27010270837076178);
   const double t71 = t69 + t70;
   const double t72 = gam[7] * 0.21388329150952573;
   const double t73 = t71 + t72;
   const double t74 = h * t73;
-  const double t75 = q0[1] + t74;
+  const double t75 = q0[1] /* q[2] */ + t74;
   const double t76 = gam[2] * 0.19331428364970482;
   const double t77 = gam[5] * (-0.27010270837076178);
   const double t78 = t76 + t77;
   const double t79 = gam[8] * 0.21388329150952573;
   const double t80 = t78 + t79;
   const double t81 = h * t80;
-  const double t82 = q0[2] + t81;
+  const double t82 = q0[2] /* q[3] */ + t81;
   const double t83 = t82 * t82 * t82;
   const double t84 = t75 * t75 * t75;
   const double t85 = 4.0 * t84;
@@ -143,21 +156,21 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t97 = gam[6] * 0.16220511281207234;
   const double t98 = t96 + t97;
   const double t99 = h * t98;
-  const double t100 = q0[0] + t99;
+  const double t100 = q0[0] /* q[1] */ + t99;
   const double t101 = gam[1] * 0.33787328829809554;
   const double t102 = gam[4] * (-0.38748562405060616);
   const double t103 = t101 + t102;
   const double t104 = gam[7] * 0.16220511281207234;
   const double t105 = t103 + t104;
   const double t106 = h * t105;
-  const double t107 = q0[1] + t106;
+  const double t107 = q0[1] /* q[2] */ + t106;
   const double t108 = gam[2] * 0.33787328829809554;
   const double t109 = gam[5] * (-0.38748562405060616);
   const double t110 = t108 + t109;
   const double t111 = gam[8] * 0.16220511281207234;
   const double t112 = t110 + t111;
   const double t113 = h * t112;
-  const double t114 = q0[2] + t113;
+  const double t114 = q0[2] /* q[3] */ + t113;
   const double t115 = t114 * t114 * t114;
   const double t116 = t107 * t107 * t107;
   const double t117 = 4.0 * t116;
@@ -174,16 +187,16 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t127 = gam[3] * (-0.43301270189221935);
   const double t128 = t126 + t127;
   const double t129 = h * t128;
-  const double t130 = q0[0] + t129;
+  const double t130 = q0[0] /* q[1] */ + t129;
   const double t131 = 0.5 * gam[1];
   const double t132 = gam[4] * (-0.43301270189221935);
   const double t133 = t131 + t132;
   const double t134 = h * t133;
-  const double t135 = q0[1] + t134;
+  const double t135 = q0[1] /* q[2] */ + t134;
   const double t136 = gam[5] * (-0.43301270189221935);
   const double t137 = t0 + t136;
   const double t138 = h * t137;
-  const double t139 = q0[2] + t138;
+  const double t139 = q0[2] /* q[3] */ + t138;
   const double t140 = t139 * t139 * t139;
   const double t141 = t135 * t135 * t135;
   const double t142 = 4.0 * t141;
@@ -200,21 +213,21 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t152 = gam[6] * (-0.16220511281207237);
   const double t153 = t151 + t152;
   const double t154 = h * t153;
-  const double t155 = q0[0] + t154;
+  const double t155 = q0[0] /* q[1] */ + t154;
   const double t156 = gam[1] * 0.66212671170190451;
   const double t157 = gam[4] * (-0.3874856240506061);
   const double t158 = t156 + t157;
   const double t159 = gam[7] * (-0.16220511281207237);
   const double t160 = t158 + t159;
   const double t161 = h * t160;
-  const double t162 = q0[1] + t161;
+  const double t162 = q0[1] /* q[2] */ + t161;
   const double t163 = gam[2] * 0.66212671170190451;
   const double t164 = gam[5] * (-0.3874856240506061);
   const double t165 = t163 + t164;
   const double t166 = gam[8] * (-0.16220511281207237);
   const double t167 = t165 + t166;
   const double t168 = h * t167;
-  const double t169 = q0[2] + t168;
+  const double t169 = q0[2] /* q[3] */ + t168;
   const double t170 = t169 * t169 * t169;
   const double t171 = t162 * t162 * t162;
   const double t172 = 4.0 * t171;
@@ -232,19 +245,19 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t183 = gam[6] * (-0.21388329150952573);
   const double t184 = t182 + t183;
   const double t185 = h * t184;
-  const double t186 = q0[0] + t185;
+  const double t186 = q0[0] /* q[1] */ + t185;
   const double t187 = gam[1] * 0.80668571635029518;
   const double t188 = t70 + t187;
   const double t189 = gam[7] * (-0.21388329150952573);
   const double t190 = t188 + t189;
   const double t191 = h * t190;
-  const double t192 = q0[1] + t191;
+  const double t192 = q0[1] /* q[2] */ + t191;
   const double t193 = gam[2] * 0.80668571635029518;
   const double t194 = t77 + t193;
   const double t195 = gam[8] * (-0.21388329150952573);
   const double t196 = t194 + t195;
   const double t197 = h * t196;
-  const double t198 = q0[2] + t197;
+  const double t198 = q0[2] /* q[3] */ + t197;
   const double t199 = t198 * t198 * t198;
   const double t200 = t192 * t192 * t192;
   const double t201 = 4.0 * t200;
@@ -262,19 +275,19 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t212 = gam[6] * (-0.1406983313308362);
   const double t213 = t211 + t212;
   const double t214 = h * t213;
-  const double t215 = q0[0] + t214;
+  const double t215 = q0[0] /* q[1] */ + t214;
   const double t216 = gam[1] * 0.91801555366331788;
   const double t217 = t38 + t216;
   const double t218 = gam[7] * (-0.1406983313308362);
   const double t219 = t217 + t218;
   const double t220 = h * t219;
-  const double t221 = q0[1] + t220;
+  const double t221 = q0[1] /* q[2] */ + t220;
   const double t222 = gam[2] * 0.91801555366331788;
   const double t223 = t45 + t222;
   const double t224 = gam[8] * (-0.1406983313308362);
   const double t225 = t223 + t224;
   const double t226 = h * t225;
-  const double t227 = q0[2] + t226;
+  const double t227 = q0[2] /* q[3] */ + t226;
   const double t228 = t227 * t227 * t227;
   const double t229 = t221 * t221 * t221;
   const double t230 = 4.0 * t229;
@@ -292,19 +305,19 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t241 = gam[6] * (-0.033915833930187211);
   const double t242 = t240 + t241;
   const double t243 = h * t242;
-  const double t244 = q0[0] + t243;
+  const double t244 = q0[0] /* q[1] */ + t243;
   const double t245 = gam[1] * 0.98408011975381304;
   const double t246 = t9 + t245;
   const double t247 = gam[7] * (-0.033915833930187211);
   const double t248 = t246 + t247;
   const double t249 = h * t248;
-  const double t250 = q0[1] + t249;
+  const double t250 = q0[1] /* q[2] */ + t249;
   const double t251 = gam[2] * 0.98408011975381304;
   const double t252 = t16 + t251;
   const double t253 = gam[8] * (-0.033915833930187211);
   const double t254 = t252 + t253;
   const double t255 = h * t254;
-  const double t256 = q0[2] + t255;
+  const double t256 = q0[2] /* q[3] */ + t255;
   const double t257 = t256 * t256 * t256;
   const double t258 = t250 * t250 * t250;
   const double t259 = 4.0 * t258;
@@ -539,17 +552,17 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t486 = 0.28867513459481292 * t474;
   const double t487 = t485 - t486;
   const double t488 = h * t487;
-  const double t489 = p0[0] - t488;
+  const double t489 = p0[0] /* p_q[1] */ - t488;
   const double t490 = 0.5 * t470;
   const double t491 = 0.28867513459481292 * t476;
   const double t492 = t490 - t491;
   const double t493 = h * t492;
-  const double t494 = p0[1] - t493;
+  const double t494 = p0[1] /* p_q[2] */ - t493;
   const double t495 = 0.5 * t472;
   const double t496 = 0.28867513459481292 * t478;
   const double t497 = t495 - t496;
   const double t498 = h * t497;
-  const double t499 = p0[2] - t498;
+  const double t499 = p0[2] /* p_q[3] */ - t498;
   const double t500 = 0.28867513459481292 * t468;
   const double t501 = 0.12909944487358055 * t480;
   const double t502 = t500 - t501;
@@ -987,17 +1000,17 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t933 = 0.28867513459481292 * t921;
   const double t934 = t932 - t933;
   const double t935 = h * t934;
-  const double t936 = p0[0] - t935;
+  const double t936 = p0[0] /* p_q[1] */ - t935;
   const double t937 = 0.5 * t917;
   const double t938 = 0.28867513459481292 * t923;
   const double t939 = t937 - t938;
   const double t940 = h * t939;
-  const double t941 = p0[1] - t940;
+  const double t941 = p0[1] /* p_q[2] */ - t940;
   const double t942 = 0.5 * t919;
   const double t943 = 0.28867513459481292 * t925;
   const double t944 = t942 - t943;
   const double t945 = h * t944;
-  const double t946 = p0[2] - t945;
+  const double t946 = p0[2] /* p_q[3] */ - t945;
   const double t947 = 0.28867513459481292 * t915;
   const double t948 = 0.12909944487358055 * t927;
   const double t949 = t947 - t948;
@@ -1028,6 +1041,7 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t974 = -t973;
   const double t975 = h * t919;
   const double t976 = -t975;
+  /* gam */
   out[0] = t936;
   out[1] = t941;
   out[2] = t946;
@@ -1037,9 +1051,11 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   out[6] = t964;
   out[7] = t967;
   out[8] = t970;
+  /* dp */
   out[9] = t972;
   out[10] = t974;
   out[11] = t976;
+  /* lam */
   out[12] = t721;
   out[13] = t722;
   out[14] = t723;
@@ -1060,21 +1076,21 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t4 = gam[6] * 0.033915833930187211;
   const double t5 = t3 + t4;
   const double t6 = h * t5;
-  const double t7 = q0[0] + t6;
+  const double t7 = q0[0] /* q[1] */ + t6;
   const double t8 = 0.015919880246186957 * gam[1];
   const double t9 = (-0.027135065999230656) * gam[4];
   const double t10 = t8 + t9;
   const double t11 = 0.033915833930187211 * gam[7];
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[1] + t13;
+  const double t14 = q0[1] /* q[2] */ + t13;
   const double t15 = gam[2] * 0.015919880246186957;
   const double t16 = gam[5] * (-0.027135065999230656);
   const double t17 = t15 + t16;
   const double t18 = gam[8] * 0.033915833930187211;
   const double t19 = t17 + t18;
   const double t20 = h * t19;
-  const double t21 = q0[2] + t20;
+  const double t21 = q0[2] /* q[3] */ + t20;
   const double t22 = t14 * t14 * t14;
   const double t23 = (t7 * t7) * (t7 * t7) * t7;
   const double t24 = 6.0 * t23;
@@ -1091,21 +1107,21 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t34 = gam[6] * 0.1406983313308362;
   const double t35 = t33 + t34;
   const double t36 = h * t35;
-  const double t37 = q0[0] + t36;
+  const double t37 = q0[0] /* q[1] */ + t36;
   const double t38 = gam[1] * 0.081984446336682115;
   const double t39 = gam[4] * (-0.13035933455299098);
   const double t40 = t38 + t39;
   const double t41 = gam[7] * 0.1406983313308362;
   const double t42 = t40 + t41;
   const double t43 = h * t42;
-  const double t44 = q0[1] + t43;
+  const double t44 = q0[1] /* q[2] */ + t43;
   const double t45 = gam[2] * 0.081984446336682115;
   const double t46 = gam[5] * (-0.13035933455299098);
   const double t47 = t45 + t46;
   const double t48 = gam[8] * 0.1406983313308362;
   const double t49 = t47 + t48;
   const double t50 = h * t49;
-  const double t51 = q0[2] + t50;
+  const double t51 = q0[2] /* q[3] */ + t50;
   const double t52 = t44 * t44 * t44;
   const double t53 = (t37 * t37) * (t37 * t37) * t37;
   const double t54 = 6.0 * t53;
@@ -1128,21 +1144,21 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t70 = gam[6] * 0.21388329150952573;
   const double t71 = t69 + t70;
   const double t72 = h * t71;
-  const double t73 = q0[0] + t72;
+  const double t73 = q0[0] /* q[1] */ + t72;
   const double t74 = gam[1] * 0.19331428364970482;
   const double t75 = gam[4] * (-0.27010270837076178);
   const double t76 = t74 + t75;
   const double t77 = gam[7] * 0.21388329150952573;
   const double t78 = t76 + t77;
   const double t79 = h * t78;
-  const double t80 = q0[1] + t79;
+  const double t80 = q0[1] /* q[2] */ + t79;
   const double t81 = gam[2] * 0.19331428364970482;
   const double t82 = gam[5] * (-0.27010270837076178);
   const double t83 = t81 + t82;
   const double t84 = gam[8] * 0.21388329150952573;
   const double t85 = t83 + t84;
   const double t86 = h * t85;
-  const double t87 = q0[2] + t86;
+  const double t87 = q0[2] /* q[3] */ + t86;
   const double t88 = t80 * t80 * t80;
   const double t89 = (t73 * t73) * (t73 * t73) * t73;
   const double t90 = 6.0 * t89;
@@ -1165,21 +1181,21 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t106 = gam[6] * 0.16220511281207234;
   const double t107 = t105 + t106;
   const double t108 = h * t107;
-  const double t109 = q0[0] + t108;
+  const double t109 = q0[0] /* q[1] */ + t108;
   const double t110 = gam[1] * 0.33787328829809554;
   const double t111 = gam[4] * (-0.38748562405060616);
   const double t112 = t110 + t111;
   const double t113 = gam[7] * 0.16220511281207234;
   const double t114 = t112 + t113;
   const double t115 = h * t114;
-  const double t116 = q0[1] + t115;
+  const double t116 = q0[1] /* q[2] */ + t115;
   const double t117 = gam[2] * 0.33787328829809554;
   const double t118 = gam[5] * (-0.38748562405060616);
   const double t119 = t117 + t118;
   const double t120 = gam[8] * 0.16220511281207234;
   const double t121 = t119 + t120;
   const double t122 = h * t121;
-  const double t123 = q0[2] + t122;
+  const double t123 = q0[2] /* q[3] */ + t122;
   const double t124 = t116 * t116 * t116;
   const double t125 = (t109 * t109) * (t109 * t109) * t109;
   const double t126 = 6.0 * t125;
@@ -1200,16 +1216,16 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t140 = gam[3] * (-0.43301270189221935);
   const double t141 = t139 + t140;
   const double t142 = h * t141;
-  const double t143 = q0[0] + t142;
+  const double t143 = q0[0] /* q[1] */ + t142;
   const double t144 = 0.5 * gam[1];
   const double t145 = gam[4] * (-0.43301270189221935);
   const double t146 = t144 + t145;
   const double t147 = h * t146;
-  const double t148 = q0[1] + t147;
+  const double t148 = q0[1] /* q[2] */ + t147;
   const double t149 = gam[5] * (-0.43301270189221935);
   const double t150 = t0 + t149;
   const double t151 = h * t150;
-  const double t152 = q0[2] + t151;
+  const double t152 = q0[2] /* q[3] */ + t151;
   const double t153 = t148 * t148 * t148;
   const double t154 = (t143 * t143) * (t143 * t143) * t143;
   const double t155 = 6.0 * t154;
@@ -1228,21 +1244,21 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t167 = gam[6] * (-0.16220511281207237);
   const double t168 = t166 + t167;
   const double t169 = h * t168;
-  const double t170 = q0[0] + t169;
+  const double t170 = q0[0] /* q[1] */ + t169;
   const double t171 = gam[1] * 0.66212671170190451;
   const double t172 = gam[4] * (-0.3874856240506061);
   const double t173 = t171 + t172;
   const double t174 = gam[7] * (-0.16220511281207237);
   const double t175 = t173 + t174;
   const double t176 = h * t175;
-  const double t177 = q0[1] + t176;
+  const double t177 = q0[1] /* q[2] */ + t176;
   const double t178 = gam[2] * 0.66212671170190451;
   const double t179 = gam[5] * (-0.3874856240506061);
   const double t180 = t178 + t179;
   const double t181 = gam[8] * (-0.16220511281207237);
   const double t182 = t180 + t181;
   const double t183 = h * t182;
-  const double t184 = q0[2] + t183;
+  const double t184 = q0[2] /* q[3] */ + t183;
   const double t185 = t177 * t177 * t177;
   const double t186 = (t170 * t170) * (t170 * t170) * t170;
   const double t187 = 6.0 * t186;
@@ -1264,19 +1280,19 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t202 = gam[6] * (-0.21388329150952573);
   const double t203 = t201 + t202;
   const double t204 = h * t203;
-  const double t205 = q0[0] + t204;
+  const double t205 = q0[0] /* q[1] */ + t204;
   const double t206 = gam[1] * 0.80668571635029518;
   const double t207 = t75 + t206;
   const double t208 = gam[7] * (-0.21388329150952573);
   const double t209 = t207 + t208;
   const double t210 = h * t209;
-  const double t211 = q0[1] + t210;
+  const double t211 = q0[1] /* q[2] */ + t210;
   const double t212 = gam[2] * 0.80668571635029518;
   const double t213 = t82 + t212;
   const double t214 = gam[8] * (-0.21388329150952573);
   const double t215 = t213 + t214;
   const double t216 = h * t215;
-  const double t217 = q0[2] + t216;
+  const double t217 = q0[2] /* q[3] */ + t216;
   const double t218 = t211 * t211 * t211;
   const double t219 = (t205 * t205) * (t205 * t205) * t205;
   const double t220 = 6.0 * t219;
@@ -1298,19 +1314,19 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t235 = gam[6] * (-0.1406983313308362);
   const double t236 = t234 + t235;
   const double t237 = h * t236;
-  const double t238 = q0[0] + t237;
+  const double t238 = q0[0] /* q[1] */ + t237;
   const double t239 = gam[1] * 0.91801555366331788;
   const double t240 = t39 + t239;
   const double t241 = gam[7] * (-0.1406983313308362);
   const double t242 = t240 + t241;
   const double t243 = h * t242;
-  const double t244 = q0[1] + t243;
+  const double t244 = q0[1] /* q[2] */ + t243;
   const double t245 = gam[2] * 0.91801555366331788;
   const double t246 = t46 + t245;
   const double t247 = gam[8] * (-0.1406983313308362);
   const double t248 = t246 + t247;
   const double t249 = h * t248;
-  const double t250 = q0[2] + t249;
+  const double t250 = q0[2] /* q[3] */ + t249;
   const double t251 = t244 * t244 * t244;
   const double t252 = (t238 * t238) * (t238 * t238) * t238;
   const double t253 = 6.0 * t252;
@@ -1332,19 +1348,19 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t268 = gam[6] * (-0.033915833930187211);
   const double t269 = t267 + t268;
   const double t270 = h * t269;
-  const double t271 = q0[0] + t270;
+  const double t271 = q0[0] /* q[1] */ + t270;
   const double t272 = gam[1] * 0.98408011975381304;
   const double t273 = t9 + t272;
   const double t274 = gam[7] * (-0.033915833930187211);
   const double t275 = t273 + t274;
   const double t276 = h * t275;
-  const double t277 = q0[1] + t276;
+  const double t277 = q0[1] /* q[2] */ + t276;
   const double t278 = gam[2] * 0.98408011975381304;
   const double t279 = t16 + t278;
   const double t280 = gam[8] * (-0.033915833930187211);
   const double t281 = t279 + t280;
   const double t282 = h * t281;
-  const double t283 = q0[2] + t282;
+  const double t283 = q0[2] /* q[3] */ + t282;
   const double t284 = t277 * t277 * t277;
   const double t285 = (t271 * t271) * (t271 * t271) * t271;
   const double t286 = 6.0 * t285;
@@ -1786,6 +1802,7 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   const double t721 = t717 - t720;
   const double t722 = 1.0 / t710;
   const double t723 = 1.0 / t721;
+  /* lu */
   out[0] = t718;
   out[1] = t563;
   out[2] = t599;
@@ -1795,9 +1812,11 @@ static void modified_poly_k9s3_factor(const double *q0, const double *p0, const 
   out[6] = t713;
   out[7] = t719;
   out[8] = t723;
+  /* pivot */
   out[9] = t527;
   out[10] = t710;
   out[11] = t721;
+  /* adiag */
   out[12] = t527;
   out[13] = t635;
   out[14] = t707;
@@ -1808,9 +1827,10 @@ static void modified_poly_k9s3_minv_p(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
+  /* gam0 */
+  out[0] = p0[0] /* p_q[1] */;
+  out[1] = p0[1] /* p_q[2] */;
+  out[2] = p0[2] /* p_q[3] */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -1818,16 +1838,16 @@ static void modified_poly_k9s3_energy_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t0 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
   /* energy */
-  const double t1 = p0[0] * p0[0];
-  const double t2 = p0[1] * p0[1];
+  const double t1 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
+  const double t2 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
   const double t3 = t1 + t2;
-  const double t4 = p0[2] * p0[2];
+  const double t4 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
   const double t5 = t3 + t4;
   const double t6 = 0.5 * t5;
   const double t7 = t0 + t6;
+  /* H */
   out[0] = t7;
 }
 
@@ -1837,12 +1857,13 @@ static void modified_poly_k9s3_g(const double *q0, const double *p0, const doubl
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* g(q0) */
-  const double t0 = (q0[0] * q0[0] * q0[0]) * (q0[0] * q0[0] * q0[0]);
-  const double t1 = (q0[1] * q0[1]) * (q0[1] * q0[1]);
+  const double t0 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t1 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t4 = t2 + t3;
   const double t5 = t4 - 0.625;
+  /* g */
   out[0] = t5;
 }
 
@@ -1851,18 +1872,17 @@ static void modified_poly_k9s3_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
-  const double t5 = p0[0] * t2;
-  const double t6 = p0[1] * t4;
+  const double t5 = p0[0] /* p_q[1] */ * t2;
+  const double t6 = p0[1] /* p_q[2] */ * t4;
   const double t7 = t5 + t6;
-  const double t8 = t0 * p0[2];
+  const double t8 = t0 * p0[2] /* p_q[3] */;
   const double t9 = t7 + t8;
+  /* hidden */
   out[0] = t9;
 }
 
@@ -1872,12 +1892,10 @@ static void modified_poly_k9s3_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   const double t5 = t2 * t2;
   const double t6 = t4 * t4;
@@ -1885,25 +1903,26 @@ static void modified_poly_k9s3_lambda0(const double *q0, const double *p0, const
   const double t8 = t0 * t0;
   const double t9 = t7 + t8;
   /* consistent initial multiplier */
-  const double t10 = q0[2] * q0[2] * q0[2];
+  const double t10 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t11 = 4.0 * t10;
-  const double t12 = 6.0 * p0[0];
-  const double t13 = 4.0 * p0[1];
-  const double t14 = 2.0 * p0[2];
-  const double t15 = (q0[0] * q0[0]) * (q0[0] * q0[0]);
+  const double t12 = 6.0 * p0[0] /* p_q[1] */;
+  const double t13 = 4.0 * p0[1] /* p_q[2] */;
+  const double t14 = 2.0 * p0[2] /* p_q[3] */;
+  const double t15 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
   const double t16 = 5.0 * t15;
   const double t17 = t12 * t16;
-  const double t18 = q0[1] * q0[1];
+  const double t18 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t19 = 3.0 * t18;
   const double t20 = t13 * t19;
-  const double t21 = p0[0] * t17;
-  const double t22 = p0[1] * t20;
+  const double t21 = p0[0] /* p_q[1] */ * t17;
+  const double t22 = p0[1] /* p_q[2] */ * t20;
   const double t23 = t21 + t22;
-  const double t24 = p0[2] * t14;
+  const double t24 = p0[2] /* p_q[3] */ * t14;
   const double t25 = t23 + t24;
   const double t26 = t0 * t11;
   const double t27 = t25 - t26;
   const double t28 = t27 / t9;
+  /* lambda */
   out[0] = t28;
 }
 
@@ -1914,46 +1933,50 @@ static void modified_poly_k9s3_project(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2];
+  const double t0 = 2.0 * q0[2] /* q[3] */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t1 = (q0[0] * q0[0]) * (q0[0] * q0[0]) * q0[0];
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
   const double t2 = 6.0 * t1;
-  const double t3 = q0[1] * q0[1] * q0[1];
+  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
   const double t4 = 4.0 * t3;
   const double t5 = t2 * t2;
   const double t6 = t4 * t4;
   const double t7 = t5 + t6;
   const double t8 = t0 * t0;
   const double t9 = t7 + t8;
-  const double t10 = p0[0] * t2;
-  const double t11 = p0[1] * t4;
+  const double t10 = p0[0] /* p_q[1] */ * t2;
+  const double t11 = p0[1] /* p_q[2] */ * t4;
   const double t12 = t10 + t11;
-  const double t13 = t0 * p0[2];
+  const double t13 = t0 * p0[2] /* p_q[3] */;
   const double t14 = t12 + t13;
   const double t15 = t14 / t9;
   const double t16 = t2 * t15;
   const double t17 = -t16;
-  const double t18 = p0[0] - t16;
+  const double t18 = p0[0] /* p_q[1] */ - t16;
   const double t19 = t4 * t15;
   const double t20 = -t19;
-  const double t21 = p0[1] - t19;
+  const double t21 = p0[1] /* p_q[2] */ - t19;
   const double t22 = t0 * t15;
   const double t23 = -t22;
-  const double t24 = p0[2] - t22;
+  const double t24 = p0[2] /* p_q[3] */ - t22;
   const double t25 = t18 * t18;
   const double t26 = t21 * t21;
   const double t27 = t25 + t26;
   const double t28 = t24 * t24;
   const double t29 = t27 + t28;
   const double t30 = 0.5 * t29;
-  const double t31 = (q0[2] * q0[2]) * (q0[2] * q0[2]);
+  const double t31 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
+  /* dp */
   out[0] = t17;
   out[1] = t20;
   out[2] = t23;
+  /* kin */
   out[3] = t30;
+  /* U */
   out[4] = t31;
+  /* pivot */
   out[5] = t9;
+  /* adiag */
   out[6] = t9;
 }
 
@@ -1966,20 +1989,20 @@ void modified_poly_k9s3_init(modified_poly_k9s3_state *x, const double *q0, cons
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_poly_k9s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : modified_poly_k9s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : modified_poly_k9s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (modified_poly_k9s3_NU ? modified_poly_k9s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     modified_poly_k9s3_params prm;
-    double lam[NU];
+    double lam[modified_poly_k9s3_NU];
     modified_poly_k9s3_params_default(&prm);
     modified_poly_k9s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < modified_poly_k9s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -1995,32 +2018,32 @@ const char *modified_poly_k9s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) modified_poly_k9s3_params dflt_; if (!prm) { modified_poly_k9s3_params_default(&dflt_); prm = &dflt_; }
+#define modified_poly_k9s3_DEFAULT_PARAMS(prm) modified_poly_k9s3_params dflt_; if (!prm) { modified_poly_k9s3_params_default(&dflt_); prm = &dflt_; }
 
 double modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k9s3_DEFAULT_PARAMS(prm)
   modified_poly_k9s3_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *g)
 {
-  double v[NU];
+  double v[modified_poly_k9s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k9s3_DEFAULT_PARAMS(prm)
   modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < modified_poly_k9s3_NU; i++) g[i] = v[i];
 }
 
 void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *gp)
 {
-  double v[NU];
+  double v[modified_poly_k9s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k9s3_DEFAULT_PARAMS(prm)
   modified_poly_k9s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < modified_poly_k9s3_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -2028,17 +2051,17 @@ void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified
 static void modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double h, const modified_poly_k9s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_poly_k9s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < modified_poly_k9s3_S; j++)
+    for (i = 0; i < modified_poly_k9s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + modified_poly_k9s3_E[(j * S + i) * S + d];
+      for (d = modified_poly_k9s3_S - 1; d >= 0; d--) e = e * r + modified_poly_k9s3_E[(j * modified_poly_k9s3_S + i) * modified_poly_k9s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < modified_poly_k9s3_M; l++) gam[j * modified_poly_k9s3_M + l] += e * x->gam[i * modified_poly_k9s3_M + l];
     }
 }
 
@@ -2055,100 +2078,101 @@ static void modified_poly_k9s3_add(double *a, double *c, double b)
 int modified_poly_k9s3_step(modified_poly_k9s3_state *x, double h_, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = modified_poly_k9s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  modified_poly_k9s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_poly_k9s3_EBADSTEP;
   modified_poly_k9s3_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[modified_poly_k9s3_NU];
   modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below modified_poly_k9s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[9 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_NU; i++) g0[i] = fabs(g0[i]) <= modified_poly_k9s3_GTOL ? 0 : g0[i] / h;
+  double fa[9 + 2 * modified_poly_k9s3_S * modified_poly_k9s3_NU + 1], lam[modified_poly_k9s3_S * modified_poly_k9s3_NU];
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   modified_poly_k9s3_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[9 + i], dia = fa[9 + S * NU + i];
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) {
+    double piv = fa[9 + i], dia = fa[9 + modified_poly_k9s3_S * modified_poly_k9s3_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return modified_poly_k9s3_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return modified_poly_k9s3_ESINGULAR;
+    if (!(fabs(piv) > modified_poly_k9s3_SINGTOL * fabs(dia))) return modified_poly_k9s3_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= modified_poly_k9s3_MAXITER; it++) {
     modified_poly_k9s3_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < modified_poly_k9s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + i];
+    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU; i++)
       if (!isfinite(sw[i])) rc = modified_poly_k9s3_ENONFINITE;
     if (rc == modified_poly_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_poly_k9s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (modified_poly_k9s3_TOL / 256), or
+     * within 2 ulps (modified_poly_k9s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above modified_poly_k9s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = modified_poly_k9s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? modified_poly_k9s3_OK : modified_poly_k9s3_ENOCONV; break; }
+    if (inc <= modified_poly_k9s3_TOL / 256 || (inc <= modified_poly_k9s3_TOL && 4 * inc > inc_old)) { rc = modified_poly_k9s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= modified_poly_k9s3_STAGTOL ? modified_poly_k9s3_OK : modified_poly_k9s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > modified_poly_k9s3_MAXITER ? modified_poly_k9s3_MAXITER : it; st->increment = inc; }
   if (rc != modified_poly_k9s3_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k9s3_ENONFINITE;
+  double q1[modified_poly_k9s3_M], p1[modified_poly_k9s3_M], pr[modified_poly_k9s3_M + 2 + 2 * modified_poly_k9s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k9s3_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[modified_poly_k9s3_M], pc1[modified_poly_k9s3_M];
+  for (i = 0; i < modified_poly_k9s3_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     modified_poly_k9s3_add(&q1[i], &qc1[i], h * sw[i]);
-    modified_poly_k9s3_add(&p1[i], &pc1[i], sw[S * M + i]);
+    modified_poly_k9s3_add(&p1[i], &pc1[i], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   modified_poly_k9s3_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return modified_poly_k9s3_ESINGULAR;
+  for (i = 0; i < modified_poly_k9s3_NU; i++) {
+    double piv = pr[modified_poly_k9s3_M + 2 + i], dia = pr[modified_poly_k9s3_M + 2 + modified_poly_k9s3_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_poly_k9s3_SINGTOL * fabs(dia))) return modified_poly_k9s3_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < modified_poly_k9s3_M + 2 + 2 * modified_poly_k9s3_NU; i++)
     if (!isfinite(pr[i])) return modified_poly_k9s3_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[modified_poly_k9s3_M + 0];
+  U1 = pr[modified_poly_k9s3_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * modified_poly_k9s3_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_poly_k9s3_M; i++) {
     modified_poly_k9s3_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return modified_poly_k9s3_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < modified_poly_k9s3_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[modified_poly_k9s3_NU];
     modified_poly_k9s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < modified_poly_k9s3_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   modified_poly_k9s3_add(&x->t, &x->tc, h);
   x->hprev = h;

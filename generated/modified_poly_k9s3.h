@@ -4,6 +4,10 @@
 #ifndef modified_poly_k9s3_H
 #define modified_poly_k9s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define modified_poly_k9s3_M 3      /* coordinates */
 #define modified_poly_k9s3_NU 1     /* constraints */
 #define modified_poly_k9s3_K 9      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void modified_poly_k9s3_params_default(modified_poly_k9s3_params *prm);
 int modified_poly_k9s3_step(modified_poly_k9s3_state *x, double h, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st);
 const char *modified_poly_k9s3_strerror(int code);
 double modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm);
-void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *g);   /* NU values */
+void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *g);   /* modified_poly_k9s3_NU values */
 void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

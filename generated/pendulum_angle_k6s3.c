@@ -5,14 +5,27 @@
 
 #include "pendulum_angle_k6s3.h"
 
-#define M pendulum_angle_k6s3_M
-#define NU pendulum_angle_k6s3_NU
-#define S pendulum_angle_k6s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(pendulum_angle_k6s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define pendulum_angle_k6s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef pendulum_angle_k6s3_MAXITER
+#define pendulum_angle_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef pendulum_angle_k6s3_TOL
+#define pendulum_angle_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef pendulum_angle_k6s3_STAGTOL
+#define pendulum_angle_k6s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef pendulum_angle_k6s3_SINGTOL
+#define pendulum_angle_k6s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef pendulum_angle_k6s3_GTOL
+#define pendulum_angle_k6s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -42,7 +55,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t3 = gam[2] * 0.068025568234204442;
   const double t4 = t2 + t3;
   const double t5 = h * t4;
-  const double t6 = t5 + q0[0];
+  const double t6 = t5 + q0[0] /* theta */;
   const double t7 = sin(t6);
   const double t8 = t7 * 0.085662246189585178;
   const double t9 = t7 * (-0.13835177248998257);
@@ -54,7 +67,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t14 = gam[2] * 0.20802702904656017;
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[0] + t16;
+  const double t17 = q0[0] /* theta */ + t16;
   const double t18 = sin(t17);
   const double t19 = t18 * 0.1803807865240693;
   const double t20 = t8 + t19;
@@ -69,7 +82,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t28 = gam[2] * 0.1257969473866733;
   const double t29 = t27 + t28;
   const double t30 = h * t29;
-  const double t31 = q0[0] + t30;
+  const double t31 = q0[0] /* theta */ + t30;
   const double t32 = sin(t31);
   const double t33 = t32 * 0.23395696728634552;
   const double t34 = t20 + t33;
@@ -84,7 +97,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t42 = gam[2] * (-0.12579694738667335);
   const double t43 = t41 + t42;
   const double t44 = h * t43;
-  const double t45 = q0[0] + t44;
+  const double t45 = q0[0] /* theta */ + t44;
   const double t46 = sin(t45);
   const double t47 = 0.23395696728634552 * t46;
   const double t48 = t34 + t47;
@@ -98,7 +111,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t55 = gam[2] * (-0.20802702904656017);
   const double t56 = t54 + t55;
   const double t57 = h * t56;
-  const double t58 = q0[0] + t57;
+  const double t58 = q0[0] /* theta */ + t57;
   const double t59 = sin(t58);
   const double t60 = 0.1803807865240693 * t59;
   const double t61 = t48 + t60;
@@ -112,7 +125,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t68 = gam[2] * (-0.068025568234204442);
   const double t69 = t67 + t68;
   const double t70 = h * t69;
-  const double t71 = q0[0] + t70;
+  const double t71 = q0[0] /* theta */ + t70;
   const double t72 = sin(t71);
   const double t73 = 0.085662246189585178 * t72;
   const double t74 = t61 + t73;
@@ -125,7 +138,7 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t80 = t76 * 0.28867513459481292;
   const double t81 = t79 - t80;
   const double t82 = h * t81;
-  const double t83 = p0[0] - t82;
+  const double t83 = p0[0] /* p_theta */ - t82;
   const double t84 = t74 * 0.28867513459481292;
   const double t85 = t78 * 0.12909944487358055;
   const double t86 = t84 - t85;
@@ -136,9 +149,11 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t91 = -t90;
   const double t92 = h * t74;
   const double t93 = -t92;
+  /* gam */
   out[0] = t83;
   out[1] = t88;
   out[2] = t91;
+  /* dp */
   out[3] = t93;
 }
 
@@ -147,7 +162,8 @@ static void pendulum_angle_k6s3_minv_p(const double *q0, const double *p0, const
     const double *g0, const pendulum_angle_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
+  /* gam0 */
+  out[0] = p0[0] /* p_theta */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -156,10 +172,11 @@ static void pendulum_angle_k6s3_energy_kernel(const double *q0, const double *p0
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = cos(q0[0]);
+  const double t0 = p0[0] /* p_theta */ * p0[0] /* p_theta */;
+  const double t1 = cos(q0[0] /* theta */);
   const double t2 = 0.5 * t0;
   const double t3 = t2 - t1;
+  /* H */
   out[0] = t3;
 }
 
@@ -172,13 +189,13 @@ void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const double *q0, co
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : pendulum_angle_k6s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : pendulum_angle_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (pendulum_angle_k6s3_NU ? pendulum_angle_k6s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = 0;
 }
 
 const char *pendulum_angle_k6s3_strerror(int code)
@@ -193,12 +210,12 @@ const char *pendulum_angle_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) pendulum_angle_k6s3_params dflt_; if (!prm) { pendulum_angle_k6s3_params_default(&dflt_); prm = &dflt_; }
+#define pendulum_angle_k6s3_DEFAULT_PARAMS(prm) pendulum_angle_k6s3_params dflt_; if (!prm) { pendulum_angle_k6s3_params_default(&dflt_); prm = &dflt_; }
 
 double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   pendulum_angle_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
@@ -218,17 +235,17 @@ void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendul
 static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, double h, const pendulum_angle_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_angle_k6s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < pendulum_angle_k6s3_S; j++)
+    for (i = 0; i < pendulum_angle_k6s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + pendulum_angle_k6s3_E[(j * S + i) * S + d];
+      for (d = pendulum_angle_k6s3_S - 1; d >= 0; d--) e = e * r + pendulum_angle_k6s3_E[(j * pendulum_angle_k6s3_S + i) * pendulum_angle_k6s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[j * pendulum_angle_k6s3_M + l] += e * x->gam[i * pendulum_angle_k6s3_M + l];
     }
 }
 
@@ -245,49 +262,52 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
 int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_angle_k6s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_angle_k6s3_EBADSTEP;
   pendulum_angle_k6s3_predict(x, h, prm, gam);
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= pendulum_angle_k6s3_MAXITER; it++) {
     pendulum_angle_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < pendulum_angle_k6s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_angle_k6s3_ENONFINITE;
     if (rc == pendulum_angle_k6s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_angle_k6s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (pendulum_angle_k6s3_TOL / 256), or
+     * within 2 ulps (pendulum_angle_k6s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above pendulum_angle_k6s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = pendulum_angle_k6s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? pendulum_angle_k6s3_OK : pendulum_angle_k6s3_ENOCONV; break; }
+    if (inc <= pendulum_angle_k6s3_TOL / 256 || (inc <= pendulum_angle_k6s3_TOL && 4 * inc > inc_old)) { rc = pendulum_angle_k6s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= pendulum_angle_k6s3_STAGTOL ? pendulum_angle_k6s3_OK : pendulum_angle_k6s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_angle_k6s3_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return pendulum_angle_k6s3_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_angle_k6s3_ENONFINITE;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return pendulum_angle_k6s3_ENONFINITE;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     pendulum_angle_k6s3_add(&x->q[i], &x->qc[i], h * sw[i]);
-    pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + i];
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_angle_k6s3_OK;

@@ -4,6 +4,10 @@
 #ifndef pendulum_angle_k6s3_H
 #define pendulum_angle_k6s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define pendulum_angle_k6s3_M 1      /* coordinates */
 #define pendulum_angle_k6s3_NU 0     /* constraints */
 #define pendulum_angle_k6s3_K 6      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void pendulum_angle_k6s3_params_default(pendulum_angle_k6s3_params *prm);
 int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
 const char *pendulum_angle_k6s3_strerror(int code);
 double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm);
-void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *g);   /* NU values */
+void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *g);   /* pendulum_angle_k6s3_NU values */
 void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "pendulum_k1s1.h"
 
-#define M pendulum_k1s1_M
-#define NU pendulum_k1s1_NU
-#define S pendulum_k1s1_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(pendulum_k1s1_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define pendulum_k1s1_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef pendulum_k1s1_MAXITER
+#define pendulum_k1s1_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef pendulum_k1s1_TOL
+#define pendulum_k1s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef pendulum_k1s1_STAGTOL
+#define pendulum_k1s1_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef pendulum_k1s1_SINGTOL
+#define pendulum_k1s1_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef pendulum_k1s1_GTOL
+#define pendulum_k1s1_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 1 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -31,12 +44,12 @@ static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
+  const double t0 = 2.0 * q0[0] /* x */;
   const double t1 = gam[0] * 0.5;
   const double t2 = h * t1;
   const double t3 = 2.0 * t2;
   const double t4 = t0 + t3;
-  const double t5 = 2.0 * q0[1];
+  const double t5 = 2.0 * q0[1] /* y */;
   const double t6 = 0.5 * gam[1];
   const double t7 = h * t6;
   const double t8 = 2.0 * t7;
@@ -49,8 +62,8 @@ static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double
   const double t14 = h * t13;
   const double t15 = 0.5 * t9;
   const double t16 = h * t15;
-  const double t17 = t4 * p0[0];
-  const double t18 = t9 * p0[1];
+  const double t17 = t4 * p0[0] /* p_x */;
+  const double t18 = t9 * p0[1] /* p_y */;
   const double t19 = t17 + t18;
   const double t20 = t19 - t16;
   const double t21 = t20 + g0[0];
@@ -61,20 +74,25 @@ static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double
   const double t25 = 1.0 + t24;
   const double t26 = 0.5 * t23;
   const double t27 = h * t26;
-  const double t28 = p0[0] - t27;
+  const double t28 = p0[0] /* p_x */ - t27;
   const double t29 = 0.5 * t25;
   const double t30 = h * t29;
-  const double t31 = p0[1] - t30;
+  const double t31 = p0[1] /* p_y */ - t30;
   const double t32 = h * t23;
   const double t33 = -t32;
   const double t34 = h * t25;
   const double t35 = -t34;
+  /* gam */
   out[0] = t28;
   out[1] = t31;
+  /* dp */
   out[2] = t33;
   out[3] = t35;
+  /* lambda */
   out[4] = t22;
+  /* pivot */
   out[5] = t14;
+  /* adiag */
   out[6] = t14;
 }
 
@@ -83,8 +101,9 @@ static void pendulum_k1s1_minv_p(const double *q0, const double *p0, const doubl
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -93,11 +112,12 @@ static void pendulum_k1s1_energy_kernel(const double *q0, const double *p0, cons
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
   const double t3 = 0.5 * t2;
-  const double t4 = q0[1] + t3;
+  const double t4 = q0[1] /* y */ + t3;
+  /* H */
   out[0] = t4;
 }
 
@@ -107,10 +127,11 @@ static void pendulum_k1s1_g(const double *q0, const double *p0, const double *ga
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* g(q0) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
   const double t3 = t2 - 1.0;
+  /* g */
   out[0] = t3;
 }
 
@@ -119,13 +140,13 @@ static void pendulum_k1s1_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   /* hidden constraints */
-  const double t2 = t0 * p0[0];
-  const double t3 = t1 * p0[1];
+  const double t2 = t0 * p0[0] /* p_x */;
+  const double t3 = t1 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
+  /* hidden */
   out[0] = t4;
 }
 
@@ -135,20 +156,20 @@ static void pendulum_k1s1_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   /* consistent initial multiplier */
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
-  const double t5 = 2.0 * p0[0];
-  const double t6 = 2.0 * p0[1];
-  const double t7 = p0[0] * t5;
-  const double t8 = p0[1] * t6;
+  const double t5 = 2.0 * p0[0] /* p_x */;
+  const double t6 = 2.0 * p0[1] /* p_y */;
+  const double t7 = p0[0] /* p_x */ * t5;
+  const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
   const double t10 = t9 - t1;
   const double t11 = t10 / t4;
+  /* lambda */
   out[0] = t11;
 }
 
@@ -161,19 +182,19 @@ void pendulum_k1s1_init(pendulum_k1s1_state *x, const double *q0, const double *
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_k1s1_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : pendulum_k1s1_q0[i];
     x->p[i] = p0 ? (double)p0[i] : pendulum_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (pendulum_k1s1_NU ? pendulum_k1s1_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = 0;
   {
     pendulum_k1s1_params prm;
-    double lam[NU];
+    double lam[pendulum_k1s1_NU];
     pendulum_k1s1_params_default(&prm);
     pendulum_k1s1_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -189,32 +210,32 @@ const char *pendulum_k1s1_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) pendulum_k1s1_params dflt_; if (!prm) { pendulum_k1s1_params_default(&dflt_); prm = &dflt_; }
+#define pendulum_k1s1_DEFAULT_PARAMS(prm) pendulum_k1s1_params dflt_; if (!prm) { pendulum_k1s1_params_default(&dflt_); prm = &dflt_; }
 
 double pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  pendulum_k1s1_DEFAULT_PARAMS(prm)
   pendulum_k1s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *g)
 {
-  double v[NU];
+  double v[pendulum_k1s1_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_k1s1_DEFAULT_PARAMS(prm)
   pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < pendulum_k1s1_NU; i++) g[i] = v[i];
 }
 
 void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *gp)
 {
-  double v[NU];
+  double v[pendulum_k1s1_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_k1s1_DEFAULT_PARAMS(prm)
   pendulum_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < pendulum_k1s1_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -222,17 +243,17 @@ void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_para
 static void pendulum_k1s1_predict(const pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < pendulum_k1s1_S; j++)
+    for (i = 0; i < pendulum_k1s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + pendulum_k1s1_E[(j * S + i) * S + d];
+      for (d = pendulum_k1s1_S - 1; d >= 0; d--) e = e * r + pendulum_k1s1_E[(j * pendulum_k1s1_S + i) * pendulum_k1s1_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < pendulum_k1s1_M; l++) gam[j * pendulum_k1s1_M + l] += e * x->gam[i * pendulum_k1s1_M + l];
     }
 }
 
@@ -249,60 +270,63 @@ static void pendulum_k1s1_add(double *a, double *c, double b)
 int pendulum_k1s1_step(pendulum_k1s1_state *x, double h_, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_k1s1_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  pendulum_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_k1s1_EBADSTEP;
   pendulum_k1s1_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[pendulum_k1s1_NU];
   pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below pendulum_k1s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < pendulum_k1s1_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_k1s1_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= pendulum_k1s1_MAXITER; it++) {
     pendulum_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < pendulum_k1s1_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = pendulum_k1s1_ESINGULAR;
+    for (i = 0; i < pendulum_k1s1_NU; i++) {
+      double piv = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k1s1_SINGTOL * fabs(dia))) rc = pendulum_k1s1_ESINGULAR;
     }
     if (rc == pendulum_k1s1_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_k1s1_ENONFINITE;
     if (rc == pendulum_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_k1s1_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (pendulum_k1s1_TOL / 256), or
+     * within 2 ulps (pendulum_k1s1_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above pendulum_k1s1_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = pendulum_k1s1_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? pendulum_k1s1_OK : pendulum_k1s1_ENOCONV; break; }
+    if (inc <= pendulum_k1s1_TOL / 256 || (inc <= pendulum_k1s1_TOL && 4 * inc > inc_old)) { rc = pendulum_k1s1_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= pendulum_k1s1_STAGTOL ? pendulum_k1s1_OK : pendulum_k1s1_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_k1s1_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return pendulum_k1s1_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k1s1_ENONFINITE;
+  for (i = 0; i < pendulum_k1s1_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k1s1_S * pendulum_k1s1_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return pendulum_k1s1_ENONFINITE;
+  for (i = 0; i < pendulum_k1s1_M; i++) {
     pendulum_k1s1_add(&x->q[i], &x->qc[i], h * sw[i]);
-    pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[pendulum_k1s1_S * pendulum_k1s1_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + i];
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = gam[i];
   pendulum_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k1s1_OK;

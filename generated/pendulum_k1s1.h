@@ -4,6 +4,10 @@
 #ifndef pendulum_k1s1_H
 #define pendulum_k1s1_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define pendulum_k1s1_M 2      /* coordinates */
 #define pendulum_k1s1_NU 1     /* constraints */
 #define pendulum_k1s1_K 1      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void pendulum_k1s1_params_default(pendulum_k1s1_params *prm);
 int pendulum_k1s1_step(pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st);
 const char *pendulum_k1s1_strerror(int code);
 double pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm);
-void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *g);   /* NU values */
+void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *g);   /* pendulum_k1s1_NU values */
 void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

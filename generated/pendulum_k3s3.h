@@ -4,6 +4,10 @@
 #ifndef pendulum_k3s3_H
 #define pendulum_k3s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define pendulum_k3s3_M 2      /* coordinates */
 #define pendulum_k3s3_NU 1     /* constraints */
 #define pendulum_k3s3_K 3      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void pendulum_k3s3_params_default(pendulum_k3s3_params *prm);
 int pendulum_k3s3_step(pendulum_k3s3_state *x, double h, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st);
 const char *pendulum_k3s3_strerror(int code);
 double pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm);
-void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *g);   /* NU values */
+void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *g);   /* pendulum_k3s3_NU values */
 void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

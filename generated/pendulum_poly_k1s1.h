@@ -4,6 +4,10 @@
 #ifndef pendulum_poly_k1s1_H
 #define pendulum_poly_k1s1_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define pendulum_poly_k1s1_M 2      /* coordinates */
 #define pendulum_poly_k1s1_NU 1     /* constraints */
 #define pendulum_poly_k1s1_K 1      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void pendulum_poly_k1s1_params_default(pendulum_poly_k1s1_params *prm);
 int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, double h, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st);
 const char *pendulum_poly_k1s1_strerror(int code);
 double pendulum_poly_k1s1_energy(const pendulum_poly_k1s1_state *x, const pendulum_poly_k1s1_params *prm);
-void pendulum_poly_k1s1_constraints(const pendulum_poly_k1s1_state *x, const pendulum_poly_k1s1_params *prm, double *g);   /* NU values */
+void pendulum_poly_k1s1_constraints(const pendulum_poly_k1s1_state *x, const pendulum_poly_k1s1_params *prm, double *g);   /* pendulum_poly_k1s1_NU values */
 void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum_poly_k1s1_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "pendulum_poly_k2s2.h"
 
-#define M pendulum_poly_k2s2_M
-#define NU pendulum_poly_k2s2_NU
-#define S pendulum_poly_k2s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(pendulum_poly_k2s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define pendulum_poly_k2s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef pendulum_poly_k2s2_MAXITER
+#define pendulum_poly_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef pendulum_poly_k2s2_TOL
+#define pendulum_poly_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef pendulum_poly_k2s2_STAGTOL
+#define pendulum_poly_k2s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef pendulum_poly_k2s2_SINGTOL
+#define pendulum_poly_k2s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef pendulum_poly_k2s2_GTOL
+#define pendulum_poly_k2s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,22 +49,22 @@ static void pendulum_poly_k2s2_sweep(const double *q0, const double *p0, const d
   const double t1 = gam[2] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x */ + t3;
   const double t5 = gam[1] * 0.21132486540518713;
   const double t6 = gam[3] * (-0.28867513459481292);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y */ + t8;
   const double t10 = 2.0 * t9;
   const double t11 = 2.0 * t4;
   const double t12 = gam[0] * 0.78867513459481287;
   const double t13 = t1 + t12;
   const double t14 = h * t13;
-  const double t15 = q0[0] + t14;
+  const double t15 = q0[0] /* x */ + t14;
   const double t16 = gam[1] * 0.78867513459481287;
   const double t17 = t6 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[1] + t18;
+  const double t19 = q0[1] /* y */ + t18;
   const double t20 = 2.0 * t19;
   const double t21 = 2.0 * t15;
   /* the multiplier coefficients: lambda += A^-1 C(lambda) */
@@ -80,12 +93,12 @@ static void pendulum_poly_k2s2_sweep(const double *q0, const double *p0, const d
   const double t44 = 0.28867513459481292 * t40;
   const double t45 = t43 - t44;
   const double t46 = h * t45;
-  const double t47 = p0[0] - t46;
+  const double t47 = p0[0] /* p_x */ - t46;
   const double t48 = 0.5 * t38;
   const double t49 = 0.28867513459481292 * t42;
   const double t50 = t48 - t49;
   const double t51 = h * t50;
-  const double t52 = p0[1] - t51;
+  const double t52 = p0[1] /* p_y */ - t51;
   const double t53 = 0.28867513459481292 * t36;
   const double t54 = h * t53;
   const double t55 = 0.28867513459481292 * t38;
@@ -145,12 +158,12 @@ static void pendulum_poly_k2s2_sweep(const double *q0, const double *p0, const d
   const double t108 = 0.28867513459481292 * t104;
   const double t109 = t107 - t108;
   const double t110 = h * t109;
-  const double t111 = p0[0] - t110;
+  const double t111 = p0[0] /* p_x */ - t110;
   const double t112 = 0.5 * t102;
   const double t113 = 0.28867513459481292 * t106;
   const double t114 = t112 - t113;
   const double t115 = h * t114;
-  const double t116 = p0[1] - t115;
+  const double t116 = p0[1] /* p_y */ - t115;
   const double t117 = 0.28867513459481292 * t100;
   const double t118 = h * t117;
   const double t119 = -t118;
@@ -161,12 +174,15 @@ static void pendulum_poly_k2s2_sweep(const double *q0, const double *p0, const d
   const double t124 = -t123;
   const double t125 = h * t102;
   const double t126 = -t125;
+  /* gam */
   out[0] = t111;
   out[1] = t116;
   out[2] = t119;
   out[3] = t122;
+  /* dp */
   out[4] = t124;
   out[5] = t126;
+  /* lam */
   out[6] = t84;
   out[7] = t85;
 }
@@ -182,20 +198,20 @@ static void pendulum_poly_k2s2_factor(const double *q0, const double *p0, const 
   const double t1 = gam[2] * (-0.28867513459481292);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x */ + t3;
   const double t5 = gam[1] * 0.21132486540518713;
   const double t6 = gam[3] * (-0.28867513459481292);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y */ + t8;
   const double t10 = gam[0] * 0.78867513459481287;
   const double t11 = t1 + t10;
   const double t12 = h * t11;
-  const double t13 = q0[0] + t12;
+  const double t13 = q0[0] /* x */ + t12;
   const double t14 = gam[1] * 0.78867513459481287;
   const double t15 = t6 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y */ + t16;
   /* the multiplier matrix A, factored once per step */
   const double t18 = t4 + t13;
   const double t19 = t9 + t17;
@@ -262,12 +278,15 @@ static void pendulum_poly_k2s2_factor(const double *q0, const double *p0, const 
   const double t80 = t77 - t79;
   const double t81 = 1.0 / t47;
   const double t82 = 1.0 / t80;
+  /* lu */
   out[0] = t81;
   out[1] = t61;
   out[2] = t78;
   out[3] = t82;
+  /* pivot */
   out[4] = t47;
   out[5] = t80;
+  /* adiag */
   out[6] = t47;
   out[7] = t77;
 }
@@ -277,8 +296,9 @@ static void pendulum_poly_k2s2_minv_p(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -287,11 +307,12 @@ static void pendulum_poly_k2s2_energy_kernel(const double *q0, const double *p0,
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
   const double t3 = 0.5 * t2;
-  const double t4 = q0[1] + t3;
+  const double t4 = q0[1] /* y */ + t3;
+  /* H */
   out[0] = t4;
 }
 
@@ -301,10 +322,11 @@ static void pendulum_poly_k2s2_g(const double *q0, const double *p0, const doubl
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* g(q0) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
   const double t3 = t2 - 1.0;
+  /* g */
   out[0] = t3;
 }
 
@@ -313,13 +335,12 @@ static void pendulum_poly_k2s2_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = t0 * p0[0];
-  const double t3 = t1 * p0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = t0 * p0[0] /* p_x */;
+  const double t3 = t1 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
+  /* hidden */
   out[0] = t4;
 }
 
@@ -329,21 +350,20 @@ static void pendulum_poly_k2s2_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
   /* consistent initial multiplier */
-  const double t5 = 2.0 * p0[0];
-  const double t6 = 2.0 * p0[1];
-  const double t7 = p0[0] * t5;
-  const double t8 = p0[1] * t6;
+  const double t5 = 2.0 * p0[0] /* p_x */;
+  const double t6 = 2.0 * p0[1] /* p_y */;
+  const double t7 = p0[0] /* p_x */ * t5;
+  const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
   const double t10 = t9 - t1;
   const double t11 = t10 / t4;
+  /* lambda */
   out[0] = t11;
 }
 
@@ -354,32 +374,36 @@ static void pendulum_poly_k2s2_project(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
-  const double t5 = t0 * p0[0];
-  const double t6 = t1 * p0[1];
+  const double t5 = t0 * p0[0] /* p_x */;
+  const double t6 = t1 * p0[1] /* p_y */;
   const double t7 = t5 + t6;
   const double t8 = t7 / t4;
   const double t9 = t0 * t8;
   const double t10 = -t9;
-  const double t11 = p0[0] - t9;
+  const double t11 = p0[0] /* p_x */ - t9;
   const double t12 = t1 * t8;
   const double t13 = -t12;
-  const double t14 = p0[1] - t12;
+  const double t14 = p0[1] /* p_y */ - t12;
   const double t15 = t11 * t11;
   const double t16 = t14 * t14;
   const double t17 = t15 + t16;
   const double t18 = 0.5 * t17;
+  /* dp */
   out[0] = t10;
   out[1] = t13;
+  /* kin */
   out[2] = t18;
-  out[3] = q0[1];
+  /* U */
+  out[3] = q0[1] /* y */;
+  /* pivot */
   out[4] = t4;
+  /* adiag */
   out[5] = t4;
 }
 
@@ -392,20 +416,20 @@ void pendulum_poly_k2s2_init(pendulum_poly_k2s2_state *x, const double *q0, cons
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : pendulum_poly_k2s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : pendulum_poly_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (pendulum_poly_k2s2_NU ? pendulum_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     pendulum_poly_k2s2_params prm;
-    double lam[NU];
+    double lam[pendulum_poly_k2s2_NU];
     pendulum_poly_k2s2_params_default(&prm);
     pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -421,32 +445,32 @@ const char *pendulum_poly_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) pendulum_poly_k2s2_params dflt_; if (!prm) { pendulum_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
+#define pendulum_poly_k2s2_DEFAULT_PARAMS(prm) pendulum_poly_k2s2_params dflt_; if (!prm) { pendulum_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
 
 double pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
   pendulum_poly_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void pendulum_poly_k2s2_constraints(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[pendulum_poly_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
   pendulum_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < pendulum_poly_k2s2_NU; i++) g[i] = v[i];
 }
 
 void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[pendulum_poly_k2s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
   pendulum_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < pendulum_poly_k2s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -454,17 +478,17 @@ void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum
 static void pendulum_poly_k2s2_predict(const pendulum_poly_k2s2_state *x, double h, const pendulum_poly_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < pendulum_poly_k2s2_S; j++)
+    for (i = 0; i < pendulum_poly_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + pendulum_poly_k2s2_E[(j * S + i) * S + d];
+      for (d = pendulum_poly_k2s2_S - 1; d >= 0; d--) e = e * r + pendulum_poly_k2s2_E[(j * pendulum_poly_k2s2_S + i) * pendulum_poly_k2s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[j * pendulum_poly_k2s2_M + l] += e * x->gam[i * pendulum_poly_k2s2_M + l];
     }
 }
 
@@ -481,100 +505,101 @@ static void pendulum_poly_k2s2_add(double *a, double *c, double b)
 int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, double h_, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M], sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_poly_k2s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k2s2_EBADSTEP;
   pendulum_poly_k2s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[pendulum_poly_k2s2_NU];
   pendulum_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below pendulum_poly_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[4 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < pendulum_poly_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_poly_k2s2_GTOL ? 0 : g0[i] / h;
+  double fa[4 + 2 * pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + 1], lam[pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU];
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   pendulum_poly_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[4 + i], dia = fa[4 + S * NU + i];
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++) {
+    double piv = fa[4 + i], dia = fa[4 + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return pendulum_poly_k2s2_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
+    if (!(fabs(piv) > pendulum_poly_k2s2_SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= pendulum_poly_k2s2_MAXITER; it++) {
     pendulum_poly_k2s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < pendulum_poly_k2s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++) lam[i] = sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + i];
+    for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k2s2_ENONFINITE;
     if (rc == pendulum_poly_k2s2_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (pendulum_poly_k2s2_TOL / 256), or
+     * within 2 ulps (pendulum_poly_k2s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above pendulum_poly_k2s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = pendulum_poly_k2s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? pendulum_poly_k2s2_OK : pendulum_poly_k2s2_ENOCONV; break; }
+    if (inc <= pendulum_poly_k2s2_TOL / 256 || (inc <= pendulum_poly_k2s2_TOL && 4 * inc > inc_old)) { rc = pendulum_poly_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= pendulum_poly_k2s2_STAGTOL ? pendulum_poly_k2s2_OK : pendulum_poly_k2s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > pendulum_poly_k2s2_MAXITER ? pendulum_poly_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_poly_k2s2_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k2s2_ENONFINITE;
+  double q1[pendulum_poly_k2s2_M], p1[pendulum_poly_k2s2_M], pr[pendulum_poly_k2s2_M + 2 + 2 * pendulum_poly_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k2s2_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[pendulum_poly_k2s2_M], pc1[pendulum_poly_k2s2_M];
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     pendulum_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
-    pendulum_poly_k2s2_add(&p1[i], &pc1[i], sw[S * M + i]);
+    pendulum_poly_k2s2_add(&p1[i], &pc1[i], sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k2s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
+  for (i = 0; i < pendulum_poly_k2s2_NU; i++) {
+    double piv = pr[pendulum_poly_k2s2_M + 2 + i], dia = pr[pendulum_poly_k2s2_M + 2 + pendulum_poly_k2s2_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k2s2_SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < pendulum_poly_k2s2_M + 2 + 2 * pendulum_poly_k2s2_NU; i++)
     if (!isfinite(pr[i])) return pendulum_poly_k2s2_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[pendulum_poly_k2s2_M + 0];
+  U1 = pr[pendulum_poly_k2s2_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * pendulum_poly_k2s2_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
     pendulum_poly_k2s2_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return pendulum_poly_k2s2_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[pendulum_poly_k2s2_NU];
     pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   pendulum_poly_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;

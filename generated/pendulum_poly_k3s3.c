@@ -5,14 +5,27 @@
 
 #include "pendulum_poly_k3s3.h"
 
-#define M pendulum_poly_k3s3_M
-#define NU pendulum_poly_k3s3_NU
-#define S pendulum_poly_k3s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(pendulum_poly_k3s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define pendulum_poly_k3s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef pendulum_poly_k3s3_MAXITER
+#define pendulum_poly_k3s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef pendulum_poly_k3s3_TOL
+#define pendulum_poly_k3s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef pendulum_poly_k3s3_STAGTOL
+#define pendulum_poly_k3s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef pendulum_poly_k3s3_SINGTOL
+#define pendulum_poly_k3s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef pendulum_poly_k3s3_GTOL
+#define pendulum_poly_k3s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -42,24 +55,24 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   const double t5 = gam[4] * 0.1732050807568877;
   const double t6 = t4 + t5;
   const double t7 = h * t6;
-  const double t8 = q0[0] + t7;
+  const double t8 = q0[0] /* x */ + t7;
   const double t9 = gam[1] * 0.1127016653792583;
   const double t10 = gam[3] * (-0.17320508075688779);
   const double t11 = t9 + t10;
   const double t12 = gam[5] * 0.1732050807568877;
   const double t13 = t11 + t12;
   const double t14 = h * t13;
-  const double t15 = q0[1] + t14;
+  const double t15 = q0[1] /* y */ + t14;
   const double t16 = 2.0 * t15;
   const double t17 = 2.0 * t8;
   const double t18 = gam[2] * (-0.43301270189221935);
   const double t19 = t0 + t18;
   const double t20 = h * t19;
-  const double t21 = q0[0] + t20;
+  const double t21 = q0[0] /* x */ + t20;
   const double t22 = gam[3] * (-0.43301270189221935);
   const double t23 = t1 + t22;
   const double t24 = h * t23;
-  const double t25 = q0[1] + t24;
+  const double t25 = q0[1] /* y */ + t24;
   const double t26 = 2.0 * t25;
   const double t27 = 2.0 * t21;
   const double t28 = gam[0] * 0.8872983346207417;
@@ -67,13 +80,13 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   const double t30 = gam[4] * (-0.1732050807568877);
   const double t31 = t29 + t30;
   const double t32 = h * t31;
-  const double t33 = q0[0] + t32;
+  const double t33 = q0[0] /* x */ + t32;
   const double t34 = gam[1] * 0.8872983346207417;
   const double t35 = t10 + t34;
   const double t36 = gam[5] * (-0.1732050807568877);
   const double t37 = t35 + t36;
   const double t38 = h * t37;
-  const double t39 = q0[1] + t38;
+  const double t39 = q0[1] /* y */ + t38;
   const double t40 = 2.0 * t39;
   const double t41 = 2.0 * t33;
   /* the multiplier coefficients: lambda += A^-1 C(lambda) */
@@ -123,12 +136,12 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   const double t85 = 0.28867513459481292 * t77;
   const double t86 = t84 - t85;
   const double t87 = h * t86;
-  const double t88 = p0[0] - t87;
+  const double t88 = p0[0] /* p_x */ - t87;
   const double t89 = 0.5 * t75;
   const double t90 = 0.28867513459481292 * t79;
   const double t91 = t89 - t90;
   const double t92 = h * t91;
-  const double t93 = p0[1] - t92;
+  const double t93 = p0[1] /* p_y */ - t92;
   const double t94 = 0.28867513459481292 * t73;
   const double t95 = 0.12909944487358055 * t81;
   const double t96 = t94 - t95;
@@ -247,12 +260,12 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   const double t208 = 0.28867513459481292 * t200;
   const double t209 = t207 - t208;
   const double t210 = h * t209;
-  const double t211 = p0[0] - t210;
+  const double t211 = p0[0] /* p_x */ - t210;
   const double t212 = 0.5 * t198;
   const double t213 = 0.28867513459481292 * t202;
   const double t214 = t212 - t213;
   const double t215 = h * t214;
-  const double t216 = p0[1] - t215;
+  const double t216 = p0[1] /* p_y */ - t215;
   const double t217 = 0.28867513459481292 * t196;
   const double t218 = 0.12909944487358055 * t204;
   const double t219 = t217 - t218;
@@ -273,14 +286,17 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   const double t234 = -t233;
   const double t235 = h * t198;
   const double t236 = -t235;
+  /* gam */
   out[0] = t211;
   out[1] = t216;
   out[2] = t221;
   out[3] = t226;
   out[4] = t229;
   out[5] = t232;
+  /* dp */
   out[6] = t234;
   out[7] = t236;
+  /* lam */
   out[8] = t162;
   out[9] = t163;
   out[10] = t164;
@@ -302,34 +318,34 @@ static void pendulum_poly_k3s3_factor(const double *q0, const double *p0, const 
   const double t5 = gam[4] * 0.1732050807568877;
   const double t6 = t4 + t5;
   const double t7 = h * t6;
-  const double t8 = q0[0] + t7;
+  const double t8 = q0[0] /* x */ + t7;
   const double t9 = gam[1] * 0.1127016653792583;
   const double t10 = gam[3] * (-0.17320508075688779);
   const double t11 = t9 + t10;
   const double t12 = gam[5] * 0.1732050807568877;
   const double t13 = t11 + t12;
   const double t14 = h * t13;
-  const double t15 = q0[1] + t14;
+  const double t15 = q0[1] /* y */ + t14;
   const double t16 = gam[2] * (-0.43301270189221935);
   const double t17 = t0 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[0] + t18;
+  const double t19 = q0[0] /* x */ + t18;
   const double t20 = gam[3] * (-0.43301270189221935);
   const double t21 = t1 + t20;
   const double t22 = h * t21;
-  const double t23 = q0[1] + t22;
+  const double t23 = q0[1] /* y */ + t22;
   const double t24 = gam[0] * 0.8872983346207417;
   const double t25 = t3 + t24;
   const double t26 = gam[4] * (-0.1732050807568877);
   const double t27 = t25 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[0] + t28;
+  const double t29 = q0[0] /* x */ + t28;
   const double t30 = gam[1] * 0.8872983346207417;
   const double t31 = t10 + t30;
   const double t32 = gam[5] * (-0.1732050807568877);
   const double t33 = t31 + t32;
   const double t34 = h * t33;
-  const double t35 = q0[1] + t34;
+  const double t35 = q0[1] /* y */ + t34;
   /* the multiplier matrix A, factored once per step */
   const double t36 = t8 * 0.55555555555555558;
   const double t37 = t19 * 0.88888888888888884;
@@ -537,6 +553,7 @@ static void pendulum_poly_k3s3_factor(const double *q0, const double *p0, const 
   const double t239 = t235 - t238;
   const double t240 = 1.0 / t228;
   const double t241 = 1.0 / t239;
+  /* lu */
   out[0] = t236;
   out[1] = t129;
   out[2] = t153;
@@ -546,9 +563,11 @@ static void pendulum_poly_k3s3_factor(const double *q0, const double *p0, const 
   out[6] = t231;
   out[7] = t237;
   out[8] = t241;
+  /* pivot */
   out[9] = t105;
   out[10] = t228;
   out[11] = t239;
+  /* adiag */
   out[12] = t105;
   out[13] = t177;
   out[14] = t225;
@@ -559,8 +578,9 @@ static void pendulum_poly_k3s3_minv_p(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -569,11 +589,12 @@ static void pendulum_poly_k3s3_energy_kernel(const double *q0, const double *p0,
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
   const double t3 = 0.5 * t2;
-  const double t4 = q0[1] + t3;
+  const double t4 = q0[1] /* y */ + t3;
+  /* H */
   out[0] = t4;
 }
 
@@ -583,10 +604,11 @@ static void pendulum_poly_k3s3_g(const double *q0, const double *p0, const doubl
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* g(q0) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
   const double t3 = t2 - 1.0;
+  /* g */
   out[0] = t3;
 }
 
@@ -595,13 +617,12 @@ static void pendulum_poly_k3s3_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = t0 * p0[0];
-  const double t3 = t1 * p0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = t0 * p0[0] /* p_x */;
+  const double t3 = t1 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
+  /* hidden */
   out[0] = t4;
 }
 
@@ -611,21 +632,20 @@ static void pendulum_poly_k3s3_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
   /* consistent initial multiplier */
-  const double t5 = 2.0 * p0[0];
-  const double t6 = 2.0 * p0[1];
-  const double t7 = p0[0] * t5;
-  const double t8 = p0[1] * t6;
+  const double t5 = 2.0 * p0[0] /* p_x */;
+  const double t6 = 2.0 * p0[1] /* p_y */;
+  const double t7 = p0[0] /* p_x */ * t5;
+  const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
   const double t10 = t9 - t1;
   const double t11 = t10 / t4;
+  /* lambda */
   out[0] = t11;
 }
 
@@ -636,32 +656,36 @@ static void pendulum_poly_k3s3_project(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
-  const double t5 = t0 * p0[0];
-  const double t6 = t1 * p0[1];
+  const double t5 = t0 * p0[0] /* p_x */;
+  const double t6 = t1 * p0[1] /* p_y */;
   const double t7 = t5 + t6;
   const double t8 = t7 / t4;
   const double t9 = t0 * t8;
   const double t10 = -t9;
-  const double t11 = p0[0] - t9;
+  const double t11 = p0[0] /* p_x */ - t9;
   const double t12 = t1 * t8;
   const double t13 = -t12;
-  const double t14 = p0[1] - t12;
+  const double t14 = p0[1] /* p_y */ - t12;
   const double t15 = t11 * t11;
   const double t16 = t14 * t14;
   const double t17 = t15 + t16;
   const double t18 = 0.5 * t17;
+  /* dp */
   out[0] = t10;
   out[1] = t13;
+  /* kin */
   out[2] = t18;
-  out[3] = q0[1];
+  /* U */
+  out[3] = q0[1] /* y */;
+  /* pivot */
   out[4] = t4;
+  /* adiag */
   out[5] = t4;
 }
 
@@ -674,20 +698,20 @@ void pendulum_poly_k3s3_init(pendulum_poly_k3s3_state *x, const double *q0, cons
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : pendulum_poly_k3s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : pendulum_poly_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (pendulum_poly_k3s3_NU ? pendulum_poly_k3s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     pendulum_poly_k3s3_params prm;
-    double lam[NU];
+    double lam[pendulum_poly_k3s3_NU];
     pendulum_poly_k3s3_params_default(&prm);
     pendulum_poly_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < pendulum_poly_k3s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -703,32 +727,32 @@ const char *pendulum_poly_k3s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) pendulum_poly_k3s3_params dflt_; if (!prm) { pendulum_poly_k3s3_params_default(&dflt_); prm = &dflt_; }
+#define pendulum_poly_k3s3_DEFAULT_PARAMS(prm) pendulum_poly_k3s3_params dflt_; if (!prm) { pendulum_poly_k3s3_params_default(&dflt_); prm = &dflt_; }
 
 double pendulum_poly_k3s3_energy(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
   pendulum_poly_k3s3_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void pendulum_poly_k3s3_constraints(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm, double *g)
 {
-  double v[NU];
+  double v[pendulum_poly_k3s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
   pendulum_poly_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < pendulum_poly_k3s3_NU; i++) g[i] = v[i];
 }
 
 void pendulum_poly_k3s3_hidden(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm, double *gp)
 {
-  double v[NU];
+  double v[pendulum_poly_k3s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
   pendulum_poly_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < pendulum_poly_k3s3_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -736,17 +760,17 @@ void pendulum_poly_k3s3_hidden(const pendulum_poly_k3s3_state *x, const pendulum
 static void pendulum_poly_k3s3_predict(const pendulum_poly_k3s3_state *x, double h, const pendulum_poly_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < pendulum_poly_k3s3_S; j++)
+    for (i = 0; i < pendulum_poly_k3s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + pendulum_poly_k3s3_E[(j * S + i) * S + d];
+      for (d = pendulum_poly_k3s3_S - 1; d >= 0; d--) e = e * r + pendulum_poly_k3s3_E[(j * pendulum_poly_k3s3_S + i) * pendulum_poly_k3s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < pendulum_poly_k3s3_M; l++) gam[j * pendulum_poly_k3s3_M + l] += e * x->gam[i * pendulum_poly_k3s3_M + l];
     }
 }
 
@@ -763,100 +787,101 @@ static void pendulum_poly_k3s3_add(double *a, double *c, double b)
 int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, double h_, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_poly_k3s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k3s3_EBADSTEP;
   pendulum_poly_k3s3_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[pendulum_poly_k3s3_NU];
   pendulum_poly_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below pendulum_poly_k3s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[9 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_poly_k3s3_GTOL ? 0 : g0[i] / h;
+  double fa[9 + 2 * pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1], lam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU];
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   pendulum_poly_k3s3_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[9 + i], dia = fa[9 + S * NU + i];
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) {
+    double piv = fa[9 + i], dia = fa[9 + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return pendulum_poly_k3s3_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
+    if (!(fabs(piv) > pendulum_poly_k3s3_SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= pendulum_poly_k3s3_MAXITER; it++) {
     pendulum_poly_k3s3_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < pendulum_poly_k3s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + i];
+    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k3s3_ENONFINITE;
     if (rc == pendulum_poly_k3s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k3s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (pendulum_poly_k3s3_TOL / 256), or
+     * within 2 ulps (pendulum_poly_k3s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above pendulum_poly_k3s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = pendulum_poly_k3s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? pendulum_poly_k3s3_OK : pendulum_poly_k3s3_ENOCONV; break; }
+    if (inc <= pendulum_poly_k3s3_TOL / 256 || (inc <= pendulum_poly_k3s3_TOL && 4 * inc > inc_old)) { rc = pendulum_poly_k3s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= pendulum_poly_k3s3_STAGTOL ? pendulum_poly_k3s3_OK : pendulum_poly_k3s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > pendulum_poly_k3s3_MAXITER ? pendulum_poly_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_poly_k3s3_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k3s3_ENONFINITE;
+  double q1[pendulum_poly_k3s3_M], p1[pendulum_poly_k3s3_M], pr[pendulum_poly_k3s3_M + 2 + 2 * pendulum_poly_k3s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k3s3_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[pendulum_poly_k3s3_M], pc1[pendulum_poly_k3s3_M];
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     pendulum_poly_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
-    pendulum_poly_k3s3_add(&p1[i], &pc1[i], sw[S * M + i]);
+    pendulum_poly_k3s3_add(&p1[i], &pc1[i], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k3s3_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
+  for (i = 0; i < pendulum_poly_k3s3_NU; i++) {
+    double piv = pr[pendulum_poly_k3s3_M + 2 + i], dia = pr[pendulum_poly_k3s3_M + 2 + pendulum_poly_k3s3_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k3s3_SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < pendulum_poly_k3s3_M + 2 + 2 * pendulum_poly_k3s3_NU; i++)
     if (!isfinite(pr[i])) return pendulum_poly_k3s3_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[pendulum_poly_k3s3_M + 0];
+  U1 = pr[pendulum_poly_k3s3_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * pendulum_poly_k3s3_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) {
     pendulum_poly_k3s3_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return pendulum_poly_k3s3_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[pendulum_poly_k3s3_NU];
     pendulum_poly_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < pendulum_poly_k3s3_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   pendulum_poly_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;

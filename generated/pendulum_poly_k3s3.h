@@ -4,6 +4,10 @@
 #ifndef pendulum_poly_k3s3_H
 #define pendulum_poly_k3s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define pendulum_poly_k3s3_M 2      /* coordinates */
 #define pendulum_poly_k3s3_NU 1     /* constraints */
 #define pendulum_poly_k3s3_K 3      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void pendulum_poly_k3s3_params_default(pendulum_poly_k3s3_params *prm);
 int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, double h, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st);
 const char *pendulum_poly_k3s3_strerror(int code);
 double pendulum_poly_k3s3_energy(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm);
-void pendulum_poly_k3s3_constraints(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm, double *g);   /* NU values */
+void pendulum_poly_k3s3_constraints(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm, double *g);   /* pendulum_poly_k3s3_NU values */
 void pendulum_poly_k3s3_hidden(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

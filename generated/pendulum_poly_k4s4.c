@@ -5,14 +5,27 @@
 
 #include "pendulum_poly_k4s4.h"
 
-#define M pendulum_poly_k4s4_M
-#define NU pendulum_poly_k4s4_NU
-#define S pendulum_poly_k4s4_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(pendulum_poly_k4s4_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define pendulum_poly_k4s4_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef pendulum_poly_k4s4_MAXITER
+#define pendulum_poly_k4s4_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef pendulum_poly_k4s4_TOL
+#define pendulum_poly_k4s4_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef pendulum_poly_k4s4_STAGTOL
+#define pendulum_poly_k4s4_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef pendulum_poly_k4s4_SINGTOL
+#define pendulum_poly_k4s4_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef pendulum_poly_k4s4_GTOL
+#define pendulum_poly_k4s4_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 4 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -42,7 +55,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t5 = gam[6] * (-0.11572017713039036);
   const double t6 = t4 + t5;
   const double t7 = h * t6;
-  const double t8 = q0[0] + t7;
+  const double t8 = q0[0] /* x */ + t7;
   const double t9 = gam[1] * 0.069431844202973714;
   const double t10 = gam[3] * (-0.11190964421690913);
   const double t11 = t9 + t10;
@@ -51,7 +64,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t14 = gam[7] * (-0.11572017713039036);
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y */ + t16;
   const double t18 = 2.0 * t17;
   const double t19 = 2.0 * t8;
   const double t20 = gam[0] * 0.33000947820757187;
@@ -62,7 +75,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t25 = gam[6] * 0.06172525241478647;
   const double t26 = t24 + t25;
   const double t27 = h * t26;
-  const double t28 = q0[0] + t27;
+  const double t28 = q0[0] /* x */ + t27;
   const double t29 = gam[1] * 0.33000947820757187;
   const double t30 = gam[3] * (-0.38296201508848449);
   const double t31 = t29 + t30;
@@ -71,7 +84,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t34 = gam[7] * 0.06172525241478647;
   const double t35 = t33 + t34;
   const double t36 = h * t35;
-  const double t37 = q0[1] + t36;
+  const double t37 = q0[1] /* y */ + t36;
   const double t38 = 2.0 * t37;
   const double t39 = 2.0 * t28;
   const double t40 = gam[0] * 0.66999052179242813;
@@ -80,14 +93,14 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t43 = t41 + t42;
   const double t44 = t25 + t43;
   const double t45 = h * t44;
-  const double t46 = q0[0] + t45;
+  const double t46 = q0[0] /* x */ + t45;
   const double t47 = gam[1] * 0.66999052179242813;
   const double t48 = t30 + t47;
   const double t49 = gam[5] * (-0.16808725200256719);
   const double t50 = t48 + t49;
   const double t51 = t34 + t50;
   const double t52 = h * t51;
-  const double t53 = q0[1] + t52;
+  const double t53 = q0[1] /* y */ + t52;
   const double t54 = 2.0 * t53;
   const double t55 = 2.0 * t46;
   const double t56 = gam[0] * 0.93056815579702623;
@@ -98,7 +111,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t61 = gam[6] * (-0.11572017713039039);
   const double t62 = t60 + t61;
   const double t63 = h * t62;
-  const double t64 = q0[0] + t63;
+  const double t64 = q0[0] /* x */ + t63;
   const double t65 = gam[1] * 0.93056815579702623;
   const double t66 = gam[3] * (-0.11190964421690919);
   const double t67 = t65 + t66;
@@ -107,7 +120,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t70 = gam[7] * (-0.11572017713039039);
   const double t71 = t69 + t70;
   const double t72 = h * t71;
-  const double t73 = q0[1] + t72;
+  const double t73 = q0[1] /* y */ + t72;
   const double t74 = 2.0 * t73;
   const double t75 = 2.0 * t64;
   /* the multiplier coefficients: lambda += A^-1 C(lambda) */
@@ -203,12 +216,12 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t165 = 0.28867513459481292 * t153;
   const double t166 = t164 - t165;
   const double t167 = h * t166;
-  const double t168 = p0[0] - t167;
+  const double t168 = p0[0] /* p_x */ - t167;
   const double t169 = 0.5 * t151;
   const double t170 = 0.28867513459481292 * t155;
   const double t171 = t169 - t170;
   const double t172 = h * t171;
-  const double t173 = p0[1] - t172;
+  const double t173 = p0[1] /* p_y */ - t172;
   const double t174 = 0.28867513459481292 * t149;
   const double t175 = 0.12909944487358055 * t157;
   const double t176 = t174 - t175;
@@ -441,12 +454,12 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t402 = 0.28867513459481292 * t390;
   const double t403 = t401 - t402;
   const double t404 = h * t403;
-  const double t405 = p0[0] - t404;
+  const double t405 = p0[0] /* p_x */ - t404;
   const double t406 = 0.5 * t388;
   const double t407 = 0.28867513459481292 * t392;
   const double t408 = t406 - t407;
   const double t409 = h * t408;
-  const double t410 = p0[1] - t409;
+  const double t410 = p0[1] /* p_y */ - t409;
   const double t411 = 0.28867513459481292 * t386;
   const double t412 = 0.12909944487358055 * t394;
   const double t413 = t411 - t412;
@@ -477,6 +490,7 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t438 = -t437;
   const double t439 = h * t388;
   const double t440 = -t439;
+  /* gam */
   out[0] = t405;
   out[1] = t410;
   out[2] = t415;
@@ -485,8 +499,10 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   out[5] = t430;
   out[6] = t433;
   out[7] = t436;
+  /* dp */
   out[8] = t438;
   out[9] = t440;
+  /* lam */
   out[10] = t309;
   out[11] = t310;
   out[12] = t311;
@@ -508,7 +524,7 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t5 = gam[6] * (-0.11572017713039036);
   const double t6 = t4 + t5;
   const double t7 = h * t6;
-  const double t8 = q0[0] + t7;
+  const double t8 = q0[0] /* x */ + t7;
   const double t9 = gam[1] * 0.069431844202973714;
   const double t10 = gam[3] * (-0.11190964421690913);
   const double t11 = t9 + t10;
@@ -517,7 +533,7 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t14 = gam[7] * (-0.11572017713039036);
   const double t15 = t13 + t14;
   const double t16 = h * t15;
-  const double t17 = q0[1] + t16;
+  const double t17 = q0[1] /* y */ + t16;
   const double t18 = gam[0] * 0.33000947820757187;
   const double t19 = gam[2] * (-0.38296201508848449);
   const double t20 = t18 + t19;
@@ -526,7 +542,7 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t23 = gam[6] * 0.06172525241478647;
   const double t24 = t22 + t23;
   const double t25 = h * t24;
-  const double t26 = q0[0] + t25;
+  const double t26 = q0[0] /* x */ + t25;
   const double t27 = gam[1] * 0.33000947820757187;
   const double t28 = gam[3] * (-0.38296201508848449);
   const double t29 = t27 + t28;
@@ -535,21 +551,21 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t32 = gam[7] * 0.06172525241478647;
   const double t33 = t31 + t32;
   const double t34 = h * t33;
-  const double t35 = q0[1] + t34;
+  const double t35 = q0[1] /* y */ + t34;
   const double t36 = gam[0] * 0.66999052179242813;
   const double t37 = t19 + t36;
   const double t38 = gam[4] * (-0.16808725200256719);
   const double t39 = t37 + t38;
   const double t40 = t23 + t39;
   const double t41 = h * t40;
-  const double t42 = q0[0] + t41;
+  const double t42 = q0[0] /* x */ + t41;
   const double t43 = gam[1] * 0.66999052179242813;
   const double t44 = t28 + t43;
   const double t45 = gam[5] * (-0.16808725200256719);
   const double t46 = t44 + t45;
   const double t47 = t32 + t46;
   const double t48 = h * t47;
-  const double t49 = q0[1] + t48;
+  const double t49 = q0[1] /* y */ + t48;
   const double t50 = gam[0] * 0.93056815579702623;
   const double t51 = gam[2] * (-0.11190964421690919);
   const double t52 = t50 + t51;
@@ -558,7 +574,7 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t55 = gam[6] * (-0.11572017713039039);
   const double t56 = t54 + t55;
   const double t57 = h * t56;
-  const double t58 = q0[0] + t57;
+  const double t58 = q0[0] /* x */ + t57;
   const double t59 = gam[1] * 0.93056815579702623;
   const double t60 = gam[3] * (-0.11190964421690919);
   const double t61 = t59 + t60;
@@ -567,7 +583,7 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t64 = gam[7] * (-0.11572017713039039);
   const double t65 = t63 + t64;
   const double t66 = h * t65;
-  const double t67 = q0[1] + t66;
+  const double t67 = q0[1] /* y */ + t66;
   /* the multiplier matrix A, factored once per step */
   const double t68 = t8 * 0.34785484513745385;
   const double t69 = t26 * 0.65214515486254609;
@@ -1077,6 +1093,7 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   const double t573 = t569 - t572;
   const double t574 = 1.0 / t562;
   const double t575 = 1.0 / t573;
+  /* lu */
   out[0] = t559;
   out[1] = t277;
   out[2] = t311;
@@ -1093,10 +1110,12 @@ static void pendulum_poly_k4s4_factor(const double *q0, const double *p0, const 
   out[13] = t565;
   out[14] = t571;
   out[15] = t575;
+  /* pivot */
   out[16] = t243;
   out[17] = t540;
   out[18] = t562;
   out[19] = t573;
+  /* adiag */
   out[20] = t243;
   out[21] = t377;
   out[22] = t457;
@@ -1108,8 +1127,9 @@ static void pendulum_poly_k4s4_minv_p(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
+  /* gam0 */
+  out[0] = p0[0] /* p_x */;
+  out[1] = p0[1] /* p_y */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -1118,11 +1138,12 @@ static void pendulum_poly_k4s4_energy_kernel(const double *q0, const double *p0,
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
   const double t3 = 0.5 * t2;
-  const double t4 = q0[1] + t3;
+  const double t4 = q0[1] /* y */ + t3;
+  /* H */
   out[0] = t4;
 }
 
@@ -1132,10 +1153,11 @@ static void pendulum_poly_k4s4_g(const double *q0, const double *p0, const doubl
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* g(q0) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
   const double t3 = t2 - 1.0;
+  /* g */
   out[0] = t3;
 }
 
@@ -1144,13 +1166,12 @@ static void pendulum_poly_k4s4_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = t0 * p0[0];
-  const double t3 = t1 * p0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = t0 * p0[0] /* p_x */;
+  const double t3 = t1 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
+  /* hidden */
   out[0] = t4;
 }
 
@@ -1160,21 +1181,20 @@ static void pendulum_poly_k4s4_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
   /* consistent initial multiplier */
-  const double t5 = 2.0 * p0[0];
-  const double t6 = 2.0 * p0[1];
-  const double t7 = p0[0] * t5;
-  const double t8 = p0[1] * t6;
+  const double t5 = 2.0 * p0[0] /* p_x */;
+  const double t6 = 2.0 * p0[1] /* p_y */;
+  const double t7 = p0[0] /* p_x */ * t5;
+  const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
   const double t10 = t9 - t1;
   const double t11 = t10 / t4;
+  /* lambda */
   out[0] = t11;
 }
 
@@ -1185,32 +1205,36 @@ static void pendulum_poly_k4s4_project(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0];
-  const double t1 = 2.0 * q0[1];
+  const double t0 = 2.0 * q0[0] /* x */;
+  const double t1 = 2.0 * q0[1] /* y */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t2 = t0 * t0;
   const double t3 = t1 * t1;
   const double t4 = t2 + t3;
-  const double t5 = t0 * p0[0];
-  const double t6 = t1 * p0[1];
+  const double t5 = t0 * p0[0] /* p_x */;
+  const double t6 = t1 * p0[1] /* p_y */;
   const double t7 = t5 + t6;
   const double t8 = t7 / t4;
   const double t9 = t0 * t8;
   const double t10 = -t9;
-  const double t11 = p0[0] - t9;
+  const double t11 = p0[0] /* p_x */ - t9;
   const double t12 = t1 * t8;
   const double t13 = -t12;
-  const double t14 = p0[1] - t12;
+  const double t14 = p0[1] /* p_y */ - t12;
   const double t15 = t11 * t11;
   const double t16 = t14 * t14;
   const double t17 = t15 + t16;
   const double t18 = 0.5 * t17;
+  /* dp */
   out[0] = t10;
   out[1] = t13;
+  /* kin */
   out[2] = t18;
-  out[3] = q0[1];
+  /* U */
+  out[3] = q0[1] /* y */;
+  /* pivot */
   out[4] = t4;
+  /* adiag */
   out[5] = t4;
 }
 
@@ -1223,20 +1247,20 @@ void pendulum_poly_k4s4_init(pendulum_poly_k4s4_state *x, const double *q0, cons
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : pendulum_poly_k4s4_q0[i];
     x->p[i] = p0 ? (double)p0[i] : pendulum_poly_k4s4_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (pendulum_poly_k4s4_NU ? pendulum_poly_k4s4_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     pendulum_poly_k4s4_params prm;
-    double lam[NU];
+    double lam[pendulum_poly_k4s4_NU];
     pendulum_poly_k4s4_params_default(&prm);
     pendulum_poly_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < pendulum_poly_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -1252,32 +1276,32 @@ const char *pendulum_poly_k4s4_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) pendulum_poly_k4s4_params dflt_; if (!prm) { pendulum_poly_k4s4_params_default(&dflt_); prm = &dflt_; }
+#define pendulum_poly_k4s4_DEFAULT_PARAMS(prm) pendulum_poly_k4s4_params dflt_; if (!prm) { pendulum_poly_k4s4_params_default(&dflt_); prm = &dflt_; }
 
 double pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   pendulum_poly_k4s4_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *g)
 {
-  double v[NU];
+  double v[pendulum_poly_k4s4_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < pendulum_poly_k4s4_NU; i++) g[i] = v[i];
 }
 
 void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *gp)
 {
-  double v[NU];
+  double v[pendulum_poly_k4s4_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   pendulum_poly_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < pendulum_poly_k4s4_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1285,17 +1309,17 @@ void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum
 static void pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, const pendulum_poly_k4s4_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < pendulum_poly_k4s4_S; j++)
+    for (i = 0; i < pendulum_poly_k4s4_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + pendulum_poly_k4s4_E[(j * S + i) * S + d];
+      for (d = pendulum_poly_k4s4_S - 1; d >= 0; d--) e = e * r + pendulum_poly_k4s4_E[(j * pendulum_poly_k4s4_S + i) * pendulum_poly_k4s4_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < pendulum_poly_k4s4_M; l++) gam[j * pendulum_poly_k4s4_M + l] += e * x->gam[i * pendulum_poly_k4s4_M + l];
     }
 }
 
@@ -1312,100 +1336,101 @@ static void pendulum_poly_k4s4_add(double *a, double *c, double b)
 int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, double h_, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = pendulum_poly_k4s4_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k4s4_EBADSTEP;
   pendulum_poly_k4s4_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[pendulum_poly_k4s4_NU];
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below pendulum_poly_k4s4_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[16 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < pendulum_poly_k4s4_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_poly_k4s4_GTOL ? 0 : g0[i] / h;
+  double fa[16 + 2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1], lam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU];
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   pendulum_poly_k4s4_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[16 + i], dia = fa[16 + S * NU + i];
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) {
+    double piv = fa[16 + i], dia = fa[16 + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return pendulum_poly_k4s4_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return pendulum_poly_k4s4_ESINGULAR;
+    if (!(fabs(piv) > pendulum_poly_k4s4_SINGTOL * fabs(dia))) return pendulum_poly_k4s4_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= pendulum_poly_k4s4_MAXITER; it++) {
     pendulum_poly_k4s4_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < pendulum_poly_k4s4_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + i];
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k4s4_ENONFINITE;
     if (rc == pendulum_poly_k4s4_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k4s4_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (pendulum_poly_k4s4_TOL / 256), or
+     * within 2 ulps (pendulum_poly_k4s4_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above pendulum_poly_k4s4_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = pendulum_poly_k4s4_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? pendulum_poly_k4s4_OK : pendulum_poly_k4s4_ENOCONV; break; }
+    if (inc <= pendulum_poly_k4s4_TOL / 256 || (inc <= pendulum_poly_k4s4_TOL && 4 * inc > inc_old)) { rc = pendulum_poly_k4s4_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= pendulum_poly_k4s4_STAGTOL ? pendulum_poly_k4s4_OK : pendulum_poly_k4s4_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_poly_k4s4_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k4s4_ENONFINITE;
+  double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k4s4_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[pendulum_poly_k4s4_M], pc1[pendulum_poly_k4s4_M];
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     pendulum_poly_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
-    pendulum_poly_k4s4_add(&p1[i], &pc1[i], sw[S * M + i]);
+    pendulum_poly_k4s4_add(&p1[i], &pc1[i], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k4s4_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return pendulum_poly_k4s4_ESINGULAR;
+  for (i = 0; i < pendulum_poly_k4s4_NU; i++) {
+    double piv = pr[pendulum_poly_k4s4_M + 2 + i], dia = pr[pendulum_poly_k4s4_M + 2 + pendulum_poly_k4s4_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k4s4_SINGTOL * fabs(dia))) return pendulum_poly_k4s4_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU; i++)
     if (!isfinite(pr[i])) return pendulum_poly_k4s4_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[pendulum_poly_k4s4_M + 0];
+  U1 = pr[pendulum_poly_k4s4_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * pendulum_poly_k4s4_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     pendulum_poly_k4s4_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return pendulum_poly_k4s4_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[pendulum_poly_k4s4_NU];
     pendulum_poly_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < pendulum_poly_k4s4_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   pendulum_poly_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;

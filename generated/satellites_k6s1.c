@@ -5,14 +5,27 @@
 
 #include "satellites_k6s1.h"
 
-#define M satellites_k6s1_M
-#define NU satellites_k6s1_NU
-#define S satellites_k6s1_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(satellites_k6s1_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define satellites_k6s1_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef satellites_k6s1_MAXITER
+#define satellites_k6s1_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef satellites_k6s1_TOL
+#define satellites_k6s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef satellites_k6s1_STAGTOL
+#define satellites_k6s1_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef satellites_k6s1_SINGTOL
+#define satellites_k6s1_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef satellites_k6s1_GTOL
+#define satellites_k6s1_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,7 +49,7 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
   const double t2 = 0.5 * gam[0];
   const double t3 = h * t2;
@@ -46,7 +59,7 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t7 = h * t6;
   const double t8 = (-2.0) * t7;
   const double t9 = t5 + t8;
-  const double t10 = q0[1] - q0[4];
+  const double t10 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t11 = 2.0 * t10;
   const double t12 = 0.5 * gam[1];
   const double t13 = h * t12;
@@ -56,7 +69,7 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t17 = h * t16;
   const double t18 = (-2.0) * t17;
   const double t19 = t15 + t18;
-  const double t20 = q0[2] - q0[5];
+  const double t20 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t21 = 2.0 * t20;
   const double t22 = 0.5 * gam[2];
   const double t23 = h * t22;
@@ -78,21 +91,21 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t39 = t38 - t21;
   const double t40 = 2.0 * t27;
   const double t41 = t39 + t40;
-  const double t42 = q0[3] - q0[6];
+  const double t42 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t43 = 2.0 * t42;
   const double t44 = t32 + t43;
   const double t45 = 0.5 * gam[6];
   const double t46 = h * t45;
   const double t47 = (-2.0) * t46;
   const double t48 = t44 + t47;
-  const double t49 = q0[4] - q0[7];
+  const double t49 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t50 = 2.0 * t49;
   const double t51 = t36 + t50;
   const double t52 = 0.5 * gam[7];
   const double t53 = h * t52;
   const double t54 = (-2.0) * t53;
   const double t55 = t51 + t54;
-  const double t56 = q0[5] - q0[8];
+  const double t56 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t57 = 2.0 * t56;
   const double t58 = t40 + t57;
   const double t59 = 0.5 * gam[8];
@@ -108,15 +121,15 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t69 = t28 - t57;
   const double t70 = 2.0 * t60;
   const double t71 = t69 + t70;
-  const double t72 = q0[6] - q0[0];
+  const double t72 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t73 = 2.0 * t72;
   const double t74 = t4 - t73;
   const double t75 = t47 + t74;
-  const double t76 = q0[7] - q0[1];
+  const double t76 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t77 = 2.0 * t76;
   const double t78 = t14 - t77;
   const double t79 = t54 + t78;
-  const double t80 = q0[8] - q0[2];
+  const double t80 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t81 = 2.0 * t80;
   const double t82 = t24 - t81;
   const double t83 = t61 + t82;
@@ -129,31 +142,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
   const double t90 = gam[0] * 0.033765242898423975;
   const double t91 = h * t90;
-  const double t92 = q0[0] + t91;
+  const double t92 = q0[0] /* x1 */ + t91;
   const double t93 = gam[1] * 0.033765242898423975;
   const double t94 = h * t93;
-  const double t95 = q0[1] + t94;
+  const double t95 = q0[1] /* y1 */ + t94;
   const double t96 = gam[2] * 0.033765242898423975;
   const double t97 = h * t96;
-  const double t98 = q0[2] + t97;
+  const double t98 = q0[2] /* z1 */ + t97;
   const double t99 = gam[3] * 0.033765242898423975;
   const double t100 = h * t99;
-  const double t101 = q0[3] + t100;
+  const double t101 = q0[3] /* x2 */ + t100;
   const double t102 = gam[4] * 0.033765242898423975;
   const double t103 = h * t102;
-  const double t104 = q0[4] + t103;
+  const double t104 = q0[4] /* y2 */ + t103;
   const double t105 = gam[5] * 0.033765242898423975;
   const double t106 = h * t105;
-  const double t107 = q0[5] + t106;
+  const double t107 = q0[5] /* z2 */ + t106;
   const double t108 = gam[6] * 0.033765242898423975;
   const double t109 = h * t108;
-  const double t110 = q0[6] + t109;
+  const double t110 = q0[6] /* x3 */ + t109;
   const double t111 = gam[7] * 0.033765242898423975;
   const double t112 = h * t111;
-  const double t113 = q0[7] + t112;
+  const double t113 = q0[7] /* y3 */ + t112;
   const double t114 = gam[8] * 0.033765242898423975;
   const double t115 = h * t114;
-  const double t116 = q0[8] + t115;
+  const double t116 = q0[8] /* z3 */ + t115;
   const double t117 = t92 * t92;
   const double t118 = t95 * t95;
   const double t119 = t117 + t118;
@@ -214,31 +227,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t174 = gam[0] * 0.16939530676686776;
   const double t175 = h * t174;
-  const double t176 = q0[0] + t175;
+  const double t176 = q0[0] /* x1 */ + t175;
   const double t177 = gam[1] * 0.16939530676686776;
   const double t178 = h * t177;
-  const double t179 = q0[1] + t178;
+  const double t179 = q0[1] /* y1 */ + t178;
   const double t180 = gam[2] * 0.16939530676686776;
   const double t181 = h * t180;
-  const double t182 = q0[2] + t181;
+  const double t182 = q0[2] /* z1 */ + t181;
   const double t183 = gam[3] * 0.16939530676686776;
   const double t184 = h * t183;
-  const double t185 = q0[3] + t184;
+  const double t185 = q0[3] /* x2 */ + t184;
   const double t186 = gam[4] * 0.16939530676686776;
   const double t187 = h * t186;
-  const double t188 = q0[4] + t187;
+  const double t188 = q0[4] /* y2 */ + t187;
   const double t189 = gam[5] * 0.16939530676686776;
   const double t190 = h * t189;
-  const double t191 = q0[5] + t190;
+  const double t191 = q0[5] /* z2 */ + t190;
   const double t192 = gam[6] * 0.16939530676686776;
   const double t193 = h * t192;
-  const double t194 = q0[6] + t193;
+  const double t194 = q0[6] /* x3 */ + t193;
   const double t195 = gam[7] * 0.16939530676686776;
   const double t196 = h * t195;
-  const double t197 = q0[7] + t196;
+  const double t197 = q0[7] /* y3 */ + t196;
   const double t198 = gam[8] * 0.16939530676686776;
   const double t199 = h * t198;
-  const double t200 = q0[8] + t199;
+  const double t200 = q0[8] /* z3 */ + t199;
   const double t201 = t176 * t176;
   const double t202 = t179 * t179;
   const double t203 = t201 + t202;
@@ -308,31 +321,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
   const double t267 = gam[0] * 0.38069040695840156;
   const double t268 = h * t267;
-  const double t269 = q0[0] + t268;
+  const double t269 = q0[0] /* x1 */ + t268;
   const double t270 = gam[1] * 0.38069040695840156;
   const double t271 = h * t270;
-  const double t272 = q0[1] + t271;
+  const double t272 = q0[1] /* y1 */ + t271;
   const double t273 = gam[2] * 0.38069040695840156;
   const double t274 = h * t273;
-  const double t275 = q0[2] + t274;
+  const double t275 = q0[2] /* z1 */ + t274;
   const double t276 = gam[3] * 0.38069040695840156;
   const double t277 = h * t276;
-  const double t278 = q0[3] + t277;
+  const double t278 = q0[3] /* x2 */ + t277;
   const double t279 = gam[4] * 0.38069040695840156;
   const double t280 = h * t279;
-  const double t281 = q0[4] + t280;
+  const double t281 = q0[4] /* y2 */ + t280;
   const double t282 = gam[5] * 0.38069040695840156;
   const double t283 = h * t282;
-  const double t284 = q0[5] + t283;
+  const double t284 = q0[5] /* z2 */ + t283;
   const double t285 = gam[6] * 0.38069040695840156;
   const double t286 = h * t285;
-  const double t287 = q0[6] + t286;
+  const double t287 = q0[6] /* x3 */ + t286;
   const double t288 = gam[7] * 0.38069040695840156;
   const double t289 = h * t288;
-  const double t290 = q0[7] + t289;
+  const double t290 = q0[7] /* y3 */ + t289;
   const double t291 = gam[8] * 0.38069040695840156;
   const double t292 = h * t291;
-  const double t293 = q0[8] + t292;
+  const double t293 = q0[8] /* z3 */ + t292;
   const double t294 = t269 * t269;
   const double t295 = t272 * t272;
   const double t296 = t294 + t295;
@@ -402,31 +415,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
   const double t360 = gam[0] * 0.61930959304159849;
   const double t361 = h * t360;
-  const double t362 = q0[0] + t361;
+  const double t362 = q0[0] /* x1 */ + t361;
   const double t363 = gam[1] * 0.61930959304159849;
   const double t364 = h * t363;
-  const double t365 = q0[1] + t364;
+  const double t365 = q0[1] /* y1 */ + t364;
   const double t366 = gam[2] * 0.61930959304159849;
   const double t367 = h * t366;
-  const double t368 = q0[2] + t367;
+  const double t368 = q0[2] /* z1 */ + t367;
   const double t369 = gam[3] * 0.61930959304159849;
   const double t370 = h * t369;
-  const double t371 = q0[3] + t370;
+  const double t371 = q0[3] /* x2 */ + t370;
   const double t372 = gam[4] * 0.61930959304159849;
   const double t373 = h * t372;
-  const double t374 = q0[4] + t373;
+  const double t374 = q0[4] /* y2 */ + t373;
   const double t375 = gam[5] * 0.61930959304159849;
   const double t376 = h * t375;
-  const double t377 = q0[5] + t376;
+  const double t377 = q0[5] /* z2 */ + t376;
   const double t378 = gam[6] * 0.61930959304159849;
   const double t379 = h * t378;
-  const double t380 = q0[6] + t379;
+  const double t380 = q0[6] /* x3 */ + t379;
   const double t381 = gam[7] * 0.61930959304159849;
   const double t382 = h * t381;
-  const double t383 = q0[7] + t382;
+  const double t383 = q0[7] /* y3 */ + t382;
   const double t384 = gam[8] * 0.61930959304159849;
   const double t385 = h * t384;
-  const double t386 = q0[8] + t385;
+  const double t386 = q0[8] /* z3 */ + t385;
   const double t387 = t362 * t362;
   const double t388 = t365 * t365;
   const double t389 = t387 + t388;
@@ -496,31 +509,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
   const double t453 = gam[0] * 0.83060469323313224;
   const double t454 = h * t453;
-  const double t455 = q0[0] + t454;
+  const double t455 = q0[0] /* x1 */ + t454;
   const double t456 = gam[1] * 0.83060469323313224;
   const double t457 = h * t456;
-  const double t458 = q0[1] + t457;
+  const double t458 = q0[1] /* y1 */ + t457;
   const double t459 = gam[2] * 0.83060469323313224;
   const double t460 = h * t459;
-  const double t461 = q0[2] + t460;
+  const double t461 = q0[2] /* z1 */ + t460;
   const double t462 = gam[3] * 0.83060469323313224;
   const double t463 = h * t462;
-  const double t464 = q0[3] + t463;
+  const double t464 = q0[3] /* x2 */ + t463;
   const double t465 = gam[4] * 0.83060469323313224;
   const double t466 = h * t465;
-  const double t467 = q0[4] + t466;
+  const double t467 = q0[4] /* y2 */ + t466;
   const double t468 = gam[5] * 0.83060469323313224;
   const double t469 = h * t468;
-  const double t470 = q0[5] + t469;
+  const double t470 = q0[5] /* z2 */ + t469;
   const double t471 = gam[6] * 0.83060469323313224;
   const double t472 = h * t471;
-  const double t473 = q0[6] + t472;
+  const double t473 = q0[6] /* x3 */ + t472;
   const double t474 = gam[7] * 0.83060469323313224;
   const double t475 = h * t474;
-  const double t476 = q0[7] + t475;
+  const double t476 = q0[7] /* y3 */ + t475;
   const double t477 = gam[8] * 0.83060469323313224;
   const double t478 = h * t477;
-  const double t479 = q0[8] + t478;
+  const double t479 = q0[8] /* z3 */ + t478;
   const double t480 = t455 * t455;
   const double t481 = t458 * t458;
   const double t482 = t480 + t481;
@@ -590,31 +603,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
   const double t546 = gam[0] * 0.96623475710157603;
   const double t547 = h * t546;
-  const double t548 = q0[0] + t547;
+  const double t548 = q0[0] /* x1 */ + t547;
   const double t549 = gam[1] * 0.96623475710157603;
   const double t550 = h * t549;
-  const double t551 = q0[1] + t550;
+  const double t551 = q0[1] /* y1 */ + t550;
   const double t552 = gam[2] * 0.96623475710157603;
   const double t553 = h * t552;
-  const double t554 = q0[2] + t553;
+  const double t554 = q0[2] /* z1 */ + t553;
   const double t555 = gam[3] * 0.96623475710157603;
   const double t556 = h * t555;
-  const double t557 = q0[3] + t556;
+  const double t557 = q0[3] /* x2 */ + t556;
   const double t558 = gam[4] * 0.96623475710157603;
   const double t559 = h * t558;
-  const double t560 = q0[4] + t559;
+  const double t560 = q0[4] /* y2 */ + t559;
   const double t561 = gam[5] * 0.96623475710157603;
   const double t562 = h * t561;
-  const double t563 = q0[5] + t562;
+  const double t563 = q0[5] /* z2 */ + t562;
   const double t564 = gam[6] * 0.96623475710157603;
   const double t565 = h * t564;
-  const double t566 = q0[6] + t565;
+  const double t566 = q0[6] /* x3 */ + t565;
   const double t567 = gam[7] * 0.96623475710157603;
   const double t568 = h * t567;
-  const double t569 = q0[7] + t568;
+  const double t569 = q0[7] /* y3 */ + t568;
   const double t570 = gam[8] * 0.96623475710157603;
   const double t571 = h * t570;
-  const double t572 = q0[8] + t571;
+  const double t572 = q0[8] /* z3 */ + t571;
   const double t573 = t548 * t548;
   const double t574 = t551 * t551;
   const double t575 = t573 + t574;
@@ -722,16 +735,16 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t676 = t674 + t675;
   const double t677 = 0.5 * t676;
   const double t678 = h * t677;
-  const double t679 = t9 * p0[0];
-  const double t680 = t19 * p0[1];
+  const double t679 = t9 * p0[0] /* p_x1 */;
+  const double t680 = t19 * p0[1] /* p_y1 */;
   const double t681 = t679 + t680;
-  const double t682 = t29 * p0[2];
+  const double t682 = t29 * p0[2] /* p_z1 */;
   const double t683 = t681 + t682;
-  const double t684 = t33 * p0[3];
+  const double t684 = t33 * p0[3] /* p_x2 */;
   const double t685 = t683 + t684;
-  const double t686 = t37 * p0[4];
+  const double t686 = t37 * p0[4] /* p_y2 */;
   const double t687 = t685 + t686;
-  const double t688 = t41 * p0[5];
+  const double t688 = t41 * p0[5] /* p_z2 */;
   const double t689 = t687 + t688;
   const double t690 = t689 - t678;
   const double t691 = t690 + g0[0];
@@ -768,16 +781,16 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t722 = t720 + t721;
   const double t723 = 0.5 * t722;
   const double t724 = h * t723;
-  const double t725 = t48 * p0[3];
-  const double t726 = t55 * p0[4];
+  const double t725 = t48 * p0[3] /* p_x2 */;
+  const double t726 = t55 * p0[4] /* p_y2 */;
   const double t727 = t725 + t726;
-  const double t728 = t62 * p0[5];
+  const double t728 = t62 * p0[5] /* p_z2 */;
   const double t729 = t727 + t728;
-  const double t730 = t65 * p0[6];
+  const double t730 = t65 * p0[6] /* p_x3 */;
   const double t731 = t729 + t730;
-  const double t732 = t68 * p0[7];
+  const double t732 = t68 * p0[7] /* p_y3 */;
   const double t733 = t731 + t732;
-  const double t734 = t71 * p0[8];
+  const double t734 = t71 * p0[8] /* p_z3 */;
   const double t735 = t733 + t734;
   const double t736 = t735 - t724;
   const double t737 = t736 + g0[1];
@@ -807,16 +820,16 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t761 = t759 + t760;
   const double t762 = 0.5 * t761;
   const double t763 = h * t762;
-  const double t764 = t75 * p0[0];
-  const double t765 = t79 * p0[1];
+  const double t764 = t75 * p0[0] /* p_x1 */;
+  const double t765 = t79 * p0[1] /* p_y1 */;
   const double t766 = t764 + t765;
-  const double t767 = t83 * p0[2];
+  const double t767 = t83 * p0[2] /* p_z1 */;
   const double t768 = t766 + t767;
-  const double t769 = t85 * p0[6];
+  const double t769 = t85 * p0[6] /* p_x3 */;
   const double t770 = t768 + t769;
-  const double t771 = t87 * p0[7];
+  const double t771 = t87 * p0[7] /* p_y3 */;
   const double t772 = t770 + t771;
-  const double t773 = t89 * p0[8];
+  const double t773 = t89 * p0[8] /* p_z3 */;
   const double t774 = t772 + t773;
   const double t775 = t774 - t763;
   const double t776 = t775 + g0[2];
@@ -887,31 +900,31 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t840 = t828 + t839;
   const double t841 = 0.5 * t830;
   const double t842 = h * t841;
-  const double t843 = p0[0] - t842;
+  const double t843 = p0[0] /* p_x1 */ - t842;
   const double t844 = 0.5 * t832;
   const double t845 = h * t844;
-  const double t846 = p0[1] - t845;
+  const double t846 = p0[1] /* p_y1 */ - t845;
   const double t847 = 0.5 * t834;
   const double t848 = h * t847;
-  const double t849 = p0[2] - t848;
+  const double t849 = p0[2] /* p_z1 */ - t848;
   const double t850 = 0.5 * t818;
   const double t851 = h * t850;
-  const double t852 = p0[3] - t851;
+  const double t852 = p0[3] /* p_x2 */ - t851;
   const double t853 = 0.5 * t820;
   const double t854 = h * t853;
-  const double t855 = p0[4] - t854;
+  const double t855 = p0[4] /* p_y2 */ - t854;
   const double t856 = 0.5 * t822;
   const double t857 = h * t856;
-  const double t858 = p0[5] - t857;
+  const double t858 = p0[5] /* p_z2 */ - t857;
   const double t859 = 0.5 * t836;
   const double t860 = h * t859;
-  const double t861 = p0[6] - t860;
+  const double t861 = p0[6] /* p_x3 */ - t860;
   const double t862 = 0.5 * t838;
   const double t863 = h * t862;
-  const double t864 = p0[7] - t863;
+  const double t864 = p0[7] /* p_y3 */ - t863;
   const double t865 = 0.5 * t840;
   const double t866 = h * t865;
-  const double t867 = p0[8] - t866;
+  const double t867 = p0[8] /* p_z3 */ - t866;
   const double t868 = h * t830;
   const double t869 = -t868;
   const double t870 = h * t832;
@@ -930,6 +943,7 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   const double t883 = -t882;
   const double t884 = h * t840;
   const double t885 = -t884;
+  /* gam */
   out[0] = t843;
   out[1] = t846;
   out[2] = t849;
@@ -939,6 +953,7 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   out[6] = t861;
   out[7] = t864;
   out[8] = t867;
+  /* dp */
   out[9] = t869;
   out[10] = t871;
   out[11] = t873;
@@ -948,12 +963,15 @@ static void satellites_k6s1_sweep(const double *q0, const double *p0, const doub
   out[15] = t881;
   out[16] = t883;
   out[17] = t885;
+  /* lambda */
   out[18] = t804;
   out[19] = t799;
   out[20] = t796;
+  /* pivot */
   out[21] = t651;
   out[22] = t779;
   out[23] = t793;
+  /* adiag */
   out[24] = t651;
   out[25] = t704;
   out[26] = t750;
@@ -964,15 +982,16 @@ static void satellites_k6s1_minv_p(const double *q0, const double *p0, const dou
     const double *g0, const satellites_k6s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
-  out[4] = p0[4];
-  out[5] = p0[5];
-  out[6] = p0[6];
-  out[7] = p0[7];
-  out[8] = p0[8];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_z1 */;
+  out[3] = p0[3] /* p_x2 */;
+  out[4] = p0[4] /* p_y2 */;
+  out[5] = p0[5] /* p_z2 */;
+  out[6] = p0[6] /* p_x3 */;
+  out[7] = p0[7] /* p_y3 */;
+  out[8] = p0[8] /* p_z3 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -981,49 +1000,50 @@ static void satellites_k6s1_energy_kernel(const double *q0, const double *p0, co
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t1 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_z1 */ * p0[2] /* p_z1 */;
   const double t4 = t2 + t3;
-  const double t5 = p0[3] * p0[3];
+  const double t5 = p0[3] /* p_x2 */ * p0[3] /* p_x2 */;
   const double t6 = t4 + t5;
-  const double t7 = p0[4] * p0[4];
+  const double t7 = p0[4] /* p_y2 */ * p0[4] /* p_y2 */;
   const double t8 = t6 + t7;
-  const double t9 = p0[5] * p0[5];
+  const double t9 = p0[5] /* p_z2 */ * p0[5] /* p_z2 */;
   const double t10 = t8 + t9;
-  const double t11 = p0[6] * p0[6];
+  const double t11 = p0[6] /* p_x3 */ * p0[6] /* p_x3 */;
   const double t12 = t10 + t11;
-  const double t13 = p0[7] * p0[7];
+  const double t13 = p0[7] /* p_y3 */ * p0[7] /* p_y3 */;
   const double t14 = t12 + t13;
-  const double t15 = p0[8] * p0[8];
+  const double t15 = p0[8] /* p_z3 */ * p0[8] /* p_z3 */;
   const double t16 = t14 + t15;
-  const double t17 = q0[0] * q0[0];
-  const double t18 = q0[1] * q0[1];
+  const double t17 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t18 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t19 = t17 + t18;
-  const double t20 = q0[2] * q0[2];
+  const double t20 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t21 = t19 + t20;
   const double t22 = sqrt(t21);
   const double t23 = 1.0 / t22;
   const double t24 = -t23;
-  const double t25 = q0[3] * q0[3];
-  const double t26 = q0[4] * q0[4];
+  const double t25 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t26 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t27 = t25 + t26;
-  const double t28 = q0[5] * q0[5];
+  const double t28 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t29 = t27 + t28;
   const double t30 = sqrt(t29);
   const double t31 = 1.0 / t30;
   const double t32 = t24 - t31;
-  const double t33 = q0[6] * q0[6];
-  const double t34 = q0[7] * q0[7];
+  const double t33 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t34 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t35 = t33 + t34;
-  const double t36 = q0[8] * q0[8];
+  const double t36 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t37 = t35 + t36;
   const double t38 = sqrt(t37);
   const double t39 = 1.0 / t38;
   const double t40 = t32 - t39;
   const double t41 = 0.5 * t16;
   const double t42 = t40 + t41;
+  /* H */
   out[0] = t42;
 }
 
@@ -1032,16 +1052,15 @@ static void satellites_k6s1_g(const double *q0, const double *p0, const double *
     const double *g0, const satellites_k6s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
-  const double t1 = q0[1] - q0[4];
-  const double t2 = q0[2] - q0[5];
-  const double t3 = q0[3] - q0[6];
-  const double t4 = q0[4] - q0[7];
-  const double t5 = q0[5] - q0[8];
-  const double t6 = q0[6] - q0[0];
-  const double t7 = q0[7] - q0[1];
-  const double t8 = q0[8] - q0[2];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
   /* g(q0) */
   const double t9 = t0 * t0;
   const double t10 = t1 * t1;
@@ -1061,6 +1080,7 @@ static void satellites_k6s1_g(const double *q0, const double *p0, const double *
   const double t24 = t8 * t8;
   const double t25 = t23 + t24;
   const double t26 = t25 - 1.0;
+  /* g */
   out[0] = t14;
   out[1] = t20;
   out[2] = t26;
@@ -1071,60 +1091,60 @@ static void satellites_k6s1_hidden_kernel(const double *q0, const double *p0, co
     const double *g0, const satellites_k6s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
   /* hidden constraints */
-  const double t18 = t1 * p0[0];
-  const double t19 = t3 * p0[1];
+  const double t18 = t1 * p0[0] /* p_x1 */;
+  const double t19 = t3 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t5 * p0[2];
+  const double t21 = t5 * p0[2] /* p_z1 */;
   const double t22 = t20 + t21;
-  const double t23 = t1 * p0[3];
+  const double t23 = t1 * p0[3] /* p_x2 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[4];
+  const double t25 = t3 * p0[4] /* p_y2 */;
   const double t26 = t24 - t25;
-  const double t27 = t5 * p0[5];
+  const double t27 = t5 * p0[5] /* p_z2 */;
   const double t28 = t26 - t27;
-  const double t29 = t7 * p0[3];
-  const double t30 = t9 * p0[4];
+  const double t29 = t7 * p0[3] /* p_x2 */;
+  const double t30 = t9 * p0[4] /* p_y2 */;
   const double t31 = t29 + t30;
-  const double t32 = t11 * p0[5];
+  const double t32 = t11 * p0[5] /* p_z2 */;
   const double t33 = t31 + t32;
-  const double t34 = t7 * p0[6];
+  const double t34 = t7 * p0[6] /* p_x3 */;
   const double t35 = t33 - t34;
-  const double t36 = t9 * p0[7];
+  const double t36 = t9 * p0[7] /* p_y3 */;
   const double t37 = t35 - t36;
-  const double t38 = t11 * p0[8];
+  const double t38 = t11 * p0[8] /* p_z3 */;
   const double t39 = t37 - t38;
-  const double t40 = t13 * p0[0];
+  const double t40 = t13 * p0[0] /* p_x1 */;
   const double t41 = -t40;
-  const double t42 = t15 * p0[1];
+  const double t42 = t15 * p0[1] /* p_y1 */;
   const double t43 = t41 - t42;
-  const double t44 = t17 * p0[2];
+  const double t44 = t17 * p0[2] /* p_z1 */;
   const double t45 = t43 - t44;
-  const double t46 = t13 * p0[6];
+  const double t46 = t13 * p0[6] /* p_x3 */;
   const double t47 = t45 + t46;
-  const double t48 = t15 * p0[7];
+  const double t48 = t15 * p0[7] /* p_y3 */;
   const double t49 = t47 + t48;
-  const double t50 = t17 * p0[8];
+  const double t50 = t17 * p0[8] /* p_z3 */;
   const double t51 = t49 + t50;
+  /* hidden */
   out[0] = t28;
   out[1] = t39;
   out[2] = t51;
@@ -1136,44 +1156,42 @@ static void satellites_k6s1_lambda0(const double *q0, const double *p0, const do
     const double *g0, const satellites_k6s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* energy */
-  const double t18 = q0[0] * q0[0];
-  const double t19 = q0[1] * q0[1];
+  const double t18 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t19 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t20 = t18 + t19;
-  const double t21 = q0[2] * q0[2];
+  const double t21 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t22 = t20 + t21;
   const double t23 = sqrt(t22);
   const double t24 = 1.0 / t23;
-  const double t25 = q0[3] * q0[3];
-  const double t26 = q0[4] * q0[4];
+  const double t25 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t26 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t27 = t25 + t26;
-  const double t28 = q0[5] * q0[5];
+  const double t28 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t29 = t27 + t28;
   const double t30 = sqrt(t29);
   const double t31 = 1.0 / t30;
-  const double t32 = q0[6] * q0[6];
-  const double t33 = q0[7] * q0[7];
+  const double t32 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t33 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t34 = t32 + t33;
-  const double t35 = q0[8] * q0[8];
+  const double t35 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t36 = t34 + t35;
   const double t37 = sqrt(t36);
   const double t38 = 1.0 / t37;
@@ -1181,29 +1199,29 @@ static void satellites_k6s1_lambda0(const double *q0, const double *p0, const do
   const double t39 = t38 * t38;
   const double t40 = 0.5 * t39;
   const double t41 = t38 * t40;
-  const double t42 = 2.0 * q0[8];
+  const double t42 = 2.0 * q0[8] /* z3 */;
   const double t43 = t41 * t42;
-  const double t44 = 2.0 * q0[7];
+  const double t44 = 2.0 * q0[7] /* y3 */;
   const double t45 = t41 * t44;
-  const double t46 = 2.0 * q0[6];
+  const double t46 = 2.0 * q0[6] /* x3 */;
   const double t47 = t41 * t46;
   const double t48 = t31 * t31;
   const double t49 = 0.5 * t48;
   const double t50 = t31 * t49;
-  const double t51 = 2.0 * q0[5];
+  const double t51 = 2.0 * q0[5] /* z2 */;
   const double t52 = t50 * t51;
-  const double t53 = 2.0 * q0[4];
+  const double t53 = 2.0 * q0[4] /* y2 */;
   const double t54 = t50 * t53;
-  const double t55 = 2.0 * q0[3];
+  const double t55 = 2.0 * q0[3] /* x2 */;
   const double t56 = t50 * t55;
   const double t57 = t24 * t24;
   const double t58 = 0.5 * t57;
   const double t59 = t24 * t58;
-  const double t60 = 2.0 * q0[2];
+  const double t60 = 2.0 * q0[2] /* z1 */;
   const double t61 = t59 * t60;
-  const double t62 = 2.0 * q0[1];
+  const double t62 = 2.0 * q0[1] /* y1 */;
   const double t63 = t59 * t62;
-  const double t64 = 2.0 * q0[0];
+  const double t64 = 2.0 * q0[0] /* x1 */;
   const double t65 = t59 * t64;
   const double t66 = t1 * t1;
   const double t67 = t1 * t13;
@@ -1247,91 +1265,91 @@ static void satellites_k6s1_lambda0(const double *q0, const double *p0, const do
   const double t105 = t100 + t104;
   const double t106 = t101 + t105;
   const double t107 = t103 + t106;
-  const double t108 = p0[2] - p0[5];
-  const double t109 = p0[1] - p0[4];
-  const double t110 = p0[0] - p0[3];
+  const double t108 = p0[2] /* p_z1 */ - p0[5] /* p_z2 */;
+  const double t109 = p0[1] /* p_y1 */ - p0[4] /* p_y2 */;
+  const double t110 = p0[0] /* p_x1 */ - p0[3] /* p_x2 */;
   const double t111 = 2.0 * t110;
   const double t112 = 2.0 * t109;
   const double t113 = 2.0 * t108;
-  const double t114 = p0[0] * t111;
+  const double t114 = p0[0] /* p_x1 */ * t111;
   const double t115 = t1 * t65;
-  const double t116 = p0[1] * t112;
+  const double t116 = p0[1] /* p_y1 */ * t112;
   const double t117 = t114 + t116;
   const double t118 = t3 * t63;
   const double t119 = t115 + t118;
-  const double t120 = p0[2] * t113;
+  const double t120 = p0[2] /* p_z1 */ * t113;
   const double t121 = t117 + t120;
   const double t122 = t5 * t61;
   const double t123 = t119 + t122;
-  const double t124 = p0[3] * t111;
+  const double t124 = p0[3] /* p_x2 */ * t111;
   const double t125 = t121 - t124;
   const double t126 = t1 * t56;
   const double t127 = t123 - t126;
-  const double t128 = p0[4] * t112;
+  const double t128 = p0[4] /* p_y2 */ * t112;
   const double t129 = t125 - t128;
   const double t130 = t3 * t54;
   const double t131 = t127 - t130;
-  const double t132 = p0[5] * t113;
+  const double t132 = p0[5] /* p_z2 */ * t113;
   const double t133 = t129 - t132;
   const double t134 = t5 * t52;
   const double t135 = t131 - t134;
   const double t136 = t133 - t135;
-  const double t137 = p0[5] - p0[8];
-  const double t138 = p0[4] - p0[7];
-  const double t139 = p0[3] - p0[6];
+  const double t137 = p0[5] /* p_z2 */ - p0[8] /* p_z3 */;
+  const double t138 = p0[4] /* p_y2 */ - p0[7] /* p_y3 */;
+  const double t139 = p0[3] /* p_x2 */ - p0[6] /* p_x3 */;
   const double t140 = 2.0 * t139;
   const double t141 = 2.0 * t138;
   const double t142 = 2.0 * t137;
-  const double t143 = p0[3] * t140;
+  const double t143 = p0[3] /* p_x2 */ * t140;
   const double t144 = t7 * t56;
-  const double t145 = p0[4] * t141;
+  const double t145 = p0[4] /* p_y2 */ * t141;
   const double t146 = t143 + t145;
   const double t147 = t9 * t54;
   const double t148 = t144 + t147;
-  const double t149 = p0[5] * t142;
+  const double t149 = p0[5] /* p_z2 */ * t142;
   const double t150 = t146 + t149;
   const double t151 = t11 * t52;
   const double t152 = t148 + t151;
-  const double t153 = p0[6] * t140;
+  const double t153 = p0[6] /* p_x3 */ * t140;
   const double t154 = t150 - t153;
   const double t155 = t7 * t47;
   const double t156 = t152 - t155;
-  const double t157 = p0[7] * t141;
+  const double t157 = p0[7] /* p_y3 */ * t141;
   const double t158 = t154 - t157;
   const double t159 = t9 * t45;
   const double t160 = t156 - t159;
-  const double t161 = p0[8] * t142;
+  const double t161 = p0[8] /* p_z3 */ * t142;
   const double t162 = t158 - t161;
   const double t163 = t11 * t43;
   const double t164 = t160 - t163;
   const double t165 = t162 - t164;
-  const double t166 = p0[8] - p0[2];
-  const double t167 = p0[7] - p0[1];
-  const double t168 = p0[6] - p0[0];
+  const double t166 = p0[8] /* p_z3 */ - p0[2] /* p_z1 */;
+  const double t167 = p0[7] /* p_y3 */ - p0[1] /* p_y1 */;
+  const double t168 = p0[6] /* p_x3 */ - p0[0] /* p_x1 */;
   const double t169 = 2.0 * t168;
   const double t170 = 2.0 * t167;
   const double t171 = 2.0 * t166;
-  const double t172 = p0[0] * t169;
+  const double t172 = p0[0] /* p_x1 */ * t169;
   const double t173 = -t172;
   const double t174 = t13 * t65;
   const double t175 = -t174;
-  const double t176 = p0[1] * t170;
+  const double t176 = p0[1] /* p_y1 */ * t170;
   const double t177 = t173 - t176;
   const double t178 = t15 * t63;
   const double t179 = t175 - t178;
-  const double t180 = p0[2] * t171;
+  const double t180 = p0[2] /* p_z1 */ * t171;
   const double t181 = t177 - t180;
   const double t182 = t17 * t61;
   const double t183 = t179 - t182;
-  const double t184 = p0[6] * t169;
+  const double t184 = p0[6] /* p_x3 */ * t169;
   const double t185 = t181 + t184;
   const double t186 = t13 * t47;
   const double t187 = t183 + t186;
-  const double t188 = p0[7] * t170;
+  const double t188 = p0[7] /* p_y3 */ * t170;
   const double t189 = t185 + t188;
   const double t190 = t15 * t45;
   const double t191 = t187 + t190;
-  const double t192 = p0[8] * t171;
+  const double t192 = p0[8] /* p_z3 */ * t171;
   const double t193 = t189 + t192;
   const double t194 = t17 * t43;
   const double t195 = t191 + t194;
@@ -1364,6 +1382,7 @@ static void satellites_k6s1_lambda0(const double *q0, const double *p0, const do
   const double t222 = t76 * t216;
   const double t223 = t221 - t222;
   const double t224 = t223 / t83;
+  /* lambda */
   out[0] = t224;
   out[1] = t219;
   out[2] = t216;
@@ -1378,19 +1397,19 @@ void satellites_k6s1_init(satellites_k6s1_state *x, const double *q0, const doub
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_k6s1_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : satellites_k6s1_q0[i];
     x->p[i] = p0 ? (double)p0[i] : satellites_k6s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (satellites_k6s1_NU ? satellites_k6s1_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = 0;
   {
     satellites_k6s1_params prm;
-    double lam[NU];
+    double lam[satellites_k6s1_NU];
     satellites_k6s1_params_default(&prm);
     satellites_k6s1_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < satellites_k6s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -1406,32 +1425,32 @@ const char *satellites_k6s1_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) satellites_k6s1_params dflt_; if (!prm) { satellites_k6s1_params_default(&dflt_); prm = &dflt_; }
+#define satellites_k6s1_DEFAULT_PARAMS(prm) satellites_k6s1_params dflt_; if (!prm) { satellites_k6s1_params_default(&dflt_); prm = &dflt_; }
 
 double satellites_k6s1_energy(const satellites_k6s1_state *x, const satellites_k6s1_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s1_DEFAULT_PARAMS(prm)
   satellites_k6s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void satellites_k6s1_constraints(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *g)
 {
-  double v[NU];
+  double v[satellites_k6s1_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s1_DEFAULT_PARAMS(prm)
   satellites_k6s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < satellites_k6s1_NU; i++) g[i] = v[i];
 }
 
 void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *gp)
 {
-  double v[NU];
+  double v[satellites_k6s1_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s1_DEFAULT_PARAMS(prm)
   satellites_k6s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < satellites_k6s1_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1439,17 +1458,17 @@ void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s
 static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, const satellites_k6s1_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_k6s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < satellites_k6s1_S; j++)
+    for (i = 0; i < satellites_k6s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + satellites_k6s1_E[(j * S + i) * S + d];
+      for (d = satellites_k6s1_S - 1; d >= 0; d--) e = e * r + satellites_k6s1_E[(j * satellites_k6s1_S + i) * satellites_k6s1_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < satellites_k6s1_M; l++) gam[j * satellites_k6s1_M + l] += e * x->gam[i * satellites_k6s1_M + l];
     }
 }
 
@@ -1466,60 +1485,63 @@ static void satellites_k6s1_add(double *a, double *c, double b)
 int satellites_k6s1_step(satellites_k6s1_state *x, double h_, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[satellites_k6s1_S * satellites_k6s1_M], sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = satellites_k6s1_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_k6s1_EBADSTEP;
   satellites_k6s1_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[satellites_k6s1_NU];
   satellites_k6s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below satellites_k6s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < satellites_k6s1_NU; i++) g0[i] = fabs(g0[i]) <= satellites_k6s1_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= satellites_k6s1_MAXITER; it++) {
     satellites_k6s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < satellites_k6s1_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = satellites_k6s1_ESINGULAR;
+    for (i = 0; i < satellites_k6s1_NU; i++) {
+      double piv = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + satellites_k6s1_NU + i], dia = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 2 * satellites_k6s1_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s1_SINGTOL * fabs(dia))) rc = satellites_k6s1_ESINGULAR;
     }
     if (rc == satellites_k6s1_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + satellites_k6s1_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s1_ENONFINITE;
     if (rc == satellites_k6s1_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s1_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (satellites_k6s1_TOL / 256), or
+     * within 2 ulps (satellites_k6s1_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above satellites_k6s1_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = satellites_k6s1_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? satellites_k6s1_OK : satellites_k6s1_ENOCONV; break; }
+    if (inc <= satellites_k6s1_TOL / 256 || (inc <= satellites_k6s1_TOL && 4 * inc > inc_old)) { rc = satellites_k6s1_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= satellites_k6s1_STAGTOL ? satellites_k6s1_OK : satellites_k6s1_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > satellites_k6s1_MAXITER ? satellites_k6s1_MAXITER : it; st->increment = inc; }
   if (rc != satellites_k6s1_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return satellites_k6s1_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s1_ENONFINITE;
+  for (i = 0; i < satellites_k6s1_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s1_S * satellites_k6s1_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return satellites_k6s1_ENONFINITE;
+  for (i = 0; i < satellites_k6s1_M; i++) {
     satellites_k6s1_add(&x->q[i], &x->qc[i], h * sw[i]);
-    satellites_k6s1_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    satellites_k6s1_add(&x->p[i], &x->pc[i], sw[satellites_k6s1_S * satellites_k6s1_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s1_NU; i++) x->lambda[i] = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + i];
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = gam[i];
   satellites_k6s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s1_OK;

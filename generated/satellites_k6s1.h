@@ -4,6 +4,10 @@
 #ifndef satellites_k6s1_H
 #define satellites_k6s1_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define satellites_k6s1_M 9      /* coordinates */
 #define satellites_k6s1_NU 3     /* constraints */
 #define satellites_k6s1_K 6      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void satellites_k6s1_params_default(satellites_k6s1_params *prm);
 int satellites_k6s1_step(satellites_k6s1_state *x, double h, const satellites_k6s1_params *prm, satellites_k6s1_stats *st);
 const char *satellites_k6s1_strerror(int code);
 double satellites_k6s1_energy(const satellites_k6s1_state *x, const satellites_k6s1_params *prm);
-void satellites_k6s1_constraints(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *g);   /* NU values */
+void satellites_k6s1_constraints(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *g);   /* satellites_k6s1_NU values */
 void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

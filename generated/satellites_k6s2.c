@@ -5,14 +5,27 @@
 
 #include "satellites_k6s2.h"
 
-#define M satellites_k6s2_M
-#define NU satellites_k6s2_NU
-#define S satellites_k6s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(satellites_k6s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define satellites_k6s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef satellites_k6s2_MAXITER
+#define satellites_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef satellites_k6s2_TOL
+#define satellites_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef satellites_k6s2_STAGTOL
+#define satellites_k6s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef satellites_k6s2_SINGTOL
+#define satellites_k6s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef satellites_k6s2_GTOL
+#define satellites_k6s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,7 +49,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
   const double t2 = 0.5 * gam[0];
   const double t3 = gam[9] * 0.28867513459481292;
@@ -57,7 +70,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t18 = h * t17;
   const double t19 = (-2.0) * t18;
   const double t20 = t16 + t19;
-  const double t21 = q0[1] - q0[4];
+  const double t21 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t22 = 2.0 * t21;
   const double t23 = 0.5 * gam[1];
   const double t24 = 0.28867513459481292 * gam[10];
@@ -78,7 +91,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t39 = h * t38;
   const double t40 = (-2.0) * t39;
   const double t41 = t37 + t40;
-  const double t42 = q0[2] - q0[5];
+  const double t42 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t43 = 2.0 * t42;
   const double t44 = 0.5 * gam[2];
   const double t45 = 0.28867513459481292 * gam[11];
@@ -120,7 +133,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t81 = (-2.0) * t57;
   const double t82 = 2.0 * t60;
   const double t83 = t81 + t82;
-  const double t84 = q0[3] - q0[6];
+  const double t84 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t85 = 2.0 * t84;
   const double t86 = t65 + t85;
   const double t87 = 0.5 * gam[6];
@@ -133,7 +146,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t94 = h * t93;
   const double t95 = (-2.0) * t94;
   const double t96 = t68 + t95;
-  const double t97 = q0[4] - q0[7];
+  const double t97 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t98 = 2.0 * t97;
   const double t99 = t72 + t98;
   const double t100 = 0.5 * gam[7];
@@ -146,7 +159,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t107 = h * t106;
   const double t108 = (-2.0) * t107;
   const double t109 = t75 + t108;
-  const double t110 = q0[5] - q0[8];
+  const double t110 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t111 = 2.0 * t110;
   const double t112 = t79 + t111;
   const double t113 = 0.5 * gam[8];
@@ -174,17 +187,17 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t135 = t133 + t134;
   const double t136 = 2.0 * t120;
   const double t137 = t61 + t136;
-  const double t138 = q0[6] - q0[0];
+  const double t138 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t139 = 2.0 * t138;
   const double t140 = t6 - t139;
   const double t141 = t91 + t140;
   const double t142 = t16 + t95;
-  const double t143 = q0[7] - q0[1];
+  const double t143 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t144 = 2.0 * t143;
   const double t145 = t27 - t144;
   const double t146 = t104 + t145;
   const double t147 = t37 + t108;
-  const double t148 = q0[8] - q0[2];
+  const double t148 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t149 = 2.0 * t148;
   const double t150 = t48 - t149;
   const double t151 = t117 + t150;
@@ -203,47 +216,47 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t163 = gam[9] * (-0.056508419605012766);
   const double t164 = t162 + t163;
   const double t165 = h * t164;
-  const double t166 = q0[0] + t165;
+  const double t166 = q0[0] /* x1 */ + t165;
   const double t167 = gam[1] * 0.033765242898423975;
   const double t168 = gam[10] * (-0.056508419605012766);
   const double t169 = t167 + t168;
   const double t170 = h * t169;
-  const double t171 = q0[1] + t170;
+  const double t171 = q0[1] /* y1 */ + t170;
   const double t172 = gam[2] * 0.033765242898423975;
   const double t173 = gam[11] * (-0.056508419605012766);
   const double t174 = t172 + t173;
   const double t175 = h * t174;
-  const double t176 = q0[2] + t175;
+  const double t176 = q0[2] /* z1 */ + t175;
   const double t177 = gam[3] * 0.033765242898423975;
   const double t178 = gam[12] * (-0.056508419605012766);
   const double t179 = t177 + t178;
   const double t180 = h * t179;
-  const double t181 = q0[3] + t180;
+  const double t181 = q0[3] /* x2 */ + t180;
   const double t182 = gam[4] * 0.033765242898423975;
   const double t183 = gam[13] * (-0.056508419605012766);
   const double t184 = t182 + t183;
   const double t185 = h * t184;
-  const double t186 = q0[4] + t185;
+  const double t186 = q0[4] /* y2 */ + t185;
   const double t187 = gam[5] * 0.033765242898423975;
   const double t188 = gam[14] * (-0.056508419605012766);
   const double t189 = t187 + t188;
   const double t190 = h * t189;
-  const double t191 = q0[5] + t190;
+  const double t191 = q0[5] /* z2 */ + t190;
   const double t192 = gam[6] * 0.033765242898423975;
   const double t193 = gam[15] * (-0.056508419605012766);
   const double t194 = t192 + t193;
   const double t195 = h * t194;
-  const double t196 = q0[6] + t195;
+  const double t196 = q0[6] /* x3 */ + t195;
   const double t197 = gam[7] * 0.033765242898423975;
   const double t198 = gam[16] * (-0.056508419605012766);
   const double t199 = t197 + t198;
   const double t200 = h * t199;
-  const double t201 = q0[7] + t200;
+  const double t201 = q0[7] /* y3 */ + t200;
   const double t202 = gam[8] * 0.033765242898423975;
   const double t203 = gam[17] * (-0.056508419605012766);
   const double t204 = t202 + t203;
   const double t205 = h * t204;
-  const double t206 = q0[8] + t205;
+  const double t206 = q0[8] /* z3 */ + t205;
   const double t207 = t166 * t166;
   const double t208 = t171 * t171;
   const double t209 = t207 + t208;
@@ -315,47 +328,47 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t274 = gam[9] * (-0.24370047841099157);
   const double t275 = t273 + t274;
   const double t276 = h * t275;
-  const double t277 = q0[0] + t276;
+  const double t277 = q0[0] /* x1 */ + t276;
   const double t278 = gam[1] * 0.16939530676686776;
   const double t279 = gam[10] * (-0.24370047841099157);
   const double t280 = t278 + t279;
   const double t281 = h * t280;
-  const double t282 = q0[1] + t281;
+  const double t282 = q0[1] /* y1 */ + t281;
   const double t283 = gam[2] * 0.16939530676686776;
   const double t284 = gam[11] * (-0.24370047841099157);
   const double t285 = t283 + t284;
   const double t286 = h * t285;
-  const double t287 = q0[2] + t286;
+  const double t287 = q0[2] /* z1 */ + t286;
   const double t288 = gam[3] * 0.16939530676686776;
   const double t289 = gam[12] * (-0.24370047841099157);
   const double t290 = t288 + t289;
   const double t291 = h * t290;
-  const double t292 = q0[3] + t291;
+  const double t292 = q0[3] /* x2 */ + t291;
   const double t293 = gam[4] * 0.16939530676686776;
   const double t294 = gam[13] * (-0.24370047841099157);
   const double t295 = t293 + t294;
   const double t296 = h * t295;
-  const double t297 = q0[4] + t296;
+  const double t297 = q0[4] /* y2 */ + t296;
   const double t298 = gam[5] * 0.16939530676686776;
   const double t299 = gam[14] * (-0.24370047841099157);
   const double t300 = t298 + t299;
   const double t301 = h * t300;
-  const double t302 = q0[5] + t301;
+  const double t302 = q0[5] /* z2 */ + t301;
   const double t303 = gam[6] * 0.16939530676686776;
   const double t304 = gam[15] * (-0.24370047841099157);
   const double t305 = t303 + t304;
   const double t306 = h * t305;
-  const double t307 = q0[6] + t306;
+  const double t307 = q0[6] /* x3 */ + t306;
   const double t308 = gam[7] * 0.16939530676686776;
   const double t309 = gam[16] * (-0.24370047841099157);
   const double t310 = t308 + t309;
   const double t311 = h * t310;
-  const double t312 = q0[7] + t311;
+  const double t312 = q0[7] /* y3 */ + t311;
   const double t313 = gam[8] * 0.16939530676686776;
   const double t314 = gam[17] * (-0.24370047841099157);
   const double t315 = t313 + t314;
   const double t316 = h * t315;
-  const double t317 = q0[8] + t316;
+  const double t317 = q0[8] /* z3 */ + t316;
   const double t318 = t277 * t277;
   const double t319 = t282 * t282;
   const double t320 = t318 + t319;
@@ -445,47 +458,47 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t403 = gam[9] * (-0.40835734144399111);
   const double t404 = t402 + t403;
   const double t405 = h * t404;
-  const double t406 = q0[0] + t405;
+  const double t406 = q0[0] /* x1 */ + t405;
   const double t407 = gam[1] * 0.38069040695840156;
   const double t408 = gam[10] * (-0.40835734144399111);
   const double t409 = t407 + t408;
   const double t410 = h * t409;
-  const double t411 = q0[1] + t410;
+  const double t411 = q0[1] /* y1 */ + t410;
   const double t412 = gam[2] * 0.38069040695840156;
   const double t413 = gam[11] * (-0.40835734144399111);
   const double t414 = t412 + t413;
   const double t415 = h * t414;
-  const double t416 = q0[2] + t415;
+  const double t416 = q0[2] /* z1 */ + t415;
   const double t417 = gam[3] * 0.38069040695840156;
   const double t418 = gam[12] * (-0.40835734144399111);
   const double t419 = t417 + t418;
   const double t420 = h * t419;
-  const double t421 = q0[3] + t420;
+  const double t421 = q0[3] /* x2 */ + t420;
   const double t422 = gam[4] * 0.38069040695840156;
   const double t423 = gam[13] * (-0.40835734144399111);
   const double t424 = t422 + t423;
   const double t425 = h * t424;
-  const double t426 = q0[4] + t425;
+  const double t426 = q0[4] /* y2 */ + t425;
   const double t427 = gam[5] * 0.38069040695840156;
   const double t428 = gam[14] * (-0.40835734144399111);
   const double t429 = t427 + t428;
   const double t430 = h * t429;
-  const double t431 = q0[5] + t430;
+  const double t431 = q0[5] /* z2 */ + t430;
   const double t432 = gam[6] * 0.38069040695840156;
   const double t433 = gam[15] * (-0.40835734144399111);
   const double t434 = t432 + t433;
   const double t435 = h * t434;
-  const double t436 = q0[6] + t435;
+  const double t436 = q0[6] /* x3 */ + t435;
   const double t437 = gam[7] * 0.38069040695840156;
   const double t438 = gam[16] * (-0.40835734144399111);
   const double t439 = t437 + t438;
   const double t440 = h * t439;
-  const double t441 = q0[7] + t440;
+  const double t441 = q0[7] /* y3 */ + t440;
   const double t442 = gam[8] * 0.38069040695840156;
   const double t443 = gam[17] * (-0.40835734144399111);
   const double t444 = t442 + t443;
   const double t445 = h * t444;
-  const double t446 = q0[8] + t445;
+  const double t446 = q0[8] /* z3 */ + t445;
   const double t447 = t406 * t406;
   const double t448 = t411 * t411;
   const double t449 = t447 + t448;
@@ -575,47 +588,47 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t532 = gam[9] * (-0.40835734144399105);
   const double t533 = t531 + t532;
   const double t534 = h * t533;
-  const double t535 = q0[0] + t534;
+  const double t535 = q0[0] /* x1 */ + t534;
   const double t536 = gam[1] * 0.61930959304159849;
   const double t537 = gam[10] * (-0.40835734144399105);
   const double t538 = t536 + t537;
   const double t539 = h * t538;
-  const double t540 = q0[1] + t539;
+  const double t540 = q0[1] /* y1 */ + t539;
   const double t541 = gam[2] * 0.61930959304159849;
   const double t542 = gam[11] * (-0.40835734144399105);
   const double t543 = t541 + t542;
   const double t544 = h * t543;
-  const double t545 = q0[2] + t544;
+  const double t545 = q0[2] /* z1 */ + t544;
   const double t546 = gam[3] * 0.61930959304159849;
   const double t547 = gam[12] * (-0.40835734144399105);
   const double t548 = t546 + t547;
   const double t549 = h * t548;
-  const double t550 = q0[3] + t549;
+  const double t550 = q0[3] /* x2 */ + t549;
   const double t551 = gam[4] * 0.61930959304159849;
   const double t552 = gam[13] * (-0.40835734144399105);
   const double t553 = t551 + t552;
   const double t554 = h * t553;
-  const double t555 = q0[4] + t554;
+  const double t555 = q0[4] /* y2 */ + t554;
   const double t556 = gam[5] * 0.61930959304159849;
   const double t557 = gam[14] * (-0.40835734144399105);
   const double t558 = t556 + t557;
   const double t559 = h * t558;
-  const double t560 = q0[5] + t559;
+  const double t560 = q0[5] /* z2 */ + t559;
   const double t561 = gam[6] * 0.61930959304159849;
   const double t562 = gam[15] * (-0.40835734144399105);
   const double t563 = t561 + t562;
   const double t564 = h * t563;
-  const double t565 = q0[6] + t564;
+  const double t565 = q0[6] /* x3 */ + t564;
   const double t566 = gam[7] * 0.61930959304159849;
   const double t567 = gam[16] * (-0.40835734144399105);
   const double t568 = t566 + t567;
   const double t569 = h * t568;
-  const double t570 = q0[7] + t569;
+  const double t570 = q0[7] /* y3 */ + t569;
   const double t571 = gam[8] * 0.61930959304159849;
   const double t572 = gam[17] * (-0.40835734144399105);
   const double t573 = t571 + t572;
   const double t574 = h * t573;
-  const double t575 = q0[8] + t574;
+  const double t575 = q0[8] /* z3 */ + t574;
   const double t576 = t535 * t535;
   const double t577 = t540 * t540;
   const double t578 = t576 + t577;
@@ -704,39 +717,39 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t660 = gam[0] * 0.83060469323313224;
   const double t661 = t274 + t660;
   const double t662 = h * t661;
-  const double t663 = q0[0] + t662;
+  const double t663 = q0[0] /* x1 */ + t662;
   const double t664 = gam[1] * 0.83060469323313224;
   const double t665 = t279 + t664;
   const double t666 = h * t665;
-  const double t667 = q0[1] + t666;
+  const double t667 = q0[1] /* y1 */ + t666;
   const double t668 = gam[2] * 0.83060469323313224;
   const double t669 = t284 + t668;
   const double t670 = h * t669;
-  const double t671 = q0[2] + t670;
+  const double t671 = q0[2] /* z1 */ + t670;
   const double t672 = gam[3] * 0.83060469323313224;
   const double t673 = t289 + t672;
   const double t674 = h * t673;
-  const double t675 = q0[3] + t674;
+  const double t675 = q0[3] /* x2 */ + t674;
   const double t676 = gam[4] * 0.83060469323313224;
   const double t677 = t294 + t676;
   const double t678 = h * t677;
-  const double t679 = q0[4] + t678;
+  const double t679 = q0[4] /* y2 */ + t678;
   const double t680 = gam[5] * 0.83060469323313224;
   const double t681 = t299 + t680;
   const double t682 = h * t681;
-  const double t683 = q0[5] + t682;
+  const double t683 = q0[5] /* z2 */ + t682;
   const double t684 = gam[6] * 0.83060469323313224;
   const double t685 = t304 + t684;
   const double t686 = h * t685;
-  const double t687 = q0[6] + t686;
+  const double t687 = q0[6] /* x3 */ + t686;
   const double t688 = gam[7] * 0.83060469323313224;
   const double t689 = t309 + t688;
   const double t690 = h * t689;
-  const double t691 = q0[7] + t690;
+  const double t691 = q0[7] /* y3 */ + t690;
   const double t692 = gam[8] * 0.83060469323313224;
   const double t693 = t314 + t692;
   const double t694 = h * t693;
-  const double t695 = q0[8] + t694;
+  const double t695 = q0[8] /* z3 */ + t694;
   const double t696 = t663 * t663;
   const double t697 = t667 * t667;
   const double t698 = t696 + t697;
@@ -825,39 +838,39 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t780 = gam[0] * 0.96623475710157603;
   const double t781 = t163 + t780;
   const double t782 = h * t781;
-  const double t783 = q0[0] + t782;
+  const double t783 = q0[0] /* x1 */ + t782;
   const double t784 = gam[1] * 0.96623475710157603;
   const double t785 = t168 + t784;
   const double t786 = h * t785;
-  const double t787 = q0[1] + t786;
+  const double t787 = q0[1] /* y1 */ + t786;
   const double t788 = gam[2] * 0.96623475710157603;
   const double t789 = t173 + t788;
   const double t790 = h * t789;
-  const double t791 = q0[2] + t790;
+  const double t791 = q0[2] /* z1 */ + t790;
   const double t792 = gam[3] * 0.96623475710157603;
   const double t793 = t178 + t792;
   const double t794 = h * t793;
-  const double t795 = q0[3] + t794;
+  const double t795 = q0[3] /* x2 */ + t794;
   const double t796 = gam[4] * 0.96623475710157603;
   const double t797 = t183 + t796;
   const double t798 = h * t797;
-  const double t799 = q0[4] + t798;
+  const double t799 = q0[4] /* y2 */ + t798;
   const double t800 = gam[5] * 0.96623475710157603;
   const double t801 = t188 + t800;
   const double t802 = h * t801;
-  const double t803 = q0[5] + t802;
+  const double t803 = q0[5] /* z2 */ + t802;
   const double t804 = gam[6] * 0.96623475710157603;
   const double t805 = t193 + t804;
   const double t806 = h * t805;
-  const double t807 = q0[6] + t806;
+  const double t807 = q0[6] /* x3 */ + t806;
   const double t808 = gam[7] * 0.96623475710157603;
   const double t809 = t198 + t808;
   const double t810 = h * t809;
-  const double t811 = q0[7] + t810;
+  const double t811 = q0[7] /* y3 */ + t810;
   const double t812 = gam[8] * 0.96623475710157603;
   const double t813 = t203 + t812;
   const double t814 = h * t813;
-  const double t815 = q0[8] + t814;
+  const double t815 = q0[8] /* z3 */ + t814;
   const double t816 = t783 * t783;
   const double t817 = t787 * t787;
   const double t818 = t816 + t817;
@@ -1034,16 +1047,16 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t988 = 0.28867513459481292 * t987;
   const double t989 = t964 + t988;
   const double t990 = h * t989;
-  const double t991 = t13 * p0[0];
-  const double t992 = t34 * p0[1];
+  const double t991 = t13 * p0[0] /* p_x1 */;
+  const double t992 = t34 * p0[1] /* p_y1 */;
   const double t993 = t991 + t992;
-  const double t994 = t55 * p0[2];
+  const double t994 = t55 * p0[2] /* p_z1 */;
   const double t995 = t993 + t994;
-  const double t996 = t66 * p0[3];
+  const double t996 = t66 * p0[3] /* p_x2 */;
   const double t997 = t995 + t996;
-  const double t998 = t73 * p0[4];
+  const double t998 = t73 * p0[4] /* p_y2 */;
   const double t999 = t997 + t998;
-  const double t1000 = t80 * p0[5];
+  const double t1000 = t80 * p0[5] /* p_z2 */;
   const double t1001 = t999 + t1000;
   const double t1002 = t1001 - t990;
   const double t1003 = t1002 + g0[0];
@@ -1122,16 +1135,16 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t1076 = 0.28867513459481292 * t1075;
   const double t1077 = t1052 + t1076;
   const double t1078 = h * t1077;
-  const double t1079 = t92 * p0[3];
-  const double t1080 = t105 * p0[4];
+  const double t1079 = t92 * p0[3] /* p_x2 */;
+  const double t1080 = t105 * p0[4] /* p_y2 */;
   const double t1081 = t1079 + t1080;
-  const double t1082 = t118 * p0[5];
+  const double t1082 = t118 * p0[5] /* p_z2 */;
   const double t1083 = t1081 + t1082;
-  const double t1084 = t125 * p0[6];
+  const double t1084 = t125 * p0[6] /* p_x3 */;
   const double t1085 = t1083 + t1084;
-  const double t1086 = t130 * p0[7];
+  const double t1086 = t130 * p0[7] /* p_y3 */;
   const double t1087 = t1085 + t1086;
-  const double t1088 = t135 * p0[8];
+  const double t1088 = t135 * p0[8] /* p_z3 */;
   const double t1089 = t1087 + t1088;
   const double t1090 = t1089 - t1078;
   const double t1091 = t1090 + g0[1];
@@ -1194,16 +1207,16 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t1148 = 0.28867513459481292 * t1147;
   const double t1149 = t1124 + t1148;
   const double t1150 = h * t1149;
-  const double t1151 = t141 * p0[0];
-  const double t1152 = t146 * p0[1];
+  const double t1151 = t141 * p0[0] /* p_x1 */;
+  const double t1152 = t146 * p0[1] /* p_y1 */;
   const double t1153 = t1151 + t1152;
-  const double t1154 = t151 * p0[2];
+  const double t1154 = t151 * p0[2] /* p_z1 */;
   const double t1155 = t1153 + t1154;
-  const double t1156 = t154 * p0[6];
+  const double t1156 = t154 * p0[6] /* p_x3 */;
   const double t1157 = t1155 + t1156;
-  const double t1158 = t157 * p0[7];
+  const double t1158 = t157 * p0[7] /* p_y3 */;
   const double t1159 = t1157 + t1158;
-  const double t1160 = t160 * p0[8];
+  const double t1160 = t160 * p0[8] /* p_z3 */;
   const double t1161 = t1159 + t1160;
   const double t1162 = t1161 - t1150;
   const double t1163 = t1162 + g0[2];
@@ -1312,47 +1325,47 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t1265 = 0.28867513459481292 * t1253;
   const double t1266 = t1264 - t1265;
   const double t1267 = h * t1266;
-  const double t1268 = p0[0] - t1267;
+  const double t1268 = p0[0] /* p_x1 */ - t1267;
   const double t1269 = 0.5 * t1219;
   const double t1270 = 0.28867513459481292 * t1255;
   const double t1271 = t1269 - t1270;
   const double t1272 = h * t1271;
-  const double t1273 = p0[1] - t1272;
+  const double t1273 = p0[1] /* p_y1 */ - t1272;
   const double t1274 = 0.5 * t1221;
   const double t1275 = 0.28867513459481292 * t1257;
   const double t1276 = t1274 - t1275;
   const double t1277 = h * t1276;
-  const double t1278 = p0[2] - t1277;
+  const double t1278 = p0[2] /* p_z1 */ - t1277;
   const double t1279 = 0.5 * t1205;
   const double t1280 = 0.28867513459481292 * t1241;
   const double t1281 = t1279 - t1280;
   const double t1282 = h * t1281;
-  const double t1283 = p0[3] - t1282;
+  const double t1283 = p0[3] /* p_x2 */ - t1282;
   const double t1284 = 0.5 * t1207;
   const double t1285 = 0.28867513459481292 * t1243;
   const double t1286 = t1284 - t1285;
   const double t1287 = h * t1286;
-  const double t1288 = p0[4] - t1287;
+  const double t1288 = p0[4] /* p_y2 */ - t1287;
   const double t1289 = 0.5 * t1209;
   const double t1290 = 0.28867513459481292 * t1245;
   const double t1291 = t1289 - t1290;
   const double t1292 = h * t1291;
-  const double t1293 = p0[5] - t1292;
+  const double t1293 = p0[5] /* p_z2 */ - t1292;
   const double t1294 = 0.5 * t1223;
   const double t1295 = 0.28867513459481292 * t1259;
   const double t1296 = t1294 - t1295;
   const double t1297 = h * t1296;
-  const double t1298 = p0[6] - t1297;
+  const double t1298 = p0[6] /* p_x3 */ - t1297;
   const double t1299 = 0.5 * t1225;
   const double t1300 = 0.28867513459481292 * t1261;
   const double t1301 = t1299 - t1300;
   const double t1302 = h * t1301;
-  const double t1303 = p0[7] - t1302;
+  const double t1303 = p0[7] /* p_y3 */ - t1302;
   const double t1304 = 0.5 * t1227;
   const double t1305 = 0.28867513459481292 * t1263;
   const double t1306 = t1304 - t1305;
   const double t1307 = h * t1306;
-  const double t1308 = p0[8] - t1307;
+  const double t1308 = p0[8] /* p_z3 */ - t1307;
   const double t1309 = 0.28867513459481292 * t1217;
   const double t1310 = h * t1309;
   const double t1311 = -t1310;
@@ -1398,6 +1411,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t1351 = -t1350;
   const double t1352 = h * t1227;
   const double t1353 = -t1352;
+  /* gam */
   out[0] = t1268;
   out[1] = t1273;
   out[2] = t1278;
@@ -1416,6 +1430,7 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   out[15] = t1329;
   out[16] = t1332;
   out[17] = t1335;
+  /* dp */
   out[18] = t1337;
   out[19] = t1339;
   out[20] = t1341;
@@ -1425,12 +1440,15 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   out[24] = t1349;
   out[25] = t1351;
   out[26] = t1353;
+  /* lambda */
   out[27] = t1191;
   out[28] = t1186;
   out[29] = t1183;
+  /* pivot */
   out[30] = t912;
   out[31] = t1166;
   out[32] = t1180;
+  /* adiag */
   out[33] = t912;
   out[34] = t1020;
   out[35] = t1108;
@@ -1441,15 +1459,16 @@ static void satellites_k6s2_minv_p(const double *q0, const double *p0, const dou
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
-  out[4] = p0[4];
-  out[5] = p0[5];
-  out[6] = p0[6];
-  out[7] = p0[7];
-  out[8] = p0[8];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_z1 */;
+  out[3] = p0[3] /* p_x2 */;
+  out[4] = p0[4] /* p_y2 */;
+  out[5] = p0[5] /* p_z2 */;
+  out[6] = p0[6] /* p_x3 */;
+  out[7] = p0[7] /* p_y3 */;
+  out[8] = p0[8] /* p_z3 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -1458,49 +1477,50 @@ static void satellites_k6s2_energy_kernel(const double *q0, const double *p0, co
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t1 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_z1 */ * p0[2] /* p_z1 */;
   const double t4 = t2 + t3;
-  const double t5 = p0[3] * p0[3];
+  const double t5 = p0[3] /* p_x2 */ * p0[3] /* p_x2 */;
   const double t6 = t4 + t5;
-  const double t7 = p0[4] * p0[4];
+  const double t7 = p0[4] /* p_y2 */ * p0[4] /* p_y2 */;
   const double t8 = t6 + t7;
-  const double t9 = p0[5] * p0[5];
+  const double t9 = p0[5] /* p_z2 */ * p0[5] /* p_z2 */;
   const double t10 = t8 + t9;
-  const double t11 = p0[6] * p0[6];
+  const double t11 = p0[6] /* p_x3 */ * p0[6] /* p_x3 */;
   const double t12 = t10 + t11;
-  const double t13 = p0[7] * p0[7];
+  const double t13 = p0[7] /* p_y3 */ * p0[7] /* p_y3 */;
   const double t14 = t12 + t13;
-  const double t15 = p0[8] * p0[8];
+  const double t15 = p0[8] /* p_z3 */ * p0[8] /* p_z3 */;
   const double t16 = t14 + t15;
-  const double t17 = q0[0] * q0[0];
-  const double t18 = q0[1] * q0[1];
+  const double t17 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t18 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t19 = t17 + t18;
-  const double t20 = q0[2] * q0[2];
+  const double t20 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t21 = t19 + t20;
   const double t22 = sqrt(t21);
   const double t23 = 1.0 / t22;
   const double t24 = -t23;
-  const double t25 = q0[3] * q0[3];
-  const double t26 = q0[4] * q0[4];
+  const double t25 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t26 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t27 = t25 + t26;
-  const double t28 = q0[5] * q0[5];
+  const double t28 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t29 = t27 + t28;
   const double t30 = sqrt(t29);
   const double t31 = 1.0 / t30;
   const double t32 = t24 - t31;
-  const double t33 = q0[6] * q0[6];
-  const double t34 = q0[7] * q0[7];
+  const double t33 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t34 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t35 = t33 + t34;
-  const double t36 = q0[8] * q0[8];
+  const double t36 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t37 = t35 + t36;
   const double t38 = sqrt(t37);
   const double t39 = 1.0 / t38;
   const double t40 = t32 - t39;
   const double t41 = 0.5 * t16;
   const double t42 = t40 + t41;
+  /* H */
   out[0] = t42;
 }
 
@@ -1509,16 +1529,15 @@ static void satellites_k6s2_g(const double *q0, const double *p0, const double *
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
-  const double t1 = q0[1] - q0[4];
-  const double t2 = q0[2] - q0[5];
-  const double t3 = q0[3] - q0[6];
-  const double t4 = q0[4] - q0[7];
-  const double t5 = q0[5] - q0[8];
-  const double t6 = q0[6] - q0[0];
-  const double t7 = q0[7] - q0[1];
-  const double t8 = q0[8] - q0[2];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
   /* g(q0) */
   const double t9 = t0 * t0;
   const double t10 = t1 * t1;
@@ -1538,6 +1557,7 @@ static void satellites_k6s2_g(const double *q0, const double *p0, const double *
   const double t24 = t8 * t8;
   const double t25 = t23 + t24;
   const double t26 = t25 - 1.0;
+  /* g */
   out[0] = t14;
   out[1] = t20;
   out[2] = t26;
@@ -1548,60 +1568,60 @@ static void satellites_k6s2_hidden_kernel(const double *q0, const double *p0, co
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
   /* hidden constraints */
-  const double t18 = t1 * p0[0];
-  const double t19 = t3 * p0[1];
+  const double t18 = t1 * p0[0] /* p_x1 */;
+  const double t19 = t3 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t5 * p0[2];
+  const double t21 = t5 * p0[2] /* p_z1 */;
   const double t22 = t20 + t21;
-  const double t23 = t1 * p0[3];
+  const double t23 = t1 * p0[3] /* p_x2 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[4];
+  const double t25 = t3 * p0[4] /* p_y2 */;
   const double t26 = t24 - t25;
-  const double t27 = t5 * p0[5];
+  const double t27 = t5 * p0[5] /* p_z2 */;
   const double t28 = t26 - t27;
-  const double t29 = t7 * p0[3];
-  const double t30 = t9 * p0[4];
+  const double t29 = t7 * p0[3] /* p_x2 */;
+  const double t30 = t9 * p0[4] /* p_y2 */;
   const double t31 = t29 + t30;
-  const double t32 = t11 * p0[5];
+  const double t32 = t11 * p0[5] /* p_z2 */;
   const double t33 = t31 + t32;
-  const double t34 = t7 * p0[6];
+  const double t34 = t7 * p0[6] /* p_x3 */;
   const double t35 = t33 - t34;
-  const double t36 = t9 * p0[7];
+  const double t36 = t9 * p0[7] /* p_y3 */;
   const double t37 = t35 - t36;
-  const double t38 = t11 * p0[8];
+  const double t38 = t11 * p0[8] /* p_z3 */;
   const double t39 = t37 - t38;
-  const double t40 = t13 * p0[0];
+  const double t40 = t13 * p0[0] /* p_x1 */;
   const double t41 = -t40;
-  const double t42 = t15 * p0[1];
+  const double t42 = t15 * p0[1] /* p_y1 */;
   const double t43 = t41 - t42;
-  const double t44 = t17 * p0[2];
+  const double t44 = t17 * p0[2] /* p_z1 */;
   const double t45 = t43 - t44;
-  const double t46 = t13 * p0[6];
+  const double t46 = t13 * p0[6] /* p_x3 */;
   const double t47 = t45 + t46;
-  const double t48 = t15 * p0[7];
+  const double t48 = t15 * p0[7] /* p_y3 */;
   const double t49 = t47 + t48;
-  const double t50 = t17 * p0[8];
+  const double t50 = t17 * p0[8] /* p_z3 */;
   const double t51 = t49 + t50;
+  /* hidden */
   out[0] = t28;
   out[1] = t39;
   out[2] = t51;
@@ -1613,44 +1633,42 @@ static void satellites_k6s2_lambda0(const double *q0, const double *p0, const do
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* energy */
-  const double t18 = q0[0] * q0[0];
-  const double t19 = q0[1] * q0[1];
+  const double t18 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t19 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t20 = t18 + t19;
-  const double t21 = q0[2] * q0[2];
+  const double t21 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t22 = t20 + t21;
   const double t23 = sqrt(t22);
   const double t24 = 1.0 / t23;
-  const double t25 = q0[3] * q0[3];
-  const double t26 = q0[4] * q0[4];
+  const double t25 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t26 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t27 = t25 + t26;
-  const double t28 = q0[5] * q0[5];
+  const double t28 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t29 = t27 + t28;
   const double t30 = sqrt(t29);
   const double t31 = 1.0 / t30;
-  const double t32 = q0[6] * q0[6];
-  const double t33 = q0[7] * q0[7];
+  const double t32 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t33 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t34 = t32 + t33;
-  const double t35 = q0[8] * q0[8];
+  const double t35 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t36 = t34 + t35;
   const double t37 = sqrt(t36);
   const double t38 = 1.0 / t37;
@@ -1658,29 +1676,29 @@ static void satellites_k6s2_lambda0(const double *q0, const double *p0, const do
   const double t39 = t38 * t38;
   const double t40 = 0.5 * t39;
   const double t41 = t38 * t40;
-  const double t42 = 2.0 * q0[8];
+  const double t42 = 2.0 * q0[8] /* z3 */;
   const double t43 = t41 * t42;
-  const double t44 = 2.0 * q0[7];
+  const double t44 = 2.0 * q0[7] /* y3 */;
   const double t45 = t41 * t44;
-  const double t46 = 2.0 * q0[6];
+  const double t46 = 2.0 * q0[6] /* x3 */;
   const double t47 = t41 * t46;
   const double t48 = t31 * t31;
   const double t49 = 0.5 * t48;
   const double t50 = t31 * t49;
-  const double t51 = 2.0 * q0[5];
+  const double t51 = 2.0 * q0[5] /* z2 */;
   const double t52 = t50 * t51;
-  const double t53 = 2.0 * q0[4];
+  const double t53 = 2.0 * q0[4] /* y2 */;
   const double t54 = t50 * t53;
-  const double t55 = 2.0 * q0[3];
+  const double t55 = 2.0 * q0[3] /* x2 */;
   const double t56 = t50 * t55;
   const double t57 = t24 * t24;
   const double t58 = 0.5 * t57;
   const double t59 = t24 * t58;
-  const double t60 = 2.0 * q0[2];
+  const double t60 = 2.0 * q0[2] /* z1 */;
   const double t61 = t59 * t60;
-  const double t62 = 2.0 * q0[1];
+  const double t62 = 2.0 * q0[1] /* y1 */;
   const double t63 = t59 * t62;
-  const double t64 = 2.0 * q0[0];
+  const double t64 = 2.0 * q0[0] /* x1 */;
   const double t65 = t59 * t64;
   const double t66 = t1 * t1;
   const double t67 = t1 * t13;
@@ -1724,91 +1742,91 @@ static void satellites_k6s2_lambda0(const double *q0, const double *p0, const do
   const double t105 = t100 + t104;
   const double t106 = t101 + t105;
   const double t107 = t103 + t106;
-  const double t108 = p0[2] - p0[5];
-  const double t109 = p0[1] - p0[4];
-  const double t110 = p0[0] - p0[3];
+  const double t108 = p0[2] /* p_z1 */ - p0[5] /* p_z2 */;
+  const double t109 = p0[1] /* p_y1 */ - p0[4] /* p_y2 */;
+  const double t110 = p0[0] /* p_x1 */ - p0[3] /* p_x2 */;
   const double t111 = 2.0 * t110;
   const double t112 = 2.0 * t109;
   const double t113 = 2.0 * t108;
-  const double t114 = p0[0] * t111;
+  const double t114 = p0[0] /* p_x1 */ * t111;
   const double t115 = t1 * t65;
-  const double t116 = p0[1] * t112;
+  const double t116 = p0[1] /* p_y1 */ * t112;
   const double t117 = t114 + t116;
   const double t118 = t3 * t63;
   const double t119 = t115 + t118;
-  const double t120 = p0[2] * t113;
+  const double t120 = p0[2] /* p_z1 */ * t113;
   const double t121 = t117 + t120;
   const double t122 = t5 * t61;
   const double t123 = t119 + t122;
-  const double t124 = p0[3] * t111;
+  const double t124 = p0[3] /* p_x2 */ * t111;
   const double t125 = t121 - t124;
   const double t126 = t1 * t56;
   const double t127 = t123 - t126;
-  const double t128 = p0[4] * t112;
+  const double t128 = p0[4] /* p_y2 */ * t112;
   const double t129 = t125 - t128;
   const double t130 = t3 * t54;
   const double t131 = t127 - t130;
-  const double t132 = p0[5] * t113;
+  const double t132 = p0[5] /* p_z2 */ * t113;
   const double t133 = t129 - t132;
   const double t134 = t5 * t52;
   const double t135 = t131 - t134;
   const double t136 = t133 - t135;
-  const double t137 = p0[5] - p0[8];
-  const double t138 = p0[4] - p0[7];
-  const double t139 = p0[3] - p0[6];
+  const double t137 = p0[5] /* p_z2 */ - p0[8] /* p_z3 */;
+  const double t138 = p0[4] /* p_y2 */ - p0[7] /* p_y3 */;
+  const double t139 = p0[3] /* p_x2 */ - p0[6] /* p_x3 */;
   const double t140 = 2.0 * t139;
   const double t141 = 2.0 * t138;
   const double t142 = 2.0 * t137;
-  const double t143 = p0[3] * t140;
+  const double t143 = p0[3] /* p_x2 */ * t140;
   const double t144 = t7 * t56;
-  const double t145 = p0[4] * t141;
+  const double t145 = p0[4] /* p_y2 */ * t141;
   const double t146 = t143 + t145;
   const double t147 = t9 * t54;
   const double t148 = t144 + t147;
-  const double t149 = p0[5] * t142;
+  const double t149 = p0[5] /* p_z2 */ * t142;
   const double t150 = t146 + t149;
   const double t151 = t11 * t52;
   const double t152 = t148 + t151;
-  const double t153 = p0[6] * t140;
+  const double t153 = p0[6] /* p_x3 */ * t140;
   const double t154 = t150 - t153;
   const double t155 = t7 * t47;
   const double t156 = t152 - t155;
-  const double t157 = p0[7] * t141;
+  const double t157 = p0[7] /* p_y3 */ * t141;
   const double t158 = t154 - t157;
   const double t159 = t9 * t45;
   const double t160 = t156 - t159;
-  const double t161 = p0[8] * t142;
+  const double t161 = p0[8] /* p_z3 */ * t142;
   const double t162 = t158 - t161;
   const double t163 = t11 * t43;
   const double t164 = t160 - t163;
   const double t165 = t162 - t164;
-  const double t166 = p0[8] - p0[2];
-  const double t167 = p0[7] - p0[1];
-  const double t168 = p0[6] - p0[0];
+  const double t166 = p0[8] /* p_z3 */ - p0[2] /* p_z1 */;
+  const double t167 = p0[7] /* p_y3 */ - p0[1] /* p_y1 */;
+  const double t168 = p0[6] /* p_x3 */ - p0[0] /* p_x1 */;
   const double t169 = 2.0 * t168;
   const double t170 = 2.0 * t167;
   const double t171 = 2.0 * t166;
-  const double t172 = p0[0] * t169;
+  const double t172 = p0[0] /* p_x1 */ * t169;
   const double t173 = -t172;
   const double t174 = t13 * t65;
   const double t175 = -t174;
-  const double t176 = p0[1] * t170;
+  const double t176 = p0[1] /* p_y1 */ * t170;
   const double t177 = t173 - t176;
   const double t178 = t15 * t63;
   const double t179 = t175 - t178;
-  const double t180 = p0[2] * t171;
+  const double t180 = p0[2] /* p_z1 */ * t171;
   const double t181 = t177 - t180;
   const double t182 = t17 * t61;
   const double t183 = t179 - t182;
-  const double t184 = p0[6] * t169;
+  const double t184 = p0[6] /* p_x3 */ * t169;
   const double t185 = t181 + t184;
   const double t186 = t13 * t47;
   const double t187 = t183 + t186;
-  const double t188 = p0[7] * t170;
+  const double t188 = p0[7] /* p_y3 */ * t170;
   const double t189 = t185 + t188;
   const double t190 = t15 * t45;
   const double t191 = t187 + t190;
-  const double t192 = p0[8] * t171;
+  const double t192 = p0[8] /* p_z3 */ * t171;
   const double t193 = t189 + t192;
   const double t194 = t17 * t43;
   const double t195 = t191 + t194;
@@ -1841,6 +1859,7 @@ static void satellites_k6s2_lambda0(const double *q0, const double *p0, const do
   const double t222 = t76 * t216;
   const double t223 = t221 - t222;
   const double t224 = t223 / t83;
+  /* lambda */
   out[0] = t224;
   out[1] = t219;
   out[2] = t216;
@@ -1855,19 +1874,19 @@ void satellites_k6s2_init(satellites_k6s2_state *x, const double *q0, const doub
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_k6s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : satellites_k6s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : satellites_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (satellites_k6s2_NU ? satellites_k6s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = 0;
   {
     satellites_k6s2_params prm;
-    double lam[NU];
+    double lam[satellites_k6s2_NU];
     satellites_k6s2_params_default(&prm);
     satellites_k6s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -1883,32 +1902,32 @@ const char *satellites_k6s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) satellites_k6s2_params dflt_; if (!prm) { satellites_k6s2_params_default(&dflt_); prm = &dflt_; }
+#define satellites_k6s2_DEFAULT_PARAMS(prm) satellites_k6s2_params dflt_; if (!prm) { satellites_k6s2_params_default(&dflt_); prm = &dflt_; }
 
 double satellites_k6s2_energy(const satellites_k6s2_state *x, const satellites_k6s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s2_DEFAULT_PARAMS(prm)
   satellites_k6s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void satellites_k6s2_constraints(const satellites_k6s2_state *x, const satellites_k6s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[satellites_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s2_DEFAULT_PARAMS(prm)
   satellites_k6s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < satellites_k6s2_NU; i++) g[i] = v[i];
 }
 
 void satellites_k6s2_hidden(const satellites_k6s2_state *x, const satellites_k6s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[satellites_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s2_DEFAULT_PARAMS(prm)
   satellites_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < satellites_k6s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1916,17 +1935,17 @@ void satellites_k6s2_hidden(const satellites_k6s2_state *x, const satellites_k6s
 static void satellites_k6s2_predict(const satellites_k6s2_state *x, double h, const satellites_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < satellites_k6s2_S; j++)
+    for (i = 0; i < satellites_k6s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + satellites_k6s2_E[(j * S + i) * S + d];
+      for (d = satellites_k6s2_S - 1; d >= 0; d--) e = e * r + satellites_k6s2_E[(j * satellites_k6s2_S + i) * satellites_k6s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < satellites_k6s2_M; l++) gam[j * satellites_k6s2_M + l] += e * x->gam[i * satellites_k6s2_M + l];
     }
 }
 
@@ -1943,60 +1962,63 @@ static void satellites_k6s2_add(double *a, double *c, double b)
 int satellites_k6s2_step(satellites_k6s2_state *x, double h_, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = satellites_k6s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_k6s2_EBADSTEP;
   satellites_k6s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[satellites_k6s2_NU];
   satellites_k6s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below satellites_k6s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < satellites_k6s2_NU; i++) g0[i] = fabs(g0[i]) <= satellites_k6s2_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= satellites_k6s2_MAXITER; it++) {
     satellites_k6s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < satellites_k6s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = satellites_k6s2_ESINGULAR;
+    for (i = 0; i < satellites_k6s2_NU; i++) {
+      double piv = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU + i], dia = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 2 * satellites_k6s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s2_SINGTOL * fabs(dia))) rc = satellites_k6s2_ESINGULAR;
     }
     if (rc == satellites_k6s2_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s2_ENONFINITE;
     if (rc == satellites_k6s2_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (satellites_k6s2_TOL / 256), or
+     * within 2 ulps (satellites_k6s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above satellites_k6s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = satellites_k6s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? satellites_k6s2_OK : satellites_k6s2_ENOCONV; break; }
+    if (inc <= satellites_k6s2_TOL / 256 || (inc <= satellites_k6s2_TOL && 4 * inc > inc_old)) { rc = satellites_k6s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= satellites_k6s2_STAGTOL ? satellites_k6s2_OK : satellites_k6s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > satellites_k6s2_MAXITER ? satellites_k6s2_MAXITER : it; st->increment = inc; }
   if (rc != satellites_k6s2_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return satellites_k6s2_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s2_ENONFINITE;
+  for (i = 0; i < satellites_k6s2_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s2_S * satellites_k6s2_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return satellites_k6s2_ENONFINITE;
+  for (i = 0; i < satellites_k6s2_M; i++) {
     satellites_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
-    satellites_k6s2_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    satellites_k6s2_add(&x->p[i], &x->pc[i], sw[satellites_k6s2_S * satellites_k6s2_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + i];
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = gam[i];
   satellites_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s2_OK;

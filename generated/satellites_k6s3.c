@@ -5,14 +5,27 @@
 
 #include "satellites_k6s3.h"
 
-#define M satellites_k6s3_M
-#define NU satellites_k6s3_NU
-#define S satellites_k6s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(satellites_k6s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define satellites_k6s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef satellites_k6s3_MAXITER
+#define satellites_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef satellites_k6s3_TOL
+#define satellites_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef satellites_k6s3_STAGTOL
+#define satellites_k6s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef satellites_k6s3_SINGTOL
+#define satellites_k6s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef satellites_k6s3_GTOL
+#define satellites_k6s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -36,7 +49,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
   const double t2 = 0.5 * gam[0];
   const double t3 = gam[9] * 0.28867513459481292;
@@ -68,7 +81,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t29 = h * t28;
   const double t30 = (-2.0) * t29;
   const double t31 = t27 + t30;
-  const double t32 = q0[1] - q0[4];
+  const double t32 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t33 = 2.0 * t32;
   const double t34 = 0.5 * gam[1];
   const double t35 = 0.28867513459481292 * gam[10];
@@ -100,7 +113,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t61 = h * t60;
   const double t62 = (-2.0) * t61;
   const double t63 = t59 + t62;
-  const double t64 = q0[2] - q0[5];
+  const double t64 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t65 = 2.0 * t64;
   const double t66 = 0.5 * gam[2];
   const double t67 = 0.28867513459481292 * gam[11];
@@ -162,7 +175,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t123 = (-2.0) * t90;
   const double t124 = 2.0 * t93;
   const double t125 = t123 + t124;
-  const double t126 = q0[3] - q0[6];
+  const double t126 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t127 = 2.0 * t126;
   const double t128 = t98 + t127;
   const double t129 = 0.5 * gam[6];
@@ -181,7 +194,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t142 = h * t141;
   const double t143 = (-2.0) * t142;
   const double t144 = t104 + t143;
-  const double t145 = q0[4] - q0[7];
+  const double t145 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t146 = 2.0 * t145;
   const double t147 = t108 + t146;
   const double t148 = 0.5 * gam[7];
@@ -200,7 +213,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t161 = h * t160;
   const double t162 = (-2.0) * t161;
   const double t163 = t114 + t162;
-  const double t164 = q0[5] - q0[8];
+  const double t164 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t165 = 2.0 * t164;
   const double t166 = t118 + t165;
   const double t167 = 0.5 * gam[8];
@@ -240,19 +253,19 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t201 = t87 + t200;
   const double t202 = 2.0 * t180;
   const double t203 = t94 + t202;
-  const double t204 = q0[6] - q0[0];
+  const double t204 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t205 = 2.0 * t204;
   const double t206 = t6 - t205;
   const double t207 = t133 + t206;
   const double t208 = t18 + t139;
   const double t209 = t27 + t143;
-  const double t210 = q0[7] - q0[1];
+  const double t210 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t211 = 2.0 * t210;
   const double t212 = t38 - t211;
   const double t213 = t152 + t212;
   const double t214 = t50 + t158;
   const double t215 = t59 + t162;
-  const double t216 = q0[8] - q0[2];
+  const double t216 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t217 = 2.0 * t216;
   const double t218 = t70 - t217;
   const double t219 = t171 + t218;
@@ -277,63 +290,63 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t237 = gam[18] * 0.068025568234204442;
   const double t238 = t236 + t237;
   const double t239 = h * t238;
-  const double t240 = q0[0] + t239;
+  const double t240 = q0[0] /* x1 */ + t239;
   const double t241 = gam[1] * 0.033765242898423975;
   const double t242 = gam[10] * (-0.056508419605012766);
   const double t243 = t241 + t242;
   const double t244 = gam[19] * 0.068025568234204442;
   const double t245 = t243 + t244;
   const double t246 = h * t245;
-  const double t247 = q0[1] + t246;
+  const double t247 = q0[1] /* y1 */ + t246;
   const double t248 = gam[2] * 0.033765242898423975;
   const double t249 = gam[11] * (-0.056508419605012766);
   const double t250 = t248 + t249;
   const double t251 = gam[20] * 0.068025568234204442;
   const double t252 = t250 + t251;
   const double t253 = h * t252;
-  const double t254 = q0[2] + t253;
+  const double t254 = q0[2] /* z1 */ + t253;
   const double t255 = gam[3] * 0.033765242898423975;
   const double t256 = gam[12] * (-0.056508419605012766);
   const double t257 = t255 + t256;
   const double t258 = gam[21] * 0.068025568234204442;
   const double t259 = t257 + t258;
   const double t260 = h * t259;
-  const double t261 = q0[3] + t260;
+  const double t261 = q0[3] /* x2 */ + t260;
   const double t262 = gam[4] * 0.033765242898423975;
   const double t263 = gam[13] * (-0.056508419605012766);
   const double t264 = t262 + t263;
   const double t265 = gam[22] * 0.068025568234204442;
   const double t266 = t264 + t265;
   const double t267 = h * t266;
-  const double t268 = q0[4] + t267;
+  const double t268 = q0[4] /* y2 */ + t267;
   const double t269 = gam[5] * 0.033765242898423975;
   const double t270 = gam[14] * (-0.056508419605012766);
   const double t271 = t269 + t270;
   const double t272 = gam[23] * 0.068025568234204442;
   const double t273 = t271 + t272;
   const double t274 = h * t273;
-  const double t275 = q0[5] + t274;
+  const double t275 = q0[5] /* z2 */ + t274;
   const double t276 = gam[6] * 0.033765242898423975;
   const double t277 = gam[15] * (-0.056508419605012766);
   const double t278 = t276 + t277;
   const double t279 = gam[24] * 0.068025568234204442;
   const double t280 = t278 + t279;
   const double t281 = h * t280;
-  const double t282 = q0[6] + t281;
+  const double t282 = q0[6] /* x3 */ + t281;
   const double t283 = gam[7] * 0.033765242898423975;
   const double t284 = gam[16] * (-0.056508419605012766);
   const double t285 = t283 + t284;
   const double t286 = gam[25] * 0.068025568234204442;
   const double t287 = t285 + t286;
   const double t288 = h * t287;
-  const double t289 = q0[7] + t288;
+  const double t289 = q0[7] /* y3 */ + t288;
   const double t290 = gam[8] * 0.033765242898423975;
   const double t291 = gam[17] * (-0.056508419605012766);
   const double t292 = t290 + t291;
   const double t293 = gam[26] * 0.068025568234204442;
   const double t294 = t292 + t293;
   const double t295 = h * t294;
-  const double t296 = q0[8] + t295;
+  const double t296 = q0[8] /* z3 */ + t295;
   const double t297 = t240 * t240;
   const double t298 = t247 * t247;
   const double t299 = t297 + t298;
@@ -416,63 +429,63 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t375 = gam[18] * 0.20802702904656017;
   const double t376 = t374 + t375;
   const double t377 = h * t376;
-  const double t378 = q0[0] + t377;
+  const double t378 = q0[0] /* x1 */ + t377;
   const double t379 = gam[1] * 0.16939530676686776;
   const double t380 = gam[10] * (-0.24370047841099157);
   const double t381 = t379 + t380;
   const double t382 = gam[19] * 0.20802702904656017;
   const double t383 = t381 + t382;
   const double t384 = h * t383;
-  const double t385 = q0[1] + t384;
+  const double t385 = q0[1] /* y1 */ + t384;
   const double t386 = gam[2] * 0.16939530676686776;
   const double t387 = gam[11] * (-0.24370047841099157);
   const double t388 = t386 + t387;
   const double t389 = gam[20] * 0.20802702904656017;
   const double t390 = t388 + t389;
   const double t391 = h * t390;
-  const double t392 = q0[2] + t391;
+  const double t392 = q0[2] /* z1 */ + t391;
   const double t393 = gam[3] * 0.16939530676686776;
   const double t394 = gam[12] * (-0.24370047841099157);
   const double t395 = t393 + t394;
   const double t396 = gam[21] * 0.20802702904656017;
   const double t397 = t395 + t396;
   const double t398 = h * t397;
-  const double t399 = q0[3] + t398;
+  const double t399 = q0[3] /* x2 */ + t398;
   const double t400 = gam[4] * 0.16939530676686776;
   const double t401 = gam[13] * (-0.24370047841099157);
   const double t402 = t400 + t401;
   const double t403 = gam[22] * 0.20802702904656017;
   const double t404 = t402 + t403;
   const double t405 = h * t404;
-  const double t406 = q0[4] + t405;
+  const double t406 = q0[4] /* y2 */ + t405;
   const double t407 = gam[5] * 0.16939530676686776;
   const double t408 = gam[14] * (-0.24370047841099157);
   const double t409 = t407 + t408;
   const double t410 = gam[23] * 0.20802702904656017;
   const double t411 = t409 + t410;
   const double t412 = h * t411;
-  const double t413 = q0[5] + t412;
+  const double t413 = q0[5] /* z2 */ + t412;
   const double t414 = gam[6] * 0.16939530676686776;
   const double t415 = gam[15] * (-0.24370047841099157);
   const double t416 = t414 + t415;
   const double t417 = gam[24] * 0.20802702904656017;
   const double t418 = t416 + t417;
   const double t419 = h * t418;
-  const double t420 = q0[6] + t419;
+  const double t420 = q0[6] /* x3 */ + t419;
   const double t421 = gam[7] * 0.16939530676686776;
   const double t422 = gam[16] * (-0.24370047841099157);
   const double t423 = t421 + t422;
   const double t424 = gam[25] * 0.20802702904656017;
   const double t425 = t423 + t424;
   const double t426 = h * t425;
-  const double t427 = q0[7] + t426;
+  const double t427 = q0[7] /* y3 */ + t426;
   const double t428 = gam[8] * 0.16939530676686776;
   const double t429 = gam[17] * (-0.24370047841099157);
   const double t430 = t428 + t429;
   const double t431 = gam[26] * 0.20802702904656017;
   const double t432 = t430 + t431;
   const double t433 = h * t432;
-  const double t434 = q0[8] + t433;
+  const double t434 = q0[8] /* z3 */ + t433;
   const double t435 = t378 * t378;
   const double t436 = t385 * t385;
   const double t437 = t435 + t436;
@@ -582,63 +595,63 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t540 = gam[18] * 0.1257969473866733;
   const double t541 = t539 + t540;
   const double t542 = h * t541;
-  const double t543 = q0[0] + t542;
+  const double t543 = q0[0] /* x1 */ + t542;
   const double t544 = gam[1] * 0.38069040695840156;
   const double t545 = gam[10] * (-0.40835734144399111);
   const double t546 = t544 + t545;
   const double t547 = gam[19] * 0.1257969473866733;
   const double t548 = t546 + t547;
   const double t549 = h * t548;
-  const double t550 = q0[1] + t549;
+  const double t550 = q0[1] /* y1 */ + t549;
   const double t551 = gam[2] * 0.38069040695840156;
   const double t552 = gam[11] * (-0.40835734144399111);
   const double t553 = t551 + t552;
   const double t554 = gam[20] * 0.1257969473866733;
   const double t555 = t553 + t554;
   const double t556 = h * t555;
-  const double t557 = q0[2] + t556;
+  const double t557 = q0[2] /* z1 */ + t556;
   const double t558 = gam[3] * 0.38069040695840156;
   const double t559 = gam[12] * (-0.40835734144399111);
   const double t560 = t558 + t559;
   const double t561 = gam[21] * 0.1257969473866733;
   const double t562 = t560 + t561;
   const double t563 = h * t562;
-  const double t564 = q0[3] + t563;
+  const double t564 = q0[3] /* x2 */ + t563;
   const double t565 = gam[4] * 0.38069040695840156;
   const double t566 = gam[13] * (-0.40835734144399111);
   const double t567 = t565 + t566;
   const double t568 = gam[22] * 0.1257969473866733;
   const double t569 = t567 + t568;
   const double t570 = h * t569;
-  const double t571 = q0[4] + t570;
+  const double t571 = q0[4] /* y2 */ + t570;
   const double t572 = gam[5] * 0.38069040695840156;
   const double t573 = gam[14] * (-0.40835734144399111);
   const double t574 = t572 + t573;
   const double t575 = gam[23] * 0.1257969473866733;
   const double t576 = t574 + t575;
   const double t577 = h * t576;
-  const double t578 = q0[5] + t577;
+  const double t578 = q0[5] /* z2 */ + t577;
   const double t579 = gam[6] * 0.38069040695840156;
   const double t580 = gam[15] * (-0.40835734144399111);
   const double t581 = t579 + t580;
   const double t582 = gam[24] * 0.1257969473866733;
   const double t583 = t581 + t582;
   const double t584 = h * t583;
-  const double t585 = q0[6] + t584;
+  const double t585 = q0[6] /* x3 */ + t584;
   const double t586 = gam[7] * 0.38069040695840156;
   const double t587 = gam[16] * (-0.40835734144399111);
   const double t588 = t586 + t587;
   const double t589 = gam[25] * 0.1257969473866733;
   const double t590 = t588 + t589;
   const double t591 = h * t590;
-  const double t592 = q0[7] + t591;
+  const double t592 = q0[7] /* y3 */ + t591;
   const double t593 = gam[8] * 0.38069040695840156;
   const double t594 = gam[17] * (-0.40835734144399111);
   const double t595 = t593 + t594;
   const double t596 = gam[26] * 0.1257969473866733;
   const double t597 = t595 + t596;
   const double t598 = h * t597;
-  const double t599 = q0[8] + t598;
+  const double t599 = q0[8] /* z3 */ + t598;
   const double t600 = t543 * t543;
   const double t601 = t550 * t550;
   const double t602 = t600 + t601;
@@ -748,63 +761,63 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t705 = gam[18] * (-0.12579694738667335);
   const double t706 = t704 + t705;
   const double t707 = h * t706;
-  const double t708 = q0[0] + t707;
+  const double t708 = q0[0] /* x1 */ + t707;
   const double t709 = gam[1] * 0.61930959304159849;
   const double t710 = gam[10] * (-0.40835734144399105);
   const double t711 = t709 + t710;
   const double t712 = gam[19] * (-0.12579694738667335);
   const double t713 = t711 + t712;
   const double t714 = h * t713;
-  const double t715 = q0[1] + t714;
+  const double t715 = q0[1] /* y1 */ + t714;
   const double t716 = gam[2] * 0.61930959304159849;
   const double t717 = gam[11] * (-0.40835734144399105);
   const double t718 = t716 + t717;
   const double t719 = gam[20] * (-0.12579694738667335);
   const double t720 = t718 + t719;
   const double t721 = h * t720;
-  const double t722 = q0[2] + t721;
+  const double t722 = q0[2] /* z1 */ + t721;
   const double t723 = gam[3] * 0.61930959304159849;
   const double t724 = gam[12] * (-0.40835734144399105);
   const double t725 = t723 + t724;
   const double t726 = gam[21] * (-0.12579694738667335);
   const double t727 = t725 + t726;
   const double t728 = h * t727;
-  const double t729 = q0[3] + t728;
+  const double t729 = q0[3] /* x2 */ + t728;
   const double t730 = gam[4] * 0.61930959304159849;
   const double t731 = gam[13] * (-0.40835734144399105);
   const double t732 = t730 + t731;
   const double t733 = gam[22] * (-0.12579694738667335);
   const double t734 = t732 + t733;
   const double t735 = h * t734;
-  const double t736 = q0[4] + t735;
+  const double t736 = q0[4] /* y2 */ + t735;
   const double t737 = gam[5] * 0.61930959304159849;
   const double t738 = gam[14] * (-0.40835734144399105);
   const double t739 = t737 + t738;
   const double t740 = gam[23] * (-0.12579694738667335);
   const double t741 = t739 + t740;
   const double t742 = h * t741;
-  const double t743 = q0[5] + t742;
+  const double t743 = q0[5] /* z2 */ + t742;
   const double t744 = gam[6] * 0.61930959304159849;
   const double t745 = gam[15] * (-0.40835734144399105);
   const double t746 = t744 + t745;
   const double t747 = gam[24] * (-0.12579694738667335);
   const double t748 = t746 + t747;
   const double t749 = h * t748;
-  const double t750 = q0[6] + t749;
+  const double t750 = q0[6] /* x3 */ + t749;
   const double t751 = gam[7] * 0.61930959304159849;
   const double t752 = gam[16] * (-0.40835734144399105);
   const double t753 = t751 + t752;
   const double t754 = gam[25] * (-0.12579694738667335);
   const double t755 = t753 + t754;
   const double t756 = h * t755;
-  const double t757 = q0[7] + t756;
+  const double t757 = q0[7] /* y3 */ + t756;
   const double t758 = gam[8] * 0.61930959304159849;
   const double t759 = gam[17] * (-0.40835734144399105);
   const double t760 = t758 + t759;
   const double t761 = gam[26] * (-0.12579694738667335);
   const double t762 = t760 + t761;
   const double t763 = h * t762;
-  const double t764 = q0[8] + t763;
+  const double t764 = q0[8] /* z3 */ + t763;
   const double t765 = t708 * t708;
   const double t766 = t715 * t715;
   const double t767 = t765 + t766;
@@ -913,55 +926,55 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t869 = gam[18] * (-0.20802702904656017);
   const double t870 = t868 + t869;
   const double t871 = h * t870;
-  const double t872 = q0[0] + t871;
+  const double t872 = q0[0] /* x1 */ + t871;
   const double t873 = gam[1] * 0.83060469323313224;
   const double t874 = t380 + t873;
   const double t875 = gam[19] * (-0.20802702904656017);
   const double t876 = t874 + t875;
   const double t877 = h * t876;
-  const double t878 = q0[1] + t877;
+  const double t878 = q0[1] /* y1 */ + t877;
   const double t879 = gam[2] * 0.83060469323313224;
   const double t880 = t387 + t879;
   const double t881 = gam[20] * (-0.20802702904656017);
   const double t882 = t880 + t881;
   const double t883 = h * t882;
-  const double t884 = q0[2] + t883;
+  const double t884 = q0[2] /* z1 */ + t883;
   const double t885 = gam[3] * 0.83060469323313224;
   const double t886 = t394 + t885;
   const double t887 = gam[21] * (-0.20802702904656017);
   const double t888 = t886 + t887;
   const double t889 = h * t888;
-  const double t890 = q0[3] + t889;
+  const double t890 = q0[3] /* x2 */ + t889;
   const double t891 = gam[4] * 0.83060469323313224;
   const double t892 = t401 + t891;
   const double t893 = gam[22] * (-0.20802702904656017);
   const double t894 = t892 + t893;
   const double t895 = h * t894;
-  const double t896 = q0[4] + t895;
+  const double t896 = q0[4] /* y2 */ + t895;
   const double t897 = gam[5] * 0.83060469323313224;
   const double t898 = t408 + t897;
   const double t899 = gam[23] * (-0.20802702904656017);
   const double t900 = t898 + t899;
   const double t901 = h * t900;
-  const double t902 = q0[5] + t901;
+  const double t902 = q0[5] /* z2 */ + t901;
   const double t903 = gam[6] * 0.83060469323313224;
   const double t904 = t415 + t903;
   const double t905 = gam[24] * (-0.20802702904656017);
   const double t906 = t904 + t905;
   const double t907 = h * t906;
-  const double t908 = q0[6] + t907;
+  const double t908 = q0[6] /* x3 */ + t907;
   const double t909 = gam[7] * 0.83060469323313224;
   const double t910 = t422 + t909;
   const double t911 = gam[25] * (-0.20802702904656017);
   const double t912 = t910 + t911;
   const double t913 = h * t912;
-  const double t914 = q0[7] + t913;
+  const double t914 = q0[7] /* y3 */ + t913;
   const double t915 = gam[8] * 0.83060469323313224;
   const double t916 = t429 + t915;
   const double t917 = gam[26] * (-0.20802702904656017);
   const double t918 = t916 + t917;
   const double t919 = h * t918;
-  const double t920 = q0[8] + t919;
+  const double t920 = q0[8] /* z3 */ + t919;
   const double t921 = t872 * t872;
   const double t922 = t878 * t878;
   const double t923 = t921 + t922;
@@ -1070,55 +1083,55 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1025 = gam[18] * (-0.068025568234204442);
   const double t1026 = t1024 + t1025;
   const double t1027 = h * t1026;
-  const double t1028 = q0[0] + t1027;
+  const double t1028 = q0[0] /* x1 */ + t1027;
   const double t1029 = gam[1] * 0.96623475710157603;
   const double t1030 = t242 + t1029;
   const double t1031 = gam[19] * (-0.068025568234204442);
   const double t1032 = t1030 + t1031;
   const double t1033 = h * t1032;
-  const double t1034 = q0[1] + t1033;
+  const double t1034 = q0[1] /* y1 */ + t1033;
   const double t1035 = gam[2] * 0.96623475710157603;
   const double t1036 = t249 + t1035;
   const double t1037 = gam[20] * (-0.068025568234204442);
   const double t1038 = t1036 + t1037;
   const double t1039 = h * t1038;
-  const double t1040 = q0[2] + t1039;
+  const double t1040 = q0[2] /* z1 */ + t1039;
   const double t1041 = gam[3] * 0.96623475710157603;
   const double t1042 = t256 + t1041;
   const double t1043 = gam[21] * (-0.068025568234204442);
   const double t1044 = t1042 + t1043;
   const double t1045 = h * t1044;
-  const double t1046 = q0[3] + t1045;
+  const double t1046 = q0[3] /* x2 */ + t1045;
   const double t1047 = gam[4] * 0.96623475710157603;
   const double t1048 = t263 + t1047;
   const double t1049 = gam[22] * (-0.068025568234204442);
   const double t1050 = t1048 + t1049;
   const double t1051 = h * t1050;
-  const double t1052 = q0[4] + t1051;
+  const double t1052 = q0[4] /* y2 */ + t1051;
   const double t1053 = gam[5] * 0.96623475710157603;
   const double t1054 = t270 + t1053;
   const double t1055 = gam[23] * (-0.068025568234204442);
   const double t1056 = t1054 + t1055;
   const double t1057 = h * t1056;
-  const double t1058 = q0[5] + t1057;
+  const double t1058 = q0[5] /* z2 */ + t1057;
   const double t1059 = gam[6] * 0.96623475710157603;
   const double t1060 = t277 + t1059;
   const double t1061 = gam[24] * (-0.068025568234204442);
   const double t1062 = t1060 + t1061;
   const double t1063 = h * t1062;
-  const double t1064 = q0[6] + t1063;
+  const double t1064 = q0[6] /* x3 */ + t1063;
   const double t1065 = gam[7] * 0.96623475710157603;
   const double t1066 = t284 + t1065;
   const double t1067 = gam[25] * (-0.068025568234204442);
   const double t1068 = t1066 + t1067;
   const double t1069 = h * t1068;
-  const double t1070 = q0[7] + t1069;
+  const double t1070 = q0[7] /* y3 */ + t1069;
   const double t1071 = gam[8] * 0.96623475710157603;
   const double t1072 = t291 + t1071;
   const double t1073 = gam[26] * (-0.068025568234204442);
   const double t1074 = t1072 + t1073;
   const double t1075 = h * t1074;
-  const double t1076 = q0[8] + t1075;
+  const double t1076 = q0[8] /* z3 */ + t1075;
   const double t1077 = t1028 * t1028;
   const double t1078 = t1034 * t1034;
   const double t1079 = t1077 + t1078;
@@ -1364,16 +1377,16 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1318 = 0.12909944487358055 * t1317;
   const double t1319 = t1294 + t1318;
   const double t1320 = h * t1319;
-  const double t1321 = t13 * p0[0];
-  const double t1322 = t45 * p0[1];
+  const double t1321 = t13 * p0[0] /* p_x1 */;
+  const double t1322 = t45 * p0[1] /* p_y1 */;
   const double t1323 = t1321 + t1322;
-  const double t1324 = t77 * p0[2];
+  const double t1324 = t77 * p0[2] /* p_z1 */;
   const double t1325 = t1323 + t1324;
-  const double t1326 = t99 * p0[3];
+  const double t1326 = t99 * p0[3] /* p_x2 */;
   const double t1327 = t1325 + t1326;
-  const double t1328 = t109 * p0[4];
+  const double t1328 = t109 * p0[4] /* p_y2 */;
   const double t1329 = t1327 + t1328;
-  const double t1330 = t119 * p0[5];
+  const double t1330 = t119 * p0[5] /* p_z2 */;
   const double t1331 = t1329 + t1330;
   const double t1332 = t1331 - t1320;
   const double t1333 = t1332 + g0[0];
@@ -1493,16 +1506,16 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1447 = 0.12909944487358055 * t1446;
   const double t1448 = t1423 + t1447;
   const double t1449 = h * t1448;
-  const double t1450 = t134 * p0[3];
-  const double t1451 = t153 * p0[4];
+  const double t1450 = t134 * p0[3] /* p_x2 */;
+  const double t1451 = t153 * p0[4] /* p_y2 */;
   const double t1452 = t1450 + t1451;
-  const double t1453 = t172 * p0[5];
+  const double t1453 = t172 * p0[5] /* p_z2 */;
   const double t1454 = t1452 + t1453;
-  const double t1455 = t185 * p0[6];
+  const double t1455 = t185 * p0[6] /* p_x3 */;
   const double t1456 = t1454 + t1455;
-  const double t1457 = t192 * p0[7];
+  const double t1457 = t192 * p0[7] /* p_y3 */;
   const double t1458 = t1456 + t1457;
-  const double t1459 = t199 * p0[8];
+  const double t1459 = t199 * p0[8] /* p_z3 */;
   const double t1460 = t1458 + t1459;
   const double t1461 = t1460 - t1449;
   const double t1462 = t1461 + g0[1];
@@ -1596,16 +1609,16 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1550 = 0.12909944487358055 * t1549;
   const double t1551 = t1526 + t1550;
   const double t1552 = h * t1551;
-  const double t1553 = t207 * p0[0];
-  const double t1554 = t213 * p0[1];
+  const double t1553 = t207 * p0[0] /* p_x1 */;
+  const double t1554 = t213 * p0[1] /* p_y1 */;
   const double t1555 = t1553 + t1554;
-  const double t1556 = t219 * p0[2];
+  const double t1556 = t219 * p0[2] /* p_z1 */;
   const double t1557 = t1555 + t1556;
-  const double t1558 = t223 * p0[6];
+  const double t1558 = t223 * p0[6] /* p_x3 */;
   const double t1559 = t1557 + t1558;
-  const double t1560 = t227 * p0[7];
+  const double t1560 = t227 * p0[7] /* p_y3 */;
   const double t1561 = t1559 + t1560;
-  const double t1562 = t231 * p0[8];
+  const double t1562 = t231 * p0[8] /* p_z3 */;
   const double t1563 = t1561 + t1562;
   const double t1564 = t1563 - t1552;
   const double t1565 = t1564 + g0[2];
@@ -1750,47 +1763,47 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1703 = 0.28867513459481292 * t1655;
   const double t1704 = t1702 - t1703;
   const double t1705 = h * t1704;
-  const double t1706 = p0[0] - t1705;
+  const double t1706 = p0[0] /* p_x1 */ - t1705;
   const double t1707 = 0.5 * t1621;
   const double t1708 = 0.28867513459481292 * t1657;
   const double t1709 = t1707 - t1708;
   const double t1710 = h * t1709;
-  const double t1711 = p0[1] - t1710;
+  const double t1711 = p0[1] /* p_y1 */ - t1710;
   const double t1712 = 0.5 * t1623;
   const double t1713 = 0.28867513459481292 * t1659;
   const double t1714 = t1712 - t1713;
   const double t1715 = h * t1714;
-  const double t1716 = p0[2] - t1715;
+  const double t1716 = p0[2] /* p_z1 */ - t1715;
   const double t1717 = 0.5 * t1607;
   const double t1718 = 0.28867513459481292 * t1643;
   const double t1719 = t1717 - t1718;
   const double t1720 = h * t1719;
-  const double t1721 = p0[3] - t1720;
+  const double t1721 = p0[3] /* p_x2 */ - t1720;
   const double t1722 = 0.5 * t1609;
   const double t1723 = 0.28867513459481292 * t1645;
   const double t1724 = t1722 - t1723;
   const double t1725 = h * t1724;
-  const double t1726 = p0[4] - t1725;
+  const double t1726 = p0[4] /* p_y2 */ - t1725;
   const double t1727 = 0.5 * t1611;
   const double t1728 = 0.28867513459481292 * t1647;
   const double t1729 = t1727 - t1728;
   const double t1730 = h * t1729;
-  const double t1731 = p0[5] - t1730;
+  const double t1731 = p0[5] /* p_z2 */ - t1730;
   const double t1732 = 0.5 * t1625;
   const double t1733 = 0.28867513459481292 * t1661;
   const double t1734 = t1732 - t1733;
   const double t1735 = h * t1734;
-  const double t1736 = p0[6] - t1735;
+  const double t1736 = p0[6] /* p_x3 */ - t1735;
   const double t1737 = 0.5 * t1627;
   const double t1738 = 0.28867513459481292 * t1663;
   const double t1739 = t1737 - t1738;
   const double t1740 = h * t1739;
-  const double t1741 = p0[7] - t1740;
+  const double t1741 = p0[7] /* p_y3 */ - t1740;
   const double t1742 = 0.5 * t1629;
   const double t1743 = 0.28867513459481292 * t1665;
   const double t1744 = t1742 - t1743;
   const double t1745 = h * t1744;
-  const double t1746 = p0[8] - t1745;
+  const double t1746 = p0[8] /* p_z3 */ - t1745;
   const double t1747 = 0.28867513459481292 * t1619;
   const double t1748 = 0.12909944487358055 * t1691;
   const double t1749 = t1747 - t1748;
@@ -1881,6 +1894,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1834 = -t1833;
   const double t1835 = h * t1629;
   const double t1836 = -t1835;
+  /* gam */
   out[0] = t1706;
   out[1] = t1711;
   out[2] = t1716;
@@ -1908,6 +1922,7 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   out[24] = t1812;
   out[25] = t1815;
   out[26] = t1818;
+  /* dp */
   out[27] = t1820;
   out[28] = t1822;
   out[29] = t1824;
@@ -1917,12 +1932,15 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   out[33] = t1832;
   out[34] = t1834;
   out[35] = t1836;
+  /* lambda */
   out[36] = t1593;
   out[37] = t1588;
   out[38] = t1585;
+  /* pivot */
   out[39] = t1191;
   out[40] = t1568;
   out[41] = t1582;
+  /* adiag */
   out[42] = t1191;
   out[43] = t1353;
   out[44] = t1482;
@@ -1933,15 +1951,16 @@ static void satellites_k6s3_minv_p(const double *q0, const double *p0, const dou
     const double *g0, const satellites_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
-  out[4] = p0[4];
-  out[5] = p0[5];
-  out[6] = p0[6];
-  out[7] = p0[7];
-  out[8] = p0[8];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_z1 */;
+  out[3] = p0[3] /* p_x2 */;
+  out[4] = p0[4] /* p_y2 */;
+  out[5] = p0[5] /* p_z2 */;
+  out[6] = p0[6] /* p_x3 */;
+  out[7] = p0[7] /* p_y3 */;
+  out[8] = p0[8] /* p_z3 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -1950,49 +1969,50 @@ static void satellites_k6s3_energy_kernel(const double *q0, const double *p0, co
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* energy */
-  const double t0 = p0[0] * p0[0];
-  const double t1 = p0[1] * p0[1];
+  const double t0 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t1 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t2 = t0 + t1;
-  const double t3 = p0[2] * p0[2];
+  const double t3 = p0[2] /* p_z1 */ * p0[2] /* p_z1 */;
   const double t4 = t2 + t3;
-  const double t5 = p0[3] * p0[3];
+  const double t5 = p0[3] /* p_x2 */ * p0[3] /* p_x2 */;
   const double t6 = t4 + t5;
-  const double t7 = p0[4] * p0[4];
+  const double t7 = p0[4] /* p_y2 */ * p0[4] /* p_y2 */;
   const double t8 = t6 + t7;
-  const double t9 = p0[5] * p0[5];
+  const double t9 = p0[5] /* p_z2 */ * p0[5] /* p_z2 */;
   const double t10 = t8 + t9;
-  const double t11 = p0[6] * p0[6];
+  const double t11 = p0[6] /* p_x3 */ * p0[6] /* p_x3 */;
   const double t12 = t10 + t11;
-  const double t13 = p0[7] * p0[7];
+  const double t13 = p0[7] /* p_y3 */ * p0[7] /* p_y3 */;
   const double t14 = t12 + t13;
-  const double t15 = p0[8] * p0[8];
+  const double t15 = p0[8] /* p_z3 */ * p0[8] /* p_z3 */;
   const double t16 = t14 + t15;
-  const double t17 = q0[0] * q0[0];
-  const double t18 = q0[1] * q0[1];
+  const double t17 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t18 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t19 = t17 + t18;
-  const double t20 = q0[2] * q0[2];
+  const double t20 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t21 = t19 + t20;
   const double t22 = sqrt(t21);
   const double t23 = 1.0 / t22;
   const double t24 = -t23;
-  const double t25 = q0[3] * q0[3];
-  const double t26 = q0[4] * q0[4];
+  const double t25 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t26 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t27 = t25 + t26;
-  const double t28 = q0[5] * q0[5];
+  const double t28 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t29 = t27 + t28;
   const double t30 = sqrt(t29);
   const double t31 = 1.0 / t30;
   const double t32 = t24 - t31;
-  const double t33 = q0[6] * q0[6];
-  const double t34 = q0[7] * q0[7];
+  const double t33 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t34 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t35 = t33 + t34;
-  const double t36 = q0[8] * q0[8];
+  const double t36 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t37 = t35 + t36;
   const double t38 = sqrt(t37);
   const double t39 = 1.0 / t38;
   const double t40 = t32 - t39;
   const double t41 = 0.5 * t16;
   const double t42 = t40 + t41;
+  /* H */
   out[0] = t42;
 }
 
@@ -2001,16 +2021,15 @@ static void satellites_k6s3_g(const double *q0, const double *p0, const double *
     const double *g0, const satellites_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
-  const double t1 = q0[1] - q0[4];
-  const double t2 = q0[2] - q0[5];
-  const double t3 = q0[3] - q0[6];
-  const double t4 = q0[4] - q0[7];
-  const double t5 = q0[5] - q0[8];
-  const double t6 = q0[6] - q0[0];
-  const double t7 = q0[7] - q0[1];
-  const double t8 = q0[8] - q0[2];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
   /* g(q0) */
   const double t9 = t0 * t0;
   const double t10 = t1 * t1;
@@ -2030,6 +2049,7 @@ static void satellites_k6s3_g(const double *q0, const double *p0, const double *
   const double t24 = t8 * t8;
   const double t25 = t23 + t24;
   const double t26 = t25 - 1.0;
+  /* g */
   out[0] = t14;
   out[1] = t20;
   out[2] = t26;
@@ -2040,60 +2060,60 @@ static void satellites_k6s3_hidden_kernel(const double *q0, const double *p0, co
     const double *g0, const satellites_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
   /* hidden constraints */
-  const double t18 = t1 * p0[0];
-  const double t19 = t3 * p0[1];
+  const double t18 = t1 * p0[0] /* p_x1 */;
+  const double t19 = t3 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t5 * p0[2];
+  const double t21 = t5 * p0[2] /* p_z1 */;
   const double t22 = t20 + t21;
-  const double t23 = t1 * p0[3];
+  const double t23 = t1 * p0[3] /* p_x2 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[4];
+  const double t25 = t3 * p0[4] /* p_y2 */;
   const double t26 = t24 - t25;
-  const double t27 = t5 * p0[5];
+  const double t27 = t5 * p0[5] /* p_z2 */;
   const double t28 = t26 - t27;
-  const double t29 = t7 * p0[3];
-  const double t30 = t9 * p0[4];
+  const double t29 = t7 * p0[3] /* p_x2 */;
+  const double t30 = t9 * p0[4] /* p_y2 */;
   const double t31 = t29 + t30;
-  const double t32 = t11 * p0[5];
+  const double t32 = t11 * p0[5] /* p_z2 */;
   const double t33 = t31 + t32;
-  const double t34 = t7 * p0[6];
+  const double t34 = t7 * p0[6] /* p_x3 */;
   const double t35 = t33 - t34;
-  const double t36 = t9 * p0[7];
+  const double t36 = t9 * p0[7] /* p_y3 */;
   const double t37 = t35 - t36;
-  const double t38 = t11 * p0[8];
+  const double t38 = t11 * p0[8] /* p_z3 */;
   const double t39 = t37 - t38;
-  const double t40 = t13 * p0[0];
+  const double t40 = t13 * p0[0] /* p_x1 */;
   const double t41 = -t40;
-  const double t42 = t15 * p0[1];
+  const double t42 = t15 * p0[1] /* p_y1 */;
   const double t43 = t41 - t42;
-  const double t44 = t17 * p0[2];
+  const double t44 = t17 * p0[2] /* p_z1 */;
   const double t45 = t43 - t44;
-  const double t46 = t13 * p0[6];
+  const double t46 = t13 * p0[6] /* p_x3 */;
   const double t47 = t45 + t46;
-  const double t48 = t15 * p0[7];
+  const double t48 = t15 * p0[7] /* p_y3 */;
   const double t49 = t47 + t48;
-  const double t50 = t17 * p0[8];
+  const double t50 = t17 * p0[8] /* p_z3 */;
   const double t51 = t49 + t50;
+  /* hidden */
   out[0] = t28;
   out[1] = t39;
   out[2] = t51;
@@ -2105,44 +2125,42 @@ static void satellites_k6s3_lambda0(const double *q0, const double *p0, const do
     const double *g0, const satellites_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* energy */
-  const double t18 = q0[0] * q0[0];
-  const double t19 = q0[1] * q0[1];
+  const double t18 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t19 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t20 = t18 + t19;
-  const double t21 = q0[2] * q0[2];
+  const double t21 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t22 = t20 + t21;
   const double t23 = sqrt(t22);
   const double t24 = 1.0 / t23;
-  const double t25 = q0[3] * q0[3];
-  const double t26 = q0[4] * q0[4];
+  const double t25 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t26 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t27 = t25 + t26;
-  const double t28 = q0[5] * q0[5];
+  const double t28 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t29 = t27 + t28;
   const double t30 = sqrt(t29);
   const double t31 = 1.0 / t30;
-  const double t32 = q0[6] * q0[6];
-  const double t33 = q0[7] * q0[7];
+  const double t32 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t33 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t34 = t32 + t33;
-  const double t35 = q0[8] * q0[8];
+  const double t35 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t36 = t34 + t35;
   const double t37 = sqrt(t36);
   const double t38 = 1.0 / t37;
@@ -2150,29 +2168,29 @@ static void satellites_k6s3_lambda0(const double *q0, const double *p0, const do
   const double t39 = t38 * t38;
   const double t40 = 0.5 * t39;
   const double t41 = t38 * t40;
-  const double t42 = 2.0 * q0[8];
+  const double t42 = 2.0 * q0[8] /* z3 */;
   const double t43 = t41 * t42;
-  const double t44 = 2.0 * q0[7];
+  const double t44 = 2.0 * q0[7] /* y3 */;
   const double t45 = t41 * t44;
-  const double t46 = 2.0 * q0[6];
+  const double t46 = 2.0 * q0[6] /* x3 */;
   const double t47 = t41 * t46;
   const double t48 = t31 * t31;
   const double t49 = 0.5 * t48;
   const double t50 = t31 * t49;
-  const double t51 = 2.0 * q0[5];
+  const double t51 = 2.0 * q0[5] /* z2 */;
   const double t52 = t50 * t51;
-  const double t53 = 2.0 * q0[4];
+  const double t53 = 2.0 * q0[4] /* y2 */;
   const double t54 = t50 * t53;
-  const double t55 = 2.0 * q0[3];
+  const double t55 = 2.0 * q0[3] /* x2 */;
   const double t56 = t50 * t55;
   const double t57 = t24 * t24;
   const double t58 = 0.5 * t57;
   const double t59 = t24 * t58;
-  const double t60 = 2.0 * q0[2];
+  const double t60 = 2.0 * q0[2] /* z1 */;
   const double t61 = t59 * t60;
-  const double t62 = 2.0 * q0[1];
+  const double t62 = 2.0 * q0[1] /* y1 */;
   const double t63 = t59 * t62;
-  const double t64 = 2.0 * q0[0];
+  const double t64 = 2.0 * q0[0] /* x1 */;
   const double t65 = t59 * t64;
   const double t66 = t1 * t1;
   const double t67 = t1 * t13;
@@ -2216,91 +2234,91 @@ static void satellites_k6s3_lambda0(const double *q0, const double *p0, const do
   const double t105 = t100 + t104;
   const double t106 = t101 + t105;
   const double t107 = t103 + t106;
-  const double t108 = p0[2] - p0[5];
-  const double t109 = p0[1] - p0[4];
-  const double t110 = p0[0] - p0[3];
+  const double t108 = p0[2] /* p_z1 */ - p0[5] /* p_z2 */;
+  const double t109 = p0[1] /* p_y1 */ - p0[4] /* p_y2 */;
+  const double t110 = p0[0] /* p_x1 */ - p0[3] /* p_x2 */;
   const double t111 = 2.0 * t110;
   const double t112 = 2.0 * t109;
   const double t113 = 2.0 * t108;
-  const double t114 = p0[0] * t111;
+  const double t114 = p0[0] /* p_x1 */ * t111;
   const double t115 = t1 * t65;
-  const double t116 = p0[1] * t112;
+  const double t116 = p0[1] /* p_y1 */ * t112;
   const double t117 = t114 + t116;
   const double t118 = t3 * t63;
   const double t119 = t115 + t118;
-  const double t120 = p0[2] * t113;
+  const double t120 = p0[2] /* p_z1 */ * t113;
   const double t121 = t117 + t120;
   const double t122 = t5 * t61;
   const double t123 = t119 + t122;
-  const double t124 = p0[3] * t111;
+  const double t124 = p0[3] /* p_x2 */ * t111;
   const double t125 = t121 - t124;
   const double t126 = t1 * t56;
   const double t127 = t123 - t126;
-  const double t128 = p0[4] * t112;
+  const double t128 = p0[4] /* p_y2 */ * t112;
   const double t129 = t125 - t128;
   const double t130 = t3 * t54;
   const double t131 = t127 - t130;
-  const double t132 = p0[5] * t113;
+  const double t132 = p0[5] /* p_z2 */ * t113;
   const double t133 = t129 - t132;
   const double t134 = t5 * t52;
   const double t135 = t131 - t134;
   const double t136 = t133 - t135;
-  const double t137 = p0[5] - p0[8];
-  const double t138 = p0[4] - p0[7];
-  const double t139 = p0[3] - p0[6];
+  const double t137 = p0[5] /* p_z2 */ - p0[8] /* p_z3 */;
+  const double t138 = p0[4] /* p_y2 */ - p0[7] /* p_y3 */;
+  const double t139 = p0[3] /* p_x2 */ - p0[6] /* p_x3 */;
   const double t140 = 2.0 * t139;
   const double t141 = 2.0 * t138;
   const double t142 = 2.0 * t137;
-  const double t143 = p0[3] * t140;
+  const double t143 = p0[3] /* p_x2 */ * t140;
   const double t144 = t7 * t56;
-  const double t145 = p0[4] * t141;
+  const double t145 = p0[4] /* p_y2 */ * t141;
   const double t146 = t143 + t145;
   const double t147 = t9 * t54;
   const double t148 = t144 + t147;
-  const double t149 = p0[5] * t142;
+  const double t149 = p0[5] /* p_z2 */ * t142;
   const double t150 = t146 + t149;
   const double t151 = t11 * t52;
   const double t152 = t148 + t151;
-  const double t153 = p0[6] * t140;
+  const double t153 = p0[6] /* p_x3 */ * t140;
   const double t154 = t150 - t153;
   const double t155 = t7 * t47;
   const double t156 = t152 - t155;
-  const double t157 = p0[7] * t141;
+  const double t157 = p0[7] /* p_y3 */ * t141;
   const double t158 = t154 - t157;
   const double t159 = t9 * t45;
   const double t160 = t156 - t159;
-  const double t161 = p0[8] * t142;
+  const double t161 = p0[8] /* p_z3 */ * t142;
   const double t162 = t158 - t161;
   const double t163 = t11 * t43;
   const double t164 = t160 - t163;
   const double t165 = t162 - t164;
-  const double t166 = p0[8] - p0[2];
-  const double t167 = p0[7] - p0[1];
-  const double t168 = p0[6] - p0[0];
+  const double t166 = p0[8] /* p_z3 */ - p0[2] /* p_z1 */;
+  const double t167 = p0[7] /* p_y3 */ - p0[1] /* p_y1 */;
+  const double t168 = p0[6] /* p_x3 */ - p0[0] /* p_x1 */;
   const double t169 = 2.0 * t168;
   const double t170 = 2.0 * t167;
   const double t171 = 2.0 * t166;
-  const double t172 = p0[0] * t169;
+  const double t172 = p0[0] /* p_x1 */ * t169;
   const double t173 = -t172;
   const double t174 = t13 * t65;
   const double t175 = -t174;
-  const double t176 = p0[1] * t170;
+  const double t176 = p0[1] /* p_y1 */ * t170;
   const double t177 = t173 - t176;
   const double t178 = t15 * t63;
   const double t179 = t175 - t178;
-  const double t180 = p0[2] * t171;
+  const double t180 = p0[2] /* p_z1 */ * t171;
   const double t181 = t177 - t180;
   const double t182 = t17 * t61;
   const double t183 = t179 - t182;
-  const double t184 = p0[6] * t169;
+  const double t184 = p0[6] /* p_x3 */ * t169;
   const double t185 = t181 + t184;
   const double t186 = t13 * t47;
   const double t187 = t183 + t186;
-  const double t188 = p0[7] * t170;
+  const double t188 = p0[7] /* p_y3 */ * t170;
   const double t189 = t185 + t188;
   const double t190 = t15 * t45;
   const double t191 = t187 + t190;
-  const double t192 = p0[8] * t171;
+  const double t192 = p0[8] /* p_z3 */ * t171;
   const double t193 = t189 + t192;
   const double t194 = t17 * t43;
   const double t195 = t191 + t194;
@@ -2333,6 +2351,7 @@ static void satellites_k6s3_lambda0(const double *q0, const double *p0, const do
   const double t222 = t76 * t216;
   const double t223 = t221 - t222;
   const double t224 = t223 / t83;
+  /* lambda */
   out[0] = t224;
   out[1] = t219;
   out[2] = t216;
@@ -2347,19 +2366,19 @@ void satellites_k6s3_init(satellites_k6s3_state *x, const double *q0, const doub
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_k6s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : satellites_k6s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : satellites_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (satellites_k6s3_NU ? satellites_k6s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = 0;
   {
     satellites_k6s3_params prm;
-    double lam[NU];
+    double lam[satellites_k6s3_NU];
     satellites_k6s3_params_default(&prm);
     satellites_k6s3_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -2375,32 +2394,32 @@ const char *satellites_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) satellites_k6s3_params dflt_; if (!prm) { satellites_k6s3_params_default(&dflt_); prm = &dflt_; }
+#define satellites_k6s3_DEFAULT_PARAMS(prm) satellites_k6s3_params dflt_; if (!prm) { satellites_k6s3_params_default(&dflt_); prm = &dflt_; }
 
 double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s3_DEFAULT_PARAMS(prm)
   satellites_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H);
   return H;
 }
 
 void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *g)
 {
-  double v[NU];
+  double v[satellites_k6s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s3_DEFAULT_PARAMS(prm)
   satellites_k6s3_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < satellites_k6s3_NU; i++) g[i] = v[i];
 }
 
 void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *gp)
 {
-  double v[NU];
+  double v[satellites_k6s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s3_DEFAULT_PARAMS(prm)
   satellites_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < satellites_k6s3_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -2408,17 +2427,17 @@ void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s
 static void satellites_k6s3_predict(const satellites_k6s3_state *x, double h, const satellites_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_k6s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < satellites_k6s3_S; j++)
+    for (i = 0; i < satellites_k6s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + satellites_k6s3_E[(j * S + i) * S + d];
+      for (d = satellites_k6s3_S - 1; d >= 0; d--) e = e * r + satellites_k6s3_E[(j * satellites_k6s3_S + i) * satellites_k6s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < satellites_k6s3_M; l++) gam[j * satellites_k6s3_M + l] += e * x->gam[i * satellites_k6s3_M + l];
     }
 }
 
@@ -2435,60 +2454,63 @@ static void satellites_k6s3_add(double *a, double *c, double b)
 int satellites_k6s3_step(satellites_k6s3_state *x, double h_, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + 3 * NU + 1];
+  double gam[satellites_k6s3_S * satellites_k6s3_M], sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 3 * satellites_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = satellites_k6s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  satellites_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_k6s3_EBADSTEP;
   satellites_k6s3_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[satellites_k6s3_NU];
   satellites_k6s3_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below satellites_k6s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  for (it = 1; it <= MAXITER; it++) {
+  for (i = 0; i < satellites_k6s3_NU; i++) g0[i] = fabs(g0[i]) <= satellites_k6s3_GTOL ? 0 : g0[i] / h;
+  for (it = 1; it <= satellites_k6s3_MAXITER; it++) {
     satellites_k6s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < satellites_k6s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < NU; i++) {
-      double piv = sw[S * M + M + NU + i], dia = sw[S * M + M + 2 * NU + i];
-      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) rc = satellites_k6s3_ESINGULAR;
+    for (i = 0; i < satellites_k6s3_NU; i++) {
+      double piv = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + satellites_k6s3_NU + i], dia = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 2 * satellites_k6s3_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s3_SINGTOL * fabs(dia))) rc = satellites_k6s3_ESINGULAR;
     }
     if (rc == satellites_k6s3_ESINGULAR) break;
-    for (i = 0; i < S * M + M + NU; i++)
+    for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + satellites_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s3_ENONFINITE;
     if (rc == satellites_k6s3_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (satellites_k6s3_TOL / 256), or
+     * within 2 ulps (satellites_k6s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above satellites_k6s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = satellites_k6s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? satellites_k6s3_OK : satellites_k6s3_ENOCONV; break; }
+    if (inc <= satellites_k6s3_TOL / 256 || (inc <= satellites_k6s3_TOL && 4 * inc > inc_old)) { rc = satellites_k6s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= satellites_k6s3_STAGTOL ? satellites_k6s3_OK : satellites_k6s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > satellites_k6s3_MAXITER ? satellites_k6s3_MAXITER : it; st->increment = inc; }
   if (rc != satellites_k6s3_OK) return rc;
-  for (i = 0; i < M; i++) /* the new state must be finite too */
-    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[S * M + i])) return satellites_k6s3_ENONFINITE;
-  for (i = 0; i < M; i++) {
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s3_ENONFINITE;
+  for (i = 0; i < satellites_k6s3_M; i++) /* the new state must be finite too, compensations included */
+    if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s3_S * satellites_k6s3_M + i]) ||
+        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
+      return satellites_k6s3_ENONFINITE;
+  for (i = 0; i < satellites_k6s3_M; i++) {
     satellites_k6s3_add(&x->q[i], &x->qc[i], h * sw[i]);
-    satellites_k6s3_add(&x->p[i], &x->pc[i], sw[S * M + i]);
+    satellites_k6s3_add(&x->p[i], &x->pc[i], sw[satellites_k6s3_S * satellites_k6s3_M + i]);
   }
-  for (i = 0; i < NU; i++) x->lambda[i] = sw[S * M + M + i];
-  for (i = 0; i < S * M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + i];
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = gam[i];
   satellites_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s3_OK;

@@ -4,6 +4,10 @@
 #ifndef satellites_k6s3_H
 #define satellites_k6s3_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define satellites_k6s3_M 9      /* coordinates */
 #define satellites_k6s3_NU 3     /* constraints */
 #define satellites_k6s3_K 6      /* Gauss-Legendre nodes */
@@ -43,7 +47,11 @@ void satellites_k6s3_params_default(satellites_k6s3_params *prm);
 int satellites_k6s3_step(satellites_k6s3_state *x, double h, const satellites_k6s3_params *prm, satellites_k6s3_stats *st);
 const char *satellites_k6s3_strerror(int code);
 double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm);
-void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *g);   /* NU values */
+void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *g);   /* satellites_k6s3_NU values */
 void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

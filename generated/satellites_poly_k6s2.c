@@ -5,14 +5,27 @@
 
 #include "satellites_poly_k6s2.h"
 
-#define M satellites_poly_k6s2_M
-#define NU satellites_poly_k6s2_NU
-#define S satellites_poly_k6s2_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(satellites_poly_k6s2_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define satellites_poly_k6s2_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef satellites_poly_k6s2_MAXITER
+#define satellites_poly_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef satellites_poly_k6s2_TOL
+#define satellites_poly_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef satellites_poly_k6s2_STAGTOL
+#define satellites_poly_k6s2_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef satellites_poly_k6s2_SINGTOL
+#define satellites_poly_k6s2_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef satellites_poly_k6s2_GTOL
+#define satellites_poly_k6s2_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -40,47 +53,47 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t1 = gam[9] * (-0.056508419605012766);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x1 */ + t3;
   const double t5 = gam[1] * 0.033765242898423975;
   const double t6 = gam[10] * (-0.056508419605012766);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y1 */ + t8;
   const double t10 = gam[2] * 0.033765242898423975;
   const double t11 = gam[11] * (-0.056508419605012766);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* z1 */ + t13;
   const double t15 = gam[3] * 0.033765242898423975;
   const double t16 = gam[12] * (-0.056508419605012766);
   const double t17 = t15 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[3] + t18;
+  const double t19 = q0[3] /* x2 */ + t18;
   const double t20 = gam[4] * 0.033765242898423975;
   const double t21 = gam[13] * (-0.056508419605012766);
   const double t22 = t20 + t21;
   const double t23 = h * t22;
-  const double t24 = q0[4] + t23;
+  const double t24 = q0[4] /* y2 */ + t23;
   const double t25 = gam[5] * 0.033765242898423975;
   const double t26 = gam[14] * (-0.056508419605012766);
   const double t27 = t25 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[5] + t28;
+  const double t29 = q0[5] /* z2 */ + t28;
   const double t30 = gam[6] * 0.033765242898423975;
   const double t31 = gam[15] * (-0.056508419605012766);
   const double t32 = t30 + t31;
   const double t33 = h * t32;
-  const double t34 = q0[6] + t33;
+  const double t34 = q0[6] /* x3 */ + t33;
   const double t35 = gam[7] * 0.033765242898423975;
   const double t36 = gam[16] * (-0.056508419605012766);
   const double t37 = t35 + t36;
   const double t38 = h * t37;
-  const double t39 = q0[7] + t38;
+  const double t39 = q0[7] /* y3 */ + t38;
   const double t40 = gam[8] * 0.033765242898423975;
   const double t41 = gam[17] * (-0.056508419605012766);
   const double t42 = t40 + t41;
   const double t43 = h * t42;
-  const double t44 = q0[8] + t43;
+  const double t44 = q0[8] /* z3 */ + t43;
   const double t45 = t4 * t4;
   const double t46 = t9 * t9;
   const double t47 = t45 + t46;
@@ -152,47 +165,47 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t112 = gam[9] * (-0.24370047841099157);
   const double t113 = t111 + t112;
   const double t114 = h * t113;
-  const double t115 = q0[0] + t114;
+  const double t115 = q0[0] /* x1 */ + t114;
   const double t116 = gam[1] * 0.16939530676686776;
   const double t117 = gam[10] * (-0.24370047841099157);
   const double t118 = t116 + t117;
   const double t119 = h * t118;
-  const double t120 = q0[1] + t119;
+  const double t120 = q0[1] /* y1 */ + t119;
   const double t121 = gam[2] * 0.16939530676686776;
   const double t122 = gam[11] * (-0.24370047841099157);
   const double t123 = t121 + t122;
   const double t124 = h * t123;
-  const double t125 = q0[2] + t124;
+  const double t125 = q0[2] /* z1 */ + t124;
   const double t126 = gam[3] * 0.16939530676686776;
   const double t127 = gam[12] * (-0.24370047841099157);
   const double t128 = t126 + t127;
   const double t129 = h * t128;
-  const double t130 = q0[3] + t129;
+  const double t130 = q0[3] /* x2 */ + t129;
   const double t131 = gam[4] * 0.16939530676686776;
   const double t132 = gam[13] * (-0.24370047841099157);
   const double t133 = t131 + t132;
   const double t134 = h * t133;
-  const double t135 = q0[4] + t134;
+  const double t135 = q0[4] /* y2 */ + t134;
   const double t136 = gam[5] * 0.16939530676686776;
   const double t137 = gam[14] * (-0.24370047841099157);
   const double t138 = t136 + t137;
   const double t139 = h * t138;
-  const double t140 = q0[5] + t139;
+  const double t140 = q0[5] /* z2 */ + t139;
   const double t141 = gam[6] * 0.16939530676686776;
   const double t142 = gam[15] * (-0.24370047841099157);
   const double t143 = t141 + t142;
   const double t144 = h * t143;
-  const double t145 = q0[6] + t144;
+  const double t145 = q0[6] /* x3 */ + t144;
   const double t146 = gam[7] * 0.16939530676686776;
   const double t147 = gam[16] * (-0.24370047841099157);
   const double t148 = t146 + t147;
   const double t149 = h * t148;
-  const double t150 = q0[7] + t149;
+  const double t150 = q0[7] /* y3 */ + t149;
   const double t151 = gam[8] * 0.16939530676686776;
   const double t152 = gam[17] * (-0.24370047841099157);
   const double t153 = t151 + t152;
   const double t154 = h * t153;
-  const double t155 = q0[8] + t154;
+  const double t155 = q0[8] /* z3 */ + t154;
   const double t156 = t115 * t115;
   const double t157 = t120 * t120;
   const double t158 = t156 + t157;
@@ -282,47 +295,47 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t241 = gam[9] * (-0.40835734144399111);
   const double t242 = t240 + t241;
   const double t243 = h * t242;
-  const double t244 = q0[0] + t243;
+  const double t244 = q0[0] /* x1 */ + t243;
   const double t245 = gam[1] * 0.38069040695840156;
   const double t246 = gam[10] * (-0.40835734144399111);
   const double t247 = t245 + t246;
   const double t248 = h * t247;
-  const double t249 = q0[1] + t248;
+  const double t249 = q0[1] /* y1 */ + t248;
   const double t250 = gam[2] * 0.38069040695840156;
   const double t251 = gam[11] * (-0.40835734144399111);
   const double t252 = t250 + t251;
   const double t253 = h * t252;
-  const double t254 = q0[2] + t253;
+  const double t254 = q0[2] /* z1 */ + t253;
   const double t255 = gam[3] * 0.38069040695840156;
   const double t256 = gam[12] * (-0.40835734144399111);
   const double t257 = t255 + t256;
   const double t258 = h * t257;
-  const double t259 = q0[3] + t258;
+  const double t259 = q0[3] /* x2 */ + t258;
   const double t260 = gam[4] * 0.38069040695840156;
   const double t261 = gam[13] * (-0.40835734144399111);
   const double t262 = t260 + t261;
   const double t263 = h * t262;
-  const double t264 = q0[4] + t263;
+  const double t264 = q0[4] /* y2 */ + t263;
   const double t265 = gam[5] * 0.38069040695840156;
   const double t266 = gam[14] * (-0.40835734144399111);
   const double t267 = t265 + t266;
   const double t268 = h * t267;
-  const double t269 = q0[5] + t268;
+  const double t269 = q0[5] /* z2 */ + t268;
   const double t270 = gam[6] * 0.38069040695840156;
   const double t271 = gam[15] * (-0.40835734144399111);
   const double t272 = t270 + t271;
   const double t273 = h * t272;
-  const double t274 = q0[6] + t273;
+  const double t274 = q0[6] /* x3 */ + t273;
   const double t275 = gam[7] * 0.38069040695840156;
   const double t276 = gam[16] * (-0.40835734144399111);
   const double t277 = t275 + t276;
   const double t278 = h * t277;
-  const double t279 = q0[7] + t278;
+  const double t279 = q0[7] /* y3 */ + t278;
   const double t280 = gam[8] * 0.38069040695840156;
   const double t281 = gam[17] * (-0.40835734144399111);
   const double t282 = t280 + t281;
   const double t283 = h * t282;
-  const double t284 = q0[8] + t283;
+  const double t284 = q0[8] /* z3 */ + t283;
   const double t285 = t244 * t244;
   const double t286 = t249 * t249;
   const double t287 = t285 + t286;
@@ -412,47 +425,47 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t370 = gam[9] * (-0.40835734144399105);
   const double t371 = t369 + t370;
   const double t372 = h * t371;
-  const double t373 = q0[0] + t372;
+  const double t373 = q0[0] /* x1 */ + t372;
   const double t374 = gam[1] * 0.61930959304159849;
   const double t375 = gam[10] * (-0.40835734144399105);
   const double t376 = t374 + t375;
   const double t377 = h * t376;
-  const double t378 = q0[1] + t377;
+  const double t378 = q0[1] /* y1 */ + t377;
   const double t379 = gam[2] * 0.61930959304159849;
   const double t380 = gam[11] * (-0.40835734144399105);
   const double t381 = t379 + t380;
   const double t382 = h * t381;
-  const double t383 = q0[2] + t382;
+  const double t383 = q0[2] /* z1 */ + t382;
   const double t384 = gam[3] * 0.61930959304159849;
   const double t385 = gam[12] * (-0.40835734144399105);
   const double t386 = t384 + t385;
   const double t387 = h * t386;
-  const double t388 = q0[3] + t387;
+  const double t388 = q0[3] /* x2 */ + t387;
   const double t389 = gam[4] * 0.61930959304159849;
   const double t390 = gam[13] * (-0.40835734144399105);
   const double t391 = t389 + t390;
   const double t392 = h * t391;
-  const double t393 = q0[4] + t392;
+  const double t393 = q0[4] /* y2 */ + t392;
   const double t394 = gam[5] * 0.61930959304159849;
   const double t395 = gam[14] * (-0.40835734144399105);
   const double t396 = t394 + t395;
   const double t397 = h * t396;
-  const double t398 = q0[5] + t397;
+  const double t398 = q0[5] /* z2 */ + t397;
   const double t399 = gam[6] * 0.61930959304159849;
   const double t400 = gam[15] * (-0.40835734144399105);
   const double t401 = t399 + t400;
   const double t402 = h * t401;
-  const double t403 = q0[6] + t402;
+  const double t403 = q0[6] /* x3 */ + t402;
   const double t404 = gam[7] * 0.61930959304159849;
   const double t405 = gam[16] * (-0.40835734144399105);
   const double t406 = t404 + t405;
   const double t407 = h * t406;
-  const double t408 = q0[7] + t407;
+  const double t408 = q0[7] /* y3 */ + t407;
   const double t409 = gam[8] * 0.61930959304159849;
   const double t410 = gam[17] * (-0.40835734144399105);
   const double t411 = t409 + t410;
   const double t412 = h * t411;
-  const double t413 = q0[8] + t412;
+  const double t413 = q0[8] /* z3 */ + t412;
   const double t414 = t373 * t373;
   const double t415 = t378 * t378;
   const double t416 = t414 + t415;
@@ -541,39 +554,39 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t498 = gam[0] * 0.83060469323313224;
   const double t499 = t112 + t498;
   const double t500 = h * t499;
-  const double t501 = q0[0] + t500;
+  const double t501 = q0[0] /* x1 */ + t500;
   const double t502 = gam[1] * 0.83060469323313224;
   const double t503 = t117 + t502;
   const double t504 = h * t503;
-  const double t505 = q0[1] + t504;
+  const double t505 = q0[1] /* y1 */ + t504;
   const double t506 = gam[2] * 0.83060469323313224;
   const double t507 = t122 + t506;
   const double t508 = h * t507;
-  const double t509 = q0[2] + t508;
+  const double t509 = q0[2] /* z1 */ + t508;
   const double t510 = gam[3] * 0.83060469323313224;
   const double t511 = t127 + t510;
   const double t512 = h * t511;
-  const double t513 = q0[3] + t512;
+  const double t513 = q0[3] /* x2 */ + t512;
   const double t514 = gam[4] * 0.83060469323313224;
   const double t515 = t132 + t514;
   const double t516 = h * t515;
-  const double t517 = q0[4] + t516;
+  const double t517 = q0[4] /* y2 */ + t516;
   const double t518 = gam[5] * 0.83060469323313224;
   const double t519 = t137 + t518;
   const double t520 = h * t519;
-  const double t521 = q0[5] + t520;
+  const double t521 = q0[5] /* z2 */ + t520;
   const double t522 = gam[6] * 0.83060469323313224;
   const double t523 = t142 + t522;
   const double t524 = h * t523;
-  const double t525 = q0[6] + t524;
+  const double t525 = q0[6] /* x3 */ + t524;
   const double t526 = gam[7] * 0.83060469323313224;
   const double t527 = t147 + t526;
   const double t528 = h * t527;
-  const double t529 = q0[7] + t528;
+  const double t529 = q0[7] /* y3 */ + t528;
   const double t530 = gam[8] * 0.83060469323313224;
   const double t531 = t152 + t530;
   const double t532 = h * t531;
-  const double t533 = q0[8] + t532;
+  const double t533 = q0[8] /* z3 */ + t532;
   const double t534 = t501 * t501;
   const double t535 = t505 * t505;
   const double t536 = t534 + t535;
@@ -662,39 +675,39 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t618 = gam[0] * 0.96623475710157603;
   const double t619 = t1 + t618;
   const double t620 = h * t619;
-  const double t621 = q0[0] + t620;
+  const double t621 = q0[0] /* x1 */ + t620;
   const double t622 = gam[1] * 0.96623475710157603;
   const double t623 = t6 + t622;
   const double t624 = h * t623;
-  const double t625 = q0[1] + t624;
+  const double t625 = q0[1] /* y1 */ + t624;
   const double t626 = gam[2] * 0.96623475710157603;
   const double t627 = t11 + t626;
   const double t628 = h * t627;
-  const double t629 = q0[2] + t628;
+  const double t629 = q0[2] /* z1 */ + t628;
   const double t630 = gam[3] * 0.96623475710157603;
   const double t631 = t16 + t630;
   const double t632 = h * t631;
-  const double t633 = q0[3] + t632;
+  const double t633 = q0[3] /* x2 */ + t632;
   const double t634 = gam[4] * 0.96623475710157603;
   const double t635 = t21 + t634;
   const double t636 = h * t635;
-  const double t637 = q0[4] + t636;
+  const double t637 = q0[4] /* y2 */ + t636;
   const double t638 = gam[5] * 0.96623475710157603;
   const double t639 = t26 + t638;
   const double t640 = h * t639;
-  const double t641 = q0[5] + t640;
+  const double t641 = q0[5] /* z2 */ + t640;
   const double t642 = gam[6] * 0.96623475710157603;
   const double t643 = t31 + t642;
   const double t644 = h * t643;
-  const double t645 = q0[6] + t644;
+  const double t645 = q0[6] /* x3 */ + t644;
   const double t646 = gam[7] * 0.96623475710157603;
   const double t647 = t36 + t646;
   const double t648 = h * t647;
-  const double t649 = q0[7] + t648;
+  const double t649 = q0[7] /* y3 */ + t648;
   const double t650 = gam[8] * 0.96623475710157603;
   const double t651 = t41 + t650;
   const double t652 = h * t651;
-  const double t653 = q0[8] + t652;
+  const double t653 = q0[8] /* z3 */ + t652;
   const double t654 = t621 * t621;
   const double t655 = t625 * t625;
   const double t656 = t654 + t655;
@@ -1262,47 +1275,47 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t1207 = 0.28867513459481292 * t1189;
   const double t1208 = t1206 - t1207;
   const double t1209 = h * t1208;
-  const double t1210 = p0[0] - t1209;
+  const double t1210 = p0[0] /* p_x1 */ - t1209;
   const double t1211 = 0.5 * t1173;
   const double t1212 = 0.28867513459481292 * t1191;
   const double t1213 = t1211 - t1212;
   const double t1214 = h * t1213;
-  const double t1215 = p0[1] - t1214;
+  const double t1215 = p0[1] /* p_y1 */ - t1214;
   const double t1216 = 0.5 * t1175;
   const double t1217 = 0.28867513459481292 * t1193;
   const double t1218 = t1216 - t1217;
   const double t1219 = h * t1218;
-  const double t1220 = p0[2] - t1219;
+  const double t1220 = p0[2] /* p_z1 */ - t1219;
   const double t1221 = 0.5 * t1177;
   const double t1222 = 0.28867513459481292 * t1195;
   const double t1223 = t1221 - t1222;
   const double t1224 = h * t1223;
-  const double t1225 = p0[3] - t1224;
+  const double t1225 = p0[3] /* p_x2 */ - t1224;
   const double t1226 = 0.5 * t1179;
   const double t1227 = 0.28867513459481292 * t1197;
   const double t1228 = t1226 - t1227;
   const double t1229 = h * t1228;
-  const double t1230 = p0[4] - t1229;
+  const double t1230 = p0[4] /* p_y2 */ - t1229;
   const double t1231 = 0.5 * t1181;
   const double t1232 = 0.28867513459481292 * t1199;
   const double t1233 = t1231 - t1232;
   const double t1234 = h * t1233;
-  const double t1235 = p0[5] - t1234;
+  const double t1235 = p0[5] /* p_z2 */ - t1234;
   const double t1236 = 0.5 * t1183;
   const double t1237 = 0.28867513459481292 * t1201;
   const double t1238 = t1236 - t1237;
   const double t1239 = h * t1238;
-  const double t1240 = p0[6] - t1239;
+  const double t1240 = p0[6] /* p_x3 */ - t1239;
   const double t1241 = 0.5 * t1185;
   const double t1242 = 0.28867513459481292 * t1203;
   const double t1243 = t1241 - t1242;
   const double t1244 = h * t1243;
-  const double t1245 = p0[7] - t1244;
+  const double t1245 = p0[7] /* p_y3 */ - t1244;
   const double t1246 = 0.5 * t1187;
   const double t1247 = 0.28867513459481292 * t1205;
   const double t1248 = t1246 - t1247;
   const double t1249 = h * t1248;
-  const double t1250 = p0[8] - t1249;
+  const double t1250 = p0[8] /* p_z3 */ - t1249;
   const double t1251 = 0.28867513459481292 * t1171;
   const double t1252 = h * t1251;
   const double t1253 = 0.28867513459481292 * t1173;
@@ -2086,6 +2099,7 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t1998 = 0.1803807865240693 * t1983;
   const double t1999 = t1939 + t1998;
   w[41] = t1999;
+  /* lam */
   out[27] = t1716;
   out[28] = t1717;
   out[29] = t1718;
@@ -2185,47 +2199,47 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   const double t2083 = 0.28867513459481292 * t2065;
   const double t2084 = t2082 - t2083;
   const double t2085 = h * t2084;
-  const double t2086 = p0[0] - t2085;
+  const double t2086 = p0[0] /* p_x1 */ - t2085;
   const double t2087 = 0.5 * t2049;
   const double t2088 = 0.28867513459481292 * t2067;
   const double t2089 = t2087 - t2088;
   const double t2090 = h * t2089;
-  const double t2091 = p0[1] - t2090;
+  const double t2091 = p0[1] /* p_y1 */ - t2090;
   const double t2092 = 0.5 * t2051;
   const double t2093 = 0.28867513459481292 * t2069;
   const double t2094 = t2092 - t2093;
   const double t2095 = h * t2094;
-  const double t2096 = p0[2] - t2095;
+  const double t2096 = p0[2] /* p_z1 */ - t2095;
   const double t2097 = 0.5 * t2053;
   const double t2098 = 0.28867513459481292 * t2071;
   const double t2099 = t2097 - t2098;
   const double t2100 = h * t2099;
-  const double t2101 = p0[3] - t2100;
+  const double t2101 = p0[3] /* p_x2 */ - t2100;
   const double t2102 = 0.5 * t2055;
   const double t2103 = 0.28867513459481292 * t2073;
   const double t2104 = t2102 - t2103;
   const double t2105 = h * t2104;
-  const double t2106 = p0[4] - t2105;
+  const double t2106 = p0[4] /* p_y2 */ - t2105;
   const double t2107 = 0.5 * t2057;
   const double t2108 = 0.28867513459481292 * t2075;
   const double t2109 = t2107 - t2108;
   const double t2110 = h * t2109;
-  const double t2111 = p0[5] - t2110;
+  const double t2111 = p0[5] /* p_z2 */ - t2110;
   const double t2112 = 0.5 * t2059;
   const double t2113 = 0.28867513459481292 * t2077;
   const double t2114 = t2112 - t2113;
   const double t2115 = h * t2114;
-  const double t2116 = p0[6] - t2115;
+  const double t2116 = p0[6] /* p_x3 */ - t2115;
   const double t2117 = 0.5 * t2061;
   const double t2118 = 0.28867513459481292 * t2079;
   const double t2119 = t2117 - t2118;
   const double t2120 = h * t2119;
-  const double t2121 = p0[7] - t2120;
+  const double t2121 = p0[7] /* p_y3 */ - t2120;
   const double t2122 = 0.5 * t2063;
   const double t2123 = 0.28867513459481292 * t2081;
   const double t2124 = t2122 - t2123;
   const double t2125 = h * t2124;
-  const double t2126 = p0[8] - t2125;
+  const double t2126 = p0[8] /* p_z3 */ - t2125;
   const double t2127 = 0.28867513459481292 * t2047;
   const double t2128 = h * t2127;
   const double t2129 = -t2128;
@@ -2271,6 +2285,7 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   const double t2169 = -t2168;
   const double t2170 = h * t2063;
   const double t2171 = -t2170;
+  /* gam */
   out[0] = t2086;
   out[1] = t2091;
   out[2] = t2096;
@@ -2289,6 +2304,7 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   out[15] = t2147;
   out[16] = t2150;
   out[17] = t2153;
+  /* dp */
   out[18] = t2155;
   out[19] = t2157;
   out[20] = t2159;
@@ -2321,259 +2337,259 @@ static void satellites_poly_k6s2_factor(const double *q0, const double *p0, cons
   const double t1 = gam[9] * (-0.056508419605012766);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
-  const double t4 = q0[0] + t3;
+  const double t4 = q0[0] /* x1 */ + t3;
   const double t5 = gam[1] * 0.033765242898423975;
   const double t6 = gam[10] * (-0.056508419605012766);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
-  const double t9 = q0[1] + t8;
+  const double t9 = q0[1] /* y1 */ + t8;
   const double t10 = gam[2] * 0.033765242898423975;
   const double t11 = gam[11] * (-0.056508419605012766);
   const double t12 = t10 + t11;
   const double t13 = h * t12;
-  const double t14 = q0[2] + t13;
+  const double t14 = q0[2] /* z1 */ + t13;
   const double t15 = gam[3] * 0.033765242898423975;
   const double t16 = gam[12] * (-0.056508419605012766);
   const double t17 = t15 + t16;
   const double t18 = h * t17;
-  const double t19 = q0[3] + t18;
+  const double t19 = q0[3] /* x2 */ + t18;
   const double t20 = gam[4] * 0.033765242898423975;
   const double t21 = gam[13] * (-0.056508419605012766);
   const double t22 = t20 + t21;
   const double t23 = h * t22;
-  const double t24 = q0[4] + t23;
+  const double t24 = q0[4] /* y2 */ + t23;
   const double t25 = gam[5] * 0.033765242898423975;
   const double t26 = gam[14] * (-0.056508419605012766);
   const double t27 = t25 + t26;
   const double t28 = h * t27;
-  const double t29 = q0[5] + t28;
+  const double t29 = q0[5] /* z2 */ + t28;
   const double t30 = gam[6] * 0.033765242898423975;
   const double t31 = gam[15] * (-0.056508419605012766);
   const double t32 = t30 + t31;
   const double t33 = h * t32;
-  const double t34 = q0[6] + t33;
+  const double t34 = q0[6] /* x3 */ + t33;
   const double t35 = gam[7] * 0.033765242898423975;
   const double t36 = gam[16] * (-0.056508419605012766);
   const double t37 = t35 + t36;
   const double t38 = h * t37;
-  const double t39 = q0[7] + t38;
+  const double t39 = q0[7] /* y3 */ + t38;
   const double t40 = gam[8] * 0.033765242898423975;
   const double t41 = gam[17] * (-0.056508419605012766);
   const double t42 = t40 + t41;
   const double t43 = h * t42;
-  const double t44 = q0[8] + t43;
+  const double t44 = q0[8] /* z3 */ + t43;
   /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t45 = gam[0] * 0.16939530676686776;
   const double t46 = gam[9] * (-0.24370047841099157);
   const double t47 = t45 + t46;
   const double t48 = h * t47;
-  const double t49 = q0[0] + t48;
+  const double t49 = q0[0] /* x1 */ + t48;
   const double t50 = gam[1] * 0.16939530676686776;
   const double t51 = gam[10] * (-0.24370047841099157);
   const double t52 = t50 + t51;
   const double t53 = h * t52;
-  const double t54 = q0[1] + t53;
+  const double t54 = q0[1] /* y1 */ + t53;
   const double t55 = gam[2] * 0.16939530676686776;
   const double t56 = gam[11] * (-0.24370047841099157);
   const double t57 = t55 + t56;
   const double t58 = h * t57;
-  const double t59 = q0[2] + t58;
+  const double t59 = q0[2] /* z1 */ + t58;
   const double t60 = gam[3] * 0.16939530676686776;
   const double t61 = gam[12] * (-0.24370047841099157);
   const double t62 = t60 + t61;
   const double t63 = h * t62;
-  const double t64 = q0[3] + t63;
+  const double t64 = q0[3] /* x2 */ + t63;
   const double t65 = gam[4] * 0.16939530676686776;
   const double t66 = gam[13] * (-0.24370047841099157);
   const double t67 = t65 + t66;
   const double t68 = h * t67;
-  const double t69 = q0[4] + t68;
+  const double t69 = q0[4] /* y2 */ + t68;
   const double t70 = gam[5] * 0.16939530676686776;
   const double t71 = gam[14] * (-0.24370047841099157);
   const double t72 = t70 + t71;
   const double t73 = h * t72;
-  const double t74 = q0[5] + t73;
+  const double t74 = q0[5] /* z2 */ + t73;
   const double t75 = gam[6] * 0.16939530676686776;
   const double t76 = gam[15] * (-0.24370047841099157);
   const double t77 = t75 + t76;
   const double t78 = h * t77;
-  const double t79 = q0[6] + t78;
+  const double t79 = q0[6] /* x3 */ + t78;
   const double t80 = gam[7] * 0.16939530676686776;
   const double t81 = gam[16] * (-0.24370047841099157);
   const double t82 = t80 + t81;
   const double t83 = h * t82;
-  const double t84 = q0[7] + t83;
+  const double t84 = q0[7] /* y3 */ + t83;
   const double t85 = gam[8] * 0.16939530676686776;
   const double t86 = gam[17] * (-0.24370047841099157);
   const double t87 = t85 + t86;
   const double t88 = h * t87;
-  const double t89 = q0[8] + t88;
+  const double t89 = q0[8] /* z3 */ + t88;
   /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
   const double t90 = gam[0] * 0.38069040695840156;
   const double t91 = gam[9] * (-0.40835734144399111);
   const double t92 = t90 + t91;
   const double t93 = h * t92;
-  const double t94 = q0[0] + t93;
+  const double t94 = q0[0] /* x1 */ + t93;
   const double t95 = gam[1] * 0.38069040695840156;
   const double t96 = gam[10] * (-0.40835734144399111);
   const double t97 = t95 + t96;
   const double t98 = h * t97;
-  const double t99 = q0[1] + t98;
+  const double t99 = q0[1] /* y1 */ + t98;
   const double t100 = gam[2] * 0.38069040695840156;
   const double t101 = gam[11] * (-0.40835734144399111);
   const double t102 = t100 + t101;
   const double t103 = h * t102;
-  const double t104 = q0[2] + t103;
+  const double t104 = q0[2] /* z1 */ + t103;
   const double t105 = gam[3] * 0.38069040695840156;
   const double t106 = gam[12] * (-0.40835734144399111);
   const double t107 = t105 + t106;
   const double t108 = h * t107;
-  const double t109 = q0[3] + t108;
+  const double t109 = q0[3] /* x2 */ + t108;
   const double t110 = gam[4] * 0.38069040695840156;
   const double t111 = gam[13] * (-0.40835734144399111);
   const double t112 = t110 + t111;
   const double t113 = h * t112;
-  const double t114 = q0[4] + t113;
+  const double t114 = q0[4] /* y2 */ + t113;
   const double t115 = gam[5] * 0.38069040695840156;
   const double t116 = gam[14] * (-0.40835734144399111);
   const double t117 = t115 + t116;
   const double t118 = h * t117;
-  const double t119 = q0[5] + t118;
+  const double t119 = q0[5] /* z2 */ + t118;
   const double t120 = gam[6] * 0.38069040695840156;
   const double t121 = gam[15] * (-0.40835734144399111);
   const double t122 = t120 + t121;
   const double t123 = h * t122;
-  const double t124 = q0[6] + t123;
+  const double t124 = q0[6] /* x3 */ + t123;
   const double t125 = gam[7] * 0.38069040695840156;
   const double t126 = gam[16] * (-0.40835734144399111);
   const double t127 = t125 + t126;
   const double t128 = h * t127;
-  const double t129 = q0[7] + t128;
+  const double t129 = q0[7] /* y3 */ + t128;
   const double t130 = gam[8] * 0.38069040695840156;
   const double t131 = gam[17] * (-0.40835734144399111);
   const double t132 = t130 + t131;
   const double t133 = h * t132;
-  const double t134 = q0[8] + t133;
+  const double t134 = q0[8] /* z3 */ + t133;
   /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
   const double t135 = gam[0] * 0.61930959304159849;
   const double t136 = gam[9] * (-0.40835734144399105);
   const double t137 = t135 + t136;
   const double t138 = h * t137;
-  const double t139 = q0[0] + t138;
+  const double t139 = q0[0] /* x1 */ + t138;
   const double t140 = gam[1] * 0.61930959304159849;
   const double t141 = gam[10] * (-0.40835734144399105);
   const double t142 = t140 + t141;
   const double t143 = h * t142;
-  const double t144 = q0[1] + t143;
+  const double t144 = q0[1] /* y1 */ + t143;
   const double t145 = gam[2] * 0.61930959304159849;
   const double t146 = gam[11] * (-0.40835734144399105);
   const double t147 = t145 + t146;
   const double t148 = h * t147;
-  const double t149 = q0[2] + t148;
+  const double t149 = q0[2] /* z1 */ + t148;
   const double t150 = gam[3] * 0.61930959304159849;
   const double t151 = gam[12] * (-0.40835734144399105);
   const double t152 = t150 + t151;
   const double t153 = h * t152;
-  const double t154 = q0[3] + t153;
+  const double t154 = q0[3] /* x2 */ + t153;
   const double t155 = gam[4] * 0.61930959304159849;
   const double t156 = gam[13] * (-0.40835734144399105);
   const double t157 = t155 + t156;
   const double t158 = h * t157;
-  const double t159 = q0[4] + t158;
+  const double t159 = q0[4] /* y2 */ + t158;
   const double t160 = gam[5] * 0.61930959304159849;
   const double t161 = gam[14] * (-0.40835734144399105);
   const double t162 = t160 + t161;
   const double t163 = h * t162;
-  const double t164 = q0[5] + t163;
+  const double t164 = q0[5] /* z2 */ + t163;
   const double t165 = gam[6] * 0.61930959304159849;
   const double t166 = gam[15] * (-0.40835734144399105);
   const double t167 = t165 + t166;
   const double t168 = h * t167;
-  const double t169 = q0[6] + t168;
+  const double t169 = q0[6] /* x3 */ + t168;
   const double t170 = gam[7] * 0.61930959304159849;
   const double t171 = gam[16] * (-0.40835734144399105);
   const double t172 = t170 + t171;
   const double t173 = h * t172;
-  const double t174 = q0[7] + t173;
+  const double t174 = q0[7] /* y3 */ + t173;
   const double t175 = gam[8] * 0.61930959304159849;
   const double t176 = gam[17] * (-0.40835734144399105);
   const double t177 = t175 + t176;
   const double t178 = h * t177;
-  const double t179 = q0[8] + t178;
+  const double t179 = q0[8] /* z3 */ + t178;
   /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
   const double t180 = gam[0] * 0.83060469323313224;
   const double t181 = t46 + t180;
   const double t182 = h * t181;
-  const double t183 = q0[0] + t182;
+  const double t183 = q0[0] /* x1 */ + t182;
   const double t184 = gam[1] * 0.83060469323313224;
   const double t185 = t51 + t184;
   const double t186 = h * t185;
-  const double t187 = q0[1] + t186;
+  const double t187 = q0[1] /* y1 */ + t186;
   const double t188 = gam[2] * 0.83060469323313224;
   const double t189 = t56 + t188;
   const double t190 = h * t189;
-  const double t191 = q0[2] + t190;
+  const double t191 = q0[2] /* z1 */ + t190;
   const double t192 = gam[3] * 0.83060469323313224;
   const double t193 = t61 + t192;
   const double t194 = h * t193;
-  const double t195 = q0[3] + t194;
+  const double t195 = q0[3] /* x2 */ + t194;
   const double t196 = gam[4] * 0.83060469323313224;
   const double t197 = t66 + t196;
   const double t198 = h * t197;
-  const double t199 = q0[4] + t198;
+  const double t199 = q0[4] /* y2 */ + t198;
   const double t200 = gam[5] * 0.83060469323313224;
   const double t201 = t71 + t200;
   const double t202 = h * t201;
-  const double t203 = q0[5] + t202;
+  const double t203 = q0[5] /* z2 */ + t202;
   const double t204 = gam[6] * 0.83060469323313224;
   const double t205 = t76 + t204;
   const double t206 = h * t205;
-  const double t207 = q0[6] + t206;
+  const double t207 = q0[6] /* x3 */ + t206;
   const double t208 = gam[7] * 0.83060469323313224;
   const double t209 = t81 + t208;
   const double t210 = h * t209;
-  const double t211 = q0[7] + t210;
+  const double t211 = q0[7] /* y3 */ + t210;
   const double t212 = gam[8] * 0.83060469323313224;
   const double t213 = t86 + t212;
   const double t214 = h * t213;
-  const double t215 = q0[8] + t214;
+  const double t215 = q0[8] /* z3 */ + t214;
   /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
   const double t216 = gam[0] * 0.96623475710157603;
   const double t217 = t1 + t216;
   const double t218 = h * t217;
-  const double t219 = q0[0] + t218;
+  const double t219 = q0[0] /* x1 */ + t218;
   const double t220 = gam[1] * 0.96623475710157603;
   const double t221 = t6 + t220;
   const double t222 = h * t221;
-  const double t223 = q0[1] + t222;
+  const double t223 = q0[1] /* y1 */ + t222;
   const double t224 = gam[2] * 0.96623475710157603;
   const double t225 = t11 + t224;
   const double t226 = h * t225;
-  const double t227 = q0[2] + t226;
+  const double t227 = q0[2] /* z1 */ + t226;
   const double t228 = gam[3] * 0.96623475710157603;
   const double t229 = t16 + t228;
   const double t230 = h * t229;
-  const double t231 = q0[3] + t230;
+  const double t231 = q0[3] /* x2 */ + t230;
   const double t232 = gam[4] * 0.96623475710157603;
   const double t233 = t21 + t232;
   const double t234 = h * t233;
-  const double t235 = q0[4] + t234;
+  const double t235 = q0[4] /* y2 */ + t234;
   const double t236 = gam[5] * 0.96623475710157603;
   const double t237 = t26 + t236;
   const double t238 = h * t237;
-  const double t239 = q0[5] + t238;
+  const double t239 = q0[5] /* z2 */ + t238;
   const double t240 = gam[6] * 0.96623475710157603;
   const double t241 = t31 + t240;
   const double t242 = h * t241;
-  const double t243 = q0[6] + t242;
+  const double t243 = q0[6] /* x3 */ + t242;
   const double t244 = gam[7] * 0.96623475710157603;
   const double t245 = t36 + t244;
   const double t246 = h * t245;
-  const double t247 = q0[7] + t246;
+  const double t247 = q0[7] /* y3 */ + t246;
   const double t248 = gam[8] * 0.96623475710157603;
   const double t249 = t41 + t248;
   const double t250 = h * t249;
-  const double t251 = q0[8] + t250;
+  const double t251 = q0[8] /* z3 */ + t250;
   /* grad g at the stages */
   const double t252 = t4 - t19;
   const double t253 = t9 - t24;
@@ -3922,6 +3938,7 @@ static void satellites_poly_k6s2_factor(const double *q0, const double *p0, cons
   const double t1595 = t1591 - t1594;
   const double t1596 = 1.0 / t1584;
   const double t1597 = 1.0 / t1595;
+  /* lu */
   out[0] = t1522;
   out[1] = t995;
   out[2] = t926;
@@ -3958,12 +3975,14 @@ static void satellites_poly_k6s2_factor(const double *q0, const double *p0, cons
   out[33] = t1587;
   out[34] = t1593;
   out[35] = t1597;
+  /* pivot */
   out[36] = t812;
   out[37] = t1469;
   out[38] = t1525;
   out[39] = t1562;
   out[40] = t1584;
   out[41] = t1595;
+  /* adiag */
   out[42] = t812;
   out[43] = t1124;
   out[44] = t1346;
@@ -3977,15 +3996,16 @@ static void satellites_poly_k6s2_minv_p(const double *q0, const double *p0, cons
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
-  out[4] = p0[4];
-  out[5] = p0[5];
-  out[6] = p0[6];
-  out[7] = p0[7];
-  out[8] = p0[8];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_z1 */;
+  out[3] = p0[3] /* p_x2 */;
+  out[4] = p0[4] /* p_y2 */;
+  out[5] = p0[5] /* p_z2 */;
+  out[6] = p0[6] /* p_x3 */;
+  out[7] = p0[7] /* p_y3 */;
+  out[8] = p0[8] /* p_z3 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -3993,51 +4013,51 @@ static void satellites_poly_k6s2_energy_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t1 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t4 = t2 + t3;
   const double t5 = sqrt(t4);
   const double t6 = 1.0 / t5;
   const double t7 = -t6;
-  const double t8 = q0[3] * q0[3];
-  const double t9 = q0[4] * q0[4];
+  const double t8 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t9 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t10 = t8 + t9;
-  const double t11 = q0[5] * q0[5];
+  const double t11 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t12 = t10 + t11;
   const double t13 = sqrt(t12);
   const double t14 = 1.0 / t13;
   const double t15 = t7 - t14;
-  const double t16 = q0[6] * q0[6];
-  const double t17 = q0[7] * q0[7];
+  const double t16 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t17 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t18 = t16 + t17;
-  const double t19 = q0[8] * q0[8];
+  const double t19 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t20 = t18 + t19;
   const double t21 = sqrt(t20);
   const double t22 = 1.0 / t21;
   const double t23 = t15 - t22;
   /* energy */
-  const double t24 = p0[0] * p0[0];
-  const double t25 = p0[1] * p0[1];
+  const double t24 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t25 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t26 = t24 + t25;
-  const double t27 = p0[2] * p0[2];
+  const double t27 = p0[2] /* p_z1 */ * p0[2] /* p_z1 */;
   const double t28 = t26 + t27;
-  const double t29 = p0[3] * p0[3];
+  const double t29 = p0[3] /* p_x2 */ * p0[3] /* p_x2 */;
   const double t30 = t28 + t29;
-  const double t31 = p0[4] * p0[4];
+  const double t31 = p0[4] /* p_y2 */ * p0[4] /* p_y2 */;
   const double t32 = t30 + t31;
-  const double t33 = p0[5] * p0[5];
+  const double t33 = p0[5] /* p_z2 */ * p0[5] /* p_z2 */;
   const double t34 = t32 + t33;
-  const double t35 = p0[6] * p0[6];
+  const double t35 = p0[6] /* p_x3 */ * p0[6] /* p_x3 */;
   const double t36 = t34 + t35;
-  const double t37 = p0[7] * p0[7];
+  const double t37 = p0[7] /* p_y3 */ * p0[7] /* p_y3 */;
   const double t38 = t36 + t37;
-  const double t39 = p0[8] * p0[8];
+  const double t39 = p0[8] /* p_z3 */ * p0[8] /* p_z3 */;
   const double t40 = t38 + t39;
   const double t41 = 0.5 * t40;
   const double t42 = t23 + t41;
+  /* H */
   out[0] = t42;
 }
 
@@ -4046,16 +4066,15 @@ static void satellites_poly_k6s2_g(const double *q0, const double *p0, const dou
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
-  const double t1 = q0[1] - q0[4];
-  const double t2 = q0[2] - q0[5];
-  const double t3 = q0[3] - q0[6];
-  const double t4 = q0[4] - q0[7];
-  const double t5 = q0[5] - q0[8];
-  const double t6 = q0[6] - q0[0];
-  const double t7 = q0[7] - q0[1];
-  const double t8 = q0[8] - q0[2];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
   /* g(q0) */
   const double t9 = t0 * t0;
   const double t10 = t1 * t1;
@@ -4075,6 +4094,7 @@ static void satellites_poly_k6s2_g(const double *q0, const double *p0, const dou
   const double t24 = t8 * t8;
   const double t25 = t23 + t24;
   const double t26 = t25 - 1.0;
+  /* g */
   out[0] = t14;
   out[1] = t20;
   out[2] = t26;
@@ -4085,60 +4105,59 @@ static void satellites_poly_k6s2_hidden_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t18 = t1 * p0[0];
-  const double t19 = t3 * p0[1];
+  const double t18 = t1 * p0[0] /* p_x1 */;
+  const double t19 = t3 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t5 * p0[2];
+  const double t21 = t5 * p0[2] /* p_z1 */;
   const double t22 = t20 + t21;
-  const double t23 = t1 * p0[3];
+  const double t23 = t1 * p0[3] /* p_x2 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[4];
+  const double t25 = t3 * p0[4] /* p_y2 */;
   const double t26 = t24 - t25;
-  const double t27 = t5 * p0[5];
+  const double t27 = t5 * p0[5] /* p_z2 */;
   const double t28 = t26 - t27;
-  const double t29 = t7 * p0[3];
-  const double t30 = t9 * p0[4];
+  const double t29 = t7 * p0[3] /* p_x2 */;
+  const double t30 = t9 * p0[4] /* p_y2 */;
   const double t31 = t29 + t30;
-  const double t32 = t11 * p0[5];
+  const double t32 = t11 * p0[5] /* p_z2 */;
   const double t33 = t31 + t32;
-  const double t34 = t7 * p0[6];
+  const double t34 = t7 * p0[6] /* p_x3 */;
   const double t35 = t33 - t34;
-  const double t36 = t9 * p0[7];
+  const double t36 = t9 * p0[7] /* p_y3 */;
   const double t37 = t35 - t36;
-  const double t38 = t11 * p0[8];
+  const double t38 = t11 * p0[8] /* p_z3 */;
   const double t39 = t37 - t38;
-  const double t40 = t13 * p0[0];
+  const double t40 = t13 * p0[0] /* p_x1 */;
   const double t41 = -t40;
-  const double t42 = t15 * p0[1];
+  const double t42 = t15 * p0[1] /* p_y1 */;
   const double t43 = t41 - t42;
-  const double t44 = t17 * p0[2];
+  const double t44 = t17 * p0[2] /* p_z1 */;
   const double t45 = t43 - t44;
-  const double t46 = t13 * p0[6];
+  const double t46 = t13 * p0[6] /* p_x3 */;
   const double t47 = t45 + t46;
-  const double t48 = t15 * p0[7];
+  const double t48 = t15 * p0[7] /* p_y3 */;
   const double t49 = t47 + t48;
-  const double t50 = t17 * p0[8];
+  const double t50 = t17 * p0[8] /* p_z3 */;
   const double t51 = t49 + t50;
+  /* hidden */
   out[0] = t28;
   out[1] = t39;
   out[2] = t51;
@@ -4150,26 +4169,24 @@ static void satellites_poly_k6s2_lambda0(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t18 = t1 * t1;
   const double t19 = t1 * t13;
   const double t20 = -t19;
@@ -4225,24 +4242,24 @@ static void satellites_poly_k6s2_lambda0(const double *q0, const double *p0, con
   const double t70 = t67 / t62;
   const double t71 = t64 * t70;
   const double t72 = t69 - t71;
-  const double t73 = q0[0] * q0[0];
-  const double t74 = q0[1] * q0[1];
+  const double t73 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t74 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t75 = t73 + t74;
-  const double t76 = q0[2] * q0[2];
+  const double t76 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t77 = t75 + t76;
   const double t78 = sqrt(t77);
   const double t79 = 1.0 / t78;
-  const double t80 = q0[3] * q0[3];
-  const double t81 = q0[4] * q0[4];
+  const double t80 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t81 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t82 = t80 + t81;
-  const double t83 = q0[5] * q0[5];
+  const double t83 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t84 = t82 + t83;
   const double t85 = sqrt(t84);
   const double t86 = 1.0 / t85;
-  const double t87 = q0[6] * q0[6];
-  const double t88 = q0[7] * q0[7];
+  const double t87 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t88 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t89 = t87 + t88;
-  const double t90 = q0[8] * q0[8];
+  const double t90 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t91 = t89 + t90;
   const double t92 = sqrt(t91);
   const double t93 = 1.0 / t92;
@@ -4250,115 +4267,115 @@ static void satellites_poly_k6s2_lambda0(const double *q0, const double *p0, con
   const double t94 = t93 * t93;
   const double t95 = 0.5 * t94;
   const double t96 = t93 * t95;
-  const double t97 = 2.0 * q0[8];
+  const double t97 = 2.0 * q0[8] /* z3 */;
   const double t98 = t96 * t97;
-  const double t99 = 2.0 * q0[7];
+  const double t99 = 2.0 * q0[7] /* y3 */;
   const double t100 = t96 * t99;
-  const double t101 = 2.0 * q0[6];
+  const double t101 = 2.0 * q0[6] /* x3 */;
   const double t102 = t96 * t101;
   const double t103 = t86 * t86;
   const double t104 = 0.5 * t103;
   const double t105 = t86 * t104;
-  const double t106 = 2.0 * q0[5];
+  const double t106 = 2.0 * q0[5] /* z2 */;
   const double t107 = t105 * t106;
-  const double t108 = 2.0 * q0[4];
+  const double t108 = 2.0 * q0[4] /* y2 */;
   const double t109 = t105 * t108;
-  const double t110 = 2.0 * q0[3];
+  const double t110 = 2.0 * q0[3] /* x2 */;
   const double t111 = t105 * t110;
   const double t112 = t79 * t79;
   const double t113 = 0.5 * t112;
   const double t114 = t79 * t113;
-  const double t115 = 2.0 * q0[2];
+  const double t115 = 2.0 * q0[2] /* z1 */;
   const double t116 = t114 * t115;
-  const double t117 = 2.0 * q0[1];
+  const double t117 = 2.0 * q0[1] /* y1 */;
   const double t118 = t114 * t117;
-  const double t119 = 2.0 * q0[0];
+  const double t119 = 2.0 * q0[0] /* x1 */;
   const double t120 = t114 * t119;
-  const double t121 = p0[2] - p0[5];
-  const double t122 = p0[1] - p0[4];
-  const double t123 = p0[0] - p0[3];
+  const double t121 = p0[2] /* p_z1 */ - p0[5] /* p_z2 */;
+  const double t122 = p0[1] /* p_y1 */ - p0[4] /* p_y2 */;
+  const double t123 = p0[0] /* p_x1 */ - p0[3] /* p_x2 */;
   const double t124 = 2.0 * t123;
   const double t125 = 2.0 * t122;
   const double t126 = 2.0 * t121;
-  const double t127 = p0[0] * t124;
+  const double t127 = p0[0] /* p_x1 */ * t124;
   const double t128 = t1 * t120;
-  const double t129 = p0[1] * t125;
+  const double t129 = p0[1] /* p_y1 */ * t125;
   const double t130 = t127 + t129;
   const double t131 = t3 * t118;
   const double t132 = t128 + t131;
-  const double t133 = p0[2] * t126;
+  const double t133 = p0[2] /* p_z1 */ * t126;
   const double t134 = t130 + t133;
   const double t135 = t5 * t116;
   const double t136 = t132 + t135;
-  const double t137 = p0[3] * t124;
+  const double t137 = p0[3] /* p_x2 */ * t124;
   const double t138 = t134 - t137;
   const double t139 = t1 * t111;
   const double t140 = t136 - t139;
-  const double t141 = p0[4] * t125;
+  const double t141 = p0[4] /* p_y2 */ * t125;
   const double t142 = t138 - t141;
   const double t143 = t3 * t109;
   const double t144 = t140 - t143;
-  const double t145 = p0[5] * t126;
+  const double t145 = p0[5] /* p_z2 */ * t126;
   const double t146 = t142 - t145;
   const double t147 = t5 * t107;
   const double t148 = t144 - t147;
   const double t149 = t146 - t148;
-  const double t150 = p0[5] - p0[8];
-  const double t151 = p0[4] - p0[7];
-  const double t152 = p0[3] - p0[6];
+  const double t150 = p0[5] /* p_z2 */ - p0[8] /* p_z3 */;
+  const double t151 = p0[4] /* p_y2 */ - p0[7] /* p_y3 */;
+  const double t152 = p0[3] /* p_x2 */ - p0[6] /* p_x3 */;
   const double t153 = 2.0 * t152;
   const double t154 = 2.0 * t151;
   const double t155 = 2.0 * t150;
-  const double t156 = p0[3] * t153;
+  const double t156 = p0[3] /* p_x2 */ * t153;
   const double t157 = t7 * t111;
-  const double t158 = p0[4] * t154;
+  const double t158 = p0[4] /* p_y2 */ * t154;
   const double t159 = t156 + t158;
   const double t160 = t9 * t109;
   const double t161 = t157 + t160;
-  const double t162 = p0[5] * t155;
+  const double t162 = p0[5] /* p_z2 */ * t155;
   const double t163 = t159 + t162;
   const double t164 = t11 * t107;
   const double t165 = t161 + t164;
-  const double t166 = p0[6] * t153;
+  const double t166 = p0[6] /* p_x3 */ * t153;
   const double t167 = t163 - t166;
   const double t168 = t7 * t102;
   const double t169 = t165 - t168;
-  const double t170 = p0[7] * t154;
+  const double t170 = p0[7] /* p_y3 */ * t154;
   const double t171 = t167 - t170;
   const double t172 = t9 * t100;
   const double t173 = t169 - t172;
-  const double t174 = p0[8] * t155;
+  const double t174 = p0[8] /* p_z3 */ * t155;
   const double t175 = t171 - t174;
   const double t176 = t11 * t98;
   const double t177 = t173 - t176;
   const double t178 = t175 - t177;
-  const double t179 = p0[8] - p0[2];
-  const double t180 = p0[7] - p0[1];
-  const double t181 = p0[6] - p0[0];
+  const double t179 = p0[8] /* p_z3 */ - p0[2] /* p_z1 */;
+  const double t180 = p0[7] /* p_y3 */ - p0[1] /* p_y1 */;
+  const double t181 = p0[6] /* p_x3 */ - p0[0] /* p_x1 */;
   const double t182 = 2.0 * t181;
   const double t183 = 2.0 * t180;
   const double t184 = 2.0 * t179;
-  const double t185 = p0[0] * t182;
+  const double t185 = p0[0] /* p_x1 */ * t182;
   const double t186 = -t185;
   const double t187 = t13 * t120;
   const double t188 = -t187;
-  const double t189 = p0[1] * t183;
+  const double t189 = p0[1] /* p_y1 */ * t183;
   const double t190 = t186 - t189;
   const double t191 = t15 * t118;
   const double t192 = t188 - t191;
-  const double t193 = p0[2] * t184;
+  const double t193 = p0[2] /* p_z1 */ * t184;
   const double t194 = t190 - t193;
   const double t195 = t17 * t116;
   const double t196 = t192 - t195;
-  const double t197 = p0[6] * t182;
+  const double t197 = p0[6] /* p_x3 */ * t182;
   const double t198 = t194 + t197;
   const double t199 = t13 * t102;
   const double t200 = t196 + t199;
-  const double t201 = p0[7] * t183;
+  const double t201 = p0[7] /* p_y3 */ * t183;
   const double t202 = t198 + t201;
   const double t203 = t15 * t100;
   const double t204 = t200 + t203;
-  const double t205 = p0[8] * t184;
+  const double t205 = p0[8] /* p_z3 */ * t184;
   const double t206 = t202 + t205;
   const double t207 = t17 * t98;
   const double t208 = t204 + t207;
@@ -4378,6 +4395,7 @@ static void satellites_poly_k6s2_lambda0(const double *q0, const double *p0, con
   const double t222 = t28 * t216;
   const double t223 = t221 - t222;
   const double t224 = t223 / t35;
+  /* lambda */
   out[0] = t224;
   out[1] = t219;
   out[2] = t216;
@@ -4390,24 +4408,23 @@ static void satellites_poly_k6s2_project(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t18 = t1 * t1;
@@ -4452,39 +4469,39 @@ static void satellites_poly_k6s2_project(const double *q0, const double *p0, con
   const double t57 = t52 + t56;
   const double t58 = t53 + t57;
   const double t59 = t55 + t58;
-  const double t60 = t1 * p0[0];
-  const double t61 = t3 * p0[1];
+  const double t60 = t1 * p0[0] /* p_x1 */;
+  const double t61 = t3 * p0[1] /* p_y1 */;
   const double t62 = t60 + t61;
-  const double t63 = t5 * p0[2];
+  const double t63 = t5 * p0[2] /* p_z1 */;
   const double t64 = t62 + t63;
-  const double t65 = t1 * p0[3];
+  const double t65 = t1 * p0[3] /* p_x2 */;
   const double t66 = t64 - t65;
-  const double t67 = t3 * p0[4];
+  const double t67 = t3 * p0[4] /* p_y2 */;
   const double t68 = t66 - t67;
-  const double t69 = t5 * p0[5];
+  const double t69 = t5 * p0[5] /* p_z2 */;
   const double t70 = t68 - t69;
-  const double t71 = t7 * p0[3];
-  const double t72 = t9 * p0[4];
+  const double t71 = t7 * p0[3] /* p_x2 */;
+  const double t72 = t9 * p0[4] /* p_y2 */;
   const double t73 = t71 + t72;
-  const double t74 = t11 * p0[5];
+  const double t74 = t11 * p0[5] /* p_z2 */;
   const double t75 = t73 + t74;
-  const double t76 = t7 * p0[6];
+  const double t76 = t7 * p0[6] /* p_x3 */;
   const double t77 = t75 - t76;
-  const double t78 = t9 * p0[7];
+  const double t78 = t9 * p0[7] /* p_y3 */;
   const double t79 = t77 - t78;
-  const double t80 = t11 * p0[8];
+  const double t80 = t11 * p0[8] /* p_z3 */;
   const double t81 = t79 - t80;
-  const double t82 = t13 * p0[0];
+  const double t82 = t13 * p0[0] /* p_x1 */;
   const double t83 = -t82;
-  const double t84 = t15 * p0[1];
+  const double t84 = t15 * p0[1] /* p_y1 */;
   const double t85 = t83 - t84;
-  const double t86 = t17 * p0[2];
+  const double t86 = t17 * p0[2] /* p_z1 */;
   const double t87 = t85 - t86;
-  const double t88 = t13 * p0[6];
+  const double t88 = t13 * p0[6] /* p_x3 */;
   const double t89 = t87 + t88;
-  const double t90 = t15 * p0[7];
+  const double t90 = t15 * p0[7] /* p_y3 */;
   const double t91 = t89 + t90;
-  const double t92 = t17 * p0[8];
+  const double t92 = t17 * p0[8] /* p_z3 */;
   const double t93 = t91 + t92;
   const double t94 = t37 / t35;
   const double t95 = t37 * t94;
@@ -4517,30 +4534,30 @@ static void satellites_poly_k6s2_project(const double *q0, const double *p0, con
   const double t122 = t1 * t121;
   const double t123 = t13 * t113;
   const double t124 = t123 - t122;
-  const double t125 = p0[0] + t124;
+  const double t125 = p0[0] /* p_x1 */ + t124;
   const double t126 = t3 * t121;
   const double t127 = t15 * t113;
   const double t128 = t127 - t126;
-  const double t129 = p0[1] + t128;
+  const double t129 = p0[1] /* p_y1 */ + t128;
   const double t130 = t5 * t121;
   const double t131 = t17 * t113;
   const double t132 = t131 - t130;
-  const double t133 = p0[2] + t132;
+  const double t133 = p0[2] /* p_z1 */ + t132;
   const double t134 = t7 * t116;
   const double t135 = t122 - t134;
-  const double t136 = p0[3] + t135;
+  const double t136 = p0[3] /* p_x2 */ + t135;
   const double t137 = t9 * t116;
   const double t138 = t126 - t137;
-  const double t139 = p0[4] + t138;
+  const double t139 = p0[4] /* p_y2 */ + t138;
   const double t140 = t11 * t116;
   const double t141 = t130 - t140;
-  const double t142 = p0[5] + t141;
+  const double t142 = p0[5] /* p_z2 */ + t141;
   const double t143 = t134 - t123;
-  const double t144 = p0[6] + t143;
+  const double t144 = p0[6] /* p_x3 */ + t143;
   const double t145 = t137 - t127;
-  const double t146 = p0[7] + t145;
+  const double t146 = p0[7] /* p_y3 */ + t145;
   const double t147 = t140 - t131;
-  const double t148 = p0[8] + t147;
+  const double t148 = p0[8] /* p_z3 */ + t147;
   const double t149 = t125 * t125;
   const double t150 = t129 * t129;
   const double t151 = t149 + t150;
@@ -4559,30 +4576,31 @@ static void satellites_poly_k6s2_project(const double *q0, const double *p0, con
   const double t164 = t148 * t148;
   const double t165 = t163 + t164;
   const double t166 = 0.5 * t165;
-  const double t167 = q0[0] * q0[0];
-  const double t168 = q0[1] * q0[1];
+  const double t167 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t168 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t169 = t167 + t168;
-  const double t170 = q0[2] * q0[2];
+  const double t170 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t171 = t169 + t170;
   const double t172 = sqrt(t171);
   const double t173 = 1.0 / t172;
   const double t174 = -t173;
-  const double t175 = q0[3] * q0[3];
-  const double t176 = q0[4] * q0[4];
+  const double t175 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t176 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t177 = t175 + t176;
-  const double t178 = q0[5] * q0[5];
+  const double t178 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t179 = t177 + t178;
   const double t180 = sqrt(t179);
   const double t181 = 1.0 / t180;
   const double t182 = t174 - t181;
-  const double t183 = q0[6] * q0[6];
-  const double t184 = q0[7] * q0[7];
+  const double t183 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t184 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t185 = t183 + t184;
-  const double t186 = q0[8] * q0[8];
+  const double t186 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t187 = t185 + t186;
   const double t188 = sqrt(t187);
   const double t189 = 1.0 / t188;
   const double t190 = t182 - t189;
+  /* dp */
   out[0] = t124;
   out[1] = t128;
   out[2] = t132;
@@ -4592,11 +4610,15 @@ static void satellites_poly_k6s2_project(const double *q0, const double *p0, con
   out[6] = t143;
   out[7] = t145;
   out[8] = t147;
+  /* kin */
   out[9] = t166;
+  /* U */
   out[10] = t190;
+  /* pivot */
   out[11] = t35;
   out[12] = t96;
   out[13] = t110;
+  /* adiag */
   out[14] = t35;
   out[15] = t49;
   out[16] = t59;
@@ -4611,20 +4633,20 @@ void satellites_poly_k6s2_init(satellites_poly_k6s2_state *x, const double *q0, 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : satellites_poly_k6s2_q0[i];
     x->p[i] = p0 ? (double)p0[i] : satellites_poly_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (satellites_poly_k6s2_NU ? satellites_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     satellites_poly_k6s2_params prm;
-    double lam[NU];
+    double lam[satellites_poly_k6s2_NU];
     satellites_poly_k6s2_params_default(&prm);
     satellites_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < satellites_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -4640,32 +4662,32 @@ const char *satellites_poly_k6s2_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) satellites_poly_k6s2_params dflt_; if (!prm) { satellites_poly_k6s2_params_default(&dflt_); prm = &dflt_; }
+#define satellites_poly_k6s2_DEFAULT_PARAMS(prm) satellites_poly_k6s2_params dflt_; if (!prm) { satellites_poly_k6s2_params_default(&dflt_); prm = &dflt_; }
 
 double satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s2_DEFAULT_PARAMS(prm)
   satellites_poly_k6s2_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *g)
 {
-  double v[NU];
+  double v[satellites_poly_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s2_DEFAULT_PARAMS(prm)
   satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < satellites_poly_k6s2_NU; i++) g[i] = v[i];
 }
 
 void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *gp)
 {
-  double v[NU];
+  double v[satellites_poly_k6s2_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s2_DEFAULT_PARAMS(prm)
   satellites_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < satellites_poly_k6s2_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -4673,17 +4695,17 @@ void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const sate
 static void satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, const satellites_poly_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < satellites_poly_k6s2_S; j++)
+    for (i = 0; i < satellites_poly_k6s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s2_E[(j * S + i) * S + d];
+      for (d = satellites_poly_k6s2_S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s2_E[(j * satellites_poly_k6s2_S + i) * satellites_poly_k6s2_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < satellites_poly_k6s2_M; l++) gam[j * satellites_poly_k6s2_M + l] += e * x->gam[i * satellites_poly_k6s2_M + l];
     }
 }
 
@@ -4700,100 +4722,101 @@ static void satellites_poly_k6s2_add(double *a, double *c, double b)
 int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, double h_, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = satellites_poly_k6s2_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s2_EBADSTEP;
   satellites_poly_k6s2_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[satellites_poly_k6s2_NU];
   satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below satellites_poly_k6s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[36 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_NU; i++) g0[i] = fabs(g0[i]) <= satellites_poly_k6s2_GTOL ? 0 : g0[i] / h;
+  double fa[36 + 2 * satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1], lam[satellites_poly_k6s2_S * satellites_poly_k6s2_NU];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   satellites_poly_k6s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[36 + i], dia = fa[36 + S * NU + i];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) {
+    double piv = fa[36 + i], dia = fa[36 + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return satellites_poly_k6s2_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return satellites_poly_k6s2_ESINGULAR;
+    if (!(fabs(piv) > satellites_poly_k6s2_SINGTOL * fabs(dia))) return satellites_poly_k6s2_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= satellites_poly_k6s2_MAXITER; it++) {
     satellites_poly_k6s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < satellites_poly_k6s2_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + i];
+    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_poly_k6s2_ENONFINITE;
     if (rc == satellites_poly_k6s2_ENONFINITE || !isfinite(inc)) { rc = satellites_poly_k6s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (satellites_poly_k6s2_TOL / 256), or
+     * within 2 ulps (satellites_poly_k6s2_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above satellites_poly_k6s2_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = satellites_poly_k6s2_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? satellites_poly_k6s2_OK : satellites_poly_k6s2_ENOCONV; break; }
+    if (inc <= satellites_poly_k6s2_TOL / 256 || (inc <= satellites_poly_k6s2_TOL && 4 * inc > inc_old)) { rc = satellites_poly_k6s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= satellites_poly_k6s2_STAGTOL ? satellites_poly_k6s2_OK : satellites_poly_k6s2_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > satellites_poly_k6s2_MAXITER ? satellites_poly_k6s2_MAXITER : it; st->increment = inc; }
   if (rc != satellites_poly_k6s2_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s2_ENONFINITE;
+  double q1[satellites_poly_k6s2_M], p1[satellites_poly_k6s2_M], pr[satellites_poly_k6s2_M + 2 + 2 * satellites_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s2_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[satellites_poly_k6s2_M], pc1[satellites_poly_k6s2_M];
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     satellites_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
-    satellites_poly_k6s2_add(&p1[i], &pc1[i], sw[S * M + i]);
+    satellites_poly_k6s2_add(&p1[i], &pc1[i], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   satellites_poly_k6s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return satellites_poly_k6s2_ESINGULAR;
+  for (i = 0; i < satellites_poly_k6s2_NU; i++) {
+    double piv = pr[satellites_poly_k6s2_M + 2 + i], dia = pr[satellites_poly_k6s2_M + 2 + satellites_poly_k6s2_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_poly_k6s2_SINGTOL * fabs(dia))) return satellites_poly_k6s2_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < satellites_poly_k6s2_M + 2 + 2 * satellites_poly_k6s2_NU; i++)
     if (!isfinite(pr[i])) return satellites_poly_k6s2_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[satellites_poly_k6s2_M + 0];
+  U1 = pr[satellites_poly_k6s2_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * satellites_poly_k6s2_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
     satellites_poly_k6s2_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return satellites_poly_k6s2_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[satellites_poly_k6s2_NU];
     satellites_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < satellites_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   satellites_poly_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;

@@ -4,6 +4,10 @@
 #ifndef satellites_poly_k6s2_H
 #define satellites_poly_k6s2_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #define satellites_poly_k6s2_M 9      /* coordinates */
 #define satellites_poly_k6s2_NU 3     /* constraints */
 #define satellites_poly_k6s2_K 6      /* Gauss-Legendre nodes */
@@ -44,7 +48,11 @@ void satellites_poly_k6s2_params_default(satellites_poly_k6s2_params *prm);
 int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, double h, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st);
 const char *satellites_poly_k6s2_strerror(int code);
 double satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm);
-void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *g);   /* NU values */
+void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *g);   /* satellites_poly_k6s2_NU values */
 void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *gp);       /* grad g' M^-1 p */
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -5,14 +5,27 @@
 
 #include "satellites_poly_k6s3.h"
 
-#define M satellites_poly_k6s3_M
-#define NU satellites_poly_k6s3_NU
-#define S satellites_poly_k6s3_S
-#define MAXITER 100  /* fixed-point iterations before giving up */
-#define TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
-#define STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
-#define SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
-#define GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#if defined(__FAST_MATH__) && !defined(satellites_poly_k6s3_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums */
+#error "compile without -ffast-math (docs/api.md), or define satellites_poly_k6s3_ALLOW_FAST_MATH"
+#endif
+
+/* Limits of the iteration; each can be set with -D (docs/api.md). */
+#ifndef satellites_poly_k6s3_MAXITER
+#define satellites_poly_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
+#endif
+#ifndef satellites_poly_k6s3_TOL
+#define satellites_poly_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
+#endif
+#ifndef satellites_poly_k6s3_STAGTOL
+#define satellites_poly_k6s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#endif
+#ifndef satellites_poly_k6s3_SINGTOL
+#define satellites_poly_k6s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
+#endif
+#ifndef satellites_poly_k6s3_GTOL
+#define satellites_poly_k6s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -42,63 +55,63 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t3 = gam[18] * 0.068025568234204442;
   const double t4 = t2 + t3;
   const double t5 = h * t4;
-  const double t6 = q0[0] + t5;
+  const double t6 = q0[0] /* x1 */ + t5;
   const double t7 = gam[1] * 0.033765242898423975;
   const double t8 = gam[10] * (-0.056508419605012766);
   const double t9 = t7 + t8;
   const double t10 = gam[19] * 0.068025568234204442;
   const double t11 = t9 + t10;
   const double t12 = h * t11;
-  const double t13 = q0[1] + t12;
+  const double t13 = q0[1] /* y1 */ + t12;
   const double t14 = gam[2] * 0.033765242898423975;
   const double t15 = gam[11] * (-0.056508419605012766);
   const double t16 = t14 + t15;
   const double t17 = gam[20] * 0.068025568234204442;
   const double t18 = t16 + t17;
   const double t19 = h * t18;
-  const double t20 = q0[2] + t19;
+  const double t20 = q0[2] /* z1 */ + t19;
   const double t21 = gam[3] * 0.033765242898423975;
   const double t22 = gam[12] * (-0.056508419605012766);
   const double t23 = t21 + t22;
   const double t24 = gam[21] * 0.068025568234204442;
   const double t25 = t23 + t24;
   const double t26 = h * t25;
-  const double t27 = q0[3] + t26;
+  const double t27 = q0[3] /* x2 */ + t26;
   const double t28 = gam[4] * 0.033765242898423975;
   const double t29 = gam[13] * (-0.056508419605012766);
   const double t30 = t28 + t29;
   const double t31 = gam[22] * 0.068025568234204442;
   const double t32 = t30 + t31;
   const double t33 = h * t32;
-  const double t34 = q0[4] + t33;
+  const double t34 = q0[4] /* y2 */ + t33;
   const double t35 = gam[5] * 0.033765242898423975;
   const double t36 = gam[14] * (-0.056508419605012766);
   const double t37 = t35 + t36;
   const double t38 = gam[23] * 0.068025568234204442;
   const double t39 = t37 + t38;
   const double t40 = h * t39;
-  const double t41 = q0[5] + t40;
+  const double t41 = q0[5] /* z2 */ + t40;
   const double t42 = gam[6] * 0.033765242898423975;
   const double t43 = gam[15] * (-0.056508419605012766);
   const double t44 = t42 + t43;
   const double t45 = gam[24] * 0.068025568234204442;
   const double t46 = t44 + t45;
   const double t47 = h * t46;
-  const double t48 = q0[6] + t47;
+  const double t48 = q0[6] /* x3 */ + t47;
   const double t49 = gam[7] * 0.033765242898423975;
   const double t50 = gam[16] * (-0.056508419605012766);
   const double t51 = t49 + t50;
   const double t52 = gam[25] * 0.068025568234204442;
   const double t53 = t51 + t52;
   const double t54 = h * t53;
-  const double t55 = q0[7] + t54;
+  const double t55 = q0[7] /* y3 */ + t54;
   const double t56 = gam[8] * 0.033765242898423975;
   const double t57 = gam[17] * (-0.056508419605012766);
   const double t58 = t56 + t57;
   const double t59 = gam[26] * 0.068025568234204442;
   const double t60 = t58 + t59;
   const double t61 = h * t60;
-  const double t62 = q0[8] + t61;
+  const double t62 = q0[8] /* z3 */ + t61;
   const double t63 = t6 * t6;
   const double t64 = t13 * t13;
   const double t65 = t63 + t64;
@@ -181,63 +194,63 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t141 = gam[18] * 0.20802702904656017;
   const double t142 = t140 + t141;
   const double t143 = h * t142;
-  const double t144 = q0[0] + t143;
+  const double t144 = q0[0] /* x1 */ + t143;
   const double t145 = gam[1] * 0.16939530676686776;
   const double t146 = gam[10] * (-0.24370047841099157);
   const double t147 = t145 + t146;
   const double t148 = gam[19] * 0.20802702904656017;
   const double t149 = t147 + t148;
   const double t150 = h * t149;
-  const double t151 = q0[1] + t150;
+  const double t151 = q0[1] /* y1 */ + t150;
   const double t152 = gam[2] * 0.16939530676686776;
   const double t153 = gam[11] * (-0.24370047841099157);
   const double t154 = t152 + t153;
   const double t155 = gam[20] * 0.20802702904656017;
   const double t156 = t154 + t155;
   const double t157 = h * t156;
-  const double t158 = q0[2] + t157;
+  const double t158 = q0[2] /* z1 */ + t157;
   const double t159 = gam[3] * 0.16939530676686776;
   const double t160 = gam[12] * (-0.24370047841099157);
   const double t161 = t159 + t160;
   const double t162 = gam[21] * 0.20802702904656017;
   const double t163 = t161 + t162;
   const double t164 = h * t163;
-  const double t165 = q0[3] + t164;
+  const double t165 = q0[3] /* x2 */ + t164;
   const double t166 = gam[4] * 0.16939530676686776;
   const double t167 = gam[13] * (-0.24370047841099157);
   const double t168 = t166 + t167;
   const double t169 = gam[22] * 0.20802702904656017;
   const double t170 = t168 + t169;
   const double t171 = h * t170;
-  const double t172 = q0[4] + t171;
+  const double t172 = q0[4] /* y2 */ + t171;
   const double t173 = gam[5] * 0.16939530676686776;
   const double t174 = gam[14] * (-0.24370047841099157);
   const double t175 = t173 + t174;
   const double t176 = gam[23] * 0.20802702904656017;
   const double t177 = t175 + t176;
   const double t178 = h * t177;
-  const double t179 = q0[5] + t178;
+  const double t179 = q0[5] /* z2 */ + t178;
   const double t180 = gam[6] * 0.16939530676686776;
   const double t181 = gam[15] * (-0.24370047841099157);
   const double t182 = t180 + t181;
   const double t183 = gam[24] * 0.20802702904656017;
   const double t184 = t182 + t183;
   const double t185 = h * t184;
-  const double t186 = q0[6] + t185;
+  const double t186 = q0[6] /* x3 */ + t185;
   const double t187 = gam[7] * 0.16939530676686776;
   const double t188 = gam[16] * (-0.24370047841099157);
   const double t189 = t187 + t188;
   const double t190 = gam[25] * 0.20802702904656017;
   const double t191 = t189 + t190;
   const double t192 = h * t191;
-  const double t193 = q0[7] + t192;
+  const double t193 = q0[7] /* y3 */ + t192;
   const double t194 = gam[8] * 0.16939530676686776;
   const double t195 = gam[17] * (-0.24370047841099157);
   const double t196 = t194 + t195;
   const double t197 = gam[26] * 0.20802702904656017;
   const double t198 = t196 + t197;
   const double t199 = h * t198;
-  const double t200 = q0[8] + t199;
+  const double t200 = q0[8] /* z3 */ + t199;
   const double t201 = t144 * t144;
   const double t202 = t151 * t151;
   const double t203 = t201 + t202;
@@ -347,63 +360,63 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t306 = gam[18] * 0.1257969473866733;
   const double t307 = t305 + t306;
   const double t308 = h * t307;
-  const double t309 = q0[0] + t308;
+  const double t309 = q0[0] /* x1 */ + t308;
   const double t310 = gam[1] * 0.38069040695840156;
   const double t311 = gam[10] * (-0.40835734144399111);
   const double t312 = t310 + t311;
   const double t313 = gam[19] * 0.1257969473866733;
   const double t314 = t312 + t313;
   const double t315 = h * t314;
-  const double t316 = q0[1] + t315;
+  const double t316 = q0[1] /* y1 */ + t315;
   const double t317 = gam[2] * 0.38069040695840156;
   const double t318 = gam[11] * (-0.40835734144399111);
   const double t319 = t317 + t318;
   const double t320 = gam[20] * 0.1257969473866733;
   const double t321 = t319 + t320;
   const double t322 = h * t321;
-  const double t323 = q0[2] + t322;
+  const double t323 = q0[2] /* z1 */ + t322;
   const double t324 = gam[3] * 0.38069040695840156;
   const double t325 = gam[12] * (-0.40835734144399111);
   const double t326 = t324 + t325;
   const double t327 = gam[21] * 0.1257969473866733;
   const double t328 = t326 + t327;
   const double t329 = h * t328;
-  const double t330 = q0[3] + t329;
+  const double t330 = q0[3] /* x2 */ + t329;
   const double t331 = gam[4] * 0.38069040695840156;
   const double t332 = gam[13] * (-0.40835734144399111);
   const double t333 = t331 + t332;
   const double t334 = gam[22] * 0.1257969473866733;
   const double t335 = t333 + t334;
   const double t336 = h * t335;
-  const double t337 = q0[4] + t336;
+  const double t337 = q0[4] /* y2 */ + t336;
   const double t338 = gam[5] * 0.38069040695840156;
   const double t339 = gam[14] * (-0.40835734144399111);
   const double t340 = t338 + t339;
   const double t341 = gam[23] * 0.1257969473866733;
   const double t342 = t340 + t341;
   const double t343 = h * t342;
-  const double t344 = q0[5] + t343;
+  const double t344 = q0[5] /* z2 */ + t343;
   const double t345 = gam[6] * 0.38069040695840156;
   const double t346 = gam[15] * (-0.40835734144399111);
   const double t347 = t345 + t346;
   const double t348 = gam[24] * 0.1257969473866733;
   const double t349 = t347 + t348;
   const double t350 = h * t349;
-  const double t351 = q0[6] + t350;
+  const double t351 = q0[6] /* x3 */ + t350;
   const double t352 = gam[7] * 0.38069040695840156;
   const double t353 = gam[16] * (-0.40835734144399111);
   const double t354 = t352 + t353;
   const double t355 = gam[25] * 0.1257969473866733;
   const double t356 = t354 + t355;
   const double t357 = h * t356;
-  const double t358 = q0[7] + t357;
+  const double t358 = q0[7] /* y3 */ + t357;
   const double t359 = gam[8] * 0.38069040695840156;
   const double t360 = gam[17] * (-0.40835734144399111);
   const double t361 = t359 + t360;
   const double t362 = gam[26] * 0.1257969473866733;
   const double t363 = t361 + t362;
   const double t364 = h * t363;
-  const double t365 = q0[8] + t364;
+  const double t365 = q0[8] /* z3 */ + t364;
   const double t366 = t309 * t309;
   const double t367 = t316 * t316;
   const double t368 = t366 + t367;
@@ -513,63 +526,63 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t471 = gam[18] * (-0.12579694738667335);
   const double t472 = t470 + t471;
   const double t473 = h * t472;
-  const double t474 = q0[0] + t473;
+  const double t474 = q0[0] /* x1 */ + t473;
   const double t475 = gam[1] * 0.61930959304159849;
   const double t476 = gam[10] * (-0.40835734144399105);
   const double t477 = t475 + t476;
   const double t478 = gam[19] * (-0.12579694738667335);
   const double t479 = t477 + t478;
   const double t480 = h * t479;
-  const double t481 = q0[1] + t480;
+  const double t481 = q0[1] /* y1 */ + t480;
   const double t482 = gam[2] * 0.61930959304159849;
   const double t483 = gam[11] * (-0.40835734144399105);
   const double t484 = t482 + t483;
   const double t485 = gam[20] * (-0.12579694738667335);
   const double t486 = t484 + t485;
   const double t487 = h * t486;
-  const double t488 = q0[2] + t487;
+  const double t488 = q0[2] /* z1 */ + t487;
   const double t489 = gam[3] * 0.61930959304159849;
   const double t490 = gam[12] * (-0.40835734144399105);
   const double t491 = t489 + t490;
   const double t492 = gam[21] * (-0.12579694738667335);
   const double t493 = t491 + t492;
   const double t494 = h * t493;
-  const double t495 = q0[3] + t494;
+  const double t495 = q0[3] /* x2 */ + t494;
   const double t496 = gam[4] * 0.61930959304159849;
   const double t497 = gam[13] * (-0.40835734144399105);
   const double t498 = t496 + t497;
   const double t499 = gam[22] * (-0.12579694738667335);
   const double t500 = t498 + t499;
   const double t501 = h * t500;
-  const double t502 = q0[4] + t501;
+  const double t502 = q0[4] /* y2 */ + t501;
   const double t503 = gam[5] * 0.61930959304159849;
   const double t504 = gam[14] * (-0.40835734144399105);
   const double t505 = t503 + t504;
   const double t506 = gam[23] * (-0.12579694738667335);
   const double t507 = t505 + t506;
   const double t508 = h * t507;
-  const double t509 = q0[5] + t508;
+  const double t509 = q0[5] /* z2 */ + t508;
   const double t510 = gam[6] * 0.61930959304159849;
   const double t511 = gam[15] * (-0.40835734144399105);
   const double t512 = t510 + t511;
   const double t513 = gam[24] * (-0.12579694738667335);
   const double t514 = t512 + t513;
   const double t515 = h * t514;
-  const double t516 = q0[6] + t515;
+  const double t516 = q0[6] /* x3 */ + t515;
   const double t517 = gam[7] * 0.61930959304159849;
   const double t518 = gam[16] * (-0.40835734144399105);
   const double t519 = t517 + t518;
   const double t520 = gam[25] * (-0.12579694738667335);
   const double t521 = t519 + t520;
   const double t522 = h * t521;
-  const double t523 = q0[7] + t522;
+  const double t523 = q0[7] /* y3 */ + t522;
   const double t524 = gam[8] * 0.61930959304159849;
   const double t525 = gam[17] * (-0.40835734144399105);
   const double t526 = t524 + t525;
   const double t527 = gam[26] * (-0.12579694738667335);
   const double t528 = t526 + t527;
   const double t529 = h * t528;
-  const double t530 = q0[8] + t529;
+  const double t530 = q0[8] /* z3 */ + t529;
   const double t531 = t474 * t474;
   const double t532 = t481 * t481;
   const double t533 = t531 + t532;
@@ -678,55 +691,55 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t635 = gam[18] * (-0.20802702904656017);
   const double t636 = t634 + t635;
   const double t637 = h * t636;
-  const double t638 = q0[0] + t637;
+  const double t638 = q0[0] /* x1 */ + t637;
   const double t639 = gam[1] * 0.83060469323313224;
   const double t640 = t146 + t639;
   const double t641 = gam[19] * (-0.20802702904656017);
   const double t642 = t640 + t641;
   const double t643 = h * t642;
-  const double t644 = q0[1] + t643;
+  const double t644 = q0[1] /* y1 */ + t643;
   const double t645 = gam[2] * 0.83060469323313224;
   const double t646 = t153 + t645;
   const double t647 = gam[20] * (-0.20802702904656017);
   const double t648 = t646 + t647;
   const double t649 = h * t648;
-  const double t650 = q0[2] + t649;
+  const double t650 = q0[2] /* z1 */ + t649;
   const double t651 = gam[3] * 0.83060469323313224;
   const double t652 = t160 + t651;
   const double t653 = gam[21] * (-0.20802702904656017);
   const double t654 = t652 + t653;
   const double t655 = h * t654;
-  const double t656 = q0[3] + t655;
+  const double t656 = q0[3] /* x2 */ + t655;
   const double t657 = gam[4] * 0.83060469323313224;
   const double t658 = t167 + t657;
   const double t659 = gam[22] * (-0.20802702904656017);
   const double t660 = t658 + t659;
   const double t661 = h * t660;
-  const double t662 = q0[4] + t661;
+  const double t662 = q0[4] /* y2 */ + t661;
   const double t663 = gam[5] * 0.83060469323313224;
   const double t664 = t174 + t663;
   const double t665 = gam[23] * (-0.20802702904656017);
   const double t666 = t664 + t665;
   const double t667 = h * t666;
-  const double t668 = q0[5] + t667;
+  const double t668 = q0[5] /* z2 */ + t667;
   const double t669 = gam[6] * 0.83060469323313224;
   const double t670 = t181 + t669;
   const double t671 = gam[24] * (-0.20802702904656017);
   const double t672 = t670 + t671;
   const double t673 = h * t672;
-  const double t674 = q0[6] + t673;
+  const double t674 = q0[6] /* x3 */ + t673;
   const double t675 = gam[7] * 0.83060469323313224;
   const double t676 = t188 + t675;
   const double t677 = gam[25] * (-0.20802702904656017);
   const double t678 = t676 + t677;
   const double t679 = h * t678;
-  const double t680 = q0[7] + t679;
+  const double t680 = q0[7] /* y3 */ + t679;
   const double t681 = gam[8] * 0.83060469323313224;
   const double t682 = t195 + t681;
   const double t683 = gam[26] * (-0.20802702904656017);
   const double t684 = t682 + t683;
   const double t685 = h * t684;
-  const double t686 = q0[8] + t685;
+  const double t686 = q0[8] /* z3 */ + t685;
   const double t687 = t638 * t638;
   const double t688 = t644 * t644;
   const double t689 = t687 + t688;
@@ -835,55 +848,55 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t791 = gam[18] * (-0.068025568234204442);
   const double t792 = t790 + t791;
   const double t793 = h * t792;
-  const double t794 = q0[0] + t793;
+  const double t794 = q0[0] /* x1 */ + t793;
   const double t795 = gam[1] * 0.96623475710157603;
   const double t796 = t8 + t795;
   const double t797 = gam[19] * (-0.068025568234204442);
   const double t798 = t796 + t797;
   const double t799 = h * t798;
-  const double t800 = q0[1] + t799;
+  const double t800 = q0[1] /* y1 */ + t799;
   const double t801 = gam[2] * 0.96623475710157603;
   const double t802 = t15 + t801;
   const double t803 = gam[20] * (-0.068025568234204442);
   const double t804 = t802 + t803;
   const double t805 = h * t804;
-  const double t806 = q0[2] + t805;
+  const double t806 = q0[2] /* z1 */ + t805;
   const double t807 = gam[3] * 0.96623475710157603;
   const double t808 = t22 + t807;
   const double t809 = gam[21] * (-0.068025568234204442);
   const double t810 = t808 + t809;
   const double t811 = h * t810;
-  const double t812 = q0[3] + t811;
+  const double t812 = q0[3] /* x2 */ + t811;
   const double t813 = gam[4] * 0.96623475710157603;
   const double t814 = t29 + t813;
   const double t815 = gam[22] * (-0.068025568234204442);
   const double t816 = t814 + t815;
   const double t817 = h * t816;
-  const double t818 = q0[4] + t817;
+  const double t818 = q0[4] /* y2 */ + t817;
   const double t819 = gam[5] * 0.96623475710157603;
   const double t820 = t36 + t819;
   const double t821 = gam[23] * (-0.068025568234204442);
   const double t822 = t820 + t821;
   const double t823 = h * t822;
-  const double t824 = q0[5] + t823;
+  const double t824 = q0[5] /* z2 */ + t823;
   const double t825 = gam[6] * 0.96623475710157603;
   const double t826 = t43 + t825;
   const double t827 = gam[24] * (-0.068025568234204442);
   const double t828 = t826 + t827;
   const double t829 = h * t828;
-  const double t830 = q0[6] + t829;
+  const double t830 = q0[6] /* x3 */ + t829;
   const double t831 = gam[7] * 0.96623475710157603;
   const double t832 = t50 + t831;
   const double t833 = gam[25] * (-0.068025568234204442);
   const double t834 = t832 + t833;
   const double t835 = h * t834;
-  const double t836 = q0[7] + t835;
+  const double t836 = q0[7] /* y3 */ + t835;
   const double t837 = gam[8] * 0.96623475710157603;
   const double t838 = t57 + t837;
   const double t839 = gam[26] * (-0.068025568234204442);
   const double t840 = t838 + t839;
   const double t841 = h * t840;
-  const double t842 = q0[8] + t841;
+  const double t842 = q0[8] /* z3 */ + t841;
   const double t843 = t794 * t794;
   const double t844 = t800 * t800;
   const double t845 = t843 + t844;
@@ -1679,55 +1692,55 @@ static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0,
   const double t1552 = 0.28867513459481292 * t1516;
   const double t1553 = t1551 - t1552;
   const double t1554 = h * t1553;
-  const double t1555 = p0[0] - t1554;
+  const double t1555 = p0[0] /* p_x1 */ - t1554;
   w[42] = t1555;
   const double t1556 = 0.5 * t1500;
   const double t1557 = 0.28867513459481292 * t1518;
   const double t1558 = t1556 - t1557;
   const double t1559 = h * t1558;
-  const double t1560 = p0[1] - t1559;
+  const double t1560 = p0[1] /* p_y1 */ - t1559;
   w[45] = t1560;
   const double t1561 = 0.5 * t1502;
   const double t1562 = 0.28867513459481292 * t1520;
   const double t1563 = t1561 - t1562;
   const double t1564 = h * t1563;
-  const double t1565 = p0[2] - t1564;
+  const double t1565 = p0[2] /* p_z1 */ - t1564;
   w[0] = t1565;
   const double t1566 = 0.5 * t1504;
   const double t1567 = 0.28867513459481292 * t1522;
   const double t1568 = t1566 - t1567;
   const double t1569 = h * t1568;
-  const double t1570 = p0[3] - t1569;
+  const double t1570 = p0[3] /* p_x2 */ - t1569;
   w[4] = t1570;
   const double t1571 = 0.5 * t1506;
   const double t1572 = 0.28867513459481292 * t1524;
   const double t1573 = t1571 - t1572;
   const double t1574 = h * t1573;
-  const double t1575 = p0[4] - t1574;
+  const double t1575 = p0[4] /* p_y2 */ - t1574;
   w[7] = t1575;
   const double t1576 = 0.5 * t1508;
   const double t1577 = 0.28867513459481292 * t1526;
   const double t1578 = t1576 - t1577;
   const double t1579 = h * t1578;
-  const double t1580 = p0[5] - t1579;
+  const double t1580 = p0[5] /* p_z2 */ - t1579;
   w[10] = t1580;
   const double t1581 = 0.5 * t1510;
   const double t1582 = 0.28867513459481292 * t1528;
   const double t1583 = t1581 - t1582;
   const double t1584 = h * t1583;
-  const double t1585 = p0[6] - t1584;
+  const double t1585 = p0[6] /* p_x3 */ - t1584;
   w[13] = t1585;
   const double t1586 = 0.5 * t1512;
   const double t1587 = 0.28867513459481292 * t1530;
   const double t1588 = t1586 - t1587;
   const double t1589 = h * t1588;
-  const double t1590 = p0[7] - t1589;
+  const double t1590 = p0[7] /* p_y3 */ - t1589;
   w[16] = t1590;
   const double t1591 = 0.5 * t1514;
   const double t1592 = 0.28867513459481292 * t1532;
   const double t1593 = t1591 - t1592;
   const double t1594 = h * t1593;
-  const double t1595 = p0[8] - t1594;
+  const double t1595 = p0[8] /* p_z3 */ - t1594;
   w[19] = t1595;
   const double t1596 = 0.28867513459481292 * t1498;
   const double t1597 = 0.12909944487358055 * t1534;
@@ -2996,47 +3009,47 @@ static void satellites_poly_k6s3_sweep_part1(const double *q0, const double *p0,
   const double t2815 = 0.28867513459481292 * t2779;
   const double t2816 = t2814 - t2815;
   const double t2817 = h * t2816;
-  const double t2818 = p0[0] - t2817;
+  const double t2818 = p0[0] /* p_x1 */ - t2817;
   const double t2819 = 0.5 * t2763;
   const double t2820 = 0.28867513459481292 * t2781;
   const double t2821 = t2819 - t2820;
   const double t2822 = h * t2821;
-  const double t2823 = p0[1] - t2822;
+  const double t2823 = p0[1] /* p_y1 */ - t2822;
   const double t2824 = 0.5 * t2765;
   const double t2825 = 0.28867513459481292 * t2783;
   const double t2826 = t2824 - t2825;
   const double t2827 = h * t2826;
-  const double t2828 = p0[2] - t2827;
+  const double t2828 = p0[2] /* p_z1 */ - t2827;
   const double t2829 = 0.5 * t2767;
   const double t2830 = 0.28867513459481292 * t2785;
   const double t2831 = t2829 - t2830;
   const double t2832 = h * t2831;
-  const double t2833 = p0[3] - t2832;
+  const double t2833 = p0[3] /* p_x2 */ - t2832;
   const double t2834 = 0.5 * t2769;
   const double t2835 = 0.28867513459481292 * t2787;
   const double t2836 = t2834 - t2835;
   const double t2837 = h * t2836;
-  const double t2838 = p0[4] - t2837;
+  const double t2838 = p0[4] /* p_y2 */ - t2837;
   const double t2839 = 0.5 * t2771;
   const double t2840 = 0.28867513459481292 * t2789;
   const double t2841 = t2839 - t2840;
   const double t2842 = h * t2841;
-  const double t2843 = p0[5] - t2842;
+  const double t2843 = p0[5] /* p_z2 */ - t2842;
   const double t2844 = 0.5 * t2773;
   const double t2845 = 0.28867513459481292 * t2791;
   const double t2846 = t2844 - t2845;
   const double t2847 = h * t2846;
-  const double t2848 = p0[6] - t2847;
+  const double t2848 = p0[6] /* p_x3 */ - t2847;
   const double t2849 = 0.5 * t2775;
   const double t2850 = 0.28867513459481292 * t2793;
   const double t2851 = t2849 - t2850;
   const double t2852 = h * t2851;
-  const double t2853 = p0[7] - t2852;
+  const double t2853 = p0[7] /* p_y3 */ - t2852;
   const double t2854 = 0.5 * t2777;
   const double t2855 = 0.28867513459481292 * t2795;
   const double t2856 = t2854 - t2855;
   const double t2857 = h * t2856;
-  const double t2858 = p0[8] - t2857;
+  const double t2858 = p0[8] /* p_z3 */ - t2857;
   const double t2859 = 0.28867513459481292 * t2761;
   const double t2860 = 0.12909944487358055 * t2797;
   const double t2861 = t2859 - t2860;
@@ -3127,6 +3140,7 @@ static void satellites_poly_k6s3_sweep_part1(const double *q0, const double *p0,
   const double t2946 = -t2945;
   const double t2947 = h * t2777;
   const double t2948 = -t2947;
+  /* gam */
   out[0] = t2818;
   out[1] = t2823;
   out[2] = t2828;
@@ -3154,6 +3168,7 @@ static void satellites_poly_k6s3_sweep_part1(const double *q0, const double *p0,
   out[24] = t2924;
   out[25] = t2927;
   out[26] = t2930;
+  /* dp */
   out[27] = t2932;
   out[28] = t2934;
   out[29] = t2936;
@@ -3163,6 +3178,7 @@ static void satellites_poly_k6s3_sweep_part1(const double *q0, const double *p0,
   out[33] = t2944;
   out[34] = t2946;
   out[35] = t2948;
+  /* lam */
   out[36] = t2307;
   out[37] = t2308;
   out[38] = t2309;
@@ -3197,63 +3213,63 @@ static void satellites_poly_k6s3_factor_part0(const double *q0, const double *p0
   const double t3 = gam[18] * 0.068025568234204442;
   const double t4 = t2 + t3;
   const double t5 = h * t4;
-  const double t6 = q0[0] + t5;
+  const double t6 = q0[0] /* x1 */ + t5;
   const double t7 = gam[1] * 0.033765242898423975;
   const double t8 = gam[10] * (-0.056508419605012766);
   const double t9 = t7 + t8;
   const double t10 = gam[19] * 0.068025568234204442;
   const double t11 = t9 + t10;
   const double t12 = h * t11;
-  const double t13 = q0[1] + t12;
+  const double t13 = q0[1] /* y1 */ + t12;
   const double t14 = gam[2] * 0.033765242898423975;
   const double t15 = gam[11] * (-0.056508419605012766);
   const double t16 = t14 + t15;
   const double t17 = gam[20] * 0.068025568234204442;
   const double t18 = t16 + t17;
   const double t19 = h * t18;
-  const double t20 = q0[2] + t19;
+  const double t20 = q0[2] /* z1 */ + t19;
   const double t21 = gam[3] * 0.033765242898423975;
   const double t22 = gam[12] * (-0.056508419605012766);
   const double t23 = t21 + t22;
   const double t24 = gam[21] * 0.068025568234204442;
   const double t25 = t23 + t24;
   const double t26 = h * t25;
-  const double t27 = q0[3] + t26;
+  const double t27 = q0[3] /* x2 */ + t26;
   const double t28 = gam[4] * 0.033765242898423975;
   const double t29 = gam[13] * (-0.056508419605012766);
   const double t30 = t28 + t29;
   const double t31 = gam[22] * 0.068025568234204442;
   const double t32 = t30 + t31;
   const double t33 = h * t32;
-  const double t34 = q0[4] + t33;
+  const double t34 = q0[4] /* y2 */ + t33;
   const double t35 = gam[5] * 0.033765242898423975;
   const double t36 = gam[14] * (-0.056508419605012766);
   const double t37 = t35 + t36;
   const double t38 = gam[23] * 0.068025568234204442;
   const double t39 = t37 + t38;
   const double t40 = h * t39;
-  const double t41 = q0[5] + t40;
+  const double t41 = q0[5] /* z2 */ + t40;
   const double t42 = gam[6] * 0.033765242898423975;
   const double t43 = gam[15] * (-0.056508419605012766);
   const double t44 = t42 + t43;
   const double t45 = gam[24] * 0.068025568234204442;
   const double t46 = t44 + t45;
   const double t47 = h * t46;
-  const double t48 = q0[6] + t47;
+  const double t48 = q0[6] /* x3 */ + t47;
   const double t49 = gam[7] * 0.033765242898423975;
   const double t50 = gam[16] * (-0.056508419605012766);
   const double t51 = t49 + t50;
   const double t52 = gam[25] * 0.068025568234204442;
   const double t53 = t51 + t52;
   const double t54 = h * t53;
-  const double t55 = q0[7] + t54;
+  const double t55 = q0[7] /* y3 */ + t54;
   const double t56 = gam[8] * 0.033765242898423975;
   const double t57 = gam[17] * (-0.056508419605012766);
   const double t58 = t56 + t57;
   const double t59 = gam[26] * 0.068025568234204442;
   const double t60 = t58 + t59;
   const double t61 = h * t60;
-  const double t62 = q0[8] + t61;
+  const double t62 = q0[8] /* z3 */ + t61;
   /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
   const double t63 = gam[0] * 0.16939530676686776;
   const double t64 = gam[9] * (-0.24370047841099157);
@@ -3261,63 +3277,63 @@ static void satellites_poly_k6s3_factor_part0(const double *q0, const double *p0
   const double t66 = gam[18] * 0.20802702904656017;
   const double t67 = t65 + t66;
   const double t68 = h * t67;
-  const double t69 = q0[0] + t68;
+  const double t69 = q0[0] /* x1 */ + t68;
   const double t70 = gam[1] * 0.16939530676686776;
   const double t71 = gam[10] * (-0.24370047841099157);
   const double t72 = t70 + t71;
   const double t73 = gam[19] * 0.20802702904656017;
   const double t74 = t72 + t73;
   const double t75 = h * t74;
-  const double t76 = q0[1] + t75;
+  const double t76 = q0[1] /* y1 */ + t75;
   const double t77 = gam[2] * 0.16939530676686776;
   const double t78 = gam[11] * (-0.24370047841099157);
   const double t79 = t77 + t78;
   const double t80 = gam[20] * 0.20802702904656017;
   const double t81 = t79 + t80;
   const double t82 = h * t81;
-  const double t83 = q0[2] + t82;
+  const double t83 = q0[2] /* z1 */ + t82;
   const double t84 = gam[3] * 0.16939530676686776;
   const double t85 = gam[12] * (-0.24370047841099157);
   const double t86 = t84 + t85;
   const double t87 = gam[21] * 0.20802702904656017;
   const double t88 = t86 + t87;
   const double t89 = h * t88;
-  const double t90 = q0[3] + t89;
+  const double t90 = q0[3] /* x2 */ + t89;
   const double t91 = gam[4] * 0.16939530676686776;
   const double t92 = gam[13] * (-0.24370047841099157);
   const double t93 = t91 + t92;
   const double t94 = gam[22] * 0.20802702904656017;
   const double t95 = t93 + t94;
   const double t96 = h * t95;
-  const double t97 = q0[4] + t96;
+  const double t97 = q0[4] /* y2 */ + t96;
   const double t98 = gam[5] * 0.16939530676686776;
   const double t99 = gam[14] * (-0.24370047841099157);
   const double t100 = t98 + t99;
   const double t101 = gam[23] * 0.20802702904656017;
   const double t102 = t100 + t101;
   const double t103 = h * t102;
-  const double t104 = q0[5] + t103;
+  const double t104 = q0[5] /* z2 */ + t103;
   const double t105 = gam[6] * 0.16939530676686776;
   const double t106 = gam[15] * (-0.24370047841099157);
   const double t107 = t105 + t106;
   const double t108 = gam[24] * 0.20802702904656017;
   const double t109 = t107 + t108;
   const double t110 = h * t109;
-  const double t111 = q0[6] + t110;
+  const double t111 = q0[6] /* x3 */ + t110;
   const double t112 = gam[7] * 0.16939530676686776;
   const double t113 = gam[16] * (-0.24370047841099157);
   const double t114 = t112 + t113;
   const double t115 = gam[25] * 0.20802702904656017;
   const double t116 = t114 + t115;
   const double t117 = h * t116;
-  const double t118 = q0[7] + t117;
+  const double t118 = q0[7] /* y3 */ + t117;
   const double t119 = gam[8] * 0.16939530676686776;
   const double t120 = gam[17] * (-0.24370047841099157);
   const double t121 = t119 + t120;
   const double t122 = gam[26] * 0.20802702904656017;
   const double t123 = t121 + t122;
   const double t124 = h * t123;
-  const double t125 = q0[8] + t124;
+  const double t125 = q0[8] /* z3 */ + t124;
   /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
   const double t126 = gam[0] * 0.38069040695840156;
   const double t127 = gam[9] * (-0.40835734144399111);
@@ -3325,63 +3341,63 @@ static void satellites_poly_k6s3_factor_part0(const double *q0, const double *p0
   const double t129 = gam[18] * 0.1257969473866733;
   const double t130 = t128 + t129;
   const double t131 = h * t130;
-  const double t132 = q0[0] + t131;
+  const double t132 = q0[0] /* x1 */ + t131;
   const double t133 = gam[1] * 0.38069040695840156;
   const double t134 = gam[10] * (-0.40835734144399111);
   const double t135 = t133 + t134;
   const double t136 = gam[19] * 0.1257969473866733;
   const double t137 = t135 + t136;
   const double t138 = h * t137;
-  const double t139 = q0[1] + t138;
+  const double t139 = q0[1] /* y1 */ + t138;
   const double t140 = gam[2] * 0.38069040695840156;
   const double t141 = gam[11] * (-0.40835734144399111);
   const double t142 = t140 + t141;
   const double t143 = gam[20] * 0.1257969473866733;
   const double t144 = t142 + t143;
   const double t145 = h * t144;
-  const double t146 = q0[2] + t145;
+  const double t146 = q0[2] /* z1 */ + t145;
   const double t147 = gam[3] * 0.38069040695840156;
   const double t148 = gam[12] * (-0.40835734144399111);
   const double t149 = t147 + t148;
   const double t150 = gam[21] * 0.1257969473866733;
   const double t151 = t149 + t150;
   const double t152 = h * t151;
-  const double t153 = q0[3] + t152;
+  const double t153 = q0[3] /* x2 */ + t152;
   const double t154 = gam[4] * 0.38069040695840156;
   const double t155 = gam[13] * (-0.40835734144399111);
   const double t156 = t154 + t155;
   const double t157 = gam[22] * 0.1257969473866733;
   const double t158 = t156 + t157;
   const double t159 = h * t158;
-  const double t160 = q0[4] + t159;
+  const double t160 = q0[4] /* y2 */ + t159;
   const double t161 = gam[5] * 0.38069040695840156;
   const double t162 = gam[14] * (-0.40835734144399111);
   const double t163 = t161 + t162;
   const double t164 = gam[23] * 0.1257969473866733;
   const double t165 = t163 + t164;
   const double t166 = h * t165;
-  const double t167 = q0[5] + t166;
+  const double t167 = q0[5] /* z2 */ + t166;
   const double t168 = gam[6] * 0.38069040695840156;
   const double t169 = gam[15] * (-0.40835734144399111);
   const double t170 = t168 + t169;
   const double t171 = gam[24] * 0.1257969473866733;
   const double t172 = t170 + t171;
   const double t173 = h * t172;
-  const double t174 = q0[6] + t173;
+  const double t174 = q0[6] /* x3 */ + t173;
   const double t175 = gam[7] * 0.38069040695840156;
   const double t176 = gam[16] * (-0.40835734144399111);
   const double t177 = t175 + t176;
   const double t178 = gam[25] * 0.1257969473866733;
   const double t179 = t177 + t178;
   const double t180 = h * t179;
-  const double t181 = q0[7] + t180;
+  const double t181 = q0[7] /* y3 */ + t180;
   const double t182 = gam[8] * 0.38069040695840156;
   const double t183 = gam[17] * (-0.40835734144399111);
   const double t184 = t182 + t183;
   const double t185 = gam[26] * 0.1257969473866733;
   const double t186 = t184 + t185;
   const double t187 = h * t186;
-  const double t188 = q0[8] + t187;
+  const double t188 = q0[8] /* z3 */ + t187;
   /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
   const double t189 = gam[0] * 0.61930959304159849;
   const double t190 = gam[9] * (-0.40835734144399105);
@@ -3389,173 +3405,173 @@ static void satellites_poly_k6s3_factor_part0(const double *q0, const double *p0
   const double t192 = gam[18] * (-0.12579694738667335);
   const double t193 = t191 + t192;
   const double t194 = h * t193;
-  const double t195 = q0[0] + t194;
+  const double t195 = q0[0] /* x1 */ + t194;
   const double t196 = gam[1] * 0.61930959304159849;
   const double t197 = gam[10] * (-0.40835734144399105);
   const double t198 = t196 + t197;
   const double t199 = gam[19] * (-0.12579694738667335);
   const double t200 = t198 + t199;
   const double t201 = h * t200;
-  const double t202 = q0[1] + t201;
+  const double t202 = q0[1] /* y1 */ + t201;
   const double t203 = gam[2] * 0.61930959304159849;
   const double t204 = gam[11] * (-0.40835734144399105);
   const double t205 = t203 + t204;
   const double t206 = gam[20] * (-0.12579694738667335);
   const double t207 = t205 + t206;
   const double t208 = h * t207;
-  const double t209 = q0[2] + t208;
+  const double t209 = q0[2] /* z1 */ + t208;
   const double t210 = gam[3] * 0.61930959304159849;
   const double t211 = gam[12] * (-0.40835734144399105);
   const double t212 = t210 + t211;
   const double t213 = gam[21] * (-0.12579694738667335);
   const double t214 = t212 + t213;
   const double t215 = h * t214;
-  const double t216 = q0[3] + t215;
+  const double t216 = q0[3] /* x2 */ + t215;
   const double t217 = gam[4] * 0.61930959304159849;
   const double t218 = gam[13] * (-0.40835734144399105);
   const double t219 = t217 + t218;
   const double t220 = gam[22] * (-0.12579694738667335);
   const double t221 = t219 + t220;
   const double t222 = h * t221;
-  const double t223 = q0[4] + t222;
+  const double t223 = q0[4] /* y2 */ + t222;
   const double t224 = gam[5] * 0.61930959304159849;
   const double t225 = gam[14] * (-0.40835734144399105);
   const double t226 = t224 + t225;
   const double t227 = gam[23] * (-0.12579694738667335);
   const double t228 = t226 + t227;
   const double t229 = h * t228;
-  const double t230 = q0[5] + t229;
+  const double t230 = q0[5] /* z2 */ + t229;
   const double t231 = gam[6] * 0.61930959304159849;
   const double t232 = gam[15] * (-0.40835734144399105);
   const double t233 = t231 + t232;
   const double t234 = gam[24] * (-0.12579694738667335);
   const double t235 = t233 + t234;
   const double t236 = h * t235;
-  const double t237 = q0[6] + t236;
+  const double t237 = q0[6] /* x3 */ + t236;
   const double t238 = gam[7] * 0.61930959304159849;
   const double t239 = gam[16] * (-0.40835734144399105);
   const double t240 = t238 + t239;
   const double t241 = gam[25] * (-0.12579694738667335);
   const double t242 = t240 + t241;
   const double t243 = h * t242;
-  const double t244 = q0[7] + t243;
+  const double t244 = q0[7] /* y3 */ + t243;
   const double t245 = gam[8] * 0.61930959304159849;
   const double t246 = gam[17] * (-0.40835734144399105);
   const double t247 = t245 + t246;
   const double t248 = gam[26] * (-0.12579694738667335);
   const double t249 = t247 + t248;
   const double t250 = h * t249;
-  const double t251 = q0[8] + t250;
+  const double t251 = q0[8] /* z3 */ + t250;
   /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
   const double t252 = gam[0] * 0.83060469323313224;
   const double t253 = t64 + t252;
   const double t254 = gam[18] * (-0.20802702904656017);
   const double t255 = t253 + t254;
   const double t256 = h * t255;
-  const double t257 = q0[0] + t256;
+  const double t257 = q0[0] /* x1 */ + t256;
   const double t258 = gam[1] * 0.83060469323313224;
   const double t259 = t71 + t258;
   const double t260 = gam[19] * (-0.20802702904656017);
   const double t261 = t259 + t260;
   const double t262 = h * t261;
-  const double t263 = q0[1] + t262;
+  const double t263 = q0[1] /* y1 */ + t262;
   const double t264 = gam[2] * 0.83060469323313224;
   const double t265 = t78 + t264;
   const double t266 = gam[20] * (-0.20802702904656017);
   const double t267 = t265 + t266;
   const double t268 = h * t267;
-  const double t269 = q0[2] + t268;
+  const double t269 = q0[2] /* z1 */ + t268;
   const double t270 = gam[3] * 0.83060469323313224;
   const double t271 = t85 + t270;
   const double t272 = gam[21] * (-0.20802702904656017);
   const double t273 = t271 + t272;
   const double t274 = h * t273;
-  const double t275 = q0[3] + t274;
+  const double t275 = q0[3] /* x2 */ + t274;
   const double t276 = gam[4] * 0.83060469323313224;
   const double t277 = t92 + t276;
   const double t278 = gam[22] * (-0.20802702904656017);
   const double t279 = t277 + t278;
   const double t280 = h * t279;
-  const double t281 = q0[4] + t280;
+  const double t281 = q0[4] /* y2 */ + t280;
   const double t282 = gam[5] * 0.83060469323313224;
   const double t283 = t99 + t282;
   const double t284 = gam[23] * (-0.20802702904656017);
   const double t285 = t283 + t284;
   const double t286 = h * t285;
-  const double t287 = q0[5] + t286;
+  const double t287 = q0[5] /* z2 */ + t286;
   const double t288 = gam[6] * 0.83060469323313224;
   const double t289 = t106 + t288;
   const double t290 = gam[24] * (-0.20802702904656017);
   const double t291 = t289 + t290;
   const double t292 = h * t291;
-  const double t293 = q0[6] + t292;
+  const double t293 = q0[6] /* x3 */ + t292;
   const double t294 = gam[7] * 0.83060469323313224;
   const double t295 = t113 + t294;
   const double t296 = gam[25] * (-0.20802702904656017);
   const double t297 = t295 + t296;
   const double t298 = h * t297;
-  const double t299 = q0[7] + t298;
+  const double t299 = q0[7] /* y3 */ + t298;
   const double t300 = gam[8] * 0.83060469323313224;
   const double t301 = t120 + t300;
   const double t302 = gam[26] * (-0.20802702904656017);
   const double t303 = t301 + t302;
   const double t304 = h * t303;
-  const double t305 = q0[8] + t304;
+  const double t305 = q0[8] /* z3 */ + t304;
   /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
   const double t306 = gam[0] * 0.96623475710157603;
   const double t307 = t1 + t306;
   const double t308 = gam[18] * (-0.068025568234204442);
   const double t309 = t307 + t308;
   const double t310 = h * t309;
-  const double t311 = q0[0] + t310;
+  const double t311 = q0[0] /* x1 */ + t310;
   const double t312 = gam[1] * 0.96623475710157603;
   const double t313 = t8 + t312;
   const double t314 = gam[19] * (-0.068025568234204442);
   const double t315 = t313 + t314;
   const double t316 = h * t315;
-  const double t317 = q0[1] + t316;
+  const double t317 = q0[1] /* y1 */ + t316;
   const double t318 = gam[2] * 0.96623475710157603;
   const double t319 = t15 + t318;
   const double t320 = gam[20] * (-0.068025568234204442);
   const double t321 = t319 + t320;
   const double t322 = h * t321;
-  const double t323 = q0[2] + t322;
+  const double t323 = q0[2] /* z1 */ + t322;
   const double t324 = gam[3] * 0.96623475710157603;
   const double t325 = t22 + t324;
   const double t326 = gam[21] * (-0.068025568234204442);
   const double t327 = t325 + t326;
   const double t328 = h * t327;
-  const double t329 = q0[3] + t328;
+  const double t329 = q0[3] /* x2 */ + t328;
   const double t330 = gam[4] * 0.96623475710157603;
   const double t331 = t29 + t330;
   const double t332 = gam[22] * (-0.068025568234204442);
   const double t333 = t331 + t332;
   const double t334 = h * t333;
-  const double t335 = q0[4] + t334;
+  const double t335 = q0[4] /* y2 */ + t334;
   const double t336 = gam[5] * 0.96623475710157603;
   const double t337 = t36 + t336;
   const double t338 = gam[23] * (-0.068025568234204442);
   const double t339 = t337 + t338;
   const double t340 = h * t339;
-  const double t341 = q0[5] + t340;
+  const double t341 = q0[5] /* z2 */ + t340;
   const double t342 = gam[6] * 0.96623475710157603;
   const double t343 = t43 + t342;
   const double t344 = gam[24] * (-0.068025568234204442);
   const double t345 = t343 + t344;
   const double t346 = h * t345;
-  const double t347 = q0[6] + t346;
+  const double t347 = q0[6] /* x3 */ + t346;
   const double t348 = gam[7] * 0.96623475710157603;
   const double t349 = t50 + t348;
   const double t350 = gam[25] * (-0.068025568234204442);
   const double t351 = t349 + t350;
   const double t352 = h * t351;
-  const double t353 = q0[7] + t352;
+  const double t353 = q0[7] /* y3 */ + t352;
   const double t354 = gam[8] * 0.96623475710157603;
   const double t355 = t57 + t354;
   const double t356 = gam[26] * (-0.068025568234204442);
   const double t357 = t355 + t356;
   const double t358 = h * t357;
-  const double t359 = q0[8] + t358;
+  const double t359 = q0[8] /* z3 */ + t358;
   /* grad g at the stages */
   const double t360 = t6 - t27;
   const double t361 = t13 - t34;
@@ -5395,14 +5411,21 @@ static void satellites_poly_k6s3_factor_part0(const double *q0, const double *p0
   w[0] = t1998;
   const double t1999 = t458 * t1994;
   w[1] = t1999;
+  /* lu */
   out[2] = t1808;
   out[3] = t1481;
+  /* lu */
   out[5] = t1844;
   out[6] = t1553;
+  /* lu */
   out[8] = t1880;
+  /* pivot */
   out[81] = t1409;
+  /* adiag */
   out[90] = t1409;
+  /* adiag */
   out[93] = t1625;
+  /* adiag */
   out[96] = t1769;
 }
 
@@ -7437,10 +7460,14 @@ static void satellites_poly_k6s3_factor_part1(const double *q0, const double *p0
   w[222] = t3998;
   const double t3999 = t3946 * t3996;
   w[198] = t3999;
+  /* lu */
   out[0] = t3754;
   out[1] = t2027;
+  /* lu */
   out[4] = t2063;
+  /* lu */
   out[7] = t2099;
+  /* lu */
   out[9] = t3618;
   out[10] = t3860;
   out[11] = t3622;
@@ -7472,6 +7499,7 @@ static void satellites_poly_k6s3_factor_part1(const double *q0, const double *p0
   out[37] = t3785;
   out[38] = t3874;
   out[39] = t3940;
+  /* lu */
   out[41] = t3944;
   out[42] = t3946;
   out[43] = t3948;
@@ -7481,27 +7509,34 @@ static void satellites_poly_k6s3_factor_part1(const double *q0, const double *p0
   out[47] = t3887;
   out[48] = t3951;
   out[49] = t3996;
+  /* lu */
   out[54] = t3703;
   out[55] = t3815;
   out[56] = t3900;
   out[57] = t3962;
+  /* lu */
   out[63] = t3720;
   out[64] = t3830;
   out[65] = t3913;
   out[66] = t3973;
+  /* lu */
   out[72] = t3737;
   out[73] = t3845;
   out[74] = t3926;
   out[75] = t3984;
+  /* pivot */
   out[82] = t3620;
   out[83] = t3757;
   out[84] = t3863;
   out[85] = t3942;
   out[86] = t3998;
+  /* adiag */
   out[91] = t2426;
   out[92] = t3167;
+  /* adiag */
   out[94] = t2606;
   out[95] = t3311;
+  /* adiag */
   out[97] = t2750;
   out[98] = t3455;
 }
@@ -7582,26 +7617,32 @@ static void satellites_poly_k6s3_factor_part2(const double *q0, const double *p0
   const double t4068 = t4064 - t4067;
   const double t4069 = 1.0 / t4057;
   const double t4070 = 1.0 / t4068;
+  /* lu */
   out[40] = t4032;
+  /* lu */
   out[50] = t4054;
   out[51] = t4000;
   out[52] = t4002;
   out[53] = t4004;
+  /* lu */
   out[58] = t4005;
   out[59] = t4033;
   out[60] = t4065;
   out[61] = t4037;
   out[62] = t4039;
+  /* lu */
   out[67] = t4014;
   out[68] = t4040;
   out[69] = t4055;
   out[70] = t4069;
   out[71] = t4059;
+  /* lu */
   out[76] = t4023;
   out[77] = t4047;
   out[78] = t4060;
   out[79] = t4066;
   out[80] = t4070;
+  /* pivot */
   out[87] = t4035;
   out[88] = t4057;
   out[89] = t4068;
@@ -7623,15 +7664,16 @@ static void satellites_poly_k6s3_minv_p(const double *q0, const double *p0, cons
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  out[0] = p0[0];
-  out[1] = p0[1];
-  out[2] = p0[2];
-  out[3] = p0[3];
-  out[4] = p0[4];
-  out[5] = p0[5];
-  out[6] = p0[6];
-  out[7] = p0[7];
-  out[8] = p0[8];
+  /* gam0 */
+  out[0] = p0[0] /* p_x1 */;
+  out[1] = p0[1] /* p_y1 */;
+  out[2] = p0[2] /* p_z1 */;
+  out[3] = p0[3] /* p_x2 */;
+  out[4] = p0[4] /* p_y2 */;
+  out[5] = p0[5] /* p_z2 */;
+  out[6] = p0[6] /* p_x3 */;
+  out[7] = p0[7] /* p_y3 */;
+  out[8] = p0[8] /* p_z3 */;
 }
 
 /* out[0] = H(q0, p0) = p0' M^-1 p0 / 2 + U(q0) */
@@ -7639,51 +7681,51 @@ static void satellites_poly_k6s3_energy_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[0] * q0[0];
-  const double t1 = q0[1] * q0[1];
+  const double t0 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t1 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t2 = t0 + t1;
-  const double t3 = q0[2] * q0[2];
+  const double t3 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t4 = t2 + t3;
   const double t5 = sqrt(t4);
   const double t6 = 1.0 / t5;
   const double t7 = -t6;
-  const double t8 = q0[3] * q0[3];
-  const double t9 = q0[4] * q0[4];
+  const double t8 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t9 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t10 = t8 + t9;
-  const double t11 = q0[5] * q0[5];
+  const double t11 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t12 = t10 + t11;
   const double t13 = sqrt(t12);
   const double t14 = 1.0 / t13;
   const double t15 = t7 - t14;
-  const double t16 = q0[6] * q0[6];
-  const double t17 = q0[7] * q0[7];
+  const double t16 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t17 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t18 = t16 + t17;
-  const double t19 = q0[8] * q0[8];
+  const double t19 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t20 = t18 + t19;
   const double t21 = sqrt(t20);
   const double t22 = 1.0 / t21;
   const double t23 = t15 - t22;
   /* energy */
-  const double t24 = p0[0] * p0[0];
-  const double t25 = p0[1] * p0[1];
+  const double t24 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t25 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t26 = t24 + t25;
-  const double t27 = p0[2] * p0[2];
+  const double t27 = p0[2] /* p_z1 */ * p0[2] /* p_z1 */;
   const double t28 = t26 + t27;
-  const double t29 = p0[3] * p0[3];
+  const double t29 = p0[3] /* p_x2 */ * p0[3] /* p_x2 */;
   const double t30 = t28 + t29;
-  const double t31 = p0[4] * p0[4];
+  const double t31 = p0[4] /* p_y2 */ * p0[4] /* p_y2 */;
   const double t32 = t30 + t31;
-  const double t33 = p0[5] * p0[5];
+  const double t33 = p0[5] /* p_z2 */ * p0[5] /* p_z2 */;
   const double t34 = t32 + t33;
-  const double t35 = p0[6] * p0[6];
+  const double t35 = p0[6] /* p_x3 */ * p0[6] /* p_x3 */;
   const double t36 = t34 + t35;
-  const double t37 = p0[7] * p0[7];
+  const double t37 = p0[7] /* p_y3 */ * p0[7] /* p_y3 */;
   const double t38 = t36 + t37;
-  const double t39 = p0[8] * p0[8];
+  const double t39 = p0[8] /* p_z3 */ * p0[8] /* p_z3 */;
   const double t40 = t38 + t39;
   const double t41 = 0.5 * t40;
   const double t42 = t23 + t41;
+  /* H */
   out[0] = t42;
 }
 
@@ -7692,16 +7734,15 @@ static void satellites_poly_k6s3_g(const double *q0, const double *p0, const dou
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
-  const double t1 = q0[1] - q0[4];
-  const double t2 = q0[2] - q0[5];
-  const double t3 = q0[3] - q0[6];
-  const double t4 = q0[4] - q0[7];
-  const double t5 = q0[5] - q0[8];
-  const double t6 = q0[6] - q0[0];
-  const double t7 = q0[7] - q0[1];
-  const double t8 = q0[8] - q0[2];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
   /* g(q0) */
   const double t9 = t0 * t0;
   const double t10 = t1 * t1;
@@ -7721,6 +7762,7 @@ static void satellites_poly_k6s3_g(const double *q0, const double *p0, const dou
   const double t24 = t8 * t8;
   const double t25 = t23 + t24;
   const double t26 = t25 - 1.0;
+  /* g */
   out[0] = t14;
   out[1] = t20;
   out[2] = t26;
@@ -7731,60 +7773,59 @@ static void satellites_poly_k6s3_hidden_kernel(const double *q0, const double *p
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t18 = t1 * p0[0];
-  const double t19 = t3 * p0[1];
+  const double t18 = t1 * p0[0] /* p_x1 */;
+  const double t19 = t3 * p0[1] /* p_y1 */;
   const double t20 = t18 + t19;
-  const double t21 = t5 * p0[2];
+  const double t21 = t5 * p0[2] /* p_z1 */;
   const double t22 = t20 + t21;
-  const double t23 = t1 * p0[3];
+  const double t23 = t1 * p0[3] /* p_x2 */;
   const double t24 = t22 - t23;
-  const double t25 = t3 * p0[4];
+  const double t25 = t3 * p0[4] /* p_y2 */;
   const double t26 = t24 - t25;
-  const double t27 = t5 * p0[5];
+  const double t27 = t5 * p0[5] /* p_z2 */;
   const double t28 = t26 - t27;
-  const double t29 = t7 * p0[3];
-  const double t30 = t9 * p0[4];
+  const double t29 = t7 * p0[3] /* p_x2 */;
+  const double t30 = t9 * p0[4] /* p_y2 */;
   const double t31 = t29 + t30;
-  const double t32 = t11 * p0[5];
+  const double t32 = t11 * p0[5] /* p_z2 */;
   const double t33 = t31 + t32;
-  const double t34 = t7 * p0[6];
+  const double t34 = t7 * p0[6] /* p_x3 */;
   const double t35 = t33 - t34;
-  const double t36 = t9 * p0[7];
+  const double t36 = t9 * p0[7] /* p_y3 */;
   const double t37 = t35 - t36;
-  const double t38 = t11 * p0[8];
+  const double t38 = t11 * p0[8] /* p_z3 */;
   const double t39 = t37 - t38;
-  const double t40 = t13 * p0[0];
+  const double t40 = t13 * p0[0] /* p_x1 */;
   const double t41 = -t40;
-  const double t42 = t15 * p0[1];
+  const double t42 = t15 * p0[1] /* p_y1 */;
   const double t43 = t41 - t42;
-  const double t44 = t17 * p0[2];
+  const double t44 = t17 * p0[2] /* p_z1 */;
   const double t45 = t43 - t44;
-  const double t46 = t13 * p0[6];
+  const double t46 = t13 * p0[6] /* p_x3 */;
   const double t47 = t45 + t46;
-  const double t48 = t15 * p0[7];
+  const double t48 = t15 * p0[7] /* p_y3 */;
   const double t49 = t47 + t48;
-  const double t50 = t17 * p0[8];
+  const double t50 = t17 * p0[8] /* p_z3 */;
   const double t51 = t49 + t50;
+  /* hidden */
   out[0] = t28;
   out[1] = t39;
   out[2] = t51;
@@ -7796,26 +7837,24 @@ static void satellites_poly_k6s3_lambda0(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
-  /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t18 = t1 * t1;
   const double t19 = t1 * t13;
   const double t20 = -t19;
@@ -7871,24 +7910,24 @@ static void satellites_poly_k6s3_lambda0(const double *q0, const double *p0, con
   const double t70 = t67 / t62;
   const double t71 = t64 * t70;
   const double t72 = t69 - t71;
-  const double t73 = q0[0] * q0[0];
-  const double t74 = q0[1] * q0[1];
+  const double t73 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t74 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t75 = t73 + t74;
-  const double t76 = q0[2] * q0[2];
+  const double t76 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t77 = t75 + t76;
   const double t78 = sqrt(t77);
   const double t79 = 1.0 / t78;
-  const double t80 = q0[3] * q0[3];
-  const double t81 = q0[4] * q0[4];
+  const double t80 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t81 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t82 = t80 + t81;
-  const double t83 = q0[5] * q0[5];
+  const double t83 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t84 = t82 + t83;
   const double t85 = sqrt(t84);
   const double t86 = 1.0 / t85;
-  const double t87 = q0[6] * q0[6];
-  const double t88 = q0[7] * q0[7];
+  const double t87 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t88 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t89 = t87 + t88;
-  const double t90 = q0[8] * q0[8];
+  const double t90 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t91 = t89 + t90;
   const double t92 = sqrt(t91);
   const double t93 = 1.0 / t92;
@@ -7896,115 +7935,115 @@ static void satellites_poly_k6s3_lambda0(const double *q0, const double *p0, con
   const double t94 = t93 * t93;
   const double t95 = 0.5 * t94;
   const double t96 = t93 * t95;
-  const double t97 = 2.0 * q0[8];
+  const double t97 = 2.0 * q0[8] /* z3 */;
   const double t98 = t96 * t97;
-  const double t99 = 2.0 * q0[7];
+  const double t99 = 2.0 * q0[7] /* y3 */;
   const double t100 = t96 * t99;
-  const double t101 = 2.0 * q0[6];
+  const double t101 = 2.0 * q0[6] /* x3 */;
   const double t102 = t96 * t101;
   const double t103 = t86 * t86;
   const double t104 = 0.5 * t103;
   const double t105 = t86 * t104;
-  const double t106 = 2.0 * q0[5];
+  const double t106 = 2.0 * q0[5] /* z2 */;
   const double t107 = t105 * t106;
-  const double t108 = 2.0 * q0[4];
+  const double t108 = 2.0 * q0[4] /* y2 */;
   const double t109 = t105 * t108;
-  const double t110 = 2.0 * q0[3];
+  const double t110 = 2.0 * q0[3] /* x2 */;
   const double t111 = t105 * t110;
   const double t112 = t79 * t79;
   const double t113 = 0.5 * t112;
   const double t114 = t79 * t113;
-  const double t115 = 2.0 * q0[2];
+  const double t115 = 2.0 * q0[2] /* z1 */;
   const double t116 = t114 * t115;
-  const double t117 = 2.0 * q0[1];
+  const double t117 = 2.0 * q0[1] /* y1 */;
   const double t118 = t114 * t117;
-  const double t119 = 2.0 * q0[0];
+  const double t119 = 2.0 * q0[0] /* x1 */;
   const double t120 = t114 * t119;
-  const double t121 = p0[2] - p0[5];
-  const double t122 = p0[1] - p0[4];
-  const double t123 = p0[0] - p0[3];
+  const double t121 = p0[2] /* p_z1 */ - p0[5] /* p_z2 */;
+  const double t122 = p0[1] /* p_y1 */ - p0[4] /* p_y2 */;
+  const double t123 = p0[0] /* p_x1 */ - p0[3] /* p_x2 */;
   const double t124 = 2.0 * t123;
   const double t125 = 2.0 * t122;
   const double t126 = 2.0 * t121;
-  const double t127 = p0[0] * t124;
+  const double t127 = p0[0] /* p_x1 */ * t124;
   const double t128 = t1 * t120;
-  const double t129 = p0[1] * t125;
+  const double t129 = p0[1] /* p_y1 */ * t125;
   const double t130 = t127 + t129;
   const double t131 = t3 * t118;
   const double t132 = t128 + t131;
-  const double t133 = p0[2] * t126;
+  const double t133 = p0[2] /* p_z1 */ * t126;
   const double t134 = t130 + t133;
   const double t135 = t5 * t116;
   const double t136 = t132 + t135;
-  const double t137 = p0[3] * t124;
+  const double t137 = p0[3] /* p_x2 */ * t124;
   const double t138 = t134 - t137;
   const double t139 = t1 * t111;
   const double t140 = t136 - t139;
-  const double t141 = p0[4] * t125;
+  const double t141 = p0[4] /* p_y2 */ * t125;
   const double t142 = t138 - t141;
   const double t143 = t3 * t109;
   const double t144 = t140 - t143;
-  const double t145 = p0[5] * t126;
+  const double t145 = p0[5] /* p_z2 */ * t126;
   const double t146 = t142 - t145;
   const double t147 = t5 * t107;
   const double t148 = t144 - t147;
   const double t149 = t146 - t148;
-  const double t150 = p0[5] - p0[8];
-  const double t151 = p0[4] - p0[7];
-  const double t152 = p0[3] - p0[6];
+  const double t150 = p0[5] /* p_z2 */ - p0[8] /* p_z3 */;
+  const double t151 = p0[4] /* p_y2 */ - p0[7] /* p_y3 */;
+  const double t152 = p0[3] /* p_x2 */ - p0[6] /* p_x3 */;
   const double t153 = 2.0 * t152;
   const double t154 = 2.0 * t151;
   const double t155 = 2.0 * t150;
-  const double t156 = p0[3] * t153;
+  const double t156 = p0[3] /* p_x2 */ * t153;
   const double t157 = t7 * t111;
-  const double t158 = p0[4] * t154;
+  const double t158 = p0[4] /* p_y2 */ * t154;
   const double t159 = t156 + t158;
   const double t160 = t9 * t109;
   const double t161 = t157 + t160;
-  const double t162 = p0[5] * t155;
+  const double t162 = p0[5] /* p_z2 */ * t155;
   const double t163 = t159 + t162;
   const double t164 = t11 * t107;
   const double t165 = t161 + t164;
-  const double t166 = p0[6] * t153;
+  const double t166 = p0[6] /* p_x3 */ * t153;
   const double t167 = t163 - t166;
   const double t168 = t7 * t102;
   const double t169 = t165 - t168;
-  const double t170 = p0[7] * t154;
+  const double t170 = p0[7] /* p_y3 */ * t154;
   const double t171 = t167 - t170;
   const double t172 = t9 * t100;
   const double t173 = t169 - t172;
-  const double t174 = p0[8] * t155;
+  const double t174 = p0[8] /* p_z3 */ * t155;
   const double t175 = t171 - t174;
   const double t176 = t11 * t98;
   const double t177 = t173 - t176;
   const double t178 = t175 - t177;
-  const double t179 = p0[8] - p0[2];
-  const double t180 = p0[7] - p0[1];
-  const double t181 = p0[6] - p0[0];
+  const double t179 = p0[8] /* p_z3 */ - p0[2] /* p_z1 */;
+  const double t180 = p0[7] /* p_y3 */ - p0[1] /* p_y1 */;
+  const double t181 = p0[6] /* p_x3 */ - p0[0] /* p_x1 */;
   const double t182 = 2.0 * t181;
   const double t183 = 2.0 * t180;
   const double t184 = 2.0 * t179;
-  const double t185 = p0[0] * t182;
+  const double t185 = p0[0] /* p_x1 */ * t182;
   const double t186 = -t185;
   const double t187 = t13 * t120;
   const double t188 = -t187;
-  const double t189 = p0[1] * t183;
+  const double t189 = p0[1] /* p_y1 */ * t183;
   const double t190 = t186 - t189;
   const double t191 = t15 * t118;
   const double t192 = t188 - t191;
-  const double t193 = p0[2] * t184;
+  const double t193 = p0[2] /* p_z1 */ * t184;
   const double t194 = t190 - t193;
   const double t195 = t17 * t116;
   const double t196 = t192 - t195;
-  const double t197 = p0[6] * t182;
+  const double t197 = p0[6] /* p_x3 */ * t182;
   const double t198 = t194 + t197;
   const double t199 = t13 * t102;
   const double t200 = t196 + t199;
-  const double t201 = p0[7] * t183;
+  const double t201 = p0[7] /* p_y3 */ * t183;
   const double t202 = t198 + t201;
   const double t203 = t15 * t100;
   const double t204 = t200 + t203;
-  const double t205 = p0[8] * t184;
+  const double t205 = p0[8] /* p_z3 */ * t184;
   const double t206 = t202 + t205;
   const double t207 = t17 * t98;
   const double t208 = t204 + t207;
@@ -8024,6 +8063,7 @@ static void satellites_poly_k6s3_lambda0(const double *q0, const double *p0, con
   const double t222 = t28 * t216;
   const double t223 = t221 - t222;
   const double t224 = t223 / t35;
+  /* lambda */
   out[0] = t224;
   out[1] = t219;
   out[2] = t216;
@@ -8036,24 +8076,23 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[0] - q0[3];
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
   const double t1 = 2.0 * t0;
-  const double t2 = q0[1] - q0[4];
+  const double t2 = q0[1] /* y1 */ - q0[4] /* y2 */;
   const double t3 = 2.0 * t2;
-  const double t4 = q0[2] - q0[5];
+  const double t4 = q0[2] /* z1 */ - q0[5] /* z2 */;
   const double t5 = 2.0 * t4;
-  const double t6 = q0[3] - q0[6];
+  const double t6 = q0[3] /* x2 */ - q0[6] /* x3 */;
   const double t7 = 2.0 * t6;
-  const double t8 = q0[4] - q0[7];
+  const double t8 = q0[4] /* y2 */ - q0[7] /* y3 */;
   const double t9 = 2.0 * t8;
-  const double t10 = q0[5] - q0[8];
+  const double t10 = q0[5] /* z2 */ - q0[8] /* z3 */;
   const double t11 = 2.0 * t10;
-  const double t12 = q0[6] - q0[0];
+  const double t12 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t13 = 2.0 * t12;
-  const double t14 = q0[7] - q0[1];
+  const double t14 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t15 = 2.0 * t14;
-  const double t16 = q0[8] - q0[2];
+  const double t16 = q0[8] /* z3 */ - q0[2] /* z1 */;
   const double t17 = 2.0 * t16;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
   const double t18 = t1 * t1;
@@ -8098,39 +8137,39 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   const double t57 = t52 + t56;
   const double t58 = t53 + t57;
   const double t59 = t55 + t58;
-  const double t60 = t1 * p0[0];
-  const double t61 = t3 * p0[1];
+  const double t60 = t1 * p0[0] /* p_x1 */;
+  const double t61 = t3 * p0[1] /* p_y1 */;
   const double t62 = t60 + t61;
-  const double t63 = t5 * p0[2];
+  const double t63 = t5 * p0[2] /* p_z1 */;
   const double t64 = t62 + t63;
-  const double t65 = t1 * p0[3];
+  const double t65 = t1 * p0[3] /* p_x2 */;
   const double t66 = t64 - t65;
-  const double t67 = t3 * p0[4];
+  const double t67 = t3 * p0[4] /* p_y2 */;
   const double t68 = t66 - t67;
-  const double t69 = t5 * p0[5];
+  const double t69 = t5 * p0[5] /* p_z2 */;
   const double t70 = t68 - t69;
-  const double t71 = t7 * p0[3];
-  const double t72 = t9 * p0[4];
+  const double t71 = t7 * p0[3] /* p_x2 */;
+  const double t72 = t9 * p0[4] /* p_y2 */;
   const double t73 = t71 + t72;
-  const double t74 = t11 * p0[5];
+  const double t74 = t11 * p0[5] /* p_z2 */;
   const double t75 = t73 + t74;
-  const double t76 = t7 * p0[6];
+  const double t76 = t7 * p0[6] /* p_x3 */;
   const double t77 = t75 - t76;
-  const double t78 = t9 * p0[7];
+  const double t78 = t9 * p0[7] /* p_y3 */;
   const double t79 = t77 - t78;
-  const double t80 = t11 * p0[8];
+  const double t80 = t11 * p0[8] /* p_z3 */;
   const double t81 = t79 - t80;
-  const double t82 = t13 * p0[0];
+  const double t82 = t13 * p0[0] /* p_x1 */;
   const double t83 = -t82;
-  const double t84 = t15 * p0[1];
+  const double t84 = t15 * p0[1] /* p_y1 */;
   const double t85 = t83 - t84;
-  const double t86 = t17 * p0[2];
+  const double t86 = t17 * p0[2] /* p_z1 */;
   const double t87 = t85 - t86;
-  const double t88 = t13 * p0[6];
+  const double t88 = t13 * p0[6] /* p_x3 */;
   const double t89 = t87 + t88;
-  const double t90 = t15 * p0[7];
+  const double t90 = t15 * p0[7] /* p_y3 */;
   const double t91 = t89 + t90;
-  const double t92 = t17 * p0[8];
+  const double t92 = t17 * p0[8] /* p_z3 */;
   const double t93 = t91 + t92;
   const double t94 = t37 / t35;
   const double t95 = t37 * t94;
@@ -8163,30 +8202,30 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   const double t122 = t1 * t121;
   const double t123 = t13 * t113;
   const double t124 = t123 - t122;
-  const double t125 = p0[0] + t124;
+  const double t125 = p0[0] /* p_x1 */ + t124;
   const double t126 = t3 * t121;
   const double t127 = t15 * t113;
   const double t128 = t127 - t126;
-  const double t129 = p0[1] + t128;
+  const double t129 = p0[1] /* p_y1 */ + t128;
   const double t130 = t5 * t121;
   const double t131 = t17 * t113;
   const double t132 = t131 - t130;
-  const double t133 = p0[2] + t132;
+  const double t133 = p0[2] /* p_z1 */ + t132;
   const double t134 = t7 * t116;
   const double t135 = t122 - t134;
-  const double t136 = p0[3] + t135;
+  const double t136 = p0[3] /* p_x2 */ + t135;
   const double t137 = t9 * t116;
   const double t138 = t126 - t137;
-  const double t139 = p0[4] + t138;
+  const double t139 = p0[4] /* p_y2 */ + t138;
   const double t140 = t11 * t116;
   const double t141 = t130 - t140;
-  const double t142 = p0[5] + t141;
+  const double t142 = p0[5] /* p_z2 */ + t141;
   const double t143 = t134 - t123;
-  const double t144 = p0[6] + t143;
+  const double t144 = p0[6] /* p_x3 */ + t143;
   const double t145 = t137 - t127;
-  const double t146 = p0[7] + t145;
+  const double t146 = p0[7] /* p_y3 */ + t145;
   const double t147 = t140 - t131;
-  const double t148 = p0[8] + t147;
+  const double t148 = p0[8] /* p_z3 */ + t147;
   const double t149 = t125 * t125;
   const double t150 = t129 * t129;
   const double t151 = t149 + t150;
@@ -8205,30 +8244,31 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   const double t164 = t148 * t148;
   const double t165 = t163 + t164;
   const double t166 = 0.5 * t165;
-  const double t167 = q0[0] * q0[0];
-  const double t168 = q0[1] * q0[1];
+  const double t167 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t168 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t169 = t167 + t168;
-  const double t170 = q0[2] * q0[2];
+  const double t170 = q0[2] /* z1 */ * q0[2] /* z1 */;
   const double t171 = t169 + t170;
   const double t172 = sqrt(t171);
   const double t173 = 1.0 / t172;
   const double t174 = -t173;
-  const double t175 = q0[3] * q0[3];
-  const double t176 = q0[4] * q0[4];
+  const double t175 = q0[3] /* x2 */ * q0[3] /* x2 */;
+  const double t176 = q0[4] /* y2 */ * q0[4] /* y2 */;
   const double t177 = t175 + t176;
-  const double t178 = q0[5] * q0[5];
+  const double t178 = q0[5] /* z2 */ * q0[5] /* z2 */;
   const double t179 = t177 + t178;
   const double t180 = sqrt(t179);
   const double t181 = 1.0 / t180;
   const double t182 = t174 - t181;
-  const double t183 = q0[6] * q0[6];
-  const double t184 = q0[7] * q0[7];
+  const double t183 = q0[6] /* x3 */ * q0[6] /* x3 */;
+  const double t184 = q0[7] /* y3 */ * q0[7] /* y3 */;
   const double t185 = t183 + t184;
-  const double t186 = q0[8] * q0[8];
+  const double t186 = q0[8] /* z3 */ * q0[8] /* z3 */;
   const double t187 = t185 + t186;
   const double t188 = sqrt(t187);
   const double t189 = 1.0 / t188;
   const double t190 = t182 - t189;
+  /* dp */
   out[0] = t124;
   out[1] = t128;
   out[2] = t132;
@@ -8238,11 +8278,15 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   out[6] = t143;
   out[7] = t145;
   out[8] = t147;
+  /* kin */
   out[9] = t166;
+  /* U */
   out[10] = t190;
+  /* pivot */
   out[11] = t35;
   out[12] = t96;
   out[13] = t110;
+  /* adiag */
   out[14] = t35;
   out[15] = t49;
   out[16] = t59;
@@ -8257,20 +8301,20 @@ void satellites_poly_k6s3_init(satellites_poly_k6s3_state *x, const double *q0, 
 {
   int i;
   x->t = x->tc = x->hprev = 0;
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
     x->q[i] = q0 ? (double)q0[i] : satellites_poly_k6s3_q0[i];
     x->p[i] = p0 ? (double)p0[i] : satellites_poly_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < (NU ? NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < S * M; i++) x->gam[i] = 0;
+  for (i = 0; i < (satellites_poly_k6s3_NU ? satellites_poly_k6s3_NU : 1); i++) x->lambda[i] = 0;
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     satellites_poly_k6s3_params prm;
-    double lam[NU];
+    double lam[satellites_poly_k6s3_NU];
     satellites_poly_k6s3_params_default(&prm);
     satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+    for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
 }
 
@@ -8286,32 +8330,32 @@ const char *satellites_poly_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define DEFAULT_PARAMS(prm) satellites_poly_k6s3_params dflt_; if (!prm) { satellites_poly_k6s3_params_default(&dflt_); prm = &dflt_; }
+#define satellites_poly_k6s3_DEFAULT_PARAMS(prm) satellites_poly_k6s3_params dflt_; if (!prm) { satellites_poly_k6s3_params_default(&dflt_); prm = &dflt_; }
 
 double satellites_poly_k6s3_energy(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm)
 {
   double H;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   satellites_poly_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, &H);
   return H;
 }
 
 void satellites_poly_k6s3_constraints(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, double *g)
 {
-  double v[NU];
+  double v[satellites_poly_k6s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   satellites_poly_k6s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) g[i] = v[i];
+  for (i = 0; i < satellites_poly_k6s3_NU; i++) g[i] = v[i];
 }
 
 void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, double *gp)
 {
-  double v[NU];
+  double v[satellites_poly_k6s3_NU];
   int i;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   satellites_poly_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < NU; i++) gp[i] = v[i];
+  for (i = 0; i < satellites_poly_k6s3_NU; i++) gp[i] = v[i];
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -8319,17 +8363,17 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
 static void satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, const satellites_poly_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
-  for (i = 0; i < S * M; i++) gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < S; j++)
-    for (i = 0; i < S; i++) {
+  for (j = 0; j < satellites_poly_k6s3_S; j++)
+    for (i = 0; i < satellites_poly_k6s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s3_E[(j * S + i) * S + d];
+      for (d = satellites_poly_k6s3_S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s3_E[(j * satellites_poly_k6s3_S + i) * satellites_poly_k6s3_S + d];
       if (e != 0)
-        for (l = 0; l < M; l++) gam[j * M + l] += e * x->gam[i * M + l];
+        for (l = 0; l < satellites_poly_k6s3_M; l++) gam[j * satellites_poly_k6s3_M + l] += e * x->gam[i * satellites_poly_k6s3_M + l];
     }
 }
 
@@ -8346,100 +8390,101 @@ static void satellites_poly_k6s3_add(double *a, double *c, double b)
 int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, double h_, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[S * M], sw[S * M + M + S * NU + 1];
+  double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, scale;
   int it, i, rc = satellites_poly_k6s3_ENOCONV;
-  DEFAULT_PARAMS(prm)
+  satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s3_EBADSTEP;
   satellites_poly_k6s3_predict(x, h, prm, gam);
-  double g0[NU];
+  double g0[satellites_poly_k6s3_NU];
   satellites_poly_k6s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
-   * cannot drift; below GTOL, g(q0) is round-off, and kicking the momenta by it
+   * cannot drift; below satellites_poly_k6s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
-  for (i = 0; i < NU; i++) g0[i] = fabs(g0[i]) <= GTOL ? 0 : g0[i] / h;
-  double fa[81 + 2 * S * NU + 1], lam[S * NU];
-  for (i = 0; i < S * NU; i++) lam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s3_NU; i++) g0[i] = fabs(g0[i]) <= satellites_poly_k6s3_GTOL ? 0 : g0[i] / h;
+  double fa[81 + 2 * satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1], lam[satellites_poly_k6s3_S * satellites_poly_k6s3_NU];
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps */
   satellites_poly_k6s3_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
-  for (i = 0; i < S * NU; i++) {
-    double piv = fa[81 + i], dia = fa[81 + S * NU + i];
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) {
+    double piv = fa[81 + i], dia = fa[81 + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + i];
     if (!isfinite(piv) || !isfinite(dia)) return satellites_poly_k6s3_ENONFINITE;
-    if (!(fabs(piv) > SINGTOL * fabs(dia))) return satellites_poly_k6s3_ESINGULAR;
+    if (!(fabs(piv) > satellites_poly_k6s3_SINGTOL * fabs(dia))) return satellites_poly_k6s3_ESINGULAR;
   }
-  for (it = 1; it <= MAXITER; it++) {
+  for (it = 1; it <= satellites_poly_k6s3_MAXITER; it++) {
     satellites_poly_k6s3_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < M; i++) {
+    for (i = 0; i < satellites_poly_k6s3_M; i++) {
       double v = fabs(x->q[i]) + fabs(h * sw[i]);
       if (v > scale) scale = v;
     }
-    for (i = 0; i < S * M; i++) {
+    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
       double v = fabs(h * (sw[i] - gam[i]));
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < S * NU; i++) lam[i] = sw[S * M + M + i];
-    for (i = 0; i < S * M + M + S * NU; i++)
+    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) lam[i] = sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + i];
+    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_poly_k6s3_ENONFINITE;
     if (rc == satellites_poly_k6s3_ENONFINITE || !isfinite(inc)) { rc = satellites_poly_k6s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (TOL / 256), or
-     * within 2 ulps (TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above STAGTOL: fail). Iterating
+    /* converged: the increment is far below an ulp of the state (satellites_poly_k6s3_TOL / 256), or
+     * within 2 ulps (satellites_poly_k6s3_TOL) and falling by less than 4x (round-off noise), or it
+     * stopped decreasing (at round-off: accept; above satellites_poly_k6s3_STAGTOL: fail). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= TOL / 256 || (inc <= TOL && 4 * inc > inc_old)) { rc = satellites_poly_k6s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= STAGTOL ? satellites_poly_k6s3_OK : satellites_poly_k6s3_ENOCONV; break; }
+    if (inc <= satellites_poly_k6s3_TOL / 256 || (inc <= satellites_poly_k6s3_TOL && 4 * inc > inc_old)) { rc = satellites_poly_k6s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= satellites_poly_k6s3_STAGTOL ? satellites_poly_k6s3_OK : satellites_poly_k6s3_ENOCONV; break; }
   }
-  if (st) { st->iters = it > MAXITER ? MAXITER : it; st->increment = inc; }
+  if (st) { st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it; st->increment = inc; }
   if (rc != satellites_poly_k6s3_OK) return rc;
-  double q1[M], p1[M], pr[M + 2 + 2 * NU + 1], K, U1, beta = 1;
+  if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
+  double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 2 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s3_energy(x, prm);
-  double qc1[M], pc1[M];
-  for (i = 0; i < M; i++) {
+  double qc1[satellites_poly_k6s3_M], pc1[satellites_poly_k6s3_M];
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
     q1[i] = x->q[i];
     qc1[i] = x->qc[i];
     p1[i] = x->p[i];
     pc1[i] = x->pc[i];
     satellites_poly_k6s3_add(&q1[i], &qc1[i], h * sw[i]);
-    satellites_poly_k6s3_add(&p1[i], &pc1[i], sw[S * M + i]);
+    satellites_poly_k6s3_add(&p1[i], &pc1[i], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   satellites_poly_k6s3_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
-  for (i = 0; i < NU; i++) {
-    double piv = pr[M + 2 + i], dia = pr[M + 2 + NU + i];
-    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > SINGTOL * fabs(dia))) return satellites_poly_k6s3_ESINGULAR;
+  for (i = 0; i < satellites_poly_k6s3_NU; i++) {
+    double piv = pr[satellites_poly_k6s3_M + 2 + i], dia = pr[satellites_poly_k6s3_M + 2 + satellites_poly_k6s3_NU + i];
+    if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_poly_k6s3_SINGTOL * fabs(dia))) return satellites_poly_k6s3_ESINGULAR;
   }
-  for (i = 0; i < M + 2 + 2 * NU; i++)
+  for (i = 0; i < satellites_poly_k6s3_M + 2 + 2 * satellites_poly_k6s3_NU; i++)
     if (!isfinite(pr[i])) return satellites_poly_k6s3_ENONFINITE;
   /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:
    * taken anew on the first step, or when the state or parameters were changed
    * since the last step (H(q0, p0) differs from H0 by more than round-off). No
    * rescale at rest (K = 0) or where H0 < U(q1). */
-  K = pr[M + 0];
-  U1 = pr[M + 1 + 0];
-  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * TOL * (K + fabs(U1)) ? x->H0 : Hn;
+  K = pr[satellites_poly_k6s3_M + 0];
+  U1 = pr[satellites_poly_k6s3_M + 1 + 0];
+  H0 = x->hprev != 0 && fabs(Hn - x->H0) <= 64 * satellites_poly_k6s3_TOL * (K + fabs(U1)) ? x->H0 : Hn;
   if (K > 0 && H0 - U1 > 0) beta = sqrt((H0 - U1) / K);
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
     satellites_poly_k6s3_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return satellites_poly_k6s3_ENONFINITE;
   }
-  for (i = 0; i < M; i++) {
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < S * M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[NU];
+    double lam0[satellites_poly_k6s3_NU];
     satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
   }
   satellites_poly_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
