@@ -367,6 +367,7 @@ typedef struct {
   int wide_step;        /* --wide-step: iterate and update one precision wider */
 } EmitOptions;
 
+int emit_check(const Model *mod, const Step *st, const EmitOptions *o); /* 1 after errors */
 int emit_solver(FILE *h, FILE *c, const Model *mod, const Method *meth, const Step *st, const EmitOptions *o);
 int emit_driver(FILE *f, const Model *mod, const Method *meth, const EmitOptions *o);
 

@@ -410,6 +410,7 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
   int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
                     !o->plain_sum, o->wide_step};
+  if (!rc && emit_check(mod, st, &eo)) return 1; /* nothing is written yet */
   atexit(remove_temporaries);
   mode_t mask = umask(0);
   umask(mask);

@@ -17,14 +17,17 @@
 #ifndef double_pendulum_k3s3_TOL
 #define double_pendulum_k3s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
-#ifndef double_pendulum_k3s3_STAGTOL
-#define double_pendulum_k3s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#ifndef double_pendulum_k3s3_NOISETOL
+#define double_pendulum_k3s3_NOISETOL 1.4210854715202004e-14  /* a stall at or below this (64 ulps) is round-off: converged */
 #endif
 #ifndef double_pendulum_k3s3_SINGTOL
 #define double_pendulum_k3s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
 #endif
 #ifndef double_pendulum_k3s3_GTOL
 #define double_pendulum_k3s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
+#ifndef double_pendulum_k3s3_STALL
+#define double_pendulum_k3s3_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
@@ -1982,8 +1985,8 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double h_, const do
 {
   const double h = (double)h_;
   double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, scale;
-  int it, i, rc = double_pendulum_k3s3_ENOCONV;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  int it, i, stall = 0, rc = double_pendulum_k3s3_ENOCONV;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k3s3_EBADSTEP;
   double_pendulum_k3s3_predict(x, h, prm, gam);
@@ -2023,12 +2026,21 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double h_, const do
       if (!isfinite(sw[i])) rc = double_pendulum_k3s3_ENONFINITE;
     if (rc == double_pendulum_k3s3_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (double_pendulum_k3s3_TOL / 256), or
-     * within 2 ulps (double_pendulum_k3s3_TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above double_pendulum_k3s3_STAGTOL: fail). Iterating
+     * within 2 ulps (double_pendulum_k3s3_TOL) and falling by less than 4x (round-off noise). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
     if (inc <= double_pendulum_k3s3_TOL / 256 || (inc <= double_pendulum_k3s3_TOL && 4 * inc > inc_old)) { rc = double_pendulum_k3s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= double_pendulum_k3s3_STAGTOL ? double_pendulum_k3s3_OK : double_pendulum_k3s3_ENOCONV; break; }
+    /* otherwise progress is a new smallest increment: those of a converging sweep
+     * need not fall every time (X_s has complex eigenvalues), so a rise alone is
+     * no failure. double_pendulum_k3s3_STALL sweeps without one are a stall: converged if it is at
+     * round-off (double_pendulum_k3s3_NOISETOL), else a failure: never a step that has not converged. */
+    if (inc < inc_min) {
+      inc_min = inc;
+      stall = 0;
+    } else if (++stall >= double_pendulum_k3s3_STALL) {
+      rc = inc_min <= double_pendulum_k3s3_NOISETOL ? double_pendulum_k3s3_OK : double_pendulum_k3s3_ENOCONV;
+      break;
+    }
   }
   if (st) { st->iters = it > double_pendulum_k3s3_MAXITER ? double_pendulum_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_k3s3_OK) return rc;

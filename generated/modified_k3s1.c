@@ -17,14 +17,17 @@
 #ifndef modified_k3s1_TOL
 #define modified_k3s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
-#ifndef modified_k3s1_STAGTOL
-#define modified_k3s1_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#ifndef modified_k3s1_NOISETOL
+#define modified_k3s1_NOISETOL 1.4210854715202004e-14  /* a stall at or below this (64 ulps) is round-off: converged */
 #endif
 #ifndef modified_k3s1_SINGTOL
 #define modified_k3s1_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
 #endif
 #ifndef modified_k3s1_GTOL
 #define modified_k3s1_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
+#ifndef modified_k3s1_STALL
+#define modified_k3s1_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
@@ -361,8 +364,8 @@ int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_pa
 {
   const double h = (double)h_;
   double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
-  double inc = HUGE_VAL, inc_old, scale;
-  int it, i, rc = modified_k3s1_ENOCONV;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  int it, i, stall = 0, rc = modified_k3s1_ENOCONV;
   modified_k3s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k3s1_EBADSTEP;
   modified_k3s1_predict(x, h, prm, gam);
@@ -397,12 +400,21 @@ int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_pa
       if (!isfinite(sw[i])) rc = modified_k3s1_ENONFINITE;
     if (rc == modified_k3s1_ENONFINITE || !isfinite(inc)) { rc = modified_k3s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k3s1_TOL / 256), or
-     * within 2 ulps (modified_k3s1_TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above modified_k3s1_STAGTOL: fail). Iterating
+     * within 2 ulps (modified_k3s1_TOL) and falling by less than 4x (round-off noise). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
     if (inc <= modified_k3s1_TOL / 256 || (inc <= modified_k3s1_TOL && 4 * inc > inc_old)) { rc = modified_k3s1_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= modified_k3s1_STAGTOL ? modified_k3s1_OK : modified_k3s1_ENOCONV; break; }
+    /* otherwise progress is a new smallest increment: those of a converging sweep
+     * need not fall every time (X_s has complex eigenvalues), so a rise alone is
+     * no failure. modified_k3s1_STALL sweeps without one are a stall: converged if it is at
+     * round-off (modified_k3s1_NOISETOL), else a failure: never a step that has not converged. */
+    if (inc < inc_min) {
+      inc_min = inc;
+      stall = 0;
+    } else if (++stall >= modified_k3s1_STALL) {
+      rc = inc_min <= modified_k3s1_NOISETOL ? modified_k3s1_OK : modified_k3s1_ENOCONV;
+      break;
+    }
   }
   if (st) { st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it; st->increment = inc; }
   if (rc != modified_k3s1_OK) return rc;

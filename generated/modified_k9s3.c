@@ -17,14 +17,17 @@
 #ifndef modified_k9s3_TOL
 #define modified_k9s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
-#ifndef modified_k9s3_STAGTOL
-#define modified_k9s3_STAGTOL 1e-10  /* an increment that stops decreasing above this is divergence */
+#ifndef modified_k9s3_NOISETOL
+#define modified_k9s3_NOISETOL 1.4210854715202004e-14  /* a stall at or below this (64 ulps) is round-off: converged */
 #endif
 #ifndef modified_k9s3_SINGTOL
 #define modified_k9s3_SINGTOL 1e-13  /* pivot / diagonal of A below this: singular */
 #endif
 #ifndef modified_k9s3_GTOL
 #define modified_k9s3_GTOL 1.4210854715202004e-14  /* |g| up to this (64 ulps) is round-off: not corrected */
+#endif
+#ifndef modified_k9s3_STALL
+#define modified_k9s3_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 9 (the kernels below use
@@ -741,8 +744,8 @@ int modified_k9s3_step(modified_k9s3_state *x, double h_, const modified_k9s3_pa
 {
   const double h = (double)h_;
   double gam[modified_k9s3_S * modified_k9s3_M], sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 3 * modified_k9s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, scale;
-  int it, i, rc = modified_k9s3_ENOCONV;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  int it, i, stall = 0, rc = modified_k9s3_ENOCONV;
   modified_k9s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k9s3_EBADSTEP;
   modified_k9s3_predict(x, h, prm, gam);
@@ -777,12 +780,21 @@ int modified_k9s3_step(modified_k9s3_state *x, double h_, const modified_k9s3_pa
       if (!isfinite(sw[i])) rc = modified_k9s3_ENONFINITE;
     if (rc == modified_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_k9s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k9s3_TOL / 256), or
-     * within 2 ulps (modified_k9s3_TOL) and falling by less than 4x (round-off noise), or it
-     * stopped decreasing (at round-off: accept; above modified_k9s3_STAGTOL: fail). Iterating
+     * within 2 ulps (modified_k9s3_TOL) and falling by less than 4x (round-off noise). Iterating
      * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
      * random walk over millions of steps (bench/results/longrun.txt). */
     if (inc <= modified_k9s3_TOL / 256 || (inc <= modified_k9s3_TOL && 4 * inc > inc_old)) { rc = modified_k9s3_OK; break; }
-    if (it > 1 && inc >= inc_old) { rc = inc <= modified_k9s3_STAGTOL ? modified_k9s3_OK : modified_k9s3_ENOCONV; break; }
+    /* otherwise progress is a new smallest increment: those of a converging sweep
+     * need not fall every time (X_s has complex eigenvalues), so a rise alone is
+     * no failure. modified_k9s3_STALL sweeps without one are a stall: converged if it is at
+     * round-off (modified_k9s3_NOISETOL), else a failure: never a step that has not converged. */
+    if (inc < inc_min) {
+      inc_min = inc;
+      stall = 0;
+    } else if (++stall >= modified_k9s3_STALL) {
+      rc = inc_min <= modified_k9s3_NOISETOL ? modified_k9s3_OK : modified_k9s3_ENOCONV;
+      break;
+    }
   }
   if (st) { st->iters = it > modified_k9s3_MAXITER ? modified_k9s3_MAXITER : it; st->increment = inc; }
   if (rc != modified_k9s3_OK) return rc;

@@ -124,11 +124,32 @@ static void run_done(Run *r)
   remove_tree(r->dir);
 }
 
-/* Run the generator as `hbvmgen -o OUT model` in a child whose stdout and
- * stderr go to files, killed by SIGALRM after TIMEOUT seconds (the alarm
- * survives exec). Fills r->status, r->signal and r->err. */
+/* The options a model asks for on its first line, "# flags: --real float",
+ * split into argv (at most 8, into buf); returns their number. */
+static int model_flags(const char *model, char *buf, size_t size, char **argv)
+{
+  FILE *f = fopen(model, "r");
+  int n = 0;
+  if (!f)
+    return 0;
+  if (fgets(buf, (int)size, f) && !strncmp(buf, "# flags: ", 9))
+    for (char *t = strtok(buf + 9, " \r\n"); t && n < 8; t = strtok(NULL, " \r\n"))
+      argv[n++] = t;
+  fclose(f);
+  return n;
+}
+
+/* Run the generator as `hbvmgen [flags] -o OUT model` in a child whose
+ * stdout and stderr go to files, killed by SIGALRM after TIMEOUT seconds
+ * (the alarm survives exec). Fills r->status, r->signal and r->err. */
 static void run_generator(Run *r, const char *model)
 {
+  char flagbuf[256], *argv[13] = {GENERATOR};
+  int argc = 1 + model_flags(model, flagbuf, sizeof flagbuf, argv + 1);
+  argv[argc++] = "-o";
+  argv[argc++] = r->out;
+  argv[argc++] = (char *)model;
+  argv[argc] = NULL;
   fflush(NULL);
   pid_t pid = fork();
   ck_assert_msg(pid >= 0, "fork failed");
@@ -138,7 +159,7 @@ static void run_generator(Run *r, const char *model)
     if (out < 0 || err < 0 || dup2(out, 1) < 0 || dup2(err, 2) < 0)
       _exit(127);
     alarm(TIMEOUT);
-    execl(GENERATOR, GENERATOR, "-o", r->out, model, (char *)NULL);
+    execv(GENERATOR, argv);
     _exit(127);
   }
   int status;
