@@ -180,7 +180,8 @@ void ad_reverse(Dag *d, const int *roots, const int *seeds, int nroots, int n, i
   }
 }
 
-void ad_gradient(Dag *d, int root, int n, int *grad) { ad_reverse(d, &root, NULL, 1, n, grad); }
+void ad_gradient(Dag *d, int root, int n, int *grad) {
+  d->work += n; ad_reverse(d, &root, NULL, 1, n, grad); }
 
 static int by_coord(const void *a, const void *b) {
   const Entry *x = a, *y = b;

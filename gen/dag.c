@@ -359,6 +359,7 @@ void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, i
   if (top < 0) return;
   unsigned char *mark = xcalloc((size_t)top + 1, 1);
   int *img = xmalloc((size_t)(top + 1) * sizeof *img);
+  d->work += top + 1;
   dag_reach(d, roots, nroots, mark);
   for (int id = 0; id <= top; id++) {
     if (!mark[id]) continue;

@@ -76,20 +76,20 @@ static void project_affine(Build *b, const int *roots, int n, int *out) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
   step_section(b, "affine derivative entries, projected in closed form");
-  int *grad = step_nodes(m), *q0 = step_nodes(m), *xg = step_nodes(s * m);
+  int *q0 = step_nodes(m), *xg = step_nodes(s * m), *f0 = step_nodes(n);
   for (int i = 0; i < m; i++) q0[i] = step_in(b, IN_Q0, i);
   for (int j = 0; j < s; j++)
     for (int i = 0; i < m; i++) xg[j * m + i] = -1; /* built on first use */
+  dag_subst(d, roots, n, q0, m, f0); /* all at once: one pass over the DAG */
   for (int r = 0; r < n; r++) {
-    int f0;
-    ad_gradient(d, roots[r], m, grad); /* constants or parameters: f is affine */
-    dag_subst(d, &roots[r], 1, q0, m, &f0);
+    SparseVec grad; /* constants or parameters: f is affine */
+    ad_gradient_sparse(d, roots[r], m, &grad);
     for (int j = 0; j < s; j++) {
-      int acc = j == 0 ? f0 : dag_const(d, 0);
-      for (int i = 0; i < m; i++) {
-        if (dag_is_zero(d, grad[i])) continue;
+      int acc = j == 0 ? f0[r] : dag_const(d, 0);
+      for (int e = 0; e < grad.n; e++) {
+        int i = grad.e[e].coord;
         if (xg[j * m + i] < 0) xg[j * m + i] = dag_mul(d, b->h, apply_x(b, j, i, gamma_coef, NULL));
-        acc = dag_add(d, acc, dag_mul(d, grad[i], xg[j * m + i]));
+        acc = dag_add(d, acc, dag_mul(d, grad.e[e].node, xg[j * m + i]));
       }
       out[j * n + r] = acc;
     }
@@ -224,11 +224,15 @@ void step_gamma_update(Build *b, int **theta) {
 // The dense columns G[a] (m nodes each) of grad g at the point q.
 int **step_jacobian_at(Build *b, const int *q) {
   Model *mod = b->mod;
-  int **G = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
-  for (int a = 0; a < b->nu; a++) {
+  int nnz = 0, **G = arena_alloc((size_t)(b->nu + 1) * sizeof(int *));
+  for (int a = 0; a < b->nu; a++) nnz += mod->jac[a].n;
+  int *roots = step_nodes(nnz), *img = step_nodes(nnz);
+  for (int a = 0, r = 0; a < b->nu; a++)
+    for (int e = 0; e < mod->jac[a].n; e++) roots[r++] = mod->jac[a].e[e].node;
+  dag_subst(b->d, roots, nnz, q, b->m, img); /* all entries in one pass over the DAG */
+  for (int a = 0, r = 0; a < b->nu; a++) {
     G[a] = zeros(b->d, b->m);
-    for (int e = 0; e < mod->jac[a].n; e++)
-      dag_subst(b->d, &mod->jac[a].e[e].node, 1, q, b->m, &G[a][mod->jac[a].e[e].coord]);
+    for (int e = 0; e < mod->jac[a].n; e++) G[a][mod->jac[a].e[e].coord] = img[r++];
   }
   return G;
 }
@@ -264,22 +268,30 @@ static void build_initial_multiplier(Build *b, const int *q, const int *v) {
   int m = b->m, nu = b->nu;
   b->owners = 1u << K_LAMBDA0;
   step_section(b, "consistent initial multiplier");
-  int *dw = step_nodes(m), *col = step_nodes(m), *gu = step_nodes(m), *mgu = step_nodes(m);
+  int *gu = step_nodes(m), *mgu = step_nodes(m);
   int *B = step_nodes(nu * nu), *r = step_nodes(nu), *piv = step_nodes(nu), *lambda0 = step_nodes(nu);
-  int z = dag_const(d, 0);
+  int z = dag_const(d, 0), ndw = 0;
   int **G = step_jacobian_at(b, q);
   dag_subst(d, mod->gradU, m, q, m, gu);
   minv_apply(mod, d, gu, mgu);
   step_gram(b, G, B);
+  SparseVec *dw = arena_alloc((size_t)(nu + 1) * sizeof *dw); /* grad w_a, sparse, then at q */
   for (int a = 0; a < nu; a++) {
-    int w = z, hvv = z, gmu = z;
+    int w = z;
     for (int e = 0; e < mod->jac[a].n; e++)
       w = dag_add(d, w, dag_mul(d, mod->jac[a].e[e].node, v[mod->jac[a].e[e].coord]));
-    ad_gradient(d, w, m, dw);
-    for (int i = 0; i < m; i++) col[i] = dw[i];
-    dag_subst(d, col, m, q, m, dw);
-    for (int i = 0; i < m; i++) {
-      hvv = dag_add(d, hvv, dag_mul(d, dw[i], v[i]));
+    ad_gradient_sparse(d, w, m, &dw[a]);
+    ndw += dw[a].n;
+  }
+  int *roots = step_nodes(ndw), *img = step_nodes(ndw);
+  for (int a = 0, t = 0; a < nu; a++)
+    for (int e = 0; e < dw[a].n; e++) roots[t++] = dw[a].e[e].node;
+  dag_subst(d, roots, ndw, q, m, img); /* all in one pass over the DAG */
+  for (int a = 0, t = 0; a < nu; a++) {
+    int hvv = z, gmu = z;
+    for (int e = 0; e < dw[a].n; e++) hvv = dag_add(d, hvv, dag_mul(d, img[t++], v[dw[a].e[e].coord]));
+    for (int e = 0; e < mod->jac[a].n; e++) {
+      int i = mod->jac[a].e[e].coord;
       gmu = dag_add(d, gmu, dag_mul(d, G[a][i], mgu[i]));
     }
     r[a] = dag_sub(d, hvv, gmu);
@@ -314,14 +326,11 @@ static void build_diagnostics(Build *b) {
   int H = dag_add(d, dag_mul(d, dag_const(d, 0.5), kin), U);
   b->owners = 1u << K_HIDDEN;
   step_section(b, "hidden constraints");
+  int **G = step_jacobian_at(b, q);
   for (int a = 0; a < nu; a++) {
     const SparseVec *col = &mod->jac[a];
     int acc = dag_const(d, 0);
-    for (int e = 0; e < col->n; e++) {
-      int ga;
-      dag_subst(d, &col->e[e].node, 1, q, m, &ga);
-      acc = dag_add(d, acc, dag_mul(d, ga, v[col->e[e].coord]));
-    }
+    for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, G[a][col->e[e].coord], v[col->e[e].coord]));
     hidden[a] = acc;
   }
   step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);

@@ -47,24 +47,24 @@ static void conical_k1s1_sweep(const double *q0, const double *p0, const double 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = h * t1;
-  const double t3 = 2.0 * t2;
-  const double t4 = t0 + t3;
-  const double t5 = 2.0 * q0[1] /* y */;
-  const double t6 = 0.5 * gam[1];
-  const double t7 = h * t6;
-  const double t8 = 2.0 * t7;
-  const double t9 = t5 + t8;
-  const double t10 = 2.0 * q0[2] /* z */;
+  const double t0 = 2.0 * q0[2] /* z */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = gam[0] * 0.5;
+  const double t4 = h * t3;
+  const double t5 = 2.0 * t4;
+  const double t6 = t2 + t5;
+  const double t7 = 0.5 * gam[1];
+  const double t8 = h * t7;
+  const double t9 = 2.0 * t8;
+  const double t10 = t1 + t9;
   const double t11 = 0.5 * gam[2];
   const double t12 = h * t11;
   const double t13 = 2.0 * t12;
-  const double t14 = t10 + t13;
+  const double t14 = t0 + t13;
   /* multiplier system A lambda = r */
-  const double t15 = t4 * t4;
-  const double t16 = t9 * t9;
+  const double t15 = t6 * t6;
+  const double t16 = t10 * t10;
   const double t17 = t15 + t16;
   const double t18 = t14 * t14;
   const double t19 = t17 + t18;
@@ -72,8 +72,8 @@ static void conical_k1s1_sweep(const double *q0, const double *p0, const double 
   const double t21 = h * t20;
   const double t22 = 0.5 * t14;
   const double t23 = h * t22;
-  const double t24 = t4 * p0[0] /* p_x */;
-  const double t25 = t9 * p0[1] /* p_y */;
+  const double t24 = t6 * p0[0] /* p_x */;
+  const double t25 = t10 * p0[1] /* p_y */;
   const double t26 = t24 + t25;
   const double t27 = t14 * p0[2] /* p_z */;
   const double t28 = t26 + t27;
@@ -81,8 +81,8 @@ static void conical_k1s1_sweep(const double *q0, const double *p0, const double 
   const double t30 = t29 + g0[0];
   const double t31 = t30 / t21;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t32 = t4 * t31;
-  const double t33 = t9 * t31;
+  const double t32 = t6 * t31;
+  const double t33 = t10 * t31;
   const double t34 = t14 * t31;
   const double t35 = 1.0 + t34;
   const double t36 = 0.5 * t32;
@@ -165,14 +165,14 @@ static void conical_k1s1_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t3 = t0 * p0[0] /* p_x */;
+  const double t3 = t2 * p0[0] /* p_x */;
   const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2] /* p_z */;
+  const double t6 = t0 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
   /* hidden */
   out[0] = t7;
@@ -184,14 +184,14 @@ static void conical_k1s1_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t3 = t0 * t0;
+  const double t3 = t2 * t2;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
-  const double t6 = t2 * t2;
+  const double t6 = t0 * t0;
   const double t7 = t5 + t6;
   const double t8 = 2.0 * p0[0] /* p_x */;
   const double t9 = 2.0 * p0[1] /* p_y */;
@@ -201,7 +201,7 @@ static void conical_k1s1_lambda0(const double *q0, const double *p0, const doubl
   const double t13 = t11 + t12;
   const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
-  const double t16 = t15 - t2;
+  const double t16 = t15 - t0;
   const double t17 = t16 / t7;
   /* lambda */
   out[0] = t17;

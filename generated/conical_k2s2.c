@@ -48,39 +48,39 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = gam[3] * 0.28867513459481292;
-  const double t3 = t1 - t2;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481292;
-  const double t8 = h * t7;
-  const double t9 = 2.0 * t8;
-  const double t10 = 2.0 * q0[1] /* y */;
-  const double t11 = 0.5 * gam[1];
-  const double t12 = 0.28867513459481292 * gam[4];
-  const double t13 = t11 - t12;
-  const double t14 = h * t13;
-  const double t15 = 2.0 * t14;
-  const double t16 = t10 + t15;
-  const double t17 = 0.28867513459481292 * gam[1];
-  const double t18 = h * t17;
-  const double t19 = 2.0 * t18;
-  const double t20 = 2.0 * q0[2] /* z */;
+  const double t0 = 2.0 * q0[2] /* z */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = gam[0] * 0.5;
+  const double t4 = gam[3] * 0.28867513459481292;
+  const double t5 = t3 - t4;
+  const double t6 = h * t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t2 + t7;
+  const double t9 = gam[0] * 0.28867513459481292;
+  const double t10 = h * t9;
+  const double t11 = 2.0 * t10;
+  const double t12 = 0.5 * gam[1];
+  const double t13 = 0.28867513459481292 * gam[4];
+  const double t14 = t12 - t13;
+  const double t15 = h * t14;
+  const double t16 = 2.0 * t15;
+  const double t17 = t1 + t16;
+  const double t18 = 0.28867513459481292 * gam[1];
+  const double t19 = h * t18;
+  const double t20 = 2.0 * t19;
   const double t21 = 0.5 * gam[2];
   const double t22 = 0.28867513459481292 * gam[5];
   const double t23 = t21 - t22;
   const double t24 = h * t23;
   const double t25 = 2.0 * t24;
-  const double t26 = t20 + t25;
+  const double t26 = t0 + t25;
   const double t27 = 0.28867513459481292 * gam[2];
   const double t28 = h * t27;
   const double t29 = 2.0 * t28;
   /* multiplier system A lambda = r */
-  const double t30 = t6 * t6;
-  const double t31 = t16 * t16;
+  const double t30 = t8 * t8;
+  const double t31 = t17 * t17;
   const double t32 = t30 + t31;
   const double t33 = t26 * t26;
   const double t34 = t32 + t33;
@@ -90,8 +90,8 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t38 = t28 * 0.57735026918962584;
   const double t39 = t37 + t38;
   const double t40 = h * t39;
-  const double t41 = t6 * p0[0] /* p_x */;
-  const double t42 = t16 * p0[1] /* p_y */;
+  const double t41 = t8 * p0[0] /* p_x */;
+  const double t42 = t17 * p0[1] /* p_y */;
   const double t43 = t41 + t42;
   const double t44 = t26 * p0[2] /* p_z */;
   const double t45 = t43 + t44;
@@ -99,12 +99,12 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t47 = t46 + g0[0];
   const double t48 = t47 / t36;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t49 = t6 * t48;
-  const double t50 = t16 * t48;
+  const double t49 = t8 * t48;
+  const double t50 = t17 * t48;
   const double t51 = t26 * t48;
   const double t52 = 1.0 + t51;
-  const double t53 = t9 * t48;
-  const double t54 = t19 * t48;
+  const double t53 = t11 * t48;
+  const double t54 = t20 * t48;
   const double t55 = t29 * t48;
   const double t56 = 0.5 * t49;
   const double t57 = 0.28867513459481292 * t53;
@@ -204,14 +204,14 @@ static void conical_k2s2_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t3 = t0 * p0[0] /* p_x */;
+  const double t3 = t2 * p0[0] /* p_x */;
   const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2] /* p_z */;
+  const double t6 = t0 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
   /* hidden */
   out[0] = t7;
@@ -223,14 +223,14 @@ static void conical_k2s2_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t3 = t0 * t0;
+  const double t3 = t2 * t2;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
-  const double t6 = t2 * t2;
+  const double t6 = t0 * t0;
   const double t7 = t5 + t6;
   const double t8 = 2.0 * p0[0] /* p_x */;
   const double t9 = 2.0 * p0[1] /* p_y */;
@@ -240,7 +240,7 @@ static void conical_k2s2_lambda0(const double *q0, const double *p0, const doubl
   const double t13 = t11 + t12;
   const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
-  const double t16 = t15 - t2;
+  const double t16 = t15 - t0;
   const double t17 = t16 / t7;
   /* lambda */
   out[0] = t17;

@@ -49,43 +49,43 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = gam[3] * 0.28867513459481292;
-  const double t3 = t1 - t2;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481292;
-  const double t8 = gam[6] * 0.12909944487358055;
-  const double t9 = t7 - t8;
-  const double t10 = h * t9;
-  const double t11 = 2.0 * t10;
-  const double t12 = gam[3] * 0.12909944487358055;
-  const double t13 = h * t12;
-  const double t14 = 2.0 * t13;
-  const double t15 = 2.0 * q0[1] /* y */;
-  const double t16 = 0.5 * gam[1];
-  const double t17 = 0.28867513459481292 * gam[4];
-  const double t18 = t16 - t17;
-  const double t19 = h * t18;
-  const double t20 = 2.0 * t19;
-  const double t21 = t15 + t20;
-  const double t22 = 0.28867513459481292 * gam[1];
-  const double t23 = 0.12909944487358055 * gam[7];
-  const double t24 = t22 - t23;
-  const double t25 = h * t24;
-  const double t26 = 2.0 * t25;
-  const double t27 = 0.12909944487358055 * gam[4];
-  const double t28 = h * t27;
-  const double t29 = 2.0 * t28;
-  const double t30 = 2.0 * q0[2] /* z */;
+  const double t0 = 2.0 * q0[2] /* z */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = gam[0] * 0.5;
+  const double t4 = gam[3] * 0.28867513459481292;
+  const double t5 = t3 - t4;
+  const double t6 = h * t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t2 + t7;
+  const double t9 = gam[0] * 0.28867513459481292;
+  const double t10 = gam[6] * 0.12909944487358055;
+  const double t11 = t9 - t10;
+  const double t12 = h * t11;
+  const double t13 = 2.0 * t12;
+  const double t14 = gam[3] * 0.12909944487358055;
+  const double t15 = h * t14;
+  const double t16 = 2.0 * t15;
+  const double t17 = 0.5 * gam[1];
+  const double t18 = 0.28867513459481292 * gam[4];
+  const double t19 = t17 - t18;
+  const double t20 = h * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = t1 + t21;
+  const double t23 = 0.28867513459481292 * gam[1];
+  const double t24 = 0.12909944487358055 * gam[7];
+  const double t25 = t23 - t24;
+  const double t26 = h * t25;
+  const double t27 = 2.0 * t26;
+  const double t28 = 0.12909944487358055 * gam[4];
+  const double t29 = h * t28;
+  const double t30 = 2.0 * t29;
   const double t31 = 0.5 * gam[2];
   const double t32 = 0.28867513459481292 * gam[5];
   const double t33 = t31 - t32;
   const double t34 = h * t33;
   const double t35 = 2.0 * t34;
-  const double t36 = t30 + t35;
+  const double t36 = t0 + t35;
   const double t37 = 0.28867513459481292 * gam[2];
   const double t38 = 0.12909944487358055 * gam[8];
   const double t39 = t37 - t38;
@@ -95,8 +95,8 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t43 = h * t42;
   const double t44 = 2.0 * t43;
   /* multiplier system A lambda = r */
-  const double t45 = t6 * t6;
-  const double t46 = t21 * t21;
+  const double t45 = t8 * t8;
+  const double t46 = t22 * t22;
   const double t47 = t45 + t46;
   const double t48 = t36 * t36;
   const double t49 = t47 + t48;
@@ -106,8 +106,8 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t53 = t40 * 0.57735026918962584;
   const double t54 = t52 + t53;
   const double t55 = h * t54;
-  const double t56 = t6 * p0[0] /* p_x */;
-  const double t57 = t21 * p0[1] /* p_y */;
+  const double t56 = t8 * p0[0] /* p_x */;
+  const double t57 = t22 * p0[1] /* p_y */;
   const double t58 = t56 + t57;
   const double t59 = t36 * p0[2] /* p_z */;
   const double t60 = t58 + t59;
@@ -115,15 +115,15 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t62 = t61 + g0[0];
   const double t63 = t62 / t51;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t64 = t6 * t63;
-  const double t65 = t21 * t63;
+  const double t64 = t8 * t63;
+  const double t65 = t22 * t63;
   const double t66 = t36 * t63;
   const double t67 = 1.0 + t66;
-  const double t68 = t11 * t63;
-  const double t69 = t26 * t63;
+  const double t68 = t13 * t63;
+  const double t69 = t27 * t63;
   const double t70 = t41 * t63;
-  const double t71 = t14 * t63;
-  const double t72 = t29 * t63;
+  const double t71 = t16 * t63;
+  const double t72 = t30 * t63;
   const double t73 = t44 * t63;
   const double t74 = 0.5 * t64;
   const double t75 = 0.28867513459481292 * t68;
@@ -241,14 +241,14 @@ static void conical_k3s3_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t3 = t0 * p0[0] /* p_x */;
+  const double t3 = t2 * p0[0] /* p_x */;
   const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2] /* p_z */;
+  const double t6 = t0 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
   /* hidden */
   out[0] = t7;
@@ -260,14 +260,14 @@ static void conical_k3s3_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t3 = t0 * t0;
+  const double t3 = t2 * t2;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
-  const double t6 = t2 * t2;
+  const double t6 = t0 * t0;
   const double t7 = t5 + t6;
   const double t8 = 2.0 * p0[0] /* p_x */;
   const double t9 = 2.0 * p0[1] /* p_y */;
@@ -277,7 +277,7 @@ static void conical_k3s3_lambda0(const double *q0, const double *p0, const doubl
   const double t13 = t11 + t12;
   const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
-  const double t16 = t15 - t2;
+  const double t16 = t15 - t0;
   const double t17 = t16 / t7;
   /* lambda */
   out[0] = t17;

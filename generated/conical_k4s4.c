@@ -50,53 +50,53 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = gam[3] * 0.28867513459481292;
-  const double t3 = t1 - t2;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481292;
-  const double t8 = gam[6] * 0.12909944487358055;
-  const double t9 = t7 - t8;
-  const double t10 = h * t9;
-  const double t11 = 2.0 * t10;
-  const double t12 = gam[3] * 0.12909944487358055;
-  const double t13 = gam[9] * 0.084515425472851652;
-  const double t14 = t12 - t13;
-  const double t15 = h * t14;
-  const double t16 = 2.0 * t15;
-  const double t17 = gam[6] * 0.084515425472851652;
-  const double t18 = h * t17;
-  const double t19 = 2.0 * t18;
-  const double t20 = 2.0 * q0[1] /* y */;
-  const double t21 = 0.5 * gam[1];
-  const double t22 = 0.28867513459481292 * gam[4];
-  const double t23 = t21 - t22;
-  const double t24 = h * t23;
-  const double t25 = 2.0 * t24;
-  const double t26 = t20 + t25;
-  const double t27 = 0.28867513459481292 * gam[1];
-  const double t28 = 0.12909944487358055 * gam[7];
-  const double t29 = t27 - t28;
-  const double t30 = h * t29;
-  const double t31 = 2.0 * t30;
-  const double t32 = 0.12909944487358055 * gam[4];
-  const double t33 = 0.084515425472851652 * gam[10];
-  const double t34 = t32 - t33;
-  const double t35 = h * t34;
-  const double t36 = 2.0 * t35;
-  const double t37 = 0.084515425472851652 * gam[7];
-  const double t38 = h * t37;
-  const double t39 = 2.0 * t38;
-  const double t40 = 2.0 * q0[2] /* z */;
+  const double t0 = 2.0 * q0[2] /* z */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = gam[0] * 0.5;
+  const double t4 = gam[3] * 0.28867513459481292;
+  const double t5 = t3 - t4;
+  const double t6 = h * t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t2 + t7;
+  const double t9 = gam[0] * 0.28867513459481292;
+  const double t10 = gam[6] * 0.12909944487358055;
+  const double t11 = t9 - t10;
+  const double t12 = h * t11;
+  const double t13 = 2.0 * t12;
+  const double t14 = gam[3] * 0.12909944487358055;
+  const double t15 = gam[9] * 0.084515425472851652;
+  const double t16 = t14 - t15;
+  const double t17 = h * t16;
+  const double t18 = 2.0 * t17;
+  const double t19 = gam[6] * 0.084515425472851652;
+  const double t20 = h * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = 0.5 * gam[1];
+  const double t23 = 0.28867513459481292 * gam[4];
+  const double t24 = t22 - t23;
+  const double t25 = h * t24;
+  const double t26 = 2.0 * t25;
+  const double t27 = t1 + t26;
+  const double t28 = 0.28867513459481292 * gam[1];
+  const double t29 = 0.12909944487358055 * gam[7];
+  const double t30 = t28 - t29;
+  const double t31 = h * t30;
+  const double t32 = 2.0 * t31;
+  const double t33 = 0.12909944487358055 * gam[4];
+  const double t34 = 0.084515425472851652 * gam[10];
+  const double t35 = t33 - t34;
+  const double t36 = h * t35;
+  const double t37 = 2.0 * t36;
+  const double t38 = 0.084515425472851652 * gam[7];
+  const double t39 = h * t38;
+  const double t40 = 2.0 * t39;
   const double t41 = 0.5 * gam[2];
   const double t42 = 0.28867513459481292 * gam[5];
   const double t43 = t41 - t42;
   const double t44 = h * t43;
   const double t45 = 2.0 * t44;
-  const double t46 = t40 + t45;
+  const double t46 = t0 + t45;
   const double t47 = 0.28867513459481292 * gam[2];
   const double t48 = 0.12909944487358055 * gam[8];
   const double t49 = t47 - t48;
@@ -111,8 +111,8 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t58 = h * t57;
   const double t59 = 2.0 * t58;
   /* multiplier system A lambda = r */
-  const double t60 = t6 * t6;
-  const double t61 = t26 * t26;
+  const double t60 = t8 * t8;
+  const double t61 = t27 * t27;
   const double t62 = t60 + t61;
   const double t63 = t46 * t46;
   const double t64 = t62 + t63;
@@ -122,8 +122,8 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t68 = t50 * 0.57735026918962584;
   const double t69 = t67 + t68;
   const double t70 = h * t69;
-  const double t71 = t6 * p0[0] /* p_x */;
-  const double t72 = t26 * p0[1] /* p_y */;
+  const double t71 = t8 * p0[0] /* p_x */;
+  const double t72 = t27 * p0[1] /* p_y */;
   const double t73 = t71 + t72;
   const double t74 = t46 * p0[2] /* p_z */;
   const double t75 = t73 + t74;
@@ -131,18 +131,18 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t77 = t76 + g0[0];
   const double t78 = t77 / t66;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t79 = t6 * t78;
-  const double t80 = t26 * t78;
+  const double t79 = t8 * t78;
+  const double t80 = t27 * t78;
   const double t81 = t46 * t78;
   const double t82 = 1.0 + t81;
-  const double t83 = t11 * t78;
-  const double t84 = t31 * t78;
+  const double t83 = t13 * t78;
+  const double t84 = t32 * t78;
   const double t85 = t51 * t78;
-  const double t86 = t16 * t78;
-  const double t87 = t36 * t78;
+  const double t86 = t18 * t78;
+  const double t87 = t37 * t78;
   const double t88 = t56 * t78;
-  const double t89 = t19 * t78;
-  const double t90 = t39 * t78;
+  const double t89 = t21 * t78;
+  const double t90 = t40 * t78;
   const double t91 = t59 * t78;
   const double t92 = 0.5 * t79;
   const double t93 = 0.28867513459481292 * t83;
@@ -278,14 +278,14 @@ static void conical_k4s4_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t3 = t0 * p0[0] /* p_x */;
+  const double t3 = t2 * p0[0] /* p_x */;
   const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2] /* p_z */;
+  const double t6 = t0 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
   /* hidden */
   out[0] = t7;
@@ -297,14 +297,14 @@ static void conical_k4s4_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t3 = t0 * t0;
+  const double t3 = t2 * t2;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
-  const double t6 = t2 * t2;
+  const double t6 = t0 * t0;
   const double t7 = t5 + t6;
   const double t8 = 2.0 * p0[0] /* p_x */;
   const double t9 = 2.0 * p0[1] /* p_y */;
@@ -314,7 +314,7 @@ static void conical_k4s4_lambda0(const double *q0, const double *p0, const doubl
   const double t13 = t11 + t12;
   const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
-  const double t16 = t15 - t2;
+  const double t16 = t15 - t0;
   const double t17 = t16 / t7;
   /* lambda */
   out[0] = t17;

@@ -437,13 +437,13 @@ static void conical_poly_k2s2_hidden_kernel(const double *q0, const double *p0, 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
-  const double t3 = t0 * p0[0] /* p_x */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = t2 * p0[0] /* p_x */;
   const double t4 = t1 * p0[1] /* p_y */;
   const double t5 = t3 + t4;
-  const double t6 = t2 * p0[2] /* p_z */;
+  const double t6 = t0 * p0[2] /* p_z */;
   const double t7 = t5 + t6;
   /* hidden */
   out[0] = t7;
@@ -455,13 +455,13 @@ static void conical_poly_k2s2_lambda0(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
-  const double t3 = t0 * t0;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = t2 * t2;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
-  const double t6 = t2 * t2;
+  const double t6 = t0 * t0;
   const double t7 = t5 + t6;
   /* consistent initial multiplier */
   const double t8 = 2.0 * p0[0] /* p_x */;
@@ -472,7 +472,7 @@ static void conical_poly_k2s2_lambda0(const double *q0, const double *p0, const 
   const double t13 = t11 + t12;
   const double t14 = p0[2] /* p_z */ * t10;
   const double t15 = t13 + t14;
-  const double t16 = t15 - t2;
+  const double t16 = t15 - t0;
   const double t17 = t16 / t7;
   /* lambda */
   out[0] = t17;
@@ -485,28 +485,28 @@ static void conical_poly_k2s2_project(const double *q0, const double *p0, const 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
+  const double t0 = 2.0 * q0[2] /* z */;
   const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[2] /* z */;
+  const double t2 = 2.0 * q0[0] /* x */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t3 = t0 * t0;
+  const double t3 = t2 * t2;
   const double t4 = t1 * t1;
   const double t5 = t3 + t4;
-  const double t6 = t2 * t2;
+  const double t6 = t0 * t0;
   const double t7 = t5 + t6;
-  const double t8 = t0 * p0[0] /* p_x */;
+  const double t8 = t2 * p0[0] /* p_x */;
   const double t9 = t1 * p0[1] /* p_y */;
   const double t10 = t8 + t9;
-  const double t11 = t2 * p0[2] /* p_z */;
+  const double t11 = t0 * p0[2] /* p_z */;
   const double t12 = t10 + t11;
   const double t13 = t12 / t7;
-  const double t14 = t0 * t13;
+  const double t14 = t2 * t13;
   const double t15 = -t14;
   const double t16 = p0[0] /* p_x */ - t14;
   const double t17 = t1 * t13;
   const double t18 = -t17;
   const double t19 = p0[1] /* p_y */ - t17;
-  const double t20 = t2 * t13;
+  const double t20 = t0 * t13;
   const double t21 = -t20;
   const double t22 = p0[2] /* p_z */ - t20;
   const double t23 = t16 * t16;

@@ -593,13 +593,13 @@ static void modified_k9s3_hidden_kernel(const double *q0, const double *p0, cons
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   const double t0 = 2.0 * q0[2] /* q[3] */;
   /* hidden constraints */
-  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
-  const double t2 = 6.0 * t1;
-  const double t3 = p0[0] /* p_q[1] */ * t2;
-  const double t4 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
-  const double t5 = 4.0 * t4;
-  const double t6 = p0[1] /* p_q[2] */ * t5;
-  const double t7 = t3 + t6;
+  const double t1 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
+  const double t2 = 4.0 * t1;
+  const double t3 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
+  const double t4 = 6.0 * t3;
+  const double t5 = p0[0] /* p_q[1] */ * t4;
+  const double t6 = p0[1] /* p_q[2] */ * t2;
+  const double t7 = t5 + t6;
   const double t8 = t0 * p0[2] /* p_q[3] */;
   const double t9 = t7 + t8;
   /* hidden */
@@ -613,15 +613,15 @@ static void modified_k9s3_lambda0(const double *q0, const double *p0, const doub
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   const double t0 = 2.0 * q0[2] /* q[3] */;
-  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
-  const double t2 = 6.0 * t1;
-  const double t3 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
-  const double t4 = 4.0 * t3;
+  const double t1 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
+  const double t2 = 4.0 * t1;
+  const double t3 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
+  const double t4 = 6.0 * t3;
   /* consistent initial multiplier */
   const double t5 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t6 = 4.0 * t5;
-  const double t7 = t2 * t2;
-  const double t8 = t4 * t4;
+  const double t7 = t4 * t4;
+  const double t8 = t2 * t2;
   const double t9 = t7 + t8;
   const double t10 = t0 * t0;
   const double t11 = t9 + t10;

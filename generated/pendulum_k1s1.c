@@ -47,32 +47,32 @@ static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = h * t1;
-  const double t3 = 2.0 * t2;
-  const double t4 = t0 + t3;
-  const double t5 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
+  const double t2 = gam[0] * 0.5;
+  const double t3 = h * t2;
+  const double t4 = 2.0 * t3;
+  const double t5 = t1 + t4;
   const double t6 = 0.5 * gam[1];
   const double t7 = h * t6;
   const double t8 = 2.0 * t7;
-  const double t9 = t5 + t8;
+  const double t9 = t0 + t8;
   /* multiplier system A lambda = r */
-  const double t10 = t4 * t4;
+  const double t10 = t5 * t5;
   const double t11 = t9 * t9;
   const double t12 = t10 + t11;
   const double t13 = 0.5 * t12;
   const double t14 = h * t13;
   const double t15 = 0.5 * t9;
   const double t16 = h * t15;
-  const double t17 = t4 * p0[0] /* p_x */;
+  const double t17 = t5 * p0[0] /* p_x */;
   const double t18 = t9 * p0[1] /* p_y */;
   const double t19 = t17 + t18;
   const double t20 = t19 - t16;
   const double t21 = t20 + g0[0];
   const double t22 = t21 / t14;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t23 = t4 * t22;
+  const double t23 = t5 * t22;
   const double t24 = t9 * t22;
   const double t25 = 1.0 + t24;
   const double t26 = 0.5 * t23;
@@ -143,11 +143,11 @@ static void pendulum_k1s1_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t2 = t0 * p0[0] /* p_x */;
-  const double t3 = t1 * p0[1] /* p_y */;
+  const double t2 = t1 * p0[0] /* p_x */;
+  const double t3 = t0 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
   /* hidden */
   out[0] = t4;
@@ -159,18 +159,18 @@ static void pendulum_k1s1_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t2 = t0 * t0;
-  const double t3 = t1 * t1;
+  const double t2 = t1 * t1;
+  const double t3 = t0 * t0;
   const double t4 = t2 + t3;
   const double t5 = 2.0 * p0[0] /* p_x */;
   const double t6 = 2.0 * p0[1] /* p_y */;
   const double t7 = p0[0] /* p_x */ * t5;
   const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
-  const double t10 = t9 - t1;
+  const double t10 = t9 - t0;
   const double t11 = t10 / t4;
   /* lambda */
   out[0] = t11;

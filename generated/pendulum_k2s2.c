@@ -48,28 +48,28 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = gam[2] * 0.28867513459481292;
-  const double t3 = t1 - t2;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481292;
-  const double t8 = h * t7;
-  const double t9 = 2.0 * t8;
-  const double t10 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
+  const double t2 = gam[0] * 0.5;
+  const double t3 = gam[2] * 0.28867513459481292;
+  const double t4 = t2 - t3;
+  const double t5 = h * t4;
+  const double t6 = 2.0 * t5;
+  const double t7 = t1 + t6;
+  const double t8 = gam[0] * 0.28867513459481292;
+  const double t9 = h * t8;
+  const double t10 = 2.0 * t9;
   const double t11 = 0.5 * gam[1];
   const double t12 = 0.28867513459481292 * gam[3];
   const double t13 = t11 - t12;
   const double t14 = h * t13;
   const double t15 = 2.0 * t14;
-  const double t16 = t10 + t15;
+  const double t16 = t0 + t15;
   const double t17 = 0.28867513459481292 * gam[1];
   const double t18 = h * t17;
   const double t19 = 2.0 * t18;
   /* multiplier system A lambda = r */
-  const double t20 = t6 * t6;
+  const double t20 = t7 * t7;
   const double t21 = t16 * t16;
   const double t22 = t20 + t21;
   const double t23 = 0.5 * t22;
@@ -78,17 +78,17 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   const double t26 = t18 * 0.57735026918962584;
   const double t27 = t25 + t26;
   const double t28 = h * t27;
-  const double t29 = t6 * p0[0] /* p_x */;
+  const double t29 = t7 * p0[0] /* p_x */;
   const double t30 = t16 * p0[1] /* p_y */;
   const double t31 = t29 + t30;
   const double t32 = t31 - t28;
   const double t33 = t32 + g0[0];
   const double t34 = t33 / t24;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t35 = t6 * t34;
+  const double t35 = t7 * t34;
   const double t36 = t16 * t34;
   const double t37 = 1.0 + t36;
-  const double t38 = t9 * t34;
+  const double t38 = t10 * t34;
   const double t39 = t19 * t34;
   const double t40 = 0.5 * t35;
   const double t41 = 0.28867513459481292 * t38;
@@ -170,11 +170,11 @@ static void pendulum_k2s2_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t2 = t0 * p0[0] /* p_x */;
-  const double t3 = t1 * p0[1] /* p_y */;
+  const double t2 = t1 * p0[0] /* p_x */;
+  const double t3 = t0 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
   /* hidden */
   out[0] = t4;
@@ -186,18 +186,18 @@ static void pendulum_k2s2_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t2 = t0 * t0;
-  const double t3 = t1 * t1;
+  const double t2 = t1 * t1;
+  const double t3 = t0 * t0;
   const double t4 = t2 + t3;
   const double t5 = 2.0 * p0[0] /* p_x */;
   const double t6 = 2.0 * p0[1] /* p_y */;
   const double t7 = p0[0] /* p_x */ * t5;
   const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
-  const double t10 = t9 - t1;
+  const double t10 = t9 - t0;
   const double t11 = t10 / t4;
   /* lambda */
   out[0] = t11;

@@ -49,28 +49,28 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = gam[0] * 0.5;
-  const double t2 = gam[2] * 0.28867513459481292;
-  const double t3 = t1 - t2;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t0 + t5;
-  const double t7 = gam[0] * 0.28867513459481292;
-  const double t8 = gam[4] * 0.12909944487358055;
-  const double t9 = t7 - t8;
-  const double t10 = h * t9;
-  const double t11 = 2.0 * t10;
-  const double t12 = gam[2] * 0.12909944487358055;
-  const double t13 = h * t12;
-  const double t14 = 2.0 * t13;
-  const double t15 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
+  const double t2 = gam[0] * 0.5;
+  const double t3 = gam[2] * 0.28867513459481292;
+  const double t4 = t2 - t3;
+  const double t5 = h * t4;
+  const double t6 = 2.0 * t5;
+  const double t7 = t1 + t6;
+  const double t8 = gam[0] * 0.28867513459481292;
+  const double t9 = gam[4] * 0.12909944487358055;
+  const double t10 = t8 - t9;
+  const double t11 = h * t10;
+  const double t12 = 2.0 * t11;
+  const double t13 = gam[2] * 0.12909944487358055;
+  const double t14 = h * t13;
+  const double t15 = 2.0 * t14;
   const double t16 = 0.5 * gam[1];
   const double t17 = 0.28867513459481292 * gam[3];
   const double t18 = t16 - t17;
   const double t19 = h * t18;
   const double t20 = 2.0 * t19;
-  const double t21 = t15 + t20;
+  const double t21 = t0 + t20;
   const double t22 = 0.28867513459481292 * gam[1];
   const double t23 = 0.12909944487358055 * gam[5];
   const double t24 = t22 - t23;
@@ -80,7 +80,7 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   const double t28 = h * t27;
   const double t29 = 2.0 * t28;
   /* multiplier system A lambda = r */
-  const double t30 = t6 * t6;
+  const double t30 = t7 * t7;
   const double t31 = t21 * t21;
   const double t32 = t30 + t31;
   const double t33 = 0.5 * t32;
@@ -89,19 +89,19 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   const double t36 = t25 * 0.57735026918962584;
   const double t37 = t35 + t36;
   const double t38 = h * t37;
-  const double t39 = t6 * p0[0] /* p_x */;
+  const double t39 = t7 * p0[0] /* p_x */;
   const double t40 = t21 * p0[1] /* p_y */;
   const double t41 = t39 + t40;
   const double t42 = t41 - t38;
   const double t43 = t42 + g0[0];
   const double t44 = t43 / t34;
   /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t45 = t6 * t44;
+  const double t45 = t7 * t44;
   const double t46 = t21 * t44;
   const double t47 = 1.0 + t46;
-  const double t48 = t11 * t44;
+  const double t48 = t12 * t44;
   const double t49 = t26 * t44;
-  const double t50 = t14 * t44;
+  const double t50 = t15 * t44;
   const double t51 = t29 * t44;
   const double t52 = 0.5 * t45;
   const double t53 = 0.28867513459481292 * t48;
@@ -195,11 +195,11 @@ static void pendulum_k3s3_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t2 = t0 * p0[0] /* p_x */;
-  const double t3 = t1 * p0[1] /* p_y */;
+  const double t2 = t1 * p0[0] /* p_x */;
+  const double t3 = t0 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
   /* hidden */
   out[0] = t4;
@@ -211,18 +211,18 @@ static void pendulum_k3s3_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* consistent initial multiplier */
-  const double t2 = t0 * t0;
-  const double t3 = t1 * t1;
+  const double t2 = t1 * t1;
+  const double t3 = t0 * t0;
   const double t4 = t2 + t3;
   const double t5 = 2.0 * p0[0] /* p_x */;
   const double t6 = 2.0 * p0[1] /* p_y */;
   const double t7 = p0[0] /* p_x */ * t5;
   const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
-  const double t10 = t9 - t1;
+  const double t10 = t9 - t0;
   const double t11 = t10 / t4;
   /* lambda */
   out[0] = t11;

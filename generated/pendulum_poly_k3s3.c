@@ -620,10 +620,10 @@ static void pendulum_poly_k3s3_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = t0 * p0[0] /* p_x */;
-  const double t3 = t1 * p0[1] /* p_y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
+  const double t2 = t1 * p0[0] /* p_x */;
+  const double t3 = t0 * p0[1] /* p_y */;
   const double t4 = t2 + t3;
   /* hidden */
   out[0] = t4;
@@ -635,10 +635,10 @@ static void pendulum_poly_k3s3_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = t0 * t0;
-  const double t3 = t1 * t1;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
+  const double t2 = t1 * t1;
+  const double t3 = t0 * t0;
   const double t4 = t2 + t3;
   /* consistent initial multiplier */
   const double t5 = 2.0 * p0[0] /* p_x */;
@@ -646,7 +646,7 @@ static void pendulum_poly_k3s3_lambda0(const double *q0, const double *p0, const
   const double t7 = p0[0] /* p_x */ * t5;
   const double t8 = p0[1] /* p_y */ * t6;
   const double t9 = t7 + t8;
-  const double t10 = t9 - t1;
+  const double t10 = t9 - t0;
   const double t11 = t10 / t4;
   /* lambda */
   out[0] = t11;
@@ -659,20 +659,20 @@ static void pendulum_poly_k3s3_project(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[0] /* x */;
-  const double t1 = 2.0 * q0[1] /* y */;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = t0 * t0;
-  const double t3 = t1 * t1;
+  const double t2 = t1 * t1;
+  const double t3 = t0 * t0;
   const double t4 = t2 + t3;
-  const double t5 = t0 * p0[0] /* p_x */;
-  const double t6 = t1 * p0[1] /* p_y */;
+  const double t5 = t1 * p0[0] /* p_x */;
+  const double t6 = t0 * p0[1] /* p_y */;
   const double t7 = t5 + t6;
   const double t8 = t7 / t4;
-  const double t9 = t0 * t8;
+  const double t9 = t1 * t8;
   const double t10 = -t9;
   const double t11 = p0[0] /* p_x */ - t9;
-  const double t12 = t1 * t8;
+  const double t12 = t0 * t8;
   const double t13 = -t12;
   const double t14 = p0[1] /* p_y */ - t12;
   const double t15 = t11 * t11;
