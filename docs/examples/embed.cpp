@@ -6,9 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-extern "C" {  // C linkage for the solver (compiled as C)
-#include "pendulum.h"
-}
+#include "pendulum.h"  // C linkage: the header has extern "C" guards
 
 // The solver's state behind a small class; a failed step throws and
 // leaves the state as it was.
