@@ -306,7 +306,7 @@ typedef struct {
   double *E;          /* s x s x s: warm start, E[j][i] = sum_d E[(j*s+i)*s+d] r^d */
 } Method;
 
-int method_auto_k(int s, int degU, int degg, const char **why);
+int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why);
 Method *method_new(int k, int s, MultFamily family);
 
 /* ---- step.c, step_const.c, step_poly.c, lu.c: the step as a DAG ---- */

@@ -452,7 +452,7 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
 static void report_degree(const Model *mod, int s, int k) {
   const char *why;
   int best = -1;
-  if (mod->degU == DEG_NONPOLY || method_auto_k(s, mod->degU, 0, &why) <= MAX_K)
+  if (mod->degU == DEG_NONPOLY || method_auto_k(s, mod->degU, 0, MULT_CONST, &why) <= MAX_K)
     for (int a = 0; a < mod->nu; a++)
       if (best < 0 || mod->dag->nodes[mod->g[a]].deg > mod->dag->nodes[mod->g[best]].deg) best = a;
   error_at(best < 0 ? mod->U_loc : mod->g_loc[best],
@@ -482,8 +482,9 @@ int main(int argc, char **argv) {
   model_differentiate(mod);
   model_check_initial(mod);
   const char *why = "given with -k";
-  int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, &why);
-  MultFamily fam = o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 && mod->nu ? MULT_POLY : MULT_CONST;
+  /* the family changes nothing without constraints */
+  MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
+  int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
   if (k > MAX_K) {
     report_degree(mod, o.s, k);
     rc = 1;

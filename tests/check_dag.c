@@ -312,19 +312,22 @@ END_TEST
 START_TEST(test_auto_k)
 {
   static const struct {
-    int s, degU, degg, k;
+    int s, degU, degg, k, kpoly; /* kpoly: with the polynomial multiplier's rescale */
   } cases[] = {
-      {2, 1, 2, 2},           {1, 4, 6, 3}, {2, 4, 6, 6},           {3, 4, 6, 9},
-      {2, 3, 0, 3},           {1, 1, 0, 1}, {1, DEG_NONPOLY, 2, 14}, {4, DEG_NONPOLY, 2, 20},
-      {2, 2, DEG_NONPOLY, 16}, {5, 4, 6, 15},        {1, 3, 0, 2}, {3, 3, 2, 5},
-      {5, 1, 3, 8},
+      {2, 1, 2, 2, 2},            {1, 4, 6, 3, 3},  {2, 4, 6, 6, 6},            {3, 4, 6, 9, 9},
+      {2, 3, 0, 3, 3},            {1, 1, 0, 1, 1},  {1, DEG_NONPOLY, 2, 14, 1}, {4, DEG_NONPOLY, 2, 20, 4},
+      {2, 2, DEG_NONPOLY, 16, 2}, {5, 4, 6, 15, 15}, {1, 3, 0, 2, 2},           {3, 3, 2, 5, 5},
+      {5, 1, 3, 8, 8},            {2, DEG_NONPOLY, 6, 16, 6},
   };
   for (int i = 0; i < NCASES(cases); i++) {
     const char *why = NULL;
-    int k = method_auto_k(cases[i].s, cases[i].degU, cases[i].degg, &why);
+    int k = method_auto_k(cases[i].s, cases[i].degU, cases[i].degg, MULT_CONST, &why);
     ck_assert_msg(k == cases[i].k, "auto k(s=%d, degU=%d, degg=%d) = %d, want %d", cases[i].s, cases[i].degU,
                   cases[i].degg, k, cases[i].k);
     ck_assert_msg(why && *why, "no reason given for k=%d", k);
+    k = method_auto_k(cases[i].s, cases[i].degU, cases[i].degg, MULT_POLY, &why);
+    ck_assert_msg(k == cases[i].kpoly, "poly: auto k(s=%d, degU=%d, degg=%d) = %d, want %d", cases[i].s,
+                  cases[i].degU, cases[i].degg, k, cases[i].kpoly);
   }
 }
 END_TEST

@@ -517,9 +517,9 @@ static const struct {
     {"modified", 2, "model modified: m=3 nu=1 deg(U)=4 deg(g)=6 k=6 s=2"},
     {"modified", 1, "model modified: m=3 nu=1 deg(U)=4 deg(g)=6 k=3 s=1"},
     {"modified", 3, "model modified: m=3 nu=1 deg(U)=4 deg(g)=6 k=9 s=3"},
-    {"satellites", 2, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=16 s=2"},
+    {"satellites", 2, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=2 s=2"}, /* poly: k = s */
     {"satellites", 1, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=14 s=1"},
-    {"satellites", 3, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=18 s=3"},
+    {"satellites", 3, "model satellites: m=9 nu=3 deg(U)=nonpoly deg(g)=2 k=3 s=3"},
 };
 
 START_TEST(test_check_models)

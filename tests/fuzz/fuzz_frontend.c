@@ -128,7 +128,7 @@ void __wrap_free(void *p) {
 static void build_and_emit(Model *mod, int s, int variant) {
   static FILE *sink;
   const char *why;
-  int k = method_auto_k(s, mod->degU, mod->degg, &why);
+  int k = method_auto_k(s, mod->degU, mod->degg, MULT_CONST, &why);
   if (mod->m > FUZZ_MAX_M || mod->nu > FUZZ_MAX_NU || k > FUZZ_MAX_K || mod->dag->n > FUZZ_MAX_NODES) return;
   const Method *me = method_new(k, s, MULT_CONST);
   Step *st = step_build(mod, me);
