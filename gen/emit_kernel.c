@@ -353,7 +353,7 @@ static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, co
   }
   out(e, "/* %s: the %d parts above in order */\n", k->name, nparts);
   kernel_signature(e, k, -1);
-  out(e, "  %s w[%d];\n", real_type(e, e->wide), nslots);
+  out(e, "  %s w[%d];\n", real_type(e, e->wide), nslots > 0 ? nslots : 1); /* C has no empty arrays */
   for (int p = 0; p < nparts; p++) {
     out(e, "  %s_%s_part%d(", e->P, k->name, p);
     for (int i = 0; i < IN_COUNT; i++)
