@@ -48,7 +48,7 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   tmpl(e, "} $P_params;\n\n"
           "typedef struct {\n"
           "  int iters;         /* fixed-point iterations */\n"
-          "  double increment;  /* last scaled increment of the iteration */\n"
+          "  $P_real increment; /* last scaled increment of the iteration */\n"
           "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
           " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
@@ -64,11 +64,11 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "int $P_project($P_state *x, const $P_params *prm, $P_real *dq, $P_real *dp);\n"
           "void $P_params_default($P_params *prm);\n"
           "/* One step of size h; prm and st may be NULL. Returns $P_OK or an error code. */\n"
-          "int $P_step($P_state *x, double h, const $P_params *prm, $P_stats *st);\n"
+          "int $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st);\n"
           "const char *$P_strerror(int code);\n"
-          "double $P_energy(const $P_state *x, const $P_params *prm);\n"
-          "void $P_constraints(const $P_state *x, const $P_params *prm, double *g);   /* $P_NU values */\n"
-          "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp);       /* grad g' M^-1 p */\n"
+          "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
+          "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
+          "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp);       /* grad g' M^-1 p */\n"
           "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
 }
 
@@ -177,19 +177,17 @@ static void emit_public(Emitter *e) {
           "  case $P_ESINGULAR: return \"singular multiplier system\";\n"
           "  case $P_EBADSTEP: return \"step size zero or not finite\";\n"
           "  }\n  return \"unknown error\";\n}\n\n"
-          "double $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  $P_DEFAULT_PARAMS(prm)\n"
+          "$P_real $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  $(energy_kernel q0=x->q p0=x->p out=&H);\n  return H;\n}\n\n");
   if (e->mod->nu)
-    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, double *g)\n{\n"
-            "  $R v[$P_NU];\n  int i;\n  $P_DEFAULT_PARAMS(prm)\n"
-            "  $(g q0=x->q p0=x->p out=v);\n  for (i = 0; i < $P_NU; i++) g[i] = v[i];\n}\n\n"
-            "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp)\n{\n"
-            "  $R v[$P_NU];\n  int i;\n  $P_DEFAULT_PARAMS(prm)\n"
-            "  $(hidden_kernel q0=x->q p0=x->p out=v);\n  for (i = 0; i < $P_NU; i++) gp[i] = v[i];\n}\n");
+    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g)\n{\n"
+            "  $P_DEFAULT_PARAMS(prm)\n  $(g q0=x->q p0=x->p out=g);\n}\n\n"
+            "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp)\n{\n"
+            "  $P_DEFAULT_PARAMS(prm)\n  $(hidden_kernel q0=x->q p0=x->p out=gp);\n}\n");
   else
-    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, double *g)\n{\n"
+    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g)\n{\n"
             "  (void)x; (void)prm; (void)g;\n}\n\n"
-            "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp)\n{\n"
+            "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp)\n{\n"
             "  (void)x; (void)prm; (void)gp;\n}\n");
 }
 
@@ -268,7 +266,7 @@ static void emit_step(Emitter *e) {
             "static void $P_add($R *a, $R *c, $R b)\n{\n  (void)c;\n  *a += b;\n}\n\n");
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "int $P_step($P_state *x, double h_, const $P_params *prm, $P_stats *st)\n{\n"
+          "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
           "  $R inc = HUGE_VAL, inc_old, scale;\n"

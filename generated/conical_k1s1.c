@@ -302,7 +302,7 @@ const char *conical_k1s1_strerror(int code)
   return "unknown error";
 }
 
-double conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm)
+conical_k1s1_real conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm)
 {
   double H;
   conical_k1s1_DEFAULT_PARAMS(prm)
@@ -310,22 +310,16 @@ double conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_param
   return H;
 }
 
-void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *g)
+void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *g)
 {
-  double v[conical_k1s1_NU];
-  int i;
   conical_k1s1_DEFAULT_PARAMS(prm)
-  conical_k1s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k1s1_NU; i++) g[i] = v[i];
+  conical_k1s1_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *gp)
+void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *gp)
 {
-  double v[conical_k1s1_NU];
-  int i;
   conical_k1s1_DEFAULT_PARAMS(prm)
-  conical_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k1s1_NU; i++) gp[i] = v[i];
+  conical_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -357,7 +351,7 @@ static void conical_k1s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_k1s1_step(conical_k1s1_state *x, double h_, const conical_k1s1_params *prm, conical_k1s1_stats *st)
+int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h_, const conical_k1s1_params *prm, conical_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_k1s1_S * conical_k1s1_M], sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 3 * conical_k1s1_NU + 1];

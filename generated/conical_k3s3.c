@@ -378,7 +378,7 @@ const char *conical_k3s3_strerror(int code)
   return "unknown error";
 }
 
-double conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm)
+conical_k3s3_real conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm)
 {
   double H;
   conical_k3s3_DEFAULT_PARAMS(prm)
@@ -386,22 +386,16 @@ double conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_param
   return H;
 }
 
-void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *g)
+void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *g)
 {
-  double v[conical_k3s3_NU];
-  int i;
   conical_k3s3_DEFAULT_PARAMS(prm)
-  conical_k3s3_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k3s3_NU; i++) g[i] = v[i];
+  conical_k3s3_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *gp)
+void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *gp)
 {
-  double v[conical_k3s3_NU];
-  int i;
   conical_k3s3_DEFAULT_PARAMS(prm)
-  conical_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k3s3_NU; i++) gp[i] = v[i];
+  conical_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -433,7 +427,7 @@ static void conical_k3s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_k3s3_step(conical_k3s3_state *x, double h_, const conical_k3s3_params *prm, conical_k3s3_stats *st)
+int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_k3s3_S * conical_k3s3_M], sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + 1];

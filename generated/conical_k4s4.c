@@ -415,7 +415,7 @@ const char *conical_k4s4_strerror(int code)
   return "unknown error";
 }
 
-double conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm)
+conical_k4s4_real conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm)
 {
   double H;
   conical_k4s4_DEFAULT_PARAMS(prm)
@@ -423,22 +423,16 @@ double conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_param
   return H;
 }
 
-void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *g)
+void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *g)
 {
-  double v[conical_k4s4_NU];
-  int i;
   conical_k4s4_DEFAULT_PARAMS(prm)
-  conical_k4s4_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k4s4_NU; i++) g[i] = v[i];
+  conical_k4s4_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void conical_k4s4_hidden(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *gp)
+void conical_k4s4_hidden(const conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *gp)
 {
-  double v[conical_k4s4_NU];
-  int i;
   conical_k4s4_DEFAULT_PARAMS(prm)
-  conical_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k4s4_NU; i++) gp[i] = v[i];
+  conical_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -470,7 +464,7 @@ static void conical_k4s4_add(double *a, double *c, double b)
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_k4s4_step(conical_k4s4_state *x, double h_, const conical_k4s4_params *prm, conical_k4s4_stats *st)
+int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h_, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_k4s4_S * conical_k4s4_M], sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + 3 * conical_k4s4_NU + 1];

@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  conical_k4s4_real increment; /* last scaled increment of the iteration */
 } conical_k4s4_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void conical_k4s4_init(conical_k4s4_state *x, const conical_k4s4_real *q0, const
 int conical_k4s4_project(conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *dq, conical_k4s4_real *dp);
 void conical_k4s4_params_default(conical_k4s4_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_k4s4_OK or an error code. */
-int conical_k4s4_step(conical_k4s4_state *x, double h, const conical_k4s4_params *prm, conical_k4s4_stats *st);
+int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_k4s4_params *prm, conical_k4s4_stats *st);
 const char *conical_k4s4_strerror(int code);
-double conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm);
-void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *g);   /* conical_k4s4_NU values */
-void conical_k4s4_hidden(const conical_k4s4_state *x, const conical_k4s4_params *prm, double *gp);       /* grad g' M^-1 p */
+conical_k4s4_real conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm);
+void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *g);   /* conical_k4s4_NU values */
+void conical_k4s4_hidden(const conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -625,7 +625,7 @@ const char *conical_poly_k2s2_strerror(int code)
   return "unknown error";
 }
 
-double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm)
+conical_poly_k2s2_real conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm)
 {
   double H;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -633,22 +633,16 @@ double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_
   return H;
 }
 
-void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g)
+void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *g)
 {
-  double v[conical_poly_k2s2_NU];
-  int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_poly_k2s2_NU; i++) g[i] = v[i];
+  conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *gp)
+void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *gp)
 {
-  double v[conical_poly_k2s2_NU];
-  int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  conical_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_poly_k2s2_NU; i++) gp[i] = v[i];
+  conical_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -680,7 +674,7 @@ static void conical_poly_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h_, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
+int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];

@@ -36,7 +36,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  conical_poly_k2s2_real increment; /* last scaled increment of the iteration */
 } conical_poly_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -52,11 +52,11 @@ void conical_poly_k2s2_init(conical_poly_k2s2_state *x, const conical_poly_k2s2_
 int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *dq, conical_poly_k2s2_real *dp);
 void conical_poly_k2s2_params_default(conical_poly_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_poly_k2s2_OK or an error code. */
-int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
+int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
 const char *conical_poly_k2s2_strerror(int code);
-double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
-void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g);   /* conical_poly_k2s2_NU values */
-void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+conical_poly_k2s2_real conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
+void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *g);   /* conical_poly_k2s2_NU values */
+void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

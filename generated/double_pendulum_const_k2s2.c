@@ -532,7 +532,7 @@ const char *double_pendulum_const_k2s2_strerror(int code)
   return "unknown error";
 }
 
-double double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm)
+double_pendulum_const_k2s2_real double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm)
 {
   double H;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
@@ -540,22 +540,16 @@ double double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state 
   return H;
 }
 
-void double_pendulum_const_k2s2_constraints(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double *g)
+void double_pendulum_const_k2s2_constraints(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_real *g)
 {
-  double v[double_pendulum_const_k2s2_NU];
-  int i;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
-  double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) g[i] = v[i];
+  double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double *gp)
+void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_real *gp)
 {
-  double v[double_pendulum_const_k2s2_NU];
-  int i;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
-  double_pendulum_const_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) gp[i] = v[i];
+  double_pendulum_const_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -587,7 +581,7 @@ static void double_pendulum_const_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double h_, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
+int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h_, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];

@@ -36,7 +36,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  double_pendulum_k2s2_real increment; /* last scaled increment of the iteration */
 } double_pendulum_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -52,11 +52,11 @@ void double_pendulum_k2s2_init(double_pendulum_k2s2_state *x, const double_pendu
 int double_pendulum_k2s2_project(double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_real *dq, double_pendulum_k2s2_real *dp);
 void double_pendulum_k2s2_params_default(double_pendulum_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns double_pendulum_k2s2_OK or an error code. */
-int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double h, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st);
+int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st);
 const char *double_pendulum_k2s2_strerror(int code);
-double double_pendulum_k2s2_energy(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm);
-void double_pendulum_k2s2_constraints(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double *g);   /* double_pendulum_k2s2_NU values */
-void double_pendulum_k2s2_hidden(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+double_pendulum_k2s2_real double_pendulum_k2s2_energy(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm);
+void double_pendulum_k2s2_constraints(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_real *g);   /* double_pendulum_k2s2_NU values */
+void double_pendulum_k2s2_hidden(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -2023,7 +2023,7 @@ const char *double_pendulum_k3s3_strerror(int code)
   return "unknown error";
 }
 
-double double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm)
+double_pendulum_k3s3_real double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm)
 {
   double H;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
@@ -2031,22 +2031,16 @@ double double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const do
   return H;
 }
 
-void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *g)
+void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *g)
 {
-  double v[double_pendulum_k3s3_NU];
-  int i;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
-  double_pendulum_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_k3s3_NU; i++) g[i] = v[i];
+  double_pendulum_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *gp)
+void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *gp)
 {
-  double v[double_pendulum_k3s3_NU];
-  int i;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
-  double_pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_k3s3_NU; i++) gp[i] = v[i];
+  double_pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -2078,7 +2072,7 @@ static void double_pendulum_k3s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double h_, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
+int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];

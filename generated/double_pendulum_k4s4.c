@@ -3938,7 +3938,7 @@ const char *double_pendulum_k4s4_strerror(int code)
   return "unknown error";
 }
 
-double double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm)
+double_pendulum_k4s4_real double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm)
 {
   double H;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
@@ -3946,22 +3946,16 @@ double double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const do
   return H;
 }
 
-void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *g)
+void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_real *g)
 {
-  double v[double_pendulum_k4s4_NU];
-  int i;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
-  double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_k4s4_NU; i++) g[i] = v[i];
+  double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *gp)
+void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_real *gp)
 {
-  double v[double_pendulum_k4s4_NU];
-  int i;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
-  double_pendulum_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_k4s4_NU; i++) gp[i] = v[i];
+  double_pendulum_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -3993,7 +3987,7 @@ static void double_pendulum_k4s4_add(double *a, double *c, double b)
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double h_, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
+int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];

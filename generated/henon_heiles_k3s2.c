@@ -222,7 +222,7 @@ const char *henon_heiles_k3s2_strerror(int code)
   return "unknown error";
 }
 
-double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm)
+henon_heiles_k3s2_real henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm)
 {
   double H;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
@@ -230,12 +230,12 @@ double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_he
   return H;
 }
 
-void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *g)
+void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *gp)
+void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -269,7 +269,7 @@ static void henon_heiles_k3s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, double h_, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
+int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
   double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];

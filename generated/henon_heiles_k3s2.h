@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  henon_heiles_k3s2_real increment; /* last scaled increment of the iteration */
 } henon_heiles_k3s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_
 int henon_heiles_k3s2_project(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *dq, henon_heiles_k3s2_real *dp);
 void henon_heiles_k3s2_params_default(henon_heiles_k3s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns henon_heiles_k3s2_OK or an error code. */
-int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, double h, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st);
+int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st);
 const char *henon_heiles_k3s2_strerror(int code);
-double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm);
-void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *g);   /* henon_heiles_k3s2_NU values */
-void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *gp);       /* grad g' M^-1 p */
+henon_heiles_k3s2_real henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm);
+void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *g);   /* henon_heiles_k3s2_NU values */
+void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -149,7 +149,7 @@ const char *kepler_k1s1_strerror(int code)
   return "unknown error";
 }
 
-double kepler_k1s1_energy(const kepler_k1s1_state *x, const kepler_k1s1_params *prm)
+kepler_k1s1_real kepler_k1s1_energy(const kepler_k1s1_state *x, const kepler_k1s1_params *prm)
 {
   double H;
   kepler_k1s1_DEFAULT_PARAMS(prm)
@@ -157,12 +157,12 @@ double kepler_k1s1_energy(const kepler_k1s1_state *x, const kepler_k1s1_params *
   return H;
 }
 
-void kepler_k1s1_constraints(const kepler_k1s1_state *x, const kepler_k1s1_params *prm, double *g)
+void kepler_k1s1_constraints(const kepler_k1s1_state *x, const kepler_k1s1_params *prm, kepler_k1s1_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *prm, double *gp)
+void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *prm, kepler_k1s1_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -196,7 +196,7 @@ static void kepler_k1s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k1s1_step(kepler_k1s1_state *x, double h_, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
+int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h_, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k1s1_S * kepler_k1s1_M], sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + 3 * kepler_k1s1_NU + 1];

@@ -199,7 +199,7 @@ const char *kepler_k2s2_strerror(int code)
   return "unknown error";
 }
 
-double kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *prm)
+kepler_k2s2_real kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *prm)
 {
   double H;
   kepler_k2s2_DEFAULT_PARAMS(prm)
@@ -207,12 +207,12 @@ double kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *
   return H;
 }
 
-void kepler_k2s2_constraints(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *g)
+void kepler_k2s2_constraints(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, kepler_k2s2_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *gp)
+void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, kepler_k2s2_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -246,7 +246,7 @@ static void kepler_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k2s2_step(kepler_k2s2_state *x, double h_, const kepler_k2s2_params *prm, kepler_k2s2_stats *st)
+int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h_, const kepler_k2s2_params *prm, kepler_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k2s2_S * kepler_k2s2_M], sw[kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + 3 * kepler_k2s2_NU + 1];

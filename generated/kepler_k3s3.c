@@ -257,7 +257,7 @@ const char *kepler_k3s3_strerror(int code)
   return "unknown error";
 }
 
-double kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm)
+kepler_k3s3_real kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm)
 {
   double H;
   kepler_k3s3_DEFAULT_PARAMS(prm)
@@ -265,12 +265,12 @@ double kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *
   return H;
 }
 
-void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *g)
+void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, kepler_k3s3_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *gp)
+void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, kepler_k3s3_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -304,7 +304,7 @@ static void kepler_k3s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k3s3_step(kepler_k3s3_state *x, double h_, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
+int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h_, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k3s3_S * kepler_k3s3_M], sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + 3 * kepler_k3s3_NU + 1];

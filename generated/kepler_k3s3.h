@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  kepler_k3s3_real increment; /* last scaled increment of the iteration */
 } kepler_k3s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void kepler_k3s3_init(kepler_k3s3_state *x, const kepler_k3s3_real *q0, const ke
 int kepler_k3s3_project(kepler_k3s3_state *x, const kepler_k3s3_params *prm, kepler_k3s3_real *dq, kepler_k3s3_real *dp);
 void kepler_k3s3_params_default(kepler_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns kepler_k3s3_OK or an error code. */
-int kepler_k3s3_step(kepler_k3s3_state *x, double h, const kepler_k3s3_params *prm, kepler_k3s3_stats *st);
+int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h, const kepler_k3s3_params *prm, kepler_k3s3_stats *st);
 const char *kepler_k3s3_strerror(int code);
-double kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm);
-void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *g);   /* kepler_k3s3_NU values */
-void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+kepler_k3s3_real kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm);
+void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, kepler_k3s3_real *g);   /* kepler_k3s3_NU values */
+void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, kepler_k3s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

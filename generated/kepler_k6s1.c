@@ -271,7 +271,7 @@ const char *kepler_k6s1_strerror(int code)
   return "unknown error";
 }
 
-double kepler_k6s1_energy(const kepler_k6s1_state *x, const kepler_k6s1_params *prm)
+kepler_k6s1_real kepler_k6s1_energy(const kepler_k6s1_state *x, const kepler_k6s1_params *prm)
 {
   double H;
   kepler_k6s1_DEFAULT_PARAMS(prm)
@@ -279,12 +279,12 @@ double kepler_k6s1_energy(const kepler_k6s1_state *x, const kepler_k6s1_params *
   return H;
 }
 
-void kepler_k6s1_constraints(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *g)
+void kepler_k6s1_constraints(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, kepler_k6s1_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *gp)
+void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, kepler_k6s1_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -318,7 +318,7 @@ static void kepler_k6s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k6s1_step(kepler_k6s1_state *x, double h_, const kepler_k6s1_params *prm, kepler_k6s1_stats *st)
+int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h_, const kepler_k6s1_params *prm, kepler_k6s1_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k6s1_S * kepler_k6s1_M], sw[kepler_k6s1_S * kepler_k6s1_M + kepler_k6s1_M + 3 * kepler_k6s1_NU + 1];

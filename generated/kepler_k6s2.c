@@ -325,7 +325,7 @@ const char *kepler_k6s2_strerror(int code)
   return "unknown error";
 }
 
-double kepler_k6s2_energy(const kepler_k6s2_state *x, const kepler_k6s2_params *prm)
+kepler_k6s2_real kepler_k6s2_energy(const kepler_k6s2_state *x, const kepler_k6s2_params *prm)
 {
   double H;
   kepler_k6s2_DEFAULT_PARAMS(prm)
@@ -333,12 +333,12 @@ double kepler_k6s2_energy(const kepler_k6s2_state *x, const kepler_k6s2_params *
   return H;
 }
 
-void kepler_k6s2_constraints(const kepler_k6s2_state *x, const kepler_k6s2_params *prm, double *g)
+void kepler_k6s2_constraints(const kepler_k6s2_state *x, const kepler_k6s2_params *prm, kepler_k6s2_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void kepler_k6s2_hidden(const kepler_k6s2_state *x, const kepler_k6s2_params *prm, double *gp)
+void kepler_k6s2_hidden(const kepler_k6s2_state *x, const kepler_k6s2_params *prm, kepler_k6s2_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -372,7 +372,7 @@ static void kepler_k6s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k6s2_step(kepler_k6s2_state *x, double h_, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
+int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k6s2_S * kepler_k6s2_M], sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + 3 * kepler_k6s2_NU + 1];

@@ -363,7 +363,7 @@ const char *modified_k3s1_strerror(int code)
   return "unknown error";
 }
 
-double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm)
+modified_k3s1_real modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm)
 {
   double H;
   modified_k3s1_DEFAULT_PARAMS(prm)
@@ -371,22 +371,16 @@ double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_pa
   return H;
 }
 
-void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *g)
+void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *g)
 {
-  double v[modified_k3s1_NU];
-  int i;
   modified_k3s1_DEFAULT_PARAMS(prm)
-  modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_k3s1_NU; i++) g[i] = v[i];
+  modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *gp)
+void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *gp)
 {
-  double v[modified_k3s1_NU];
-  int i;
   modified_k3s1_DEFAULT_PARAMS(prm)
-  modified_k3s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_k3s1_NU; i++) gp[i] = v[i];
+  modified_k3s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -418,7 +412,7 @@ static void modified_k3s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_params *prm, modified_k3s1_stats *st)
+int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];

@@ -526,7 +526,7 @@ const char *modified_k6s2_strerror(int code)
   return "unknown error";
 }
 
-double modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm)
+modified_k6s2_real modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm)
 {
   double H;
   modified_k6s2_DEFAULT_PARAMS(prm)
@@ -534,22 +534,16 @@ double modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_pa
   return H;
 }
 
-void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *g)
+void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *g)
 {
-  double v[modified_k6s2_NU];
-  int i;
   modified_k6s2_DEFAULT_PARAMS(prm)
-  modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_k6s2_NU; i++) g[i] = v[i];
+  modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *gp)
+void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *gp)
 {
-  double v[modified_k6s2_NU];
-  int i;
   modified_k6s2_DEFAULT_PARAMS(prm)
-  modified_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_k6s2_NU; i++) gp[i] = v[i];
+  modified_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -581,7 +575,7 @@ static void modified_k6s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_k6s2_step(modified_k6s2_state *x, double h_, const modified_k6s2_params *prm, modified_k6s2_stats *st)
+int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + 1];

@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  modified_k6s2_real increment; /* last scaled increment of the iteration */
 } modified_k6s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void modified_k6s2_init(modified_k6s2_state *x, const modified_k6s2_real *q0, co
 int modified_k6s2_project(modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *dq, modified_k6s2_real *dp);
 void modified_k6s2_params_default(modified_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k6s2_OK or an error code. */
-int modified_k6s2_step(modified_k6s2_state *x, double h, const modified_k6s2_params *prm, modified_k6s2_stats *st);
+int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h, const modified_k6s2_params *prm, modified_k6s2_stats *st);
 const char *modified_k6s2_strerror(int code);
-double modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm);
-void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *g);   /* modified_k6s2_NU values */
-void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_params *prm, double *gp);       /* grad g' M^-1 p */
+modified_k6s2_real modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm);
+void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *g);   /* modified_k6s2_NU values */
+void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  modified_k9s3_real increment; /* last scaled increment of the iteration */
 } modified_k9s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void modified_k9s3_init(modified_k9s3_state *x, const modified_k9s3_real *q0, co
 int modified_k9s3_project(modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *dq, modified_k9s3_real *dp);
 void modified_k9s3_params_default(modified_k9s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k9s3_OK or an error code. */
-int modified_k9s3_step(modified_k9s3_state *x, double h, const modified_k9s3_params *prm, modified_k9s3_stats *st);
+int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modified_k9s3_params *prm, modified_k9s3_stats *st);
 const char *modified_k9s3_strerror(int code);
-double modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
-void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, double *g);   /* modified_k9s3_NU values */
-void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_params *prm, double *gp);       /* grad g' M^-1 p */
+modified_k9s3_real modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
+void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *g);   /* modified_k9s3_NU values */
+void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -1119,7 +1119,7 @@ const char *modified_poly_k6s2_strerror(int code)
   return "unknown error";
 }
 
-double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm)
+modified_poly_k6s2_real modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm)
 {
   double H;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -1127,22 +1127,16 @@ double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modifi
   return H;
 }
 
-void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *g)
+void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *g)
 {
-  double v[modified_poly_k6s2_NU];
-  int i;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
-  modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_poly_k6s2_NU; i++) g[i] = v[i];
+  modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *gp)
+void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *gp)
 {
-  double v[modified_poly_k6s2_NU];
-  int i;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
-  modified_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_poly_k6s2_NU; i++) gp[i] = v[i];
+  modified_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1174,7 +1168,7 @@ static void modified_poly_k6s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h_, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
+int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];

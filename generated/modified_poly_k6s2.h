@@ -36,7 +36,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  modified_poly_k6s2_real increment; /* last scaled increment of the iteration */
 } modified_poly_k6s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -52,11 +52,11 @@ void modified_poly_k6s2_init(modified_poly_k6s2_state *x, const modified_poly_k6
 int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *dq, modified_poly_k6s2_real *dp);
 void modified_poly_k6s2_params_default(modified_poly_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_poly_k6s2_OK or an error code. */
-int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st);
+int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real h, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st);
 const char *modified_poly_k6s2_strerror(int code);
-double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm);
-void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *g);   /* modified_poly_k6s2_NU values */
-void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *gp);       /* grad g' M^-1 p */
+modified_poly_k6s2_real modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm);
+void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *g);   /* modified_poly_k6s2_NU values */
+void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

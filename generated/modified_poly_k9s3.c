@@ -2081,7 +2081,7 @@ const char *modified_poly_k9s3_strerror(int code)
   return "unknown error";
 }
 
-double modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm)
+modified_poly_k9s3_real modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm)
 {
   double H;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
@@ -2089,22 +2089,16 @@ double modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modifi
   return H;
 }
 
-void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *g)
+void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, modified_poly_k9s3_real *g)
 {
-  double v[modified_poly_k9s3_NU];
-  int i;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
-  modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_poly_k9s3_NU; i++) g[i] = v[i];
+  modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, double *gp)
+void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, modified_poly_k9s3_real *gp)
 {
-  double v[modified_poly_k9s3_NU];
-  int i;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
-  modified_poly_k9s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_poly_k9s3_NU; i++) gp[i] = v[i];
+  modified_poly_k9s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -2136,7 +2130,7 @@ static void modified_poly_k9s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_poly_k9s3_step(modified_poly_k9s3_state *x, double h_, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
+int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];

@@ -218,7 +218,7 @@ const char *pendulum_angle_k6s3_strerror(int code)
   return "unknown error";
 }
 
-double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm)
+pendulum_angle_k6s3_real pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm)
 {
   double H;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
@@ -226,12 +226,12 @@ double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pend
   return H;
 }
 
-void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *g)
+void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *gp)
+void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -265,7 +265,7 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
+int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];

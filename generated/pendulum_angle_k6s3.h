@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_angle_k6s3_real increment; /* last scaled increment of the iteration */
 } pendulum_angle_k6s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const pendulum_angle
 int pendulum_angle_k6s3_project(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *dq, pendulum_angle_k6s3_real *dp);
 void pendulum_angle_k6s3_params_default(pendulum_angle_k6s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_angle_k6s3_OK or an error code. */
-int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
+int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
 const char *pendulum_angle_k6s3_strerror(int code);
-double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm);
-void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *g);   /* pendulum_angle_k6s3_NU values */
-void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_angle_k6s3_real pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm);
+void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *g);   /* pendulum_angle_k6s3_NU values */
+void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -258,7 +258,7 @@ const char *pendulum_k1s1_strerror(int code)
   return "unknown error";
 }
 
-double pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm)
+pendulum_k1s1_real pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm)
 {
   double H;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
@@ -266,22 +266,16 @@ double pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_pa
   return H;
 }
 
-void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *g)
+void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *g)
 {
-  double v[pendulum_k1s1_NU];
-  int i;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
-  pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_k1s1_NU; i++) g[i] = v[i];
+  pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *gp)
+void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *gp)
 {
-  double v[pendulum_k1s1_NU];
-  int i;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
-  pendulum_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_k1s1_NU; i++) gp[i] = v[i];
+  pendulum_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -313,7 +307,7 @@ static void pendulum_k1s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_k1s1_step(pendulum_k1s1_state *x, double h_, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
+int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];

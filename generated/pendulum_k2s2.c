@@ -285,7 +285,7 @@ const char *pendulum_k2s2_strerror(int code)
   return "unknown error";
 }
 
-double pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm)
+pendulum_k2s2_real pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm)
 {
   double H;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -293,22 +293,16 @@ double pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_pa
   return H;
 }
 
-void pendulum_k2s2_constraints(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, double *g)
+void pendulum_k2s2_constraints(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *g)
 {
-  double v[pendulum_k2s2_NU];
-  int i;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
-  pendulum_k2s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_k2s2_NU; i++) g[i] = v[i];
+  pendulum_k2s2_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void pendulum_k2s2_hidden(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, double *gp)
+void pendulum_k2s2_hidden(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *gp)
 {
-  double v[pendulum_k2s2_NU];
-  int i;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
-  pendulum_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_k2s2_NU; i++) gp[i] = v[i];
+  pendulum_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -340,7 +334,7 @@ static void pendulum_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_k2s2_step(pendulum_k2s2_state *x, double h_, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
+int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h_, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];

@@ -310,7 +310,7 @@ const char *pendulum_k3s3_strerror(int code)
   return "unknown error";
 }
 
-double pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm)
+pendulum_k3s3_real pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm)
 {
   double H;
   pendulum_k3s3_DEFAULT_PARAMS(prm)
@@ -318,22 +318,16 @@ double pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_pa
   return H;
 }
 
-void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *g)
+void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *g)
 {
-  double v[pendulum_k3s3_NU];
-  int i;
   pendulum_k3s3_DEFAULT_PARAMS(prm)
-  pendulum_k3s3_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_k3s3_NU; i++) g[i] = v[i];
+  pendulum_k3s3_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *gp)
+void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *gp)
 {
-  double v[pendulum_k3s3_NU];
-  int i;
   pendulum_k3s3_DEFAULT_PARAMS(prm)
-  pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_k3s3_NU; i++) gp[i] = v[i];
+  pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -365,7 +359,7 @@ static void pendulum_k3s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_k3s3_step(pendulum_k3s3_state *x, double h_, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
+int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_k3s3_S * pendulum_k3s3_M], sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 3 * pendulum_k3s3_NU + 1];

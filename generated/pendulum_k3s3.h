@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_k3s3_real increment; /* last scaled increment of the iteration */
 } pendulum_k3s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void pendulum_k3s3_init(pendulum_k3s3_state *x, const pendulum_k3s3_real *q0, co
 int pendulum_k3s3_project(pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *dq, pendulum_k3s3_real *dp);
 void pendulum_k3s3_params_default(pendulum_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k3s3_OK or an error code. */
-int pendulum_k3s3_step(pendulum_k3s3_state *x, double h, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st);
+int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st);
 const char *pendulum_k3s3_strerror(int code);
-double pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm);
-void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *g);   /* pendulum_k3s3_NU values */
-void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_k3s3_real pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm);
+void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *g);   /* pendulum_k3s3_NU values */
+void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

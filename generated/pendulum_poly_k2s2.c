@@ -493,7 +493,7 @@ const char *pendulum_poly_k2s2_strerror(int code)
   return "unknown error";
 }
 
-double pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm)
+pendulum_poly_k2s2_real pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm)
 {
   double H;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -501,22 +501,16 @@ double pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendul
   return H;
 }
 
-void pendulum_poly_k2s2_constraints(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, double *g)
+void pendulum_poly_k2s2_constraints(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_real *g)
 {
-  double v[pendulum_poly_k2s2_NU];
-  int i;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
-  pendulum_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_poly_k2s2_NU; i++) g[i] = v[i];
+  pendulum_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, double *gp)
+void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_real *gp)
 {
-  double v[pendulum_poly_k2s2_NU];
-  int i;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
-  pendulum_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_poly_k2s2_NU; i++) gp[i] = v[i];
+  pendulum_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -548,7 +542,7 @@ static void pendulum_poly_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, double h_, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
+int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real h_, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M], sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + 1];

@@ -1324,7 +1324,7 @@ const char *pendulum_poly_k4s4_strerror(int code)
   return "unknown error";
 }
 
-double pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm)
+pendulum_poly_k4s4_real pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm)
 {
   double H;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
@@ -1332,22 +1332,16 @@ double pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendul
   return H;
 }
 
-void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *g)
+void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *g)
 {
-  double v[pendulum_poly_k4s4_NU];
-  int i;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
-  pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_poly_k4s4_NU; i++) g[i] = v[i];
+  pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *gp)
+void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *gp)
 {
-  double v[pendulum_poly_k4s4_NU];
-  int i;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
-  pendulum_poly_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_poly_k4s4_NU; i++) gp[i] = v[i];
+  pendulum_poly_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1379,7 +1373,7 @@ static void pendulum_poly_k4s4_add(double *a, double *c, double b)
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, double h_, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
+int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];

@@ -36,7 +36,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_poly_k4s4_real increment; /* last scaled increment of the iteration */
 } pendulum_poly_k4s4_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -52,11 +52,11 @@ void pendulum_poly_k4s4_init(pendulum_poly_k4s4_state *x, const pendulum_poly_k4
 int pendulum_poly_k4s4_project(pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *dq, pendulum_poly_k4s4_real *dp);
 void pendulum_poly_k4s4_params_default(pendulum_poly_k4s4_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_poly_k4s4_OK or an error code. */
-int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, double h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
+int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
 const char *pendulum_poly_k4s4_strerror(int code);
-double pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm);
-void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *g);   /* pendulum_poly_k4s4_NU values */
-void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_poly_k4s4_real pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm);
+void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *g);   /* pendulum_poly_k4s4_NU values */
+void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

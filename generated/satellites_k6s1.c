@@ -1669,7 +1669,7 @@ const char *satellites_k6s1_strerror(int code)
   return "unknown error";
 }
 
-double satellites_k6s1_energy(const satellites_k6s1_state *x, const satellites_k6s1_params *prm)
+satellites_k6s1_real satellites_k6s1_energy(const satellites_k6s1_state *x, const satellites_k6s1_params *prm)
 {
   double H;
   satellites_k6s1_DEFAULT_PARAMS(prm)
@@ -1677,22 +1677,16 @@ double satellites_k6s1_energy(const satellites_k6s1_state *x, const satellites_k
   return H;
 }
 
-void satellites_k6s1_constraints(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *g)
+void satellites_k6s1_constraints(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, satellites_k6s1_real *g)
 {
-  double v[satellites_k6s1_NU];
-  int i;
   satellites_k6s1_DEFAULT_PARAMS(prm)
-  satellites_k6s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_k6s1_NU; i++) g[i] = v[i];
+  satellites_k6s1_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, double *gp)
+void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, satellites_k6s1_real *gp)
 {
-  double v[satellites_k6s1_NU];
-  int i;
   satellites_k6s1_DEFAULT_PARAMS(prm)
-  satellites_k6s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_k6s1_NU; i++) gp[i] = v[i];
+  satellites_k6s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1724,7 +1718,7 @@ static void satellites_k6s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_k6s1_step(satellites_k6s1_state *x, double h_, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
+int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h_, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_k6s1_S * satellites_k6s1_M], sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + 1];

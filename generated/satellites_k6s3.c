@@ -2638,7 +2638,7 @@ const char *satellites_k6s3_strerror(int code)
   return "unknown error";
 }
 
-double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm)
+satellites_k6s3_real satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm)
 {
   double H;
   satellites_k6s3_DEFAULT_PARAMS(prm)
@@ -2646,22 +2646,16 @@ double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k
   return H;
 }
 
-void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *g)
+void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *g)
 {
-  double v[satellites_k6s3_NU];
-  int i;
   satellites_k6s3_DEFAULT_PARAMS(prm)
-  satellites_k6s3_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_k6s3_NU; i++) g[i] = v[i];
+  satellites_k6s3_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *gp)
+void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *gp)
 {
-  double v[satellites_k6s3_NU];
-  int i;
   satellites_k6s3_DEFAULT_PARAMS(prm)
-  satellites_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_k6s3_NU; i++) gp[i] = v[i];
+  satellites_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -2693,7 +2687,7 @@ static void satellites_k6s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_k6s3_step(satellites_k6s3_state *x, double h_, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
+int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h_, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_k6s3_S * satellites_k6s3_M], sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 3 * satellites_k6s3_NU + 1];

@@ -35,7 +35,7 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  satellites_k6s3_real increment; /* last scaled increment of the iteration */
 } satellites_k6s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -51,11 +51,11 @@ void satellites_k6s3_init(satellites_k6s3_state *x, const satellites_k6s3_real *
 int satellites_k6s3_project(satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *dq, satellites_k6s3_real *dp);
 void satellites_k6s3_params_default(satellites_k6s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns satellites_k6s3_OK or an error code. */
-int satellites_k6s3_step(satellites_k6s3_state *x, double h, const satellites_k6s3_params *prm, satellites_k6s3_stats *st);
+int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h, const satellites_k6s3_params *prm, satellites_k6s3_stats *st);
 const char *satellites_k6s3_strerror(int code);
-double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm);
-void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *g);   /* satellites_k6s3_NU values */
-void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *gp);       /* grad g' M^-1 p */
+satellites_k6s3_real satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm);
+void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *g);   /* satellites_k6s3_NU values */
+void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -4906,7 +4906,7 @@ const char *satellites_poly_k6s2_strerror(int code)
   return "unknown error";
 }
 
-double satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm)
+satellites_poly_k6s2_real satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm)
 {
   double H;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -4914,22 +4914,16 @@ double satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const sa
   return H;
 }
 
-void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *g)
+void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_real *g)
 {
-  double v[satellites_poly_k6s2_NU];
-  int i;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
-  satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_poly_k6s2_NU; i++) g[i] = v[i];
+  satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, double *gp)
+void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_real *gp)
 {
-  double v[satellites_poly_k6s2_NU];
-  int i;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
-  satellites_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_poly_k6s2_NU; i++) gp[i] = v[i];
+  satellites_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -4961,7 +4955,7 @@ static void satellites_poly_k6s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, double h_, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
+int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];

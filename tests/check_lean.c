@@ -143,7 +143,7 @@ static void float_run(int n, double *dH, double *dg, pendulum_float_k2s2_state *
   *dH = *dg = 0;
   for (int i = 0; i < n; i++) {
     ck_assert_int_eq(pendulum_float_k2s2_step(&x, 2.0 / n, NULL, NULL), 0);
-    double g;
+    pendulum_float_k2s2_real g;
     pendulum_float_k2s2_constraints(&x, NULL, &g);
     *dH = fmax(*dH, fabs(pendulum_float_k2s2_energy(&x, NULL) - H0));
     *dg = fmax(*dg, fabs(g));

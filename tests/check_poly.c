@@ -222,7 +222,7 @@ START_TEST(float_variant) {
   double H0 = polyfloat_k3s3_energy(&x, NULL), dH = 0, dg = 0;
   for (int n = 0; n < 1000; n++) {
     ck_assert_int_eq(polyfloat_k3s3_step(&x, 0.1, NULL, NULL), 0);
-    double g;
+    polyfloat_k3s3_real g;
     polyfloat_k3s3_constraints(&x, NULL, &g);
     dH = fmax(dH, fabs(polyfloat_k3s3_energy(&x, NULL) - H0));
     dg = fmax(dg, fabs(g));
