@@ -114,6 +114,7 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   for (int l = 0; l < me->k; l++) out(e, " *   c_%d = %.17g   b_%d = %.17g\n", l + 1, me->c[l], l + 1, me->b[l]);
   out(e, " */\n/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */\n");
   emit_array(e, "E", me->E, me->s * me->s * me->s);
+  if (e->st->kern[K_INITIAL].nout) return; /* q0, p0 use params: the kernel "initial" computes them */
   out(e, "/* Model defaults for q0 and p0. */\n");
   emit_array(e, "q0", e->mod->q0, e->mod->m);
   emit_array(e, "p0", e->mod->p0, e->mod->m);
