@@ -49,8 +49,8 @@ typedef struct {
    * drivers from hbvmgen 0.1, which end before this field) gives the
    * numbered header q1..qm. */
   const char *const *names;
-  /* From hbvmgen 0.2 (NULL, 0 in older drivers, which then start as before,
-   * unchecked): init at the run's params (q0, p0 NULL: the model's, which may
+  /* Drivers generated before these fields leave them NULL, 0 and start as
+   * before, unchecked.  Init at the run's params (q0, p0 NULL: the model's, which may
    * depend on them); the projection onto the constraints (NAME_project: 0 or a
    * step code, x unchanged on failure; dq, dp the largest change of a q, p);
    * the relative precision of the solver's real type (DBL_EPSILON,
