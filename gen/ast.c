@@ -424,16 +424,18 @@ static int flatten(Ctx *cx, const Ast *e, List *out) {
   return 0;
 }
 
-// Flatten a list of constants (q0, p0, diag entries, a row of M) into
-// want doubles; what names the list, whole what it is part of.
-static double *constant_list(Ctx *cx, const Stmt *st, const char *what, const char *whole, int want) {
+// Flatten a list (q0, p0, diag entries, a row of M) into want nodes that
+// depend on no coordinate, and on no param unless params_ok; what names the
+// list, whole what it is part of.
+static int *value_list(Ctx *cx, const Stmt *st, const char *what, const char *whole, int want, int params_ok) {
   List l = {{0}, {0}, {0}};
   if (flatten(cx, st->expr, &l) < 0) return NULL;
   for (int i = 0; i < l.nodes.n; i++) {
     const Node *nd = &cx->d->nodes[l.nodes.v[i]];
-    if (nd->op != OP_CONST) {
+    if (nd->op != OP_CONST && (!params_ok || nd->flags & DEP_INPUT)) {
       Loc loc = {l.lines.v[i], l.cols.v[i]};
-      error_at(loc, "%s must be constant, but this value depends on %s", whole, dependence(nd));
+      if (params_ok) error_at(loc, "%s cannot depend on a coordinate (it may use params), but this value does", whole);
+      else error_at(loc, "%s must be constant, but this value depends on %s", whole, dependence(nd));
       return NULL;
     }
   }
@@ -442,8 +444,15 @@ static double *constant_list(Ctx *cx, const Stmt *st, const char *what, const ch
              l.nodes.n == 1 ? "" : "s", want);
     return NULL;
   }
+  return l.nodes.v;
+}
+
+// value_list of constants, as doubles.
+static double *constant_list(Ctx *cx, const Stmt *st, const char *what, const char *whole, int want) {
+  int *nodes = value_list(cx, st, what, whole, want, 0);
+  if (!nodes) return NULL;
   double *v = arena_alloc((size_t)want * sizeof(double));
-  for (int i = 0; i < want; i++) v[i] = cx->d->nodes[l.nodes.v[i]].val;
+  for (int i = 0; i < want; i++) v[i] = cx->d->nodes[nodes[i]].val;
   return v;
 }
 
@@ -625,11 +634,23 @@ static void lower_mass(Ctx *cx) {
   mass_setup_diag(mod, dg, e->loc);
 }
 
-static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc *loc) {
-  if (!st) return arena_alloc((size_t)cx->mod->m * sizeof(double));
+// q0 = [...] or p0 = [...]: m values that may use params (NAME_init_params
+// evaluates them then) into *nodes, and their values at the default params;
+// zeros when the statement is missing.
+static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc *loc, int **nodes) {
+  int m = cx->mod->m;
+  double *v = arena_alloc((size_t)m * sizeof(double)), *prm = arena_alloc((size_t)(cx->nparams + 1) * sizeof(double));
+  *nodes = arena_alloc((size_t)m * sizeof(int));
+  for (int i = 0; i < m; i++) (*nodes)[i] = cx->d->zero;
+  if (!st) return v;
   cx->stmt = stmt;
   cx->d->where = *loc = st->loc;
-  return constant_list(cx, st, what, what, cx->mod->m);
+  int *n = value_list(cx, st, what, what, m, 1);
+  if (!n) return NULL;
+  for (int i = 0; i < cx->nparams; i++) prm[i] = cx->params[i].value;
+  memcpy(*nodes, n, (size_t)m * sizeof(int));
+  dag_eval_many(cx->d, n, m, NULL, prm, v);
+  return v;
 }
 
 static int by_location(const void *a, const void *b) {
@@ -685,8 +706,8 @@ Model *analyse(const char *file, Stmt *prog) {
   if (mod->m == 0 && !diag_error_count()) error_at((Loc){1, 1}, "the model declares no coordinates: add 'variables x, ...'");
   if (mod->m > 0 && !diag_too_many()) {
     lower_mass(cx);
-    mod->q0 = initial_values(cx, cx->q0, cx->q0_stmt, "q0", &mod->q0_loc);
-    mod->p0 = initial_values(cx, cx->p0, cx->p0_stmt, "p0", &mod->p0_loc);
+    mod->q0 = initial_values(cx, cx->q0, cx->q0_stmt, "q0", &mod->q0_loc, &mod->q0n);
+    mod->p0 = initial_values(cx, cx->p0, cx->p0_stmt, "p0", &mod->p0_loc, &mod->p0n);
   }
   mod->nu = cx->g.n;
   mod->g = cx->g.v;

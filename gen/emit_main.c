@@ -5,6 +5,8 @@
  * values, and adapters from the runtime's opaque pointers to the typed
  * functions of NAME.h. Options, the loop, CSV and the summary live in the
  * runtime, so every generated driver behaves the same. */
+#include <string.h>
+
 #include "hbvmgen.h"
 
 static void emit_values(FILE *f, const char *name, const double *v, int n) {
@@ -13,24 +15,87 @@ static void emit_values(FILE *f, const char *name, const double *v, int n) {
   fprintf(f, "};\n");
 }
 
+// Adapters from the runtime's opaque pointers to the double solver's
+// typed functions: the runtime reads and writes its state directly.
+static void emit_adapters(FILE *f, const char *P) {
+  fprintf(f, "static void init(void *x, const double *q0, const double *p0) { %s_init(x, q0, p0); }\n", P);
+  fprintf(f, "static void init_params(void *x, const double *q0, const double *p0, const void *prm)\n"
+             "{\n  %s_init_params(x, q0, p0, prm);\n}\n", P);
+  fprintf(f, "static void params_default(void *prm) { %s_params_default(prm); }\n", P);
+  fprintf(f, "static double energy(const void *x, const void *prm) { return %s_energy(x, prm); }\n", P);
+  fprintf(f, "static void constraints(const void *x, const void *prm, double *g) { %s_constraints(x, prm, g); }\n", P);
+  fprintf(f, "static void hidden(const void *x, const void *prm, double *gp) { %s_hidden(x, prm, gp); }\n", P);
+  fprintf(f, "static int project(void *x, const void *prm, double *dq, double *dp) { return %s_project(x, prm, dq, dp); }\n\n",
+          P);
+  fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n");
+  fprintf(f, "  %s_stats s;\n  int rc = %s_step(x, h, prm, &s);\n", P, P);
+  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  return rc;\n}\n\n");
+}
+
+// The same for a float solver: the runtime works in double, so it is given
+// a view (the state's public fields in double beside the float state, and
+// the params in double), converted at every call.
+static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
+  int nu1 = mod->nu ? mod->nu : 1;
+  fprintf(f, "/* The runtime reads and writes doubles: it sees this view of the float state and\n"
+             " * params, converted at every call. */\n");
+  fprintf(f, "typedef struct {\n  double t, q[%s_M], p[%s_M], lambda[%d];\n  %s_state s;\n} view;\n\n", P, P, nu1, P);
+  fprintf(f, "typedef struct {\n");
+  for (int i = 0; i < mod->nparams; i++) fprintf(f, "  double %s;\n", mod->params[i].name);
+  if (!mod->nparams) fprintf(f, "  char unused_;\n");
+  fprintf(f, "} view_params;\n\n");
+  fprintf(f, "static void to_real(const void *prm, %s_params *r)\n{\n  const view_params *d = prm;\n", P);
+  for (int i = 0; i < mod->nparams; i++)
+    fprintf(f, "  r->%s = (%s_real)d->%s;\n", mod->params[i].name, P, mod->params[i].name);
+  fprintf(f, mod->nparams ? "}\n\n" : "  (void)d;\n  r->unused_ = 0;\n}\n\n");
+  fprintf(f, "static void params_default(void *prm)\n{\n  view_params *d = prm;\n  %s_params r;\n"
+             "  %s_params_default(&r);\n", P, P);
+  for (int i = 0; i < mod->nparams; i++) fprintf(f, "  d->%s = r.%s;\n", mod->params[i].name, mod->params[i].name);
+  fprintf(f, mod->nparams ? "}\n\n" : "  d->unused_ = r.unused_;\n}\n\n");
+  fprintf(f, "static void sync(view *v)\n{\n  int i;\n  v->t = v->s.t;\n"
+             "  for (i = 0; i < %s_M; i++) {\n    v->q[i] = v->s.q[i];\n    v->p[i] = v->s.p[i];\n  }\n"
+             "  for (i = 0; i < %d; i++) v->lambda[i] = v->s.lambda[i];\n}\n\n", P, nu1);
+  fprintf(f, "static void init_params(void *x, const double *q0, const double *p0, const void *prm)\n{\n"
+             "  %s_real q[%s_M], p[%s_M];\n  %s_params r;\n  int i;\n"
+             "  for (i = 0; i < %s_M; i++) {\n    q[i] = q0 ? (%s_real)q0[i] : 0;\n"
+             "    p[i] = p0 ? (%s_real)p0[i] : 0;\n  }\n"
+             "  to_real(prm, &r);\n  %s_init_params(&((view *)x)->s, q0 ? q : NULL, p0 ? p : NULL, &r);\n"
+             "  sync(x);\n}\n\n", P, P, P, P, P, P, P, P);
+  fprintf(f, "static void init(void *x, const double *q0, const double *p0)\n{\n  view_params d;\n"
+             "  params_default(&d);\n  init_params(x, q0, p0, &d);\n}\n\n");
+  fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n"
+             "  %s_params r;\n  %s_stats s;\n  int rc;\n  to_real(prm, &r);\n"
+             "  rc = %s_step(&((view *)x)->s, (%s_real)h, &r, &s);\n"
+             "  st->iters = s.iters;\n  st->increment = s.increment;\n  sync(x);\n  return rc;\n}\n\n", P, P, P, P);
+  fprintf(f, "static double energy(const void *x, const void *prm)\n{\n  %s_params r;\n  to_real(prm, &r);\n"
+             "  return %s_energy(&((const view *)x)->s, &r);\n}\n\n", P, P);
+  static const char *const fun[2] = {"constraints", "hidden"};
+  for (int k = 0; k < 2; k++)
+    fprintf(f, "static void %s(const void *x, const void *prm, double *out)\n{\n  %s_params r;\n  %s_real v[%d];\n"
+               "  int i;\n  to_real(prm, &r);\n  %s_%s(&((const view *)x)->s, &r, v);\n"
+               "  for (i = 0; i < %s_NU; i++) out[i] = v[i];\n}\n\n", fun[k], P, P, nu1, P, fun[k], P);
+  fprintf(f, "static int project(void *x, const void *prm, double *dq, double *dp)\n{\n  %s_params r;\n"
+             "  %s_real a = 0, b = 0;\n  int rc;\n  to_real(prm, &r);\n  rc = %s_project(&((view *)x)->s, &r, &a, &b);\n"
+             "  if (dq) *dq = a;\n  if (dp) *dp = b;\n  sync(x);\n  return rc;\n}\n\n", P, P, P);
+}
+
 // Write NAME_main.c to f. Returns 0, or -1 on a write error.
 int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *o) {
   const char *P = o->name;
   fprintf(f, "/* %s_main.c - generated by hbvmgen %s from %s: do not edit.\n", P, HBVMGEN_VERSION, o->model_file);
   fprintf(f, " * Standalone driver: cc -O2 -std=c99 -Iruntime -Igenerated generated/%s.c generated/%s_main.c\n", P, P);
   fprintf(f, " *   runtime/libhbvmrt.a -lm; run ./%s --help for its options. */\n", P);
-  fprintf(f, "#include <stddef.h>\n\n#include \"hbvmrt.h\"\n#include \"%s.h\"\n\n", P);
-  fprintf(f, "static void init(void *x, const double *q0, const double *p0) { %s_init(x, q0, p0); }\n", P);
-  fprintf(f, "static void params_default(void *prm) { %s_params_default(prm); }\n", P);
-  fprintf(f, "static double energy(const void *x, const void *prm) { return %s_energy(x, prm); }\n", P);
-  fprintf(f, "static void constraints(const void *x, const void *prm, double *g) { %s_constraints(x, prm, g); }\n", P);
-  fprintf(f, "static void hidden(const void *x, const void *prm, double *gp) { %s_hidden(x, prm, gp); }\n\n", P);
-  fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n");
-  fprintf(f, "  %s_stats s;\n  int rc = %s_step(x, h, prm, &s);\n", P, P);
-  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  return rc;\n}\n\n");
+  fprintf(f, "#include <float.h>\n#include <stddef.h>\n\n#include \"hbvmrt.h\"\n#include \"%s.h\"\n\n", P);
+  if (o->single) emit_float_adapters(f, mod, P);
+  else emit_adapters(f, P);
+  /* what the runtime sees: the solver's state and params, or their double view */
+  size_t n = strlen(P) + 16;
+  char *st = arena_alloc(n), *pt = arena_alloc(n);
+  snprintf(st, n, "%s_state", P);
+  snprintf(pt, n, "%s_params", P);
+  if (o->single) strcpy(st, "view"), strcpy(pt, "view_params");
   fprintf(f, "static const hbvmrt_param params[] = {\n");
-  for (int i = 0; i < mod->nparams; i++)
-    fprintf(f, "  {\"%s\", offsetof(%s_params, %s)},\n", mod->params[i].name, P, mod->params[i].name);
+  for (int i = 0; i < mod->nparams; i++) fprintf(f, "  {\"%s\", offsetof(%s, %s)},\n", mod->params[i].name, pt, mod->params[i].name);
   if (!mod->nparams) fprintf(f, "  {NULL, 0},\n");
   fprintf(f, "};\n");
   fprintf(f, "static const char *const names[] = {");
@@ -40,11 +105,11 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   emit_values(f, "p0", mod->p0, mod->m);
   fprintf(f, "\nint main(int argc, char **argv)\n{\n  static const hbvmrt_model model = {\n");
   fprintf(f, "    \"%s\", %s_M, %s_NU, %s_K, %s_S,\n", P, P, P, P, P);
-  fprintf(f, "    sizeof(%s_state), sizeof(%s_params),\n", P, P);
-  fprintf(f, "    offsetof(%s_state, t), offsetof(%s_state, q), offsetof(%s_state, p), offsetof(%s_state, lambda),\n",
-          P, P, P, P);
+  fprintf(f, "    sizeof(%s), sizeof(%s),\n", st, pt);
+  fprintf(f, "    offsetof(%s, t), offsetof(%s, q), offsetof(%s, p), offsetof(%s, lambda),\n", st, st, st, st);
   fprintf(f, "    %d, params, q0, p0,\n", mod->nparams);
-  fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n  };\n", P);
+  fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
+  fprintf(f, "    init_params, project, %s,\n  };\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
   fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");
   (void)me;
   return ferror(f) ? -1 : 0;

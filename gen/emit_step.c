@@ -50,20 +50,27 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   tmpl(e, "} $P_params;\n\n"
           "typedef struct {\n"
           "  int iters;         /* fixed-point iterations */\n"
-          "  double increment;  /* last scaled increment of the iteration */\n"
+          "  $P_real increment; /* last scaled increment of the iteration */\n"
           "} $P_stats;\n\n"
-          "/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier\n"
-          " * consistent with (q0, p0) at the default parameters (0 if that is singular)\n");
+          "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
+          " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
+          " * that is singular)\n");
   tmpl(e, poly ? " * and after each step is the multiplier consistent with the new (q, p), of order 2s. */\n"
                : " * and is the constant multiplier of the last step after each step. */\n");
-  tmpl(e, "void $P_init($P_state *x, const double *q0, const double *p0);\n"
+  tmpl(e, "void $P_init_params($P_state *x, const $P_real *q0, const $P_real *p0, const $P_params *prm);\n"
+          "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0);   /* at the default parameters */\n"
+          "/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the\n"
+          " * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations\n"
+          " * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].\n"
+          " * Returns $P_OK, or $P_ENOCONV, $P_ESINGULAR, $P_ENONFINITE with x unchanged. */\n"
+          "int $P_project($P_state *x, const $P_params *prm, $P_real *dq, $P_real *dp);\n"
           "void $P_params_default($P_params *prm);\n"
           "/* One step of size h; prm and st may be NULL. Returns $P_OK or an error code. */\n"
-          "int $P_step($P_state *x, double h, const $P_params *prm, $P_stats *st);\n"
+          "int $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st);\n"
           "const char *$P_strerror(int code);\n"
-          "double $P_energy(const $P_state *x, const $P_params *prm);\n"
-          "void $P_constraints(const $P_state *x, const $P_params *prm, double *g);   /* $P_NU values */\n"
-          "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp);       /* grad g' M^-1 p */\n"
+          "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
+          "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
+          "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp);       /* grad g' M^-1 p */\n"
           "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
 }
 
@@ -111,6 +118,7 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   for (int l = 0; l < me->k; l++) out(e, " *   c_%d = %.17g   b_%d = %.17g\n", l + 1, me->c[l], l + 1, me->b[l]);
   out(e, " */\n/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */\n");
   emit_array(e, "E", me->E, me->s * me->s * me->s);
+  if (e->st->kern[K_INITIAL].nout) return; /* q0, p0 use params: the kernel "initial" computes them */
   out(e, "/* Model defaults for q0 and p0. */\n");
   emit_array(e, "q0", e->mod->q0, e->mod->m);
   emit_array(e, "p0", e->mod->p0, e->mod->m);
@@ -122,6 +130,40 @@ static void emit_kernels(Emitter *e) {
     if (e->st->kern[k].nout) emit_kernel(e, (KernelId)k);
 }
 
+// The multiplier consistent with (x->q, x->p) at prm into x->lambda (0 where
+// its system is singular), for init and project.
+static void emit_set_lambda(Emitter *e) {
+  tmpl(e, "  {\n    $R lam[$P_NU];\n    $(lambda0 q0=x->q p0=x->p out=lam);\n"
+          "    for (i = 0; i < $P_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;\n  }\n");
+}
+
+// NAME_init_params, and NAME_init calling it with the default parameters.
+// q0, p0 default to the model's: a kernel of prm when they use params.
+static void emit_init(Emitter *e) {
+  int of_params = e->st->kern[K_INITIAL].nout > 0;
+  tmpl(e, "void $P_init_params($P_state *x, const $P_real *q0, const $P_real *p0, const $P_params *prm)\n{\n"
+          "  int i;\n");
+  if (of_params) tmpl(e, "  $R v[$<initial>];\n");
+  tmpl(e, "  $P_DEFAULT_PARAMS(prm)\n");
+  if (of_params) tmpl(e, "  $(initial out=v);\n");
+  tmpl(e, "  x->t = x->tc = x->hprev = 0;\n"
+          "  for (i = 0; i < $P_M; i++) {\n");
+  if (of_params)
+    tmpl(e, "    x->q[i] = q0 ? q0[i] : v[$[initial.q0]i];\n"
+            "    x->p[i] = p0 ? p0[i] : v[$[initial.p0]i];\n");
+  else
+    tmpl(e, "    x->q[i] = q0 ? q0[i] : $P_q0[i];\n"
+            "    x->p[i] = p0 ? p0[i] : $P_p0[i];\n");
+  tmpl(e, "    x->qc[i] = x->pc[i] = 0;\n  }\n"
+          "  for (i = 0; i < ($P_NU ? $P_NU : 1); i++) x->lambda[i] = 0;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n");
+  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
+  if (e->mod->nu) emit_set_lambda(e);
+  tmpl(e, "}\n\n"
+          "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0)\n{\n"
+          "  $P_init_params(x, q0, p0, 0);\n}\n\n");
+}
+
 static void emit_public(Emitter *e) {
   tmpl(e, "\nvoid $P_params_default($P_params *prm)\n{\n");
   for (int i = 0; i < e->mod->nparams; i++) {
@@ -131,42 +173,26 @@ static void emit_public(Emitter *e) {
   }
   if (!e->mod->nparams) out(e, "  prm->unused_ = 0;\n");
   tmpl(e, "}\n\n"
-          "void $P_init($P_state *x, const double *q0, const double *p0)\n{\n"
-          "  int i;\n"
-          "  x->t = x->tc = x->hprev = 0;\n"
-          "  for (i = 0; i < $P_M; i++) {\n"
-          "    x->q[i] = q0 ? ($R)q0[i] : $P_q0[i];\n"
-          "    x->p[i] = p0 ? ($R)p0[i] : $P_p0[i];\n"
-          "    x->qc[i] = x->pc[i] = 0;\n  }\n"
-          "  for (i = 0; i < ($P_NU ? $P_NU : 1); i++) x->lambda[i] = 0;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n");
-  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
-  if (e->mod->nu)
-    tmpl(e, "  {\n    $P_params prm;\n    $R lam[$P_NU];\n    $P_params_default(&prm);\n"
-            "    $(lambda0 q0=x->q p0=x->p prm=&prm out=lam);\n"
-            "    for (i = 0; i < $P_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;\n  }\n");
-  tmpl(e, "}\n\n"
-          "const char *$P_strerror(int code)\n{\n  switch (code) {\n"
+          "#define $P_DEFAULT_PARAMS(prm) $P_params dflt_; if (!prm) { $P_params_default(&dflt_); prm = &dflt_; }\n\n");
+  emit_init(e);
+  tmpl(e, "const char *$P_strerror(int code)\n{\n  switch (code) {\n"
           "  case $P_OK: return \"ok\";\n"
           "  case $P_ENOCONV: return \"fixed-point iteration did not converge\";\n"
           "  case $P_ENONFINITE: return \"non-finite value\";\n"
           "  case $P_ESINGULAR: return \"singular multiplier system\";\n"
           "  case $P_EBADSTEP: return \"step size zero or not finite\";\n"
           "  }\n  return \"unknown error\";\n}\n\n"
-          "#define $P_DEFAULT_PARAMS(prm) $P_params dflt_; if (!prm) { $P_params_default(&dflt_); prm = &dflt_; }\n\n"
-          "double $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  $P_DEFAULT_PARAMS(prm)\n"
+          "$P_real $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  $(energy_kernel q0=x->q p0=x->p out=&H);\n  return H;\n}\n\n");
   if (e->mod->nu)
-    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, double *g)\n{\n"
-            "  $R v[$P_NU];\n  int i;\n  $P_DEFAULT_PARAMS(prm)\n"
-            "  $(g q0=x->q p0=x->p out=v);\n  for (i = 0; i < $P_NU; i++) g[i] = v[i];\n}\n\n"
-            "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp)\n{\n"
-            "  $R v[$P_NU];\n  int i;\n  $P_DEFAULT_PARAMS(prm)\n"
-            "  $(hidden_kernel q0=x->q p0=x->p out=v);\n  for (i = 0; i < $P_NU; i++) gp[i] = v[i];\n}\n");
+    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g)\n{\n"
+            "  $P_DEFAULT_PARAMS(prm)\n  $(g q0=x->q p0=x->p out=g);\n}\n\n"
+            "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp)\n{\n"
+            "  $P_DEFAULT_PARAMS(prm)\n  $(hidden_kernel q0=x->q p0=x->p out=gp);\n}\n");
   else
-    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, double *g)\n{\n"
+    tmpl(e, "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g)\n{\n"
             "  (void)x; (void)prm; (void)g;\n}\n\n"
-            "void $P_hidden(const $P_state *x, const $P_params *prm, double *gp)\n{\n"
+            "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp)\n{\n"
             "  (void)x; (void)prm; (void)gp;\n}\n");
 }
 
@@ -176,7 +202,7 @@ static void emit_public(Emitter *e) {
 // of the run, the multiplier consistent with (q1, p1), then the commit.
 static void emit_end_poly(Emitter *e) {
   int wide = e->wide_step;
-  tmpl(e, "  $W q1[$P_M], p1[$P_M], pr[$<project> + 1], K, U1, beta = 1;\n  $R H0, Hn = $P_energy(x, prm);\n");
+  tmpl(e, "  $W q1[$P_M], p1[$P_M], pr[$<project_p1> + 1], K, U1, beta = 1;\n  $R H0, Hn = $P_energy(x, prm);\n");
   if (wide)
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    q1[i] = q0w[i] + h * sw[$[sweep.gam]i];\n    p1[i] = p0w[i] + sw[$[sweep.dp]i];\n  }\n");
@@ -187,37 +213,36 @@ static void emit_end_poly(Emitter *e) {
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
   tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
-          "  $(project q0=q1 p0=p1 out=pr);\n"
+          "  $(project_p1 q0=q1 p0=p1 out=pr);\n"
           "  for (i = 0; i < $P_NU; i++) {\n"
-          "    $W piv = pr[$[project.pivot]i], dia = pr[$[project.adiag]i];\n"
+          "    $W piv = pr[$[project_p1.pivot]i], dia = pr[$[project_p1.adiag]i];\n"
           "    if (isfinite(piv) && isfinite(dia) && !(fabs$g(piv) > $P_SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n"
-          "  for (i = 0; i < $<project>; i++)\n    if (!isfinite(pr[i])) return $P_ENONFINITE;\n"
+          "  for (i = 0; i < $<project_p1>; i++)\n    if (!isfinite(pr[i])) return $P_ENONFINITE;\n"
           "  /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:\n"
           "   * taken anew on the first step, or when the state or parameters were changed\n"
           "   * since the last step (H(q0, p0) differs from H0 by more than round-off). No\n"
           "   * rescale at rest (K = 0) or where H0 < U(q1). */\n"
-          "  K = pr[$[project.kin]0];\n  U1 = pr[$[project.U]0];\n"
+          "  K = pr[$[project_p1.kin]0];\n  U1 = pr[$[project_p1.U]0];\n"
           "  H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$g(U1)) ? x->H0 : Hn;\n"
           "  if (K > 0 && H0 - U1 > 0) beta = sqrt$g((H0 - U1) / K);\n");
   if (wide)
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
-            "    p1[i] = beta * (p1[i] + pr[$[project.dp]i]);\n"
+            "    p1[i] = beta * (p1[i] + pr[$[project_p1.dp]i]);\n"
             "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
             "  /* q1, p1 rounded once into q, p; what the rounding lost is the new qc, pc */\n"
             "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = ($R)q1[i];\n    x->p[i] = ($R)p1[i];\n");
   else
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
-            "    $P_add(&p1[i], &pc1[i], pr[$[project.dp]i] + (beta - 1) * (p1[i] + pr[$[project.dp]i]));\n"
+            "    $P_add(&p1[i], &pc1[i], pr[$[project_p1.dp]i] + (beta - 1) * (p1[i] + pr[$[project_p1.dp]i]));\n"
             "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
             "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
   tmpl(e, "  }\n"
           "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
-          "  x->H0 = H0;\n"
-          "  {\n    $R lam0[$P_NU];\n    $(lambda0 q0=x->q p0=x->p out=lam0);\n"
-          "    for (i = 0; i < $P_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;\n  }\n"
-          "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
+          "  x->H0 = H0;\n");
+  emit_set_lambda(e);
+  tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
 // The warm start, iteration and compensated update around the sweep kernel.
@@ -246,7 +271,7 @@ static void emit_step(Emitter *e) {
             "static void $P_add($R *a, $R *c, $R b)\n{\n  (void)c;\n  *a += b;\n}\n\n");
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "int $P_step($P_state *x, double h_, const $P_params *prm, $P_stats *st)\n{\n"
+          "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
           "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;\n"
@@ -382,6 +407,54 @@ int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
   return bad;
 }
 
+// NAME_project: the Newton iteration of the kernel "consistent" on a copy of
+// q until its correction is at round-off, then p projected at that q; the
+// state is written only on success.
+static void emit_project(Emitter *e) {
+  tmpl(e, "\n/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q\n"
+          " * ($P_TOL) or stops decreasing at round-off, at most $P_MAXITER times; then p\n"
+          " * projected onto the hidden constraint at that q. x is written only on success. */\n"
+          "int $P_project($P_state *x, const $P_params *prm, $P_real *dq, $P_real *dp)\n{\n");
+  if (!e->mod->nu) {
+    tmpl(e, "  (void)x;\n  (void)prm;\n  if (dq) *dq = 0;\n  if (dp) *dp = 0;\n  return $P_OK;\n}\n");
+    return;
+  }
+  tmpl(e, "  $R q[$P_M], p[$P_M], out[$<consistent>], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;\n"
+          "  int it, i, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
+          "  for (i = 0; i < $P_M; i++) {\n    q[i] = x->q[i];\n    p[i] = x->p[i];\n  }\n"
+          "  for (it = 1; it <= $P_MAXITER; it++) {\n"
+          "    $(consistent q0=q p0=p out=out);\n"
+          "    for (i = 0; i < $P_NU; i++) {\n"
+          "      $R piv = out[$[consistent.pivot]i], dia = out[$[consistent.adiag]i];\n"
+          "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
+          "    }\n"
+          "    if (rc == $P_ESINGULAR) break;\n"
+          "    for (i = 0; i < $<consistent>; i++)\n      if (!isfinite(out[i])) rc = $P_ENONFINITE;\n"
+          "    if (rc == $P_ENONFINITE) break;\n"
+          "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
+          "    for (i = 0; i < $P_M; i++) {\n"
+          "      if (fabs$f(q[i]) > scale) scale = fabs$f(q[i]);\n"
+          "      if (fabs$f(out[$[consistent.dq]i]) > inc) inc = fabs$f(out[$[consistent.dq]i]);\n    }\n"
+          "    if (scale > 0) inc /= scale;\n"
+          "    /* at round-off the last correction is left out, so that dp below is at q */\n"
+          "    if (inc <= $P_TOL) { rc = $P_OK; break; }\n"
+          "    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * $P_TOL ? $P_OK : $P_ENOCONV; break; }\n"
+          "    for (i = 0; i < $P_M; i++) q[i] += out[$[consistent.dq]i];\n  }\n"
+          "  if (rc != $P_OK) return rc;\n"
+          "  for (i = 0; i < $P_M; i++) {\n"
+          "    p[i] += out[$[consistent.dp]i];\n"
+          "    if (!isfinite(p[i])) return $P_ENONFINITE;\n"
+          "    if (fabs$f(q[i] - x->q[i]) > dqmax) dqmax = fabs$f(q[i] - x->q[i]);\n"
+          "    if (fabs$f(p[i] - x->p[i]) > dpmax) dpmax = fabs$f(p[i] - x->p[i]);\n  }\n"
+          "  for (i = 0; i < $P_M; i++) {\n"
+          "    x->q[i] = q[i];\n    x->p[i] = p[i];\n    x->qc[i] = x->pc[i] = 0;\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n"
+          "  x->hprev = 0;  /* the next step starts afresh, as after init */\n");
+  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;\n");
+  emit_set_lambda(e);
+  tmpl(e, "  if (dq) *dq = dqmax;\n  if (dp) *dp = dpmax;\n  return $P_OK;\n}\n");
+}
+
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP};
@@ -392,6 +465,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_kernels(&e);
   emit_public(&e);
   emit_step(&e);
+  emit_project(&e);
   free(e.temp);
   return ferror(hf) || ferror(cf) ? -1 : 0;
 }

@@ -275,7 +275,8 @@ typedef struct {
   MassKind mass;
   double *minv;               /* m*m row-major inverse mass (dense only), else NULL */
   double *minv_diag;          /* m entries of diag(M^-1) */
-  double *q0, *p0;            /* m each */
+  double *q0, *p0;            /* m each, at the default params */
+  int *q0n, *p0n;             /* m nodes each: q0, p0 as functions of the params */
   Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
   int degU, degg;             /* DEG_NONPOLY or degree; degg = 0 without constraints */
 } Model;
@@ -332,7 +333,12 @@ typedef struct {
 enum { IN_Q0, IN_P0, IN_GAM, IN_H, IN_G0, IN_LAM, IN_LU, IN_COUNT };
 
 /* The kernels of a solver, in the order they are printed. */
-typedef enum { K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_LAMBDA0, K_PROJECT, K_COUNT } KernelId;
+typedef enum {
+  K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_LAMBDA0, K_PROJECT,
+  K_CONSISTENT, /* NAME_project: a Newton step onto g = 0, p projected onto the hidden constraint */
+  K_INITIAL,    /* the model's q0, p0 as functions of the params (when they use any) */
+  K_COUNT
+} KernelId;
 
 #define MAX_BLOCKS 8
 

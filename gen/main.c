@@ -149,7 +149,6 @@ static int parse_args(int argc, char **argv, Options *o) {
     }
   }
   if (!o->model) return fail("%s", "no model file given (see hbvmgen --help)");
-  if (o->single && o->emit_main) return fail("%s", "--main needs double precision (the driver's CSV is in double)");
   if (o->k && o->k < o->s) {
     char buf[64];
     snprintf(buf, sizeof buf, "k=%d < s=%d", o->k, o->s);

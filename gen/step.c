@@ -257,6 +257,68 @@ void step_gram(Build *b, int **G, int *B) {
   }
 }
 
+// The M-orthogonal projection of p onto grad g(q)' M^-1 p = 0, for the dense
+// columns G of grad g at q and B = G' M^-1 G: dp = -G mu (m nodes) with
+// B mu = G' M^-1 p, and the pivots and diagonal entries of B's factors (nu
+// each), by which the caller tells a singular B.
+void step_project_momenta(Build *b, int **G, const int *B, const int *p, int *dp, int *pivot, int *adiag) {
+  Dag *d = b->d;
+  int m = b->m, nu = b->nu, z = dag_const(d, 0);
+  int *v = step_nodes(m), *rhs = step_nodes(nu), *mu = step_nodes(nu);
+  minv_apply(b->mod, d, p, v);
+  for (int a = 0; a < nu; a++) {
+    rhs[a] = z;
+    for (int i = 0; i < m; i++) rhs[a] = dag_add(d, rhs[a], dag_mul(d, G[a][i], v[i]));
+  }
+  lu_solve_ordered(d, B, rhs, nu, mu, pivot, adiag);
+  for (int i = 0; i < m; i++) {
+    dp[i] = z;
+    for (int a = 0; a < nu; a++) dp[i] = dag_sub(d, dp[i], dag_mul(d, G[a][i], mu[a]));
+  }
+}
+
+// The kernel "consistent" of NAME_project: at (q, p) = inputs (q0, p0), the
+// Newton step towards g(q) = 0 with the smallest change in the M norm,
+//   dq = -M^-1 G y,  (G' M^-1 G) y = g(q),  G = grad g(q),
+// the projection dp of p onto the hidden constraint at q, and the pivots
+// and diagonal of G' M^-1 G. NAME_project iterates it until dq is at
+// round-off, then adds the last dp.
+static void build_consistent(Build *b, const int *q, const int *p, const int *g) {
+  Dag *d = b->d;
+  int m = b->m, nu = b->nu, z = dag_const(d, 0);
+  b->owners = 1u << K_CONSISTENT;
+  step_section(b, "Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint");
+  int *B = step_nodes(nu * nu), *y = step_nodes(nu), *gy = step_nodes(m), *dq = step_nodes(m), *dp = step_nodes(m);
+  int *pivot = step_nodes(nu), *adiag = step_nodes(nu), *unused = step_nodes(nu);
+  int **G = step_jacobian_at(b, q);
+  step_gram(b, G, B);
+  lu_solve_ordered(d, B, g, nu, y, unused, NULL); /* the factors are those of the projection below, shared */
+  for (int i = 0; i < m; i++) {
+    gy[i] = z;
+    for (int a = 0; a < nu; a++) gy[i] = dag_add(d, gy[i], dag_mul(d, G[a][i], y[a]));
+  }
+  minv_apply(b->mod, d, gy, dq);
+  for (int i = 0; i < m; i++) dq[i] = dag_neg(d, dq[i]);
+  step_project_momenta(b, G, B, p, dp, pivot, adiag);
+  Step *st = b->st;
+  step_result(st, K_CONSISTENT, "dq", SZ_M, 1, m, dq);
+  step_result(st, K_CONSISTENT, "dp", SZ_M, 1, m, dp);
+  step_result(st, K_CONSISTENT, "pivot", SZ_NU, 1, nu, pivot);
+  step_result(st, K_CONSISTENT, "adiag", SZ_NU, 1, nu, adiag);
+}
+
+// The kernel "initial" when the model's q0 or p0 use params: their values
+// for the params of NAME_init_params.
+static void build_initial_values(Build *b) {
+  Model *mod = b->mod;
+  int uses = 0;
+  for (int i = 0; i < b->m; i++)
+    uses |= b->d->nodes[mod->q0n[i]].op != OP_CONST || b->d->nodes[mod->p0n[i]].op != OP_CONST;
+  if (!uses) return;
+  step_result(b->st, K_INITIAL, "q0", SZ_M, 1, b->m, mod->q0n);
+  step_result(b->st, K_INITIAL, "p0", SZ_M, 1, b->m, mod->p0n);
+}
+
 // The multiplier consistent with (q0, p0): differentiating the hidden
 // constraint G' M^-1 p = 0 along the flow gives
 //   (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U,  v = M^-1 p,
@@ -335,10 +397,12 @@ static void build_diagnostics(Build *b) {
   }
   step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);
   step_result(b->st, K_ENERGY, "H", SZ_ONE, 1, 1, &H);
+  build_initial_values(b);
   if (!nu) return;
   step_result(b->st, K_G, "g", SZ_NU, 1, nu, g);
   step_result(b->st, K_HIDDEN, "hidden", SZ_NU, 1, nu, hidden);
   build_initial_multiplier(b, q, v);
+  build_consistent(b, q, p, g);
 }
 
 // Append the result block name (len nodes, len = coef * sym) to kernel k.
@@ -404,7 +468,14 @@ static const struct {
                    "out = the multiplier consistent with (q0, p0):\n"
                    " * (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U, G = grad g(q0), v = M^-1 p0",
                    0},
-    [K_PROJECT] = {"project", NULL, 1},
+    [K_PROJECT] = {"project_p1", NULL, 1},
+    [K_CONSISTENT] = {"consistent",
+                      "The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,\n"
+                      " * smallest in the M norm,"
+                      " -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),\n"
+                      " * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0)",
+                      0},
+    [K_INITIAL] = {"initial", "out = the model's q0 (M) and p0 (M) at the parameters prm", 0},
 };
 
 Step *step_build(Model *mod, const Method *me) {

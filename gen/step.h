@@ -33,6 +33,7 @@ void step_gamma(Build *b, int **theta, int *gam, int *dp); /* gamma_j and p1 - p
 void step_gamma_update(Build *b, int **theta);        /* the same, as the sweep's results */
 int **step_jacobian_at(Build *b, const int *q);       /* dense columns of grad g at q */
 void step_gram(Build *b, int **G, int *B);            /* B = G' M^-1 G */
+void step_project_momenta(Build *b, int **G, const int *B, const int *p, int *dp, int *pivot, int *adiag);
 int step_dot_col(Build *b, int j, int a, const int *v);
 void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
 

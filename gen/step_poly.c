@@ -17,7 +17,7 @@
  * section 5: as few sweeps as re-solving A every sweep).
  *
  * After the iteration the step projects p1 onto the hidden constraint at
- * q1 and rescales it so that H keeps its value; the kernel "project" gives
+ * q1 and rescales it so that H keeps its value; the kernel "project_p1" gives
  * the correction -G1 mu (mu = (G1' M^-1 G1)^-1 G1' M^-1 p1), the kinetic
  * energy after it and U(q1), and the step template applies them. With the
  * projection the step has order 2s (section 8: without it, s or s+1). */
@@ -185,7 +185,7 @@ static int *conditions(Build *b, int ***G, const int *gam) {
   return C;
 }
 
-// The kernel "project": at (q, p) = inputs (q0, p0), which the step sets to
+// The kernel "project_p1": at (q, p) = inputs (q0, p0), which the step sets to
 // (q1, p1), the correction dp = -G1 mu onto grad g(q1)' M^-1 p = 0, the
 // kinetic energy after it, U(q1), and the pivots of G1' M^-1 G1.
 static void build_projection(Build *b) {
@@ -194,25 +194,16 @@ static void build_projection(Build *b) {
   int m = b->m, nu = b->nu, z = dag_const(d, 0);
   b->owners = 1u << K_PROJECT;
   step_section(b, "projection onto the hidden constraint at q1, kinetic energy after it, U(q1)");
-  int *q = step_nodes(m), *p = step_nodes(m), *v = step_nodes(m), *B = step_nodes(nu * nu), *rhs = step_nodes(nu);
-  int *mu = step_nodes(nu), *pivot = step_nodes(nu), *adiag = step_nodes(nu), *dp = step_nodes(m), *pt = step_nodes(m);
+  int *q = step_nodes(m), *p = step_nodes(m), *v = step_nodes(m), *B = step_nodes(nu * nu);
+  int *pivot = step_nodes(nu), *adiag = step_nodes(nu), *dp = step_nodes(m), *pt = step_nodes(m);
   for (int i = 0; i < m; i++) {
     q[i] = step_in(b, IN_Q0, i);
     p[i] = step_in(b, IN_P0, i);
   }
   int **G = step_jacobian_at(b, q);
   step_gram(b, G, B);
-  minv_apply(mod, d, p, v);
-  for (int a = 0; a < nu; a++) {
-    rhs[a] = z;
-    for (int i = 0; i < m; i++) rhs[a] = dag_add(d, rhs[a], dag_mul(d, G[a][i], v[i]));
-  }
-  lu_solve_ordered(d, B, rhs, nu, mu, pivot, adiag);
-  for (int i = 0; i < m; i++) {
-    dp[i] = z;
-    for (int a = 0; a < nu; a++) dp[i] = dag_sub(d, dp[i], dag_mul(d, G[a][i], mu[a]));
-    pt[i] = dag_add(d, p[i], dp[i]);
-  }
+  step_project_momenta(b, G, B, p, dp, pivot, adiag);
+  for (int i = 0; i < m; i++) pt[i] = dag_add(d, p[i], dp[i]);
   minv_apply(mod, d, pt, v);
   int kin = z, U;
   for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, pt[i], v[i]));
@@ -231,7 +222,7 @@ static void build_projection(Build *b) {
 
 // The kernels of the polynomial family: "factor" (the frozen multiplier
 // matrix, once per step), "sweep" (with the factor's entries as the input
-// lu) and "project".
+// lu) and "project_p1".
 void build_poly_multiplier(Build *b) {
   Dag *d = b->d;
   Step *st = b->st;

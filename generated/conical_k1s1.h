@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  conical_k1s1_real increment; /* last scaled increment of the iteration */
 } conical_k1s1_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void conical_k1s1_init(conical_k1s1_state *x, const double *q0, const double *p0);
+void conical_k1s1_init_params(conical_k1s1_state *x, const conical_k1s1_real *q0, const conical_k1s1_real *p0, const conical_k1s1_params *prm);
+void conical_k1s1_init(conical_k1s1_state *x, const conical_k1s1_real *q0, const conical_k1s1_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns conical_k1s1_OK, or conical_k1s1_ENOCONV, conical_k1s1_ESINGULAR, conical_k1s1_ENONFINITE with x unchanged. */
+int conical_k1s1_project(conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *dq, conical_k1s1_real *dp);
 void conical_k1s1_params_default(conical_k1s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_k1s1_OK or an error code. */
-int conical_k1s1_step(conical_k1s1_state *x, double h, const conical_k1s1_params *prm, conical_k1s1_stats *st);
+int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_k1s1_params *prm, conical_k1s1_stats *st);
 const char *conical_k1s1_strerror(int code);
-double conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm);
-void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *g);   /* conical_k1s1_NU values */
-void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params *prm, double *gp);       /* grad g' M^-1 p */
+conical_k1s1_real conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm);
+void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *g);   /* conical_k1s1_NU values */
+void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

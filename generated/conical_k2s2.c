@@ -246,29 +246,90 @@ static void conical_k2s2_lambda0(const double *q0, const double *p0, const doubl
   out[0] = t17;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void conical_k2s2_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const conical_k2s2_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  const double t0 = 2.0 * q0[2] /* z */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
+  const double t5 = t3 + t4;
+  const double t6 = q0[2] /* z */ * q0[2] /* z */;
+  const double t7 = t5 + t6;
+  const double t8 = t7 - 1.0;
+  const double t9 = t2 * p0[0] /* p_x */;
+  const double t10 = t1 * p0[1] /* p_y */;
+  const double t11 = t9 + t10;
+  const double t12 = t0 * p0[2] /* p_z */;
+  const double t13 = t11 + t12;
+  const double t14 = t2 * t2;
+  const double t15 = t1 * t1;
+  const double t16 = t14 + t15;
+  const double t17 = t0 * t0;
+  const double t18 = t16 + t17;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t19 = t8 / t18;
+  const double t20 = t2 * t19;
+  const double t21 = t1 * t19;
+  const double t22 = t0 * t19;
+  const double t23 = -t20;
+  const double t24 = -t21;
+  const double t25 = -t22;
+  const double t26 = t13 / t18;
+  const double t27 = t2 * t26;
+  const double t28 = -t27;
+  const double t29 = t1 * t26;
+  const double t30 = -t29;
+  const double t31 = t0 * t26;
+  const double t32 = -t31;
+  /* dq */
+  out[0] = t23;
+  out[1] = t24;
+  out[2] = t25;
+  /* dp */
+  out[3] = t28;
+  out[4] = t30;
+  out[5] = t32;
+  /* pivot */
+  out[6] = t18;
+  /* adiag */
+  out[7] = t18;
+}
+
 void conical_k2s2_params_default(conical_k2s2_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void conical_k2s2_init(conical_k2s2_state *x, const double *q0, const double *p0)
+#define conical_k2s2_DEFAULT_PARAMS(prm) conical_k2s2_params dflt_; if (!prm) { conical_k2s2_params_default(&dflt_); prm = &dflt_; }
+
+void conical_k2s2_init_params(conical_k2s2_state *x, const conical_k2s2_real *q0, const conical_k2s2_real *p0, const conical_k2s2_params *prm)
 {
   int i;
+  conical_k2s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < conical_k2s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : conical_k2s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : conical_k2s2_p0[i];
+    x->q[i] = q0 ? q0[i] : conical_k2s2_q0[i];
+    x->p[i] = p0 ? p0[i] : conical_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k2s2_NU ? conical_k2s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
   {
-    conical_k2s2_params prm;
     double lam[conical_k2s2_NU];
-    conical_k2s2_params_default(&prm);
-    conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
     for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void conical_k2s2_init(conical_k2s2_state *x, const conical_k2s2_real *q0, const conical_k2s2_real *p0)
+{
+  conical_k2s2_init_params(x, q0, p0, 0);
 }
 
 const char *conical_k2s2_strerror(int code)
@@ -283,9 +344,7 @@ const char *conical_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define conical_k2s2_DEFAULT_PARAMS(prm) conical_k2s2_params dflt_; if (!prm) { conical_k2s2_params_default(&dflt_); prm = &dflt_; }
-
-double conical_k2s2_energy(const conical_k2s2_state *x, const conical_k2s2_params *prm)
+conical_k2s2_real conical_k2s2_energy(const conical_k2s2_state *x, const conical_k2s2_params *prm)
 {
   double H;
   conical_k2s2_DEFAULT_PARAMS(prm)
@@ -293,22 +352,16 @@ double conical_k2s2_energy(const conical_k2s2_state *x, const conical_k2s2_param
   return H;
 }
 
-void conical_k2s2_constraints(const conical_k2s2_state *x, const conical_k2s2_params *prm, double *g)
+void conical_k2s2_constraints(const conical_k2s2_state *x, const conical_k2s2_params *prm, conical_k2s2_real *g)
 {
-  double v[conical_k2s2_NU];
-  int i;
   conical_k2s2_DEFAULT_PARAMS(prm)
-  conical_k2s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k2s2_NU; i++) g[i] = v[i];
+  conical_k2s2_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void conical_k2s2_hidden(const conical_k2s2_state *x, const conical_k2s2_params *prm, double *gp)
+void conical_k2s2_hidden(const conical_k2s2_state *x, const conical_k2s2_params *prm, conical_k2s2_real *gp)
 {
-  double v[conical_k2s2_NU];
-  int i;
   conical_k2s2_DEFAULT_PARAMS(prm)
-  conical_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_k2s2_NU; i++) gp[i] = v[i];
+  conical_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -340,7 +393,7 @@ static void conical_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_k2s2_step(conical_k2s2_state *x, double h_, const conical_k2s2_params *prm, conical_k2s2_stats *st)
+int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + 1];
@@ -411,5 +464,64 @@ int conical_k2s2_step(conical_k2s2_state *x, double h_, const conical_k2s2_param
   for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return conical_k2s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (conical_k2s2_TOL) or stops decreasing at round-off, at most conical_k2s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int conical_k2s2_project(conical_k2s2_state *x, const conical_k2s2_params *prm, conical_k2s2_real *dq, conical_k2s2_real *dp)
+{
+  double q[conical_k2s2_M], p[conical_k2s2_M], out[2 * conical_k2s2_M + 2 * conical_k2s2_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = conical_k2s2_ENOCONV;
+  conical_k2s2_DEFAULT_PARAMS(prm)
+  for (i = 0; i < conical_k2s2_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= conical_k2s2_MAXITER; it++) {
+    conical_k2s2_consistent(q, p, 0, 0, 0, prm, out);
+    for (i = 0; i < conical_k2s2_NU; i++) {
+      double piv = out[2 * conical_k2s2_M + i], dia = out[2 * conical_k2s2_M + conical_k2s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k2s2_SINGTOL * fabs(dia))) rc = conical_k2s2_ESINGULAR;
+    }
+    if (rc == conical_k2s2_ESINGULAR) break;
+    for (i = 0; i < 2 * conical_k2s2_M + 2 * conical_k2s2_NU; i++)
+      if (!isfinite(out[i])) rc = conical_k2s2_ENONFINITE;
+    if (rc == conical_k2s2_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < conical_k2s2_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= conical_k2s2_TOL) { rc = conical_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * conical_k2s2_TOL ? conical_k2s2_OK : conical_k2s2_ENOCONV; break; }
+    for (i = 0; i < conical_k2s2_M; i++) q[i] += out[i];
+  }
+  if (rc != conical_k2s2_OK) return rc;
+  for (i = 0; i < conical_k2s2_M; i++) {
+    p[i] += out[conical_k2s2_M + i];
+    if (!isfinite(p[i])) return conical_k2s2_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < conical_k2s2_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  {
+    double lam[conical_k2s2_NU];
+    conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
+    for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return conical_k2s2_OK;
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  conical_k3s3_real increment; /* last scaled increment of the iteration */
 } conical_k3s3_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void conical_k3s3_init(conical_k3s3_state *x, const double *q0, const double *p0);
+void conical_k3s3_init_params(conical_k3s3_state *x, const conical_k3s3_real *q0, const conical_k3s3_real *p0, const conical_k3s3_params *prm);
+void conical_k3s3_init(conical_k3s3_state *x, const conical_k3s3_real *q0, const conical_k3s3_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns conical_k3s3_OK, or conical_k3s3_ENOCONV, conical_k3s3_ESINGULAR, conical_k3s3_ENONFINITE with x unchanged. */
+int conical_k3s3_project(conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *dq, conical_k3s3_real *dp);
 void conical_k3s3_params_default(conical_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_k3s3_OK or an error code. */
-int conical_k3s3_step(conical_k3s3_state *x, double h, const conical_k3s3_params *prm, conical_k3s3_stats *st);
+int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h, const conical_k3s3_params *prm, conical_k3s3_stats *st);
 const char *conical_k3s3_strerror(int code);
-double conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm);
-void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *g);   /* conical_k3s3_NU values */
-void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+conical_k3s3_real conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm);
+void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *g);   /* conical_k3s3_NU values */
+void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

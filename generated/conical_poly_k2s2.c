@@ -481,7 +481,7 @@ static void conical_poly_k2s2_lambda0(const double *q0, const double *p0, const 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
  * and diagonal (NU) of G1' M^-1 G1. */
-static void conical_poly_k2s2_project(const double *q0, const double *p0, const double *gam, double h,
+static void conical_poly_k2s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
@@ -502,23 +502,23 @@ static void conical_poly_k2s2_project(const double *q0, const double *p0, const 
   const double t13 = t12 / t7;
   const double t14 = t2 * t13;
   const double t15 = -t14;
-  const double t16 = p0[0] /* p_x */ - t14;
-  const double t17 = t1 * t13;
-  const double t18 = -t17;
-  const double t19 = p0[1] /* p_y */ - t17;
-  const double t20 = t0 * t13;
-  const double t21 = -t20;
-  const double t22 = p0[2] /* p_z */ - t20;
-  const double t23 = t16 * t16;
-  const double t24 = t19 * t19;
+  const double t16 = t1 * t13;
+  const double t17 = -t16;
+  const double t18 = t0 * t13;
+  const double t19 = -t18;
+  const double t20 = p0[0] /* p_x */ - t14;
+  const double t21 = p0[1] /* p_y */ - t16;
+  const double t22 = p0[2] /* p_z */ - t18;
+  const double t23 = t20 * t20;
+  const double t24 = t21 * t21;
   const double t25 = t23 + t24;
   const double t26 = t22 * t22;
   const double t27 = t25 + t26;
   const double t28 = 0.5 * t27;
   /* dp */
   out[0] = t15;
-  out[1] = t18;
-  out[2] = t21;
+  out[1] = t17;
+  out[2] = t19;
   /* kin */
   out[3] = t28;
   /* U */
@@ -529,30 +529,91 @@ static void conical_poly_k2s2_project(const double *q0, const double *p0, const 
   out[6] = t7;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void conical_poly_k2s2_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = 2.0 * q0[2] /* z */;
+  const double t1 = 2.0 * q0[1] /* y */;
+  const double t2 = 2.0 * q0[0] /* x */;
+  const double t3 = t2 * t2;
+  const double t4 = t1 * t1;
+  const double t5 = t3 + t4;
+  const double t6 = t0 * t0;
+  const double t7 = t5 + t6;
+  const double t8 = t2 * p0[0] /* p_x */;
+  const double t9 = t1 * p0[1] /* p_y */;
+  const double t10 = t8 + t9;
+  const double t11 = t0 * p0[2] /* p_z */;
+  const double t12 = t10 + t11;
+  const double t13 = t12 / t7;
+  const double t14 = t2 * t13;
+  const double t15 = -t14;
+  const double t16 = t1 * t13;
+  const double t17 = -t16;
+  const double t18 = t0 * t13;
+  const double t19 = -t18;
+  const double t20 = q0[0] /* x */ * q0[0] /* x */;
+  const double t21 = q0[1] /* y */ * q0[1] /* y */;
+  const double t22 = t20 + t21;
+  const double t23 = q0[2] /* z */ * q0[2] /* z */;
+  const double t24 = t22 + t23;
+  const double t25 = t24 - 1.0;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t26 = t25 / t7;
+  const double t27 = t2 * t26;
+  const double t28 = t1 * t26;
+  const double t29 = t0 * t26;
+  const double t30 = -t27;
+  const double t31 = -t28;
+  const double t32 = -t29;
+  /* dq */
+  out[0] = t30;
+  out[1] = t31;
+  out[2] = t32;
+  /* dp */
+  out[3] = t15;
+  out[4] = t17;
+  out[5] = t19;
+  /* pivot */
+  out[6] = t7;
+  /* adiag */
+  out[7] = t7;
+}
+
 void conical_poly_k2s2_params_default(conical_poly_k2s2_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void conical_poly_k2s2_init(conical_poly_k2s2_state *x, const double *q0, const double *p0)
+#define conical_poly_k2s2_DEFAULT_PARAMS(prm) conical_poly_k2s2_params dflt_; if (!prm) { conical_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
+
+void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_poly_k2s2_real *q0, const conical_poly_k2s2_real *p0, const conical_poly_k2s2_params *prm)
 {
   int i;
+  conical_poly_k2s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < conical_poly_k2s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : conical_poly_k2s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : conical_poly_k2s2_p0[i];
+    x->q[i] = q0 ? q0[i] : conical_poly_k2s2_q0[i];
+    x->p[i] = p0 ? p0[i] : conical_poly_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_poly_k2s2_NU ? conical_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
-    conical_poly_k2s2_params prm;
     double lam[conical_poly_k2s2_NU];
-    conical_poly_k2s2_params_default(&prm);
-    conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
+    conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
     for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void conical_poly_k2s2_init(conical_poly_k2s2_state *x, const conical_poly_k2s2_real *q0, const conical_poly_k2s2_real *p0)
+{
+  conical_poly_k2s2_init_params(x, q0, p0, 0);
 }
 
 const char *conical_poly_k2s2_strerror(int code)
@@ -567,9 +628,7 @@ const char *conical_poly_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define conical_poly_k2s2_DEFAULT_PARAMS(prm) conical_poly_k2s2_params dflt_; if (!prm) { conical_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
-
-double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm)
+conical_poly_k2s2_real conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm)
 {
   double H;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -577,22 +636,16 @@ double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_
   return H;
 }
 
-void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g)
+void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *g)
 {
-  double v[conical_poly_k2s2_NU];
-  int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_poly_k2s2_NU; i++) g[i] = v[i];
+  conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *gp)
+void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *gp)
 {
-  double v[conical_poly_k2s2_NU];
-  int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  conical_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < conical_poly_k2s2_NU; i++) gp[i] = v[i];
+  conical_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -624,7 +677,7 @@ static void conical_poly_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h_, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
+int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
@@ -700,7 +753,7 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h_, const conical_
     conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
-  conical_poly_k2s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
+  conical_poly_k2s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < conical_poly_k2s2_NU; i++) {
     double piv = pr[conical_poly_k2s2_M + 2 + i], dia = pr[conical_poly_k2s2_M + 2 + conical_poly_k2s2_NU + i];
     if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
@@ -728,11 +781,71 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h_, const conical_
   for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[conical_poly_k2s2_NU];
-    conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    double lam[conical_poly_k2s2_NU];
+    conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   conical_poly_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return conical_poly_k2s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (conical_poly_k2s2_TOL) or stops decreasing at round-off, at most conical_poly_k2s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *dq, conical_poly_k2s2_real *dp)
+{
+  double q[conical_poly_k2s2_M], p[conical_poly_k2s2_M], out[2 * conical_poly_k2s2_M + 2 * conical_poly_k2s2_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = conical_poly_k2s2_ENOCONV;
+  conical_poly_k2s2_DEFAULT_PARAMS(prm)
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= conical_poly_k2s2_MAXITER; it++) {
+    conical_poly_k2s2_consistent(q, p, 0, 0, 0, 0, 0, prm, out);
+    for (i = 0; i < conical_poly_k2s2_NU; i++) {
+      double piv = out[2 * conical_poly_k2s2_M + i], dia = out[2 * conical_poly_k2s2_M + conical_poly_k2s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) rc = conical_poly_k2s2_ESINGULAR;
+    }
+    if (rc == conical_poly_k2s2_ESINGULAR) break;
+    for (i = 0; i < 2 * conical_poly_k2s2_M + 2 * conical_poly_k2s2_NU; i++)
+      if (!isfinite(out[i])) rc = conical_poly_k2s2_ENONFINITE;
+    if (rc == conical_poly_k2s2_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < conical_poly_k2s2_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= conical_poly_k2s2_TOL) { rc = conical_poly_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * conical_poly_k2s2_TOL ? conical_poly_k2s2_OK : conical_poly_k2s2_ENOCONV; break; }
+    for (i = 0; i < conical_poly_k2s2_M; i++) q[i] += out[i];
+  }
+  if (rc != conical_poly_k2s2_OK) return rc;
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
+    p[i] += out[conical_poly_k2s2_M + i];
+    if (!isfinite(p[i])) return conical_poly_k2s2_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  x->H0 = 0;
+  {
+    double lam[conical_poly_k2s2_NU];
+    conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return conical_poly_k2s2_OK;
 }

@@ -36,20 +36,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  conical_poly_k2s2_real increment; /* last scaled increment of the iteration */
 } conical_poly_k2s2_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and after each step is the multiplier consistent with the new (q, p), of order 2s. */
-void conical_poly_k2s2_init(conical_poly_k2s2_state *x, const double *q0, const double *p0);
+void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_poly_k2s2_real *q0, const conical_poly_k2s2_real *p0, const conical_poly_k2s2_params *prm);
+void conical_poly_k2s2_init(conical_poly_k2s2_state *x, const conical_poly_k2s2_real *q0, const conical_poly_k2s2_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns conical_poly_k2s2_OK, or conical_poly_k2s2_ENOCONV, conical_poly_k2s2_ESINGULAR, conical_poly_k2s2_ENONFINITE with x unchanged. */
+int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *dq, conical_poly_k2s2_real *dp);
 void conical_poly_k2s2_params_default(conical_poly_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_poly_k2s2_OK or an error code. */
-int conical_poly_k2s2_step(conical_poly_k2s2_state *x, double h, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
+int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
 const char *conical_poly_k2s2_strerror(int code);
-double conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
-void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *g);   /* conical_poly_k2s2_NU values */
-void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+conical_poly_k2s2_real conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
+void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *g);   /* conical_poly_k2s2_NU values */
+void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -396,29 +396,131 @@ static void double_pendulum_const_k2s2_lambda0(const double *q0, const double *p
   out[1] = t41;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void double_pendulum_const_k2s2_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
+  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
+  const double t2 = 2.0 * q0[1] /* y1 */;
+  const double t3 = 2.0 * q0[0] /* x1 */;
+  const double t4 = 2.0 * t1;
+  const double t5 = 2.0 * t0;
+  const double t6 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t7 = q0[1] /* y1 */ * q0[1] /* y1 */;
+  const double t8 = t6 + t7;
+  const double t9 = t8 - 1.0;
+  const double t10 = t0 * t0;
+  const double t11 = t1 * t1;
+  const double t12 = t10 + t11;
+  const double t13 = t12 - 1.0;
+  const double t14 = t3 * p0[0] /* p_x1 */;
+  const double t15 = t2 * p0[1] /* p_y1 */;
+  const double t16 = t14 + t15;
+  const double t17 = t5 * p0[0] /* p_x1 */;
+  const double t18 = -t17;
+  const double t19 = t4 * p0[1] /* p_y1 */;
+  const double t20 = t18 - t19;
+  const double t21 = t5 * p0[2] /* p_x2 */;
+  const double t22 = t20 + t21;
+  const double t23 = t4 * p0[3] /* p_y2 */;
+  const double t24 = t22 + t23;
+  const double t25 = t3 * t3;
+  const double t26 = t3 * t5;
+  const double t27 = -t26;
+  const double t28 = t2 * t2;
+  const double t29 = t25 + t28;
+  const double t30 = t2 * t4;
+  const double t31 = t27 - t30;
+  const double t32 = t5 * t5;
+  const double t33 = t4 * t4;
+  const double t34 = t32 + t33;
+  const double t35 = t32 + t34;
+  const double t36 = t33 + t35;
+  const double t37 = t31 / t29;
+  const double t38 = t31 * t37;
+  const double t39 = t36 - t38;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t40 = t9 * t37;
+  const double t41 = t13 - t40;
+  const double t42 = t41 / t39;
+  const double t43 = t31 * t42;
+  const double t44 = t9 - t43;
+  const double t45 = t44 / t29;
+  const double t46 = t3 * t45;
+  const double t47 = t5 * t42;
+  const double t48 = -t47;
+  const double t49 = t46 - t47;
+  const double t50 = t2 * t45;
+  const double t51 = t4 * t42;
+  const double t52 = -t51;
+  const double t53 = t50 - t51;
+  const double t54 = -t49;
+  const double t55 = -t53;
+  const double t56 = t16 * t37;
+  const double t57 = t24 - t56;
+  const double t58 = t57 / t39;
+  const double t59 = t31 * t58;
+  const double t60 = t16 - t59;
+  const double t61 = t60 / t29;
+  const double t62 = t3 * t61;
+  const double t63 = t5 * t58;
+  const double t64 = -t63;
+  const double t65 = t63 - t62;
+  const double t66 = t2 * t61;
+  const double t67 = t4 * t58;
+  const double t68 = -t67;
+  const double t69 = t67 - t66;
+  /* dq */
+  out[0] = t54;
+  out[1] = t55;
+  out[2] = t48;
+  out[3] = t52;
+  /* dp */
+  out[4] = t65;
+  out[5] = t69;
+  out[6] = t64;
+  out[7] = t68;
+  /* pivot */
+  out[8] = t29;
+  out[9] = t39;
+  /* adiag */
+  out[10] = t29;
+  out[11] = t36;
+}
+
 void double_pendulum_const_k2s2_params_default(double_pendulum_const_k2s2_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void double_pendulum_const_k2s2_init(double_pendulum_const_k2s2_state *x, const double *q0, const double *p0)
+#define double_pendulum_const_k2s2_DEFAULT_PARAMS(prm) double_pendulum_const_k2s2_params dflt_; if (!prm) { double_pendulum_const_k2s2_params_default(&dflt_); prm = &dflt_; }
+
+void double_pendulum_const_k2s2_init_params(double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_real *q0, const double_pendulum_const_k2s2_real *p0, const double_pendulum_const_k2s2_params *prm)
 {
   int i;
+  double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : double_pendulum_const_k2s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : double_pendulum_const_k2s2_p0[i];
+    x->q[i] = q0 ? q0[i] : double_pendulum_const_k2s2_q0[i];
+    x->p[i] = p0 ? p0[i] : double_pendulum_const_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_const_k2s2_NU ? double_pendulum_const_k2s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = 0;
   {
-    double_pendulum_const_k2s2_params prm;
     double lam[double_pendulum_const_k2s2_NU];
-    double_pendulum_const_k2s2_params_default(&prm);
-    double_pendulum_const_k2s2_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    double_pendulum_const_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
     for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void double_pendulum_const_k2s2_init(double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_real *q0, const double_pendulum_const_k2s2_real *p0)
+{
+  double_pendulum_const_k2s2_init_params(x, q0, p0, 0);
 }
 
 const char *double_pendulum_const_k2s2_strerror(int code)
@@ -433,9 +535,7 @@ const char *double_pendulum_const_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define double_pendulum_const_k2s2_DEFAULT_PARAMS(prm) double_pendulum_const_k2s2_params dflt_; if (!prm) { double_pendulum_const_k2s2_params_default(&dflt_); prm = &dflt_; }
-
-double double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm)
+double_pendulum_const_k2s2_real double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm)
 {
   double H;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
@@ -443,22 +543,16 @@ double double_pendulum_const_k2s2_energy(const double_pendulum_const_k2s2_state 
   return H;
 }
 
-void double_pendulum_const_k2s2_constraints(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double *g)
+void double_pendulum_const_k2s2_constraints(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_real *g)
 {
-  double v[double_pendulum_const_k2s2_NU];
-  int i;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
-  double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) g[i] = v[i];
+  double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double *gp)
+void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_real *gp)
 {
-  double v[double_pendulum_const_k2s2_NU];
-  int i;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
-  double_pendulum_const_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) gp[i] = v[i];
+  double_pendulum_const_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -490,7 +584,7 @@ static void double_pendulum_const_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double h_, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
+int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h_, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
@@ -561,5 +655,64 @@ int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double 
   for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return double_pendulum_const_k2s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (double_pendulum_const_k2s2_TOL) or stops decreasing at round-off, at most double_pendulum_const_k2s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int double_pendulum_const_k2s2_project(double_pendulum_const_k2s2_state *x, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_real *dq, double_pendulum_const_k2s2_real *dp)
+{
+  double q[double_pendulum_const_k2s2_M], p[double_pendulum_const_k2s2_M], out[2 * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = double_pendulum_const_k2s2_ENOCONV;
+  double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= double_pendulum_const_k2s2_MAXITER; it++) {
+    double_pendulum_const_k2s2_consistent(q, p, 0, 0, 0, prm, out);
+    for (i = 0; i < double_pendulum_const_k2s2_NU; i++) {
+      double piv = out[2 * double_pendulum_const_k2s2_M + i], dia = out[2 * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_const_k2s2_SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
+    }
+    if (rc == double_pendulum_const_k2s2_ESINGULAR) break;
+    for (i = 0; i < 2 * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU; i++)
+      if (!isfinite(out[i])) rc = double_pendulum_const_k2s2_ENONFINITE;
+    if (rc == double_pendulum_const_k2s2_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= double_pendulum_const_k2s2_TOL) { rc = double_pendulum_const_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * double_pendulum_const_k2s2_TOL ? double_pendulum_const_k2s2_OK : double_pendulum_const_k2s2_ENOCONV; break; }
+    for (i = 0; i < double_pendulum_const_k2s2_M; i++) q[i] += out[i];
+  }
+  if (rc != double_pendulum_const_k2s2_OK) return rc;
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
+    p[i] += out[double_pendulum_const_k2s2_M + i];
+    if (!isfinite(p[i])) return double_pendulum_const_k2s2_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  {
+    double lam[double_pendulum_const_k2s2_NU];
+    double_pendulum_const_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
+    for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return double_pendulum_const_k2s2_OK;
 }

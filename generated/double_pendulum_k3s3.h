@@ -36,20 +36,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  double_pendulum_k3s3_real increment; /* last scaled increment of the iteration */
 } double_pendulum_k3s3_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and after each step is the multiplier consistent with the new (q, p), of order 2s. */
-void double_pendulum_k3s3_init(double_pendulum_k3s3_state *x, const double *q0, const double *p0);
+void double_pendulum_k3s3_init_params(double_pendulum_k3s3_state *x, const double_pendulum_k3s3_real *q0, const double_pendulum_k3s3_real *p0, const double_pendulum_k3s3_params *prm);
+void double_pendulum_k3s3_init(double_pendulum_k3s3_state *x, const double_pendulum_k3s3_real *q0, const double_pendulum_k3s3_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns double_pendulum_k3s3_OK, or double_pendulum_k3s3_ENOCONV, double_pendulum_k3s3_ESINGULAR, double_pendulum_k3s3_ENONFINITE with x unchanged. */
+int double_pendulum_k3s3_project(double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *dq, double_pendulum_k3s3_real *dp);
 void double_pendulum_k3s3_params_default(double_pendulum_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns double_pendulum_k3s3_OK or an error code. */
-int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double h, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
+int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
 const char *double_pendulum_k3s3_strerror(int code);
-double double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm);
-void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *g);   /* double_pendulum_k3s3_NU values */
-void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+double_pendulum_k3s3_real double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm);
+void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *g);   /* double_pendulum_k3s3_NU values */
+void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -3720,7 +3720,7 @@ static void double_pendulum_k4s4_lambda0(const double *q0, const double *p0, con
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
  * and diagonal (NU) of G1' M^-1 G1. */
-static void double_pendulum_k4s4_project(const double *q0, const double *p0, const double *gam, double h,
+static void double_pendulum_k4s4_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
@@ -3767,15 +3767,15 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
   const double t39 = t5 * t34;
   const double t40 = -t39;
   const double t41 = t39 - t38;
-  const double t42 = p0[0] /* p_x1 */ + t41;
-  const double t43 = t2 * t37;
-  const double t44 = t4 * t34;
-  const double t45 = -t44;
-  const double t46 = t44 - t43;
-  const double t47 = p0[1] /* p_y1 */ + t46;
+  const double t42 = t2 * t37;
+  const double t43 = t4 * t34;
+  const double t44 = -t43;
+  const double t45 = t43 - t42;
+  const double t46 = p0[0] /* p_x1 */ + t41;
+  const double t47 = p0[1] /* p_y1 */ + t45;
   const double t48 = p0[2] /* p_x2 */ - t39;
-  const double t49 = p0[3] /* p_y2 */ - t44;
-  const double t50 = t42 * t42;
+  const double t49 = p0[3] /* p_y2 */ - t43;
+  const double t50 = t46 * t46;
   const double t51 = t47 * t47;
   const double t52 = t50 + t51;
   const double t53 = t48 * t48;
@@ -3786,9 +3786,9 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
   const double t58 = q0[1] /* y1 */ + q0[3] /* y2 */;
   /* dp */
   out[0] = t41;
-  out[1] = t46;
+  out[1] = t45;
   out[2] = t40;
-  out[3] = t45;
+  out[3] = t44;
   /* kin */
   out[4] = t57;
   /* U */
@@ -3801,30 +3801,132 @@ static void double_pendulum_k4s4_project(const double *q0, const double *p0, con
   out[9] = t17;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void double_pendulum_k4s4_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
+  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
+  const double t2 = 2.0 * q0[1] /* y1 */;
+  const double t3 = 2.0 * q0[0] /* x1 */;
+  const double t4 = 2.0 * t1;
+  const double t5 = 2.0 * t0;
+  const double t6 = t3 * t3;
+  const double t7 = t3 * t5;
+  const double t8 = -t7;
+  const double t9 = t2 * t2;
+  const double t10 = t6 + t9;
+  const double t11 = t2 * t4;
+  const double t12 = t8 - t11;
+  const double t13 = t5 * t5;
+  const double t14 = t4 * t4;
+  const double t15 = t13 + t14;
+  const double t16 = t13 + t15;
+  const double t17 = t14 + t16;
+  const double t18 = t3 * p0[0] /* p_x1 */;
+  const double t19 = t2 * p0[1] /* p_y1 */;
+  const double t20 = t18 + t19;
+  const double t21 = t5 * p0[0] /* p_x1 */;
+  const double t22 = -t21;
+  const double t23 = t4 * p0[1] /* p_y1 */;
+  const double t24 = t22 - t23;
+  const double t25 = t5 * p0[2] /* p_x2 */;
+  const double t26 = t24 + t25;
+  const double t27 = t4 * p0[3] /* p_y2 */;
+  const double t28 = t26 + t27;
+  const double t29 = t12 / t10;
+  const double t30 = t12 * t29;
+  const double t31 = t17 - t30;
+  const double t32 = t20 * t29;
+  const double t33 = t28 - t32;
+  const double t34 = t33 / t31;
+  const double t35 = t12 * t34;
+  const double t36 = t20 - t35;
+  const double t37 = t36 / t10;
+  const double t38 = t3 * t37;
+  const double t39 = t5 * t34;
+  const double t40 = -t39;
+  const double t41 = t39 - t38;
+  const double t42 = t2 * t37;
+  const double t43 = t4 * t34;
+  const double t44 = -t43;
+  const double t45 = t43 - t42;
+  const double t46 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t47 = q0[1] /* y1 */ * q0[1] /* y1 */;
+  const double t48 = t46 + t47;
+  const double t49 = t48 - 1.0;
+  const double t50 = t0 * t0;
+  const double t51 = t1 * t1;
+  const double t52 = t50 + t51;
+  const double t53 = t52 - 1.0;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t54 = t29 * t49;
+  const double t55 = t53 - t54;
+  const double t56 = t55 / t31;
+  const double t57 = t12 * t56;
+  const double t58 = t49 - t57;
+  const double t59 = t58 / t10;
+  const double t60 = t3 * t59;
+  const double t61 = t5 * t56;
+  const double t62 = -t61;
+  const double t63 = t60 - t61;
+  const double t64 = t2 * t59;
+  const double t65 = t4 * t56;
+  const double t66 = -t65;
+  const double t67 = t64 - t65;
+  const double t68 = -t63;
+  const double t69 = -t67;
+  /* dq */
+  out[0] = t68;
+  out[1] = t69;
+  out[2] = t62;
+  out[3] = t66;
+  /* dp */
+  out[4] = t41;
+  out[5] = t45;
+  out[6] = t40;
+  out[7] = t44;
+  /* pivot */
+  out[8] = t10;
+  out[9] = t31;
+  /* adiag */
+  out[10] = t10;
+  out[11] = t17;
+}
+
 void double_pendulum_k4s4_params_default(double_pendulum_k4s4_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void double_pendulum_k4s4_init(double_pendulum_k4s4_state *x, const double *q0, const double *p0)
+#define double_pendulum_k4s4_DEFAULT_PARAMS(prm) double_pendulum_k4s4_params dflt_; if (!prm) { double_pendulum_k4s4_params_default(&dflt_); prm = &dflt_; }
+
+void double_pendulum_k4s4_init_params(double_pendulum_k4s4_state *x, const double_pendulum_k4s4_real *q0, const double_pendulum_k4s4_real *p0, const double_pendulum_k4s4_params *prm)
 {
   int i;
+  double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < double_pendulum_k4s4_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : double_pendulum_k4s4_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : double_pendulum_k4s4_p0[i];
+    x->q[i] = q0 ? q0[i] : double_pendulum_k4s4_q0[i];
+    x->p[i] = p0 ? p0[i] : double_pendulum_k4s4_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k4s4_NU ? double_pendulum_k4s4_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
-    double_pendulum_k4s4_params prm;
     double lam[double_pendulum_k4s4_NU];
-    double_pendulum_k4s4_params_default(&prm);
-    double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
+    double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
     for (i = 0; i < double_pendulum_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void double_pendulum_k4s4_init(double_pendulum_k4s4_state *x, const double_pendulum_k4s4_real *q0, const double_pendulum_k4s4_real *p0)
+{
+  double_pendulum_k4s4_init_params(x, q0, p0, 0);
 }
 
 const char *double_pendulum_k4s4_strerror(int code)
@@ -3839,9 +3941,7 @@ const char *double_pendulum_k4s4_strerror(int code)
   return "unknown error";
 }
 
-#define double_pendulum_k4s4_DEFAULT_PARAMS(prm) double_pendulum_k4s4_params dflt_; if (!prm) { double_pendulum_k4s4_params_default(&dflt_); prm = &dflt_; }
-
-double double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm)
+double_pendulum_k4s4_real double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm)
 {
   double H;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
@@ -3849,22 +3949,16 @@ double double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const do
   return H;
 }
 
-void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *g)
+void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_real *g)
 {
-  double v[double_pendulum_k4s4_NU];
-  int i;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
-  double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_k4s4_NU; i++) g[i] = v[i];
+  double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double *gp)
+void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_real *gp)
 {
-  double v[double_pendulum_k4s4_NU];
-  int i;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
-  double_pendulum_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < double_pendulum_k4s4_NU; i++) gp[i] = v[i];
+  double_pendulum_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -3896,7 +3990,7 @@ static void double_pendulum_k4s4_add(double *a, double *c, double b)
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double h_, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
+int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
@@ -3972,7 +4066,7 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double h_, const do
     double_pendulum_k4s4_add(&p1[i], &pc1[i], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
-  double_pendulum_k4s4_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
+  double_pendulum_k4s4_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_k4s4_NU; i++) {
     double piv = pr[double_pendulum_k4s4_M + 2 + i], dia = pr[double_pendulum_k4s4_M + 2 + double_pendulum_k4s4_NU + i];
     if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k4s4_SINGTOL * fabs(dia))) return double_pendulum_k4s4_ESINGULAR;
@@ -4000,11 +4094,71 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double h_, const do
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[double_pendulum_k4s4_NU];
-    double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < double_pendulum_k4s4_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    double lam[double_pendulum_k4s4_NU];
+    double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < double_pendulum_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   double_pendulum_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return double_pendulum_k4s4_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (double_pendulum_k4s4_TOL) or stops decreasing at round-off, at most double_pendulum_k4s4_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int double_pendulum_k4s4_project(double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_real *dq, double_pendulum_k4s4_real *dp)
+{
+  double q[double_pendulum_k4s4_M], p[double_pendulum_k4s4_M], out[2 * double_pendulum_k4s4_M + 2 * double_pendulum_k4s4_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = double_pendulum_k4s4_ENOCONV;
+  double_pendulum_k4s4_DEFAULT_PARAMS(prm)
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= double_pendulum_k4s4_MAXITER; it++) {
+    double_pendulum_k4s4_consistent(q, p, 0, 0, 0, 0, 0, prm, out);
+    for (i = 0; i < double_pendulum_k4s4_NU; i++) {
+      double piv = out[2 * double_pendulum_k4s4_M + i], dia = out[2 * double_pendulum_k4s4_M + double_pendulum_k4s4_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k4s4_SINGTOL * fabs(dia))) rc = double_pendulum_k4s4_ESINGULAR;
+    }
+    if (rc == double_pendulum_k4s4_ESINGULAR) break;
+    for (i = 0; i < 2 * double_pendulum_k4s4_M + 2 * double_pendulum_k4s4_NU; i++)
+      if (!isfinite(out[i])) rc = double_pendulum_k4s4_ENONFINITE;
+    if (rc == double_pendulum_k4s4_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < double_pendulum_k4s4_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= double_pendulum_k4s4_TOL) { rc = double_pendulum_k4s4_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * double_pendulum_k4s4_TOL ? double_pendulum_k4s4_OK : double_pendulum_k4s4_ENOCONV; break; }
+    for (i = 0; i < double_pendulum_k4s4_M; i++) q[i] += out[i];
+  }
+  if (rc != double_pendulum_k4s4_OK) return rc;
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
+    p[i] += out[double_pendulum_k4s4_M + i];
+    if (!isfinite(p[i])) return double_pendulum_k4s4_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  x->H0 = 0;
+  {
+    double lam[double_pendulum_k4s4_NU];
+    double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < double_pendulum_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return double_pendulum_k4s4_OK;
 }

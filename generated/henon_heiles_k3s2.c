@@ -192,17 +192,25 @@ void henon_heiles_k3s2_params_default(henon_heiles_k3s2_params *prm)
   prm->unused_ = 0;
 }
 
-void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const double *q0, const double *p0)
+#define henon_heiles_k3s2_DEFAULT_PARAMS(prm) henon_heiles_k3s2_params dflt_; if (!prm) { henon_heiles_k3s2_params_default(&dflt_); prm = &dflt_; }
+
+void henon_heiles_k3s2_init_params(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0, const henon_heiles_k3s2_params *prm)
 {
   int i;
+  henon_heiles_k3s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < henon_heiles_k3s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : henon_heiles_k3s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : henon_heiles_k3s2_p0[i];
+    x->q[i] = q0 ? q0[i] : henon_heiles_k3s2_q0[i];
+    x->p[i] = p0 ? p0[i] : henon_heiles_k3s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (henon_heiles_k3s2_NU ? henon_heiles_k3s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = 0;
+}
+
+void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0)
+{
+  henon_heiles_k3s2_init_params(x, q0, p0, 0);
 }
 
 const char *henon_heiles_k3s2_strerror(int code)
@@ -217,9 +225,7 @@ const char *henon_heiles_k3s2_strerror(int code)
   return "unknown error";
 }
 
-#define henon_heiles_k3s2_DEFAULT_PARAMS(prm) henon_heiles_k3s2_params dflt_; if (!prm) { henon_heiles_k3s2_params_default(&dflt_); prm = &dflt_; }
-
-double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm)
+henon_heiles_k3s2_real henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm)
 {
   double H;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
@@ -227,12 +233,12 @@ double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_he
   return H;
 }
 
-void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *g)
+void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *gp)
+void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -266,7 +272,7 @@ static void henon_heiles_k3s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, double h_, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
+int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
   double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
@@ -326,5 +332,17 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, double h_, const henon_he
   for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = gam[i];
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return henon_heiles_k3s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (henon_heiles_k3s2_TOL) or stops decreasing at round-off, at most henon_heiles_k3s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int henon_heiles_k3s2_project(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *dq, henon_heiles_k3s2_real *dp)
+{
+  (void)x;
+  (void)prm;
+  if (dq) *dq = 0;
+  if (dp) *dp = 0;
   return henon_heiles_k3s2_OK;
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  henon_heiles_k3s2_real increment; /* last scaled increment of the iteration */
 } henon_heiles_k3s2_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const double *q0, const double *p0);
+void henon_heiles_k3s2_init_params(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0, const henon_heiles_k3s2_params *prm);
+void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns henon_heiles_k3s2_OK, or henon_heiles_k3s2_ENOCONV, henon_heiles_k3s2_ESINGULAR, henon_heiles_k3s2_ENONFINITE with x unchanged. */
+int henon_heiles_k3s2_project(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *dq, henon_heiles_k3s2_real *dp);
 void henon_heiles_k3s2_params_default(henon_heiles_k3s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns henon_heiles_k3s2_OK or an error code. */
-int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, double h, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st);
+int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st);
 const char *henon_heiles_k3s2_strerror(int code);
-double henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm);
-void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *g);   /* henon_heiles_k3s2_NU values */
-void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, double *gp);       /* grad g' M^-1 p */
+henon_heiles_k3s2_real henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm);
+void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *g);   /* henon_heiles_k3s2_NU values */
+void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -609,17 +609,25 @@ void kepler_k16s2_params_default(kepler_k16s2_params *prm)
   prm->unused_ = 0;
 }
 
-void kepler_k16s2_init(kepler_k16s2_state *x, const double *q0, const double *p0)
+#define kepler_k16s2_DEFAULT_PARAMS(prm) kepler_k16s2_params dflt_; if (!prm) { kepler_k16s2_params_default(&dflt_); prm = &dflt_; }
+
+void kepler_k16s2_init_params(kepler_k16s2_state *x, const kepler_k16s2_real *q0, const kepler_k16s2_real *p0, const kepler_k16s2_params *prm)
 {
   int i;
+  kepler_k16s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < kepler_k16s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : kepler_k16s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : kepler_k16s2_p0[i];
+    x->q[i] = q0 ? q0[i] : kepler_k16s2_q0[i];
+    x->p[i] = p0 ? p0[i] : kepler_k16s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k16s2_NU ? kepler_k16s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) x->gam[i] = 0;
+}
+
+void kepler_k16s2_init(kepler_k16s2_state *x, const kepler_k16s2_real *q0, const kepler_k16s2_real *p0)
+{
+  kepler_k16s2_init_params(x, q0, p0, 0);
 }
 
 const char *kepler_k16s2_strerror(int code)
@@ -634,9 +642,7 @@ const char *kepler_k16s2_strerror(int code)
   return "unknown error";
 }
 
-#define kepler_k16s2_DEFAULT_PARAMS(prm) kepler_k16s2_params dflt_; if (!prm) { kepler_k16s2_params_default(&dflt_); prm = &dflt_; }
-
-double kepler_k16s2_energy(const kepler_k16s2_state *x, const kepler_k16s2_params *prm)
+kepler_k16s2_real kepler_k16s2_energy(const kepler_k16s2_state *x, const kepler_k16s2_params *prm)
 {
   double H;
   kepler_k16s2_DEFAULT_PARAMS(prm)
@@ -644,12 +650,12 @@ double kepler_k16s2_energy(const kepler_k16s2_state *x, const kepler_k16s2_param
   return H;
 }
 
-void kepler_k16s2_constraints(const kepler_k16s2_state *x, const kepler_k16s2_params *prm, double *g)
+void kepler_k16s2_constraints(const kepler_k16s2_state *x, const kepler_k16s2_params *prm, kepler_k16s2_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void kepler_k16s2_hidden(const kepler_k16s2_state *x, const kepler_k16s2_params *prm, double *gp)
+void kepler_k16s2_hidden(const kepler_k16s2_state *x, const kepler_k16s2_params *prm, kepler_k16s2_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -683,7 +689,7 @@ static void kepler_k16s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(16,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k16s2_step(kepler_k16s2_state *x, double h_, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
+int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h_, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k16s2_S * kepler_k16s2_M], sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + 3 * kepler_k16s2_NU + 1];
@@ -743,5 +749,17 @@ int kepler_k16s2_step(kepler_k16s2_state *x, double h_, const kepler_k16s2_param
   for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) x->gam[i] = gam[i];
   kepler_k16s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return kepler_k16s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (kepler_k16s2_TOL) or stops decreasing at round-off, at most kepler_k16s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int kepler_k16s2_project(kepler_k16s2_state *x, const kepler_k16s2_params *prm, kepler_k16s2_real *dq, kepler_k16s2_real *dp)
+{
+  (void)x;
+  (void)prm;
+  if (dq) *dq = 0;
+  if (dp) *dp = 0;
   return kepler_k16s2_OK;
 }

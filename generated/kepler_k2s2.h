@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  kepler_k2s2_real increment; /* last scaled increment of the iteration */
 } kepler_k2s2_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void kepler_k2s2_init(kepler_k2s2_state *x, const double *q0, const double *p0);
+void kepler_k2s2_init_params(kepler_k2s2_state *x, const kepler_k2s2_real *q0, const kepler_k2s2_real *p0, const kepler_k2s2_params *prm);
+void kepler_k2s2_init(kepler_k2s2_state *x, const kepler_k2s2_real *q0, const kepler_k2s2_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns kepler_k2s2_OK, or kepler_k2s2_ENOCONV, kepler_k2s2_ESINGULAR, kepler_k2s2_ENONFINITE with x unchanged. */
+int kepler_k2s2_project(kepler_k2s2_state *x, const kepler_k2s2_params *prm, kepler_k2s2_real *dq, kepler_k2s2_real *dp);
 void kepler_k2s2_params_default(kepler_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns kepler_k2s2_OK or an error code. */
-int kepler_k2s2_step(kepler_k2s2_state *x, double h, const kepler_k2s2_params *prm, kepler_k2s2_stats *st);
+int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h, const kepler_k2s2_params *prm, kepler_k2s2_stats *st);
 const char *kepler_k2s2_strerror(int code);
-double kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *prm);
-void kepler_k2s2_constraints(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *g);   /* kepler_k2s2_NU values */
-void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+kepler_k2s2_real kepler_k2s2_energy(const kepler_k2s2_state *x, const kepler_k2s2_params *prm);
+void kepler_k2s2_constraints(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, kepler_k2s2_real *g);   /* kepler_k2s2_NU values */
+void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *prm, kepler_k2s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

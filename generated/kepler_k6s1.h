@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  kepler_k6s1_real increment; /* last scaled increment of the iteration */
 } kepler_k6s1_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void kepler_k6s1_init(kepler_k6s1_state *x, const double *q0, const double *p0);
+void kepler_k6s1_init_params(kepler_k6s1_state *x, const kepler_k6s1_real *q0, const kepler_k6s1_real *p0, const kepler_k6s1_params *prm);
+void kepler_k6s1_init(kepler_k6s1_state *x, const kepler_k6s1_real *q0, const kepler_k6s1_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns kepler_k6s1_OK, or kepler_k6s1_ENOCONV, kepler_k6s1_ESINGULAR, kepler_k6s1_ENONFINITE with x unchanged. */
+int kepler_k6s1_project(kepler_k6s1_state *x, const kepler_k6s1_params *prm, kepler_k6s1_real *dq, kepler_k6s1_real *dp);
 void kepler_k6s1_params_default(kepler_k6s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns kepler_k6s1_OK or an error code. */
-int kepler_k6s1_step(kepler_k6s1_state *x, double h, const kepler_k6s1_params *prm, kepler_k6s1_stats *st);
+int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h, const kepler_k6s1_params *prm, kepler_k6s1_stats *st);
 const char *kepler_k6s1_strerror(int code);
-double kepler_k6s1_energy(const kepler_k6s1_state *x, const kepler_k6s1_params *prm);
-void kepler_k6s1_constraints(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *g);   /* kepler_k6s1_NU values */
-void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, double *gp);       /* grad g' M^-1 p */
+kepler_k6s1_real kepler_k6s1_energy(const kepler_k6s1_state *x, const kepler_k6s1_params *prm);
+void kepler_k6s1_constraints(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, kepler_k6s1_real *g);   /* kepler_k6s1_NU values */
+void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *prm, kepler_k6s1_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

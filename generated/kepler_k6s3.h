@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  kepler_k6s3_real increment; /* last scaled increment of the iteration */
 } kepler_k6s3_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void kepler_k6s3_init(kepler_k6s3_state *x, const double *q0, const double *p0);
+void kepler_k6s3_init_params(kepler_k6s3_state *x, const kepler_k6s3_real *q0, const kepler_k6s3_real *p0, const kepler_k6s3_params *prm);
+void kepler_k6s3_init(kepler_k6s3_state *x, const kepler_k6s3_real *q0, const kepler_k6s3_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns kepler_k6s3_OK, or kepler_k6s3_ENOCONV, kepler_k6s3_ESINGULAR, kepler_k6s3_ENONFINITE with x unchanged. */
+int kepler_k6s3_project(kepler_k6s3_state *x, const kepler_k6s3_params *prm, kepler_k6s3_real *dq, kepler_k6s3_real *dp);
 void kepler_k6s3_params_default(kepler_k6s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns kepler_k6s3_OK or an error code. */
-int kepler_k6s3_step(kepler_k6s3_state *x, double h, const kepler_k6s3_params *prm, kepler_k6s3_stats *st);
+int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h, const kepler_k6s3_params *prm, kepler_k6s3_stats *st);
 const char *kepler_k6s3_strerror(int code);
-double kepler_k6s3_energy(const kepler_k6s3_state *x, const kepler_k6s3_params *prm);
-void kepler_k6s3_constraints(const kepler_k6s3_state *x, const kepler_k6s3_params *prm, double *g);   /* kepler_k6s3_NU values */
-void kepler_k6s3_hidden(const kepler_k6s3_state *x, const kepler_k6s3_params *prm, double *gp);       /* grad g' M^-1 p */
+kepler_k6s3_real kepler_k6s3_energy(const kepler_k6s3_state *x, const kepler_k6s3_params *prm);
+void kepler_k6s3_constraints(const kepler_k6s3_state *x, const kepler_k6s3_params *prm, kepler_k6s3_real *g);   /* kepler_k6s3_NU values */
+void kepler_k6s3_hidden(const kepler_k6s3_state *x, const kepler_k6s3_params *prm, kepler_k6s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

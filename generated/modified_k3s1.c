@@ -266,29 +266,92 @@ static void modified_k3s1_lambda0(const double *q0, const double *p0, const doub
   out[0] = t28;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void modified_k3s1_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const modified_k3s1_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t2 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
+  const double t3 = t1 + t2;
+  const double t4 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
+  const double t5 = t3 + t4;
+  const double t6 = t5 - 0.625;
+  const double t7 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
+  const double t8 = 4.0 * t7;
+  const double t9 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
+  const double t10 = 6.0 * t9;
+  const double t11 = p0[0] /* p_q[1] */ * t10;
+  const double t12 = p0[1] /* p_q[2] */ * t8;
+  const double t13 = t11 + t12;
+  const double t14 = t0 * p0[2] /* p_q[3] */;
+  const double t15 = t13 + t14;
+  const double t16 = t10 * t10;
+  const double t17 = t8 * t8;
+  const double t18 = t16 + t17;
+  const double t19 = t0 * t0;
+  const double t20 = t18 + t19;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t21 = t6 / t20;
+  const double t22 = t10 * t21;
+  const double t23 = t8 * t21;
+  const double t24 = t0 * t21;
+  const double t25 = -t22;
+  const double t26 = -t23;
+  const double t27 = -t24;
+  const double t28 = t15 / t20;
+  const double t29 = t10 * t28;
+  const double t30 = -t29;
+  const double t31 = t8 * t28;
+  const double t32 = -t31;
+  const double t33 = t0 * t28;
+  const double t34 = -t33;
+  /* dq */
+  out[0] = t25;
+  out[1] = t26;
+  out[2] = t27;
+  /* dp */
+  out[3] = t30;
+  out[4] = t32;
+  out[5] = t34;
+  /* pivot */
+  out[6] = t20;
+  /* adiag */
+  out[7] = t20;
+}
+
 void modified_k3s1_params_default(modified_k3s1_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void modified_k3s1_init(modified_k3s1_state *x, const double *q0, const double *p0)
+#define modified_k3s1_DEFAULT_PARAMS(prm) modified_k3s1_params dflt_; if (!prm) { modified_k3s1_params_default(&dflt_); prm = &dflt_; }
+
+void modified_k3s1_init_params(modified_k3s1_state *x, const modified_k3s1_real *q0, const modified_k3s1_real *p0, const modified_k3s1_params *prm)
 {
   int i;
+  modified_k3s1_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < modified_k3s1_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : modified_k3s1_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : modified_k3s1_p0[i];
+    x->q[i] = q0 ? q0[i] : modified_k3s1_q0[i];
+    x->p[i] = p0 ? p0[i] : modified_k3s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k3s1_NU ? modified_k3s1_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
   {
-    modified_k3s1_params prm;
     double lam[modified_k3s1_NU];
-    modified_k3s1_params_default(&prm);
-    modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
     for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void modified_k3s1_init(modified_k3s1_state *x, const modified_k3s1_real *q0, const modified_k3s1_real *p0)
+{
+  modified_k3s1_init_params(x, q0, p0, 0);
 }
 
 const char *modified_k3s1_strerror(int code)
@@ -303,9 +366,7 @@ const char *modified_k3s1_strerror(int code)
   return "unknown error";
 }
 
-#define modified_k3s1_DEFAULT_PARAMS(prm) modified_k3s1_params dflt_; if (!prm) { modified_k3s1_params_default(&dflt_); prm = &dflt_; }
-
-double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm)
+modified_k3s1_real modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm)
 {
   double H;
   modified_k3s1_DEFAULT_PARAMS(prm)
@@ -313,22 +374,16 @@ double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_pa
   return H;
 }
 
-void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *g)
+void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *g)
 {
-  double v[modified_k3s1_NU];
-  int i;
   modified_k3s1_DEFAULT_PARAMS(prm)
-  modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_k3s1_NU; i++) g[i] = v[i];
+  modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *gp)
+void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *gp)
 {
-  double v[modified_k3s1_NU];
-  int i;
   modified_k3s1_DEFAULT_PARAMS(prm)
-  modified_k3s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_k3s1_NU; i++) gp[i] = v[i];
+  modified_k3s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -360,7 +415,7 @@ static void modified_k3s1_add(double *a, double *c, double b)
 
 /* One step of HBVM(3,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_params *prm, modified_k3s1_stats *st)
+int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
@@ -431,5 +486,64 @@ int modified_k3s1_step(modified_k3s1_state *x, double h_, const modified_k3s1_pa
   for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return modified_k3s1_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (modified_k3s1_TOL) or stops decreasing at round-off, at most modified_k3s1_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *dq, modified_k3s1_real *dp)
+{
+  double q[modified_k3s1_M], p[modified_k3s1_M], out[2 * modified_k3s1_M + 2 * modified_k3s1_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = modified_k3s1_ENOCONV;
+  modified_k3s1_DEFAULT_PARAMS(prm)
+  for (i = 0; i < modified_k3s1_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= modified_k3s1_MAXITER; it++) {
+    modified_k3s1_consistent(q, p, 0, 0, 0, prm, out);
+    for (i = 0; i < modified_k3s1_NU; i++) {
+      double piv = out[2 * modified_k3s1_M + i], dia = out[2 * modified_k3s1_M + modified_k3s1_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k3s1_SINGTOL * fabs(dia))) rc = modified_k3s1_ESINGULAR;
+    }
+    if (rc == modified_k3s1_ESINGULAR) break;
+    for (i = 0; i < 2 * modified_k3s1_M + 2 * modified_k3s1_NU; i++)
+      if (!isfinite(out[i])) rc = modified_k3s1_ENONFINITE;
+    if (rc == modified_k3s1_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < modified_k3s1_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= modified_k3s1_TOL) { rc = modified_k3s1_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * modified_k3s1_TOL ? modified_k3s1_OK : modified_k3s1_ENOCONV; break; }
+    for (i = 0; i < modified_k3s1_M; i++) q[i] += out[i];
+  }
+  if (rc != modified_k3s1_OK) return rc;
+  for (i = 0; i < modified_k3s1_M; i++) {
+    p[i] += out[modified_k3s1_M + i];
+    if (!isfinite(p[i])) return modified_k3s1_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < modified_k3s1_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  {
+    double lam[modified_k3s1_NU];
+    modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
+    for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return modified_k3s1_OK;
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  modified_k3s1_real increment; /* last scaled increment of the iteration */
 } modified_k3s1_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void modified_k3s1_init(modified_k3s1_state *x, const double *q0, const double *p0);
+void modified_k3s1_init_params(modified_k3s1_state *x, const modified_k3s1_real *q0, const modified_k3s1_real *p0, const modified_k3s1_params *prm);
+void modified_k3s1_init(modified_k3s1_state *x, const modified_k3s1_real *q0, const modified_k3s1_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns modified_k3s1_OK, or modified_k3s1_ENOCONV, modified_k3s1_ESINGULAR, modified_k3s1_ENONFINITE with x unchanged. */
+int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *dq, modified_k3s1_real *dp);
 void modified_k3s1_params_default(modified_k3s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k3s1_OK or an error code. */
-int modified_k3s1_step(modified_k3s1_state *x, double h, const modified_k3s1_params *prm, modified_k3s1_stats *st);
+int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modified_k3s1_params *prm, modified_k3s1_stats *st);
 const char *modified_k3s1_strerror(int code);
-double modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm);
-void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *g);   /* modified_k3s1_NU values */
-void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, double *gp);       /* grad g' M^-1 p */
+modified_k3s1_real modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm);
+void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *g);   /* modified_k3s1_NU values */
+void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  modified_k9s3_real increment; /* last scaled increment of the iteration */
 } modified_k9s3_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void modified_k9s3_init(modified_k9s3_state *x, const double *q0, const double *p0);
+void modified_k9s3_init_params(modified_k9s3_state *x, const modified_k9s3_real *q0, const modified_k9s3_real *p0, const modified_k9s3_params *prm);
+void modified_k9s3_init(modified_k9s3_state *x, const modified_k9s3_real *q0, const modified_k9s3_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns modified_k9s3_OK, or modified_k9s3_ENOCONV, modified_k9s3_ESINGULAR, modified_k9s3_ENONFINITE with x unchanged. */
+int modified_k9s3_project(modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *dq, modified_k9s3_real *dp);
 void modified_k9s3_params_default(modified_k9s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k9s3_OK or an error code. */
-int modified_k9s3_step(modified_k9s3_state *x, double h, const modified_k9s3_params *prm, modified_k9s3_stats *st);
+int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modified_k9s3_params *prm, modified_k9s3_stats *st);
 const char *modified_k9s3_strerror(int code);
-double modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
-void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, double *g);   /* modified_k9s3_NU values */
-void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_params *prm, double *gp);       /* grad g' M^-1 p */
+modified_k9s3_real modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
+void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *g);   /* modified_k9s3_NU values */
+void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -970,7 +970,7 @@ static void modified_poly_k6s2_lambda0(const double *q0, const double *p0, const
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
  * and diagonal (NU) of G1' M^-1 G1. */
-static void modified_poly_k6s2_project(const double *q0, const double *p0, const double *gam, double h,
+static void modified_poly_k6s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
@@ -993,15 +993,15 @@ static void modified_poly_k6s2_project(const double *q0, const double *p0, const
   const double t15 = t14 / t9;
   const double t16 = t4 * t15;
   const double t17 = -t16;
-  const double t18 = p0[0] /* p_q[1] */ - t16;
-  const double t19 = t2 * t15;
-  const double t20 = -t19;
-  const double t21 = p0[1] /* p_q[2] */ - t19;
-  const double t22 = t0 * t15;
-  const double t23 = -t22;
-  const double t24 = p0[2] /* p_q[3] */ - t22;
-  const double t25 = t18 * t18;
-  const double t26 = t21 * t21;
+  const double t18 = t2 * t15;
+  const double t19 = -t18;
+  const double t20 = t0 * t15;
+  const double t21 = -t20;
+  const double t22 = p0[0] /* p_q[1] */ - t16;
+  const double t23 = p0[1] /* p_q[2] */ - t18;
+  const double t24 = p0[2] /* p_q[3] */ - t20;
+  const double t25 = t22 * t22;
+  const double t26 = t23 * t23;
   const double t27 = t25 + t26;
   const double t28 = t24 * t24;
   const double t29 = t27 + t28;
@@ -1009,8 +1009,8 @@ static void modified_poly_k6s2_project(const double *q0, const double *p0, const
   const double t31 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
   /* dp */
   out[0] = t17;
-  out[1] = t20;
-  out[2] = t23;
+  out[1] = t19;
+  out[2] = t21;
   /* kin */
   out[3] = t30;
   /* U */
@@ -1021,30 +1021,93 @@ static void modified_poly_k6s2_project(const double *q0, const double *p0, const
   out[6] = t9;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void modified_poly_k6s2_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = 2.0 * q0[2] /* q[3] */;
+  const double t1 = q0[1] /* q[2] */ * q0[1] /* q[2] */ * q0[1] /* q[2] */;
+  const double t2 = 4.0 * t1;
+  const double t3 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */) * q0[0] /* q[1] */;
+  const double t4 = 6.0 * t3;
+  const double t5 = t4 * t4;
+  const double t6 = t2 * t2;
+  const double t7 = t5 + t6;
+  const double t8 = t0 * t0;
+  const double t9 = t7 + t8;
+  const double t10 = p0[0] /* p_q[1] */ * t4;
+  const double t11 = p0[1] /* p_q[2] */ * t2;
+  const double t12 = t10 + t11;
+  const double t13 = t0 * p0[2] /* p_q[3] */;
+  const double t14 = t12 + t13;
+  const double t15 = t14 / t9;
+  const double t16 = t4 * t15;
+  const double t17 = -t16;
+  const double t18 = t2 * t15;
+  const double t19 = -t18;
+  const double t20 = t0 * t15;
+  const double t21 = -t20;
+  const double t22 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t23 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
+  const double t24 = t22 + t23;
+  const double t25 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
+  const double t26 = t24 + t25;
+  const double t27 = t26 - 0.625;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t28 = t27 / t9;
+  const double t29 = t4 * t28;
+  const double t30 = t2 * t28;
+  const double t31 = t0 * t28;
+  const double t32 = -t29;
+  const double t33 = -t30;
+  const double t34 = -t31;
+  /* dq */
+  out[0] = t32;
+  out[1] = t33;
+  out[2] = t34;
+  /* dp */
+  out[3] = t17;
+  out[4] = t19;
+  out[5] = t21;
+  /* pivot */
+  out[6] = t9;
+  /* adiag */
+  out[7] = t9;
+}
+
 void modified_poly_k6s2_params_default(modified_poly_k6s2_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void modified_poly_k6s2_init(modified_poly_k6s2_state *x, const double *q0, const double *p0)
+#define modified_poly_k6s2_DEFAULT_PARAMS(prm) modified_poly_k6s2_params dflt_; if (!prm) { modified_poly_k6s2_params_default(&dflt_); prm = &dflt_; }
+
+void modified_poly_k6s2_init_params(modified_poly_k6s2_state *x, const modified_poly_k6s2_real *q0, const modified_poly_k6s2_real *p0, const modified_poly_k6s2_params *prm)
 {
   int i;
+  modified_poly_k6s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < modified_poly_k6s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : modified_poly_k6s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : modified_poly_k6s2_p0[i];
+    x->q[i] = q0 ? q0[i] : modified_poly_k6s2_q0[i];
+    x->p[i] = p0 ? p0[i] : modified_poly_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_poly_k6s2_NU ? modified_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
-    modified_poly_k6s2_params prm;
     double lam[modified_poly_k6s2_NU];
-    modified_poly_k6s2_params_default(&prm);
-    modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
+    modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
     for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void modified_poly_k6s2_init(modified_poly_k6s2_state *x, const modified_poly_k6s2_real *q0, const modified_poly_k6s2_real *p0)
+{
+  modified_poly_k6s2_init_params(x, q0, p0, 0);
 }
 
 const char *modified_poly_k6s2_strerror(int code)
@@ -1059,9 +1122,7 @@ const char *modified_poly_k6s2_strerror(int code)
   return "unknown error";
 }
 
-#define modified_poly_k6s2_DEFAULT_PARAMS(prm) modified_poly_k6s2_params dflt_; if (!prm) { modified_poly_k6s2_params_default(&dflt_); prm = &dflt_; }
-
-double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm)
+modified_poly_k6s2_real modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm)
 {
   double H;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -1069,22 +1130,16 @@ double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modifi
   return H;
 }
 
-void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *g)
+void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *g)
 {
-  double v[modified_poly_k6s2_NU];
-  int i;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
-  modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_poly_k6s2_NU; i++) g[i] = v[i];
+  modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *gp)
+void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *gp)
 {
-  double v[modified_poly_k6s2_NU];
-  int i;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
-  modified_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < modified_poly_k6s2_NU; i++) gp[i] = v[i];
+  modified_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -1116,7 +1171,7 @@ static void modified_poly_k6s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h_, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
+int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
@@ -1192,7 +1247,7 @@ int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h_, const modifi
     modified_poly_k6s2_add(&p1[i], &pc1[i], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
-  modified_poly_k6s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
+  modified_poly_k6s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < modified_poly_k6s2_NU; i++) {
     double piv = pr[modified_poly_k6s2_M + 2 + i], dia = pr[modified_poly_k6s2_M + 2 + modified_poly_k6s2_NU + i];
     if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_poly_k6s2_SINGTOL * fabs(dia))) return modified_poly_k6s2_ESINGULAR;
@@ -1220,11 +1275,71 @@ int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h_, const modifi
   for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[modified_poly_k6s2_NU];
-    modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    double lam[modified_poly_k6s2_NU];
+    modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   modified_poly_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return modified_poly_k6s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (modified_poly_k6s2_TOL) or stops decreasing at round-off, at most modified_poly_k6s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *dq, modified_poly_k6s2_real *dp)
+{
+  double q[modified_poly_k6s2_M], p[modified_poly_k6s2_M], out[2 * modified_poly_k6s2_M + 2 * modified_poly_k6s2_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = modified_poly_k6s2_ENOCONV;
+  modified_poly_k6s2_DEFAULT_PARAMS(prm)
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= modified_poly_k6s2_MAXITER; it++) {
+    modified_poly_k6s2_consistent(q, p, 0, 0, 0, 0, 0, prm, out);
+    for (i = 0; i < modified_poly_k6s2_NU; i++) {
+      double piv = out[2 * modified_poly_k6s2_M + i], dia = out[2 * modified_poly_k6s2_M + modified_poly_k6s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_poly_k6s2_SINGTOL * fabs(dia))) rc = modified_poly_k6s2_ESINGULAR;
+    }
+    if (rc == modified_poly_k6s2_ESINGULAR) break;
+    for (i = 0; i < 2 * modified_poly_k6s2_M + 2 * modified_poly_k6s2_NU; i++)
+      if (!isfinite(out[i])) rc = modified_poly_k6s2_ENONFINITE;
+    if (rc == modified_poly_k6s2_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < modified_poly_k6s2_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= modified_poly_k6s2_TOL) { rc = modified_poly_k6s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * modified_poly_k6s2_TOL ? modified_poly_k6s2_OK : modified_poly_k6s2_ENOCONV; break; }
+    for (i = 0; i < modified_poly_k6s2_M; i++) q[i] += out[i];
+  }
+  if (rc != modified_poly_k6s2_OK) return rc;
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
+    p[i] += out[modified_poly_k6s2_M + i];
+    if (!isfinite(p[i])) return modified_poly_k6s2_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  x->H0 = 0;
+  {
+    double lam[modified_poly_k6s2_NU];
+    modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return modified_poly_k6s2_OK;
 }

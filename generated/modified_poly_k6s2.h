@@ -36,20 +36,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  modified_poly_k6s2_real increment; /* last scaled increment of the iteration */
 } modified_poly_k6s2_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and after each step is the multiplier consistent with the new (q, p), of order 2s. */
-void modified_poly_k6s2_init(modified_poly_k6s2_state *x, const double *q0, const double *p0);
+void modified_poly_k6s2_init_params(modified_poly_k6s2_state *x, const modified_poly_k6s2_real *q0, const modified_poly_k6s2_real *p0, const modified_poly_k6s2_params *prm);
+void modified_poly_k6s2_init(modified_poly_k6s2_state *x, const modified_poly_k6s2_real *q0, const modified_poly_k6s2_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns modified_poly_k6s2_OK, or modified_poly_k6s2_ENOCONV, modified_poly_k6s2_ESINGULAR, modified_poly_k6s2_ENONFINITE with x unchanged. */
+int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *dq, modified_poly_k6s2_real *dp);
 void modified_poly_k6s2_params_default(modified_poly_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_poly_k6s2_OK or an error code. */
-int modified_poly_k6s2_step(modified_poly_k6s2_state *x, double h, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st);
+int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real h, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st);
 const char *modified_poly_k6s2_strerror(int code);
-double modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm);
-void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *g);   /* modified_poly_k6s2_NU values */
-void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, double *gp);       /* grad g' M^-1 p */
+modified_poly_k6s2_real modified_poly_k6s2_energy(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm);
+void modified_poly_k6s2_constraints(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *g);   /* modified_poly_k6s2_NU values */
+void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified_poly_k6s2_params *prm, modified_poly_k6s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

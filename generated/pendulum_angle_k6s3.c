@@ -188,17 +188,25 @@ void pendulum_angle_k6s3_params_default(pendulum_angle_k6s3_params *prm)
   prm->unused_ = 0;
 }
 
-void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const double *q0, const double *p0)
+#define pendulum_angle_k6s3_DEFAULT_PARAMS(prm) pendulum_angle_k6s3_params dflt_; if (!prm) { pendulum_angle_k6s3_params_default(&dflt_); prm = &dflt_; }
+
+void pendulum_angle_k6s3_init_params(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_real *q0, const pendulum_angle_k6s3_real *p0, const pendulum_angle_k6s3_params *prm)
 {
   int i;
+  pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : pendulum_angle_k6s3_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : pendulum_angle_k6s3_p0[i];
+    x->q[i] = q0 ? q0[i] : pendulum_angle_k6s3_q0[i];
+    x->p[i] = p0 ? p0[i] : pendulum_angle_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_angle_k6s3_NU ? pendulum_angle_k6s3_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = 0;
+}
+
+void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_real *q0, const pendulum_angle_k6s3_real *p0)
+{
+  pendulum_angle_k6s3_init_params(x, q0, p0, 0);
 }
 
 const char *pendulum_angle_k6s3_strerror(int code)
@@ -213,9 +221,7 @@ const char *pendulum_angle_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define pendulum_angle_k6s3_DEFAULT_PARAMS(prm) pendulum_angle_k6s3_params dflt_; if (!prm) { pendulum_angle_k6s3_params_default(&dflt_); prm = &dflt_; }
-
-double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm)
+pendulum_angle_k6s3_real pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm)
 {
   double H;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
@@ -223,12 +229,12 @@ double pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pend
   return H;
 }
 
-void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *g)
+void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *g)
 {
   (void)x; (void)prm; (void)g;
 }
 
-void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, double *gp)
+void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *gp)
 {
   (void)x; (void)prm; (void)gp;
 }
@@ -262,7 +268,7 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
+int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
@@ -322,5 +328,17 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, double h_, const pend
   for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return pendulum_angle_k6s3_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (pendulum_angle_k6s3_TOL) or stops decreasing at round-off, at most pendulum_angle_k6s3_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int pendulum_angle_k6s3_project(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *dq, pendulum_angle_k6s3_real *dp)
+{
+  (void)x;
+  (void)prm;
+  if (dq) *dq = 0;
+  if (dp) *dp = 0;
   return pendulum_angle_k6s3_OK;
 }

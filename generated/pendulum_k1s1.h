@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_k1s1_real increment; /* last scaled increment of the iteration */
 } pendulum_k1s1_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void pendulum_k1s1_init(pendulum_k1s1_state *x, const double *q0, const double *p0);
+void pendulum_k1s1_init_params(pendulum_k1s1_state *x, const pendulum_k1s1_real *q0, const pendulum_k1s1_real *p0, const pendulum_k1s1_params *prm);
+void pendulum_k1s1_init(pendulum_k1s1_state *x, const pendulum_k1s1_real *q0, const pendulum_k1s1_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns pendulum_k1s1_OK, or pendulum_k1s1_ENOCONV, pendulum_k1s1_ESINGULAR, pendulum_k1s1_ENONFINITE with x unchanged. */
+int pendulum_k1s1_project(pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *dq, pendulum_k1s1_real *dp);
 void pendulum_k1s1_params_default(pendulum_k1s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k1s1_OK or an error code. */
-int pendulum_k1s1_step(pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st);
+int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st);
 const char *pendulum_k1s1_strerror(int code);
-double pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm);
-void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *g);   /* pendulum_k1s1_NU values */
-void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_k1s1_real pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm);
+void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *g);   /* pendulum_k1s1_NU values */
+void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_k2s2_real increment; /* last scaled increment of the iteration */
 } pendulum_k2s2_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void pendulum_k2s2_init(pendulum_k2s2_state *x, const double *q0, const double *p0);
+void pendulum_k2s2_init_params(pendulum_k2s2_state *x, const pendulum_k2s2_real *q0, const pendulum_k2s2_real *p0, const pendulum_k2s2_params *prm);
+void pendulum_k2s2_init(pendulum_k2s2_state *x, const pendulum_k2s2_real *q0, const pendulum_k2s2_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns pendulum_k2s2_OK, or pendulum_k2s2_ENOCONV, pendulum_k2s2_ESINGULAR, pendulum_k2s2_ENONFINITE with x unchanged. */
+int pendulum_k2s2_project(pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *dq, pendulum_k2s2_real *dp);
 void pendulum_k2s2_params_default(pendulum_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k2s2_OK or an error code. */
-int pendulum_k2s2_step(pendulum_k2s2_state *x, double h, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st);
+int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st);
 const char *pendulum_k2s2_strerror(int code);
-double pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm);
-void pendulum_k2s2_constraints(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, double *g);   /* pendulum_k2s2_NU values */
-void pendulum_k2s2_hidden(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_k2s2_real pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm);
+void pendulum_k2s2_constraints(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *g);   /* pendulum_k2s2_NU values */
+void pendulum_k2s2_hidden(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_k3s3_real increment; /* last scaled increment of the iteration */
 } pendulum_k3s3_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void pendulum_k3s3_init(pendulum_k3s3_state *x, const double *q0, const double *p0);
+void pendulum_k3s3_init_params(pendulum_k3s3_state *x, const pendulum_k3s3_real *q0, const pendulum_k3s3_real *p0, const pendulum_k3s3_params *prm);
+void pendulum_k3s3_init(pendulum_k3s3_state *x, const pendulum_k3s3_real *q0, const pendulum_k3s3_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns pendulum_k3s3_OK, or pendulum_k3s3_ENOCONV, pendulum_k3s3_ESINGULAR, pendulum_k3s3_ENONFINITE with x unchanged. */
+int pendulum_k3s3_project(pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *dq, pendulum_k3s3_real *dp);
 void pendulum_k3s3_params_default(pendulum_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k3s3_OK or an error code. */
-int pendulum_k3s3_step(pendulum_k3s3_state *x, double h, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st);
+int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st);
 const char *pendulum_k3s3_strerror(int code);
-double pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm);
-void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *g);   /* pendulum_k3s3_NU values */
-void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_k3s3_real pendulum_k3s3_energy(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm);
+void pendulum_k3s3_constraints(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *g);   /* pendulum_k3s3_NU values */
+void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_params *prm, pendulum_k3s3_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

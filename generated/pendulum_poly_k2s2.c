@@ -373,7 +373,7 @@ static void pendulum_poly_k2s2_lambda0(const double *q0, const double *p0, const
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
  * and diagonal (NU) of G1' M^-1 G1. */
-static void pendulum_poly_k2s2_project(const double *q0, const double *p0, const double *gam, double h,
+static void pendulum_poly_k2s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
@@ -389,21 +389,63 @@ static void pendulum_poly_k2s2_project(const double *q0, const double *p0, const
   const double t8 = t7 / t4;
   const double t9 = t1 * t8;
   const double t10 = -t9;
-  const double t11 = p0[0] /* p_x */ - t9;
-  const double t12 = t0 * t8;
-  const double t13 = -t12;
-  const double t14 = p0[1] /* p_y */ - t12;
-  const double t15 = t11 * t11;
+  const double t11 = t0 * t8;
+  const double t12 = -t11;
+  const double t13 = p0[0] /* p_x */ - t9;
+  const double t14 = p0[1] /* p_y */ - t11;
+  const double t15 = t13 * t13;
   const double t16 = t14 * t14;
   const double t17 = t15 + t16;
   const double t18 = 0.5 * t17;
   /* dp */
   out[0] = t10;
-  out[1] = t13;
+  out[1] = t12;
   /* kin */
   out[2] = t18;
   /* U */
   out[3] = q0[1] /* y */;
+  /* pivot */
+  out[4] = t4;
+  /* adiag */
+  out[5] = t4;
+}
+
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void pendulum_poly_k2s2_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = 2.0 * q0[1] /* y */;
+  const double t1 = 2.0 * q0[0] /* x */;
+  const double t2 = t1 * t1;
+  const double t3 = t0 * t0;
+  const double t4 = t2 + t3;
+  const double t5 = t1 * p0[0] /* p_x */;
+  const double t6 = t0 * p0[1] /* p_y */;
+  const double t7 = t5 + t6;
+  const double t8 = t7 / t4;
+  const double t9 = t1 * t8;
+  const double t10 = -t9;
+  const double t11 = t0 * t8;
+  const double t12 = -t11;
+  const double t13 = q0[0] /* x */ * q0[0] /* x */;
+  const double t14 = q0[1] /* y */ * q0[1] /* y */;
+  const double t15 = t13 + t14;
+  const double t16 = t15 - 1.0;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t17 = t16 / t4;
+  const double t18 = t1 * t17;
+  const double t19 = t0 * t17;
+  const double t20 = -t18;
+  const double t21 = -t19;
+  /* dq */
+  out[0] = t20;
+  out[1] = t21;
+  /* dp */
+  out[2] = t10;
+  out[3] = t12;
   /* pivot */
   out[4] = t4;
   /* adiag */
@@ -415,25 +457,31 @@ void pendulum_poly_k2s2_params_default(pendulum_poly_k2s2_params *prm)
   prm->unused_ = 0;
 }
 
-void pendulum_poly_k2s2_init(pendulum_poly_k2s2_state *x, const double *q0, const double *p0)
+#define pendulum_poly_k2s2_DEFAULT_PARAMS(prm) pendulum_poly_k2s2_params dflt_; if (!prm) { pendulum_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
+
+void pendulum_poly_k2s2_init_params(pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_real *q0, const pendulum_poly_k2s2_real *p0, const pendulum_poly_k2s2_params *prm)
 {
   int i;
+  pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < pendulum_poly_k2s2_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : pendulum_poly_k2s2_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : pendulum_poly_k2s2_p0[i];
+    x->q[i] = q0 ? q0[i] : pendulum_poly_k2s2_q0[i];
+    x->p[i] = p0 ? p0[i] : pendulum_poly_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k2s2_NU ? pendulum_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
-    pendulum_poly_k2s2_params prm;
     double lam[pendulum_poly_k2s2_NU];
-    pendulum_poly_k2s2_params_default(&prm);
-    pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
+    pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
     for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void pendulum_poly_k2s2_init(pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_real *q0, const pendulum_poly_k2s2_real *p0)
+{
+  pendulum_poly_k2s2_init_params(x, q0, p0, 0);
 }
 
 const char *pendulum_poly_k2s2_strerror(int code)
@@ -448,9 +496,7 @@ const char *pendulum_poly_k2s2_strerror(int code)
   return "unknown error";
 }
 
-#define pendulum_poly_k2s2_DEFAULT_PARAMS(prm) pendulum_poly_k2s2_params dflt_; if (!prm) { pendulum_poly_k2s2_params_default(&dflt_); prm = &dflt_; }
-
-double pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm)
+pendulum_poly_k2s2_real pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm)
 {
   double H;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -458,22 +504,16 @@ double pendulum_poly_k2s2_energy(const pendulum_poly_k2s2_state *x, const pendul
   return H;
 }
 
-void pendulum_poly_k2s2_constraints(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, double *g)
+void pendulum_poly_k2s2_constraints(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_real *g)
 {
-  double v[pendulum_poly_k2s2_NU];
-  int i;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
-  pendulum_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_poly_k2s2_NU; i++) g[i] = v[i];
+  pendulum_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, double *gp)
+void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_real *gp)
 {
-  double v[pendulum_poly_k2s2_NU];
-  int i;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
-  pendulum_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < pendulum_poly_k2s2_NU; i++) gp[i] = v[i];
+  pendulum_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -505,7 +545,7 @@ static void pendulum_poly_k2s2_add(double *a, double *c, double b)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, double h_, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
+int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real h_, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M], sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + 1];
@@ -581,7 +621,7 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, double h_, const pendul
     pendulum_poly_k2s2_add(&p1[i], &pc1[i], sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
-  pendulum_poly_k2s2_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
+  pendulum_poly_k2s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < pendulum_poly_k2s2_NU; i++) {
     double piv = pr[pendulum_poly_k2s2_M + 2 + i], dia = pr[pendulum_poly_k2s2_M + 2 + pendulum_poly_k2s2_NU + i];
     if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k2s2_SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
@@ -609,11 +649,71 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, double h_, const pendul
   for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[pendulum_poly_k2s2_NU];
-    pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    double lam[pendulum_poly_k2s2_NU];
+    pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   pendulum_poly_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return pendulum_poly_k2s2_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (pendulum_poly_k2s2_TOL) or stops decreasing at round-off, at most pendulum_poly_k2s2_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int pendulum_poly_k2s2_project(pendulum_poly_k2s2_state *x, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_real *dq, pendulum_poly_k2s2_real *dp)
+{
+  double q[pendulum_poly_k2s2_M], p[pendulum_poly_k2s2_M], out[2 * pendulum_poly_k2s2_M + 2 * pendulum_poly_k2s2_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = pendulum_poly_k2s2_ENOCONV;
+  pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= pendulum_poly_k2s2_MAXITER; it++) {
+    pendulum_poly_k2s2_consistent(q, p, 0, 0, 0, 0, 0, prm, out);
+    for (i = 0; i < pendulum_poly_k2s2_NU; i++) {
+      double piv = out[2 * pendulum_poly_k2s2_M + i], dia = out[2 * pendulum_poly_k2s2_M + pendulum_poly_k2s2_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k2s2_SINGTOL * fabs(dia))) rc = pendulum_poly_k2s2_ESINGULAR;
+    }
+    if (rc == pendulum_poly_k2s2_ESINGULAR) break;
+    for (i = 0; i < 2 * pendulum_poly_k2s2_M + 2 * pendulum_poly_k2s2_NU; i++)
+      if (!isfinite(out[i])) rc = pendulum_poly_k2s2_ENONFINITE;
+    if (rc == pendulum_poly_k2s2_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < pendulum_poly_k2s2_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= pendulum_poly_k2s2_TOL) { rc = pendulum_poly_k2s2_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * pendulum_poly_k2s2_TOL ? pendulum_poly_k2s2_OK : pendulum_poly_k2s2_ENOCONV; break; }
+    for (i = 0; i < pendulum_poly_k2s2_M; i++) q[i] += out[i];
+  }
+  if (rc != pendulum_poly_k2s2_OK) return rc;
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
+    p[i] += out[pendulum_poly_k2s2_M + i];
+    if (!isfinite(p[i])) return pendulum_poly_k2s2_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < pendulum_poly_k2s2_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  x->H0 = 0;
+  {
+    double lam[pendulum_poly_k2s2_NU];
+    pendulum_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return pendulum_poly_k2s2_OK;
 }

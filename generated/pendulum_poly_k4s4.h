@@ -36,20 +36,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  pendulum_poly_k4s4_real increment; /* last scaled increment of the iteration */
 } pendulum_poly_k4s4_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and after each step is the multiplier consistent with the new (q, p), of order 2s. */
-void pendulum_poly_k4s4_init(pendulum_poly_k4s4_state *x, const double *q0, const double *p0);
+void pendulum_poly_k4s4_init_params(pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_real *q0, const pendulum_poly_k4s4_real *p0, const pendulum_poly_k4s4_params *prm);
+void pendulum_poly_k4s4_init(pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_real *q0, const pendulum_poly_k4s4_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns pendulum_poly_k4s4_OK, or pendulum_poly_k4s4_ENOCONV, pendulum_poly_k4s4_ESINGULAR, pendulum_poly_k4s4_ENONFINITE with x unchanged. */
+int pendulum_poly_k4s4_project(pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *dq, pendulum_poly_k4s4_real *dp);
 void pendulum_poly_k4s4_params_default(pendulum_poly_k4s4_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_poly_k4s4_OK or an error code. */
-int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, double h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
+int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
 const char *pendulum_poly_k4s4_strerror(int code);
-double pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm);
-void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *g);   /* pendulum_poly_k4s4_NU values */
-void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, double *gp);       /* grad g' M^-1 p */
+pendulum_poly_k4s4_real pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm);
+void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *g);   /* pendulum_poly_k4s4_NU values */
+void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -35,20 +35,27 @@ typedef struct {
 
 typedef struct {
   int iters;         /* fixed-point iterations */
-  double increment;  /* last scaled increment of the iteration */
+  satellites_k6s2_real increment; /* last scaled increment of the iteration */
 } satellites_k6s2_stats;
 
-/* q0, p0 NULL: the model's initial values. lambda starts as the multiplier
- * consistent with (q0, p0) at the default parameters (0 if that is singular)
+/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
+ * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if
+ * that is singular)
  * and is the constant multiplier of the last step after each step. */
-void satellites_k6s2_init(satellites_k6s2_state *x, const double *q0, const double *p0);
+void satellites_k6s2_init_params(satellites_k6s2_state *x, const satellites_k6s2_real *q0, const satellites_k6s2_real *p0, const satellites_k6s2_params *prm);
+void satellites_k6s2_init(satellites_k6s2_state *x, const satellites_k6s2_real *q0, const satellites_k6s2_real *p0);   /* at the default parameters */
+/* Moves q onto g(q) = 0 (Newton, the smallest change in the M norm), then p onto the
+ * hidden constraint (M-orthogonally), and recomputes lambda; clears the compensations
+ * and the step's history. dq, dp (may be NULL): the largest change of a q[i], p[i].
+ * Returns satellites_k6s2_OK, or satellites_k6s2_ENOCONV, satellites_k6s2_ESINGULAR, satellites_k6s2_ENONFINITE with x unchanged. */
+int satellites_k6s2_project(satellites_k6s2_state *x, const satellites_k6s2_params *prm, satellites_k6s2_real *dq, satellites_k6s2_real *dp);
 void satellites_k6s2_params_default(satellites_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns satellites_k6s2_OK or an error code. */
-int satellites_k6s2_step(satellites_k6s2_state *x, double h, const satellites_k6s2_params *prm, satellites_k6s2_stats *st);
+int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h, const satellites_k6s2_params *prm, satellites_k6s2_stats *st);
 const char *satellites_k6s2_strerror(int code);
-double satellites_k6s2_energy(const satellites_k6s2_state *x, const satellites_k6s2_params *prm);
-void satellites_k6s2_constraints(const satellites_k6s2_state *x, const satellites_k6s2_params *prm, double *g);   /* satellites_k6s2_NU values */
-void satellites_k6s2_hidden(const satellites_k6s2_state *x, const satellites_k6s2_params *prm, double *gp);       /* grad g' M^-1 p */
+satellites_k6s2_real satellites_k6s2_energy(const satellites_k6s2_state *x, const satellites_k6s2_params *prm);
+void satellites_k6s2_constraints(const satellites_k6s2_state *x, const satellites_k6s2_params *prm, satellites_k6s2_real *g);   /* satellites_k6s2_NU values */
+void satellites_k6s2_hidden(const satellites_k6s2_state *x, const satellites_k6s2_params *prm, satellites_k6s2_real *gp);       /* grad g' M^-1 p */
 
 #ifdef __cplusplus
 }

@@ -2360,29 +2360,273 @@ static void satellites_k6s3_lambda0(const double *q0, const double *p0, const do
   out[2] = t216;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void satellites_k6s3_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const satellites_k6s3_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
+  const double t9 = 2.0 * t2;
+  const double t10 = 2.0 * t1;
+  const double t11 = 2.0 * t0;
+  const double t12 = 2.0 * t5;
+  const double t13 = 2.0 * t4;
+  const double t14 = 2.0 * t3;
+  const double t15 = 2.0 * t8;
+  const double t16 = 2.0 * t7;
+  const double t17 = 2.0 * t6;
+  const double t18 = t0 * t0;
+  const double t19 = t1 * t1;
+  const double t20 = t18 + t19;
+  const double t21 = t2 * t2;
+  const double t22 = t20 + t21;
+  const double t23 = t22 - 1.0;
+  const double t24 = t3 * t3;
+  const double t25 = t4 * t4;
+  const double t26 = t24 + t25;
+  const double t27 = t5 * t5;
+  const double t28 = t26 + t27;
+  const double t29 = t28 - 1.0;
+  const double t30 = t6 * t6;
+  const double t31 = t7 * t7;
+  const double t32 = t30 + t31;
+  const double t33 = t8 * t8;
+  const double t34 = t32 + t33;
+  const double t35 = t34 - 1.0;
+  const double t36 = t11 * p0[0] /* p_x1 */;
+  const double t37 = t10 * p0[1] /* p_y1 */;
+  const double t38 = t36 + t37;
+  const double t39 = t9 * p0[2] /* p_z1 */;
+  const double t40 = t38 + t39;
+  const double t41 = t11 * p0[3] /* p_x2 */;
+  const double t42 = t40 - t41;
+  const double t43 = t10 * p0[4] /* p_y2 */;
+  const double t44 = t42 - t43;
+  const double t45 = t9 * p0[5] /* p_z2 */;
+  const double t46 = t44 - t45;
+  const double t47 = t14 * p0[3] /* p_x2 */;
+  const double t48 = t13 * p0[4] /* p_y2 */;
+  const double t49 = t47 + t48;
+  const double t50 = t12 * p0[5] /* p_z2 */;
+  const double t51 = t49 + t50;
+  const double t52 = t14 * p0[6] /* p_x3 */;
+  const double t53 = t51 - t52;
+  const double t54 = t13 * p0[7] /* p_y3 */;
+  const double t55 = t53 - t54;
+  const double t56 = t12 * p0[8] /* p_z3 */;
+  const double t57 = t55 - t56;
+  const double t58 = t17 * p0[0] /* p_x1 */;
+  const double t59 = -t58;
+  const double t60 = t16 * p0[1] /* p_y1 */;
+  const double t61 = t59 - t60;
+  const double t62 = t15 * p0[2] /* p_z1 */;
+  const double t63 = t61 - t62;
+  const double t64 = t17 * p0[6] /* p_x3 */;
+  const double t65 = t63 + t64;
+  const double t66 = t16 * p0[7] /* p_y3 */;
+  const double t67 = t65 + t66;
+  const double t68 = t15 * p0[8] /* p_z3 */;
+  const double t69 = t67 + t68;
+  const double t70 = t11 * t11;
+  const double t71 = t11 * t17;
+  const double t72 = -t71;
+  const double t73 = t10 * t10;
+  const double t74 = t70 + t73;
+  const double t75 = t10 * t16;
+  const double t76 = t72 - t75;
+  const double t77 = t9 * t9;
+  const double t78 = t74 + t77;
+  const double t79 = t9 * t15;
+  const double t80 = t76 - t79;
+  const double t81 = t70 + t78;
+  const double t82 = t11 * t14;
+  const double t83 = -t82;
+  const double t84 = t73 + t81;
+  const double t85 = t10 * t13;
+  const double t86 = t83 - t85;
+  const double t87 = t77 + t84;
+  const double t88 = t9 * t12;
+  const double t89 = t86 - t88;
+  const double t90 = t14 * t14;
+  const double t91 = t13 * t13;
+  const double t92 = t90 + t91;
+  const double t93 = t12 * t12;
+  const double t94 = t92 + t93;
+  const double t95 = t90 + t94;
+  const double t96 = t14 * t17;
+  const double t97 = -t96;
+  const double t98 = t91 + t95;
+  const double t99 = t13 * t16;
+  const double t100 = t97 - t99;
+  const double t101 = t93 + t98;
+  const double t102 = t12 * t15;
+  const double t103 = t100 - t102;
+  const double t104 = t17 * t17;
+  const double t105 = t16 * t16;
+  const double t106 = t104 + t105;
+  const double t107 = t15 * t15;
+  const double t108 = t106 + t107;
+  const double t109 = t104 + t108;
+  const double t110 = t105 + t109;
+  const double t111 = t107 + t110;
+  const double t112 = t89 / t87;
+  const double t113 = t89 * t112;
+  const double t114 = t101 - t113;
+  const double t115 = t80 * t112;
+  const double t116 = t103 - t115;
+  const double t117 = t80 / t87;
+  const double t118 = t89 * t117;
+  const double t119 = t103 - t118;
+  const double t120 = t80 * t117;
+  const double t121 = t111 - t120;
+  const double t122 = t119 / t114;
+  const double t123 = t116 * t122;
+  const double t124 = t121 - t123;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t125 = t23 * t112;
+  const double t126 = t29 - t125;
+  const double t127 = t23 * t117;
+  const double t128 = t35 - t127;
+  const double t129 = t122 * t126;
+  const double t130 = t128 - t129;
+  const double t131 = t130 / t124;
+  const double t132 = t116 * t131;
+  const double t133 = t126 - t132;
+  const double t134 = t133 / t114;
+  const double t135 = t89 * t134;
+  const double t136 = t23 - t135;
+  const double t137 = t80 * t131;
+  const double t138 = t136 - t137;
+  const double t139 = t138 / t87;
+  const double t140 = t11 * t139;
+  const double t141 = t17 * t131;
+  const double t142 = t140 - t141;
+  const double t143 = t10 * t139;
+  const double t144 = t16 * t131;
+  const double t145 = t143 - t144;
+  const double t146 = t9 * t139;
+  const double t147 = t15 * t131;
+  const double t148 = t146 - t147;
+  const double t149 = t14 * t134;
+  const double t150 = t149 - t140;
+  const double t151 = t13 * t134;
+  const double t152 = t151 - t143;
+  const double t153 = t12 * t134;
+  const double t154 = t153 - t146;
+  const double t155 = t141 - t149;
+  const double t156 = t144 - t151;
+  const double t157 = t147 - t153;
+  const double t158 = -t142;
+  const double t159 = -t145;
+  const double t160 = -t148;
+  const double t161 = -t150;
+  const double t162 = -t152;
+  const double t163 = -t154;
+  const double t164 = -t155;
+  const double t165 = -t156;
+  const double t166 = -t157;
+  const double t167 = t46 * t112;
+  const double t168 = t57 - t167;
+  const double t169 = t46 * t117;
+  const double t170 = t69 - t169;
+  const double t171 = t122 * t168;
+  const double t172 = t170 - t171;
+  const double t173 = t172 / t124;
+  const double t174 = t116 * t173;
+  const double t175 = t168 - t174;
+  const double t176 = t175 / t114;
+  const double t177 = t89 * t176;
+  const double t178 = t46 - t177;
+  const double t179 = t80 * t173;
+  const double t180 = t178 - t179;
+  const double t181 = t180 / t87;
+  const double t182 = t11 * t181;
+  const double t183 = t17 * t173;
+  const double t184 = t183 - t182;
+  const double t185 = t10 * t181;
+  const double t186 = t16 * t173;
+  const double t187 = t186 - t185;
+  const double t188 = t9 * t181;
+  const double t189 = t15 * t173;
+  const double t190 = t189 - t188;
+  const double t191 = t14 * t176;
+  const double t192 = t182 - t191;
+  const double t193 = t13 * t176;
+  const double t194 = t185 - t193;
+  const double t195 = t12 * t176;
+  const double t196 = t188 - t195;
+  const double t197 = t191 - t183;
+  const double t198 = t193 - t186;
+  const double t199 = t195 - t189;
+  /* dq */
+  out[0] = t158;
+  out[1] = t159;
+  out[2] = t160;
+  out[3] = t161;
+  out[4] = t162;
+  out[5] = t163;
+  out[6] = t164;
+  out[7] = t165;
+  out[8] = t166;
+  /* dp */
+  out[9] = t184;
+  out[10] = t187;
+  out[11] = t190;
+  out[12] = t192;
+  out[13] = t194;
+  out[14] = t196;
+  out[15] = t197;
+  out[16] = t198;
+  out[17] = t199;
+  /* pivot */
+  out[18] = t87;
+  out[19] = t114;
+  out[20] = t124;
+  /* adiag */
+  out[21] = t87;
+  out[22] = t101;
+  out[23] = t111;
+}
+
 void satellites_k6s3_params_default(satellites_k6s3_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void satellites_k6s3_init(satellites_k6s3_state *x, const double *q0, const double *p0)
+#define satellites_k6s3_DEFAULT_PARAMS(prm) satellites_k6s3_params dflt_; if (!prm) { satellites_k6s3_params_default(&dflt_); prm = &dflt_; }
+
+void satellites_k6s3_init_params(satellites_k6s3_state *x, const satellites_k6s3_real *q0, const satellites_k6s3_real *p0, const satellites_k6s3_params *prm)
 {
   int i;
+  satellites_k6s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < satellites_k6s3_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : satellites_k6s3_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : satellites_k6s3_p0[i];
+    x->q[i] = q0 ? q0[i] : satellites_k6s3_q0[i];
+    x->p[i] = p0 ? p0[i] : satellites_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_k6s3_NU ? satellites_k6s3_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = 0;
   {
-    satellites_k6s3_params prm;
     double lam[satellites_k6s3_NU];
-    satellites_k6s3_params_default(&prm);
-    satellites_k6s3_lambda0(x->q, x->p, 0, 0, 0, &prm, lam);
+    satellites_k6s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
     for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void satellites_k6s3_init(satellites_k6s3_state *x, const satellites_k6s3_real *q0, const satellites_k6s3_real *p0)
+{
+  satellites_k6s3_init_params(x, q0, p0, 0);
 }
 
 const char *satellites_k6s3_strerror(int code)
@@ -2397,9 +2641,7 @@ const char *satellites_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define satellites_k6s3_DEFAULT_PARAMS(prm) satellites_k6s3_params dflt_; if (!prm) { satellites_k6s3_params_default(&dflt_); prm = &dflt_; }
-
-double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm)
+satellites_k6s3_real satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k6s3_params *prm)
 {
   double H;
   satellites_k6s3_DEFAULT_PARAMS(prm)
@@ -2407,22 +2649,16 @@ double satellites_k6s3_energy(const satellites_k6s3_state *x, const satellites_k
   return H;
 }
 
-void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *g)
+void satellites_k6s3_constraints(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *g)
 {
-  double v[satellites_k6s3_NU];
-  int i;
   satellites_k6s3_DEFAULT_PARAMS(prm)
-  satellites_k6s3_g(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_k6s3_NU; i++) g[i] = v[i];
+  satellites_k6s3_g(x->q, x->p, 0, 0, 0, prm, g);
 }
 
-void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, double *gp)
+void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *gp)
 {
-  double v[satellites_k6s3_NU];
-  int i;
   satellites_k6s3_DEFAULT_PARAMS(prm)
-  satellites_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_k6s3_NU; i++) gp[i] = v[i];
+  satellites_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -2454,7 +2690,7 @@ static void satellites_k6s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_k6s3_step(satellites_k6s3_state *x, double h_, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
+int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h_, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_k6s3_S * satellites_k6s3_M], sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 3 * satellites_k6s3_NU + 1];
@@ -2525,5 +2761,64 @@ int satellites_k6s3_step(satellites_k6s3_state *x, double h_, const satellites_k
   for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = gam[i];
   satellites_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return satellites_k6s3_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (satellites_k6s3_TOL) or stops decreasing at round-off, at most satellites_k6s3_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int satellites_k6s3_project(satellites_k6s3_state *x, const satellites_k6s3_params *prm, satellites_k6s3_real *dq, satellites_k6s3_real *dp)
+{
+  double q[satellites_k6s3_M], p[satellites_k6s3_M], out[2 * satellites_k6s3_M + 2 * satellites_k6s3_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = satellites_k6s3_ENOCONV;
+  satellites_k6s3_DEFAULT_PARAMS(prm)
+  for (i = 0; i < satellites_k6s3_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= satellites_k6s3_MAXITER; it++) {
+    satellites_k6s3_consistent(q, p, 0, 0, 0, prm, out);
+    for (i = 0; i < satellites_k6s3_NU; i++) {
+      double piv = out[2 * satellites_k6s3_M + i], dia = out[2 * satellites_k6s3_M + satellites_k6s3_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s3_SINGTOL * fabs(dia))) rc = satellites_k6s3_ESINGULAR;
+    }
+    if (rc == satellites_k6s3_ESINGULAR) break;
+    for (i = 0; i < 2 * satellites_k6s3_M + 2 * satellites_k6s3_NU; i++)
+      if (!isfinite(out[i])) rc = satellites_k6s3_ENONFINITE;
+    if (rc == satellites_k6s3_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < satellites_k6s3_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= satellites_k6s3_TOL) { rc = satellites_k6s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * satellites_k6s3_TOL ? satellites_k6s3_OK : satellites_k6s3_ENOCONV; break; }
+    for (i = 0; i < satellites_k6s3_M; i++) q[i] += out[i];
+  }
+  if (rc != satellites_k6s3_OK) return rc;
+  for (i = 0; i < satellites_k6s3_M; i++) {
+    p[i] += out[satellites_k6s3_M + i];
+    if (!isfinite(p[i])) return satellites_k6s3_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < satellites_k6s3_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  {
+    double lam[satellites_k6s3_NU];
+    satellites_k6s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
+    for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return satellites_k6s3_OK;
 }

@@ -8075,7 +8075,7 @@ static void satellites_poly_k6s3_lambda0(const double *q0, const double *p0, con
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
  * and diagonal (NU) of G1' M^-1 G1. */
-static void satellites_poly_k6s3_project(const double *q0, const double *p0, const double *gam, double h,
+static void satellites_poly_k6s3_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
@@ -8205,44 +8205,44 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   const double t122 = t11 * t121;
   const double t123 = t17 * t113;
   const double t124 = t123 - t122;
-  const double t125 = p0[0] /* p_x1 */ + t124;
-  const double t126 = t10 * t121;
-  const double t127 = t16 * t113;
-  const double t128 = t127 - t126;
-  const double t129 = p0[1] /* p_y1 */ + t128;
-  const double t130 = t9 * t121;
-  const double t131 = t15 * t113;
-  const double t132 = t131 - t130;
-  const double t133 = p0[2] /* p_z1 */ + t132;
-  const double t134 = t14 * t116;
-  const double t135 = t122 - t134;
-  const double t136 = p0[3] /* p_x2 */ + t135;
-  const double t137 = t13 * t116;
-  const double t138 = t126 - t137;
-  const double t139 = p0[4] /* p_y2 */ + t138;
-  const double t140 = t12 * t116;
-  const double t141 = t130 - t140;
-  const double t142 = p0[5] /* p_z2 */ + t141;
-  const double t143 = t134 - t123;
-  const double t144 = p0[6] /* p_x3 */ + t143;
-  const double t145 = t137 - t127;
-  const double t146 = p0[7] /* p_y3 */ + t145;
-  const double t147 = t140 - t131;
-  const double t148 = p0[8] /* p_z3 */ + t147;
-  const double t149 = t125 * t125;
-  const double t150 = t129 * t129;
+  const double t125 = t10 * t121;
+  const double t126 = t16 * t113;
+  const double t127 = t126 - t125;
+  const double t128 = t9 * t121;
+  const double t129 = t15 * t113;
+  const double t130 = t129 - t128;
+  const double t131 = t14 * t116;
+  const double t132 = t122 - t131;
+  const double t133 = t13 * t116;
+  const double t134 = t125 - t133;
+  const double t135 = t12 * t116;
+  const double t136 = t128 - t135;
+  const double t137 = t131 - t123;
+  const double t138 = t133 - t126;
+  const double t139 = t135 - t129;
+  const double t140 = p0[0] /* p_x1 */ + t124;
+  const double t141 = p0[1] /* p_y1 */ + t127;
+  const double t142 = p0[2] /* p_z1 */ + t130;
+  const double t143 = p0[3] /* p_x2 */ + t132;
+  const double t144 = p0[4] /* p_y2 */ + t134;
+  const double t145 = p0[5] /* p_z2 */ + t136;
+  const double t146 = p0[6] /* p_x3 */ + t137;
+  const double t147 = p0[7] /* p_y3 */ + t138;
+  const double t148 = p0[8] /* p_z3 */ + t139;
+  const double t149 = t140 * t140;
+  const double t150 = t141 * t141;
   const double t151 = t149 + t150;
-  const double t152 = t133 * t133;
+  const double t152 = t142 * t142;
   const double t153 = t151 + t152;
-  const double t154 = t136 * t136;
+  const double t154 = t143 * t143;
   const double t155 = t153 + t154;
-  const double t156 = t139 * t139;
+  const double t156 = t144 * t144;
   const double t157 = t155 + t156;
-  const double t158 = t142 * t142;
+  const double t158 = t145 * t145;
   const double t159 = t157 + t158;
-  const double t160 = t144 * t144;
+  const double t160 = t146 * t146;
   const double t161 = t159 + t160;
-  const double t162 = t146 * t146;
+  const double t162 = t147 * t147;
   const double t163 = t161 + t162;
   const double t164 = t148 * t148;
   const double t165 = t163 + t164;
@@ -8273,14 +8273,14 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   const double t190 = t182 - t189;
   /* dp */
   out[0] = t124;
-  out[1] = t128;
-  out[2] = t132;
-  out[3] = t135;
-  out[4] = t138;
-  out[5] = t141;
-  out[6] = t143;
-  out[7] = t145;
-  out[8] = t147;
+  out[1] = t127;
+  out[2] = t130;
+  out[3] = t132;
+  out[4] = t134;
+  out[5] = t136;
+  out[6] = t137;
+  out[7] = t138;
+  out[8] = t139;
   /* kin */
   out[9] = t166;
   /* U */
@@ -8295,30 +8295,274 @@ static void satellites_poly_k6s3_project(const double *q0, const double *p0, con
   out[16] = t59;
 }
 
+/* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
+ * smallest in the M norm, -M^-1 G (G' M^-1 G)^-1 g(q0) (M), the projection dp of p0 onto the hidden constraint (M),
+ * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0) */
+static void satellites_poly_k6s3_consistent(const double *q0, const double *p0, const double *gam, double h,
+    const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
+{
+  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = q0[0] /* x1 */ - q0[3] /* x2 */;
+  const double t1 = q0[1] /* y1 */ - q0[4] /* y2 */;
+  const double t2 = q0[2] /* z1 */ - q0[5] /* z2 */;
+  const double t3 = q0[3] /* x2 */ - q0[6] /* x3 */;
+  const double t4 = q0[4] /* y2 */ - q0[7] /* y3 */;
+  const double t5 = q0[5] /* z2 */ - q0[8] /* z3 */;
+  const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
+  const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
+  const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
+  const double t9 = 2.0 * t2;
+  const double t10 = 2.0 * t1;
+  const double t11 = 2.0 * t0;
+  const double t12 = 2.0 * t5;
+  const double t13 = 2.0 * t4;
+  const double t14 = 2.0 * t3;
+  const double t15 = 2.0 * t8;
+  const double t16 = 2.0 * t7;
+  const double t17 = 2.0 * t6;
+  const double t18 = t11 * t11;
+  const double t19 = t11 * t17;
+  const double t20 = -t19;
+  const double t21 = t10 * t10;
+  const double t22 = t18 + t21;
+  const double t23 = t10 * t16;
+  const double t24 = t20 - t23;
+  const double t25 = t9 * t9;
+  const double t26 = t22 + t25;
+  const double t27 = t9 * t15;
+  const double t28 = t24 - t27;
+  const double t29 = t18 + t26;
+  const double t30 = t11 * t14;
+  const double t31 = -t30;
+  const double t32 = t21 + t29;
+  const double t33 = t10 * t13;
+  const double t34 = t31 - t33;
+  const double t35 = t25 + t32;
+  const double t36 = t9 * t12;
+  const double t37 = t34 - t36;
+  const double t38 = t14 * t14;
+  const double t39 = t13 * t13;
+  const double t40 = t38 + t39;
+  const double t41 = t12 * t12;
+  const double t42 = t40 + t41;
+  const double t43 = t38 + t42;
+  const double t44 = t14 * t17;
+  const double t45 = -t44;
+  const double t46 = t39 + t43;
+  const double t47 = t13 * t16;
+  const double t48 = t45 - t47;
+  const double t49 = t41 + t46;
+  const double t50 = t12 * t15;
+  const double t51 = t48 - t50;
+  const double t52 = t17 * t17;
+  const double t53 = t16 * t16;
+  const double t54 = t52 + t53;
+  const double t55 = t15 * t15;
+  const double t56 = t54 + t55;
+  const double t57 = t52 + t56;
+  const double t58 = t53 + t57;
+  const double t59 = t55 + t58;
+  const double t60 = t11 * p0[0] /* p_x1 */;
+  const double t61 = t10 * p0[1] /* p_y1 */;
+  const double t62 = t60 + t61;
+  const double t63 = t9 * p0[2] /* p_z1 */;
+  const double t64 = t62 + t63;
+  const double t65 = t11 * p0[3] /* p_x2 */;
+  const double t66 = t64 - t65;
+  const double t67 = t10 * p0[4] /* p_y2 */;
+  const double t68 = t66 - t67;
+  const double t69 = t9 * p0[5] /* p_z2 */;
+  const double t70 = t68 - t69;
+  const double t71 = t14 * p0[3] /* p_x2 */;
+  const double t72 = t13 * p0[4] /* p_y2 */;
+  const double t73 = t71 + t72;
+  const double t74 = t12 * p0[5] /* p_z2 */;
+  const double t75 = t73 + t74;
+  const double t76 = t14 * p0[6] /* p_x3 */;
+  const double t77 = t75 - t76;
+  const double t78 = t13 * p0[7] /* p_y3 */;
+  const double t79 = t77 - t78;
+  const double t80 = t12 * p0[8] /* p_z3 */;
+  const double t81 = t79 - t80;
+  const double t82 = t17 * p0[0] /* p_x1 */;
+  const double t83 = -t82;
+  const double t84 = t16 * p0[1] /* p_y1 */;
+  const double t85 = t83 - t84;
+  const double t86 = t15 * p0[2] /* p_z1 */;
+  const double t87 = t85 - t86;
+  const double t88 = t17 * p0[6] /* p_x3 */;
+  const double t89 = t87 + t88;
+  const double t90 = t16 * p0[7] /* p_y3 */;
+  const double t91 = t89 + t90;
+  const double t92 = t15 * p0[8] /* p_z3 */;
+  const double t93 = t91 + t92;
+  const double t94 = t37 / t35;
+  const double t95 = t37 * t94;
+  const double t96 = t49 - t95;
+  const double t97 = t28 * t94;
+  const double t98 = t51 - t97;
+  const double t99 = t70 * t94;
+  const double t100 = t81 - t99;
+  const double t101 = t28 / t35;
+  const double t102 = t37 * t101;
+  const double t103 = t51 - t102;
+  const double t104 = t28 * t101;
+  const double t105 = t59 - t104;
+  const double t106 = t70 * t101;
+  const double t107 = t93 - t106;
+  const double t108 = t103 / t96;
+  const double t109 = t98 * t108;
+  const double t110 = t105 - t109;
+  const double t111 = t100 * t108;
+  const double t112 = t107 - t111;
+  const double t113 = t112 / t110;
+  const double t114 = t98 * t113;
+  const double t115 = t100 - t114;
+  const double t116 = t115 / t96;
+  const double t117 = t37 * t116;
+  const double t118 = t70 - t117;
+  const double t119 = t28 * t113;
+  const double t120 = t118 - t119;
+  const double t121 = t120 / t35;
+  const double t122 = t11 * t121;
+  const double t123 = t17 * t113;
+  const double t124 = t123 - t122;
+  const double t125 = t10 * t121;
+  const double t126 = t16 * t113;
+  const double t127 = t126 - t125;
+  const double t128 = t9 * t121;
+  const double t129 = t15 * t113;
+  const double t130 = t129 - t128;
+  const double t131 = t14 * t116;
+  const double t132 = t122 - t131;
+  const double t133 = t13 * t116;
+  const double t134 = t125 - t133;
+  const double t135 = t12 * t116;
+  const double t136 = t128 - t135;
+  const double t137 = t131 - t123;
+  const double t138 = t133 - t126;
+  const double t139 = t135 - t129;
+  const double t140 = t0 * t0;
+  const double t141 = t1 * t1;
+  const double t142 = t140 + t141;
+  const double t143 = t2 * t2;
+  const double t144 = t142 + t143;
+  const double t145 = t144 - 1.0;
+  const double t146 = t3 * t3;
+  const double t147 = t4 * t4;
+  const double t148 = t146 + t147;
+  const double t149 = t5 * t5;
+  const double t150 = t148 + t149;
+  const double t151 = t150 - 1.0;
+  const double t152 = t6 * t6;
+  const double t153 = t7 * t7;
+  const double t154 = t152 + t153;
+  const double t155 = t8 * t8;
+  const double t156 = t154 + t155;
+  const double t157 = t156 - 1.0;
+  /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
+  const double t158 = t94 * t145;
+  const double t159 = t151 - t158;
+  const double t160 = t101 * t145;
+  const double t161 = t157 - t160;
+  const double t162 = t108 * t159;
+  const double t163 = t161 - t162;
+  const double t164 = t163 / t110;
+  const double t165 = t98 * t164;
+  const double t166 = t159 - t165;
+  const double t167 = t166 / t96;
+  const double t168 = t37 * t167;
+  const double t169 = t145 - t168;
+  const double t170 = t28 * t164;
+  const double t171 = t169 - t170;
+  const double t172 = t171 / t35;
+  const double t173 = t11 * t172;
+  const double t174 = t17 * t164;
+  const double t175 = t173 - t174;
+  const double t176 = t10 * t172;
+  const double t177 = t16 * t164;
+  const double t178 = t176 - t177;
+  const double t179 = t9 * t172;
+  const double t180 = t15 * t164;
+  const double t181 = t179 - t180;
+  const double t182 = t14 * t167;
+  const double t183 = t182 - t173;
+  const double t184 = t13 * t167;
+  const double t185 = t184 - t176;
+  const double t186 = t12 * t167;
+  const double t187 = t186 - t179;
+  const double t188 = t174 - t182;
+  const double t189 = t177 - t184;
+  const double t190 = t180 - t186;
+  const double t191 = -t175;
+  const double t192 = -t178;
+  const double t193 = -t181;
+  const double t194 = -t183;
+  const double t195 = -t185;
+  const double t196 = -t187;
+  const double t197 = -t188;
+  const double t198 = -t189;
+  const double t199 = -t190;
+  /* dq */
+  out[0] = t191;
+  out[1] = t192;
+  out[2] = t193;
+  out[3] = t194;
+  out[4] = t195;
+  out[5] = t196;
+  out[6] = t197;
+  out[7] = t198;
+  out[8] = t199;
+  /* dp */
+  out[9] = t124;
+  out[10] = t127;
+  out[11] = t130;
+  out[12] = t132;
+  out[13] = t134;
+  out[14] = t136;
+  out[15] = t137;
+  out[16] = t138;
+  out[17] = t139;
+  /* pivot */
+  out[18] = t35;
+  out[19] = t96;
+  out[20] = t110;
+  /* adiag */
+  out[21] = t35;
+  out[22] = t49;
+  out[23] = t59;
+}
+
 void satellites_poly_k6s3_params_default(satellites_poly_k6s3_params *prm)
 {
   prm->unused_ = 0;
 }
 
-void satellites_poly_k6s3_init(satellites_poly_k6s3_state *x, const double *q0, const double *p0)
+#define satellites_poly_k6s3_DEFAULT_PARAMS(prm) satellites_poly_k6s3_params dflt_; if (!prm) { satellites_poly_k6s3_params_default(&dflt_); prm = &dflt_; }
+
+void satellites_poly_k6s3_init_params(satellites_poly_k6s3_state *x, const satellites_poly_k6s3_real *q0, const satellites_poly_k6s3_real *p0, const satellites_poly_k6s3_params *prm)
 {
   int i;
+  satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = 0;
   for (i = 0; i < satellites_poly_k6s3_M; i++) {
-    x->q[i] = q0 ? (double)q0[i] : satellites_poly_k6s3_q0[i];
-    x->p[i] = p0 ? (double)p0[i] : satellites_poly_k6s3_p0[i];
+    x->q[i] = q0 ? q0[i] : satellites_poly_k6s3_q0[i];
+    x->p[i] = p0 ? p0[i] : satellites_poly_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_poly_k6s3_NU ? satellites_poly_k6s3_NU : 1); i++) x->lambda[i] = 0;
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
-    satellites_poly_k6s3_params prm;
     double lam[satellites_poly_k6s3_NU];
-    satellites_poly_k6s3_params_default(&prm);
-    satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, &prm, lam);
+    satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
     for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
+}
+
+void satellites_poly_k6s3_init(satellites_poly_k6s3_state *x, const satellites_poly_k6s3_real *q0, const satellites_poly_k6s3_real *p0)
+{
+  satellites_poly_k6s3_init_params(x, q0, p0, 0);
 }
 
 const char *satellites_poly_k6s3_strerror(int code)
@@ -8333,9 +8577,7 @@ const char *satellites_poly_k6s3_strerror(int code)
   return "unknown error";
 }
 
-#define satellites_poly_k6s3_DEFAULT_PARAMS(prm) satellites_poly_k6s3_params dflt_; if (!prm) { satellites_poly_k6s3_params_default(&dflt_); prm = &dflt_; }
-
-double satellites_poly_k6s3_energy(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm)
+satellites_poly_k6s3_real satellites_poly_k6s3_energy(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm)
 {
   double H;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
@@ -8343,22 +8585,16 @@ double satellites_poly_k6s3_energy(const satellites_poly_k6s3_state *x, const sa
   return H;
 }
 
-void satellites_poly_k6s3_constraints(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, double *g)
+void satellites_poly_k6s3_constraints(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_real *g)
 {
-  double v[satellites_poly_k6s3_NU];
-  int i;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
-  satellites_poly_k6s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_poly_k6s3_NU; i++) g[i] = v[i];
+  satellites_poly_k6s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g);
 }
 
-void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, double *gp)
+void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_real *gp)
 {
-  double v[satellites_poly_k6s3_NU];
-  int i;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
-  satellites_poly_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, v);
-  for (i = 0; i < satellites_poly_k6s3_NU; i++) gp[i] = v[i];
+  satellites_poly_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
@@ -8390,7 +8626,7 @@ static void satellites_poly_k6s3_add(double *a, double *c, double b)
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, double h_, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
@@ -8466,7 +8702,7 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, double h_, const sa
     satellites_poly_k6s3_add(&p1[i], &pc1[i], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i]);
   }
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
-  satellites_poly_k6s3_project(q1, p1, 0, 0, 0, 0, 0, prm, pr);
+  satellites_poly_k6s3_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < satellites_poly_k6s3_NU; i++) {
     double piv = pr[satellites_poly_k6s3_M + 2 + i], dia = pr[satellites_poly_k6s3_M + 2 + satellites_poly_k6s3_NU + i];
     if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_poly_k6s3_SINGTOL * fabs(dia))) return satellites_poly_k6s3_ESINGULAR;
@@ -8494,11 +8730,71 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, double h_, const sa
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
-    double lam0[satellites_poly_k6s3_NU];
-    satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam0);
-    for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam0[i]) ? lam0[i] : 0;
+    double lam[satellites_poly_k6s3_NU];
+    satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   satellites_poly_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
+  return satellites_poly_k6s3_OK;
+}
+
+/* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
+ * (satellites_poly_k6s3_TOL) or stops decreasing at round-off, at most satellites_poly_k6s3_MAXITER times; then p
+ * projected onto the hidden constraint at that q. x is written only on success. */
+int satellites_poly_k6s3_project(satellites_poly_k6s3_state *x, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_real *dq, satellites_poly_k6s3_real *dp)
+{
+  double q[satellites_poly_k6s3_M], p[satellites_poly_k6s3_M], out[2 * satellites_poly_k6s3_M + 2 * satellites_poly_k6s3_NU], inc = HUGE_VAL, inc_old, scale, dqmax = 0, dpmax = 0;
+  int it, i, rc = satellites_poly_k6s3_ENOCONV;
+  satellites_poly_k6s3_DEFAULT_PARAMS(prm)
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
+    q[i] = x->q[i];
+    p[i] = x->p[i];
+  }
+  for (it = 1; it <= satellites_poly_k6s3_MAXITER; it++) {
+    satellites_poly_k6s3_consistent(q, p, 0, 0, 0, 0, 0, prm, out);
+    for (i = 0; i < satellites_poly_k6s3_NU; i++) {
+      double piv = out[2 * satellites_poly_k6s3_M + i], dia = out[2 * satellites_poly_k6s3_M + satellites_poly_k6s3_NU + i];
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_poly_k6s3_SINGTOL * fabs(dia))) rc = satellites_poly_k6s3_ESINGULAR;
+    }
+    if (rc == satellites_poly_k6s3_ESINGULAR) break;
+    for (i = 0; i < 2 * satellites_poly_k6s3_M + 2 * satellites_poly_k6s3_NU; i++)
+      if (!isfinite(out[i])) rc = satellites_poly_k6s3_ENONFINITE;
+    if (rc == satellites_poly_k6s3_ENONFINITE) break;
+    inc_old = inc;
+    inc = 0;
+    scale = 0;
+    for (i = 0; i < satellites_poly_k6s3_M; i++) {
+      if (fabs(q[i]) > scale) scale = fabs(q[i]);
+      if (fabs(out[i]) > inc) inc = fabs(out[i]);
+    }
+    if (scale > 0) inc /= scale;
+    /* at round-off the last correction is left out, so that dp below is at q */
+    if (inc <= satellites_poly_k6s3_TOL) { rc = satellites_poly_k6s3_OK; break; }
+    if (it > 1 && inc >= inc_old) { rc = inc <= 16 * satellites_poly_k6s3_TOL ? satellites_poly_k6s3_OK : satellites_poly_k6s3_ENOCONV; break; }
+    for (i = 0; i < satellites_poly_k6s3_M; i++) q[i] += out[i];
+  }
+  if (rc != satellites_poly_k6s3_OK) return rc;
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
+    p[i] += out[satellites_poly_k6s3_M + i];
+    if (!isfinite(p[i])) return satellites_poly_k6s3_ENONFINITE;
+    if (fabs(q[i] - x->q[i]) > dqmax) dqmax = fabs(q[i] - x->q[i]);
+    if (fabs(p[i] - x->p[i]) > dpmax) dpmax = fabs(p[i] - x->p[i]);
+  }
+  for (i = 0; i < satellites_poly_k6s3_M; i++) {
+    x->q[i] = q[i];
+    x->p[i] = p[i];
+    x->qc[i] = x->pc[i] = 0;
+  }
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = 0;
+  x->hprev = 0;  /* the next step starts afresh, as after init */
+  x->H0 = 0;
+  {
+    double lam[satellites_poly_k6s3_NU];
+    satellites_poly_k6s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
+    for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  }
+  if (dq) *dq = dqmax;
+  if (dp) *dp = dpmax;
   return satellites_poly_k6s3_OK;
 }

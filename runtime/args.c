@@ -1,7 +1,7 @@
 /* args.c - the standalone driver's options (SPEC section 4).
  *
  *   NAME [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..] [--p0 a,b,..]
- *        [--param name=value] [--csv FILE] [--quiet] [--help]
+ *        [--param name=value] [--project] [--csv FILE] [--quiet] [--help]
  *
  * Options are read left to right; a repeated option overrides the earlier one
  * (--param per name).  A value is the next argument, so `-h -0.01` works; it
@@ -20,7 +20,7 @@
 
 typedef enum {
   OPT_STEP, OPT_TIME, OPT_STEPS, OPT_EVERY, OPT_Q0, OPT_P0, OPT_PARAM,
-  OPT_CSV, OPT_QUIET, OPT_HELP
+  OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT
 } OptId;
 
 typedef struct {
@@ -33,7 +33,7 @@ static const Option options[] = {
   {"-h", OPT_STEP, 1},      {"-T", OPT_TIME, 1},     {"-N", OPT_STEPS, 1},
   {"--every", OPT_EVERY, 1}, {"--q0", OPT_Q0, 1},    {"--p0", OPT_P0, 1},
   {"--param", OPT_PARAM, 1}, {"--csv", OPT_CSV, 1},  {"--quiet", OPT_QUIET, 0},
-  {"--help", OPT_HELP, 0},
+  {"--help", OPT_HELP, 0},   {"--project", OPT_PROJECT, 0},
 };
 
 /* What was seen on the way, for the checks that need all options. */
@@ -234,7 +234,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
 
   fprintf(out,
     "usage: %s [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..]\n"
-    "       %*s [--p0 a,b,..] [--param name=value] [--csv FILE] [--quiet]\n"
+    "       %*s [--p0 a,b,..] [--param name=value] [--project] [--csv FILE]\n"
+    "       %*s [--quiet]\n"
     "\n"
     "Integrates the model %s (m=%d coordinates, nu=%d constraints) with the\n"
     "HBVM(k=%d,s=%d) line integral method, N steps of the constant step h.\n"
@@ -247,7 +248,7 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --every K          a CSV row every K steps, K >= 1; t=0 and the last\n"
     "                     step are always written (default 1)\n"
     "  --q0 a,b,..        initial positions, %d values (default ",
-    md->name, (int)strlen(md->name), "", md->name, md->m, md->nu, md->k,
+    md->name, (int)strlen(md->name), "", (int)strlen(md->name), "", md->name, md->m, md->nu, md->k,
     md->s, HBVMRT_DEFAULT_H, HBVMRT_DEFAULT_T, md->m);
   print_vector(out, md->q0, md->m);
   fprintf(out, ")\n  --p0 a,b,..        initial momenta, %d values (default ",
@@ -255,6 +256,10 @@ static int print_help(const hbvmrt_model *md, FILE *out)
   print_vector(out, md->p0, md->m);
   fputs(")\n"
     "  --param name=value set a run-time parameter (repeatable)\n"
+    "  --project          move q0 onto the constraints g = 0 and p0 onto the hidden\n"
+    "                     constraints first, and report the change; without it,\n"
+    "                     initial values off them (by more than 1e-10 relative)\n"
+    "                     are refused\n"
     "  --csv FILE         write the rows t,x..,p_x..,lambda_1..,H,g_1..,hc_1.. to\n"
     "                     FILE ('-' for stdout); no CSV without it\n"
     "  --quiet            no progress line on a terminal\n"
@@ -273,8 +278,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
   fputs("\nAt the end one line on stderr:\n"
     "  steps=N iters_mean=X iters_max=Y max_dH=E max_g=E max_hc=E seconds=S\n"
     "with the maxima of |H-H0|, |g_i| and |hc_i| over every step.\n"
-    "Exit status: 0 success, 1 bad arguments or an output error, 2 a failed "
-    "step.\n", out);
+    "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"
+    "included) or an output error, 2 a failed step or projection.\n", out);
   free(prm);
   if (fflush(out) != 0 || ferror(out)) {
     hbvmrt_error(md, "cannot write the help text");
@@ -321,6 +326,9 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
     return 0;
   case OPT_QUIET:
     o->quiet = 1;
+    return 0;
+  case OPT_PROJECT:
+    o->project = 1;
     return 0;
   case OPT_HELP:
     break;

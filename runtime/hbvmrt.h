@@ -47,8 +47,17 @@ typedef struct {
   void (*hidden)(const void *x, const void *prm, double *gp);
   /* The m coordinate names ("x", "x[3]") for the CSV header; NULL (as in
    * drivers from hbvmgen 0.1, which end before this field) gives the
-   * numbered header q1..qm.  Add new fields after this one. */
+   * numbered header q1..qm. */
   const char *const *names;
+  /* Drivers generated before these fields leave them NULL, 0 and start as
+   * before, unchecked.  Init at the run's params (q0, p0 NULL: the model's, which may
+   * depend on them); the projection onto the constraints (NAME_project: 0 or a
+   * step code, x unchanged on failure; dq, dp the largest change of a q, p);
+   * the relative precision of the solver's real type (DBL_EPSILON,
+   * FLT_EPSILON).  Add new fields after these. */
+  void (*init_params)(void *x, const double *q0, const double *p0, const void *prm);
+  int (*project)(void *x, const void *prm, double *dq, double *dp);
+  double eps;
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status

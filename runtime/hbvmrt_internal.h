@@ -19,6 +19,10 @@
 
 #define HBVMRT_DEFAULT_H 0.01   /* step when -h is not given */
 #define HBVMRT_DEFAULT_T 10.0   /* time span when neither -T nor -N is given */
+/* Initial values whose projection onto the constraints moves q or p by more
+ * than this, relative to max|q|, max|p|, are refused without --project (or
+ * 64 ulps of the solver's real type, if that is more: float). */
+#define HBVMRT_CONSISTENCY_TOL 1e-10
 
 /* The driver options once parsed and checked. */
 typedef struct {
@@ -30,6 +34,7 @@ typedef struct {
   char *param_set;     /* ... nonzero where one was given */
   const char *csv;     /* NULL: no CSV; "-": stdout */
   int quiet;           /* no progress line */
+  int project;         /* --project: move q0, p0 onto the constraints */
 } hbvmrt_opts;
 
 /* What hbvmrt_parse_args tells the caller to do next. */

@@ -86,12 +86,78 @@ static void observe(Run *r)
   }
 }
 
+/* max |v[i]| over n doubles at byte offset off of the state x */
+static double max_abs(const void *x, size_t off, int n)
+{
+  const double *v = (const double *)(const void *)((const char *)x + off);
+  double m = 0;
+  int i;
+
+  for (i = 0; i < n; i++)
+    keep_max(&m, v[i]);
+  return m;
+}
+
+/* The initial state against the constraints (drivers that can project): a
+ * copy is projected, and a change of q or p beyond HBVMRT_CONSISTENCY_TOL
+ * relative (64 ulps in float) is refused, naming the sizes, unless
+ * --project was given; then the projected state is kept and the change
+ * reported.  Returns 0, or the exit status after reporting. */
+static int check_initial(Run *r)
+{
+  const hbvmrt_model *md = r->md;
+  double dq = 0, dp = 0, gmax = 0, hmax = 0, tol = HBVMRT_CONSISTENCY_TOL;
+  double qmax = max_abs(r->x, md->off_q, md->m), pmax = max_abs(r->x, md->off_p, md->m);
+  void *y;
+  int i, code, status = 0;
+
+  if (md->nu <= 0 || !md->project)
+    return 0;
+  if (64 * md->eps > tol)
+    tol = 64 * md->eps;
+  if (!(y = malloc(md->state_size + 1))) {
+    hbvmrt_error(md, "out of memory");
+    return 1;
+  }
+  memcpy(y, r->x, md->state_size);
+  code = md->project(y, r->prm, &dq, &dp);
+  md->constraints(r->x, r->prm, r->g);
+  md->hidden(r->x, r->prm, r->hc);
+  for (i = 0; i < md->nu; i++) {
+    keep_max(&gmax, r->g[i]);
+    keep_max(&hmax, r->hc[i]);
+  }
+  if (code != 0 && (r->o->project || !(gmax <= tol && hmax <= tol))) {
+    hbvmrt_error(md, "cannot project the initial values onto the constraints "
+                 "(max|g(q0)| = %.3e, max|hidden(q0, p0)| = %.3e): %s", gmax,
+                 hmax, md->strerror ? md->strerror(code) : "failed");
+    status = 2;
+  } else if (r->o->project) {
+    memcpy(r->x, y, md->state_size);
+    fprintf(stderr, "%s: projected the initial values onto the constraints: "
+            "max|g(q0)| = %.3e, max|hidden(q0, p0)| = %.3e; q moved by %.3e, "
+            "p by %.3e\n", md->name, gmax, hmax, dq, dp);
+  } else if (code == 0 && !(dq <= tol * qmax && dp <= tol * pmax)) {
+    hbvmrt_error(md, "the initial values are off the constraints: max|g(q0)| "
+                 "= %.3e, max|hidden(q0, p0)| = %.3e (q would move by %.3e, "
+                 "p by %.3e, more than %.0e relative); give consistent "
+                 "--q0/--p0, or pass --project to move them onto the "
+                 "constraints", gmax, hmax, dq, dp, tol);
+    status = 1;
+  }
+  free(y);
+  return status;
+}
+
 /* Allocate the blocks, set the params and the initial state (SPEC 3:
- * NULL q0/p0 means the model defaults).  -1 after reporting. */
+ * NULL q0/p0 means the model defaults, at the run's params when the driver
+ * can say so), checked against the constraints.  The exit status after
+ * reporting, or 0. */
 static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
 {
   const double *q0 = o->q0, *p0 = o->p0;
   size_t nu = (size_t)(md->nu > 0 ? md->nu : 0);
+  int status;
 
   memset(r, 0, sizeof *r);
   r->md = md;
@@ -102,18 +168,23 @@ static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
   r->hc = calloc(nu + 1, sizeof *r->hc);
   if (!r->x || !r->prm || !r->g || !r->hc) {
     hbvmrt_error(md, "out of memory");
-    return -1;
+    return 1;
   }
   if (md->params_default)
     md->params_default(r->prm);
   hbvmrt_apply_params(md, o, r->prm);
-  if (q0 || p0) {
-    q0 = q0 ? q0 : md->q0;
-    p0 = p0 ? p0 : md->p0;
+  if (md->init_params) {
+    md->init_params(r->x, q0, p0, r->prm);
+  } else {
+    if (q0 || p0) {
+      q0 = q0 ? q0 : md->q0;
+      p0 = p0 ? p0 : md->p0;
+    }
+    md->init(r->x, q0, p0);
   }
-  md->init(r->x, q0, p0);
+  status = check_initial(r);
   r->H0 = md->energy(r->x, r->prm);
-  return 0;
+  return status;
 }
 
 static void teardown(Run *r)
@@ -313,9 +384,9 @@ int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv)
     hbvmrt_opts_free(&o);
     return status == HBVMRT_ARGS_DONE ? 0 : 1;
   }
-  status = 1;
-  if (setup(&r, model, &o) == 0 && open_csv(&r) == 0)
-    status = simulate(&r);
+  status = setup(&r, model, &o);
+  if (status == 0)
+    status = open_csv(&r) == 0 ? simulate(&r) : 1;
   teardown(&r);
   hbvmrt_opts_free(&o);
   return status;

@@ -143,7 +143,7 @@ static void float_run(int n, double *dH, double *dg, pendulum_float_k2s2_state *
   *dH = *dg = 0;
   for (int i = 0; i < n; i++) {
     ck_assert_int_eq(pendulum_float_k2s2_step(&x, 2.0 / n, NULL, NULL), 0);
-    double g;
+    pendulum_float_k2s2_real g;
     pendulum_float_k2s2_constraints(&x, NULL, &g);
     *dH = fmax(*dH, fabs(pendulum_float_k2s2_energy(&x, NULL) - H0));
     *dg = fmax(*dg, fabs(g));
@@ -177,8 +177,8 @@ START_TEST(wide_step_widens_only_the_iteration) {
                                           {"--wide-step -s 3", "--wide-step --real float -s 3"}};
   static const char *const wide[2] = {"const long double t", "const double t"};
   static const char *const narrow[2] = {"const double t", "const float t"};
-  static const char *const kernels[] = {"_sweep(", "_factor(", "_project(", "_minv_p(", "_energy_kernel(", "_g(",
-                                        "_hidden_kernel(", "_lambda0("};
+  static const char *const kernels[] = {"_sweep(", "_factor(", "_project_p1(", "_minv_p(", "_energy_kernel(", "_g(",
+                                        "_hidden_kernel(", "_lambda0(", "_consistent("};
   int nwide = _i ? 3 : 1;
   for (int v = 0; v < 2; v++) {
     char *src = generate("variables x, y\nU = x^2 * y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", flags[_i][v]);

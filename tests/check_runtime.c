@@ -103,7 +103,8 @@ static const hbvmrt_model osc = {
   osc_q0, osc_p0,
   osc_init, osc_params_default, osc_step, osc_strerror, osc_energy,
   NULL, NULL,                   /* nu = 0: never called */
-  NULL                          /* no names: the numbered CSV header */
+  NULL,                         /* no names: the numbered CSV header */
+  NULL, NULL, 0                 /* as a driver of hbvmgen 0.1: no projection */
 };
 
 /* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
@@ -200,8 +201,51 @@ static const hbvmrt_model ring = {
   ring_q0, ring_p0,
   ring_init, ring_params_default, ring_step, ring_strerror, ring_energy,
   ring_constraints, ring_hidden,
-  NULL
+  NULL,
+  NULL, NULL, 0
 };
+
+/* ring with the fields of hbvmgen 0.2 drivers: init at the run's params
+ * and the projection onto |q| = 1, q.p = 0 (code 3 at q = 0). */
+static void ringp_init_params(void *x, const double *q0, const double *p0, const void *prm)
+{
+  (void)prm;
+  ring_init(x, q0, p0);
+}
+
+static int ringp_project(void *x, const void *prm, double *dq, double *dp)
+{
+  RingState *s = x;
+  double r = hypot(s->q[0], s->q[1]), q[2], qp;
+  int i;
+
+  (void)prm;
+  if (r == 0)
+    return 3;
+  q[0] = s->q[0] / r;
+  q[1] = s->q[1] / r;
+  qp = q[0] * s->p[0] + q[1] * s->p[1];
+  *dq = *dp = 0;
+  for (i = 0; i < 2; i++) {
+    *dq = fmax(*dq, fabs(q[i] - s->q[i]));
+    *dp = fmax(*dp, fabs(qp * q[i]));
+    s->q[i] = q[i];
+    s->p[i] -= qp * q[i];
+  }
+  return 0;
+}
+
+/* ring as a driver with those fields */
+static hbvmrt_model ring_projecting(void)
+{
+  hbvmrt_model md = ring;
+
+  md.name = "ringp";
+  md.init_params = ringp_init_params;
+  md.project = ringp_project;
+  md.eps = 2.220446049250313e-16;
+  return md;
+}
 
 /* --- running the driver ---------------------------------------------------- */
 
@@ -787,6 +831,39 @@ START_TEST(disk_full)
 }
 END_TEST
 
+/* Initial values off the constraints: refused (status 1, the sizes named)
+ * by a driver that can project, run as they are by an older one, projected
+ * with --project (reported, g and hc zero at t = 0); a projection that fails
+ * is status 2; values off by round-off only run unchanged. */
+START_TEST(inconsistent_start)
+{
+  const hbvmrt_model ringp = ring_projecting();
+  Result r = run(&ringp, "--q0 1.1,0 --p0 0.5,1 -N 2 --csv @");
+  ck_assert_int_eq(r.status, 1);
+  ck_assert_msg(strstr(r.err, "ringp: error: the initial values are off the constraints: max|g(q0)| = 2.100e-01, "
+                              "max|hidden(q0, p0)| = 1.100e+00") && strstr(r.err, "--project"), "%s", r.err);
+  ck_assert_str_eq(r.csv, "");
+  done(&r);
+  r = run(&ring, "--q0 1.1,0 -N 2");
+  ck_assert_int_eq(r.status, 0);
+  done(&r);
+  r = run(&ringp, "--q0 1.1,0 --p0 0.5,1 -N 2 --project --csv @");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_msg(strstr(r.err, "ringp: projected the initial values onto the constraints: max|g(q0)| = 2.100e-01, "
+                              "max|hidden(q0, p0)| = 1.100e+00; q moved by 1.000e-01, p by 5.000e-01\n"), "%s", r.err);
+  ck_assert(cell(r.csv, 0, 1) == 1 && cell(r.csv, 0, 3) == 0 && cell(r.csv, 0, 7) == 0 && cell(r.csv, 0, 8) == 0);
+  done(&r);
+  r = run(&ringp, "--q0 0,0 -N 2 --project");
+  ck_assert_int_eq(r.status, 2);
+  ck_assert_msg(strstr(r.err, "ringp: error: cannot project the initial values onto the constraints"), "%s", r.err);
+  done(&r);
+  r = run(&ringp, "--q0 0.6,0.8 --p0 -0.8,0.6 -N 2 --csv @");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert(cell(r.csv, 0, 1) == 0.6 && cell(r.csv, 0, 4) == 0.6);
+  done(&r);
+}
+END_TEST
+
 START_TEST(help)
 {
   Result r = run(&ring, "--help");
@@ -901,6 +978,7 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, summary_nu1);
   tcase_add_test(run_, summary_every_step);
   tcase_add_test(run_, ring_default_run);
+  tcase_add_test(run_, inconsistent_start);
   tcase_add_test(run_, step_failure);
   tcase_add_test(run_, step_failure_every);
   tcase_add_test(run_, no_progress_off_terminal);
