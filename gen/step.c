@@ -164,6 +164,25 @@ static void build_stages(Build *b) {
   }
 }
 
+// The constraints c coupled with constraint a, each once, in the order met:
+// those listed in touch[i] for a coordinate i of grad g_a (touch[i]: the
+// constraints whose M^-1-weighted columns are nonzero at i). pair (nu ints,
+// -1 at first) remembers the last a each c was listed for. Returns how
+// many, written to out.
+int step_coupled(Build *b, const IntVec *touch, int *pair, int a, int *out) {
+  const SparseVec *col = &b->mod->jac[a];
+  int n = 0;
+  for (int e = 0; e < col->n; e++) {
+    const IntVec *t = &touch[col->e[e].coord];
+    for (int q = 0; q < t->n; q++)
+      if (pair[t->v[q]] != a) {
+        pair[t->v[q]] = a;
+        out[n++] = t->v[q];
+      }
+  }
+  return n;
+}
+
 // <rho_j[:, a], v> over the structural nonzeros of column a.
 int step_dot_col(Build *b, int j, int a, const int *v) {
   Dag *d = b->d;

@@ -35,6 +35,7 @@ int **step_jacobian_at(Build *b, const int *q);       /* dense columns of grad g
 void step_gram(Build *b, int **G, int *B);            /* B = G' M^-1 G */
 void step_project_momenta(Build *b, int **G, const int *B, const int *p, int *dp, int *pivot, int *adiag);
 int step_dot_col(Build *b, int j, int a, const int *v);
+int step_coupled(Build *b, const IntVec *touch, int *pair, int a, int *out); /* constraints coupled with a */
 void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
 
 void build_const_multiplier(Build *b);

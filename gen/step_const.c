@@ -43,23 +43,17 @@ static void build_system(Build *b, int *lambda, int *pivot, int *adiag) {
       for (int j = 0; j < s; j++) any |= !dag_is_zero(d, b->vrho[j][a][i]);
       if (any) intvec_push(&touch[i], a);
     }
-  int *pair = step_nodes(nu);
+  int *pair = step_nodes(nu), *coupled = step_nodes(nu);
   for (int a = 0; a < nu; a++) pair[a] = -1;
   int *minvp0 = step_nodes(m), *p0 = step_nodes(m);
   for (int i = 0; i < m; i++) p0[i] = step_in(b, IN_P0, i);
   minv_apply(b->mod, d, p0, minvp0);
   for (int a = 0; a < nu; a++) {
     for (int c = 0; c < nu; c++) A[a * nu + c] = dag_const(d, 0);
-    const SparseVec *col = &b->mod->jac[a];
-    for (int e = 0; e < col->n; e++) {
-      IntVec *t = &touch[col->e[e].coord];
-      for (int q = 0; q < t->n; q++) {
-        int c = t->v[q];
-        if (pair[c] == a) continue;
-        pair[c] = a;
-        for (int j = 0; j < s; j++) y[j] = b->vrho[j][c];
-        A[a * nu + c] = dag_mul(d, b->h, skew_form(b, a, y));
-      }
+    for (int q = 0, n = step_coupled(b, touch, pair, a, coupled); q < n; q++) {
+      int c = coupled[q];
+      for (int j = 0; j < s; j++) y[j] = b->vrho[j][c];
+      A[a * nu + c] = dag_mul(d, b->h, skew_form(b, a, y));
     }
     for (int j = 0; j < s; j++) y[j] = b->vpsi[j];
     int rhs = dag_sub(d, step_dot_col(b, 0, a, minvp0), dag_mul(d, b->h, skew_form(b, a, y)));

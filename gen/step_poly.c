@@ -109,27 +109,22 @@ static int *multiplier_matrix(Build *b, int ***G) {
         for (int l = 0; l < s; l++) any |= !dag_is_zero(d, vR[r][c][l][i]);
       if (any) intvec_push(&touch[i], c);
     }
-  int *A = step_nodes(n * n), *pair = step_nodes(nu), *xv = step_nodes(m);
+  int *A = step_nodes(n * n), *pair = step_nodes(nu), *coupled = step_nodes(nu), *xv = step_nodes(m);
   for (int t = 0; t < n * n; t++) A[t] = z;
   for (int a = 0; a < nu; a++) pair[a] = -1;
   for (int a = 0; a < nu; a++) {
     const SparseVec *col = &b->mod->jac[a];
-    for (int e = 0; e < col->n; e++) {
-      IntVec *t = &touch[col->e[e].coord];
-      for (int q = 0; q < t->n; q++) {
-        int c = t->v[q];
-        if (pair[c] == a) continue;
-        pair[c] = a;
-        for (int i = 0; i < s; i++)
-          for (int r = 0; r < s; r++) {
-            int acc = z;
-            for (int j = 0; j < s; j++) {
-              for (int f = 0; f < col->n; f++) xv[col->e[f].coord] = step_apply_x(b, j, col->e[f].coord, vR[r][c]);
-              acc = dag_add(d, acc, dot_sparse(b, a, R[i][j][a], xv));
-            }
-            A[(i * nu + a) * n + r * nu + c] = dag_mul(d, b->h, acc);
+    for (int q = 0, nc = step_coupled(b, touch, pair, a, coupled); q < nc; q++) {
+      int c = coupled[q];
+      for (int i = 0; i < s; i++)
+        for (int r = 0; r < s; r++) {
+          int acc = z;
+          for (int j = 0; j < s; j++) {
+            for (int f = 0; f < col->n; f++) xv[col->e[f].coord] = step_apply_x(b, j, col->e[f].coord, vR[r][c]);
+            acc = dag_add(d, acc, dot_sparse(b, a, R[i][j][a], xv));
           }
-      }
+          A[(i * nu + a) * n + r * nu + c] = dag_mul(d, b->h, acc);
+        }
     }
   }
   return A;

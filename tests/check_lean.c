@@ -11,47 +11,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "generate.h"
 #include "pendulum_float_k2s2.h"
 #include "pendulum_k2s2.h"
 #include "pendulum_wide_k2s2.h"
 #include "pendulum_floatwide_k2s2.h"
 
-// Generate `text` as model NAME.ham in a fresh directory; returns the
-// generated C source (malloc'd) or NULL.
-static char *generate(const char *text, const char *flags) {
-  char dir[] = "/tmp/hbvm-lean-XXXXXX", path[256], cmd[512];
-  if (!mkdtemp(dir)) return NULL;
-  snprintf(path, sizeof path, "%s/model.ham", dir);
-  FILE *f = fopen(path, "w");
-  if (!f) return NULL;
-  fputs(text, f);
-  fclose(f);
-  snprintf(cmd, sizeof cmd, "../gen/hbvmgen %s -o %s %s", flags, dir, path);
-  char *src = NULL;
-  if (system(cmd) == 0) {
-    snprintf(path, sizeof path, "%s/model.c", dir);
-    if ((f = fopen(path, "rb"))) {
-      src = calloc(1, 1 << 20);
-      if (src) fread(src, 1, (1 << 20) - 1, f);
-      fclose(f);
-    }
-  }
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  if (system(cmd)) return src;
-  return src;
-}
-
-// Number of temporaries in the sweep kernel of generated source src.
-static int sweep_temporaries(const char *src) {
-  const char *p = strstr(src, "_sweep(");
-  const char *end = p ? strstr(p, "\n}\n") : NULL;
-  int n = 0;
-  while (p && (p = strstr(p, "const double t")) && p < end) {
-    n++;
-    p++;
-  }
-  return n;
-}
+#define SWEEP_TEMPS(src) kernel_temporaries(src, "_sweep(")
 
 START_TEST(equal_mass_matrices_give_equal_code) {
   static const char *const forms[] = {"M = [[2, 0], [0, 2]]", "M = diag(2, 2)", "M = 2", "M = diag(4/2, 2)"};
@@ -59,7 +25,7 @@ START_TEST(equal_mass_matrices_give_equal_code) {
   for (size_t i = 0; i < sizeof forms / sizeof forms[0]; i++) {
     char text[256];
     snprintf(text, sizeof text, "variables x, y\n%s\nU = y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", forms[i]);
-    char *src = generate(text, "-s 2");
+    char *src = generate_source(text, "-s 2");
     ck_assert_msg(src != NULL, "generation failed for %s", forms[i]);
     if (!first) first = src;
     else {
@@ -73,7 +39,7 @@ START_TEST(equal_mass_matrices_give_equal_code) {
 END_TEST
 
 START_TEST(no_multiplier_code_without_constraints) {
-  char *src = generate("variables x, y\nU = x^4 + y^4 + x*y\nq0 = [1, 0]\np0 = [0, 1]\n", "-s 2");
+  char *src = generate_source("variables x, y\nU = x^4 + y^4 + x*y\nq0 = [1, 0]\np0 = [0, 1]\n", "-s 2");
   ck_assert_ptr_nonnull(src);
   ck_assert_msg(!strstr(src, "A lambda = r"), "multiplier code in an unconstrained model");
   ck_assert_msg(!strstr(src, "g0["), "g(q0) used in an unconstrained model");
@@ -84,9 +50,9 @@ END_TEST
 
 START_TEST(no_force_code_without_potential) {
   /* a free particle: gamma_0 = p0, nothing to compute in the sweep */
-  char *src = generate("variables x, y, z\nq0 = [0, 0, 0]\np0 = [1, 2, 3]\n", "-s 3");
+  char *src = generate_source("variables x, y, z\nq0 = [0, 0, 0]\np0 = [1, 2, 3]\n", "-s 3");
   ck_assert_ptr_nonnull(src);
-  ck_assert_int_eq(sweep_temporaries(src), 0);
+  ck_assert_int_eq(SWEEP_TEMPS(src), 0);
   free(src);
 }
 END_TEST
@@ -94,7 +60,7 @@ END_TEST
 START_TEST(structural_zeros_never_multiplied) {
   /* a chain: each constraint touches 2 or 4 coordinates; the code may not
    * multiply by a literal 0 or 1 anywhere */
-  char *src = generate("N = 6\nvariables x[N], y[N]\nU = sum(i in 1..N, y[i])\n"
+  char *src = generate_source("N = 6\nvariables x[N], y[N]\nU = sum(i in 1..N, y[i])\n"
                        "g = [x[1]^2 + y[1]^2 - 1, [(x[i] - x[i-1])^2 + (y[i] - y[i-1])^2 - 1 for i in 2..N]]\n"
                        "q0 = [[i for i in 1..N], [0 for i in 1..N]]\np0 = [0 for i in 1..2*N]\n",
                        "-s 2");
@@ -117,7 +83,7 @@ static char *chain_in_order(const int order[8]) {
     strcat(text, k < 7 ? ", " : "]\n");
   }
   strcat(text, "q0 = [[i for i in 1..N], [0 for i in 1..N]]\np0 = [0 for i in 1..2*N]\n");
-  return generate(text, "-s 2");
+  return generate_source(text, "-s 2");
 }
 
 START_TEST(elimination_order_keeps_sparsity) {
@@ -128,8 +94,8 @@ START_TEST(elimination_order_keeps_sparsity) {
   char *a = chain_in_order(natural), *b = chain_in_order(scrambled);
   ck_assert_ptr_nonnull(a);
   ck_assert_ptr_nonnull(b);
-  ck_assert_int_eq(sweep_temporaries(a), sweep_temporaries(b));
-  ck_assert_int_gt(sweep_temporaries(a), 100);
+  ck_assert_int_eq(SWEEP_TEMPS(a), SWEEP_TEMPS(b));
+  ck_assert_int_gt(SWEEP_TEMPS(a), 100);
   free(a);
   free(b);
 }
@@ -181,7 +147,7 @@ START_TEST(wide_step_widens_only_the_iteration) {
                                         "_hidden_kernel(", "_lambda0(", "_consistent("};
   int nwide = _i ? 3 : 1;
   for (int v = 0; v < 2; v++) {
-    char *src = generate("variables x, y\nU = x^2 * y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", flags[_i][v]);
+    char *src = generate_source("variables x, y\nU = x^2 * y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n", flags[_i][v]);
     ck_assert_ptr_nonnull(src);
     for (size_t k = 0; k < sizeof kernels / sizeof kernels[0]; k++) {
       const char *start = strstr(src, kernels[k]);

@@ -25,6 +25,7 @@
 
 #include "polyfloat_k3s3.h"
 #include "polywide_k3s3.h"
+#include "generate.h"
 #include "ref.h"
 #include "solvers.h"
 
@@ -260,19 +261,11 @@ END_TEST
 
 // The C source hbvmgen writes for models/NAME.ham with flags (malloc'd).
 static char *generate(const char *model, const char *flags) {
-  char dir[] = "/tmp/hbvm-poly-XXXXXX", cmd[512], path[300];
-  ck_assert(mkdtemp(dir) != NULL);
-  snprintf(cmd, sizeof cmd, "../gen/hbvmgen %s -n m -o %s ../models/%s.ham", flags, dir, model);
-  ck_assert_msg(system(cmd) == 0, "%s failed", cmd);
-  snprintf(path, sizeof path, "%s/m.c", dir);
-  FILE *f = fopen(path, "rb");
-  ck_assert(f != NULL);
-  char *src = calloc(1, 1 << 22);
-  ck_assert(src != NULL);
-  ck_assert(fread(src, 1, (1 << 22) - 1, f) > 0);
-  fclose(f);
-  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-  ck_assert_int_eq(system(cmd), 0);
+  char path[256];
+  snprintf(path, sizeof path, "../models/%s.ham", model);
+  char *text = read_text(path), *src = text ? generate_source(text, flags) : NULL;
+  ck_assert_msg(src != NULL, "hbvmgen %s %s failed", flags, path);
+  free(text);
   return src;
 }
 
@@ -311,27 +304,12 @@ START_TEST(chain_factor_is_banded) {
       "q0 = [[i for i in 1..N], [0 for i in 1..N]]\np0 = [0 for i in 1..2*N]\n";
   int temps[2];
   for (int v = 0; v < 2; v++) {
-    char dir[] = "/tmp/hbvm-chain-XXXXXX", path[300], cmd[512];
-    ck_assert(mkdtemp(dir) != NULL);
-    snprintf(path, sizeof path, "%s/c.ham", dir);
-    FILE *f = fopen(path, "w");
-    ck_assert(f != NULL);
-    fprintf(f, "N = %d\n%s", v ? 8 : 4, chain);
-    fclose(f);
-    snprintf(cmd, sizeof cmd, "../gen/hbvmgen -s 2 -o %s %s", dir, path);
-    ck_assert_int_eq(system(cmd), 0);
-    snprintf(path, sizeof path, "%s/c.c", dir);
-    f = fopen(path, "rb");
-    char *src = calloc(1, 1 << 22);
-    ck_assert(f && src && fread(src, 1, (1 << 22) - 1, f) > 0);
-    fclose(f);
-    const char *p = strstr(src, "_factor("), *end = p ? strstr(p, "\n}\n") : NULL;
-    ck_assert(end != NULL);
-    temps[v] = 0;
-    while ((p = strstr(p + 1, "const double t")) && p < end) temps[v]++;
+    char text[1024];
+    snprintf(text, sizeof text, "N = %d\n%s", v ? 8 : 4, chain);
+    char *src = generate_source(text, "-s 2");
+    ck_assert_ptr_nonnull(src);
+    temps[v] = kernel_temporaries(src, "_factor(");
     free(src);
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    ck_assert_int_eq(system(cmd), 0);
   }
   printf("poly: chain factor kernel: %d temporaries (4 links), %d (8 links)\n", temps[0], temps[1]);
   ck_assert_msg(temps[1] < 2.5 * temps[0], "chain factor grows faster than linearly: %d -> %d", temps[0], temps[1]);
