@@ -243,8 +243,8 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
            "constant)\n", 2 * o->s);
   if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
   else
-    printf("M: with params, %s at their defaults; M^-1 from them in every kernel (%s)\n", mass_str(mod->mass),
-           mod->mass_L ? "L D L' factorisation" : "1/M_ii");
+    printf("M: with params: %s, computed from them in every kernel call\n",
+           mod->mass_L ? "dense, M^-1 v by its L D L' factors" : "diagonal, M^-1 = 1/M_ii");
   long nnz = 0;
   for (int a2 = 0; a2 < mod->nu; a2++) nnz += mod->jac[a2].n;
   if (mod->nu)
