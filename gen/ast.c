@@ -447,15 +447,6 @@ static int *value_list(Ctx *cx, const Stmt *st, const char *what, const char *wh
   return l.nodes.v;
 }
 
-// value_list of constants, as doubles.
-static double *constant_list(Ctx *cx, const Stmt *st, const char *what, const char *whole, int want) {
-  int *nodes = value_list(cx, st, what, whole, want, 0);
-  if (!nodes) return NULL;
-  double *v = arena_alloc((size_t)want * sizeof(double));
-  for (int i = 0; i < want; i++) v[i] = cx->d->nodes[nodes[i]].val;
-  return v;
-}
-
 /* ---- statements ---- */
 
 // Name coordinate slot for comments in the emitted code: "x" or "x[3]".
@@ -569,8 +560,53 @@ static void add_constraints(Ctx *cx, const Stmt *st) {
   }
 }
 
-// Lower M = ... into a dense matrix when written as [[...]] (mass_setup), else
-// into its diagonal (mass_setup_diag); they check it and find its structure.
+// Flatten a list of entries of M (diag(...) or a row) into want nodes,
+// constants or expressions of params; a value that depends on a coordinate
+// is an error there, a wrong count an error at at, naming the list what.
+static int *mass_list(Ctx *cx, const Ast *e, Loc at, const char *what, int want) {
+  List l = {{0}, {0}, {0}};
+  if (flatten(cx, e, &l) < 0) return NULL;
+  for (int i = 0; i < l.nodes.n; i++)
+    if (cx->d->nodes[l.nodes.v[i]].flags & DEP_INPUT) {
+      Loc loc = {l.lines.v[i], l.cols.v[i]};
+      error_at(loc, "M cannot depend on a coordinate (only on constants and params), but this value does");
+      return NULL;
+    }
+  if (l.nodes.n != want) {
+    error_at(at, "%s has %d value%s, expected %d (one per coordinate)", what, l.nodes.n, l.nodes.n == 1 ? "" : "s",
+             want);
+    return NULL;
+  }
+  return l.nodes.v;
+}
+
+// The params' default values, to evaluate M at them (freed by the caller).
+static double *param_values(const Ctx *cx) {
+  double *prm = xmalloc((size_t)(cx->nparams + 1) * sizeof *prm);
+  for (int i = 0; i < cx->nparams; i++) prm[i] = cx->params[i].value;
+  return prm;
+}
+
+// M from its entries as nodes: m of the diagonal, or m*m row-major when
+// dense. With params, M^-1 goes into the DAG (mass_setup_params); either
+// way M's value (at the default params) is checked and classified by
+// mass_setup or mass_setup_diag.
+static void mass_from_nodes(Ctx *cx, const int *nodes, int dense, Loc loc) {
+  Model *mod = cx->mod;
+  int n = dense ? mod->m * mod->m : mod->m, params = 0;
+  for (int i = 0; i < n; i++) params |= cx->d->nodes[nodes[i]].op != OP_CONST;
+  if (params && mass_setup_params(mod, nodes, dense, loc) < 0) return;
+  double *prm = param_values(cx), *v = xmalloc((size_t)n * sizeof *v);
+  dag_eval_many(cx->d, nodes, n, NULL, prm, v);
+  if (dense) mass_setup(mod, v, loc);
+  else mass_setup_diag(mod, v, loc);
+  free(prm);
+  free(v);
+}
+
+// Lower M = ... into its m*m entries when written as [[...]], else into its
+// diagonal, as nodes of constants and params; mass_from_nodes checks it
+// and finds its structure.
 static void lower_mass(Ctx *cx) {
   Model *mod = cx->mod;
   int m = mod->m;
@@ -586,12 +622,10 @@ static void lower_mass(Ctx *cx) {
     return;
   }
   if (e->kind == A_DIAG) {
-    Stmt tmp = *cx->mass;
     Ast list = *e;
     list.kind = A_LIST;
-    tmp.expr = &list;
-    double *dg = constant_list(cx, &tmp, "diag(...) of M", "M", m);
-    if (dg) mass_setup_diag(mod, dg, e->loc);
+    int *dg = mass_list(cx, &list, cx->mass->loc, "diag(...) of M", m);
+    if (dg) mass_from_nodes(cx, dg, 0, e->loc);
     return;
   }
   if (e->kind == A_LIST) {
@@ -602,36 +636,37 @@ static void lower_mass(Ctx *cx) {
       return;
     }
     /* every row read and checked before the m x m matrix is allocated */
-    double **v = arena_alloc((size_t)m * sizeof *v);
+    int **v = arena_alloc((size_t)m * sizeof *v);
     int i = 0;
     for (const Ast *r = e->args; r; r = r->next, i++) {
-      Stmt row = *cx->mass;
-      row.expr = (Ast *)r;
-      row.loc = r->loc;
-      v[i] = r->kind == A_LIST ? constant_list(cx, &row, "a row of M", "M", m) : NULL;
+      v[i] = r->kind == A_LIST ? mass_list(cx, r, r->loc, "a row of M", m) : NULL;
       if (r->kind != A_LIST) error_at(r->loc, "M = [[...], ...] needs each row as a list");
       if (!v[i]) return;
     }
-    double *dense = xcalloc((size_t)m * (size_t)m, sizeof(double));
-    for (i = 0; i < m; i++) memcpy(dense + (size_t)i * m, v[i], (size_t)m * sizeof(double));
-    mass_setup(mod, dense, e->loc);
+    int *dense = xmalloc((size_t)m * (size_t)m * sizeof *dense);
+    for (i = 0; i < m; i++) memcpy(dense + (size_t)i * m, v[i], (size_t)m * sizeof *dense);
+    mass_from_nodes(cx, dense, 1, e->loc);
     free(dense);
     return;
   }
   int n = lower(cx, e);
   if (n < 0) return;
   const Node *nd = &cx->d->nodes[n];
-  if (nd->op != OP_CONST) {
-    error_at(e->loc, "M must be constant, but it depends on %s", dependence(nd));
+  if (nd->flags & DEP_INPUT) {
+    error_at(e->loc, "M cannot depend on a coordinate (only on constants and params), but it does");
     return;
   }
-  if (!(nd->val > 0)) {
-    error_at(e->loc, "M = c (c times the identity) needs c > 0, got %g", nd->val);
+  double *prm = param_values(cx);
+  double c = dag_eval(cx->d, n, NULL, prm);
+  free(prm);
+  if (!(c > 0)) {
+    error_at(e->loc, "M = c (c times the identity) needs c > 0%s, got %g", nd->op == OP_CONST ? "" : " at the default params",
+             c);
     return;
   }
-  double *dg = arena_alloc((size_t)m * sizeof(double));
-  for (int i = 0; i < m; i++) dg[i] = nd->val;
-  mass_setup_diag(mod, dg, e->loc);
+  int *dg = arena_alloc((size_t)m * sizeof *dg);
+  for (int i = 0; i < m; i++) dg[i] = n;
+  mass_from_nodes(cx, dg, 0, e->loc);
 }
 
 // q0 = [...] or p0 = [...]: m values that may use params (NAME_init_params

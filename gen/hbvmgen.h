@@ -5,7 +5,7 @@
  *   ast.c               names, shapes, semantic errors; lowers to the DAG (Model)
  *   dag.c               hash-consed expression DAG: CSE, folding, degrees
  *   ad.c                reverse-mode gradients and Jacobians on the DAG
- *   mass.c              the mass matrix: SPD check and structure of M^-1
+ *   mass.c              the mass matrix: SPD check and structure of M^-1 (in the DAG with params)
  *   model.c             gradient of U, Jacobian of g, checks of q0 and p0
  *   method.c            HBVM(k,s) constants and the choice of k
  *   step.c              the step of the method, built as one more DAG (step.h):
@@ -272,9 +272,15 @@ typedef struct {
   Loc *g_loc;
   int *gradU;                 /* m nodes */
   SparseVec *jac;             /* nu columns: grad g_a, structural nonzeros only */
-  MassKind mass;
+  MassKind mass;              /* what M is (at the default params when it has params) */
   double *minv;               /* m*m row-major inverse mass (dense only), else NULL */
   double *minv_diag;          /* m entries of diag(M^-1) */
+  /* M with params (mass.c): M = L D L' as nodes of the params, NULL when M
+   * is constant. minv_node: the m entries of D^-1 (NaN where a pivot is not
+   * positive); mass_L: the m rows of L below the diagonal, NULL when M is
+   * diagonal. minv, minv_diag and mass then hold M at the default params. */
+  int *minv_node;
+  SparseVec *mass_L;
   double *q0, *p0;            /* m each, at the default params */
   int *q0n, *p0n;             /* m nodes each: q0, p0 as functions of the params */
   Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
@@ -284,6 +290,9 @@ typedef struct {
 Model *analyse(const char *file, Stmt *prog);      /* NULL when errors were reported */
 int mass_setup(Model *mod, const double *dense, Loc loc); /* 0 ok, else error reported */
 int mass_setup_diag(Model *mod, const double *diag, Loc loc); /* M = diag(diag[0..m-1]) */
+/* M of nodes with params (m diagonal entries, or m*m row-major when dense):
+ * M^-1 in the DAG; call before mass_setup* with M at the default params. */
+int mass_setup_params(Model *mod, const int *entries, int dense, Loc loc);
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out); /* out = M^-1 v, nodes */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);

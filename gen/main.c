@@ -240,7 +240,10 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   else
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda (%d where the true multiplier is "
            "constant)\n", 2 * o->s);
-  printf("M: %s\n", mass_str(mod->mass));
+  if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
+  else
+    printf("M: with params: %s, computed from them in every kernel call\n",
+           mod->mass_L ? "dense, M^-1 v by its L D L' factors" : "diagonal, M^-1 = 1/M_ii");
   long nnz = 0;
   for (int a2 = 0; a2 < mod->nu; a2++) nnz += mod->jac[a2].n;
   if (mod->nu)

@@ -5,7 +5,18 @@
  * classified by what it really is: identity, a scalar multiple of the
  * identity, diagonal, or dense. Products M^-1 v are then built as DAG nodes
  * for exactly that structure, so equal matrices written differently give
- * the same generated code, and multiplications by 1 and 0 never appear. */
+ * the same generated code, and multiplications by 1 and 0 never appear.
+ *
+ * An M whose entries use params cannot be inverted here. It is checked at
+ * the default params like a constant one, and factored symbolically,
+ * M = L D L' with L unit lower triangular, on DAG nodes of the params
+ * (mass_setup_params); M^-1 v is then two triangular solves and a scaling
+ * by D^-1 (for a diagonal M just v_i / m_ii). These nodes depend on params
+ * only, so they are the same at every stage, and the emitted kernels
+ * compute them from the params they are called with. Each D^-1 entry
+ * carries a guard that makes it NaN when its pivot is not positive: params
+ * that make M singular or indefinite make the step fail with a non-finite
+ * result instead of running on. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +25,13 @@
 #include <gsl/gsl_linalg.h>
 
 #include "hbvmgen.h"
+
+/* Operations the factorisation of an M with params may add to the DAG: it
+ * is redone in every kernel call. A dense M of up to 38 coordinates fits. */
+#define MAX_MASS_FACTOR 20000
+
+// Why M fails its checks: at its value, or at the default params.
+static const char *at_defaults(const Model *mod) { return mod->minv_node ? " at the default params" : ""; }
 
 // Record a diagonal M given by its m diagonal entries: each must be
 // positive; M is then the identity, a scalar multiple of it, or diagonal.
@@ -27,12 +45,13 @@ int mass_setup_diag(Model *mod, const double *diag, Loc loc) {
   for (int i = 0; i < m; i++) {
     double d = diag[i];
     if (!(d > 0)) {
-      error_at(loc, "M is not positive definite: diagonal entry %d is %.17g", i + 1, d);
+      error_at(loc, "M is not positive definite%s: diagonal entry %d is %.17g", at_defaults(mod), i + 1, d);
       return -1;
     }
     mod->minv_diag[i] = 1 / d;
     if (!isfinite(mod->minv_diag[i])) {
-      error_at(loc, "M^-1 is not finite in double: diagonal entry %d of M is %.17g (below 1/DBL_MAX)", i + 1, d);
+      error_at(loc, "M^-1 is not finite in double%s: diagonal entry %d of M is %.17g (below 1/DBL_MAX)",
+               at_defaults(mod), i + 1, d);
       return -1;
     }
     if (d != diag[0]) mod->mass = MASS_DIAG;
@@ -56,7 +75,8 @@ int mass_setup(Model *mod, const double *dense, Loc loc) {
       double a = dense[(size_t)i * m + j], b = dense[(size_t)j * m + i];
       if (i != j && a != 0) diagonal = 0;
       if (fabs(a - b) > 1e-14 * (fabs(a) + fabs(b))) {
-        error_at(loc, "M is not symmetric: M[%d][%d] = %.17g but M[%d][%d] = %.17g", i + 1, j + 1, a, j + 1, i + 1, b);
+        error_at(loc, "M is not symmetric%s: M[%d][%d] = %.17g but M[%d][%d] = %.17g", at_defaults(mod), i + 1, j + 1,
+                 a, j + 1, i + 1, b);
         return -1;
       }
     }
@@ -73,13 +93,13 @@ int mass_setup(Model *mod, const double *dense, Loc loc) {
   gsl_set_error_handler(old);
   if (rc) {
     gsl_matrix_free(a);
-    error_at(loc, "M is not positive definite (its Cholesky factorisation fails)");
+    error_at(loc, "M is not positive definite%s (its Cholesky factorisation fails)", at_defaults(mod));
     return -1;
   }
   for (size_t i = 0; i < (size_t)m * m; i++)
     if (!isfinite(a->data[i])) {
       gsl_matrix_free(a);
-      error_at(loc, "M^-1 is not finite in double: M is too close to singular");
+      error_at(loc, "M^-1 is not finite in double%s: M is too close to singular", at_defaults(mod));
       return -1;
     }
   mod->mass = MASS_DENSE;
@@ -90,9 +110,109 @@ int mass_setup(Model *mod, const double *dense, Loc loc) {
   return 0;
 }
 
+// 1/x as a node, NaN unless x > 0: sqrt(x)/sqrt(x) is exactly 1 for every
+// positive finite x and NaN otherwise, so the value is exactly 1/x where M
+// is positive definite. For a constant x it folds to the constant 1/x.
+static int guarded_inverse(Dag *d, int x) {
+  int r = dag_op(d, OP_SQRT, x, -1);
+  return dag_mul(d, dag_div(d, dag_const(d, 1), x), dag_div(d, r, r));
+}
+
+// M = L D L' on nodes, row by row, without pivoting (the pivots of a
+// positive definite M are positive): for i < j
+//   W_ji = M_ji - sum_{k<i} W_jk L_ik    (= L_ji d_i),   L_ji = W_ji / d_i,
+//   d_j  = M_jj - sum_{k<j} W_jk L_jk.
+// Zeros stay structural (folding), so a banded M keeps its band. Returns 0,
+// or -1 after an error when the factorisation is too large.
+static int factor_params(Model *mod, const int *a, Loc loc) {
+  Dag *d = mod->dag;
+  int m = mod->m, start = d->n;
+  int *w = xmalloc((size_t)m * sizeof *w);
+  mod->mass_L = arena_alloc((size_t)m * sizeof *mod->mass_L);
+  long total = 0;
+  for (int j = 0; j < m; j++) {
+    int nnz = 0;
+    for (int i = 0; i < j; i++) {
+      int x = a[(size_t)j * m + i];
+      const SparseVec *row = &mod->mass_L[i];
+      for (int e = 0; e < row->n; e++)
+        if (!dag_is_zero(d, w[row->e[e].coord])) x = dag_sub(d, x, dag_mul(d, w[row->e[e].coord], row->e[e].node));
+      w[i] = x;
+      nnz += !dag_is_zero(d, x);
+    }
+    SparseVec *lj = &mod->mass_L[j];
+    lj->e = arena_alloc((size_t)(nnz + 1) * sizeof *lj->e);
+    int dj = a[(size_t)j * m + j];
+    for (int i = 0; i < j; i++) {
+      if (dag_is_zero(d, w[i])) continue;
+      int l = dag_mul(d, w[i], mod->minv_node[i]);
+      lj->e[lj->n++] = (Entry){i, l};
+      dj = dag_sub(d, dj, dag_mul(d, w[i], l));
+    }
+    mod->minv_node[j] = guarded_inverse(d, dj);
+    total += lj->n;
+    if (d->n - start > MAX_MASS_FACTOR) {
+      free(w);
+      error_at(loc, "M has params, so it is factored in every kernel call: here that needs more than %d operations "
+               "(at row %d of %d); make M constant, diagonal or sparser", MAX_MASS_FACTOR, j + 1, m);
+      return -1;
+    }
+  }
+  free(w);
+  if (!total) mod->mass_L = NULL; /* diagonal after all */
+  return 0;
+}
+
+// M with params: entries are m nodes of the diagonal, or m*m row-major when
+// dense (constants or expressions of params, never of coordinates). Builds
+// M^-1 in the DAG (mod->minv_node, mod->mass_L); the caller then checks M
+// at the default params with mass_setup or mass_setup_diag. A dense M must
+// be symmetric in its expressions, not only at the defaults. Returns 0, or
+// -1 after reporting an error at loc.
+int mass_setup_params(Model *mod, const int *entries, int dense, Loc loc) {
+  Dag *d = mod->dag;
+  int m = mod->m;
+  mod->minv_node = arena_alloc((size_t)m * sizeof(int));
+  if (!dense) {
+    for (int i = 0; i < m; i++) mod->minv_node[i] = guarded_inverse(d, entries[i]);
+    return 0;
+  }
+  for (int i = 0; i < m; i++)
+    for (int j = i + 1; j < m; j++) {
+      int a = entries[(size_t)i * m + j], b = entries[(size_t)j * m + i];
+      if (a != b && !(d->nodes[a].op == OP_CONST && d->nodes[b].op == OP_CONST)) {
+        error_at(loc, "M is not symmetric: M[%d][%d] and M[%d][%d] are different expressions of params (write the "
+                 "same expression in both, or name it)", i + 1, j + 1, j + 1, i + 1);
+        return -1;
+      }
+    }
+  return factor_params(mod, entries, loc);
+}
+
+// out = M^-1 v from the factors of an M with params: L y = v, z = D^-1 y,
+// L' out = z (the last solve column by column, from the rows of L).
+static void minv_apply_params(const Model *mod, Dag *d, const int *v, int *out) {
+  int m = mod->m;
+  const SparseVec *L = mod->mass_L;
+  memcpy(out, v, (size_t)m * sizeof *out);
+  for (int i = 0; L && i < m; i++)
+    for (int e = 0; e < L[i].n; e++)
+      if (!dag_is_zero(d, out[L[i].e[e].coord]))
+        out[i] = dag_sub(d, out[i], dag_mul(d, L[i].e[e].node, out[L[i].e[e].coord]));
+  for (int i = 0; i < m; i++)
+    if (!dag_is_zero(d, out[i])) out[i] = dag_mul(d, mod->minv_node[i], out[i]);
+  for (int i = m - 1; L && i >= 0; i--)
+    for (int e = 0; e < L[i].n && !dag_is_zero(d, out[i]); e++)
+      out[L[i].e[e].coord] = dag_sub(d, out[L[i].e[e].coord], dag_mul(d, L[i].e[e].node, out[i]));
+}
+
 // out = M^-1 v for node vectors of length m (out may not alias v). Zeros of
 // v cost no lookup: the columns of a sparse Jacobian are mostly zeros.
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out) {
+  if (mod->minv_node) {
+    minv_apply_params(mod, d, v, out);
+    return;
+  }
   int m = mod->m, zero = dag_const(d, 0);
   for (int i = 0; i < m; i++) {
     if (mod->mass != MASS_DENSE) {

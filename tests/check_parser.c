@@ -193,6 +193,60 @@ START_TEST(test_mass)
 }
 END_TEST
 
+/* M with params: M^-1 v from the DAG (mass.c's L D L' factors, or 1/m_ii)
+ * times M is v at any params; a constant M stays constants; params making M
+ * singular or indefinite give NaN, never a finite wrong value. */
+static void minv_columns(Model *mod, const double *prm, double *inv)
+{
+  int m = mod->m, v[3] = {0}, out[3] = {0};
+  for (int i = 0; i < m; i++) v[i] = dag_input(mod->dag, i);
+  minv_apply(mod, mod->dag, v, out);
+  for (int j = 0; j < m; j++) {
+    double e[3] = {0, 0, 0};
+    e[j] = 1;
+    for (int i = 0; i < m; i++) inv[i * m + j] = dag_eval(mod->dag, out[i], e, prm);
+  }
+}
+
+START_TEST(test_mass_params)
+{
+  Model *mod = load("variables x, y, z\nparam a = 2\nparam c = 0.5\n"
+                    "M = [[a, c, 0], [c, 1 + a, c / 2], [0, c / 2, a * a]]\nU = x*y*z\n");
+  ck_assert(mod->minv_node && mod->mass_L);
+  ck_assert_int_eq(mod->mass, MASS_DENSE); /* at the defaults */
+  static const double prms[][2] = {{2, 0.5}, {1, 0}, {5, -1.5}, {0.3, 0.2}};
+  for (int t = 0; t < NCASES(prms); t++) {
+    double a = prms[t][0], c = prms[t][1], inv[9];
+    const double M[9] = {a, c, 0, c, 1 + a, c / 2, 0, c / 2, a * a};
+    minv_columns(mod, prms[t], inv);
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        double mi = 0;
+        for (int k = 0; k < 3; k++) mi += M[i * 3 + k] * inv[k * 3 + j];
+        ck_assert_msg(fabs(mi - (i == j)) <= 1e-14, "a=%g c=%g: (M M^-1)[%d][%d] = %.17g", a, c, i, j, mi);
+      }
+  }
+  const double indefinite[] = {1, 2}, singular[] = {0, 0};
+  double inv[9];
+  minv_columns(mod, indefinite, inv);
+  ck_assert_msg(isnan(inv[8]), "an indefinite M gives M^-1 = %g, want NaN", inv[8]);
+  minv_columns(mod, singular, inv);
+  ck_assert_msg(!isfinite(inv[0]), "a singular M gives M^-1 = %g, want non-finite", inv[0]);
+
+  mod = load("variables x, y\nparam m1 = 2\nM = diag(m1, 1)\nU = x*y\n");
+  ck_assert(mod->minv_node && !mod->mass_L);
+  ck_assert_int_eq(mod->mass, MASS_DIAG);
+  for (double m1 = -1; m1 <= 3; m1 += 0.5) {
+    double d[4];
+    minv_columns(mod, &m1, d);
+    if (m1 > 0) ck_assert_msg(d[0] == 1 / m1 && d[3] == 1 && d[1] == 0, "m1=%g: M^-1 = diag(%g, %g)", m1, d[0], d[3]);
+    else ck_assert_msg(isnan(d[0]), "m1=%g: M^-1[0][0] = %g, want NaN", m1, d[0]);
+  }
+  mod = load("variables x, y\nparam k = 3\nM = diag(2, 1)\nU = k*x*y\n");
+  ck_assert(!mod->minv_node); /* constant: baked in as before */
+}
+END_TEST
+
 START_TEST(test_potential_default)
 {
   Model *mod = load("variables x\n");
@@ -616,6 +670,7 @@ Suite *parser_suite(void)
   tcase_add_test(fe, test_definitions);
   tcase_add_test(fe, test_param);
   tcase_add_loop_test(fe, test_mass, 0, NCASES(mass_cases));
+  tcase_add_test(fe, test_mass_params);
   tcase_add_test(fe, test_potential_default);
   tcase_add_test(fe, test_constraints);
   tcase_add_test(fe, test_sum_and_indexing);

@@ -1,0 +1,184 @@
+/* check_mass.c - Check suite for a mass matrix with params (gen/mass.c):
+ * M^-1 built in the DAG from the params instead of baked in as constants.
+ *
+ *   same       tests/models/mass_param.ham (M = diag(m1, 1), m1 = 2) and
+ *              mass_const.ham (M = diag(2, 1)) give the same trajectory,
+ *              for both multiplier families; mass_dense.ham (a dense M of
+ *              params, factored L D L' in the step) follows
+ *              mass_dense_const.ham (its inverse at generation time) to
+ *              round-off.
+ *   physics    mass_osc.ham: the period of x'' = -(k/m) x is 2 pi sqrt(m/k)
+ *              for every m and k set at run time.
+ *   singular   params that make M singular or indefinite (a zero or
+ *              negative mass, an indefinite dense M) make the step fail
+ *              with NAME_ENONFINITE and leave the state as it was.
+ * The generator's side (errors at the default params, the DAG's M^-1
+ * against GSL's inverse) is in check_parser.c and tests/err/mass_param_*.
+ * The suite is mass_suite(); the project's runner adds it. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "mass_const_c_k2s2.h"
+#include "mass_const_k2s2.h"
+#include "mass_dense_const_k2s2.h"
+#include "mass_dense_k2s2.h"
+#include "mass_osc_k2s2.h"
+#include "mass_param_c_k2s2.h"
+#include "mass_param_k2s2.h"
+
+Suite *mass_suite(void);
+
+#define PI 3.14159265358979323846
+#define NSTEPS 400
+
+/* max(worst, |a[i] - b[i]| for i < n) */
+static double max_diff(double worst, const double *a, const double *b, int n)
+{
+  for (int i = 0; i < n; i++) worst = fmax(worst, fabs(a[i] - b[i]));
+  return worst;
+}
+
+/* Step a model with M of params (default params) and the same model with
+ * that M written as constants, side by side, NSTEPS steps of h; returns the
+ * largest difference of (t, q, p, lambda) over the run. P is the param
+ * solver, C the constant one; their public fields lead the state. */
+#define SIDE_BY_SIDE(P, C, h, worst)                                                                    \
+  do {                                                                                                  \
+    P##_state xp;                                                                                       \
+    C##_state xc;                                                                                       \
+    P##_params prm;                                                                                     \
+    P##_params_default(&prm);                                                                           \
+    P##_init(&xp, NULL, NULL);                                                                          \
+    C##_init(&xc, NULL, NULL);                                                                          \
+    (worst) = 0;                                                                                        \
+    for (int n = 0; n < NSTEPS; n++) {                                                                  \
+      int rp = P##_step(&xp, (h), &prm, NULL), rc = C##_step(&xc, (h), NULL, NULL);                     \
+      ck_assert_msg(rp == 0 && rc == 0, #P " / " #C " step %d: %s / %s", n, P##_strerror(rp),           \
+                    C##_strerror(rc));                                                                  \
+      (worst) = max_diff(fmax((worst), fabs(xp.t - xc.t)), xp.q, xc.q, P##_M);                            \
+      (worst) = max_diff((worst), xp.p, xc.p, P##_M);                                                   \
+      (worst) = max_diff((worst), xp.lambda, xc.lambda, P##_NU);                                        \
+    }                                                                                                   \
+  } while (0)
+
+/* A diagonal M of params gives M^-1 entries 1/m_ii, exactly the constants
+ * the constant M bakes in: the trajectories agree to the last bit (allowed:
+ * a few ulps, should a product be formed in another order). */
+START_TEST(test_diag_same_trajectory)
+{
+  double worst;
+  SIDE_BY_SIDE(mass_param_k2s2, mass_const_k2s2, 0.05, worst);
+  printf("mass: diag(m1, 1) vs diag(2, 1), poly family: max |difference| %.3g over %d steps\n", worst, NSTEPS);
+  ck_assert_msg(worst <= 1e-14, "poly family: the trajectories differ by %.3g", worst);
+  SIDE_BY_SIDE(mass_param_c_k2s2, mass_const_c_k2s2, 0.05, worst);
+  printf("mass: diag(m1, 1) vs diag(2, 1), const family: max |difference| %.3g over %d steps\n", worst, NSTEPS);
+  ck_assert_msg(worst <= 1e-14, "const family: the trajectories differ by %.3g", worst);
+}
+END_TEST
+
+/* A dense M of params is solved through its L D L' factors where the
+ * constant M uses GSL's inverse: equal to round-off. */
+START_TEST(test_dense_same_trajectory)
+{
+  double worst;
+  SIDE_BY_SIDE(mass_dense_k2s2, mass_dense_const_k2s2, 0.05, worst);
+  printf("mass: dense M of params vs constant: max |difference| %.3g over %d steps\n", worst, NSTEPS);
+  ck_assert_msg(worst <= 1e-12, "the trajectories differ by %.3g", worst);
+}
+END_TEST
+
+/* x'' = -(k/m) x from x = 1, p = 0: x(t) = cos(t sqrt(k/m)). Over one
+ * period 2 pi sqrt(m/k) in 1000 steps, x returns to 1 and passes -1 half
+ * way; with m = 4 and k = 1, the period of m = 1 is only half of one. */
+START_TEST(test_period)
+{
+  static const double cases[][2] = {{1, 1}, {4, 1}, {0.25, 1}, {2, 8}, {3, 0.5}};
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+    mass_osc_k2s2_params prm = {cases[c][0], cases[c][1]};
+    double period = 2 * PI * sqrt(prm.m / prm.k), h = period / 1000;
+    mass_osc_k2s2_state x;
+    mass_osc_k2s2_init(&x, NULL, NULL);
+    double H0 = mass_osc_k2s2_energy(&x, &prm);
+    ck_assert_msg(fabs(H0 - prm.k / 2) <= 1e-15, "m=%g k=%g: H = %.17g, want k/2", prm.m, prm.k, H0);
+    for (int n = 1; n <= 1000; n++) {
+      int rc = mass_osc_k2s2_step(&x, h, &prm, NULL);
+      ck_assert_msg(rc == 0, "m=%g k=%g step %d: %s", prm.m, prm.k, n, mass_osc_k2s2_strerror(rc));
+      double want = cos(x.t * sqrt(prm.k / prm.m));
+      ck_assert_msg(fabs(x.q[0] - want) <= 1e-9, "m=%g k=%g t=%g: x = %.12g, want %.12g", prm.m, prm.k, x.t,
+                    x.q[0], want);
+      if (n == 500) ck_assert_msg(fabs(x.q[0] + 1) <= 1e-9, "m=%g k=%g: x(T/2) = %.12g", prm.m, prm.k, x.q[0]);
+    }
+    ck_assert_msg(fabs(x.q[0] - 1) <= 1e-9 && fabs(x.p[0]) <= 1e-9, "m=%g k=%g: (x, p)(T) = (%.12g, %.3g)", prm.m,
+                  prm.k, x.q[0], x.p[0]);
+    ck_assert_msg(fabs(mass_osc_k2s2_energy(&x, &prm) - H0) <= 1e-14, "m=%g k=%g: |H - H0| = %.3g", prm.m, prm.k,
+                  fabs(mass_osc_k2s2_energy(&x, &prm) - H0));
+  }
+  /* the default (m = 1) and m = 4 part ways: at t = 2 pi one is back at 1, the other at -1 */
+  mass_osc_k2s2_params one, four = {4, 1};
+  mass_osc_k2s2_params_default(&one);
+  mass_osc_k2s2_state a, b;
+  mass_osc_k2s2_init(&a, NULL, NULL);
+  mass_osc_k2s2_init(&b, NULL, NULL);
+  for (int n = 0; n < 1000; n++) {
+    ck_assert_int_eq(mass_osc_k2s2_step(&a, 2 * PI / 1000, &one, NULL), 0);
+    ck_assert_int_eq(mass_osc_k2s2_step(&b, 2 * PI / 1000, &four, NULL), 0);
+  }
+  ck_assert_msg(fabs(a.q[0] - 1) <= 1e-9 && fabs(b.q[0] + 1) <= 1e-9, "x(2 pi): %.12g (m = 1), %.12g (m = 4)",
+                a.q[0], b.q[0]);
+}
+END_TEST
+
+/* One step of solver P from its initial state with params prm must fail
+ * with P_ENONFINITE and leave the state byte for byte as it was; then the
+ * default params step from that same state. */
+#define ASSERT_REFUSED(P, prm, what)                                                                  \
+  do {                                                                                                \
+    P##_state x, before;                                                                              \
+    P##_params dflt;                                                                                  \
+    P##_params_default(&dflt);                                                                        \
+    P##_init(&x, NULL, NULL);                                                                         \
+    memcpy(&before, &x, sizeof x);                                                                    \
+    int rc = P##_step(&x, 0.05, &(prm), NULL);                                                        \
+    ck_assert_msg(rc == P##_ENONFINITE, #P ", %s: step returned %d (%s), want ENONFINITE", what, rc,   \
+                  P##_strerror(rc));                                                                  \
+    ck_assert_msg(!memcmp(&before, &x, sizeof x), #P ", %s: the failed step changed the state", what); \
+    ck_assert_int_eq(P##_step(&x, 0.05, &dflt, NULL), 0);                                             \
+  } while (0)
+
+/* Params that make M singular or indefinite: a failure code, never a
+ * state of garbage (gen/mass.c: D^-1 is NaN where a pivot is not > 0). */
+START_TEST(test_singular_mass)
+{
+  static const double masses[] = {0, -1, -0.0, 1e-320, INFINITY, NAN};
+  for (size_t i = 0; i < sizeof masses / sizeof masses[0]; i++) {
+    char what[32];
+    snprintf(what, sizeof what, "mass %g", masses[i]);
+    mass_osc_k2s2_params o = {masses[i], 1};
+    ASSERT_REFUSED(mass_osc_k2s2, o, what);
+    mass_param_k2s2_params p = {masses[i]};
+    ASSERT_REFUSED(mass_param_k2s2, p, what);
+    mass_param_c_k2s2_params pc = {masses[i]};
+    ASSERT_REFUSED(mass_param_c_k2s2, pc, what);
+    mass_dense_k2s2_params d = {masses[i], 0.5};
+    ASSERT_REFUSED(mass_dense_k2s2, d, what);
+  }
+  mass_dense_k2s2_params indefinite = {2, 2}; /* M[1..2][1..2] = [[2, 2], [2, 1]]: a negative pivot */
+  ASSERT_REFUSED(mass_dense_k2s2, indefinite, "c = 2");
+  mass_dense_k2s2_params semidefinite = {2, sqrt(2)}; /* that pivot 0 (or a rounding of it) */
+  ASSERT_REFUSED(mass_dense_k2s2, semidefinite, "c = sqrt 2");
+}
+END_TEST
+
+Suite *mass_suite(void)
+{
+  Suite *s = suite_create("mass");
+  TCase *tc = tcase_create("params in M");
+  tcase_add_test(tc, test_diag_same_trajectory);
+  tcase_add_test(tc, test_dense_same_trajectory);
+  tcase_add_test(tc, test_period);
+  tcase_add_test(tc, test_singular_mass);
+  suite_add_tcase(s, tc);
+  return s;
+}
