@@ -1,9 +1,9 @@
 /* bench.h - what every method of the benchmark implements, and the pieces
  * the driver shares between them.
  *
- * A fixed-step method (hbvm, hbvm-generic, rattle) opens a Stepper on a
+ * A fixed-step method (hbvm, hbvm-poly, hbvm-generic, rattle) opens a Stepper on a
  * problem at its initial values; fixedstep_run() then takes the steps and
- * watches the invariants, the same loop for all three. An adaptive method
+ * watches the invariants, the same loop for all of them. An adaptive method
  * (ida, gsl-rk8pd, gsl-rk4imp) integrates to the final time itself. */
 #ifndef BENCH_BENCH_H
 #define BENCH_BENCH_H
@@ -59,7 +59,8 @@ int method_run(const MethodDef *md, const Setting *set, Observer *ob, Outcome *o
 int fixedstep_run(const Stepper *sp, const Setting *set, Observer *ob, Outcome *out);
 
 /* The methods (one file each). */
-int hbvm_open(const Setting *set, Stepper *sp);
+int hbvm_open(const Setting *set, Stepper *sp);      /* --multiplier const */
+int hbvm_poly_open(const Setting *set, Stepper *sp); /* --multiplier poly */
 void hbvm_close(Stepper *sp);
 int generic_open(const Setting *set, Stepper *sp);
 void generic_close(Stepper *sp);

@@ -1,5 +1,7 @@
-/* hbvm.c - the method "hbvm": a generated solver, found by problem and
- * (k, s) among those bench/run.sh built. */
+/* hbvm.c - the methods "hbvm" and "hbvm-poly": a generated solver, found by
+ * problem, (k, s) and multiplier family among those bench/run.sh built
+ * (NAME_kKsS: --multiplier const, the paper's method; NAME_kKsSpoly:
+ * --multiplier poly, order 2s). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,11 +9,11 @@
 #include "bench.h"
 #include "hbvm.h"
 
-const GenSolver *gen_solver_find(const char *problem, int k, int s)
+const GenSolver *gen_solver_find(const char *problem, int k, int s, GenFamily family)
 {
   char name[128];
   int i;
-  snprintf(name, sizeof name, "%s_k%ds%d", problem, k, s);
+  snprintf(name, sizeof name, "%s_k%ds%d%s", problem, k, s, family == GEN_POLY ? "poly" : "");
   for (i = 0; gen_solvers[i]; i++)
     if (strcmp(gen_solvers[i]->name, name) == 0) return gen_solvers[i];
   return NULL;
@@ -35,9 +37,9 @@ static void open_get(const void *state, double *q, double *p)
   o->gs->get(o->x, q, p);
 }
 
-int hbvm_open(const Setting *set, Stepper *sp)
+static int open_family(const Setting *set, Stepper *sp, GenFamily family)
 {
-  const GenSolver *gs = gen_solver_find(set->pb->name, set->k, set->s);
+  const GenSolver *gs = gen_solver_find(set->pb->name, set->k, set->s, family);
   double q0[BENCH_MAXM], p0[BENCH_MAXM];
   Open *o;
   if (!gs || gs->m != set->pb->m || gs->nu != set->pb->nu) return -1;
@@ -54,6 +56,10 @@ int hbvm_open(const Setting *set, Stepper *sp)
   sp->get = open_get;
   return 0;
 }
+
+int hbvm_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_CONST); }
+
+int hbvm_poly_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_POLY); }
 
 void hbvm_close(Stepper *sp)
 {

@@ -1,7 +1,8 @@
 /* hbvm.h - a generated solver behind a uniform interface.
  *
- * bench/run.sh generates NAME_kKsS.c/.h with gen/hbvmgen into build/bench/gen,
- * compiles bench/hbvm_gen.c once per solver (-DSOLVER=NAME_kKsS) to get its
+ * bench/run.sh generates NAME_kKsS.c/.h (hbvmgen --multiplier const) and
+ * NAME_kKsSpoly.c/.h (--multiplier poly) into build/bench/gen, compiles
+ * bench/hbvm_gen.c once per solver (-DSOLVER=NAME_kKsS[poly]) to get its
  * GenSolver, and writes the table gen_solvers[] of all of them. */
 #ifndef BENCH_HBVM_H
 #define BENCH_HBVM_H
@@ -9,7 +10,7 @@
 #include <stddef.h>
 
 typedef struct {
-  const char *name; /* NAME_kKsS */
+  const char *name; /* NAME_kKsS or NAME_kKsSpoly */
   int m, nu, k, s;
   size_t size;      /* of the solver's state */
   void (*init)(void *x, const double *q0, const double *p0);
@@ -21,7 +22,10 @@ typedef struct {
  * by bench/run.sh). */
 extern const GenSolver *const gen_solvers[];
 
-/* The generated solver for problem at (k, s), or NULL. */
-const GenSolver *gen_solver_find(const char *problem, int k, int s);
+/* The multiplier family a solver was generated with (hbvmgen --multiplier). */
+typedef enum { GEN_CONST, GEN_POLY } GenFamily;
+
+/* The generated solver for problem at (k, s) of that family, or NULL. */
+const GenSolver *gen_solver_find(const char *problem, int k, int s, GenFamily family);
 
 #endif

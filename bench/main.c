@@ -7,9 +7,11 @@
  *       integrator, the drift of g and H along it
  *   bench sweep PROBLEM METHOD OUTDIR REFFILE FROM:TO:FACTOR [options]
  *       one work-precision line, appended to OUTDIR/work_precision.csv,
- *       iterations.csv (HBVM) and overhead.csv (generated HBVM); FROM:TO
+ *       iterations.csv (HBVM) and overhead.csv (hbvm only); FROM:TO
  *       is the range of h, or of the tolerance for adaptive methods
- *       options: -k K -s S (HBVM), --cap SECONDS, --floor ERR,
+ *       options: -k K -s S (HBVM: hbvm and hbvm-generic are the paper's
+ *                --multiplier const, hbvm-poly --multiplier poly),
+ *                --cap SECONDS, --floor ERR,
  *                --repeats N, --min SECONDS (of one timed repeat)
  *   bench count PROBLEM METHOD K S H WARMUP STEPS
  *       WARMUP steps, then STEPS steps inside count_steps() (for callgrind);

@@ -5,6 +5,7 @@
 
 static const MethodDef methods[] = {
     {"hbvm", hbvm_open, hbvm_close, NULL},
+    {"hbvm-poly", hbvm_poly_open, hbvm_close, NULL},
     {"hbvm-generic", generic_open, generic_close, NULL},
     {"rattle", rattle_open, rattle_close, NULL},
     {"ida", NULL, NULL, ida_integrate},

@@ -1,8 +1,10 @@
 #!/bin/sh
 # bench/plot.sh RESULTS WORKDIR - the figures of bench/results from its CSVs:
 #   wp_PROBLEM.png    CPU seconds against err_q (work-precision), one line
-#                     per method and per (k,s) for HBVM; the generic HBVM
-#                     dashed in the colour of the generated one
+#                     per method and per (k,s) for HBVM: const(k,s) the
+#                     paper's method (hbvm), the generic HBVM dashed in its
+#                     colour, poly(k,s) (hbvm-poly, order 2s) thick, with
+#                     triangles, in a palette of its own
 #   inv_PROBLEM.png   max |H - H0| and max |g| against CPU seconds
 #   iterations.png    mean fixed-point iterations per step against h
 # The series are split out of the CSVs into WORKDIR/*.dat, then drawn by
@@ -18,7 +20,8 @@ if echo 'set terminal' | gnuplot 2>&1 | grep -q pngcairo; then
 else
   term="png size 1100,750"
 fi
-KS_COLORS="#1f77b4 #ff7f0e #2ca02c #d62728 #17becf #e377c2 #8c564b #bcbd22"
+KS_COLORS="#1f77b4 #ff7f0e #2ca02c #d62728 #17becf #e377c2 #8c564b #bcbd22 #aec7e8"
+POLY_COLORS="#000080 #b22222 #006400 #ff00ff #8b4513"
 
 # Split csv ($1) into WORKDIR/PROBLEM__SERIES.dat (h, seconds, err_q, err_H,
 # err_g or, for iterations.csv, h, iters_per_step) and list the series as
@@ -36,22 +39,25 @@ split() {
 # The gnuplot lists (files, titles, colours, dash types, point types) of a
 # problem's series, from "problem series" lines on stdin.
 lists() {
-  awk -v prob="$1" -v w="$W" -v kind="$2" -v palette="$KS_COLORS" '
-    BEGIN { np = split(palette, pal, " ")
+  awk -v prob="$1" -v w="$W" -v kind="$2" -v palette="$KS_COLORS" -v ppalette="$POLY_COLORS" '
+    BEGIN { np = split(palette, pal, " "); npp = split(ppalette, ppal, " ")
             other["rattle"] = "#000000"; other["ida"] = "#9467bd"
             other["gsl-rk8pd"] = "#7f7f7f"; other["gsl-rk4imp"] = "#aa6600" }
     $1 == prob {
       key = $2; method = key; ks = ""
       if (i = index(key, "(")) { method = substr(key, 1, i - 1); ks = substr(key, i) }
-      if (ks != "") {
+      if (method == "hbvm-poly") {
+        if (!(ks in pcol)) pcol[ks] = ppal[++npk > npp ? npp : npk]
+        c = pcol[ks]; d = 1; t = "poly" ks; pt = 9; lw = 2.5
+      } else if (ks != "") {
         if (!(ks in col)) col[ks] = pal[++nks > np ? np : nks]
-        c = col[ks]; d = method == "hbvm" ? 1 : 2; t = method == "hbvm" ? "hbvm" ks : "generic" ks
-        pt = method == "hbvm" ? 7 : 6
-      } else { c = other[method]; d = 1; t = method; pt = 5 }
+        c = col[ks]; d = method == "hbvm" ? 1 : 2; t = method == "hbvm" ? "const" ks : "generic" ks
+        pt = method == "hbvm" ? 7 : 6; lw = 1.5
+      } else { c = other[method]; d = 1; t = method; pt = 5; lw = 1.5 }
       files = files " " w "/" prob "__" key "." kind ".dat"; titles = titles " " t
-      colors = colors " " c; dts = dts " " d; pts = pts " " pt
+      colors = colors " " c; dts = dts " " d; pts = pts " " pt; lws = lws " " lw
     }
-    END { printf "files=\"%s\"; titles=\"%s\"; colors=\"%s\"; dts=\"%s\"; pts=\"%s\"\n", files, titles, colors, dts, pts }'
+    END { printf "files=\"%s\"; titles=\"%s\"; colors=\"%s\"; dts=\"%s\"; pts=\"%s\"; lws=\"%s\"\n", files, titles, colors, dts, pts, lws }'
 }
 
 split "$R/work_precision.csv" wp >"$W/series.wp"
@@ -66,7 +72,7 @@ probs=$(cut -d' ' -f1 "$W/series.it" | uniq | tr '\n' ' ')
 {
   for p in $probs; do
     lists "$p" it <"$W/series.it" | sed "s/^files=/files_$p=/; s/; titles=/; titles_$p=/;
-      s/; colors=/; colors_$p=/; s/; dts=/; dts_$p=/; s/; pts=/; pts_$p=/"
+      s/; colors=/; colors_$p=/; s/; dts=/; dts_$p=/; s/; pts=/; pts_$p=/; s/; lws=/; lws_$p=/"
   done
 } >"$W/iterations.gp"
 gnuplot -e "term=\"$term\"; mode=\"iters\"; probs=\"$probs\"; out=\"$R/iterations.png\"" \

@@ -30,6 +30,7 @@
 #include "pendulum_comp.h"
 #include "pendulum_plain.h"
 #include "pendulum_wide.h"
+#include "pendulum_poly.h"
 
 #define REL_PERTURBATION 1e-12
 #define FIT_FROM 1000L     /* the slope is fitted from this step on */
@@ -98,7 +99,8 @@ typedef struct {
   }
 #define SOLVERS(X)                                                                                         \
   X(kepler_comp, FREE) X(kepler_plain, FREE) X(kepler_wide, FREE) X(pendulum_comp, PENDULUM)                \
-  X(pendulum_plain, PENDULUM) X(pendulum_wide, PENDULUM) X(oscillator_comp, FREE) X(oscillator_wide, FREE)
+  X(pendulum_plain, PENDULUM) X(pendulum_wide, PENDULUM) X(pendulum_poly, PENDULUM) X(oscillator_comp, FREE)   \
+  X(oscillator_wide, FREE)
 #define ADAPT2(P, K) ADAPT(P)
 SOLVERS(ADAPT2)
 #define ENTRY(P, K) {#P, K, P##_K, P##_S, P##_NU, sizeof(P##_state), P##_init_, P##_step_, P##_energy_, P##_g_, P##_qp_},
@@ -196,7 +198,7 @@ int main(int argc, char **argv) {
   long steps = strtol(argv[3], NULL, 10);
   int runs = atoi(argv[4]);
   if (!sv || !(h > 0) || steps < 1 || runs < 1) {
-    fprintf(stderr, "longrun: bad arguments (solvers: kepler_comp kepler_plain kepler_wide pendulum_comp pendulum_plain pendulum_wide oscillator_comp oscillator_wide)\n");
+    fprintf(stderr, "longrun: bad arguments (solvers: kepler_comp kepler_plain kepler_wide pendulum_comp pendulum_plain pendulum_wide pendulum_poly oscillator_comp oscillator_wide)\n");
     return 1;
   }
   static Grid gr;

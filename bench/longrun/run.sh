@@ -2,9 +2,9 @@
 # Long runs: Brouwer's law for the generated solvers (not part of make check).
 #   bench/longrun/run.sh [--quick]
 # Generates HBVM(k,s) for models/kepler.ham (s=2, -k auto: k=16, h = 2 pi/200)
-# and models/pendulum.ham (s=2, -k auto: k=2, h = 0.1), each with compensated
-# summation, with --plain-sum, and compensated with --wide-step (the sweep in
-# long double), and bench/longrun/oscillator.ham (two harmonic oscillators,
+# and models/pendulum.ham (s=2, -k auto: k=2, h = 0.1), --multiplier const, each
+# with compensated summation, with --plain-sum, and compensated with --wide-step
+# (the sweep in long double), the pendulum with --multiplier poly, and bench/longrun/oscillator.ham (two harmonic oscillators,
 # s=2, k=2, h = 0.1) compensated with and without --wide-step; runs each RUNS=8 times from initial values
 # perturbed by a relative 1e-12 for STEPS=10^7 steps (bench/longrun/longrun.c)
 # and writes
@@ -27,22 +27,26 @@ if [ "${1:-}" = "--quick" ]; then STEPS=100000; RUNS=2; R=$B/quick; fi
 mkdir -p "$B" "$R"
 
 [ -x gen/hbvmgen ] || make --no-print-directory gen/hbvmgen >/dev/null
+# the paper's method (--multiplier const; the default is poly for s >= 2 with
+# constraints), and the pendulum once more with poly, whose energy rescale
+# holds H at each step
 for model in kepler pendulum; do
-  gen/hbvmgen -s 2 -k auto -n "${model}_comp" -o "$B" "models/$model.ham"
-  gen/hbvmgen -s 2 -k auto --plain-sum -n "${model}_plain" -o "$B" "models/$model.ham"
-  gen/hbvmgen -s 2 -k auto --wide-step -n "${model}_wide" -o "$B" "models/$model.ham"
+  gen/hbvmgen -s 2 -k auto --multiplier const -n "${model}_comp" -o "$B" "models/$model.ham"
+  gen/hbvmgen -s 2 -k auto --multiplier const --plain-sum -n "${model}_plain" -o "$B" "models/$model.ham"
+  gen/hbvmgen -s 2 -k auto --multiplier const --wide-step -n "${model}_wide" -o "$B" "models/$model.ham"
 done
+gen/hbvmgen -s 2 -k auto --multiplier poly -n pendulum_poly -o "$B" models/pendulum.ham
 gen/hbvmgen -s 2 -k auto -n oscillator_comp -o "$B" bench/longrun/oscillator.ham
 gen/hbvmgen -s 2 -k auto --wide-step -n oscillator_wide -o "$B" bench/longrun/oscillator.ham
 ${CC:-cc} -O2 -std=c99 -Wall -Wextra -pedantic -I"$B" -o "$B/longrun" bench/longrun/longrun.c \
   "$B/kepler_comp.c" "$B/kepler_plain.c" "$B/kepler_wide.c" "$B/pendulum_comp.c" "$B/pendulum_plain.c" "$B/pendulum_wide.c" \
-  "$B/oscillator_comp.c" "$B/oscillator_wide.c" -lm
+  "$B/pendulum_poly.c" "$B/oscillator_comp.c" "$B/oscillator_wide.c" -lm
 
 # results are written in $B and copied to $R at the end
 KEPLER_H=$(awk 'BEGIN { printf "%.17g", 8 * atan2(1, 1) / 200 }')
 echo "solver,n,t,rms_dH,max_dH,rms_g,max_g" > "$B/longrun.csv"
 : > "$B/summary"
-for sv in kepler_comp kepler_plain kepler_wide pendulum_comp pendulum_plain pendulum_wide oscillator_comp oscillator_wide; do
+for sv in kepler_comp kepler_plain kepler_wide pendulum_comp pendulum_plain pendulum_wide pendulum_poly oscillator_comp oscillator_wide; do
   case "$sv" in kepler*) h=$KEPLER_H ;; *) h=0.1 ;; esac
   "$B/longrun" "$sv" "$h" "$STEPS" "$RUNS" >> "$B/longrun.csv" 2>> "$B/summary"
 done
@@ -55,7 +59,8 @@ verdict=$(awk -v w="$worst" -v t="$TARGET" 'BEGIN { print (w + 0 <= t + 0) ? "me
 {
   echo "# bench/longrun/run.sh: $RUNS runs of $STEPS steps per solver, initial values perturbed by 1e-12"
   echo "# HBVM(k,s) with s=2, -k auto; Kepler e=0.6 at h = 2 pi/200, pendulum and oscillator at h = 0.1"
-  echo "# _comp: compensated (Kahan) summation of q, p, t; _plain: --plain-sum; _wide: compensated, --wide-step"
+  echo "# --multiplier const; _comp: compensated (Kahan) summation of q, p, t; _plain: --plain-sum; _wide: compensated, --wide-step"
+  echo "# pendulum_poly: --multiplier poly (order 4, p projected and rescaled to H0 each step), compensated"
   echo "# slope: least squares of log(RMS over the runs) against log(t), from 10^3 steps on"
   cat "$B/summary"
   echo "target: Kepler, compensated, max |H-H0| over $mid steps = $worst <= $TARGET: $verdict"
@@ -83,6 +88,7 @@ plot "$B/longrun.csv" using (strcol(1) eq "kepler_comp" ? \$2 : NaN):4 with line
      "" using (strcol(1) eq "pendulum_plain" ? \$2 : NaN):4 with lines lw 2 title "pendulum, plain sum", \
      "" using (strcol(1) eq "kepler_wide" ? \$2 : NaN):4 with lines lw 2 title "Kepler, compensated, wide step", \
      "" using (strcol(1) eq "pendulum_wide" ? \$2 : NaN):4 with lines lw 2 title "pendulum, compensated, wide step", \
+     "" using (strcol(1) eq "pendulum_poly" ? \$2 : NaN):4 with lines lw 2 title "pendulum, poly (rescaled to H0)", \
      "" using (strcol(1) eq "oscillator_comp" ? \$2 : NaN):4 with lines lw 1 dt 4 title "oscillator, compensated", \
      "" using (strcol(1) eq "oscillator_wide" ? \$2 : NaN):4 with lines lw 1 dt 5 title "oscillator, compensated, wide step", \
      [1000:$STEPS] 2e-16 * sqrt(x) with lines dt 2 lc "black" title "slope 1/2", \
@@ -92,6 +98,7 @@ set title "constraint residual (pendulum)"
 plot "$B/longrun.csv" using (strcol(1) eq "pendulum_comp" ? \$2 : NaN):6 with lines lw 2 lc 3 title "pendulum, compensated", \
      "" using (strcol(1) eq "pendulum_plain" ? \$2 : NaN):6 with lines lw 2 lc 4 title "pendulum, plain sum", \
      "" using (strcol(1) eq "pendulum_wide" ? \$2 : NaN):6 with lines lw 2 lc 6 title "pendulum, compensated, wide step", \
+     "" using (strcol(1) eq "pendulum_poly" ? \$2 : NaN):6 with lines lw 2 lc 7 title "pendulum, poly", \
      [1000:$STEPS] 2e-16 * sqrt(x) with lines dt 2 lc "black" title "slope 1/2"
 unset multiplot
 GP
