@@ -36,6 +36,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double conical_k1s1_E[1] = {1.0};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double conical_k1s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double conical_k1s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k1s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -338,7 +340,10 @@ static void conical_k1s1_predict(const conical_k1s1_state *x, double h, const co
   for (j = 0; j < conical_k1s1_S; j++)
     for (i = 0; i < conical_k1s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = conical_k1s1_S - 1; d >= 0; d--) e = e * r + conical_k1s1_E[(j * conical_k1s1_S + i) * conical_k1s1_S + d];
+      if (h == x->hprev)
+        e = conical_k1s1_E1[j * conical_k1s1_S + i];
+      else
+        for (d = conical_k1s1_S - 1; d >= 0; d--) e = e * r + conical_k1s1_E[(j * conical_k1s1_S + i) * conical_k1s1_S + d];
       if (e != 0)
         for (l = 0; l < conical_k1s1_M; l++) gam[j * conical_k1s1_M + l] += e * x->gam[i * conical_k1s1_M + l];
     }

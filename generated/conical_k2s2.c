@@ -37,6 +37,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double conical_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double conical_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double conical_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -377,7 +379,10 @@ static void conical_k2s2_predict(const conical_k2s2_state *x, double h, const co
   for (j = 0; j < conical_k2s2_S; j++)
     for (i = 0; i < conical_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = conical_k2s2_S - 1; d >= 0; d--) e = e * r + conical_k2s2_E[(j * conical_k2s2_S + i) * conical_k2s2_S + d];
+      if (h == x->hprev)
+        e = conical_k2s2_E1[j * conical_k2s2_S + i];
+      else
+        for (d = conical_k2s2_S - 1; d >= 0; d--) e = e * r + conical_k2s2_E[(j * conical_k2s2_S + i) * conical_k2s2_S + d];
       if (e != 0)
         for (l = 0; l < conical_k2s2_M; l++) gam[j * conical_k2s2_M + l] += e * x->gam[i * conical_k2s2_M + l];
     }

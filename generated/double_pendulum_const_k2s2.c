@@ -37,6 +37,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double double_pendulum_const_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double double_pendulum_const_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double double_pendulum_const_k2s2_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_const_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
@@ -568,7 +570,10 @@ static void double_pendulum_const_k2s2_predict(const double_pendulum_const_k2s2_
   for (j = 0; j < double_pendulum_const_k2s2_S; j++)
     for (i = 0; i < double_pendulum_const_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = double_pendulum_const_k2s2_S - 1; d >= 0; d--) e = e * r + double_pendulum_const_k2s2_E[(j * double_pendulum_const_k2s2_S + i) * double_pendulum_const_k2s2_S + d];
+      if (h == x->hprev)
+        e = double_pendulum_const_k2s2_E1[j * double_pendulum_const_k2s2_S + i];
+      else
+        for (d = double_pendulum_const_k2s2_S - 1; d >= 0; d--) e = e * r + double_pendulum_const_k2s2_E[(j * double_pendulum_const_k2s2_S + i) * double_pendulum_const_k2s2_S + d];
       if (e != 0)
         for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[j * double_pendulum_const_k2s2_M + l] += e * x->gam[i * double_pendulum_const_k2s2_M + l];
     }

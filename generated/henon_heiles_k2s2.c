@@ -37,6 +37,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double henon_heiles_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double henon_heiles_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double henon_heiles_k2s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k2s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
@@ -231,7 +233,10 @@ static void henon_heiles_k2s2_predict(const henon_heiles_k2s2_state *x, double h
   for (j = 0; j < henon_heiles_k2s2_S; j++)
     for (i = 0; i < henon_heiles_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = henon_heiles_k2s2_S - 1; d >= 0; d--) e = e * r + henon_heiles_k2s2_E[(j * henon_heiles_k2s2_S + i) * henon_heiles_k2s2_S + d];
+      if (h == x->hprev)
+        e = henon_heiles_k2s2_E1[j * henon_heiles_k2s2_S + i];
+      else
+        for (d = henon_heiles_k2s2_S - 1; d >= 0; d--) e = e * r + henon_heiles_k2s2_E[(j * henon_heiles_k2s2_S + i) * henon_heiles_k2s2_S + d];
       if (e != 0)
         for (l = 0; l < henon_heiles_k2s2_M; l++) gam[j * henon_heiles_k2s2_M + l] += e * x->gam[i * henon_heiles_k2s2_M + l];
     }

@@ -51,6 +51,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double kepler_k16s2_E[8] = {1.0000000000000002, 0.0, 1.7320508075688776, 1.732050807568877, (-2.0816681711721685e-17), 0.0, (-3.6055550369691825e-17), 0.99999999999999989};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double kepler_k16s2_E1[4] = {1.0000000000000002, 3.4641016151377544, (-2.0816681711721685e-17), 0.99999999999999989};
 /* Model defaults for q0 and p0. */
 static const double kepler_k16s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k16s2_p0[2] = {0.0, 2.0};
@@ -673,7 +675,10 @@ static void kepler_k16s2_predict(const kepler_k16s2_state *x, double h, const ke
   for (j = 0; j < kepler_k16s2_S; j++)
     for (i = 0; i < kepler_k16s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = kepler_k16s2_S - 1; d >= 0; d--) e = e * r + kepler_k16s2_E[(j * kepler_k16s2_S + i) * kepler_k16s2_S + d];
+      if (h == x->hprev)
+        e = kepler_k16s2_E1[j * kepler_k16s2_S + i];
+      else
+        for (d = kepler_k16s2_S - 1; d >= 0; d--) e = e * r + kepler_k16s2_E[(j * kepler_k16s2_S + i) * kepler_k16s2_S + d];
       if (e != 0)
         for (l = 0; l < kepler_k16s2_M; l++) gam[j * kepler_k16s2_M + l] += e * x->gam[i * kepler_k16s2_M + l];
     }

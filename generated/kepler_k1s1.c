@@ -36,6 +36,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double kepler_k1s1_E[1] = {1.0};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double kepler_k1s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double kepler_k1s1_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k1s1_p0[2] = {0.0, 2.0};
@@ -183,7 +185,10 @@ static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, const kepl
   for (j = 0; j < kepler_k1s1_S; j++)
     for (i = 0; i < kepler_k1s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = kepler_k1s1_S - 1; d >= 0; d--) e = e * r + kepler_k1s1_E[(j * kepler_k1s1_S + i) * kepler_k1s1_S + d];
+      if (h == x->hprev)
+        e = kepler_k1s1_E1[j * kepler_k1s1_S + i];
+      else
+        for (d = kepler_k1s1_S - 1; d >= 0; d--) e = e * r + kepler_k1s1_E[(j * kepler_k1s1_S + i) * kepler_k1s1_S + d];
       if (e != 0)
         for (l = 0; l < kepler_k1s1_M; l++) gam[j * kepler_k1s1_M + l] += e * x->gam[i * kepler_k1s1_M + l];
     }

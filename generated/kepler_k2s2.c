@@ -37,6 +37,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double kepler_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double kepler_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
 static const double kepler_k2s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k2s2_p0[2] = {0.0, 2.0};
@@ -233,7 +235,10 @@ static void kepler_k2s2_predict(const kepler_k2s2_state *x, double h, const kepl
   for (j = 0; j < kepler_k2s2_S; j++)
     for (i = 0; i < kepler_k2s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = kepler_k2s2_S - 1; d >= 0; d--) e = e * r + kepler_k2s2_E[(j * kepler_k2s2_S + i) * kepler_k2s2_S + d];
+      if (h == x->hprev)
+        e = kepler_k2s2_E1[j * kepler_k2s2_S + i];
+      else
+        for (d = kepler_k2s2_S - 1; d >= 0; d--) e = e * r + kepler_k2s2_E[(j * kepler_k2s2_S + i) * kepler_k2s2_S + d];
       if (e != 0)
         for (l = 0; l < kepler_k2s2_M; l++) gam[j * kepler_k2s2_M + l] += e * x->gam[i * kepler_k2s2_M + l];
     }

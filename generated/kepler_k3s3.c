@@ -38,6 +38,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double kepler_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double kepler_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
 /* Model defaults for q0 and p0. */
 static const double kepler_k3s3_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k3s3_p0[2] = {0.0, 2.0};
@@ -291,7 +293,10 @@ static void kepler_k3s3_predict(const kepler_k3s3_state *x, double h, const kepl
   for (j = 0; j < kepler_k3s3_S; j++)
     for (i = 0; i < kepler_k3s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = kepler_k3s3_S - 1; d >= 0; d--) e = e * r + kepler_k3s3_E[(j * kepler_k3s3_S + i) * kepler_k3s3_S + d];
+      if (h == x->hprev)
+        e = kepler_k3s3_E1[j * kepler_k3s3_S + i];
+      else
+        for (d = kepler_k3s3_S - 1; d >= 0; d--) e = e * r + kepler_k3s3_E[(j * kepler_k3s3_S + i) * kepler_k3s3_S + d];
       if (e != 0)
         for (l = 0; l < kepler_k3s3_M; l++) gam[j * kepler_k3s3_M + l] += e * x->gam[i * kepler_k3s3_M + l];
     }

@@ -38,6 +38,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double modified_k3s1_E[1] = {1.0};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double modified_k3s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double modified_k3s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k3s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -399,7 +401,10 @@ static void modified_k3s1_predict(const modified_k3s1_state *x, double h, const 
   for (j = 0; j < modified_k3s1_S; j++)
     for (i = 0; i < modified_k3s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = modified_k3s1_S - 1; d >= 0; d--) e = e * r + modified_k3s1_E[(j * modified_k3s1_S + i) * modified_k3s1_S + d];
+      if (h == x->hprev)
+        e = modified_k3s1_E1[j * modified_k3s1_S + i];
+      else
+        for (d = modified_k3s1_S - 1; d >= 0; d--) e = e * r + modified_k3s1_E[(j * modified_k3s1_S + i) * modified_k3s1_S + d];
       if (e != 0)
         for (l = 0; l < modified_k3s1_M; l++) gam[j * modified_k3s1_M + l] += e * x->gam[i * modified_k3s1_M + l];
     }

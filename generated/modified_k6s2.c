@@ -41,6 +41,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double modified_k6s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 5.5511151231257827e-17, 0.0, 9.6148134319178191e-17, 0.99999999999999989};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double modified_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231257827e-17, 1.0};
 /* Model defaults for q0 and p0. */
 static const double modified_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -562,7 +564,10 @@ static void modified_k6s2_predict(const modified_k6s2_state *x, double h, const 
   for (j = 0; j < modified_k6s2_S; j++)
     for (i = 0; i < modified_k6s2_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = modified_k6s2_S - 1; d >= 0; d--) e = e * r + modified_k6s2_E[(j * modified_k6s2_S + i) * modified_k6s2_S + d];
+      if (h == x->hprev)
+        e = modified_k6s2_E1[j * modified_k6s2_S + i];
+      else
+        for (d = modified_k6s2_S - 1; d >= 0; d--) e = e * r + modified_k6s2_E[(j * modified_k6s2_S + i) * modified_k6s2_S + d];
       if (e != 0)
         for (l = 0; l < modified_k6s2_M; l++) gam[j * modified_k6s2_M + l] += e * x->gam[i * modified_k6s2_M + l];
     }

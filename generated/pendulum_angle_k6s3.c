@@ -41,6 +41,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double pendulum_angle_k6s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995796, 5.5511151231257827e-17, 0.0, 0.0, 9.6148134319178191e-17, 0.99999999999999989, 0.0, 1.2412670766236366e-16, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0000000000000002};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double pendulum_angle_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 5.5511151231257827e-17, 1.0, 7.745966692414834, 0.0, 0.0, 1.0000000000000002};
 /* Model defaults for q0 and p0. */
 static const double pendulum_angle_k6s3_q0[1] = {0.0};
 static const double pendulum_angle_k6s3_p0[1] = {1.0};
@@ -252,7 +254,10 @@ static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, doub
   for (j = 0; j < pendulum_angle_k6s3_S; j++)
     for (i = 0; i < pendulum_angle_k6s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = pendulum_angle_k6s3_S - 1; d >= 0; d--) e = e * r + pendulum_angle_k6s3_E[(j * pendulum_angle_k6s3_S + i) * pendulum_angle_k6s3_S + d];
+      if (h == x->hprev)
+        e = pendulum_angle_k6s3_E1[j * pendulum_angle_k6s3_S + i];
+      else
+        for (d = pendulum_angle_k6s3_S - 1; d >= 0; d--) e = e * r + pendulum_angle_k6s3_E[(j * pendulum_angle_k6s3_S + i) * pendulum_angle_k6s3_S + d];
       if (e != 0)
         for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[j * pendulum_angle_k6s3_M + l] += e * x->gam[i * pendulum_angle_k6s3_M + l];
     }

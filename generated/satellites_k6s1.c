@@ -41,6 +41,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double satellites_k6s1_E[1] = {1.0};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double satellites_k6s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double satellites_k6s1_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s1_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -1705,7 +1707,10 @@ static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, co
   for (j = 0; j < satellites_k6s1_S; j++)
     for (i = 0; i < satellites_k6s1_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = satellites_k6s1_S - 1; d >= 0; d--) e = e * r + satellites_k6s1_E[(j * satellites_k6s1_S + i) * satellites_k6s1_S + d];
+      if (h == x->hprev)
+        e = satellites_k6s1_E1[j * satellites_k6s1_S + i];
+      else
+        for (d = satellites_k6s1_S - 1; d >= 0; d--) e = e * r + satellites_k6s1_E[(j * satellites_k6s1_S + i) * satellites_k6s1_S + d];
       if (e != 0)
         for (l = 0; l < satellites_k6s1_M; l++) gam[j * satellites_k6s1_M + l] += e * x->gam[i * satellites_k6s1_M + l];
     }

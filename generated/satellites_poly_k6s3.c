@@ -41,6 +41,8 @@
  */
 /* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
 static const double satellites_poly_k6s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995796, 5.5511151231257827e-17, 0.0, 0.0, 9.6148134319178191e-17, 0.99999999999999989, 0.0, 1.2412670766236366e-16, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0000000000000002};
+/* E[j][i](1): the warm start of a step as long as the last one. */
+static const double satellites_poly_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 5.5511151231257827e-17, 1.0, 7.745966692414834, 0.0, 0.0, 1.0000000000000002};
 /* Model defaults for q0 and p0. */
 static const double satellites_poly_k6s3_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_poly_k6s3_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -8610,7 +8612,10 @@ static void satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, do
   for (j = 0; j < satellites_poly_k6s3_S; j++)
     for (i = 0; i < satellites_poly_k6s3_S; i++) {
       double r = h / x->hprev, e = 0;
-      for (d = satellites_poly_k6s3_S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s3_E[(j * satellites_poly_k6s3_S + i) * satellites_poly_k6s3_S + d];
+      if (h == x->hprev)
+        e = satellites_poly_k6s3_E1[j * satellites_poly_k6s3_S + i];
+      else
+        for (d = satellites_poly_k6s3_S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s3_E[(j * satellites_poly_k6s3_S + i) * satellites_poly_k6s3_S + d];
       if (e != 0)
         for (l = 0; l < satellites_poly_k6s3_M; l++) gam[j * satellites_poly_k6s3_M + l] += e * x->gam[i * satellites_poly_k6s3_M + l];
     }
@@ -8684,11 +8689,9 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_poly_k6s3_ENONFINITE;
     if (rc == satellites_poly_k6s3_ENONFINITE || !isfinite(inc)) { rc = satellites_poly_k6s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (satellites_poly_k6s3_TOL / 256), or
-     * within 2 ulps (satellites_poly_k6s3_TOL) and falling by less than 4x (round-off noise). Iterating
-     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
-     * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= satellites_poly_k6s3_TOL / 256 || (inc <= satellites_poly_k6s3_TOL && 4 * inc > inc_old)) { rc = satellites_poly_k6s3_OK; break; }
+    /* converged: the increment is within 2 ulps of the state (satellites_poly_k6s3_TOL). Iterating
+     * further would not help H, which the rescale keeps (bench/README.md) */
+    if (inc <= satellites_poly_k6s3_TOL) { rc = satellites_poly_k6s3_OK; break; }
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. satellites_poly_k6s3_STALL sweeps without one are a stall: converged if it is at
