@@ -1,7 +1,7 @@
 #!/bin/sh
 # make demo: generate, build and run the planar pendulum with HBVM(2,2) in both
-# multiplier families, and
-# show what a user wants to see: errors, conservation, iterations per step.
+# multiplier families, and show what a user wants to see: errors, conservation,
+# iterations per step.
 set -eu
 out=demo
 mkdir -p "$out"
