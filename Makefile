@@ -24,7 +24,7 @@ CHECK   := $(shell pkg-config --cflags check 2>/dev/null)
 CHECKLIB:= $(shell pkg-config --libs check 2>/dev/null)
 ALLCFLAGS = $(WARN) $(CFLAGS) $(SAN) -MMD -MP
 
-GEN_SRC  := util.c ast.c dag.c ad.c mass.c model.c method.c lu.c step.c step_const.c step_poly.c emit_kernel.c emit_step.c emit_main.c
+GEN_SRC  := util.c ast.c dag.c ad.c mass.c model.c method.c lu.c step.c step_const.c step_poly.c emit_kernel.c emit_step.c emit_batch.c emit_main.c
 GEN_OBJ  := $(addprefix $(B)/gen/,$(GEN_SRC:.c=.o) parser.o lexer.o)
 RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
 SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {sub(/:.*/, "", $$1); print $$1 "_k" $$2 "s" $$3}')
@@ -42,11 +42,16 @@ TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
 # stale or mismatched binary behind).
 HBVMGEN  := $(B)/hbvmgen
 LIBRT    := $(B)/libhbvmrt.a
+LIBRT_OMP:= $(B)/libhbvmrt_omp.a
+LIBRT_MPI:= $(B)/libhbvmrt_mpi.a
+MPICC    ?= mpicc
 
 .PHONY: all deps check demo generated tables figures bench fuzz clean install uninstall
-all: $(HBVMGEN) $(LIBRT)
+all: $(HBVMGEN) $(LIBRT) $(LIBRT_OMP) $(if $(MPI),$(LIBRT_MPI))
 	@cmp -s $(HBVMGEN) gen/hbvmgen || cp $(HBVMGEN) gen/hbvmgen
 	@cmp -s $(LIBRT) runtime/libhbvmrt.a || cp $(LIBRT) runtime/libhbvmrt.a
+	@cmp -s $(LIBRT_OMP) runtime/libhbvmrt_omp.a || cp $(LIBRT_OMP) runtime/libhbvmrt_omp.a
+	@$(if $(MPI),cmp -s $(LIBRT_MPI) runtime/libhbvmrt_mpi.a || cp $(LIBRT_MPI) runtime/libhbvmrt_mpi.a)
 
 gen/hbvmgen runtime/libhbvmrt.a: all
 
@@ -80,6 +85,25 @@ $(B)/runtime/%.o: runtime/%.c
 	$(CC) $(ALLCFLAGS) -Iruntime -c -o $@ $<
 
 $(LIBRT): $(RT_OBJ)
+	rm -f $@
+	ar rcs $@ $^
+
+# The runtime again for ensembles (runtime/ensemble.c) on threads:
+# libhbvmrt_omp.a, linked with -fopenmp; and with MPI=1 on MPI ranks too:
+# libhbvmrt_mpi.a, linked with $(MPICC) -fopenmp (scripts/deps.sh mpi).
+$(B)/runtime-omp/%.o: runtime/%.c
+	@mkdir -p $(@D)
+	$(CC) $(ALLCFLAGS) -fopenmp -Iruntime -c -o $@ $<
+
+$(B)/runtime-mpi/%.o: runtime/%.c
+	@mkdir -p $(@D)
+	$(MPICC) $(ALLCFLAGS) -fopenmp -DHBVMRT_MPI -Iruntime -c -o $@ $<
+
+$(LIBRT_OMP): $(patsubst runtime/%.c,$(B)/runtime-omp/%.o,$(wildcard runtime/*.c))
+	rm -f $@
+	ar rcs $@ $^
+
+$(LIBRT_MPI): $(patsubst runtime/%.c,$(B)/runtime-mpi/%.o,$(wildcard runtime/*.c))
 	rm -f $@
 	ar rcs $@ $^
 
@@ -178,6 +202,6 @@ fuzz:
 	tests/fuzz/run.sh $(FUZZ_SECONDS)
 
 clean:
-	rm -rf build build-san gen/hbvmgen runtime/libhbvmrt.a demo
+	rm -rf build build-san gen/hbvmgen runtime/libhbvmrt.a runtime/libhbvmrt_omp.a runtime/libhbvmrt_mpi.a demo
 
 -include $(shell find $(B) -name '*.d' 2>/dev/null)

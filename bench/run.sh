@@ -220,6 +220,7 @@ echo "== long runs ($(elapsed) s)"
 RUNS=${LONGRUN_RUNS:-4} bench/longrun/run.sh || echo "bench: the long-run target was missed (bench/results/longrun.txt)"
 echo "== lean-code measurements ($(elapsed) s)"
 bench/lean/run.sh current
+bench/batch/run.sh || echo "bench: the batch/ensemble benchmark failed"
 bench/lean/kauto.sh
 
 echo "load after (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg)" >>"$R/machine.txt"

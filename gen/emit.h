@@ -25,6 +25,7 @@ typedef struct {
   int wide_step;   /* --wide-step: the step iterates one precision wider */
   int wide;        /* the kernel being printed computes one precision wider */
   KernelId kid;    /* the kernel being printed */
+  int lanes;       /* W > 0: kernels print as loops over W lanes (--batch, emit_batch.c) */
 } Emitter;
 
 void out(Emitter *e, const char *fmt, ...);
@@ -33,5 +34,9 @@ const char *math_suffix(const Emitter *e, int wide);
 void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
 void emit_kernel(Emitter *e, KernelId k);
+
+/* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
+void emit_batch_header(Emitter *e, int lanes);
+void emit_batch_source(Emitter *e, int lanes);
 
 #endif

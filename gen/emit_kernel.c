@@ -9,7 +9,13 @@
  * the input slots of the DAG map to the same C names everywhere. This file
  * also holds the small printing helpers emit_step.c uses: out, tmpl (the
  * template expander, which also names kernel calls and result offsets from
- * the blocks) and format_real. */
+ * the blocks) and format_real.
+ *
+ * With e->lanes = W (--batch W) the same kernels print as NAME_batch_KERNEL:
+ * the straight-line body inside one loop over W lanes, every array in
+ * struct-of-arrays form (value i of lane l at [i * W + l]), so that each
+ * lane does exactly the scalar kernel's operations and the compiler can
+ * vectorise the loop. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -120,7 +126,7 @@ static void kernel_call(Emitter *e, const char *text, const char *end) {
     vlen[slot] = vl;
     p += nl + 1 + vl;
   }
-  fprintf(e->f, "%s_%s(", e->P, e->st->kern[k].name);
+  fprintf(e->f, "%s_%s%s(", e->P, e->lanes ? "batch_" : "", e->st->kern[k].name);
   for (int i = 0; i < IN_COUNT; i++)
     if (e->st->in[i].len || i < IN_LAM) fprintf(e->f, "%.*s, ", val[i] ? (int)vlen[i] : 1, val[i] ? val[i] : "0");
   fprintf(e->f, "%.*s, %.*s)", val[IN_COUNT] ? (int)vlen[IN_COUNT] : 3, val[IN_COUNT] ? val[IN_COUNT] : "prm",
@@ -182,22 +188,28 @@ static void name_of(Emitter *e, int id, char *buf, size_t size) {
   const Step *st = e->st;
   switch ((Op)n->op) {
   case OP_CONST: format_real(e, buf, size, n->val); return;
-  case OP_PARAM: snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name); return;
+  case OP_PARAM:
+    if (e->lanes) snprintf(buf, size, "prm[%d + l] /* %s */", n->idx * e->lanes, e->mod->params[n->idx].name);
+    else snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name);
+    return;
   case OP_INPUT:
     for (int i = 0; i < IN_COUNT; i++) {
       const Slots *in = &st->in[i];
       if (n->idx < in->first || n->idx >= in->first + in->len) continue;
       int i = n->idx - in->first;
+      char at[32];
+      snprintf(at, sizeof at, e->lanes ? "%d + l" : "%d", e->lanes ? i * e->lanes : i);
       if (in->scalar) snprintf(buf, size, "%s", in->name);
       else if (i < e->mod->m && (in == &st->in[IN_Q0] || in == &st->in[IN_P0])) /* name the coordinate */
-        snprintf(buf, size, "%s[%d] /* %s%s */", in->name, i, in == &st->in[IN_P0] ? "p_" : "", e->mod->coord_names[i]);
-      else snprintf(buf, size, "%s[%d]", in->name, i);
+        snprintf(buf, size, "%s[%s] /* %s%s */", in->name, at, in == &st->in[IN_P0] ? "p_" : "", e->mod->coord_names[i]);
+      else snprintf(buf, size, "%s[%s]", in->name, at);
       return;
     }
     internal_error("model coordinate %d reached a kernel", n->idx);
     return;
   default:
-    if (e->chunk && e->chunk[id] != e->part) snprintf(buf, size, "w[%d]", e->slot[id]);
+    if (e->chunk && e->chunk[id] != e->part && e->lanes) snprintf(buf, size, "w[%d + l]", e->slot[id] * e->lanes);
+    else if (e->chunk && e->chunk[id] != e->part) snprintf(buf, size, "w[%d]", e->slot[id]);
     else snprintf(buf, size, "t%d", e->temp[id]);
     return;
   }
@@ -252,7 +264,7 @@ static void emit_node(Emitter *e, int id) {
     if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a, b);
     else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a);
   }
-  out(e, "  const %s t%d = %s;\n", real_type(e, e->wide), e->temp[id], rhs);
+  out(e, "%s  const %s t%d = %s;\n", e->lanes ? "  " : "", real_type(e, e->wide), e->temp[id], rhs);
 }
 
 // The signature of kernel k (of its part-th part when part >= 0): one
@@ -260,17 +272,20 @@ static void emit_node(Emitter *e, int id) {
 static void kernel_signature(Emitter *e, const Kernel *k, int part) {
   const Step *st = e->st;
   const char *t = real_type(e, e->wide); /* the sweep of --wide-step: state, gamma, results wider */
-  tmpl(e, "static void $P_");
+  const char *rs = e->lanes ? "*restrict " : "*"; /* lanes: the compiler may assume no overlap */
+  tmpl(e, e->lanes ? "static void $P_batch_" : "static void $P_");
   out(e, part >= 0 ? "%s_part%d(" : "%s(", k->name, part);
   for (int i = 0; i < IN_COUNT; i++) {
     const Slots *in = &st->in[i];
     if (!in->len && i >= IN_LAM) continue; /* the inputs of one family only */
     const char *ty = in->narrow ? real_type(e, 0) : t;
-    out(e, in->scalar ? "%s %s,%s" : "const %s *%s,%s", ty, in->name, in->wrap ? "\n    " : " ");
+    if (in->scalar) out(e, "%s %s,%s", ty, in->name, in->wrap ? "\n    " : " ");
+    else out(e, "const %s %s%s,%s", ty, rs, in->name, in->wrap ? "\n    " : " ");
   }
-  tmpl(e, "const $P_params *prm, ");
-  if (part >= 0) out(e, "%s *w, ", t);
-  out(e, "%s *out)\n{\n ", t);
+  if (e->lanes) out(e, "const %s *restrict prm, ", t);
+  else tmpl(e, "const $P_params *prm, ");
+  if (part >= 0) out(e, "%s %sw, ", t, rs);
+  out(e, "%s %sout)\n{\n ", t, rs);
   for (int i = 0; i < IN_COUNT; i++)
     if (st->in[i].len || i < IN_LAM) out(e, " (void)%s;", st->in[i].name);
   out(e, " (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
@@ -294,12 +309,13 @@ static void emit_ops(Emitter *e, const int *ops, int from, int to) {
     int id = ops[i];
     while (sec + 1 < d->marks.n && d->marks.v[sec + 1] <= id) sec++;
     if (sec >= 0 && sec != shown) {
-      if (section_here(e, sec)) out(e, "  /* %s */\n", d->labels[sec]);
+      if (section_here(e, sec)) out(e, "%s  /* %s */\n", e->lanes ? "  " : "", d->labels[sec]);
       shown = sec;
     }
     e->temp[id] = i;
     emit_node(e, id);
-    if (e->chunk && e->slot[id] >= 0) out(e, "  w[%d] = t%d;\n", e->slot[id], i);
+    if (e->chunk && e->slot[id] >= 0 && e->lanes) out(e, "    w[%d + l] = t%d;\n", e->slot[id] * e->lanes, i);
+    else if (e->chunk && e->slot[id] >= 0) out(e, "  w[%d] = t%d;\n", e->slot[id], i);
   }
 }
 
@@ -310,10 +326,11 @@ static void emit_outputs(Emitter *e, const Kernel *k, const int *outs, int nouts
     if (e->chunk && e->chunk[outs[i]] != e->part) continue;
     while (b + 1 < k->nout && k->out[b + 1].first <= i) b++;
     if (i == k->out[b].first || (e->chunk && i > 0 && e->chunk[outs[i - 1]] != e->part))
-      out(e, "  /* %s */\n", k->out[b].name);
+      out(e, "%s  /* %s */\n", e->lanes ? "  " : "", k->out[b].name);
     char r[NAME_SIZE];
     ref(e, outs[i], r, sizeof r);
-    out(e, "  out[%d] = %s;\n", i, r);
+    if (e->lanes) out(e, "    out[%d + l] = %s;\n", i * e->lanes, r);
+    else out(e, "  out[%d] = %s;\n", i, r);
   }
 }
 
@@ -333,6 +350,13 @@ static int split_parts(Emitter *e, const int *ops, int nops) {
   return nslots;
 }
 
+// The loop over the lanes around a kernel's body (open, else close); nothing
+// for a scalar kernel.
+static void lane_loop(Emitter *e, int open) {
+  if (e->lanes && open) tmpl(e, "  for (int l = 0; l < $P_W; l++) {\n");
+  else if (e->lanes) out(e, "  }\n");
+}
+
 // Print the kernel k's parts, each a function of straight-line code over
 // ops[] (ops in DAG order), and the kernel calling them in order.
 static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, const int *outs, int nouts, int top) {
@@ -347,15 +371,17 @@ static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, co
   for (e->part = 0; e->part < nparts; e->part++) {
     kernel_signature(e, k, e->part);
     int from = e->part * PART_NODES, to = from + PART_NODES < nops ? from + PART_NODES : nops;
+    lane_loop(e, 1);
     emit_ops(e, ops, from, to);
     emit_outputs(e, k, outs, nouts); /* those computed in this part (leaves in the last) */
+    lane_loop(e, 0);
     out(e, "}\n\n");
   }
   out(e, "/* %s: the %d parts above in order */\n", k->name, nparts);
   kernel_signature(e, k, -1);
-  out(e, "  %s w[%d];\n", real_type(e, e->wide), nslots > 0 ? nslots : 1); /* C has no empty arrays */
+  out(e, "  %s w[%d];\n", real_type(e, e->wide), (nslots > 0 ? nslots : 1) * (e->lanes ? e->lanes : 1)); /* C has no empty arrays */
   for (int p = 0; p < nparts; p++) {
-    out(e, "  %s_%s_part%d(", e->P, k->name, p);
+    out(e, "  %s_%s%s_part%d(", e->P, e->lanes ? "batch_" : "", k->name, p);
     for (int i = 0; i < IN_COUNT; i++)
       if (e->st->in[i].len || i < IN_LAM) out(e, "%s, ", e->st->in[i].name);
     out(e, "prm, w, out);\n");
@@ -391,8 +417,10 @@ void emit_kernel(Emitter *e, KernelId id) {
     emit_parts(e, k, ops, nops, outs, nouts, top);
   } else {
     kernel_signature(e, k, -1);
+    lane_loop(e, 1);
     emit_ops(e, ops, 0, nops);
     emit_outputs(e, k, outs, nouts);
+    lane_loop(e, 0);
     out(e, "}\n");
   }
   e->wide = 0;

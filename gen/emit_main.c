@@ -79,6 +79,31 @@ static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
              "  if (dq) *dq = a;\n  if (dp) *dp = b;\n  sync(x);\n  return rc;\n}\n\n", P, P, P);
 }
 
+// With --batch: adapters of NAME_batch_* for the runtime's ensemble runner
+// (the state blocks it moves in and out of lanes are views in float).
+static void emit_batch_adapters(FILE *f, const char *P, int single) {
+  const char *in = single ? "&((const view *)x)->s" : "x", *outx = single ? "&((view *)x)->s" : "x";
+  fprintf(f, "static void batch_set(void *b, int lane, const void *x) { %s_batch_set(b, lane, %s); }\n", P, in);
+  fprintf(f, "static void batch_get(const void *b, int lane, void *x)\n{\n  %s_batch_get(b, lane, %s);%s\n}\n", P,
+          outx, single ? "\n  sync(x);" : "");
+  fprintf(f, "static void batch_idle(void *b, int lane, int idle) { ((%s_batch *)b)->idle[lane] = idle != 0; }\n\n", P);
+  if (single)
+    fprintf(f, "static void batch_params(const void *prm, %s_params *r)\n{\n  int l;\n"
+               "  for (l = 0; l < %s_W; l++) to_real((const view_params *)prm + l, &r[l]);\n}\n\n", P, P);
+  fprintf(f, "static int batch_step(void *b, double h, const void *prm, int *code, int *iters)\n{\n"
+             "  %s_batch_stats s;\n  int l, rc;\n", P);
+  if (single) fprintf(f, "  %s_params r[%s_W];\n  batch_params(prm, r);\n  rc = %s_batch_step(b, (%s_real)h, r, &s);\n", P, P, P, P);
+  else fprintf(f, "  rc = %s_batch_step(b, h, prm, &s);\n", P);
+  fprintf(f, "  for (l = 0; l < %s_W; l++) {\n    code[l] = s.code[l];\n    iters[l] = s.iters[l];\n  }\n"
+             "  return rc;\n}\n\n", P);
+  fprintf(f, "static void batch_observe(const void *b, const void *prm, double *H, double *g, double *hc)\n{\n"
+             "  %s_real e[%s_W], v[(%s_NU + 1) * %s_W], w[(%s_NU + 1) * %s_W];\n  int i;\n", P, P, P, P, P, P);
+  if (single) fprintf(f, "  %s_params r[%s_W];\n  batch_params(prm, r);\n  prm = r;\n", P, P);
+  fprintf(f, "  %s_batch_energy(b, prm, e);\n  %s_batch_constraints(b, prm, v);\n  %s_batch_hidden(b, prm, w);\n"
+             "  for (i = 0; i < %s_W; i++) H[i] = e[i];\n"
+             "  for (i = 0; i < %s_NU * %s_W; i++) {\n    g[i] = v[i];\n    hc[i] = w[i];\n  }\n}\n\n", P, P, P, P, P, P);
+}
+
 // Write NAME_main.c to f. Returns 0, or -1 on a write error.
 int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *o) {
   const char *P = o->name;
@@ -88,6 +113,7 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "#include <float.h>\n#include <stddef.h>\n\n#include \"hbvmrt.h\"\n#include \"%s.h\"\n\n", P);
   if (o->single) emit_float_adapters(f, mod, P);
   else emit_adapters(f, P);
+  if (o->batch) emit_batch_adapters(f, P, o->single);
   /* what the runtime sees: the solver's state and params, or their double view */
   size_t n = strlen(P) + 16;
   char *st = arena_alloc(n), *pt = arena_alloc(n);
@@ -110,7 +136,13 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    %d, params, q0, p0,\n", mod->nparams);
   fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
   fprintf(f, "    init_params, project, %s,\n  };\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
-  fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");
+  if (o->batch) {
+    fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
+               "batch_step, batch_observe,\n  };\n", P, P);
+    fprintf(f, "  return hbvmrt_main_batch(&model, &batch, argc, argv);\n}\n");
+  } else {
+    fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");
+  }
   (void)me;
   return ferror(f) ? -1 : 0;
 }

@@ -70,8 +70,9 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "const char *$P_strerror(int code);\n"
           "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
           "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
-          "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp);       /* grad g' M^-1 p */\n"
-          "\n#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
+          "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp);       /* grad g' M^-1 p */\n\n");
+  if (o->batch) emit_batch_header(e, o->batch);
+  tmpl(e, "#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
 }
 
 /* ---- the source ---- */
@@ -497,7 +498,7 @@ static void emit_project(Emitter *e) {
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP};
+  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP, 0};
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;
@@ -506,6 +507,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_public(&e);
   emit_step(&e);
   emit_project(&e);
+  if (o->batch) emit_batch_source(&e, o->batch);
   free(e.temp);
   return ferror(hf) || ferror(cf) ? -1 : 0;
 }

@@ -14,6 +14,7 @@
  *     lu.c              linear systems of DAG nodes, factored at generation time
  *   emit_kernel.c       C text of the kernels: straight-line code from the DAG (emit.h)
  *   emit_step.c         C text of NAME.h / NAME.c around them: types, step templates
+ *   emit_batch.c        --batch W: the same step over W lanes in struct-of-arrays form
  *   emit_main.c         C text of NAME_main.c, the standalone driver
  *   main.c              the command line
  * util.c holds the arena, growable arrays, the fatal-error path and the
@@ -373,7 +374,7 @@ Step *step_build(Model *mod, const Method *meth);
 const Slots *step_block(const Step *st, KernelId k, const char *name);
 int kernel_size(const Kernel *k);   /* slots of out[] */
 
-/* ---- emit_kernel.c, emit_step.c, emit_main.c ---- */
+/* ---- emit_kernel.c, emit_step.c, emit_batch.c, emit_main.c ---- */
 
 typedef struct {
   const char *name;     /* C prefix */
@@ -381,6 +382,7 @@ typedef struct {
   int single;           /* --real float */
   int compensated;      /* Kahan summation (off with --plain-sum) */
   int wide_step;        /* --wide-step: iterate and update one precision wider */
+  int batch;            /* --batch W: also NAME_batch_step over W lanes (0: none) */
 } EmitOptions;
 
 int emit_check(const Model *mod, const Step *st, const EmitOptions *o); /* 1 after errors */

@@ -263,6 +263,11 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --csv FILE         write the rows t,x..,p_x..,lambda_1..,H,g_1..,hc_1.. to\n"
     "                     FILE ('-' for stdout); no CSV without it\n"
     "  --quiet            no progress line on a terminal\n"
+    "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
+    "                     (coordinates, p_ and a coordinate, params) and a row\n"
+    "                     per trajectory; --csv gets a summary row for each\n"
+    "  --sweep NAME=A:B:N N trajectories, NAME (a column as above) from A to B\n"
+    "  --threads N        threads for --ensemble/--sweep (OpenMP runtime only)\n"
     "  --help             this text\n", out);
   if (md->nparams > 0) {
     fputs("\nparameters (default):\n", out);

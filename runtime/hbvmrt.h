@@ -64,6 +64,25 @@ typedef struct {
  * (0 success, 1 bad arguments, 2 a failed step). */
 int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
 
+/* The batch step of a solver generated with --batch W, for the ensemble
+ * runner (--ensemble, --sweep), which then steps W trajectories at a time.
+ * The batch block is size bytes; lanes are moved in and out as state blocks;
+ * step takes W params blocks one after another and writes W codes and
+ * iteration counts; observe writes H (W values), g and hc (nu * W values
+ * each, value a of lane l at a * W + l). */
+typedef struct {
+  int w;
+  size_t size;
+  void (*set)(void *b, int lane, const void *x);
+  void (*get)(const void *b, int lane, void *x);
+  void (*idle)(void *b, int lane, int idle);
+  int (*step)(void *b, double h, const void *prm, int *code, int *iters);
+  void (*observe)(const void *b, const void *prm, double *H, double *g, double *hc);
+} hbvmrt_batch;
+
+/* hbvmrt_main for a driver with a batch step. */
+int hbvmrt_main_batch(const hbvmrt_model *model, const hbvmrt_batch *batch, int argc, char **argv);
+
 #ifdef __cplusplus
 }
 #endif

@@ -13,6 +13,11 @@
 #define HBVMRT_PRINTF(f, a) __attribute__((format(printf, f, a)))
 #else
 #define HBVMRT_PRINTF(f, a)
+/* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
+
+int hbvmrt_ensemble_wanted(int argc, char **argv);
+int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int argc, char **argv);
+
 #endif
 
 /* args.c */
@@ -57,5 +62,10 @@ void hbvmrt_error(const hbvmrt_model *md, const char *fmt, ...)
 int hbvmrt_csv_header(FILE *f, const hbvmrt_model *md);
 int hbvmrt_csv_row(FILE *f, const hbvmrt_model *md, const void *x, double H,
                    const double *g, const double *hc);
+
+/* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
+
+int hbvmrt_ensemble_wanted(int argc, char **argv);
+int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int argc, char **argv);
 
 #endif

@@ -378,8 +378,11 @@ int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv)
 {
   hbvmrt_opts o;
   Run r;
-  int status = hbvmrt_parse_args(model, argc, argv, &o);
+  int status;
 
+  if (hbvmrt_ensemble_wanted(argc, argv))
+    return hbvmrt_ensemble_main(model, NULL, argc, argv);   /* ensemble.c */
+  status = hbvmrt_parse_args(model, argc, argv, &o);
   if (status != HBVMRT_ARGS_RUN) {
     hbvmrt_opts_free(&o);
     return status == HBVMRT_ARGS_DONE ? 0 : 1;

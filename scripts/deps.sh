@@ -4,6 +4,7 @@
 #   scripts/deps.sh bench      also the benchmark peers and plotting
 #   scripts/deps.sh embedded   also the ARM cross compiler for the embedded build check
 #   scripts/deps.sh fuzz       also clang with libFuzzer
+#   scripts/deps.sh mpi        also Open MPI (make MPI=1: ensembles across ranks)
 # As root it runs apt-get install -y; otherwise it prints the exact line to run.
 set -eu
 
@@ -13,7 +14,8 @@ for set in "$@"; do
     bench)    pkgs="$pkgs libsundials-dev gnuplot-nox" ;;
     embedded) pkgs="$pkgs gcc-arm-none-eabi libnewlib-arm-none-eabi" ;;
     fuzz)     pkgs="$pkgs clang libclang-rt-14-dev" ;;
-    *) echo "deps.sh: unknown package set '$set' (bench, embedded, fuzz)" >&2; exit 1 ;;
+    mpi)      pkgs="$pkgs libopenmpi-dev openmpi-bin" ;;
+    *) echo "deps.sh: unknown package set '$set' (bench, embedded, fuzz, mpi)" >&2; exit 1 ;;
   esac
 done
 

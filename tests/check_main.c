@@ -17,6 +17,8 @@ Suite *files_suite(void);
 Suite *poly_suite(void);
 Suite *init_suite(void);
 Suite *mass_suite(void);
+Suite *batch_suite(void);
+Suite *ensemble_suite(void);
 
 int main(void) {
   SRunner *sr = srunner_create(parser_suite());
@@ -34,6 +36,8 @@ int main(void) {
   srunner_add_suite(sr, poly_suite());
   srunner_add_suite(sr, init_suite());
   srunner_add_suite(sr, mass_suite());
+  srunner_add_suite(sr, batch_suite());
+  srunner_add_suite(sr, ensemble_suite());
   srunner_run_all(sr, CK_NORMAL);
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);

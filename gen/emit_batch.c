@@ -1,0 +1,281 @@
+/* emit_batch.c - --batch W: the step over W trajectories in SIMD lanes.
+ *
+ * NAME_batch holds W states in struct-of-arrays form: value i of lane l at
+ * [i * NAME_W + l]. The kernels are printed a second time as loops over the
+ * lanes around the same straight-line body (emit_kernel.c with e->lanes),
+ * which gcc and clang vectorise: one vector register holds one temporary of
+ * W lanes. Around them, NAME_batch_step runs the scalar step's algorithm
+ * (emit_step.c) lane by lane: the same prediction, the same sweeps until the
+ * lane's own increment is at round-off, the same tests and the same
+ * compensated update, so each lane is bitwise the scalar NAME_step from the
+ * same state. The sweep runs over all lanes while any of them iterates; a
+ * lane that has stopped keeps its last sweep (fin[]) and ignores the rest.
+ * A lane that fails is not written. */
+#include "emit.h"
+
+// The batch declarations of NAME.h.
+void emit_batch_header(Emitter *e, int lanes) {
+  int poly = e->st->kern[K_FACTOR].nout > 0, nu1 = e->mod->nu ? e->mod->nu : 1;
+  out(e, "/* --batch %d: %d trajectories stepped together (docs/api.md, \"Batches\"). Struct of\n", lanes, lanes);
+  tmpl(e, " * arrays: value i of lane l is at [i * $P_W + l], q[i * $P_W + l] the coordinate i\n"
+          " * of trajectory l. */\n");
+  out(e, "#define %s_W %d\n\n", e->P, lanes);
+  tmpl(e, "typedef struct {\n  $P_real t[$P_W], q[$P_M * $P_W], p[$P_M * $P_W], lambda[");
+  out(e, "%d * %s_W];\n", nu1, e->P);
+  tmpl(e, "  unsigned char idle[$P_W];  /* nonzero: the lane is not stepped (cleared by $P_batch_set) */\n"
+          "  /* private, per lane as in $P_state */\n"
+          "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n");
+  if (poly) tmpl(e, "  $P_real H0[$P_W];\n");
+  tmpl(e, "} $P_batch;\n\n"
+          "typedef struct {\n"
+          "  int code[$P_W];            /* the lane's return code, as $P_step's ($P_OK for idle lanes) */\n"
+          "  int iters[$P_W];           /* fixed-point iterations (0: failed or idle before the first) */\n"
+          "  $P_real increment[$P_W];  /* last scaled increment */\n"
+          "} $P_batch_stats;\n\n"
+          "/* Lane `lane` of x from / into a state; set also makes the lane active (idle 0). */\n"
+          "void $P_batch_set($P_batch *x, int lane, const $P_state *s);\n"
+          "void $P_batch_get(const $P_batch *x, int lane, $P_state *s);\n"
+          "/* One step of size h on every active lane; prm: NULL (the defaults) or $P_W params, one\n"
+          " * per lane; st may be NULL. Each lane is bitwise what $P_step would make of it; a lane\n"
+          " * that fails is left unchanged. Returns the number of lanes that failed. */\n"
+          "int $P_batch_step($P_batch *x, $P_real h, const $P_params *prm, $P_batch_stats *st);\n"
+          "/* H (W values), g and the hidden constraints ($P_NU * $P_W values) of every lane. */\n"
+          "void $P_batch_energy(const $P_batch *x, const $P_params *prm, $P_real *H);\n"
+          "void $P_batch_constraints(const $P_batch *x, const $P_params *prm, $P_real *g);\n"
+          "void $P_batch_hidden(const $P_batch *x, const $P_params *prm, $P_real *gp);\n\n");
+}
+
+// NAME_batch_set and NAME_batch_get: one lane to and from a NAME_state.
+static void emit_set_get(Emitter *e) {
+  static const char *const scalar[] = {"t", "tc", "hprev", "H0"}, *const array[][2] = {
+      {"q", "$P_M"}, {"p", "$P_M"}, {"qc", "$P_M"}, {"pc", "$P_M"}, {"gam", "$P_S * $P_M"}, {"lambda", "$P_NU"}};
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  char line[160];
+  for (int get = 0; get < 2; get++) {
+    tmpl(e, get ? "void $P_batch_get(const $P_batch *x, int l, $P_state *s)\n{\n  int i;\n"
+                : "void $P_batch_set($P_batch *x, int l, const $P_state *s)\n{\n  int i;\n");
+    for (int f = 0; f < (poly ? 4 : 3); f++)
+      out(e, get ? "  s->%s = x->%s[l];\n" : "  x->%s[l] = s->%s;\n", scalar[f], scalar[f]);
+    for (int f = 0; f < 6; f++) {
+      const char *n = array[f][0];
+      if (get) snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) s->%s[i] = x->%s[i * $P_W + l];\n", array[f][1], n, n);
+      else snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) x->%s[i * $P_W + l] = s->%s[i];\n", array[f][1], n, n);
+      tmpl(e, line);
+    }
+    if (get && !e->mod->nu) tmpl(e, "  s->lambda[0] = 0;\n");
+    tmpl(e, get ? "}\n\n" : "  x->idle[l] = 0;\n}\n\n");
+  }
+}
+
+// The params of the lanes transposed for the kernels (par[k * W + l]), the
+// defaults when prm is NULL; and the public functions of the state.
+static void emit_params_observers(Emitter *e) {
+  tmpl(e, "static void $P_batch_params(const $P_params *prm, $R *par)\n{\n"
+          "  $P_params dflt;\n  int l;\n  (void)par;\n"
+          "  if (!prm) $P_params_default(&dflt);\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    const $P_params *r = prm ? &prm[l] : &dflt;\n    (void)r;\n");
+  for (int i = 0; i < e->mod->nparams; i++) out(e, "    par[%d * %s_W + l] = r->%s;\n", i, e->P, e->mod->params[i].name);
+  tmpl(e, "  }\n}\n\n"
+          "void $P_batch_energy(const $P_batch *x, const $P_params *prm, $P_real *H)\n{\n"
+          "  $R par[($P_NPARAMS + 1) * $P_W];\n"
+          "  $P_batch_params(prm, par);\n"
+          "  $(energy_kernel q0=x->q p0=x->p prm=par out=H);\n}\n\n");
+  if (e->mod->nu)
+    tmpl(e, "void $P_batch_constraints(const $P_batch *x, const $P_params *prm, $P_real *g)\n{\n"
+            "  $R par[($P_NPARAMS + 1) * $P_W];\n  $P_batch_params(prm, par);\n"
+            "  $(g q0=x->q p0=x->p prm=par out=g);\n}\n\n"
+            "void $P_batch_hidden(const $P_batch *x, const $P_params *prm, $P_real *gp)\n{\n"
+            "  $R par[($P_NPARAMS + 1) * $P_W];\n  $P_batch_params(prm, par);\n"
+            "  $(hidden_kernel q0=x->q p0=x->p prm=par out=gp);\n}\n\n");
+  else
+    tmpl(e, "void $P_batch_constraints(const $P_batch *x, const $P_params *prm, $P_real *g)\n{\n"
+            "  (void)x; (void)prm; (void)g;\n}\n\n"
+            "void $P_batch_hidden(const $P_batch *x, const $P_params *prm, $P_real *gp)\n{\n"
+            "  (void)x; (void)prm; (void)gp;\n}\n\n");
+}
+
+// $P_predict, lane by lane.
+static void emit_predict(Emitter *e) {
+  tmpl(e, "static void $P_batch_predict(const $P_batch *x, $R h, const $R *par, $R *gam)\n{\n"
+          "  $R mp[$P_M * $P_W];\n  int i, j, l, m, d;\n"
+          "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) gam[i * $P_W + l] = 0;\n"
+          "    if (x->hprev[l] == 0) {\n"
+          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n"
+          "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
+          "        $R r = h / x->hprev[l], e = 0;\n"
+          "        for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
+          "        if (e != 0)\n"
+          "          for (m = 0; m < $P_M; m++) gam[(j * $P_M + m) * $P_W + l] += e * x->gam[(i * $P_M + m) * $P_W + l];\n"
+          "      }\n  }\n}\n\n");
+}
+
+// The iteration's tests for lane l after a sweep, as in $P_step: sets rc[l]
+// and returns 1 when the lane stops.
+static void emit_lane_test(Emitter *e, int poly) {
+  tmpl(e, "/* After a sweep: lane l's increment and tests, those of $P_step; 1 when it stops\n"
+          " * (rc[l] then says why). */\n"
+          "static int $P_batch_test(const $P_batch *x, $R h, const $R *sw, $R *gam, $R *lam, int l,\n"
+          "    $R *inc, $R *inc_min, int *stall, int *rc)\n{\n"
+          "  $R inc_old = inc[l], scale = 0;\n  int i;\n  (void)lam;\n"
+          "  inc[l] = 0;\n"
+          "  for (i = 0; i < $P_M; i++) {\n"
+          "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+          "    if (v > scale) scale = v;\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) {\n"
+          "    $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
+          "    if (v > inc[l]) inc[l] = v;\n"
+          "    gam[i * $P_W + l] = sw[($[sweep.gam]i) * $P_W + l];\n  }\n"
+          "  if (scale > 0) inc[l] /= scale;\n");
+  if (poly)
+    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++) lam[i * $P_W + l] = sw[($[sweep.lam]i) * $P_W + l];\n"
+            "  for (i = 0; i < $<sweep>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
+  else if (e->mod->nu)
+    tmpl(e, "  for (i = 0; i < $P_NU; i++) {\n"
+            "    $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
+            "    if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
+            "  }\n"
+            "  if (rc[l] == $P_ESINGULAR) return 1;\n");
+  if (!poly) tmpl(e, "  for (i = 0; i < $<sweep.pivot>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
+  tmpl(e, "  if (rc[l] == $P_ENONFINITE || !isfinite(inc[l])) {\n    rc[l] = $P_ENONFINITE;\n    return 1;\n  }\n"
+          "  if (inc[l] <= $P_TOL / 256 || (inc[l] <= $P_TOL && 4 * inc[l] > inc_old)) {\n"
+          "    rc[l] = $P_OK;\n    return 1;\n  }\n"
+          "  if (inc[l] < inc_min[l]) {\n    inc_min[l] = inc[l];\n    stall[l] = 0;\n"
+          "  } else if (++stall[l] >= $P_STALL) {\n"
+          "    rc[l] = inc_min[l] <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n    return 1;\n  }\n"
+          "  return 0;\n}\n\n");
+}
+
+// The end of the step for the lanes whose iteration converged (go[l]):
+// the constant family's update, or the polynomial family's projection,
+// rescale and multiplier (emit_end_poly in emit_step.c), lane by lane.
+static void emit_commit(Emitter *e, int poly) {
+  if (!poly) {
+    tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    if (!go[l]) continue;\n"
+            "    for (i = 0; i < $P_M; i++)\n"
+            "      if (!isfinite(x->q[i * $P_W + l] + h * fin[($[sweep.gam]i) * $P_W + l]) ||\n"
+            "          !isfinite(x->p[i * $P_W + l] + fin[($[sweep.dp]i) * $P_W + l]) ||\n"
+            "          !isfinite(x->qc[i * $P_W + l]) || !isfinite(x->pc[i * $P_W + l]))\n"
+            "        rc[l] = $P_ENONFINITE;\n"
+            "    if (rc[l] != $P_OK) continue;\n"
+            "    for (i = 0; i < $P_M; i++) {\n"
+            "      $P_add(&x->q[i * $P_W + l], &x->qc[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
+            "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n    }\n"
+            "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = fin[($[sweep.lambda]i) * $P_W + l];\n"
+            "    for (i = 0; i < $P_S * $P_M; i++) x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
+            "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev[l] = h;\n  }\n");
+    return;
+  }
+  tmpl(e, "  {\n"
+          "    $R q1[$P_M * $P_W], p1[$P_M * $P_W], qc1[$P_M * $P_W], pc1[$P_M * $P_W];\n"
+          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam0[$P_NU * $P_W];\n"
+          "    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n"
+          "    for (i = 0; i < $P_M * $P_W; i++) {\n"
+          "      q1[i] = x->q[i];\n      qc1[i] = x->qc[i];\n      p1[i] = x->p[i];\n      pc1[i] = x->pc[i];\n    }\n"
+          "    for (l = 0; l < $P_W; l++)\n      for (i = 0; go[l] && i < $P_M; i++) {\n"
+          "        $P_add(&q1[i * $P_W + l], &qc1[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
+          "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n      }\n"
+          "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
+          "    for (l = 0; l < $P_W; l++) {\n"
+          "      $R K, U1, H0, beta = 1;\n      if (!go[l]) continue;\n"
+          "      for (i = 0; i < $P_NU; i++) {\n"
+          "        $R piv = pr[($[project_p1.pivot]i) * $P_W + l], dia = pr[($[project_p1.adiag]i) * $P_W + l];\n"
+          "        if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
+          "      }\n"
+          "      for (i = 0; rc[l] == $P_OK && i < $<project_p1>; i++)\n"
+          "        if (!isfinite(pr[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n"
+          "      if (rc[l] != $P_OK) continue;\n"
+          "      K = pr[($[project_p1.kin]0) * $P_W + l];\n      U1 = pr[($[project_p1.U]0) * $P_W + l];\n"
+          "      H0 = x->hprev[l] != 0 && fabs$f(Hn[l] - x->H0[l]) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0[l] : Hn[l];\n"
+          "      if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
+          "      for (i = 0; i < $P_M; i++) {\n"
+          "        $R d = pr[($[project_p1.dp]i) * $P_W + l];\n"
+          "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], d + (beta - 1) * (p1[i * $P_W + l] + d));\n"
+          "        if (!isfinite(q1[i * $P_W + l]) || !isfinite(p1[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n"
+          "      }\n"
+          "      if (rc[l] != $P_OK) continue;\n"
+          "      for (i = 0; i < $P_M; i++) {\n"
+          "        x->q[i * $P_W + l] = q1[i * $P_W + l];\n        x->p[i * $P_W + l] = p1[i * $P_W + l];\n"
+          "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n      }\n"
+          "      for (i = 0; i < $P_S * $P_M; i++) x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
+          "      x->H0[l] = H0;\n    }\n"
+          "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
+          "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"
+          "    for (l = 0; l < $P_W; l++) {\n      if (!go[l] || rc[l] != $P_OK) continue;\n"
+          "      for (i = 0; i < $P_NU; i++)\n"
+          "        x->lambda[i * $P_W + l] = isfinite(lam0[i * $P_W + l]) ? lam0[i * $P_W + l] : 0;\n"
+          "      $P_add(&x->t[l], &x->tc[l], h);\n      x->hprev[l] = h;\n    }\n  }\n");
+}
+
+// NAME_batch_step.
+static void emit_batch_step(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
+  emit_lane_test(e, poly);
+  tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
+          "  const $R h = ($R)h_;\n"
+          "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
+          "  $R sw[($<sweep> + 1) * $P_W], fin[($<sweep> + 1) * $P_W];\n"
+          "  $R inc[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n"
+          "  int rc[$P_W], go[$P_W], stall[$P_W], iters[$P_W];\n"
+          "  int it, i, l, nrun = 0, nfail = 0;\n"
+          "  $P_batch_params(prm, par);\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    inc[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n"
+          "    rc[l] = x->idle[l] ? $P_OK : !(h != 0 && isfinite(h)) ? $P_EBADSTEP : $P_ENOCONV;\n"
+          "    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n  }\n"
+          "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) fin[i] = 0;\n"
+          "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n"
+          "  $P_batch_predict(x, h, par, gam);\n");
+  if (nu)
+    tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
+            "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+  if (poly)
+    tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
+            "  $(factor q0=x->q gam=gam h=h prm=par out=fa);\n"
+            "  for (l = 0; l < $P_W; l++)\n    for (i = 0; go[l] && i < $P_S * $P_NU; i++) {\n"
+            "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
+            "      if (!isfinite(piv) || !isfinite(dia)) rc[l] = $P_ENONFINITE;\n"
+            "      else if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
+            "      go[l] = rc[l] == $P_ENOCONV;\n    }\n");
+  char call[160];
+  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=gam h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
+           poly ? " lam=lam lu=fa" : "");
+  tmpl(e, "  for (l = 0; l < $P_W; l++) nrun += go[l];\n"
+          "  /* the sweep over all lanes while any iterates; a lane that stops keeps its last sweep */\n"
+          "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
+  tmpl(e, call);
+  tmpl(e, "    for (l = 0; l < $P_W; l++) {\n"
+          "      if (!go[l] || iters[l] || !$P_batch_test(x, h, sw, gam, lam, l, inc, inc_min, stall, rc)) continue;\n"
+          "      iters[l] = it;\n      nrun--;\n"
+          "      for (i = 0; i < $<sweep>; i++) fin[i * $P_W + l] = sw[i * $P_W + l];\n    }\n  }\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    if (go[l] && !iters[l]) iters[l] = $P_MAXITER;  /* did not converge: rc[l] is $P_ENOCONV */\n"
+          "    go[l] = go[l] && rc[l] == $P_OK;  /* now: the lane is committed */\n"
+          "    if (go[l] && (!isfinite(x->t[l] + h) || !isfinite(x->tc[l]))) {\n"
+          "      rc[l] = $P_ENONFINITE;\n      go[l] = 0;\n    }\n  }\n");
+  emit_commit(e, poly);
+  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
+          "    nfail += rc[l] != $P_OK;\n"
+          "    if (!st) continue;\n"
+          "    st->code[l] = rc[l];\n    st->iters[l] = iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n"
+          "  }\n  return nfail;\n}\n");
+}
+
+// The batch half of NAME.c: the kernels over lanes, then the functions.
+void emit_batch_source(Emitter *e, int lanes) {
+  static const KernelId used[] = {K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_PROJECT, K_LAMBDA0};
+  int poly = e->st->kern[K_FACTOR].nout > 0; /* lambda0: only the polynomial family's step needs it */
+  e->lanes = lanes;
+  tmpl(e, "\n/* ---- --batch: the kernels above as loops over $P_W lanes; value i of lane l is\n"
+          " * at [i * $P_W + l]. Each lane does the scalar kernel's operations in its order. ---- */\n");
+  for (size_t i = 0; i < sizeof used / sizeof used[0]; i++)
+    if (e->st->kern[used[i]].nout && (poly || used[i] != K_LAMBDA0)) emit_kernel(e, used[i]);
+  out(e, "\n");
+  emit_set_get(e);
+  emit_params_observers(e);
+  emit_predict(e);
+  emit_batch_step(e);
+  e->lanes = 0;
+}

@@ -1,0 +1,689 @@
+/* ensemble.c - many trajectories of one model: --ensemble FILE.csv or
+ * --sweep NAME=A:B:N (docs/api.md, "Ensembles").
+ *
+ * Each trajectory is a row: initial values and params by column name over
+ * the run's defaults (--q0, --p0, --param), N steps of h as in run.c, and one
+ * summary row (final state, max |H - H0|, |g|, |hc|, iterations, status).
+ * Trajectories are cut into chunks of consecutive rows: W of them when the
+ * solver has a batch step (stepped together, one lane each), else
+ * HBVMRT_SCALAR_CHUNK stepped one after another.  Chunks are handed out
+ * dynamically: to the threads of an OpenMP build (libhbvmrt_omp.a, a
+ * critical section around the counter) and, built with MPI
+ * (libhbvmrt_mpi.a, make MPI=1), across ranks by an atomic fetch-and-add on
+ * a counter in rank 0's memory.  Every trajectory's arithmetic is the same
+ * whoever computes it (a lane of NAME_batch_step is bitwise NAME_step), so
+ * the output does not depend on W, threads or ranks; rank 0 collects the
+ * rows (a bitwise OR of the zero-initialised tables, each row written by
+ * one rank only) and writes them in input order. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "hbvmrt_internal.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#ifdef HBVMRT_MPI
+#include <mpi.h>
+#include <stdint.h>
+#endif
+
+#define HBVMRT_SCALAR_CHUNK 4  /* trajectories per chunk without a batch step */
+
+/* Where a column of the input goes. */
+enum { COL_Q, COL_P, COL_PARAM };
+
+typedef struct {
+  const hbvmrt_model *md;
+  const hbvmrt_batch *bt;      /* NULL: no batch step */
+  hbvmrt_opts o;
+  const char *file, *sweep;
+  int threads;
+  int ncol, *kind, *index;     /* per column: COL_*, coordinate or param */
+  long nrow;
+  double *val;                 /* nrow x ncol */
+  int width;                   /* doubles per result row */
+  double *res;                 /* nrow x width, see result() */
+  long nchunk, chunk, next;
+  int rank, nranks;
+#ifdef HBVMRT_MPI
+  MPI_Win win;
+  long *counter;
+#endif
+} Ens;
+
+/* What one thread works in. */
+typedef struct {
+  void *x, *prm, *b, *prms;    /* a state, a params block; a batch and W params */
+  double *g, *hc;              /* nu * max(W, 1) each */
+  double *H0, *Hb;
+  int *code, *iters;
+} Work;
+
+/* The result row of trajectory i: status, steps, t, q, p, lambda, then from
+ * R_H on H, max_dH, max_g, max_hc, iters_mean, iters_max and the running sum
+ * of the iterations. */
+enum { R_H, R_DH, R_G, R_HC, R_MEAN, R_MAX, R_SUM, R_COUNT };
+
+static double *result(const Ens *e, long i)
+{
+  return e->res + i * e->width;
+}
+
+/* where the H column of a result row is */
+static int at_H(const hbvmrt_model *md)
+{
+  return 3 + 2 * md->m + (md->nu > 0 ? md->nu : 0);
+}
+
+/* the doubles at byte offset off of a state block */
+static double *field(const void *x, size_t off)
+{
+  return (double *)(void *)((char *)(size_t)x + off);
+}
+
+static void keep_max(double *max, double v)
+{
+  v = fabs(v);
+  if (!(v <= *max) && !isnan(*max))
+    *max = v;
+}
+
+/* ---- the options of the ensemble, and its input ---- */
+
+int hbvmrt_ensemble_wanted(int argc, char **argv)
+{
+  int i;
+
+  for (i = 1; i < argc; i++)
+    if (!strncmp(argv[i], "--ensemble", 10) || !strncmp(argv[i], "--sweep", 7))
+      return 1;
+  return 0;
+}
+
+/* Take --ensemble, --sweep, --threads out of argv (into e), leaving the
+ * driver's own options in *rest for hbvmrt_parse_args. */
+static int own_options(Ens *e, int argc, char **argv, char **rest, int *nrest)
+{
+  int i;
+
+  *nrest = 0;
+  for (i = 0; i < argc; i++) {
+    const char *a = argv[i], **to = NULL;
+    char *end;
+    if (i > 0 && (!strcmp(a, "--ensemble") || !strcmp(a, "--sweep") || !strcmp(a, "--threads"))) {
+      if (i + 1 >= argc) {
+        hbvmrt_error(e->md, "option %s needs a value", a);
+        return -1;
+      }
+      if (!strcmp(a, "--threads")) {
+        long v = strtol(argv[++i], &end, 10);
+        if (*end || v < 1 || v > 4096) {
+          hbvmrt_error(e->md, "--threads needs a whole number from 1 to 4096, got '%s'", argv[i]);
+          return -1;
+        }
+        e->threads = (int)v;
+        continue;
+      }
+      to = a[2] == 'e' ? &e->file : &e->sweep;
+      if (*to) {
+        hbvmrt_error(e->md, "%s given twice", a);
+        return -1;
+      }
+      *to = argv[++i];
+      continue;
+    }
+    rest[(*nrest)++] = argv[i];
+  }
+  if (e->file && e->sweep) {
+    hbvmrt_error(e->md, "--ensemble and --sweep cannot be used together");
+    return -1;
+  }
+  return 0;
+}
+
+/* The column called name: a coordinate (x, x[3]), a momentum (p_x) or a
+ * param; -1 after an error naming it. */
+static int column(Ens *e, int c, const char *name, size_t len)
+{
+  const hbvmrt_model *md = e->md;
+  int i;
+
+  for (i = 0; i < md->m; i++) {
+    const char *n = md->names[i];
+    if (strlen(n) == len && !strncmp(n, name, len)) {
+      e->kind[c] = COL_Q, e->index[c] = i;
+      return 0;
+    }
+    if (len > 2 && !strncmp(name, "p_", 2) && strlen(n) == len - 2 && !strncmp(n, name + 2, len - 2)) {
+      e->kind[c] = COL_P, e->index[c] = i;
+      return 0;
+    }
+  }
+  for (i = 0; i < md->nparams; i++)
+    if (strlen(md->params[i].name) == len && !strncmp(md->params[i].name, name, len)) {
+      e->kind[c] = COL_PARAM, e->index[c] = i;
+      return 0;
+    }
+  hbvmrt_error(md, "unknown column '%.*s' (a coordinate, p_ and a coordinate, or a parameter)", (int)len, name);
+  return -1;
+}
+
+static int add_columns(Ens *e, int n)
+{
+  e->ncol = n;
+  e->kind = calloc((size_t)n + 1, sizeof *e->kind);
+  e->index = calloc((size_t)n + 1, sizeof *e->index);
+  if (!e->kind || !e->index) {
+    hbvmrt_error(e->md, "out of memory");
+    return -1;
+  }
+  return 0;
+}
+
+/* --sweep NAME=A:B:N: N rows, NAME from A to B evenly (A alone for N = 1). */
+static int read_sweep(Ens *e)
+{
+  const char *eq = strchr(e->sweep, '=');
+  double a, b, n;
+  char tail;
+  long i;
+
+  if (!eq || sscanf(eq + 1, "%lf:%lf:%lf%c", &a, &b, &n, &tail) != 3 || !isfinite(a) || !isfinite(b) ||
+      n != floor(n) || n < 1 || n > 1e9) {
+    hbvmrt_error(e->md, "invalid value '%s' for --sweep (expected NAME=A:B:N, N >= 1 whole)", e->sweep);
+    return -1;
+  }
+  if (add_columns(e, 1) || column(e, 0, e->sweep, (size_t)(eq - e->sweep)))
+    return -1;
+  e->nrow = (long)n;
+  if (!(e->val = calloc((size_t)e->nrow, sizeof *e->val))) {
+    hbvmrt_error(e->md, "out of memory");
+    return -1;
+  }
+  for (i = 0; i < e->nrow; i++)
+    e->val[i] = e->nrow == 1 ? a : i == e->nrow - 1 ? b : a + (b - a) * (double)i / (double)(e->nrow - 1);
+  return 0;
+}
+
+/* --ensemble FILE: a header of column names, then one row of numbers per
+ * trajectory (blank lines and lines starting with # skipped). */
+static int read_ensemble(Ens *e)
+{
+  FILE *f = fopen(e->file, "r");
+  char *line = NULL, *p;
+  size_t cap = 0;
+  long lineno = 0, rcap = 0;
+  int rc = -1, c;
+
+  if (!f) {
+    hbvmrt_error(e->md, "cannot open '%s': %s", e->file, strerror(errno));
+    return -1;
+  }
+  while (getline(&line, &cap, f) > 0) {
+    lineno++;
+    line[strcspn(line, "\r\n")] = 0;
+    if (!line[strspn(line, " \t")] || line[0] == '#')
+      continue;
+    if (!e->kind) {               /* the header */
+      int n = 1;
+      for (p = line; *p; p++)
+        n += *p == ',';
+      if (add_columns(e, n))
+        goto done;
+      for (c = 0, p = line; c < n; c++) {
+        size_t len = strcspn(p, ",");
+        char *s = p;
+        while (*s == ' ' || *s == '\t')
+          s++, len--;
+        while (len > 0 && (s[len - 1] == ' ' || s[len - 1] == '\t'))
+          len--;
+        if (column(e, c, s, len))
+          goto done;
+        p += strcspn(p, ",") + (c + 1 < n);
+      }
+      continue;
+    }
+    if (e->nrow == rcap) {
+      double *v;
+      rcap = rcap ? 2 * rcap : 64;
+      if (!(v = realloc(e->val, (size_t)rcap * (size_t)e->ncol * sizeof *v))) {
+        hbvmrt_error(e->md, "out of memory");
+        goto done;
+      }
+      e->val = v;
+    }
+    for (c = 0, p = line; c < e->ncol; c++) {
+      char *end;
+      double v = strtod(p, &end);
+      while (*end == ' ' || *end == '\t')
+        end++;
+      if (end == p || !isfinite(v) || (*end != (c + 1 < e->ncol ? ',' : '\0'))) {
+        hbvmrt_error(e->md, "%s:%ld: expected %d finite numbers separated by commas", e->file, lineno, e->ncol);
+        goto done;
+      }
+      e->val[e->nrow * e->ncol + c] = v;
+      p = end + 1;
+    }
+    e->nrow++;
+  }
+  if (!e->kind)
+    hbvmrt_error(e->md, "%s: no header line (column names)", e->file);
+  else
+    rc = 0;
+done:
+  free(line);
+  fclose(f);
+  return rc;
+}
+
+/* ---- one trajectory's start and its result ---- */
+
+/* Trajectory i's params block and initial state in w->x; its status (0, or
+ * -1 off the constraints without --project, -2 projection failed). */
+static int start(const Ens *e, long i, void *x, void *prm, double *g, double *hc)
+{
+  const hbvmrt_model *md = e->md;
+  const double *row = e->val + i * e->ncol;
+  double q[1024], p[1024], *qv = e->o.q0, *pv = e->o.p0, dq = 0, dp = 0;
+  double tol = 64 * md->eps > HBVMRT_CONSISTENCY_TOL ? 64 * md->eps : HBVMRT_CONSISTENCY_TOL;
+  int c, k, code, setq = 0, setp = 0;
+
+  if (md->params_default)
+    md->params_default(prm);
+  hbvmrt_apply_params(md, &e->o, prm);
+  for (c = 0; c < e->ncol; c++) {
+    if (e->kind[c] == COL_PARAM)
+      memcpy((char *)prm + md->params[e->index[c]].offset, &row[c], sizeof row[c]);
+    setq |= e->kind[c] == COL_Q;
+    setp |= e->kind[c] == COL_P;
+  }
+  md->init_params(x, qv, pv, prm);  /* the base values at the row's params */
+  if (setq || setp) {
+    memcpy(q, field(x, md->off_q), (size_t)md->m * sizeof *q);
+    memcpy(p, field(x, md->off_p), (size_t)md->m * sizeof *p);
+    for (c = 0; c < e->ncol; c++)
+      if (e->kind[c] != COL_PARAM)
+        (e->kind[c] == COL_Q ? q : p)[e->index[c]] = row[c];
+    md->init_params(x, q, p, prm);
+  }
+  if (md->nu <= 0 || !md->project)
+    return 0;
+  {
+    double qmax = 0, pmax = 0, gmax = 0, hmax = 0;
+    char y[sizeof(double) * 4096];
+    void *yb = md->state_size <= sizeof y ? y : malloc(md->state_size);
+    if (!yb)
+      return -2;
+    for (k = 0; k < md->m; k++) {
+      keep_max(&qmax, field(x, md->off_q)[k]);
+      keep_max(&pmax, field(x, md->off_p)[k]);
+    }
+    memcpy(yb, x, md->state_size);
+    code = md->project(yb, prm, &dq, &dp);
+    md->constraints(x, prm, g);
+    md->hidden(x, prm, hc);
+    for (k = 0; k < md->nu; k++) {
+      keep_max(&gmax, g[k]);
+      keep_max(&hmax, hc[k]);
+    }
+    if (code != 0 && (e->o.project || !(gmax <= tol && hmax <= tol)))
+      code = -2;
+    else if (e->o.project)
+      memcpy(x, yb, md->state_size), code = 0;
+    else
+      code = code == 0 && !(dq <= tol * qmax && dp <= tol * pmax) ? -1 : 0;
+    if (yb != y)
+      free(yb);
+    return code;
+  }
+}
+
+/* |H - H0|, |g|, |hc| of a state into the maxima of result r (g, hc: nu
+ * values, stride apart). */
+static void observe(const Ens *e, double *r, double H, double H0, const double *g, const double *hc, int stride)
+{
+  double *f = r + at_H(e->md);
+  int a;
+
+  keep_max(&f[R_DH], H - H0);
+  for (a = 0; a < e->md->nu; a++) {
+    keep_max(&f[R_G], g[a * stride]);
+    keep_max(&f[R_HC], hc[a * stride]);
+  }
+}
+
+/* One step's iterations into result r. */
+static void count(const hbvmrt_model *md, double *r, long step, int iters)
+{
+  double *f = r + at_H(md);
+
+  r[1] = (double)step;
+  f[R_SUM] += iters;
+  if (iters > f[R_MAX])
+    f[R_MAX] = iters;
+}
+
+/* The final state x into result r (status and counters already there). */
+static void finish(const Ens *e, double *r, const void *x, const void *prm)
+{
+  const hbvmrt_model *md = e->md;
+  int m = md->m, nu = md->nu > 0 ? md->nu : 0;
+  double *f = r + at_H(md);
+
+  r[2] = *field(x, md->off_t);
+  memcpy(r + 3, field(x, md->off_q), (size_t)m * sizeof *r);
+  memcpy(r + 3 + m, field(x, md->off_p), (size_t)m * sizeof *r);
+  memcpy(r + 3 + 2 * m, field(x, md->off_lambda), (size_t)nu * sizeof *r);
+  f[R_H] = md->energy(x, prm);
+  f[R_MEAN] = r[1] > 0 ? f[R_SUM] / r[1] : 0;
+}
+
+/* ---- running chunks ---- */
+
+/* Trajectories [first, first + n) one after another. */
+static void run_scalar(const Ens *e, Work *w, long first, long n)
+{
+  const hbvmrt_model *md = e->md;
+  long i, k;
+
+  for (i = first; i < first + n; i++) {
+    double *r = result(e, i), H0;
+    r[0] = start(e, i, w->x, w->prm, w->g, w->hc);
+    H0 = md->energy(w->x, w->prm);
+    if (r[0] == 0) {
+      if (md->nu > 0) {
+        md->constraints(w->x, w->prm, w->g);
+        md->hidden(w->x, w->prm, w->hc);
+      }
+      observe(e, r, H0, H0, w->g, w->hc, 1);
+    }
+    for (k = 1; r[0] == 0 && k <= e->o.nsteps; k++) {
+      hbvmrt_stats st = {0, 0.0};
+      int code = md->step(w->x, e->o.h, w->prm, &st);
+      if (code != 0) {
+        r[0] = code;
+        break;
+      }
+      count(md, r, k, st.iters);
+      if (md->nu > 0) {
+        md->constraints(w->x, w->prm, w->g);
+        md->hidden(w->x, w->prm, w->hc);
+      }
+      observe(e, r, md->energy(w->x, w->prm), H0, w->g, w->hc, 1);
+    }
+    finish(e, r, w->x, w->prm);
+  }
+}
+
+/* Trajectories [first, first + n), n <= W, in the lanes of one batch; the
+ * lanes not used, not started or failed are idle. */
+static void run_batch(const Ens *e, Work *w, long first, long n)
+{
+  const hbvmrt_model *md = e->md;
+  int W = e->bt->w, l, live = 0;
+  long k;
+
+  for (l = 0; l < W; l++) {
+    char *prm = (char *)w->prms + (size_t)l * md->params_size;
+    long i = first + (l < n ? l : 0);
+    int status = start(e, i, w->x, prm, w->g, w->hc);
+    e->bt->set(w->b, l, w->x);
+    w->H0[l] = md->energy(w->x, prm);
+    if (l < n)
+      result(e, i)[0] = status;
+    e->bt->idle(w->b, l, l >= n || status != 0);
+    live += l < n && status == 0;
+  }
+  e->bt->observe(w->b, w->prms, w->Hb, w->g, w->hc);
+  for (l = 0; l < n; l++)
+    if (result(e, first + l)[0] == 0)
+      observe(e, result(e, first + l), w->Hb[l], w->H0[l], w->g + l, w->hc + l, W);
+  for (k = 1; live > 0 && k <= e->o.nsteps; k++) {
+    e->bt->step(w->b, e->o.h, w->prms, w->code, w->iters);
+    e->bt->observe(w->b, w->prms, w->Hb, w->g, w->hc);
+    for (l = 0; l < n; l++) {
+      double *r = result(e, first + l);
+      if (r[0] != 0)
+        continue;
+      if (w->code[l] != 0) {
+        r[0] = w->code[l];
+        e->bt->idle(w->b, l, 1);
+        live--;
+        continue;
+      }
+      count(md, r, k, w->iters[l]);
+      observe(e, r, w->Hb[l], w->H0[l], w->g + l, w->hc + l, W);
+    }
+  }
+  for (l = 0; l < n; l++) {
+    char *prm = (char *)w->prms + (size_t)l * md->params_size;
+    e->bt->get(w->b, l, w->x);
+    finish(e, result(e, first + l), w->x, prm);
+  }
+}
+
+/* The next chunk to run, or -1: from the counter of this process, or of
+ * rank 0 under MPI.  Called by one thread at a time. */
+static long next_chunk(Ens *e)
+{
+  long c;
+
+#ifdef HBVMRT_MPI
+  long one = 1;
+  MPI_Fetch_and_op(&one, &c, MPI_LONG, 0, 0, MPI_SUM, e->win);
+  MPI_Win_flush(0, e->win);
+#else
+  c = e->next++;
+#endif
+  return c < e->nchunk ? c : -1;
+}
+
+static int work_alloc(const Ens *e, Work *w)
+{
+  const hbvmrt_model *md = e->md;
+  size_t W = (size_t)(e->bt ? e->bt->w : 1), nu = (size_t)(md->nu > 0 ? md->nu : 0);
+
+  memset(w, 0, sizeof *w);
+  w->x = calloc(1, md->state_size + 1);
+  w->prm = calloc(1, md->params_size + 1);
+  w->prms = calloc(W, md->params_size + 1);
+  w->b = calloc(1, (e->bt ? e->bt->size : 0) + 1);
+  w->g = calloc(nu * W + 1, sizeof *w->g);
+  w->hc = calloc(nu * W + 1, sizeof *w->hc);
+  w->H0 = calloc(W, sizeof *w->H0);
+  w->Hb = calloc(W, sizeof *w->Hb);
+  w->code = calloc(W, sizeof *w->code);
+  w->iters = calloc(W, sizeof *w->iters);
+  return w->x && w->prm && w->prms && w->b && w->g && w->hc && w->H0 && w->Hb && w->code && w->iters ? 0 : -1;
+}
+
+static void work_free(Work *w)
+{
+  free(w->x), free(w->prm), free(w->prms), free(w->b), free(w->g), free(w->hc);
+  free(w->H0), free(w->Hb), free(w->code), free(w->iters);
+}
+
+/* One thread: chunks until there are none; -1 when out of memory. */
+static int worker(Ens *e)
+{
+  Work w;
+  long c;
+  int rc = work_alloc(e, &w);
+
+  for (;;) {
+#ifdef _OPENMP
+#pragma omp critical(hbvmrt_next_chunk)
+#endif
+    c = rc == 0 ? next_chunk(e) : -1;
+    if (c < 0)
+      break;
+    if (e->bt)
+      run_batch(e, &w, c * e->chunk, e->nrow - c * e->chunk < e->chunk ? e->nrow - c * e->chunk : e->chunk);
+    else
+      run_scalar(e, &w, c * e->chunk, e->nrow - c * e->chunk < e->chunk ? e->nrow - c * e->chunk : e->chunk);
+  }
+  work_free(&w);
+  return rc;
+}
+
+/* ---- output ---- */
+
+static int write_results(const Ens *e, FILE *f)
+{
+  const hbvmrt_model *md = e->md;
+  int m = md->m, nu = md->nu > 0 ? md->nu : 0, i;
+  long t;
+
+  fputs("traj,status,steps,t", f);
+  for (i = 0; i < m; i++)
+    fprintf(f, ",%s", md->names[i]);
+  for (i = 0; i < m; i++)
+    fprintf(f, ",p_%s", md->names[i]);
+  for (i = 0; i < nu; i++)
+    fprintf(f, ",lambda_%d", i + 1);
+  fputs(",H,max_dH,max_g,max_hc,iters_mean,iters_max\n", f);
+  for (t = 0; t < e->nrow; t++) {
+    const double *r = result(e, t);
+    fprintf(f, "%ld,%d,%ld", t + 1, (int)r[0], (long)r[1]);
+    for (i = 2; i < at_H(md) + R_SUM; i++)
+      fprintf(f, ",%.17g", r[i]);
+    fputc('\n', f);
+  }
+  return ferror(f) ? -1 : 0;
+}
+
+static double now(void)
+{
+  struct timespec ts;
+
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Run every chunk on this process's threads (and ranks); 0 or -1. */
+static int run_all(Ens *e)
+{
+  int bad = 0;
+
+#ifdef _OPENMP
+  if (e->threads > 0)
+    omp_set_num_threads(e->threads);
+#pragma omp parallel reduction(| : bad)
+  bad |= worker(e) != 0;
+#else
+  bad = worker(e) != 0;
+#endif
+#ifdef HBVMRT_MPI
+  {                            /* each row was written by one rank: OR them */
+    size_t n = (size_t)e->nrow * (size_t)e->width;
+    MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD);
+    MPI_Reduce(e->rank == 0 ? MPI_IN_PLACE : e->res, e->res, (int)n, MPI_UINT64_T, MPI_BOR, 0, MPI_COMM_WORLD);
+  }
+#endif
+  return bad ? -1 : 0;
+}
+
+static int threads_used(const Ens *e)
+{
+#ifdef _OPENMP
+  return e->threads > 0 ? e->threads : omp_get_max_threads();
+#else
+  (void)e;
+  return 1;
+#endif
+}
+
+int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int argc, char **argv)
+{
+  Ens e;
+  char **rest = calloc((size_t)argc + 1, sizeof *rest);
+  int nrest, status = 1, failed = 0;
+  double t0;
+  long i;
+
+  memset(&e, 0, sizeof e);
+  e.md = md;
+  e.bt = bt;
+  e.nranks = 1;
+#ifdef HBVMRT_MPI
+  {
+    int provided;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided);
+    MPI_Comm_rank(MPI_COMM_WORLD, &e.rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &e.nranks);
+  }
+#endif
+  if (!rest || own_options(&e, argc, argv, rest, &nrest) != 0)
+    goto out;
+  status = hbvmrt_parse_args(md, nrest, rest, &e.o);
+  if (status != HBVMRT_ARGS_RUN) {
+    status = status == HBVMRT_ARGS_DONE ? 0 : 1;
+    goto out;
+  }
+  status = 1;
+  if (!md->init_params || !md->names || md->m > 1024) {
+    hbvmrt_error(md, "this driver cannot run ensembles (generated by an earlier hbvmgen, or m > 1024)");
+    goto out;
+  }
+  if ((e.file ? read_ensemble(&e) : read_sweep(&e)) != 0)
+    goto out;
+  e.width = at_H(md) + R_COUNT;
+  e.chunk = bt ? bt->w : HBVMRT_SCALAR_CHUNK;
+  e.nchunk = (e.nrow + e.chunk - 1) / e.chunk;
+  if (!(e.res = calloc((size_t)e.nrow * (size_t)e.width + 1, sizeof *e.res))) {
+    hbvmrt_error(md, "out of memory");
+    goto out;
+  }
+#ifdef HBVMRT_MPI
+  MPI_Win_allocate(e.rank == 0 ? (MPI_Aint)sizeof(long) : 0, sizeof(long), MPI_INFO_NULL, MPI_COMM_WORLD, &e.counter,
+                   &e.win);
+  if (e.rank == 0)
+    *e.counter = 0;
+  MPI_Barrier(MPI_COMM_WORLD);
+  MPI_Win_lock_all(0, e.win);
+#endif
+  t0 = now();
+  if (run_all(&e) != 0) {
+    hbvmrt_error(md, "out of memory");
+    goto out;
+  }
+#ifdef HBVMRT_MPI
+  MPI_Win_unlock_all(e.win);
+  MPI_Win_free(&e.win);
+#endif
+  for (i = 0; i < e.nrow; i++)
+    failed += result(&e, i)[0] != 0;
+  status = failed ? 2 : 0;
+  if (e.rank == 0 && e.o.csv) {
+    FILE *f = strcmp(e.o.csv, "-") ? fopen(e.o.csv, "w") : stdout;
+    if (!f || write_results(&e, f) != 0 || (f != stdout ? fclose(f) : fflush(f)) != 0) {
+      hbvmrt_error(md, "cannot write '%s': %s", e.o.csv, strerror(errno ? errno : EIO));
+      status = 1;
+    }
+  }
+  if (e.rank == 0)
+    fprintf(stderr, "trajectories=%ld ok=%ld failed=%d steps=%ld W=%d threads=%d ranks=%d seconds=%.3g\n", e.nrow,
+            e.nrow - failed, failed, e.o.nsteps, bt ? bt->w : 1, threads_used(&e), e.nranks,
+            now() - t0);
+out:
+  hbvmrt_opts_free(&e.o);
+  free(rest), free(e.kind), free(e.index), free(e.val), free(e.res);
+#ifdef HBVMRT_MPI
+  MPI_Finalize();
+#endif
+  return status;
+}
+
+int hbvmrt_main_batch(const hbvmrt_model *model, const hbvmrt_batch *batch, int argc, char **argv)
+{
+  if (hbvmrt_ensemble_wanted(argc, argv))
+    return hbvmrt_ensemble_main(model, batch, argc, argv);
+  return hbvmrt_main(model, argc, argv);
+}

@@ -1,0 +1,137 @@
+/* check_batch.c - hbvmgen --batch W: every lane of NAME_batch_step is bitwise
+ * NAME_step from the same state, for both multiplier families, float and
+ * double, with params per lane, lanes that fail (left byte-identical while
+ * the others advance) and idle lanes (tests/models/LIST, the b* solvers). */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bchain_k2s2.h"
+#include "bconst_k2s2.h"
+#include "bfloat_k2s2.h"
+#include "bfloatpoly_k2s2.h"
+#include "bkepler_k16s2.h"
+#include "bmass_k2s2.h"
+#include "bplain_k3s3.h"
+#include "bpoly_k3s3.h"
+#include "bsat_k6s2.h"
+
+/* Lane l starts from the model's initial values after l scalar steps of
+ * h (1 + l / 8), so the lanes differ in state and in the previous step (lane
+ * 0 has none); the last lane's momenta are then made 1e4 times larger
+ * (without constraints: q 1e6 times smaller), a step that cannot converge, and lane 1 is idle for the first steps. NSTEP
+ * batch steps of h, then NSTEP of 1.5 h, each compared lane by lane with
+ * NAME_step: the code, the iterations and the state's bytes. With params,
+ * each lane's first param is scaled by 1 + l / 4. */
+#define BATCH_TEST(P, HSTEP, NSTEP)                                                                      \
+  START_TEST(test_##P) {                                                                             \
+    P##_batch b;                                                                                     \
+    P##_state s[P##_W], y;                                                                           \
+    P##_params prm[P##_W];                                                                           \
+    P##_batch_stats bs;                                                                              \
+    P##_stats ss;                                                                                    \
+    P##_real *first;                                                                                 \
+    int l, n, i, ok = 0, failed = 0;                                                                 \
+    memset(&b, 0xA5, sizeof b); /* garbage where nothing is set */                                 \
+    for (l = 0; l < P##_W; l++) {                                                                    \
+      P##_params_default(&prm[l]);                                                                   \
+      first = (P##_real *)(void *)&prm[l];                                                          \
+      if (P##_NPARAMS) *first *= (P##_real)(1 + l / 4.0);                                           \
+      P##_init_params(&s[l], NULL, NULL, &prm[l]);                                                   \
+      for (n = 0; n < l; n++) ck_assert_int_eq(P##_step(&s[l], (P##_real)((HSTEP) * (1 + l / 8.0)), &prm[l], NULL), 0); \
+      if (l == P##_W - 1 && l > 0)                                                                   \
+        for (i = 0; i < P##_M; i++) {                                                                \
+          if (P##_NU) s[l].p[i] = s[l].p[i] * 1e4f + 1e3f;                                           \
+          else s[l].q[i] *= 1e-6f; /* Kepler: near the singularity */                              \
+        }                                                                                            \
+      P##_batch_set(&b, l, &s[l]);                                                                   \
+    }                                                                                                \
+    if (P##_W > 2) b.idle[1] = 1;                                                                    \
+    for (n = 0; n < 2 * (NSTEP); n++) {                                                              \
+      P##_real h = (P##_real)((HSTEP) * (n < (NSTEP) ? 1 : 1.5));                                        \
+      int nf = P##_batch_step(&b, h, prm, &bs), nf2 = 0;                                             \
+      if (n == (NSTEP) / 2) b.idle[1] = 0;                                                           \
+      for (l = 0; l < P##_W; l++) {                                                                  \
+        int rc = 0;                                                                                  \
+        if (!(P##_W > 2 && l == 1 && n <= (NSTEP) / 2)) {                                            \
+          rc = P##_step(&s[l], h, &prm[l], &ss);                                                     \
+          if (bs.iters[l]) ck_assert_int_eq(bs.iters[l], ss.iters);                                 \
+        } else                                                                                       \
+          ck_assert_int_eq(bs.iters[l], 0);                                                          \
+        ck_assert_msg(bs.code[l] == rc, #P " step %d lane %d: code %d, scalar %d", n, l, bs.code[l], rc); \
+        nf2 += rc != 0;                                                                              \
+        ok += rc == 0;                                                                               \
+        failed += rc != 0;                                                                           \
+        P##_batch_get(&b, l, &y);                                                                    \
+        ck_assert_msg(!memcmp(&y, &s[l], sizeof y), #P " step %d lane %d: the state differs", n, l); \
+      }                                                                                              \
+      ck_assert_int_eq(nf, nf2);                                                                     \
+    }                                                                                                \
+    ck_assert_msg(ok > 0 && (P##_W == 1 || failed > 0), #P ": %d lane steps ok, %d failed", ok, failed); \
+    {                                                                                                \
+      P##_real H[P##_W], g[(P##_NU + 1) * P##_W], gs[P##_NU + 1];                                    \
+      P##_batch_energy(&b, prm, H);                                                                  \
+      P##_batch_constraints(&b, prm, g);                                                             \
+      for (l = 0; l < P##_W; l++) {                                                                  \
+        P##_real e = P##_energy(&s[l], &prm[l]);                                                     \
+        ck_assert(!memcmp(&H[l], &e, sizeof e));                                                     \
+        P##_constraints(&s[l], &prm[l], gs);                                                         \
+        for (i = 0; i < P##_NU; i++) ck_assert(!memcmp(&g[i * P##_W + l], &gs[i], sizeof gs[i]));    \
+      }                                                                                              \
+    }                                                                                                \
+  }                                                                                                  \
+  END_TEST
+
+BATCH_TEST(bconst_k2s2, 0.05, 12)
+BATCH_TEST(bpoly_k3s3, 0.1, 12)
+BATCH_TEST(bfloat_k2s2, 0.05, 12)
+BATCH_TEST(bfloatpoly_k2s2, 0.05, 12)
+BATCH_TEST(bchain_k2s2, 0.005, 8)
+BATCH_TEST(bsat_k6s2, 0.05, 8)
+BATCH_TEST(bkepler_k16s2, 0.03, 12)
+BATCH_TEST(bmass_k2s2, 0.05, 12)
+BATCH_TEST(bplain_k3s3, 0.1, 12)
+
+/* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
+START_TEST(test_defaults_and_idle) {
+  bconst_k2s2_batch b, c;
+  bconst_k2s2_state s;
+  bconst_k2s2_params prm[bconst_k2s2_W];
+  int l;
+  memset(&b, 0, sizeof b);
+  bconst_k2s2_init(&s, NULL, NULL);
+  for (l = 0; l < bconst_k2s2_W; l++) {
+    bconst_k2s2_params_default(&prm[l]);
+    bconst_k2s2_batch_set(&b, l, &s);
+  }
+  memcpy(&c, &b, sizeof b);
+  ck_assert_int_eq(bconst_k2s2_batch_step(&b, 0.05, NULL, NULL), 0);
+  ck_assert_int_eq(bconst_k2s2_batch_step(&c, 0.05, prm, NULL), 0);
+  ck_assert(!memcmp(&b, &c, sizeof b));
+  for (l = 0; l < bconst_k2s2_W; l++) b.idle[l] = 1;
+  memcpy(&c, &b, sizeof b);
+  ck_assert_int_eq(bconst_k2s2_batch_step(&b, 0.05, NULL, NULL), 0);
+  ck_assert(!memcmp(&b, &c, sizeof b));
+  for (l = 0; l < bconst_k2s2_W; l++) b.idle[l] = 0;
+  ck_assert_int_eq(bconst_k2s2_batch_step(&b, 0, NULL, NULL), bconst_k2s2_W); /* EBADSTEP in every lane */
+}
+END_TEST
+
+Suite *batch_suite(void) {
+  Suite *s = suite_create("batch");
+  TCase *tc = tcase_create("lanes");
+  tcase_set_timeout(tc, 60);
+  tcase_add_test(tc, test_bconst_k2s2);
+  tcase_add_test(tc, test_bpoly_k3s3);
+  tcase_add_test(tc, test_bfloat_k2s2);
+  tcase_add_test(tc, test_bfloatpoly_k2s2);
+  tcase_add_test(tc, test_bchain_k2s2);
+  tcase_add_test(tc, test_bsat_k6s2);
+  tcase_add_test(tc, test_bkepler_k16s2);
+  tcase_add_test(tc, test_bmass_k2s2);
+  tcase_add_test(tc, test_bplain_k3s3);
+  tcase_add_test(tc, test_defaults_and_idle);
+  suite_add_tcase(s, tc);
+  return s;
+}

@@ -1,0 +1,159 @@
+/* check_ensemble.c - the ensemble runner (runtime/ensemble.c): the summary
+ * file of --ensemble and --sweep is byte for byte the same for the scalar
+ * step and --batch W (W = 1, 3, 4), on 1 and 2 OpenMP threads, and on 1 and
+ * 2 MPI ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI). */
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "generate.h"
+
+static char dir[] = "/tmp/hbvm-ens-XXXXXX";
+
+static int sh(const char *cmd)
+{
+  int rc = system(cmd);
+  return rc == -1 || !WIFEXITED(rc) ? -1 : WEXITSTATUS(rc);
+}
+
+/* Generate NAME from model with flags; build its driver with cc against
+ * runtime/libhbvmrt_omp.a (-fopenmp), or with mpicc against the runtime
+ * compiled for MPI. */
+static void build(const char *name, const char *model, const char *flags, int mpi)
+{
+  char cmd[2048];
+  const char *san = getenv("HBVM_SANITIZED") && *getenv("HBVM_SANITIZED") && !mpi
+                        ? "-fsanitize=address,undefined -fno-omit-frame-pointer" : "";
+  snprintf(cmd, sizeof cmd,
+           "../gen/hbvmgen %s --main -n %s -o %s %s 2>/dev/null && %s -O2 -std=c99 -Wall -Wextra -pedantic -Werror "
+           "-fopenmp %s -I../runtime -I%s %s/%s.c %s/%s_main.c %s -lm -o %s/%s",
+           flags, name, dir, model, mpi ? "mpicc -DHBVMRT_MPI" : "cc", san, dir, dir, name, dir, name,
+           mpi ? "../runtime/*.c" : "../runtime/libhbvmrt_omp.a", dir, name);
+  ck_assert_msg(sh(cmd) == 0, "cannot build: %s", cmd);
+}
+
+/* Run dir/name with args, the summary into dir/out; returns the file. */
+static char *run(const char *launch, const char *name, const char *args, const char *out, int status)
+{
+  char cmd[2048], path[256];
+  snprintf(path, sizeof path, "%s/%s", dir, out);
+  snprintf(cmd, sizeof cmd, "%s %s/%s %s --csv %s 2>/dev/null", launch, dir, name, args, path);
+  int rc = sh(cmd);
+  ck_assert_msg(rc == status, "%s: exit status %d, expected %d", cmd, rc, status);
+  char *text = read_text(path);
+  ck_assert_ptr_nonnull(text);
+  return text;
+}
+
+/* The pendulum from rest at 8 angles, a row with momenta that no step of
+ * h = 0.1 converges from (status 1), and one off the constraint (-1). */
+static const char rows[] =
+    "x, y, p_x, p_y\n"
+    "0.1, -0.99498743710661997, 0, 0\n0.2, -0.9797958971132712, 0, 0\n0.3, -0.95393920141694566, 0, 0\n"
+    "0.4, -0.91651513899116799, 0, 0\n0.5, -0.8660254037844386, 0, 0\n0.6, -0.8, 0, 0\n"
+    "# a comment line\n"
+    "0, -1, 3000, 0\n0.7, -0.71414284285428498, 0, 0\n0, -1.5, 0, 0\n0.8, -0.6, 0, 0\n";
+
+START_TEST(test_independent_of_w_and_threads)
+{
+  static const char *const flags[] = {"-s 2", "-s 2 --batch 1", "-s 2 --batch 3", "-s 2 --batch 4"};
+  char path[256], name[32], *ref = NULL;
+  snprintf(path, sizeof path, "%s/rows.csv", dir);
+  FILE *f = fopen(path, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs(rows, f);
+  fclose(f);
+  for (int i = 0; i < 4; i++) {
+    snprintf(name, sizeof name, "pend%d", i);
+    build(name, "../models/pendulum.ham", flags[i], 0);
+    for (int t = 1; t <= 2; t++) {
+      char args[512];
+      snprintf(args, sizeof args, "--ensemble %s -h 0.1 -N 100 --threads %d", path, t);
+      char *got = run("", name, args, "ens.csv", 2); /* a trajectory failed */
+      if (!ref) {
+        ref = got;
+        ck_assert_ptr_nonnull(strstr(ref, "traj,status,steps,t,x,y,p_x,p_y,lambda_1,H,max_dH,max_g,max_hc,"));
+        ck_assert_ptr_nonnull(strstr(ref, "\n7,1,0,0,0,-1,3000,0,")); /* ENOCONV at the first step */
+        ck_assert_ptr_nonnull(strstr(ref, "\n9,-1,0,0,0,-1.5,0,0,")); /* off the constraint: not run */
+        ck_assert_ptr_nonnull(strstr(ref, "\n10,0,100,"));
+        continue;
+      }
+      ck_assert_msg(!strcmp(got, ref), "%s with %d threads: the summary differs", flags[i], t);
+      free(got);
+    }
+  }
+  free(ref);
+}
+END_TEST
+
+START_TEST(test_sweep_and_mpi)
+{
+  char *one, *got;
+  build("mp", "models/mass_param.ham", "-s 2", 0);
+  build("mpb", "models/mass_param.ham", "-s 2 --batch 4", 0);
+  one = run("", "mp", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 1", "s1.csv", 0);
+  ck_assert_ptr_nonnull(strstr(one, "\n11,0,200,10,"));
+  got = run("", "mpb", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 2", "s2.csv", 0);
+  ck_assert_msg(!strcmp(got, one), "--sweep with --batch 4 on 2 threads differs");
+  free(got);
+  if (sh("command -v mpicc >/dev/null && command -v mpirun >/dev/null") != 0) {
+    fprintf(stderr, "check_ensemble: MPI is not installed (scripts/deps.sh mpi): the test on 2 ranks is skipped\n");
+    free(one);
+    return;
+  }
+  build("mpm", "models/mass_param.ham", "-s 2 --batch 4", 1);
+  build("mps", "models/mass_param.ham", "-s 2", 1);
+  const char *mpirun = "OMPI_MCA_btl=self,vader OMPI_MCA_plm_rsh_agent=false timeout 120 mpirun --allow-run-as-root "
+                       "--oversubscribe -np 2";
+  got = run(mpirun, "mpm", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 1", "s3.csv", 0);
+  ck_assert_msg(!strcmp(got, one), "--sweep with --batch 4 on 2 MPI ranks differs");
+  free(got);
+  got = run(mpirun, "mps", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 2", "s4.csv", 0);
+  ck_assert_msg(!strcmp(got, one), "--sweep, scalar, on 2 MPI ranks of 2 threads differs");
+  free(got);
+  free(one);
+}
+END_TEST
+
+START_TEST(test_errors)
+{
+  char cmd[512];
+  build("pe", "../models/pendulum.ham", "-s 2 --batch 2", 0);
+  static const char *const bad[] = {"--sweep z=0:1:3", "--sweep x=0:1", "--ensemble /nonexistent.csv",
+                                    "--sweep x=0:1:3 --ensemble a.csv", "--sweep x=0:1:3 --threads 0"};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    snprintf(cmd, sizeof cmd, "%s/pe %s -N 1 2>/dev/null", dir, bad[i]);
+    ck_assert_msg(sh(cmd) == 1, "%s: expected exit status 1", bad[i]);
+  }
+}
+END_TEST
+
+static void setup(void)
+{
+  ck_assert_ptr_nonnull(mkdtemp(dir));
+}
+
+static void teardown(void)
+{
+  char cmd[128];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  if (sh(cmd) != 0)
+    fprintf(stderr, "check_ensemble: could not remove %s\n", dir);
+  strcpy(dir, "/tmp/hbvm-ens-XXXXXX");
+}
+
+Suite *ensemble_suite(void)
+{
+  Suite *s = suite_create("ensemble");
+  TCase *tc = tcase_create("ensemble");
+  tcase_add_checked_fixture(tc, setup, teardown);
+  tcase_set_timeout(tc, 300);
+  tcase_add_test(tc, test_independent_of_w_and_threads);
+  tcase_add_test(tc, test_sweep_and_mpi);
+  tcase_add_test(tc, test_errors);
+  suite_add_tcase(s, tc);
+  return s;
+}
