@@ -242,8 +242,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "\n"
     "  -h STEP            step size h, nonzero, negative to go back in time\n"
     "                     (default %g)\n"
-    "  -T TIME            time span, TIME >= 0: N = ceil(TIME/|h|) steps, so\n"
-    "                     the last time is N*h (default %g)\n"
+    "  -T TIME            time span, TIME >= 0: N = ceil(TIME/|h|) steps, the\n"
+    "                     last shortened to end at TIME exactly (default %g)\n"
     "  -N STEPS           number of steps N >= 0 instead of -T\n"
     "  --every K          a CSV row every K steps, K >= 1; t=0 and the last\n"
     "                     step are always written (default 1)\n"
@@ -280,9 +280,12 @@ static int print_help(const hbvmrt_model *md, FILE *out)
       fprintf(out, "  %s = %.17g\n", md->params[i].name, v);
     }
   }
-  fputs("\nAt the end one line on stderr:\n"
+  fputs("\nA step that fails is retried as two halves, down to h/256, on stderr.\n"
+    "At the end one line on stderr:\n"
     "  steps=N iters_mean=X iters_max=Y max_dH=E max_g=E max_hc=E seconds=S\n"
-    "with the maxima of |H-H0|, |g_i| and |hc_i| over every step.\n"
+    "  steps_rejected=R h_min=E h_max=E\n"
+    "with the maxima of |H-H0|, |g_i| and |hc_i| over every step, the failed\n"
+    "steps retried smaller and the smallest and largest |h| taken.\n"
     "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"
     "included) or an output error, 2 a failed step or projection.\n", out);
   free(prm);
@@ -353,6 +356,8 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
   if (seen->have_N)
     return 0;
   T = seen->have_T ? seen->T : HBVMRT_DEFAULT_T;
+  o->T = T;
+  o->to_T = 1;
   /* the 1e-9 keeps T/h = 1000.0000000000001 from becoming 1001 steps; a
    * span T > 0 shorter than |h| is still one step, as ceil(T/|h|) says */
   n = ceil(T / fabs(o->h) - 1e-9);

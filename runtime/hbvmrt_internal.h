@@ -28,11 +28,16 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
  * than this, relative to max|q|, max|p|, are refused without --project (or
  * 64 ulps of the solver's real type, if that is more: float). */
 #define HBVMRT_CONSISTENCY_TOL 1e-10
+/* A failed step of the fixed h is retried as two halves, each of which may
+ * be halved again, this many times deep (h / 256) before the run stops. */
+#define HBVMRT_HALVINGS 8
 
 /* The driver options once parsed and checked. */
 typedef struct {
   double h;            /* step, nonzero, may be negative */
   long nsteps;         /* N >= 0 (from -N, or from -T and h) */
+  double T;            /* with to_T: the span, hit exactly (last step shortened) */
+  int to_T;            /* the span came from -T or its default, not -N */
   long every;          /* K >= 1: a CSV row every K steps */
   double *q0, *p0;     /* m values each; NULL when the option was not given */
   double *param_val;   /* nparams values from --param ... */

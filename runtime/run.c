@@ -2,11 +2,14 @@
  *
  * After the options (args.c) it allocates the state and params blocks, fills
  * the params with the defaults and the --param values, initialises the state
- * and takes N steps of the constant step h.  After t=0 and after every step it
- * evaluates H, g and the hidden constraints hc, so the maxima in the summary
- * are over every step, not just the rows written (every K-th step, t=0 and
- * the last step).  A failed step stops the loop: the state it left is the
- * last good one, written as the final row, and the exit status is 2.
+ * and takes N steps of the constant step h, the last one shortened to end
+ * on -T exactly.  A step that fails is retried as two halves (each of which
+ * may be halved again, HBVMRT_HALVINGS deep), said once on stderr.  After
+ * t=0 and after every step it evaluates H, g and the hidden constraints hc,
+ * so the maxima in the summary are over every step, not just the rows
+ * written (every K-th step, t=0 and the last step).  A step that fails even
+ * halved stops the loop: the state it left is the last good one, written as
+ * the final row, and the exit status is 2.
  *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
@@ -34,6 +37,8 @@ typedef struct {
   double iters_sum;
   int iters_max;
   long steps;                 /* steps taken successfully */
+  long rejected;              /* steps tried and failed (then retried smaller) */
+  double h_min, h_max;        /* of the steps taken, in |h| */
   int fail_code;              /* the failed step's code, or 0 */
   FILE *csv;                  /* NULL: no CSV */
   int csv_errno;              /* errno of the first failed write, or 0 */
@@ -293,30 +298,77 @@ static void progress_clear(Progress *pg)
   pg->width = 0;
 }
 
-/* Rows at t=0, every K steps and at the last step taken; stops at the
- * first failed step (code in r->fail_code) or failed write. */
-static void loop(Run *r, Progress *pg)
+/* The time of the state (its rounded value). */
+static double state_t(const Run *r)
+{
+  double t;
+
+  memcpy(&t, (const char *)r->x + r->md->off_t, sizeof t);
+  return t;
+}
+
+/* A step of size h was taken: its figures into the run's. */
+static void taken(Run *r, const hbvmrt_stats *st, double h)
+{
+  r->steps++;
+  r->iters_sum += st->iters;
+  if (st->iters > r->iters_max)
+    r->iters_max = st->iters;
+  if (r->steps == 1 || fabs(h) < r->h_min)
+    r->h_min = fabs(h);
+  if (fabs(h) > r->h_max)
+    r->h_max = fabs(h);
+  observe(r);
+}
+
+/* Advance the state by h: one step, or, when it fails, two halves, each of
+ * which may be halved again, HBVMRT_HALVINGS deep, so that the run keeps
+ * its grid of fixed steps.  A failed step leaves the state as it was, so
+ * the retry starts from the same point.  The first retry of a fixed step
+ * is said on stderr.  Returns 0, or the code of the last failed step. */
+static int advance(Run *r, double h, int depth)
 {
   const hbvmrt_model *md = r->md;
+  hbvmrt_stats st = {0, 0.0};
+  double target = state_t(r) + h;
+  int code = md->step(r->x, h, r->prm, &st);
+
+  if (code == 0) {
+    taken(r, &st, h);
+    return 0;
+  }
+  r->rejected++;
+  if (depth >= HBVMRT_HALVINGS)
+    return code;
+  if (depth == 0)
+    fprintf(stderr, "%s: step h=%.6g failed at t=%.15g (%s): retrying with "
+            "halved steps\n", md->name, h, state_t(r),
+            md->strerror ? md->strerror(code) : "failed");
+  if ((code = advance(r, h / 2, depth + 1)) != 0)
+    return code;
+  return advance(r, target - state_t(r), depth + 1);
+}
+
+/* Rows at t=0, every K steps and at the last step taken; stops at the
+ * first step that fails even halved (code in r->fail_code) or failed
+ * write.  With a span (-T) the last step is shortened to end on it. */
+static void loop(Run *r, Progress *pg)
+{
   long n, N = r->o->nsteps, K = r->o->every;
+  double h = r->o->h, t_end = h < 0 ? -r->o->T : r->o->T;
 
   observe(r);
   if (write_row(r) != 0)
     return;
   for (n = 1; n <= N; n++) {
-    hbvmrt_stats st = {0, 0.0};
-    int code = md->step(r->x, r->o->h, r->prm, &st);
+    double hn = n == N && r->o->to_T ? t_end - state_t(r) : h;
+    int code = advance(r, hn, 0);
     if (code != 0) {
       r->fail_code = code;
-      if (r->steps % K != 0)
+      if ((n - 1) % K != 0)
         write_row(r);          /* the state the failed step left */
       return;
     }
-    r->steps = n;
-    r->iters_sum += st.iters;
-    if (st.iters > r->iters_max)
-      r->iters_max = st.iters;
-    observe(r);
     if ((n % K == 0 || n == N) && write_row(r) != 0)
       return;
     if (pg->on && n >= pg->next)
@@ -352,7 +404,8 @@ static void summary(const Run *r, double seconds)
     fprintf(stderr, "max_g=%.3e max_hc=%.3e", r->max_g, r->max_hc);
   else
     fputs("max_g=0 max_hc=0", stderr);
-  fprintf(stderr, " seconds=%.3g\n", seconds);
+  fprintf(stderr, " seconds=%.3g steps_rejected=%ld h_min=%.3e h_max=%.3e\n",
+          seconds, r->rejected, r->h_min, r->h_max);
 }
 
 /* The loop and everything reported after it; returns the exit status. */

@@ -23,6 +23,8 @@
 
 #include "hbvmrt.h"
 
+#define HALVINGS 8              /* HBVMRT_HALVINGS of runtime/hbvmrt_internal.h */
+
 /* --- osc: m=1, nu=0, no parameters ------------------------------------- */
 
 typedef struct {
@@ -78,6 +80,14 @@ static int osc_step_slow(void *x, double h, const void *prm, hbvmrt_stats *st)
   struct timespec ms = {0, 1000000};
 
   nanosleep(&ms, NULL);
+  return osc_step(x, h, prm, st);
+}
+
+/* as osc_step, but every step longer than 0.06 fails */
+static int osc_step_short(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  if (fabs(h) > 0.06)
+    return 7;
   return osc_step(x, h, prm, st);
 }
 
@@ -443,6 +453,8 @@ typedef struct {
   double iters_mean;
   int iters_max;
   double max_dH, max_g, max_hc, seconds;
+  long rejected;
+  double h_min, h_max;
 } Summary;
 
 static Summary summary_of(const char *err)
@@ -453,9 +465,11 @@ static Summary summary_of(const char *err)
   ck_assert_msg(p != NULL, "no summary in: %s", err);
   ck_assert_msg(p == err || p[-1] == '\n', "summary not at a line start");
   ck_assert_int_eq(sscanf(p, "steps=%ld iters_mean=%lf iters_max=%d "
-                          "max_dH=%lf max_g=%lf max_hc=%lf seconds=%lf",
+                          "max_dH=%lf max_g=%lf max_hc=%lf seconds=%lf "
+                          "steps_rejected=%ld h_min=%lf h_max=%lf",
                           &s.steps, &s.iters_mean, &s.iters_max, &s.max_dH,
-                          &s.max_g, &s.max_hc, &s.seconds), 7);
+                          &s.max_g, &s.max_hc, &s.seconds, &s.rejected,
+                          &s.h_min, &s.h_max), 10);
   ck_assert_ptr_eq(strchr(p, '\n'), p + strlen(p) - 1);
   return s;
 }
@@ -513,7 +527,7 @@ static const struct {
   {"-h 0.1 -N 0 --csv @", 1, 0.0},
   {"-h 0.1 -N 0 --every 5 --csv @", 1, 0.0},
   {"-h 0.1 -T 1 --csv @", 11, 1.0},
-  {"-h 0.3 -T 1 --csv @", 5, 1.2},
+  {"-h 0.3 -T 1 --csv @", 5, 1.0},   /* the last step shortened to 0.1 */
   {"-h 0.1 -T 0.3 --csv @", 4, 0.3},
   {"-h -0.1 -T 1 --csv @", 11, -1.0},
   {"-T 0 --csv @", 1, 0.0},
@@ -715,7 +729,9 @@ END_TEST
 START_TEST(step_failure)
 {
   const char *want =
-    "osc: error: step failed at t=0.5: did not converge\nsteps=5 ";
+    "osc: step h=0.1 failed at t=0.5 (did not converge): retrying with "
+    "halved steps\nosc: error: step failed at t=0.5: did not converge\n"
+    "steps=5 ";
   hbvmrt_model failing = osc;
   Result r;
 
@@ -726,7 +742,58 @@ START_TEST(step_failure)
   ck_assert_double_eq_tol(cell(r.csv, 5, 0), 0.5, 1e-12);
   ck_assert_int_eq(strncmp(r.err, want, strlen(want)), 0);
   ck_assert_int_eq(summary_of(r.err).steps, 5);
-  ck_assert_int_eq(count_lines(r.err), 2);
+  ck_assert_int_eq(summary_of(r.err).rejected, 1 + HALVINGS);
+  ck_assert_int_eq(count_lines(r.err), 3);
+  done(&r);
+}
+END_TEST
+
+/* a fixed step that fails is retried in halves, on the same grid: the rows
+ * stay at multiples of h, the summary counts the failures and the sizes */
+START_TEST(step_retried)
+{
+  hbvmrt_model shortish = osc;
+  Result r;
+  Summary s;
+
+  shortish.step = osc_step_short;
+  r = run(&shortish, "-h 0.1 -N 3 --csv @");
+  s = summary_of(r.err);
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 4);
+  ck_assert_double_eq_tol(cell(r.csv, 3, 0), 0.3, 1e-15);
+  ck_assert_double_eq_tol(cell(r.csv, 3, 1), cos(0.3), 1e-14);
+  ck_assert_int_eq(s.steps, 6);
+  ck_assert_int_eq(s.rejected, 3);
+  ck_assert_double_eq_tol(s.h_min, 0.05, 1e-15);
+  ck_assert_double_eq_tol(s.h_max, 0.05, 1e-15);
+  ck_assert_int_eq(count_lines(r.err), 3 + 1);
+  ck_assert_ptr_nonnull(strstr(r.err, "osc: step h=0.1 failed at t=0.2 (did "
+                               "not converge): retrying with halved steps\n"));
+  done(&r);
+}
+END_TEST
+
+/* -T is hit exactly: the last step is shortened (0.3, 0.3, 0.3, 0.1) */
+START_TEST(span_hit_exactly)
+{
+  Result r = run(&osc, "-h 0.3 -T 1 --csv @");
+  Summary s = summary_of(r.err);
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(count_lines(r.csv), 1 + 5);
+  ck_assert_double_eq_tol(cell(r.csv, 4, 0), 1.0, 1e-15);
+  ck_assert_double_eq_tol(cell(r.csv, 4, 1), cos(1.0), 1e-14);
+  ck_assert_int_eq(s.steps, 4);
+  ck_assert_double_eq_tol(s.h_min, 0.1, 1e-14);
+  ck_assert_double_eq_tol(s.h_max, 0.3, 1e-15);
+  done(&r);
+  r = run(&osc, "-h -0.3 -T 1 --csv @");                  /* backwards */
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq_tol(cell(r.csv, 4, 0), -1.0, 1e-15);
+  done(&r);
+  r = run(&osc, "-h 0.3 -N 4 --csv @");                   /* -N: N steps of h */
+  ck_assert_double_eq_tol(cell(r.csv, 4, 0), 1.2, 1e-15);
   done(&r);
 }
 END_TEST
@@ -981,6 +1048,8 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, inconsistent_start);
   tcase_add_test(run_, step_failure);
   tcase_add_test(run_, step_failure_every);
+  tcase_add_test(run_, step_retried);
+  tcase_add_test(run_, span_hit_exactly);
   tcase_add_test(run_, no_progress_off_terminal);
   tcase_add_test(run_, progress_on_terminal);
   tcase_set_timeout(run_, 30);
