@@ -948,7 +948,7 @@ START_TEST(help)
   ck_assert_ptr_nonnull(strstr(r.out, "m=2 "));
   ck_assert_ptr_nonnull(strstr(r.out, "nu=1 "));
   ck_assert_ptr_nonnull(strstr(r.out, "k=3,s=2"));
-  ck_assert_ptr_nonnull(strstr(r.out, "N*h"));
+  ck_assert_ptr_nonnull(strstr(r.out, "end at TIME exactly"));
   ck_assert_ptr_nonnull(strstr(r.out, "  k = 1\n"));
   ck_assert_ptr_nonnull(strstr(r.out, "default 1,0)"));     /* q0 */
   done(&r);
