@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 
 #include "generate.h"
 #include "pendulum_float_k2s2.h"
@@ -241,12 +242,43 @@ START_TEST(corpus_models_compile) {
 }
 END_TEST
 
+/* The iteration's limits are #ifndef-guarded macros that -D sets when the
+ * solver is compiled (docs/api.md): with pendulum_k2s2_MAXITER=1 no step can
+ * converge, so the first returns NAME_ENOCONV (1); with the default it
+ * succeeds (0). */
+START_TEST(limits_settable_with_D) {
+  static const char *const prog = "#include \"pendulum_k2s2.h\"\n"
+                                  "int main(void) { pendulum_k2s2_state x; pendulum_k2s2_init(&x, 0, 0);\n"
+                                  "  return pendulum_k2s2_step(&x, 0.1, 0, 0); }\n";
+  char dir[] = "/tmp/hbvm-limits-XXXXXX", cmd[1024];
+  ck_assert(mkdtemp(dir) != NULL);
+  snprintf(cmd, sizeof cmd, "%s/main.c", dir);
+  FILE *f = fopen(cmd, "w");
+  ck_assert(f != NULL);
+  fputs(prog, f);
+  fclose(f);
+  static const char *const defs[2] = {"", "-Dpendulum_k2s2_MAXITER=1"};
+  for (int v = 0; v < 2; v++) {
+    snprintf(cmd, sizeof cmd, "cc -std=c99 -Wall -Werror %s -I../generated -o %s/a %s/main.c ../generated/pendulum_k2s2.c -lm",
+             defs[v], dir, dir);
+    ck_assert_msg(system(cmd) == 0, "%s failed", cmd);
+    snprintf(cmd, sizeof cmd, "%s/a", dir);
+    int rc = system(cmd);
+    ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == v, "%s: step returned %d, want %d", defs[v],
+                  WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, v);
+  }
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  ck_assert_int_eq(system(cmd), 0);
+}
+END_TEST
+
 Suite *lean_suite(void) {
   Suite *s = suite_create("lean");
   TCase *tc = tcase_create("structure");
   tcase_set_timeout(tc, 180); /* the corpus compile takes ~20 s, more under the sanitizers */
   tcase_add_test(tc, equal_mass_matrices_give_equal_code);
   tcase_add_test(tc, corpus_models_compile);
+  tcase_add_test(tc, limits_settable_with_D);
   tcase_add_test(tc, no_multiplier_code_without_constraints);
   tcase_add_test(tc, no_force_code_without_potential);
   tcase_add_test(tc, structural_zeros_never_multiplied);
