@@ -13,8 +13,11 @@
  * which the kernel "factor" builds from the predicted stage data and
  * factors once per step (lu.c, minimum-degree order: a chain's blocks keep
  * their band). Each sweep then updates lambda <- lambda + A^-1 C(lambda)
- * with that frozen factor and recomputes Theta and gamma (METHOD-HO.md
- * section 5: as few sweeps as re-solving A every sweep).
+ * with that frozen factor and recomputes Theta and gamma (docs/method-poly.md
+ * section 5: as few sweeps as re-solving A every sweep while h is small;
+ * where the iteration slows down the step template calls "factor" again at
+ * the current gamma, which keeps it converging to the h of the constant
+ * family).
  *
  * After the iteration the step projects p1 onto the hidden constraint at
  * q1 and rescales it so that H keeps its value; the kernel "project_p1" gives
