@@ -92,13 +92,15 @@ static KernelId kernel_named(const Emitter *e, const char *name, size_t n) {
 // "sw[$[sweep.dp]i]" reads sw[S * M + i] or sw[i].
 static void offset_of(const Emitter *e, const char *text, const char *end, int plus) {
   const char *dot = memchr(text, '.', (size_t)(end - text));
-  const Kernel *k = &e->st->kern[kernel_named(e, text, (size_t)((dot ? dot : end) - text))];
+  KernelId id = kernel_named(e, text, (size_t)((dot ? dot : end) - text));
+  const Kernel *k = &e->st->kern[id];
   int upto = k->nout;
   if (dot) {
-    for (upto = 0; upto < k->nout; upto++)
-      if (strlen(k->out[upto].name) == (size_t)(end - dot - 1) && !strncmp(k->out[upto].name, dot + 1, (size_t)(end - dot - 1)))
-        break;
-    if (upto == k->nout) internal_error("template names an unknown result '%.*s'", (int)(end - text), text);
+    char name[64];
+    snprintf(name, sizeof name, "%.*s", (int)(end - dot - 1), dot + 1);
+    const Slots *bl = step_block(e->st, id, name);
+    if (!bl) internal_error("template names an unknown result '%.*s'", (int)(end - text), text);
+    upto = (int)(bl - k->out);
   }
   char buf[1024];
   size_expr(e->P, k->out, upto, buf, sizeof buf);
