@@ -30,6 +30,19 @@ static void accumulate(Sweep *sw, int id, int contribution) {
   sw->adj[id] = sw->adj[id] < 0 ? contribution : dag_add(sw->d, sw->adj[id], contribution);
 }
 
+// The adjoint w of a table row (OP_TROW node n) into its vector's entries.
+static void propagate_table_row(Sweep *sw, const Node *n, int w) {
+  Dag *d = sw->d;
+  const DagTable *t = &d->tables[(int)n->val];
+  int *e = xmalloc((size_t)t->cols * sizeof *e);
+  dag_vector_entries(d, n->a, e);
+  for (int j = 0; j < t->cols; j++) {
+    double c = t->v[(size_t)n->idx * (size_t)t->cols + (size_t)j];
+    if (c != 0) accumulate(sw, e[j], dag_mul(d, dag_const(d, c), w));
+  }
+  free(e);
+}
+
 // Propagate the adjoint w of node id into its operands.
 static void propagate(Sweep *sw, int id, int w) {
   Dag *d = sw->d;
@@ -37,6 +50,7 @@ static void propagate(Sweep *sw, int id, int w) {
   int a = n.a, b = n.b, one = dag_const(d, 1);
   switch ((Op)n.op) {
   case OP_CONST:
+  case OP_VEC:
   case OP_INPUT:
   case OP_PARAM:
   case OP_SIGN:
@@ -62,6 +76,9 @@ static void propagate(Sweep *sw, int id, int w) {
   }
   case OP_NEG:
     accumulate(sw, a, dag_neg(d, w));
+    return;
+  case OP_TROW: /* sum_j T[row][j] v_j: w T[row][j] to each entry (VEC nodes pass nothing) */
+    propagate_table_row(sw, &n, w);
     return;
   case OP_POW:
     if (d->nodes[b].op == OP_CONST) {

@@ -713,6 +713,7 @@ Model *analyse(const char *file, Stmt *prog) {
   grow_table(cx);
   Model *mod = arena_alloc(sizeof *mod);
   mod->file = file;
+  mod->mass_loop = MASS_LOOP_DEFAULT;
   cx->mod = mod;
   cx->d = mod->dag = dag_new();
   cx->prog = prog;

@@ -95,7 +95,10 @@ static int node_degree(const Dag *d, const Node *n) {
   case OP_DIV:
     return db == 0 ? da : DEG_NONPOLY;
   case OP_NEG:
+  case OP_TROW:
     return da;
+  case OP_VEC:
+    return da < 0 || db < 0 ? DEG_NONPOLY : (da > db ? da : db);
   case OP_POW: {
     const Node *e = &d->nodes[n->b];
     if (e->op == OP_CONST && e->val >= 0 && e->val == floor(e->val) && e->val <= (1 << 20))
@@ -292,6 +295,61 @@ int dag_mul(Dag *d, int a, int b) { return dag_op(d, OP_MUL, a, b); }
 int dag_div(Dag *d, int a, int b) { return dag_op(d, OP_DIV, a, b); }
 int dag_neg(Dag *d, int a) { return dag_op(d, OP_NEG, a, -1); }
 
+// Register a constant table (rows x cols, row-major; v must outlive the
+// Dag) for dag_table_row; returns its number.
+int dag_table(Dag *d, const char *name, const double *v, int rows, int cols) {
+  VEC_RESERVE(d->tables, d->ntables, d->tabcap, d->ntables + 1);
+  d->tables[d->ntables] = (DagTable){name, v, rows, cols};
+  return d->ntables++;
+}
+
+// The vector v[0..n-1] as a chain of VEC nodes (see hbvmgen.h); returns
+// its last node. Equal vectors give the same chain.
+static int dag_vector_link(Dag *d, int entry, int prev, int j) {
+  Node x = leaf(OP_VEC);
+  x.a = entry;
+  x.b = prev;
+  x.idx = j;
+  return intern(d, x);
+}
+
+int dag_vector(Dag *d, const int *v, int n) {
+  int vec = -1;
+  ASSERT(n >= 1);
+  for (int j = 0; j < n; j++) vec = dag_vector_link(d, v[j], vec, j);
+  return vec;
+}
+
+int dag_vector_len(const Dag *d, int vec) { return d->nodes[vec].idx + 1; }
+
+void dag_vector_entries(const Dag *d, int vec, int *out) {
+  for (int id = vec; id >= 0; id = d->nodes[id].b) out[d->nodes[id].idx] = d->nodes[id].a;
+}
+
+// Row row of table times the vector whose chain ends at vec.
+int dag_table_row(Dag *d, int table, int row, int vec) {
+  ASSERT(table >= 0 && table < d->ntables && row >= 0 && row < d->tables[table].rows &&
+         d->nodes[vec].op == OP_VEC && dag_vector_len(d, vec) == d->tables[table].cols);
+  Node x = leaf(OP_TROW);
+  x.a = vec;
+  x.idx = row;
+  x.val = table;
+  return intern(d, x);
+}
+
+// The value of a TROW node from the values v[] of its vector's entries,
+// summed in the order the emitted loop sums them.
+static double table_row_value(const Dag *d, const Node *n, const double *v) {
+  const DagTable *t = &d->tables[(int)n->val];
+  int *e = xmalloc((size_t)t->cols * sizeof *e);
+  dag_vector_entries(d, n->a, e);
+  const double *row = t->v + (size_t)n->idx * (size_t)t->cols;
+  double acc = row[0] * v[e[0]];
+  for (int j = 1; j < t->cols; j++) acc += row[j] * v[e[j]];
+  free(e);
+  return acc;
+}
+
 // Start a labelled section: nodes created from now on belong to it (for
 // the comments of the emitted code).
 void dag_section(Dag *d, const char *label) {
@@ -336,6 +394,8 @@ void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inp
     case OP_CONST: v[id] = n->val; break;
     case OP_INPUT: v[id] = inputs[n->idx]; break;
     case OP_PARAM: v[id] = params[n->idx]; break;
+    case OP_VEC: v[id] = 0; break;
+    case OP_TROW: v[id] = table_row_value(d, n, v); break;
     default: v[id] = op_apply((Op)n->op, v[n->a], n->b >= 0 ? v[n->b] : 0);
     }
   }
@@ -368,6 +428,10 @@ void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, i
       img[id] = map[n.idx];
     else if (n.a < 0)
       img[id] = id;
+    else if (n.op == OP_VEC) /* rebuilt link by link: the chain of the images */
+      img[id] = dag_vector_link(d, img[n.a], n.b >= 0 ? img[n.b] : -1, n.idx);
+    else if (n.op == OP_TROW)
+      img[id] = dag_table_row(d, (int)n.val, n.idx, img[n.a]);
     else
       img[id] = dag_op(d, (Op)n.op, img[n.a], n.b >= 0 ? img[n.b] : -1);
   }

@@ -26,6 +26,7 @@ typedef struct {
   int wide;        /* the kernel being printed computes one precision wider */
   KernelId kid;    /* the kernel being printed */
   int lanes;       /* W > 0: kernels print as loops over W lanes (--batch, emit_batch.c) */
+  int *vec_part;   /* per VEC node: 1 + the part whose function declares its array, or 0 */
 } Emitter;
 
 void out(Emitter *e, const char *fmt, ...);
@@ -34,6 +35,7 @@ const char *math_suffix(const Emitter *e, int wide);
 void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
 void emit_kernel(Emitter *e, KernelId k);
+void emit_tables(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);

@@ -243,10 +243,86 @@ static int power_expr(char *buf, size_t size, const char *x, double n) {
   return 1;
 }
 
+// The type the tables are printed in: that of the widest kernel, so that
+// each kernel reads the value its literal would have (after a cast).
+static const char *table_type(const Emitter *e) { return real_type(e, e->wide_step); }
+
+// The constant tables TROW nodes of the kernels read (dag_table), as static
+// arrays before the kernels; those no kernel uses are left out.
+void emit_tables(Emitter *e) {
+  const Dag *d = e->mod->dag;
+  unsigned char *used = xcalloc((size_t)d->ntables + 1, 1), *mark = xcalloc((size_t)d->n + 1, 1);
+  for (int k = 0; k < K_COUNT; k++)
+    for (int b = 0; b < e->st->kern[k].nout; b++) dag_reach(d, e->st->kern[k].out[b].nodes, e->st->kern[k].out[b].len, mark);
+  for (int id = 0; id < d->n; id++)
+    if (mark[id] && d->nodes[id].op == OP_TROW) used[(int)d->nodes[id].val] = 1;
+  for (int t = 0; t < d->ntables; t++) {
+    const DagTable *tb = &d->tables[t];
+    if (!used[t]) continue;
+    out(e, "/* The table the loops of the kernels below multiply by (%s), transposed:\n"
+           " * %s_%s[j][i] is row i, column j. */\n", tb->name, e->P, tb->name);
+    out(e, "static const %s %s_%s[%d][%d] = {\n", table_type(e), e->P, tb->name, tb->cols, tb->rows);
+    int wide = e->wide;
+    e->wide = e->wide_step; /* the literals of the table's type */
+    for (int j = 0; j < tb->cols; j++) {
+      out(e, "  {");
+      for (int i = 0; i < tb->rows; i++) {
+        char lit[64];
+        format_real(e, lit, sizeof lit, tb->v[(size_t)i * (size_t)tb->cols + (size_t)j]);
+        out(e, "%s%s", i ? ", " : "", lit);
+      }
+      out(e, "}%s\n", j + 1 < tb->cols ? "," : "");
+    }
+    e->wide = wide;
+    out(e, "};\n\n");
+  }
+  free(used);
+  free(mark);
+}
+
+// The product of table t with the vector whose chain ends at vec, in the
+// part being printed on first use there: the vector's entries in an array
+// vID, then yID[i] = sum_j T[i][j] vID[j] for every row i, summed in order
+// of j (as dag.c evaluates it) with the loop over i innermost, so that the
+// compiler vectorises it; the table is printed transposed for that.
+static void declare_product(Emitter *e, const DagTable *tb, int vec) {
+  const Dag *d = e->mod->dag;
+  if (e->vec_part[vec] == e->part + 1) return;
+  e->vec_part[vec] = e->part + 1;
+  int n = dag_vector_len(d, vec), *ent = xmalloc((size_t)n * sizeof *ent);
+  const char *ty = real_type(e, e->wide), *in = e->lanes ? "  " : "";
+  char cast[32] = "";
+  if (strcmp(ty, table_type(e))) snprintf(cast, sizeof cast, "(%s)", ty);
+  dag_vector_entries(d, vec, ent);
+  out(e, "%s  const %s v%d[%d] = {", in, ty, vec, n);
+  for (int j = 0; j < n; j++) {
+    char r[NAME_SIZE];
+    ref(e, ent[j], r, sizeof r);
+    out(e, "%s%s", j ? ", " : "", r);
+  }
+  out(e, "};\n%s  %s y%d[%d];\n", in, ty, vec, tb->rows);
+  out(e, "%s  for (int i = 0; i < %d; i++) y%d[i] = %s%s_%s[0][i] * v%d[0];\n", in, tb->rows, vec, cast, e->P, tb->name, vec);
+  out(e, "%s  for (int j = 1; j < %d; j++)\n%s    for (int i = 0; i < %d; i++) y%d[i] += %s%s_%s[j][i] * v%d[j];\n", in,
+      n, in, tb->rows, vec, cast, e->P, tb->name, vec);
+  free(ent);
+}
+
+// A TROW node: row idx of its table's product with its vector.
+static void emit_table_row(Emitter *e, int id) {
+  const Dag *d = e->mod->dag;
+  const Node *n = &d->nodes[id];
+  declare_product(e, &d->tables[(int)n->val], n->a);
+  out(e, "%s  const %s t%d = y%d[%d];\n", e->lanes ? "  " : "", real_type(e, e->wide), e->temp[id], n->a, n->idx);
+}
+
 // One line computing node id into its temporary.
 static void emit_node(Emitter *e, int id) {
   const Node *n = &e->mod->dag->nodes[id];
   char a[NAME_SIZE], b[NAME_SIZE], rhs[8 * NAME_SIZE];
+  if (n->op == OP_TROW) {
+    emit_table_row(e, id);
+    return;
+  }
   ref(e, n->a, a, sizeof a);
   if (n->b >= 0) ref(e, n->b, b, sizeof b);
   switch ((Op)n->op) {
@@ -336,18 +412,34 @@ static void emit_outputs(Emitter *e, const Kernel *k, const int *outs, int nouts
   }
 }
 
+// The values an operation reads: its operands, or for a TROW node the
+// entries of its vector (the VEC chain itself is never printed).
+static void operands(const Dag *d, const Node *n, IntVec *kids) {
+  kids->n = 0;
+  if (n->op != OP_TROW) {
+    intvec_push(kids, n->a);
+    intvec_push(kids, n->b);
+    return;
+  }
+  int len = dag_vector_len(d, n->a);
+  while (kids->n < len) intvec_push(kids, -1);
+  dag_vector_entries(d, n->a, kids->v);
+}
+
 // Assign each operation its part, and a slot in w[] to every value used in
 // a later part than its own. Returns the number of slots.
 static int split_parts(Emitter *e, const int *ops, int nops) {
   const Dag *d = e->mod->dag;
   int nslots = 0;
   for (int i = 0; i < nops; i++) e->chunk[ops[i]] = i / PART_NODES;
+  IntVec kids = {0};
   for (int i = 0; i < nops; i++) {
     const Node *n = &d->nodes[ops[i]];
-    int kids[2] = {n->a, n->b};
-    for (int k = 0; k < 2; k++)
-      if (kids[k] >= 0 && d->nodes[kids[k]].a >= 0 && e->chunk[kids[k]] < e->chunk[ops[i]] && e->slot[kids[k]] < 0)
-        e->slot[kids[k]] = nslots++;
+    operands(d, n, &kids);
+    for (int k = 0; k < kids.n; k++) {
+      int x = kids.v[k];
+      if (x >= 0 && d->nodes[x].a >= 0 && e->chunk[x] < e->chunk[ops[i]] && e->slot[x] < 0) e->slot[x] = nslots++;
+    }
   }
   return nslots;
 }
@@ -411,7 +503,8 @@ void emit_kernel(Emitter *e, KernelId id) {
   dag_reach(d, outs, nouts, mark);
   e->kid = id;
   for (int i = 0; i <= top; i++)
-    if (mark[i] && d->nodes[i].a >= 0) ops[nops++] = i;
+    if (mark[i] && d->nodes[i].a >= 0 && d->nodes[i].op != OP_VEC) ops[nops++] = i;
+  e->vec_part = xcalloc((size_t)top + 2, sizeof *e->vec_part);
   e->wide = e->wide_step && k->wide;
   if (e->wide) out(e, "\n/* --wide-step: the %s below computes in %s. */", k->name, real_type(e, 1));
   out(e, "\n/* %s */\n", k->what);
@@ -426,6 +519,8 @@ void emit_kernel(Emitter *e, KernelId id) {
     out(e, "}\n");
   }
   e->wide = 0;
+  free(e->vec_part);
+  e->vec_part = NULL;
   free(outs);
   free(mark);
   free(ops);

@@ -142,6 +142,7 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
 
 // Every kernel the step built, in the Step's order.
 static void emit_kernels(Emitter *e) {
+  emit_tables(e);
   for (int k = 0; k < K_COUNT; k++)
     if (e->st->kern[k].nout) emit_kernel(e, (KernelId)k);
 }
@@ -498,7 +499,7 @@ static void emit_project(Emitter *e) {
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP, 0};
+  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP, 0, NULL};
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;

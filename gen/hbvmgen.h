@@ -157,7 +157,9 @@ Stmt *parse_model(const char *src, size_t len);   /* NULL for no statements; che
   X(ABS, 1, "fabs")              \
   X(SIGN, 1, NULL)               \
   X(MIN, 2, "fmin")              \
-  X(MAX, 2, "fmax")
+  X(MAX, 2, "fmax")              \
+  X(VEC, 2, NULL)                \
+  X(TROW, 1, NULL)
 
 typedef enum {
 #define X(name, arity, cfun) OP_##name,
@@ -169,6 +171,13 @@ typedef enum {
 int op_arity(Op op);
 const char *op_cfun(Op op);
 const char *op_name(Op op);
+
+/* OP_VEC and OP_TROW (dag_vector, dag_table_row) are a product with a
+ * constant table that stays a loop in the emitted code instead of m^2
+ * operations: VEC nodes chain the entries of a vector (a = entry j, b = the
+ * chain of entries 0..j-1 or -1, idx = j) and are never printed by
+ * themselves; TROW (a = the last VEC of a chain, idx = row, val = table
+ * number) is sum_j T[row][j] v_j, summed in order of j from j = 0. */
 
 /* Node flags: whether a node depends on a coordinate. */
 enum { DEP_INPUT = 1 };
@@ -186,6 +195,13 @@ typedef struct {
 
 /* Nodes are numbered in creation order, so children always have smaller ids
  * and every pass over the DAG is a loop over ids, never a recursion. */
+/* A constant table of the DAG (dag_table): rows x cols, row-major. */
+typedef struct {
+  const char *name;    /* its C name after the prefix */
+  const double *v;
+  int rows, cols;
+} DagTable;
+
 typedef struct {
   Node *nodes;
   int n, cap;
@@ -203,6 +219,8 @@ typedef struct {
   int *sweep_stamp, *sweep_adj;
   int sweep_cap, sweep_epoch;
   IntVec sweep_ids;
+  DagTable *tables;    /* the constant tables TROW nodes read */
+  int ntables, tabcap;
 } Dag;
 
 #ifndef MAX_NODES /* (the fuzz harness builds with smaller limits, tests/fuzz/run.sh) */
@@ -219,6 +237,11 @@ int dag_sub(Dag *d, int a, int b);
 int dag_mul(Dag *d, int a, int b);
 int dag_div(Dag *d, int a, int b);
 int dag_neg(Dag *d, int a);
+int dag_table(Dag *d, const char *name, const double *v, int rows, int cols); /* its number */
+int dag_vector(Dag *d, const int *v, int n);          /* the chain of v[0..n-1], n >= 1 */
+int dag_table_row(Dag *d, int table, int row, int vec); /* sum_j T[row][j] v_j */
+int dag_vector_len(const Dag *d, int vec);
+void dag_vector_entries(const Dag *d, int vec, int *out); /* the dag_vector_len entries of the chain */
 int dag_is_const(const Dag *d, int n, double v);
 int dag_is_zero(const Dag *d, int n);
 void dag_section(Dag *d, const char *label);
@@ -286,7 +309,12 @@ typedef struct {
   int *q0n, *p0n;             /* m nodes each: q0, p0 as functions of the params */
   Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
   int degU, degg;             /* DEG_NONPOLY or degree; degg = 0 without constraints */
+  long mass_loop;             /* a product M^-1 v of a dense constant M with this many
+                               * multiplications or more is a loop over a table (--mass-loop) */
 } Model;
+
+/* The default of Model.mass_loop, from the measurements in docs/embedding.md. */
+#define MASS_LOOP_DEFAULT 1024
 
 Model *analyse(const char *file, Stmt *prog);      /* NULL when errors were reported */
 int mass_setup(Model *mod, const double *dense, Loc loc); /* 0 ok, else error reported */

@@ -26,6 +26,9 @@
 #define PATH_MAX 4096
 #endif
 
+#define STR_(x) #x
+#define STR(x) STR_(x)
+
 static const char usage[] =
     "usage: hbvmgen [options] MODEL.ham\n"
     "\n"
@@ -58,6 +61,9 @@ static const char usage[] =
     "  --batch W     also emit NAME_batch_step: W trajectories (1 <= W <= 64) stepped\n"
     "                together in struct-of-arrays lanes that the compiler vectorises,\n"
     "                each lane bitwise equal to NAME_step (not with --wide-step)\n"
+    "  --mass-loop N  compute M^-1 v for a dense constant M as a loop over a table of\n"
+    "                M^-1 when it takes N or more multiplications, straight-line code\n"
+    "                below (default " STR(MASS_LOOP_DEFAULT) ": the measured crossover, docs/embedding.md)\n"
     "  -h, --help    this text\n"
     "  --version     the version\n";
 
@@ -68,6 +74,7 @@ typedef struct {
   int single, plain_sum, wide_step;
   int multiplier; /* -1: default for s and the model; else a MultFamily */
   int batch;      /* --batch W, 0 without */
+  long mass_loop; /* --mass-loop N, 0 for the default */
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -136,6 +143,11 @@ static int parse_args(int argc, char **argv, Options *o) {
       const char *v = argv[++i];
       if (strcmp(v, "float") && strcmp(v, "double")) return fail("--real needs 'float' or 'double', got '%s'", v);
       o->single = !strcmp(v, "float");
+    } else if (!strcmp(a, "--mass-loop")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      int n;
+      if (parse_count(argv[++i], 1, 1 << 30, &n)) return fail("--mass-loop needs an integer from 1 to 2^30, got '%s'", argv[i]);
+      o->mass_loop = n;
     } else if (!strcmp(a, "--batch")) {
       if (!has_value) return fail("option %s needs a value", a);
       if (parse_count(argv[++i], 1, 64, &o->batch)) return fail("--batch needs an integer from 1 to 64, got '%s'", argv[i]);
@@ -472,7 +484,7 @@ static void report_degree(const Model *mod, int s, int k) {
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0};
+  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name && bad_name(o.name = default_name(o.model), o.model)) return 1;
@@ -490,6 +502,7 @@ int main(int argc, char **argv) {
     arena_free_all();
     return 1;
   }
+  if (o.mass_loop) mod->mass_loop = o.mass_loop;
   model_differentiate(mod);
   model_check_initial(mod);
   const char *why = "given with -k";

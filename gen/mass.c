@@ -206,14 +206,32 @@ static void minv_apply_params(const Model *mod, Dag *d, const int *v, int *out) 
       out[L[i].e[e].coord] = dag_sub(d, out[L[i].e[e].coord], dag_mul(d, L[i].e[e].node, out[i]));
 }
 
+// The table of M^-1 in the DAG (registered on first use).
+static int minv_table(const Model *mod, Dag *d) {
+  for (int t = 0; t < d->ntables; t++)
+    if (d->tables[t].v == mod->minv) return t;
+  return dag_table(d, "minv", mod->minv, mod->m, mod->m);
+}
+
 // out = M^-1 v for node vectors of length m (out may not alias v). Zeros of
-// v cost no lookup: the columns of a sparse Jacobian are mostly zeros.
+// v cost no lookup: the columns of a sparse Jacobian are mostly zeros. A
+// dense constant M whose product has mod->mass_loop multiplications or
+// more (nonzeros of M^-1 against those of v) is applied as rows of its table (dag_table_row), which the emitter
+// prints as loops: m^2 operations would be m^2 lines of C.
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out) {
   if (mod->minv_node) {
     minv_apply_params(mod, d, v, out);
     return;
   }
   int m = mod->m, zero = dag_const(d, 0);
+  long products = 0; /* of the straight-line form */
+  for (int j = 0; mod->mass == MASS_DENSE && j < m; j++)
+    for (int i = 0; !dag_is_zero(d, v[j]) && i < m; i++) products += mod->minv[(size_t)i * m + j] != 0;
+  if (products && products >= mod->mass_loop) {
+    int t = minv_table(mod, d), vec = dag_vector(d, v, m);
+    for (int i = 0; i < m; i++) out[i] = dag_table_row(d, t, i, vec);
+    return;
+  }
   for (int i = 0; i < m; i++) {
     if (mod->mass != MASS_DENSE) {
       out[i] = dag_is_zero(d, v[i]) ? zero : dag_mul(d, dag_const(d, mod->minv_diag[i]), v[i]);

@@ -20,6 +20,11 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dense_chain_c_k2s2.h"
+#include "dense_chain_k2s2.h"
+#include "dense_loop_c_k2s2.h"
+#include "dense_loop_fw_k2s2.h"
+#include "dense_loop_k2s2.h"
 #include "mass_const_c_k2s2.h"
 #include "mass_const_k2s2.h"
 #include "mass_dense_const_k2s2.h"
@@ -86,6 +91,42 @@ START_TEST(test_dense_same_trajectory)
   SIDE_BY_SIDE(mass_dense_k2s2, mass_dense_const_k2s2, 0.05, worst);
   printf("mass: dense M of params vs constant: max |difference| %.3g over %d steps\n", worst, NSTEPS);
   ck_assert_msg(worst <= 1e-12, "the trajectories differ by %.3g", worst);
+}
+END_TEST
+
+/* tests/models/dense_chain.ham with M^-1 v as loops over the table of M^-1
+ * (--mass-loop 1) and as straight-line code: the same sums in the same
+ * order (up to a constant factor merged into a product, and the sign of a
+ * zero), so equal to round-off; and the loop form keeps H and g at
+ * round-off. Both multiplier families; and --real float --wide-step, whose
+ * kernels read the table in two types, follows the double solver to
+ * float accuracy. */
+START_TEST(test_table_same_trajectory)
+{
+  double worst;
+  SIDE_BY_SIDE(dense_loop_k2s2, dense_chain_k2s2, 0.01, worst);
+  printf("mass: dense M, loops over M^-1 vs straight-line, poly: max |difference| %.3g over %d steps\n", worst, NSTEPS);
+  ck_assert_msg(worst <= 1e-13, "poly family: the trajectories differ by %.3g", worst);
+  SIDE_BY_SIDE(dense_loop_c_k2s2, dense_chain_c_k2s2, 0.01, worst);
+  printf("mass: dense M, loops over M^-1 vs straight-line, const: max |difference| %.3g over %d steps\n", worst, NSTEPS);
+  ck_assert_msg(worst <= 1e-13, "const family: the trajectories differ by %.3g", worst);
+  dense_loop_k2s2_state x;
+  dense_loop_fw_k2s2_state y;
+  double g[dense_loop_k2s2_NU], dH = 0, dg = 0, dq = 0;
+  dense_loop_k2s2_init(&x, NULL, NULL);
+  dense_loop_fw_k2s2_init(&y, NULL, NULL);
+  double H0 = dense_loop_k2s2_energy(&x, NULL);
+  for (int n = 0; n < NSTEPS; n++) {
+    ck_assert_int_eq(dense_loop_k2s2_step(&x, 0.01, NULL, NULL), 0);
+    ck_assert_int_eq(dense_loop_fw_k2s2_step(&y, 0.01f, NULL, NULL), 0);
+    dense_loop_k2s2_constraints(&x, NULL, g);
+    dH = fmax(dH, fabs(dense_loop_k2s2_energy(&x, NULL) - H0));
+    for (int a = 0; a < dense_loop_k2s2_NU; a++) dg = fmax(dg, fabs(g[a]));
+    for (int i = 0; i < dense_loop_k2s2_M; i++) dq = fmax(dq, fabs(x.q[i] - (double)y.q[i]));
+  }
+  printf("mass: dense M as loops: |H - H0| %.3g, |g| %.3g; float --wide-step vs double: %.3g\n", dH, dg, dq);
+  ck_assert_msg(dH <= 1e-13 && dg <= 1e-13, "loops over M^-1: |H - H0| = %.3g, |g| = %.3g", dH, dg);
+  ck_assert_msg(dq <= 1e-4, "float --wide-step with loops over M^-1 is %.3g from double", dq);
 }
 END_TEST
 
@@ -177,6 +218,7 @@ Suite *mass_suite(void)
   TCase *tc = tcase_create("params in M");
   tcase_add_test(tc, test_diag_same_trajectory);
   tcase_add_test(tc, test_dense_same_trajectory);
+  tcase_add_test(tc, test_table_same_trajectory);
   tcase_add_test(tc, test_period);
   tcase_add_test(tc, test_singular_mass);
   suite_add_tcase(s, tc);
