@@ -314,7 +314,7 @@ typedef struct {
 } Model;
 
 /* The default of Model.mass_loop, from the measurements in docs/embedding.md. */
-#define MASS_LOOP_DEFAULT 1024
+#define MASS_LOOP_DEFAULT 512
 
 Model *analyse(const char *file, Stmt *prog);      /* NULL when errors were reported */
 int mass_setup(Model *mod, const double *dense, Loc loc); /* 0 ok, else error reported */

@@ -39,6 +39,55 @@ START_TEST(equal_mass_matrices_give_equal_code) {
 }
 END_TEST
 
+/* The text of an unconstrained model with m coordinates and the dense
+ * constant M_ij = 2 delta_ij + 2^-|i-j| (symmetric positive definite).
+ * malloc'd. */
+static char *dense_mass_model(int m) {
+  size_t cap = (size_t)m * (size_t)m * 24 + 4096, n = 0;
+  char *text = malloc(cap);
+  ck_assert_ptr_nonnull(text);
+  n += (size_t)snprintf(text + n, cap - n, "N = %d\nvariables q[N]\nM = [", m);
+  for (int i = 0; i < m; i++) {
+    n += (size_t)snprintf(text + n, cap - n, "%s[", i ? ",\n  " : "");
+    for (int j = 0; j < m; j++) n += (size_t)snprintf(text + n, cap - n, "%s%.17g", j ? ", " : "", (i == j ? 2 : 0) + ldexp(1, -abs(i - j)));
+    n += (size_t)snprintf(text + n, cap - n, "]");
+  }
+  snprintf(text + n, cap - n, "]\nU = sum(i in 2..N, (q[i] - q[i-1])^2) / 2 + sum(i in 1..N, q[i]^4) / 4\n"
+                              "q0 = [0.1 * i for i in 1..N]\np0 = [0 for i in 1..N]\n");
+  return text;
+}
+
+/* Issue 13 item 4: a dense constant M of m coordinates used to cost m^2
+ * lines per product M^-1 v (2.9 MB of C at m = 80, 11.6 MB at m = 160).
+ * Past --mass-loop products it is a loop over the table of M^-1, so the C
+ * is the table (m^2 literals, about 25 bytes each) plus O(m) lines per
+ * product (its vector named entry by entry): under 100 m^2 bytes, against
+ * 460 m^2 before. Timing-free: bytes of emitted C. The
+ * straight-line form is still there below the threshold and on request. */
+START_TEST(dense_mass_is_a_table) {
+  static const int sizes[] = {80, 160};
+  for (size_t c = 0; c < sizeof sizes / sizeof sizes[0]; c++) {
+    int m = sizes[c];
+    char *text = dense_mass_model(m);
+    char *src = generate_source(text, "-s 2");
+    ck_assert_msg(src != NULL, "m = %d: generation failed (or wrote more than 4 MiB)", m);
+    size_t bytes = strlen(src);
+    printf("lean: dense M, m = %d: %zu bytes of C\n", m, bytes);
+    ck_assert_msg(bytes <= (size_t)100 * m * m, "m = %d: %zu bytes of C, more than 100 m^2", m, bytes);
+    ck_assert_msg(strstr(src, "_minv[j][i] * v"), "m = %d: no loop over the table of M^-1", m);
+    free(src);
+    if (m == 80) { /* and the straight-line form on request: m^2 products a line each */
+      src = generate_source(text, "-s 2 --mass-loop 1000000000");
+      ck_assert_ptr_nonnull(src);
+      ck_assert_msg(!strstr(src, "_minv[j][i]") && strlen(src) > (size_t)200 * m * m, "--mass-loop: %zu bytes",
+                    strlen(src));
+      free(src);
+    }
+    free(text);
+  }
+}
+END_TEST
+
 START_TEST(no_multiplier_code_without_constraints) {
   char *src = generate_source("variables x, y\nU = x^4 + y^4 + x*y\nq0 = [1, 0]\np0 = [0, 1]\n", "-s 2");
   ck_assert_ptr_nonnull(src);
@@ -277,6 +326,7 @@ Suite *lean_suite(void) {
   TCase *tc = tcase_create("structure");
   tcase_set_timeout(tc, 180); /* the corpus compile takes ~20 s, more under the sanitizers */
   tcase_add_test(tc, equal_mass_matrices_give_equal_code);
+  tcase_add_test(tc, dense_mass_is_a_table);
   tcase_add_test(tc, corpus_models_compile);
   tcase_add_test(tc, limits_settable_with_D);
   tcase_add_test(tc, no_multiplier_code_without_constraints);
