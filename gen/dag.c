@@ -10,7 +10,12 @@
  *
  * Nodes are numbered in creation order and an operand is always created
  * before its user, so id order is a topological order: evaluation, degree
- * analysis, reverse sweeps and emission are loops over ids. */
+ * analysis, reverse sweeps and emission are loops over ids.
+ *
+ * A product with a large constant table (M^-1 of a dense M, mass.c) is not
+ * spelt out as rows x cols products: its vector is a chain of VEC nodes and
+ * each row one TROW node reading a table the Dag holds (dag_table), which
+ * the emitter prints as a loop. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -271,6 +276,7 @@ static int simplify(Dag *d, Op op, int a, int b) {
 // Build op(a, b): fold constants, simplify, share. b is -1 for unary ops.
 int dag_op(Dag *d, Op op, int a, int b) {
   ASSERT(a >= 0 && a < d->n && (op_arity(op) == 1 ? b < 0 : b >= 0 && b < d->n));
+  ASSERT(op != OP_VEC && op != OP_TROW); /* built by dag_vector and dag_table_row only */
   const Node *na = &d->nodes[a], *nb = b >= 0 ? &d->nodes[b] : NULL;
   if (na->op == OP_CONST && (!nb || nb->op == OP_CONST)) {
     double v = op_apply(op, na->val, nb ? nb->val : 0);

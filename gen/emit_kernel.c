@@ -2,7 +2,8 @@
  *
  * Every computation of the generated solver is a "kernel": a static
  * function printed from the result blocks of a Kernel as straight-line
- * code, one operation a line, each intermediate a named const temporary, a
+ * code, one operation a line (but a product with a constant table, a TROW
+ * node, is a loop over the table), each intermediate a named const temporary, a
  * comment where a new section of the method starts, constants with 17
  * significant digits. All kernels share one signature, printed from the
  * Step's input blocks (q0, p0, gamma, h, g0, ..., params -> out[]), so that

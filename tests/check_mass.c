@@ -68,18 +68,22 @@ static double max_diff(double worst, const double *a, const double *b, int n)
     }                                                                                                   \
   } while (0)
 
+/* SIDE_BY_SIDE, reported as what and asserted within tol. */
+#define SAME_TRAJECTORY(P, C, h, tol, what)                                                            \
+  do {                                                                                                 \
+    double worst_;                                                                                     \
+    SIDE_BY_SIDE(P, C, h, worst_);                                                                     \
+    printf("mass: %s: max |difference| %.3g over %d steps\n", what, worst_, NSTEPS);                   \
+    ck_assert_msg(worst_ <= (tol), "%s: the trajectories differ by %.3g", what, worst_);               \
+  } while (0)
+
 /* A diagonal M of params gives M^-1 entries 1/m_ii, exactly the constants
  * the constant M bakes in: the trajectories agree to the last bit (allowed:
  * a few ulps, should a product be formed in another order). */
 START_TEST(test_diag_same_trajectory)
 {
-  double worst;
-  SIDE_BY_SIDE(mass_param_k2s2, mass_const_k2s2, 0.05, worst);
-  printf("mass: diag(m1, 1) vs diag(2, 1), poly family: max |difference| %.3g over %d steps\n", worst, NSTEPS);
-  ck_assert_msg(worst <= 1e-14, "poly family: the trajectories differ by %.3g", worst);
-  SIDE_BY_SIDE(mass_param_c_k2s2, mass_const_c_k2s2, 0.05, worst);
-  printf("mass: diag(m1, 1) vs diag(2, 1), const family: max |difference| %.3g over %d steps\n", worst, NSTEPS);
-  ck_assert_msg(worst <= 1e-14, "const family: the trajectories differ by %.3g", worst);
+  SAME_TRAJECTORY(mass_param_k2s2, mass_const_k2s2, 0.05, 1e-14, "diag(m1, 1) vs diag(2, 1), poly family");
+  SAME_TRAJECTORY(mass_param_c_k2s2, mass_const_c_k2s2, 0.05, 1e-14, "diag(m1, 1) vs diag(2, 1), const family");
 }
 END_TEST
 
@@ -87,10 +91,7 @@ END_TEST
  * constant M uses GSL's inverse: equal to round-off. */
 START_TEST(test_dense_same_trajectory)
 {
-  double worst;
-  SIDE_BY_SIDE(mass_dense_k2s2, mass_dense_const_k2s2, 0.05, worst);
-  printf("mass: dense M of params vs constant: max |difference| %.3g over %d steps\n", worst, NSTEPS);
-  ck_assert_msg(worst <= 1e-12, "the trajectories differ by %.3g", worst);
+  SAME_TRAJECTORY(mass_dense_k2s2, mass_dense_const_k2s2, 0.05, 1e-12, "dense M of params vs constant");
 }
 END_TEST
 
@@ -103,13 +104,8 @@ END_TEST
  * float accuracy. */
 START_TEST(test_table_same_trajectory)
 {
-  double worst;
-  SIDE_BY_SIDE(dense_loop_k2s2, dense_chain_k2s2, 0.01, worst);
-  printf("mass: dense M, loops over M^-1 vs straight-line, poly: max |difference| %.3g over %d steps\n", worst, NSTEPS);
-  ck_assert_msg(worst <= 1e-13, "poly family: the trajectories differ by %.3g", worst);
-  SIDE_BY_SIDE(dense_loop_c_k2s2, dense_chain_c_k2s2, 0.01, worst);
-  printf("mass: dense M, loops over M^-1 vs straight-line, const: max |difference| %.3g over %d steps\n", worst, NSTEPS);
-  ck_assert_msg(worst <= 1e-13, "const family: the trajectories differ by %.3g", worst);
+  SAME_TRAJECTORY(dense_loop_k2s2, dense_chain_k2s2, 0.01, 1e-13, "dense M, loops over M^-1 vs straight-line, poly");
+  SAME_TRAJECTORY(dense_loop_c_k2s2, dense_chain_c_k2s2, 0.01, 1e-13, "dense M, loops over M^-1 vs straight-line, const");
   dense_loop_k2s2_state x;
   dense_loop_fw_k2s2_state y;
   double g[dense_loop_k2s2_NU], dH = 0, dg = 0, dq = 0;
