@@ -714,6 +714,7 @@ Model *analyse(const char *file, Stmt *prog) {
   Model *mod = arena_alloc(sizeof *mod);
   mod->file = file;
   mod->mass_loop = MASS_LOOP_DEFAULT;
+  mod->stage_loop = STAGE_LOOP_DEFAULT;
   cx->mod = mod;
   cx->d = mod->dag = dag_new();
   cx->prog = prog;

@@ -104,6 +104,8 @@ static int node_degree(const Dag *d, const Node *n) {
     return da;
   case OP_VEC:
     return da < 0 || db < 0 ? DEG_NONPOLY : (da > db ? da : db);
+  case OP_SSUM:
+    return DEG_NONPOLY;
   case OP_POW: {
     const Node *e = &d->nodes[n->b];
     if (e->op == OP_CONST && e->val >= 0 && e->val == floor(e->val) && e->val <= (1 << 20))
@@ -276,7 +278,7 @@ static int simplify(Dag *d, Op op, int a, int b) {
 // Build op(a, b): fold constants, simplify, share. b is -1 for unary ops.
 int dag_op(Dag *d, Op op, int a, int b) {
   ASSERT(a >= 0 && a < d->n && (op_arity(op) == 1 ? b < 0 : b >= 0 && b < d->n));
-  ASSERT(op != OP_VEC && op != OP_TROW); /* built by dag_vector and dag_table_row only */
+  ASSERT(op != OP_VEC && op != OP_TROW && op != OP_SSUM); /* built by their constructors only */
   const Node *na = &d->nodes[a], *nb = b >= 0 ? &d->nodes[b] : NULL;
   if (na->op == OP_CONST && (!nb || nb->op == OP_CONST)) {
     double v = op_apply(op, na->val, nb ? nb->val : 0);
@@ -343,6 +345,42 @@ int dag_table_row(Dag *d, int table, int row, int vec) {
   return intern(d, x);
 }
 
+// Register a stage loop (copied; its arrays must outlive the Dag).
+int dag_loop(Dag *d, const DagLoop *loop) {
+  VEC_RESERVE(d->loops, d->nloops, d->loopcap, d->nloops + 1);
+  d->loops[d->nloops] = *loop;
+  return d->nloops++;
+}
+
+int dag_stage_sum(Dag *d, int loop, int j, int r) {
+  const DagLoop *lp = &d->loops[loop];
+  ASSERT(loop >= 0 && loop < d->nloops && j >= 0 && j < lp->s && r >= 0 && r < lp->nroots);
+  Node x = leaf(OP_SSUM);
+  x.a = lp->h;
+  x.idx = j * lp->nroots + r;
+  x.val = loop;
+  return intern(d, x);
+}
+
+// The value of an SSUM node at the inputs: the loop's
+// stage points, its roots at each, summed as the emitted loop sums them.
+static double stage_sum_value(const Dag *d, const Node *n, const double *inputs, const double *params) {
+  const DagLoop *lp = &d->loops[(int)n->val];
+  int j = n->idx / lp->nroots, r = n->idx % lp->nroots;
+  double *in = xmalloc((size_t)(lp->m + 1) * sizeof *in), acc = 0; /* the coordinates: Q_l */
+  double h = inputs[d->nodes[lp->h].idx];
+  for (int l = 0; l < lp->k; l++) {
+    for (int i = 0; i < lp->m; i++) {
+      double a = lp->Ihat[l * lp->s] * inputs[d->nodes[lp->gam[i]].idx];
+      for (int t = 1; t < lp->s; t++) a += lp->Ihat[l * lp->s + t] * inputs[d->nodes[lp->gam[t * lp->m + i]].idx];
+      in[i] = inputs[d->nodes[lp->q0[i]].idx] + h * a;
+    }
+    acc += lp->W[l * lp->s + j] * dag_eval(d, lp->roots[r], in, params);
+  }
+  free(in);
+  return acc;
+}
+
 // The value of a TROW node from the values v[] of its vector's entries,
 // summed in the order the emitted loop sums them.
 static double table_row_value(const Dag *d, const Node *n, const double *v) {
@@ -402,6 +440,7 @@ void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inp
     case OP_PARAM: v[id] = params[n->idx]; break;
     case OP_VEC: v[id] = 0; break;
     case OP_TROW: v[id] = table_row_value(d, n, v); break;
+    case OP_SSUM: v[id] = stage_sum_value(d, n, inputs, params); break;
     default: v[id] = op_apply((Op)n->op, v[n->a], n->b >= 0 ? v[n->b] : 0);
     }
   }
@@ -438,6 +477,8 @@ void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, i
       img[id] = dag_vector_link(d, img[n.a], n.b >= 0 ? img[n.b] : -1, n.idx);
     else if (n.op == OP_TROW)
       img[id] = dag_table_row(d, (int)n.val, n.idx, img[n.a]);
+    else if (n.op == OP_SSUM) /* over its own stage points: no coordinate of the DAG */
+      img[id] = id;
     else
       img[id] = dag_op(d, (Op)n.op, img[n.a], n.b >= 0 ? img[n.b] : -1);
   }

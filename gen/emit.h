@@ -27,6 +27,8 @@ typedef struct {
   KernelId kid;    /* the kernel being printed */
   int lanes;       /* W > 0: kernels print as loops over W lanes (--batch, emit_batch.c) */
   int *vec_part;   /* per VEC node: 1 + the part whose function declares its array, or 0 */
+  int *loop_part;  /* per stage loop (DagLoop): 1 + the part that runs it, or 0 */
+  int body;        /* printing the body of a stage loop: coordinates are Q[i], values bID */
 } Emitter;
 
 void out(Emitter *e, const char *fmt, ...);

@@ -196,6 +196,10 @@ static void name_of(Emitter *e, int id, char *buf, size_t size) {
     else snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name);
     return;
   case OP_INPUT:
+    if (e->body && n->idx < e->mod->m) {
+      snprintf(buf, size, "Q[%d] /* %s */", n->idx, e->mod->coord_names[n->idx]);
+      return;
+    }
     for (int i = 0; i < IN_COUNT; i++) {
       const Slots *in = &st->in[i];
       if (n->idx < in->first || n->idx >= in->first + in->len) continue;
@@ -211,7 +215,8 @@ static void name_of(Emitter *e, int id, char *buf, size_t size) {
     internal_error("model coordinate %d reached a kernel", n->idx);
     return;
   default:
-    if (e->chunk && e->chunk[id] != e->part && e->lanes) snprintf(buf, size, "w[%d + l]", e->slot[id] * e->lanes);
+    if (e->body) snprintf(buf, size, "b%d", id); /* a stage loop's body: all its own */
+    else if (e->chunk && e->chunk[id] != e->part && e->lanes) snprintf(buf, size, "w[%d + l]", e->slot[id] * e->lanes);
     else if (e->chunk && e->chunk[id] != e->part) snprintf(buf, size, "w[%d]", e->slot[id]);
     else snprintf(buf, size, "t%d", e->temp[id]);
     return;
@@ -316,12 +321,78 @@ static void emit_table_row(Emitter *e, int id) {
   out(e, "%s  const %s t%d = y%d[%d];\n", e->lanes ? "  " : "", real_type(e, e->wide), e->temp[id], n->a, n->idx);
 }
 
+static void emit_node(Emitter *e, int id);
+
+// A static table of the method's constants (k x s) for a stage loop,
+// literals of the kernel's type.
+static void stage_table(Emitter *e, const char *name, const double *v, int k, int s) {
+  out(e, "%s    static const %s %s[%d][%d] = {", e->lanes ? "  " : "", real_type(e, e->wide), name, k, s);
+  for (int l = 0; l < k; l++) {
+    out(e, "%s{", l ? ", " : "");
+    for (int j = 0; j < s; j++) {
+      char lit[64];
+      format_real(e, lit, sizeof lit, v[l * s + j]);
+      out(e, "%s%s", j ? ", " : "", lit);
+    }
+    out(e, "}");
+  }
+  out(e, "};\n");
+}
+
+// Stage loop number loop, in the part being printed on first use there:
+// sLOOP[j * nroots + r] = sum_l W[l][j] f_r(Q_l), for l in order (as the
+// straight-line stages sum them), the model's operations printed once as
+// the loop's body (emit_node with e->body).
+static void emit_stage_loop(Emitter *e, int loop) {
+  const Dag *d = e->mod->dag;
+  const DagLoop *lp = &d->loops[loop];
+  const char *ty = real_type(e, e->wide), *in = e->lanes ? "  " : "";
+  if (e->loop_part[loop] == e->part + 1) return;
+  e->loop_part[loop] = e->part + 1;
+  char r[NAME_SIZE];
+  out(e, "%s  %s s%d[%d];\n%s  for (int i = 0; i < %d; i++) s%d[i] = 0;\n", in, ty, loop, lp->s * lp->nroots, in,
+      lp->s * lp->nroots, loop);
+  out(e, "%s  for (int st = 0; st < %d; st++) { /* the stages */\n", in, lp->k);
+  stage_table(e, "Ihat", lp->Ihat, lp->k, lp->s);
+  stage_table(e, "Wt", lp->W, lp->k, lp->s);
+  out(e, "%s    %s Q[%d];\n", in, ty, lp->m);
+  for (int i = 0; i < lp->m; i++) {
+    ref(e, lp->q0[i], r, sizeof r);
+    out(e, "%s    Q[%d] = %s + ", in, i, r);
+    ref(e, lp->h, r, sizeof r);
+    out(e, "%s * (", r);
+    for (int j = 0; j < lp->s; j++) {
+      ref(e, lp->gam[j * lp->m + i], r, sizeof r);
+      out(e, "%sIhat[st][%d] * %s", j ? " + " : "", j, r);
+    }
+    out(e, ");\n");
+  }
+  unsigned char *mark = xcalloc((size_t)d->n + 1, 1);
+  dag_reach(d, lp->roots, lp->nroots, mark);
+  e->body = 1;
+  for (int id = 0; id < d->n; id++)
+    if (mark[id] && d->nodes[id].a >= 0) emit_node(e, id);
+  for (int j = 0; j < lp->s; j++)
+    for (int t = 0; t < lp->nroots; t++) {
+      ref(e, lp->roots[t], r, sizeof r);
+      out(e, "%s    s%d[%d] += Wt[st][%d] * %s;\n", in, loop, j * lp->nroots + t, j, r);
+    }
+  e->body = 0;
+  out(e, "%s  }\n", in);
+  free(mark);
+}
+
 // One line computing node id into its temporary.
 static void emit_node(Emitter *e, int id) {
   const Node *n = &e->mod->dag->nodes[id];
   char a[NAME_SIZE], b[NAME_SIZE], rhs[8 * NAME_SIZE];
   if (n->op == OP_TROW) {
     emit_table_row(e, id);
+    return;
+  }
+  if (n->op == OP_SSUM) {
+    emit_stage_loop(e, (int)n->val);
+    out(e, "%s  const %s t%d = s%d[%d];\n", e->lanes ? "  " : "", real_type(e, e->wide), e->temp[id], (int)n->val, n->idx);
     return;
   }
   ref(e, n->a, a, sizeof a);
@@ -343,7 +414,9 @@ static void emit_node(Emitter *e, int id) {
     if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a, b);
     else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a);
   }
-  out(e, "%s  const %s t%d = %s;\n", e->lanes ? "  " : "", real_type(e, e->wide), e->temp[id], rhs);
+  char lhs[32];
+  snprintf(lhs, sizeof lhs, e->body ? "b%d" : "t%d", e->body ? id : e->temp[id]);
+  out(e, "%s%s  const %s %s = %s;\n", e->lanes ? "  " : "", e->body ? "    " : "", real_type(e, e->wide), lhs, rhs);
 }
 
 // The signature of kernel k (of its part-th part when part >= 0): one
@@ -503,9 +576,12 @@ void emit_kernel(Emitter *e, KernelId id) {
   int *ops = xmalloc((size_t)(top + 2) * sizeof(int));
   dag_reach(d, outs, nouts, mark);
   e->kid = id;
+  for (int i = 0; i <= top; i++) /* stage sums first: they read inputs only, and their loop runs once */
+    if (mark[i] && d->nodes[i].op == OP_SSUM) ops[nops++] = i;
   for (int i = 0; i <= top; i++)
-    if (mark[i] && d->nodes[i].a >= 0 && d->nodes[i].op != OP_VEC) ops[nops++] = i;
+    if (mark[i] && d->nodes[i].a >= 0 && d->nodes[i].op != OP_VEC && d->nodes[i].op != OP_SSUM) ops[nops++] = i;
   e->vec_part = xcalloc((size_t)top + 2, sizeof *e->vec_part);
+  e->loop_part = xcalloc((size_t)d->nloops + 1, sizeof *e->loop_part);
   e->wide = e->wide_step && k->wide;
   if (e->wide) out(e, "\n/* --wide-step: the %s below computes in %s. */", k->name, real_type(e, 1));
   out(e, "\n/* %s */\n", k->what);
@@ -521,7 +597,8 @@ void emit_kernel(Emitter *e, KernelId id) {
   }
   e->wide = 0;
   free(e->vec_part);
-  e->vec_part = NULL;
+  free(e->loop_part);
+  e->vec_part = e->loop_part = NULL;
   free(outs);
   free(mark);
   free(ops);

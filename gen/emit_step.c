@@ -439,6 +439,7 @@ int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
   int bad = 0, small = 0;
   for (int k = 0; k < K_COUNT; k++)
     for (int b = 0; b < st->kern[k].nout; b++) dag_reach(d, st->kern[k].out[b].nodes, st->kern[k].out[b].len, mark);
+  for (int l = 0; l < d->nloops; l++) dag_reach(d, d->loops[l].roots, d->loops[l].nroots, mark); /* their bodies */
   for (int id = 0; id < d->n && !bad; id++)
     if (mark[id] && d->nodes[id].op == OP_CONST) bad = check_constant(o, d->nodes[id].val, (Loc){0, 0}, "a constant of the step", &small);
   for (int i = 0; i < mod->nparams && !bad; i++)
@@ -499,7 +500,7 @@ static void emit_project(Emitter *e) {
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP, 0, NULL};
+  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP, 0, NULL, NULL, 0};
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;

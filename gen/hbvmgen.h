@@ -159,7 +159,8 @@ Stmt *parse_model(const char *src, size_t len);   /* NULL for no statements; che
   X(MIN, 2, "fmin")              \
   X(MAX, 2, "fmax")              \
   X(VEC, 2, NULL)                \
-  X(TROW, 1, NULL)
+  X(TROW, 1, NULL)               \
+  X(SSUM, 1, NULL)
 
 typedef enum {
 #define X(name, arity, cfun) OP_##name,
@@ -178,6 +179,12 @@ const char *op_name(Op op);
  * chain of entries 0..j-1 or -1, idx = j) and are never printed by
  * themselves; TROW (a = the last VEC of a chain, idx = row, val = table
  * number) is sum_j T[row][j] v_j, summed in order of j from j = 0. */
+
+/* OP_SSUM (dag_stage_sum) is one sum over the k stages of HBVM that stays a
+ * loop in the emitted code: sum_l W[l][j] f_r(Q_l), f_r a model node over
+ * the coordinates (inputs 0..m-1) and Q_l = q0 + h sum_j Ihat[l][j] gamma_j
+ * the stage point. a = the node of h (so it is an operation), idx = j *
+ * nroots + r, val = the loop's number (DagLoop). */
 
 /* Node flags: whether a node depends on a coordinate. */
 enum { DEP_INPUT = 1 };
@@ -202,6 +209,18 @@ typedef struct {
   int rows, cols;
 } DagTable;
 
+/* A loop over the stages (dag_loop): roots f_r over the coordinates, and
+ * what a stage point is made of. */
+typedef struct {
+  const int *roots;    /* nroots model nodes */
+  int nroots;
+  int m, k, s;
+  const double *W;     /* k x s: the weights of the sums */
+  const double *Ihat;  /* k x s: Q_l = q0 + h sum_j Ihat[l][j] gamma_j */
+  const int *q0, *gam; /* input nodes: m of q0, s*m of gamma (j*m + i) */
+  int h;               /* the input node of h */
+} DagLoop;
+
 typedef struct {
   Node *nodes;
   int n, cap;
@@ -221,6 +240,8 @@ typedef struct {
   IntVec sweep_ids;
   DagTable *tables;    /* the constant tables TROW nodes read */
   int ntables, tabcap;
+  DagLoop *loops;      /* the stage loops SSUM nodes read */
+  int nloops, loopcap;
 } Dag;
 
 #ifndef MAX_NODES /* (the fuzz harness builds with smaller limits, tests/fuzz/run.sh) */
@@ -242,6 +263,8 @@ int dag_vector(Dag *d, const int *v, int n);          /* the chain of v[0..n-1],
 int dag_table_row(Dag *d, int table, int row, int vec); /* sum_j T[row][j] v_j */
 int dag_vector_len(const Dag *d, int vec);
 void dag_vector_entries(const Dag *d, int vec, int *out); /* the dag_vector_len entries of the chain */
+int dag_loop(Dag *d, const DagLoop *loop);           /* its number */
+int dag_stage_sum(Dag *d, int loop, int j, int r);    /* sum_l W[l][j] f_r(Q_l) */
 int dag_is_const(const Dag *d, int n, double v);
 int dag_is_zero(const Dag *d, int n);
 void dag_section(Dag *d, const char *label);
@@ -309,12 +332,15 @@ typedef struct {
   int *q0n, *p0n;             /* m nodes each: q0, p0 as functions of the params */
   Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
   int degU, degg;             /* DEG_NONPOLY or degree; degg = 0 without constraints */
+  long stage_loop;            /* stages whose straight-line code would take this many
+                               * operations or more are a loop (--stage-loop) */
   long mass_loop;             /* a product M^-1 v of a dense constant M with this many
                                * multiplications or more is a loop over a table (--mass-loop) */
 } Model;
 
 /* The default of Model.mass_loop, from the measurements in docs/embedding.md. */
 #define MASS_LOOP_DEFAULT 512
+#define STAGE_LOOP_DEFAULT 4000
 
 Model *analyse(const char *file, Stmt *prog);      /* NULL when errors were reported */
 int mass_setup(Model *mod, const double *dense, Loc loc); /* 0 ok, else error reported */

@@ -64,6 +64,9 @@ static const char usage[] =
     "  --mass-loop N  compute M^-1 v for a dense constant M as a loop over a table of\n"
     "                M^-1 when it takes N or more multiplications, straight-line code\n"
     "                below (default " STR(MASS_LOOP_DEFAULT) ": the measured crossover, docs/embedding.md)\n"
+    "  --stage-loop N  print the k stages of the step as one loop over the stages (the\n"
+    "                model's derivatives once, inside it) when their straight-line code\n"
+    "                would take N or more operations (default " STR(STAGE_LOOP_DEFAULT) ", docs/embedding.md)\n"
     "  -h, --help    this text\n"
     "  --version     the version\n";
 
@@ -75,6 +78,7 @@ typedef struct {
   int multiplier; /* -1: default for s and the model; else a MultFamily */
   int batch;      /* --batch W, 0 without */
   long mass_loop; /* --mass-loop N, 0 for the default */
+  long stage_loop; /* --stage-loop N, 0 for the default */
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -143,11 +147,14 @@ static int parse_args(int argc, char **argv, Options *o) {
       const char *v = argv[++i];
       if (strcmp(v, "float") && strcmp(v, "double")) return fail("--real needs 'float' or 'double', got '%s'", v);
       o->single = !strcmp(v, "float");
-    } else if (!strcmp(a, "--mass-loop")) {
+    } else if (!strcmp(a, "--mass-loop") || !strcmp(a, "--stage-loop")) {
       if (!has_value) return fail("option %s needs a value", a);
       int n;
-      if (parse_count(argv[++i], 1, 1 << 30, &n)) return fail("--mass-loop needs an integer from 1 to 2^30, got '%s'", argv[i]);
-      o->mass_loop = n;
+      if (parse_count(argv[++i], 1, 1 << 30, &n)) {
+        fprintf(stderr, "hbvmgen: error: %s needs an integer from 1 to 2^30, got '%s'\n", a, argv[i]);
+        return 1;
+      }
+      *(a[2] == 'm' ? &o->mass_loop : &o->stage_loop) = n;
     } else if (!strcmp(a, "--batch")) {
       if (!has_value) return fail("option %s needs a value", a);
       if (parse_count(argv[++i], 1, 64, &o->batch)) return fail("--batch needs an integer from 1 to 64, got '%s'", argv[i]);
@@ -484,7 +491,7 @@ static void report_degree(const Model *mod, int s, int k) {
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0};
+  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name && bad_name(o.name = default_name(o.model), o.model)) return 1;
@@ -503,6 +510,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   if (o.mass_loop) mod->mass_loop = o.mass_loop;
+  if (o.stage_loop) mod->stage_loop = o.stage_loop;
   model_differentiate(mod);
   model_check_initial(mod);
   const char *why = "given with -k";

@@ -108,10 +108,24 @@ void step_stage_point(Build *b, int l, int *Q) {
   }
 }
 
+// Whether the k stages of the roots are printed as one loop (DagLoop):
+// when their straight-line code, k times the operations of the roots,
+// would reach mod->stage_loop operations.
+static int stages_rolled(Build *b, const int *roots, int n) {
+  Dag *d = b->d;
+  unsigned char *mark = xcalloc((size_t)d->n + 1, 1);
+  dag_reach(d, roots, n, mark);
+  long ops = 0;
+  for (int id = 0; id < d->n; id++) ops += mark[id] && d->nodes[id].a >= 0;
+  free(mark);
+  return (long)b->k * ops >= b->mod->stage_loop;
+}
+
 // Stage points, model derivatives at each stage, and their projections
 // psi_j and rho_j onto the Legendre basis. Entries of grad U and grad g that
 // are affine in q are projected in closed form (project_affine); only the
-// others are evaluated at the k stages.
+// others are evaluated at the k stages: straight-line, or as one loop over
+// the stages when that would be large (stages_rolled).
 static void build_stages(Build *b) {
   Dag *d = b->d;
   const Method *me = b->me;
@@ -139,6 +153,19 @@ static void build_stages(Build *b) {
   if (naff) project_affine(b, affine, naff, paff);
   for (int j = 0; j < s; j++)
     for (int r = 0; r < nroots; r++) proj[j * nroots + r] = where[r] >= 0 ? paff[j * naff + where[r]] : dag_const(d, 0);
+  if (ncur && stages_rolled(b, curved, ncur)) {
+    step_section(b, "the k stages as one loop: Q = q0 + h sum_j Ihat[l][j] gamma_j, grad U(Q), grad g(Q), summed "
+                    "with the weights b_l P_j(c_l)");
+    int *q0 = step_nodes(m), *gam = step_nodes(s * m);
+    for (int i = 0; i < m; i++) q0[i] = step_in(b, IN_Q0, i);
+    for (int i = 0; i < s * m; i++) gam[i] = step_in(b, IN_GAM, i);
+    DagLoop lp = {curved, ncur, m, b->k, s, me->W, me->Ihat, q0, gam, b->h};
+    int loop = dag_loop(d, &lp);
+    for (int j = 0; j < s; j++)
+      for (int r = 0; r < nroots; r++)
+        if (where[r] < 0) proj[j * nroots + r] = dag_stage_sum(d, loop, j, -1 - where[r]);
+    ncur = 0; /* (nothing left for the straight-line stages below) */
+  }
   for (int l = 0; l < b->k && ncur; l++) {
     char *label = arena_alloc(128);
     snprintf(label, 128, "stage %d of %d: Q = q0 + h sum_j Ihat[%d][j] gamma_j, grad U(Q), grad g(Q)", l + 1, b->k, l + 1);

@@ -14,6 +14,8 @@
 #include "bkepler_k16s2.h"
 #include "bmass_k2s2.h"
 #include "bdense_k2s2.h"
+#include "bloop_k16s2.h"
+#include "bswing_k6s2.h"
 #include "bplain_k3s3.h"
 #include "bpoly_k3s3.h"
 #include "bsat_k6s2.h"
@@ -93,6 +95,8 @@ BATCH_TEST(bsat_k6s2, 0.05, 8)
 BATCH_TEST(bkepler_k16s2, 0.03, 12)
 BATCH_TEST(bmass_k2s2, 0.05, 12)
 BATCH_TEST(bdense_k2s2, 0.005, 8)
+BATCH_TEST(bloop_k16s2, 0.03, 12)
+BATCH_TEST(bswing_k6s2, 0.02, 12)
 BATCH_TEST(bplain_k3s3, 0.1, 12)
 
 /* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
@@ -133,6 +137,8 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_bkepler_k16s2);
   tcase_add_test(tc, test_bmass_k2s2);
   tcase_add_test(tc, test_bdense_k2s2);
+  tcase_add_test(tc, test_bloop_k16s2);
+  tcase_add_test(tc, test_bswing_k6s2);
   tcase_add_test(tc, test_bplain_k3s3);
   tcase_add_test(tc, test_defaults_and_idle);
   suite_add_tcase(s, tc);

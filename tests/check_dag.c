@@ -423,12 +423,46 @@ START_TEST(test_subst)
 }
 END_TEST
 
+/* The nodes that stay loops in the emitted code evaluate to their sums:
+ * a table row (TROW) to sum_j T[row][j] v_j, and a stage sum (SSUM) to
+ * sum_l W[l][j] f(Q_l) at the stage points Q_l = q0 + h sum_j Ihat[l][j]
+ * gamma_j; the same sums spelt out as nodes give the same values. */
+START_TEST(test_loop_nodes)
+{
+  Dag *d = dag_new();
+  static const double T[6] = {1, 2, 3, -4, 0.5, 0.25};
+  int v[3] = {dag_input(d, 0), dag_input(d, 1), dag_const(d, 3)};
+  int t = dag_table(d, "T", T, 2, 3), vec = dag_vector(d, v, 3);
+  int r0 = dag_table_row(d, t, 0, vec), r1 = dag_table_row(d, t, 1, vec);
+  double in[2] = {0.75, -2};
+  ck_assert_double_eq(dag_eval(d, r0, in, NULL), 1 * 0.75 + 2 * -2.0 + 3 * 3.0);
+  ck_assert_double_eq(dag_eval(d, r1, in, NULL), -4 * 0.75 + 0.5 * -2.0 + 0.25 * 3.0);
+  ck_assert_int_eq(dag_table_row(d, t, 0, dag_vector(d, v, 3)), r0); /* shared */
+  /* f(x) = x^3 of coordinate 0; q0, gamma_0, gamma_1, h in slots 1..4; k = 3, s = 2 */
+  static const double W[6] = {0.25, -0.5, 0.5, 0, 0.25, 0.5}, Ih[6] = {0.1, -0.2, 0.5, 0, 0.9, 0.2};
+  int x = dag_input(d, 0), f = dag_mul(d, x, dag_mul(d, x, x));
+  int q0[1] = {dag_input(d, 1)}, gam[2] = {dag_input(d, 2), dag_input(d, 3)}, h = dag_input(d, 4);
+  DagLoop lp = {&f, 1, 1, 3, 2, W, Ih, q0, gam, h};
+  int loop = dag_loop(d, &lp);
+  double at[5] = {0, 0.3, 1.5, -0.7, 0.1};
+  for (int j = 0; j < 2; j++) {
+    double want = 0;
+    for (int l = 0; l < 3; l++) {
+      double Q = at[1] + at[4] * (Ih[l * 2] * at[2] + Ih[l * 2 + 1] * at[3]);
+      want += W[l * 2 + j] * (Q * (Q * Q));
+    }
+    ck_assert_double_eq_tol(dag_eval(d, dag_stage_sum(d, loop, j, 0), at, NULL), want, 1e-15);
+  }
+}
+END_TEST
+
 Suite *dag_suite(void)
 {
   Suite *s = suite_create("dag");
   TCase *tc = tcase_create("dag");
   tcase_add_checked_fixture(tc, NULL, teardown);
   tcase_add_test(tc, test_cse_identity);
+  tcase_add_test(tc, test_loop_nodes);
   tcase_add_test(tc, test_cse_counts);
   tcase_add_test(tc, test_cse_growth);
   tcase_add_test(tc, test_fold_values);

@@ -32,50 +32,11 @@
 #include "mass_osc_k2s2.h"
 #include "mass_param_c_k2s2.h"
 #include "mass_param_k2s2.h"
+#include "side_by_side.h"
 
 Suite *mass_suite(void);
 
 #define PI 3.14159265358979323846
-#define NSTEPS 400
-
-/* max(worst, |a[i] - b[i]| for i < n) */
-static double max_diff(double worst, const double *a, const double *b, int n)
-{
-  for (int i = 0; i < n; i++) worst = fmax(worst, fabs(a[i] - b[i]));
-  return worst;
-}
-
-/* Step a model with M of params (default params) and the same model with
- * that M written as constants, side by side, NSTEPS steps of h; returns the
- * largest difference of (t, q, p, lambda) over the run. P is the param
- * solver, C the constant one; their public fields lead the state. */
-#define SIDE_BY_SIDE(P, C, h, worst)                                                                    \
-  do {                                                                                                  \
-    P##_state xp;                                                                                       \
-    C##_state xc;                                                                                       \
-    P##_params prm;                                                                                     \
-    P##_params_default(&prm);                                                                           \
-    P##_init(&xp, NULL, NULL);                                                                          \
-    C##_init(&xc, NULL, NULL);                                                                          \
-    (worst) = 0;                                                                                        \
-    for (int n = 0; n < NSTEPS; n++) {                                                                  \
-      int rp = P##_step(&xp, (h), &prm, NULL), rc = C##_step(&xc, (h), NULL, NULL);                     \
-      ck_assert_msg(rp == 0 && rc == 0, #P " / " #C " step %d: %s / %s", n, P##_strerror(rp),           \
-                    C##_strerror(rc));                                                                  \
-      (worst) = max_diff(fmax((worst), fabs(xp.t - xc.t)), xp.q, xc.q, P##_M);                            \
-      (worst) = max_diff((worst), xp.p, xc.p, P##_M);                                                   \
-      (worst) = max_diff((worst), xp.lambda, xc.lambda, P##_NU);                                        \
-    }                                                                                                   \
-  } while (0)
-
-/* SIDE_BY_SIDE, reported as what and asserted within tol. */
-#define SAME_TRAJECTORY(P, C, h, tol, what)                                                            \
-  do {                                                                                                 \
-    double worst_;                                                                                     \
-    SIDE_BY_SIDE(P, C, h, worst_);                                                                     \
-    printf("mass: %s: max |difference| %.3g over %d steps\n", what, worst_, NSTEPS);                   \
-    ck_assert_msg(worst_ <= (tol), "%s: the trajectories differ by %.3g", what, worst_);               \
-  } while (0)
 
 /* A diagonal M of params gives M^-1 entries 1/m_ii, exactly the constants
  * the constant M bakes in: the trajectories agree to the last bit (allowed:
