@@ -26,6 +26,12 @@ typedef struct {
   int wide;        /* the kernel being printed computes one precision wider */
   KernelId kid;    /* the kernel being printed */
   int lanes;       /* W > 0: kernels print as loops over W lanes (--batch, emit_batch.c) */
+  /* the fused step (emit_kernel_inline): what the kernel's inputs are called in
+   * the step, and which of them are scalar locals PREFIX0, PREFIX1, ... */
+  const char *arg[IN_COUNT];
+  unsigned local;  /* 1 << input slot */
+  const char *res; /* non-NULL: results go to locals res0, res1, ..., not out[] */
+  int fused;       /* the step's iteration has the sweep inlined, gamma in locals */
 } Emitter;
 
 void out(Emitter *e, const char *fmt, ...);
@@ -34,6 +40,8 @@ const char *math_suffix(const Emitter *e, int wide);
 void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
 void emit_kernel(Emitter *e, KernelId k);
+int kernel_inlinable(const Emitter *e, KernelId k);
+int emit_kernel_inline(Emitter *e, KernelId k);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);
