@@ -38,6 +38,9 @@
 static const double conical_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double conical_k1s1_E1[1] = {1.0};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double conical_k1s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double conical_k1s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k1s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -199,14 +202,14 @@ void conical_k1s1_init_params(conical_k1s1_state *x, const conical_k1s1_real *q0
 {
   int i;
   conical_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < conical_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k1s1_NU ? conical_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[conical_k1s1_NU];
     conical_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -251,14 +254,23 @@ void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params 
   conical_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k1s1_predict(const conical_k1s1_state *x, double h, const conical_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     conical_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < conical_k1s1_S; j++)
+      for (i = 0; i < conical_k1s1_S; i++)
+        for (l = 0; l < conical_k1s1_M; l++)
+          gam[j * conical_k1s1_M + l] += conical_k1s1_E2[2 * conical_k1s1_S * j + i] * x->gam[i * conical_k1s1_M + l] +
+                               conical_k1s1_E2[2 * conical_k1s1_S * j + conical_k1s1_S + i] * x->gam2[i * conical_k1s1_M + l];
     return;
   }
   for (j = 0; j < conical_k1s1_S; j++)
@@ -445,8 +457,10 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h_, const conical
     conical_k1s1_add(&x->p[i], &x->pc[i], sw[conical_k1s1_S * conical_k1s1_M + i]);
   }
   for (i = 0; i < conical_k1s1_NU; i++) x->lambda[i] = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + i];
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam2[i] = x->gam[i];
   for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = gam[i];
   conical_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return conical_k1s1_OK;
 }

@@ -38,6 +38,9 @@
 static const double kepler_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double kepler_k1s1_E1[1] = {1.0};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double kepler_k1s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double kepler_k1s1_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k1s1_p0[2] = {0.0, 2.0};
@@ -83,14 +86,14 @@ void kepler_k1s1_init_params(kepler_k1s1_state *x, const kepler_k1s1_real *q0, c
 {
   int i;
   kepler_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k1s1_NU ? kepler_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k1s1_init(kepler_k1s1_state *x, const kepler_k1s1_real *q0, const kepler_k1s1_real *p0)
@@ -128,14 +131,23 @@ void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, const kepler_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < kepler_k1s1_S; j++)
+      for (i = 0; i < kepler_k1s1_S; i++)
+        for (l = 0; l < kepler_k1s1_M; l++)
+          gam[j * kepler_k1s1_M + l] += kepler_k1s1_E2[2 * kepler_k1s1_S * j + i] * x->gam[i * kepler_k1s1_M + l] +
+                               kepler_k1s1_E2[2 * kepler_k1s1_S * j + kepler_k1s1_S + i] * x->gam2[i * kepler_k1s1_M + l];
     return;
   }
   for (j = 0; j < kepler_k1s1_S; j++)
@@ -266,8 +278,10 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h_, const kepler_k1s
     kepler_k1s1_add(&x->p[i], &x->pc[i], sw[kepler_k1s1_S * kepler_k1s1_M + i]);
   }
   for (i = 0; i < kepler_k1s1_NU; i++) x->lambda[i] = sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + i];
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam2[i] = x->gam[i];
   for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = gam[i];
   kepler_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k1s1_OK;
 }

@@ -46,6 +46,9 @@
 static const double modified_poly_k9s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995796, (-2.7755575615628914e-17), 0.0, 0.0, (-4.8074067159589095e-17), 0.99999999999999989, 0.0, (-6.2063353831181828e-17), 3.872983346207417, 3.872983346207417, (-1.1102230246251565e-16), 0.0, 0.0, (-1.9229626863835638e-16), (-9.6148134319178191e-17), 0.0, (-2.4825341532472731e-16), (-3.7238012298709097e-16), 0.99999999999999956};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double modified_poly_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, (-2.7755575615628914e-17), 0.99999999999999989, 7.745966692414834, (-1.1102230246251565e-16), (-2.884444029575346e-16), 0.999999999999999};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double modified_poly_k9s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double modified_poly_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_poly_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -1037,14 +1040,14 @@ void modified_poly_k9s3_init_params(modified_poly_k9s3_state *x, const modified_
 {
   int i;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < modified_poly_k9s3_M; i++) {
     x->q[i] = q0 ? q0[i] : modified_poly_k9s3_q0[i];
     x->p[i] = p0 ? p0[i] : modified_poly_k9s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_poly_k9s3_NU ? modified_poly_k9s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[modified_poly_k9s3_NU];
@@ -1090,14 +1093,23 @@ void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified
   modified_poly_k9s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double h, const modified_poly_k9s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_poly_k9s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < modified_poly_k9s3_S; j++)
+      for (i = 0; i < modified_poly_k9s3_S; i++)
+        for (l = 0; l < modified_poly_k9s3_M; l++)
+          gam[j * modified_poly_k9s3_M + l] += modified_poly_k9s3_E2[2 * modified_poly_k9s3_S * j + i] * x->gam[i * modified_poly_k9s3_M + l] +
+                               modified_poly_k9s3_E2[2 * modified_poly_k9s3_S * j + modified_poly_k9s3_S + i] * x->gam2[i * modified_poly_k9s3_M + l];
     return;
   }
   for (j = 0; j < modified_poly_k9s3_S; j++)
@@ -2311,6 +2323,7 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam2[i] = x->gam[i];
   for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
@@ -2319,6 +2332,7 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
     for (i = 0; i < modified_poly_k9s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   modified_poly_k9s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return modified_poly_k9s3_OK;
 }

@@ -39,6 +39,9 @@
 static const double pendulum_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double pendulum_k2s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double pendulum_k2s2_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k2s2_p0[2] = {1.0, 0.0};
@@ -173,14 +176,14 @@ void pendulum_k2s2_init_params(pendulum_k2s2_state *x, const pendulum_k2s2_real 
 {
   int i;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k2s2_NU ? pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[pendulum_k2s2_NU];
     pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -225,14 +228,23 @@ void pendulum_k2s2_hidden(const pendulum_k2s2_state *x, const pendulum_k2s2_para
   pendulum_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_k2s2_predict(const pendulum_k2s2_state *x, double h, const pendulum_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_k2s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < pendulum_k2s2_S; j++)
+      for (i = 0; i < pendulum_k2s2_S; i++)
+        for (l = 0; l < pendulum_k2s2_M; l++)
+          gam[j * pendulum_k2s2_M + l] += pendulum_k2s2_E2[2 * pendulum_k2s2_S * j + i] * x->gam[i * pendulum_k2s2_M + l] +
+                               pendulum_k2s2_E2[2 * pendulum_k2s2_S * j + pendulum_k2s2_S + i] * x->gam2[i * pendulum_k2s2_M + l];
     return;
   }
   for (j = 0; j < pendulum_k2s2_S; j++)
@@ -430,8 +442,10 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h_, const pend
     pendulum_k2s2_add(&x->p[i], &x->pc[i], sw[pendulum_k2s2_S * pendulum_k2s2_M + i]);
   }
   for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + i];
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam2[i] = x->gam[i];
   for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = gam[i];
   pendulum_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_k2s2_OK;
 }

@@ -38,6 +38,9 @@
 static const double pendulum_poly_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_poly_k1s1_E1[1] = {1.0};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double pendulum_poly_k1s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double pendulum_poly_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k1s1_p0[2] = {1.0, 0.0};
@@ -241,14 +244,14 @@ void pendulum_poly_k1s1_init_params(pendulum_poly_k1s1_state *x, const pendulum_
 {
   int i;
   pendulum_poly_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_poly_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k1s1_NU ? pendulum_poly_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[pendulum_poly_k1s1_NU];
@@ -294,14 +297,23 @@ void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum
   pendulum_poly_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, const pendulum_poly_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k1s1_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < pendulum_poly_k1s1_S; j++)
+      for (i = 0; i < pendulum_poly_k1s1_S; i++)
+        for (l = 0; l < pendulum_poly_k1s1_M; l++)
+          gam[j * pendulum_poly_k1s1_M + l] += pendulum_poly_k1s1_E2[2 * pendulum_poly_k1s1_S * j + i] * x->gam[i * pendulum_poly_k1s1_M + l] +
+                               pendulum_poly_k1s1_E2[2 * pendulum_poly_k1s1_S * j + pendulum_poly_k1s1_S + i] * x->gam2[i * pendulum_poly_k1s1_M + l];
     return;
   }
   for (j = 0; j < pendulum_poly_k1s1_S; j++)
@@ -503,6 +515,7 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam2[i] = x->gam[i];
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
@@ -511,6 +524,7 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     for (i = 0; i < pendulum_poly_k1s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   pendulum_poly_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_poly_k1s1_OK;
 }

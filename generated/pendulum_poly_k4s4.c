@@ -41,6 +41,9 @@
 static const double pendulum_poly_k4s4_E[64] = {1.0, 0.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995796, 0.0, 2.6457513110645934, 15.874507866387544, 26.457513110645905, 13.228756555322951, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989, 0.0, 0.0, 0.0, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 9.1651513899116814, 22.912878474779198, 13.747727084867515, (-8.3266726846886741e-17), 0.0, 0.0, 0.0, (-1.442222014787673e-16), (-3.8459253727671276e-16), 0.0, 0.0, (-1.8619006149354548e-16), (-1.4895204919483639e-15), 0.99999999999999911, 0.0, (-2.2030305172320797e-16), (-3.5248488275713244e-15), 5.9160797830996108, 5.9160797830996108, (-1.6653345369377348e-16), 0.0, 0.0, 0.0, (-2.884444029575346e-16), (-5.7688880591506919e-16), 0.0, 0.0, (-3.7238012298709097e-16), (-2.2342807379225458e-15), (-2.4204707994160914e-15), 0.0, (-4.4060610344641594e-16), (-5.2872732413569865e-15), (-1.4319698362008503e-14), 0.99999999999999023};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_poly_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.416407864998739, 58.206528843420998, 0.0, 0.99999999999999989, 7.745966692414834, 45.825756949558397, (-8.3266726846886741e-17), (-5.2881473875548006e-16), 0.99999999999999745, 11.832159566199218, (-1.6653345369377348e-16), (-8.6533320887260379e-16), (-5.0271316603257284e-15), 0.99999999999997014};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double pendulum_poly_k4s4_E2[32] = {(-910.18749999962267), 1626.0709487800843, (-2046.4214621572421), 1911.2482261090747, 911.18749999962233, 1533.8392432770761, 1716.0424184817782, 1199.1631589599583, (-990.62480875351343), 1762.4374999992667, (-2219.9456417533411), 2030.3674438455259, 990.62480875351298, 1670.1874999993049, 1874.2818781044716, 1315.4856354327121, (-506.88865964927345), 898.77419777888406, (-1127.6874999995282), 999.13079551143642, 506.88865964927322, 857.13962680717373, 967.43749999960107, 684.7334127525794, (-150.64246527367814), 266.07580128826294, (-330.93071286699558), 283.43749999987261, 150.64246527367808, 255.76500597461808, 290.99717433109475, 208.43749999991726};
 /* Model defaults for q0 and p0. */
 static const double pendulum_poly_k4s4_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k4s4_p0[2] = {1.0, 0.0};
@@ -827,14 +830,14 @@ void pendulum_poly_k4s4_init_params(pendulum_poly_k4s4_state *x, const pendulum_
 {
   int i;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k4s4_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k4s4_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k4s4_NU ? pendulum_poly_k4s4_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[pendulum_poly_k4s4_NU];
@@ -880,14 +883,23 @@ void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum
   pendulum_poly_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, const pendulum_poly_k4s4_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < pendulum_poly_k4s4_S; j++)
+      for (i = 0; i < pendulum_poly_k4s4_S; i++)
+        for (l = 0; l < pendulum_poly_k4s4_M; l++)
+          gam[j * pendulum_poly_k4s4_M + l] += pendulum_poly_k4s4_E2[2 * pendulum_poly_k4s4_S * j + i] * x->gam[i * pendulum_poly_k4s4_M + l] +
+                               pendulum_poly_k4s4_E2[2 * pendulum_poly_k4s4_S * j + pendulum_poly_k4s4_S + i] * x->gam2[i * pendulum_poly_k4s4_M + l];
     return;
   }
   for (j = 0; j < pendulum_poly_k4s4_S; j++)
@@ -1547,6 +1559,7 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam2[i] = x->gam[i];
   for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = (double)gam[i];
   x->H0 = H0;
   {
@@ -1555,6 +1568,7 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
     for (i = 0; i < pendulum_poly_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   pendulum_poly_k4s4_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_poly_k4s4_OK;
 }
