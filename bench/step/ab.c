@@ -3,10 +3,12 @@
  * baseline generator, B with the current one, with -n A / -n B).
  *
  * One trajectory from the model's initial values, NSTEP steps of h: A and B
- * alternate REPS times (so a shared core's load hits both alike); printed as
+ * alternate REPS times (so a shared core's load hits both alike), timed in
+ * the process's CPU time (time lost to other processes does not count); printed as
  * one CSV row: the medians in ns per step, their ratio B/A, sweeps per step
  * of each, max |H - H0| over the run of each, and whether the final states
- * are bitwise equal (1) or not (0). Exits 1 if a step fails. */
+ * are bitwise equal (1) or not (0). Exits 1 if a step fails. A third argument
+ * times one run instead of REPS (for the drift of long runs). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -17,11 +19,11 @@
 #include "A.h"
 #include "B.h"
 
-#define REPS 11
+#define REPS 41
 
 static double now(void) {
   struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
@@ -38,6 +40,7 @@ static int cmp(const void *a, const void *b) {
     long n, it = 0;                                                                 \
     double H0, d = 0, t;                                                            \
     P##_init(&x, NULL, NULL);                                                       \
+    for (n = 0; n < P##_M; n++) x.p[n] *= pscale;                                   \
     H0 = P##_energy(&x, NULL);                                                      \
     t = now();                                                                      \
     for (n = 0; n < nstep && count == 0; n++) bad |= P##_step(&x, h, NULL, NULL);   \
@@ -56,9 +59,9 @@ static int cmp(const void *a, const void *b) {
 int main(int argc, char **argv) {
   double h = argc > 1 ? atof(argv[1]) : 0.01, ta[REPS], tb[REPS], sa = 0, sb = 0, da = 0, db = 0, dummy = 0;
   long nstep = argc > 2 ? atol(argv[2]) : 1000;
-  double qa[A_M], pa[A_M], qb[B_M], pb[B_M];
-  int r, bad = 0, count;
-  for (r = 0, count = 0; r < REPS; r++) {
+  double qa[A_M], pa[A_M], qb[B_M], pb[B_M], pscale = argc > 4 ? atof(argv[4]) : 1;
+  int r, bad = 0, count, reps = argc > 3 ? 1 : REPS; /* a third argument: one timed run (long runs) */
+  for (r = 0, count = 0; r < reps; r++) {
     double *q = qa, *p = pa;
     RUN(A, ta[r], dummy, dummy);
     q = qb, p = pb;
@@ -71,9 +74,9 @@ int main(int argc, char **argv) {
     q = qb, p = pb;
     RUN(B, dummy, sb, db);
   }
-  qsort(ta, REPS, sizeof ta[0], cmp);
-  qsort(tb, REPS, sizeof tb[0], cmp);
-  printf("%.1f,%.1f,%.3f,%.3f,%.3f,%.3g,%.3g,%d\n", ta[REPS / 2], tb[REPS / 2], tb[REPS / 2] / ta[REPS / 2], sa, sb, da,
+  qsort(ta, (size_t)reps, sizeof ta[0], cmp);
+  qsort(tb, (size_t)reps, sizeof tb[0], cmp);
+  printf("%.1f,%.1f,%.3f,%.3f,%.3f,%.3g,%.3g,%d\n", ta[reps / 2], tb[reps / 2], tb[reps / 2] / ta[reps / 2], sa, sb, da,
          db, !memcmp(qa, qb, sizeof qa) && !memcmp(pa, pb, sizeof pa));
   if (bad) fprintf(stderr, "ab: a step failed\n");
   return bad != 0;
