@@ -457,8 +457,10 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h_, const conical
     conical_k1s1_add(&x->p[i], &x->pc[i], sw[conical_k1s1_S * conical_k1s1_M + i]);
   }
   for (i = 0; i < conical_k1s1_NU; i++) x->lambda[i] = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + i];
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k1s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

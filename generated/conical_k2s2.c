@@ -511,8 +511,10 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
     conical_k2s2_add(&x->p[i], &x->pc[i], sw[conical_k2s2_S * conical_k2s2_M + i]);
   }
   for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + i];
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -564,8 +564,10 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical
     conical_k3s3_add(&x->p[i], &x->pc[i], sw[conical_k3s3_S * conical_k3s3_M + i]);
   }
   for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + i];
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k3s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

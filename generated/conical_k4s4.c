@@ -617,8 +617,10 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h_, const conical
     conical_k4s4_add(&x->p[i], &x->pc[i], sw[conical_k4s4_S * conical_k4s4_M + i]);
   }
   for (i = 0; i < conical_k4s4_NU; i++) x->lambda[i] = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + i];
-  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k4s4_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

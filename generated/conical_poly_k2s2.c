@@ -846,8 +846,10 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[conical_poly_k2s2_NU];

@@ -724,8 +724,10 @@ int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_
     double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]);
   }
   for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + i];
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

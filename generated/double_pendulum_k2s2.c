@@ -1319,8 +1319,10 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[double_pendulum_k2s2_NU];

@@ -4239,8 +4239,10 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[double_pendulum_k4s4_NU];

@@ -361,8 +361,10 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
     henon_heiles_k3s2_add(&x->p[i], &x->pc[i], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]);
   }
   for (i = 0; i < henon_heiles_k3s2_NU; i++) x->lambda[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + i];
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -278,8 +278,10 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h_, const kepler_k1s
     kepler_k1s1_add(&x->p[i], &x->pc[i], sw[kepler_k1s1_S * kepler_k1s1_M + i]);
   }
   for (i = 0; i < kepler_k1s1_NU; i++) x->lambda[i] = sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + i];
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k1s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

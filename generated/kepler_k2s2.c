@@ -338,8 +338,10 @@ int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h_, const kepler_k2s
     kepler_k2s2_add(&x->p[i], &x->pc[i], sw[kepler_k2s2_S * kepler_k2s2_M + i]);
   }
   for (i = 0; i < kepler_k2s2_NU; i++) x->lambda[i] = sw[kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + i];
-  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -407,8 +407,10 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h_, const kepler_k3s
     kepler_k3s3_add(&x->p[i], &x->pc[i], sw[kepler_k3s3_S * kepler_k3s3_M + i]);
   }
   for (i = 0; i < kepler_k3s3_NU; i++) x->lambda[i] = sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + i];
-  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k3s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -518,8 +518,10 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
     modified_k3s1_add(&x->p[i], &x->pc[i], sw[modified_k3s1_S * modified_k3s1_M + i]);
   }
   for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + i];
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

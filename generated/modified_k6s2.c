@@ -696,8 +696,10 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
     modified_k6s2_add(&x->p[i], &x->pc[i], sw[modified_k6s2_S * modified_k6s2_M + i]);
   }
   for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + i];
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   modified_k6s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -929,8 +929,10 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h_, const modi
     modified_k9s3_add(&x->p[i], &x->pc[i], sw[modified_k9s3_S * modified_k9s3_M + i]);
   }
   for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + i];
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   modified_k9s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

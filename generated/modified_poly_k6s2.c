@@ -1340,8 +1340,10 @@ int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[modified_poly_k6s2_NU];

@@ -2323,8 +2323,10 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[modified_poly_k9s3_NU];

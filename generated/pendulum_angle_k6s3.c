@@ -349,8 +349,10 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
     pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]);
   }
   for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + i];
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -403,8 +403,10 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
     pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[pendulum_k1s1_S * pendulum_k1s1_M + i]);
   }
   for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + i];
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_k1s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

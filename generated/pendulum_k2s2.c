@@ -442,8 +442,10 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h_, const pend
     pendulum_k2s2_add(&x->p[i], &x->pc[i], sw[pendulum_k2s2_S * pendulum_k2s2_M + i]);
   }
   for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + i];
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -477,8 +477,10 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pend
     pendulum_k3s3_add(&x->p[i], &x->pc[i], sw[pendulum_k3s3_S * pendulum_k3s3_M + i]);
   }
   for (i = 0; i < pendulum_k3s3_NU; i++) x->lambda[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + i];
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -515,8 +515,10 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k1s1_NU];

@@ -698,8 +698,10 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k2s2_NU];

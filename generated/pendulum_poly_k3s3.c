@@ -995,8 +995,10 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k3s3_NU];

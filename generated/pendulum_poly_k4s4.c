@@ -1559,8 +1559,10 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k4s4_NU];

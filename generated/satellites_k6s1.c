@@ -1890,8 +1890,10 @@ int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h_, cons
     satellites_k6s1_add(&x->p[i], &x->pc[i], sw[satellites_k6s1_S * satellites_k6s1_M + i]);
   }
   for (i = 0; i < satellites_k6s1_NU; i++) x->lambda[i] = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + i];
-  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   satellites_k6s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

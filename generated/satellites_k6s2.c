@@ -2414,8 +2414,10 @@ int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h_, cons
     satellites_k6s2_add(&x->p[i], &x->pc[i], sw[satellites_k6s2_S * satellites_k6s2_M + i]);
   }
   for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + i];
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   satellites_k6s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -2954,8 +2954,10 @@ int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h_, cons
     satellites_k6s3_add(&x->p[i], &x->pc[i], sw[satellites_k6s3_S * satellites_k6s3_M + i]);
   }
   for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + i];
-  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   satellites_k6s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;

@@ -5088,8 +5088,10 @@ int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam2[i] = x->gam[i];
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s2_NU];
