@@ -28,6 +28,14 @@
  * compilers take time superlinear in a function's size. */
 #define PART_NODES 2000
 
+/* A sweep with more operations than this is not inlined into the fused step
+ * but stays a function (of parts, above PART_NODES). Measured with gcc 12 -O2
+ * (bench/step/ab.sh, fused against the call): 0.78-0.92 of the time up to
+ * Kepler's k = 16 sweep (486 operations), 0.95-1.0 for chain8 (1268), but
+ * 1.17 for the satellites (6,2) const (1354) and 1.08-1.13 for their poly
+ * sweep (2200): past about a thousand values the compiler spills. */
+#define INLINE_NODES 1000
+
 /* Room for the C name of one value: a temporary, a literal, an input with
  * its coordinate's name, or prm->NAME. */
 #define NAME_SIZE 1024
@@ -463,19 +471,19 @@ void emit_kernel(Emitter *e, KernelId id) {
 }
 
 // Whether kernel k is small enough to be printed as one block of the fused
-// step (emit_kernel_inline).
+// step (emit_kernel_inline, INLINE_NODES).
 int kernel_inlinable(const Emitter *e, KernelId id) {
-  return kernel_ops(e, id, NULL) <= PART_NODES;
+  return kernel_ops(e, id, NULL) <= INLINE_NODES;
 }
 
 // The body of kernel k alone, for the fused step: its operations inside a
 // block, inputs named by e->arg / e->local and results assigned to the
 // locals e->res0, e->res1, ... Returns 0, or -1 (nothing printed) when the
-// kernel is too large to be one block of straight-line code.
+// kernel is too large to gain from it (INLINE_NODES).
 int emit_kernel_inline(Emitter *e, KernelId id) {
   const Kernel *k = &e->st->kern[id];
   int *ops, nops = kernel_ops(e, id, &ops);
-  if (nops > PART_NODES) {
+  if (nops > INLINE_NODES) {
     free(ops);
     return -1;
   }
