@@ -9,28 +9,16 @@
  * of each, max |H - H0| over the run of each, and whether the final states
  * are bitwise equal (1) or not (0). Exits 1 if a step fails. A third argument
  * times one run instead of REPS (for the drift of long runs). */
-#define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "A.h"
 #include "B.h"
+#include "timing.h"
 
 #define REPS 41
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
 
 /* One solver's run: timed (ns per step) or counting sweeps and the drift. */
 #define RUN(P, ns, sweeps, drift)                                                   \
@@ -42,9 +30,9 @@ static int cmp(const void *a, const void *b) {
     P##_init(&x, NULL, NULL);                                                       \
     for (n = 0; n < P##_M; n++) x.p[n] *= pscale;                                   \
     H0 = P##_energy(&x, NULL);                                                      \
-    t = now();                                                                      \
+    t = cpu_seconds();                                                                      \
     for (n = 0; n < nstep && count == 0; n++) bad |= P##_step(&x, h, NULL, NULL);   \
-    ns = (now() - t) / (double)nstep * 1e9 + 0 * dummy;                             \
+    ns = (cpu_seconds() - t) / (double)nstep * 1e9 + 0 * dummy;                             \
     for (n = 0; n < nstep && count; n++) {                                          \
       bad |= P##_step(&x, h, NULL, &st);                                            \
       it += st.iters;                                                               \
@@ -74,9 +62,8 @@ int main(int argc, char **argv) {
     q = qb, p = pb;
     RUN(B, dummy, sb, db);
   }
-  qsort(ta, (size_t)reps, sizeof ta[0], cmp);
-  qsort(tb, (size_t)reps, sizeof tb[0], cmp);
-  printf("%.1f,%.1f,%.3f,%.3f,%.3f,%.3g,%.3g,%d\n", ta[reps / 2], tb[reps / 2], tb[reps / 2] / ta[reps / 2], sa, sb, da,
+  double ma = median(ta, reps), mb = median(tb, reps);
+  printf("%.1f,%.1f,%.3f,%.3f,%.3f,%.3g,%.3g,%d\n", ma, mb, mb / ma, sa, sb, da,
          db, !memcmp(qa, qb, sizeof qa) && !memcmp(pa, pb, sizeof pa));
   if (bad) fprintf(stderr, "ab: a step failed\n");
   return bad != 0;

@@ -16,7 +16,8 @@ mkdir -p "$d"
 {
   $cc -std=c99 $flags -c "$d/A.c" -o "$d/A.o"
   ${CC_B:-$cc} -std=c99 ${FLAGS_B:-$flags} -c "$d/B.c" -o "$d/B.o"
-  $cc -std=c99 -O2 -I"$d" -c bench/step/ab.c -o "$d/ab.o"
-  $cc -o "$d/ab" "$d/ab.o" "$d/A.o" "$d/B.o" -lm
+  $cc -std=c99 -O2 -I"$d" -Ibench -c bench/step/ab.c -o "$d/ab.o"
+  $cc -std=c99 -O2 -c bench/timing.c -o "$d/timing.o"
+  $cc -o "$d/ab" "$d/ab.o" "$d/timing.o" "$d/A.o" "$d/B.o" -lm
 }
 "$d/ab" "$h" "$n" ${LONG:+long} ${PSCALE:-}

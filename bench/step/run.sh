@@ -69,7 +69,7 @@ mca() {
 
 if echo "$parts" | grep -q table; then
   gen_a=$(base_gen)
-  gcc -O2 -std=c99 bench/step/clock.c -o "$B/clock"
+  gcc -O2 -std=c99 -Ibench bench/step/clock.c bench/timing.c -o "$B/clock" -lm
   ghz=$("$B/clock")
   echo "model,k,s,h,sweeps_base,sweeps_new,ns_base,ns_new,new_vs_base,sweep_cycles,sweep_rthroughput,ghz,bound_base_ns,bound_new_ns,ratio_base,ratio_new" >"$R/step.csv"
   for p in $problems; do
