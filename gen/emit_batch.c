@@ -105,14 +105,15 @@ static void emit_predict(Emitter *e) {
           "  for (l = 0; l < $P_W; l++) {\n"
           "    for (i = 0; i < $P_S * $P_M; i++) gam[i * $P_W + l] = 0;\n"
           "    if (x->hprev[l] == 0) {\n"
-          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n"
-          "    if (h == x->hprev[l] && h == x->hprev2[l]) {\n"
-          "      for (j = 0; j < $P_S; j++)\n        for (i = 0; i < $P_S; i++)\n"
-          "          for (m = 0; m < $P_M; m++)\n"
-          "            gam[(j * $P_M + m) * $P_W + l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
-          "                                             $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n"
-          "      continue;\n    }\n"
-          "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
+          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n");
+  if (e->st->kern[K_FACTOR].nout) /* the polynomial family's two-step start, as $P_predict's */
+    tmpl(e, "    if (h == x->hprev[l] && h == x->hprev2[l]) {\n"
+            "      for (j = 0; j < $P_S; j++)\n        for (i = 0; i < $P_S; i++)\n"
+            "          for (m = 0; m < $P_M; m++)\n"
+            "            gam[(j * $P_M + m) * $P_W + l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
+            "                                             $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n"
+            "      continue;\n    }\n");
+  tmpl(e, "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
           "        $R r = h / x->hprev[l], e = 0;\n"
           "        if (h == x->hprev[l])\n          e = $P_E1[j * $P_S + i];\n        else\n"
           "          for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
