@@ -38,9 +38,6 @@
 static const double conical_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double conical_k1s1_E1[1] = {1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double conical_k1s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double conical_k1s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k1s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -255,7 +252,7 @@ void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params 
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k1s1_predict(const conical_k1s1_state *x, double h, const conical_k1s1_params *prm, double *gam)
 {
@@ -263,14 +260,6 @@ static void conical_k1s1_predict(const conical_k1s1_state *x, double h, const co
   for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     conical_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < conical_k1s1_S; j++)
-      for (i = 0; i < conical_k1s1_S; i++)
-        for (l = 0; l < conical_k1s1_M; l++)
-          gam[j * conical_k1s1_M + l] += conical_k1s1_E2[2 * conical_k1s1_S * j + i] * x->gam[i * conical_k1s1_M + l] +
-                               conical_k1s1_E2[2 * conical_k1s1_S * j + conical_k1s1_S + i] * x->gam2[i * conical_k1s1_M + l];
     return;
   }
   for (j = 0; j < conical_k1s1_S; j++)

@@ -40,9 +40,6 @@
 static const double conical_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double conical_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double conical_k3s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double conical_k3s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k3s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -257,7 +254,7 @@ void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params 
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k3s3_predict(const conical_k3s3_state *x, double h, const conical_k3s3_params *prm, double *gam)
 {
@@ -265,14 +262,6 @@ static void conical_k3s3_predict(const conical_k3s3_state *x, double h, const co
   for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     conical_k3s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < conical_k3s3_S; j++)
-      for (i = 0; i < conical_k3s3_S; i++)
-        for (l = 0; l < conical_k3s3_M; l++)
-          gam[j * conical_k3s3_M + l] += conical_k3s3_E2[2 * conical_k3s3_S * j + i] * x->gam[i * conical_k3s3_M + l] +
-                               conical_k3s3_E2[2 * conical_k3s3_S * j + conical_k3s3_S + i] * x->gam2[i * conical_k3s3_M + l];
     return;
   }
   for (j = 0; j < conical_k3s3_S; j++)

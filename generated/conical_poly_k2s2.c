@@ -450,7 +450,7 @@ void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_po
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void conical_poly_k2s2_predict(const conical_poly_k2s2_state *x, double h, const conical_poly_k2s2_params *prm, double *gam)
 {

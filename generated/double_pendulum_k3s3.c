@@ -1472,7 +1472,7 @@ void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const doub
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, const double_pendulum_k3s3_params *prm, double *gam)
 {

@@ -40,9 +40,6 @@
 static const double henon_heiles_k3s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double henon_heiles_k3s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double henon_heiles_k3s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double henon_heiles_k3s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k3s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
@@ -138,7 +135,7 @@ void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heil
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, const henon_heiles_k3s2_params *prm, double *gam)
 {
@@ -146,14 +143,6 @@ static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h
   for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     henon_heiles_k3s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < henon_heiles_k3s2_S; j++)
-      for (i = 0; i < henon_heiles_k3s2_S; i++)
-        for (l = 0; l < henon_heiles_k3s2_M; l++)
-          gam[j * henon_heiles_k3s2_M + l] += henon_heiles_k3s2_E2[2 * henon_heiles_k3s2_S * j + i] * x->gam[i * henon_heiles_k3s2_M + l] +
-                               henon_heiles_k3s2_E2[2 * henon_heiles_k3s2_S * j + henon_heiles_k3s2_S + i] * x->gam2[i * henon_heiles_k3s2_M + l];
     return;
   }
   for (j = 0; j < henon_heiles_k3s2_S; j++)

@@ -53,9 +53,6 @@
 static const double kepler_k16s2_E[8] = {1.0000000000000002, 0.0, 1.7320508075688776, 1.732050807568877, (-2.0816681711721685e-17), 0.0, (-3.6055550369691825e-17), 0.99999999999999989};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double kepler_k16s2_E1[4] = {1.0000000000000002, 3.4641016151377544, (-2.0816681711721685e-17), 0.99999999999999989};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double kepler_k16s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double kepler_k16s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k16s2_p0[2] = {0.0, 2.0};
@@ -147,7 +144,7 @@ void kepler_k16s2_hidden(const kepler_k16s2_state *x, const kepler_k16s2_params 
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k16s2_predict(const kepler_k16s2_state *x, double h, const kepler_k16s2_params *prm, double *gam)
 {
@@ -155,14 +152,6 @@ static void kepler_k16s2_predict(const kepler_k16s2_state *x, double h, const ke
   for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k16s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < kepler_k16s2_S; j++)
-      for (i = 0; i < kepler_k16s2_S; i++)
-        for (l = 0; l < kepler_k16s2_M; l++)
-          gam[j * kepler_k16s2_M + l] += kepler_k16s2_E2[2 * kepler_k16s2_S * j + i] * x->gam[i * kepler_k16s2_M + l] +
-                               kepler_k16s2_E2[2 * kepler_k16s2_S * j + kepler_k16s2_S + i] * x->gam2[i * kepler_k16s2_M + l];
     return;
   }
   for (j = 0; j < kepler_k16s2_S; j++)

@@ -43,9 +43,6 @@
 static const double kepler_k6s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double kepler_k6s1_E1[1] = {1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double kepler_k6s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double kepler_k6s1_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k6s1_p0[2] = {0.0, 2.0};
@@ -137,7 +134,7 @@ void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *pr
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k6s1_predict(const kepler_k6s1_state *x, double h, const kepler_k6s1_params *prm, double *gam)
 {
@@ -145,14 +142,6 @@ static void kepler_k6s1_predict(const kepler_k6s1_state *x, double h, const kepl
   for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     kepler_k6s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < kepler_k6s1_S; j++)
-      for (i = 0; i < kepler_k6s1_S; i++)
-        for (l = 0; l < kepler_k6s1_M; l++)
-          gam[j * kepler_k6s1_M + l] += kepler_k6s1_E2[2 * kepler_k6s1_S * j + i] * x->gam[i * kepler_k6s1_M + l] +
-                               kepler_k6s1_E2[2 * kepler_k6s1_S * j + kepler_k6s1_S + i] * x->gam2[i * kepler_k6s1_M + l];
     return;
   }
   for (j = 0; j < kepler_k6s1_S; j++)

@@ -43,9 +43,6 @@
 static const double modified_k6s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 5.5511151231257827e-17, 0.0, 9.6148134319178191e-17, 0.99999999999999989};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double modified_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231257827e-17, 1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double modified_k6s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double modified_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -276,7 +273,7 @@ void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_para
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void modified_k6s2_predict(const modified_k6s2_state *x, double h, const modified_k6s2_params *prm, double *gam)
 {
@@ -284,14 +281,6 @@ static void modified_k6s2_predict(const modified_k6s2_state *x, double h, const 
   for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < modified_k6s2_S; j++)
-      for (i = 0; i < modified_k6s2_S; i++)
-        for (l = 0; l < modified_k6s2_M; l++)
-          gam[j * modified_k6s2_M + l] += modified_k6s2_E2[2 * modified_k6s2_S * j + i] * x->gam[i * modified_k6s2_M + l] +
-                               modified_k6s2_E2[2 * modified_k6s2_S * j + modified_k6s2_S + i] * x->gam2[i * modified_k6s2_M + l];
     return;
   }
   for (j = 0; j < modified_k6s2_S; j++)

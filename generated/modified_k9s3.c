@@ -46,9 +46,6 @@
 static const double modified_k9s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995796, (-2.7755575615628914e-17), 0.0, 0.0, (-4.8074067159589095e-17), 0.99999999999999989, 0.0, (-6.2063353831181828e-17), 3.872983346207417, 3.872983346207417, (-1.1102230246251565e-16), 0.0, 0.0, (-1.9229626863835638e-16), (-9.6148134319178191e-17), 0.0, (-2.4825341532472731e-16), (-3.7238012298709097e-16), 0.99999999999999956};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double modified_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, (-2.7755575615628914e-17), 0.99999999999999989, 7.745966692414834, (-1.1102230246251565e-16), (-2.884444029575346e-16), 0.999999999999999};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double modified_k9s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double modified_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -279,7 +276,7 @@ void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_para
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void modified_k9s3_predict(const modified_k9s3_state *x, double h, const modified_k9s3_params *prm, double *gam)
 {
@@ -287,14 +284,6 @@ static void modified_k9s3_predict(const modified_k9s3_state *x, double h, const 
   for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     modified_k9s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < modified_k9s3_S; j++)
-      for (i = 0; i < modified_k9s3_S; i++)
-        for (l = 0; l < modified_k9s3_M; l++)
-          gam[j * modified_k9s3_M + l] += modified_k9s3_E2[2 * modified_k9s3_S * j + i] * x->gam[i * modified_k9s3_M + l] +
-                               modified_k9s3_E2[2 * modified_k9s3_S * j + modified_k9s3_S + i] * x->gam2[i * modified_k9s3_M + l];
     return;
   }
   for (j = 0; j < modified_k9s3_S; j++)

@@ -1094,7 +1094,7 @@ void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double h, const modified_poly_k9s3_params *prm, double *gam)
 {

@@ -298,7 +298,7 @@ void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, const pendulum_poly_k1s1_params *prm, double *gam)
 {

@@ -43,9 +43,6 @@
 static const double satellites_k6s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double satellites_k6s1_E1[1] = {1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double satellites_k6s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double satellites_k6s1_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s1_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -763,7 +760,7 @@ void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, const satellites_k6s1_params *prm, double *gam)
 {
@@ -771,14 +768,6 @@ static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, co
   for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_k6s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < satellites_k6s1_S; j++)
-      for (i = 0; i < satellites_k6s1_S; i++)
-        for (l = 0; l < satellites_k6s1_M; l++)
-          gam[j * satellites_k6s1_M + l] += satellites_k6s1_E2[2 * satellites_k6s1_S * j + i] * x->gam[i * satellites_k6s1_M + l] +
-                               satellites_k6s1_E2[2 * satellites_k6s1_S * j + satellites_k6s1_S + i] * x->gam2[i * satellites_k6s1_M + l];
     return;
   }
   for (j = 0; j < satellites_k6s1_S; j++)

@@ -8603,7 +8603,7 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
 }
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
- * when they had size h, else from the previous step's, or gamma_0 = M^-1 p,
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step. */
 static void satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, const satellites_poly_k6s3_params *prm, double *gam)
 {
