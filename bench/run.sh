@@ -221,6 +221,8 @@ RUNS=${LONGRUN_RUNS:-4} bench/longrun/run.sh || echo "bench: the long-run target
 echo "== lean-code measurements ($(elapsed) s)"
 bench/lean/run.sh current
 bench/batch/run.sh || echo "bench: the batch/ensemble benchmark failed"
+echo "== the scalar step against its bound, compilers and flags ($(elapsed) s)"
+bench/step/run.sh || echo "bench: the step benchmark failed"
 bench/lean/kauto.sh
 
 echo "load after (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg)" >>"$R/machine.txt"

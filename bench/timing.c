@@ -21,6 +21,12 @@ static int cmp_double(const void *a, const void *b)
   return (x > y) - (x < y);
 }
 
+double median(double *v, int n)
+{
+  qsort(v, (size_t)n, sizeof v[0], cmp_double);
+  return v[n / 2];
+}
+
 /* Call fn n times; the CPU time they took in *dt. */
 static int timed_calls(TimedFn fn, void *ctx, long n, double *dt)
 {

@@ -7,6 +7,9 @@
 /* CPU time of the process in seconds (CLOCK_PROCESS_CPUTIME_ID). */
 double cpu_seconds(void);
 
+/* The median of v[0..n) (n > 0), sorting v. */
+double median(double *v, int n);
+
 /* Something to time: returns 0 on success. */
 typedef int (*TimedFn)(void *ctx);
 

@@ -29,6 +29,12 @@ typedef struct {
   int *vec_part;   /* per VEC node: 1 + the part whose function declares its array, or 0 */
   int *loop_part;  /* per stage loop (DagLoop): 1 + the part that runs it, or 0 */
   int body;        /* printing the body of a stage loop: coordinates are Q[i], values bID */
+  /* the fused step (emit_kernel_inline): what the kernel's inputs are called in
+   * the step, and which of them are scalar locals PREFIX0, PREFIX1, ... */
+  const char *arg[IN_COUNT];
+  unsigned local;  /* 1 << input slot */
+  const char *res; /* non-NULL: results go to locals res0, res1, ..., not out[] */
+  int fused;       /* the step's iteration has the sweep inlined, gamma in locals */
 } Emitter;
 
 void out(Emitter *e, const char *fmt, ...);
@@ -38,6 +44,8 @@ void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
 void emit_kernel(Emitter *e, KernelId k);
 void emit_tables(Emitter *e);
+int kernel_inlinable(const Emitter *e, KernelId k);
+int emit_kernel_inline(Emitter *e, KernelId k);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);

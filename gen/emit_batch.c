@@ -24,7 +24,8 @@ void emit_batch_header(Emitter *e, int lanes) {
   out(e, "%d * %s_W];\n", nu1, e->P);
   tmpl(e, "  unsigned char idle[$P_W];  /* nonzero: the lane is not stepped (cleared by $P_batch_set) */\n"
           "  /* private, per lane as in $P_state */\n"
-          "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n");
+          "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n"
+          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W];\n");
   tmpl(e, "} $P_batch;\n\n"
           "typedef struct {\n"
@@ -47,16 +48,17 @@ void emit_batch_header(Emitter *e, int lanes) {
 
 // NAME_batch_set and NAME_batch_get: one lane to and from a NAME_state.
 static void emit_set_get(Emitter *e) {
-  static const char *const scalar[] = {"t", "tc", "hprev", "H0"}, *const array[][2] = {
-      {"q", "$P_M"}, {"p", "$P_M"}, {"qc", "$P_M"}, {"pc", "$P_M"}, {"gam", "$P_S * $P_M"}, {"lambda", "$P_NU"}};
+  static const char *const scalar[] = {"t", "tc", "hprev", "hprev2", "H0"}, *const array[][2] = {
+      {"q", "$P_M"},   {"p", "$P_M"},   {"qc", "$P_M"}, {"pc", "$P_M"}, {"gam", "$P_S * $P_M"}, {"gam2", "$P_S * $P_M"},
+      {"lambda", "$P_NU"}};
   int poly = e->st->kern[K_FACTOR].nout > 0;
   char line[160];
   for (int get = 0; get < 2; get++) {
     tmpl(e, get ? "void $P_batch_get(const $P_batch *x, int l, $P_state *s)\n{\n  int i;\n"
                 : "void $P_batch_set($P_batch *x, int l, const $P_state *s)\n{\n  int i;\n");
-    for (int f = 0; f < (poly ? 4 : 3); f++)
+    for (int f = 0; f < (poly ? 5 : 4); f++)
       out(e, get ? "  s->%s = x->%s[l];\n" : "  x->%s[l] = s->%s;\n", scalar[f], scalar[f]);
-    for (int f = 0; f < 6; f++) {
+    for (int f = 0; f < 7; f++) {
       const char *n = array[f][0];
       if (get) snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) s->%s[i] = x->%s[i * $P_W + l];\n", array[f][1], n, n);
       else snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) x->%s[i * $P_W + l] = s->%s[i];\n", array[f][1], n, n);
@@ -103,8 +105,15 @@ static void emit_predict(Emitter *e) {
           "  for (l = 0; l < $P_W; l++) {\n"
           "    for (i = 0; i < $P_S * $P_M; i++) gam[i * $P_W + l] = 0;\n"
           "    if (x->hprev[l] == 0) {\n"
-          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n"
-          "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
+          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n");
+  if (e->st->kern[K_FACTOR].nout) /* the polynomial family's two-step start, as $P_predict's */
+    tmpl(e, "    if (h == x->hprev[l] && h == x->hprev2[l]) {\n"
+            "      for (j = 0; j < $P_S; j++)\n        for (i = 0; i < $P_S; i++)\n"
+            "          for (m = 0; m < $P_M; m++)\n"
+            "            gam[(j * $P_M + m) * $P_W + l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
+            "                                             $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n"
+            "      continue;\n    }\n");
+  tmpl(e, "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
           "        $R r = h / x->hprev[l], e = 0;\n"
           "        if (h == x->hprev[l])\n          e = $P_E1[j * $P_S + i];\n        else\n"
           "          for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
@@ -167,8 +176,8 @@ static void emit_commit(Emitter *e, int poly) {
             "      $P_add(&x->q[i * $P_W + l], &x->qc[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
             "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n    }\n"
             "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = fin[($[sweep.lambda]i) * $P_W + l];\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
-            "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev[l] = h;\n  }\n");
+            "    for (i = 0; i < $P_S * $P_M; i++) {\n      x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n      x->gam[i * $P_W + l] = gam[i * $P_W + l];\n    }\n"
+            "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev2[l] = x->hprev[l];\n    x->hprev[l] = h;\n  }\n");
     return;
   }
   tmpl(e, "  {\n"
@@ -202,14 +211,14 @@ static void emit_commit(Emitter *e, int poly) {
           "      for (i = 0; i < $P_M; i++) {\n"
           "        x->q[i * $P_W + l] = q1[i * $P_W + l];\n        x->p[i * $P_W + l] = p1[i * $P_W + l];\n"
           "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n      }\n"
-          "      for (i = 0; i < $P_S * $P_M; i++) x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
+          "      for (i = 0; i < $P_S * $P_M; i++) {\n        x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n        x->gam[i * $P_W + l] = gam[i * $P_W + l];\n      }\n"
           "      x->H0[l] = H0;\n    }\n"
           "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
           "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"
           "    for (l = 0; l < $P_W; l++) {\n      if (!go[l] || rc[l] != $P_OK) continue;\n"
           "      for (i = 0; i < $P_NU; i++)\n"
           "        x->lambda[i * $P_W + l] = isfinite(lam0[i * $P_W + l]) ? lam0[i * $P_W + l] : 0;\n"
-          "      $P_add(&x->t[l], &x->tc[l], h);\n      x->hprev[l] = h;\n    }\n  }\n");
+          "      $P_add(&x->t[l], &x->tc[l], h);\n      x->hprev2[l] = x->hprev[l];\n      x->hprev[l] = h;\n    }\n  }\n");
 }
 
 // NAME_batch_step.

@@ -29,6 +29,14 @@
  * compilers take time superlinear in a function's size. */
 #define PART_NODES 2000
 
+/* A sweep with more operations than this is not inlined into the fused step
+ * but stays a function (of parts, above PART_NODES). Measured with gcc 12 -O2
+ * (bench/step/ab.sh, fused against the call): 0.78-0.92 of the time up to
+ * Kepler's k = 16 sweep (486 operations), 0.95-1.0 for chain8 (1268), but
+ * 1.17 for the satellites (6,2) const (1354) and 1.08-1.13 for their poly
+ * sweep (2200): past about a thousand values the compiler spills. */
+#define INLINE_NODES 1000
+
 /* Room for the C name of one value: a temporary, a literal, an input with
  * its coordinate's name, or prm->NAME. */
 #define NAME_SIZE 1024
@@ -203,13 +211,18 @@ static void name_of(Emitter *e, int id, char *buf, size_t size) {
     for (int i = 0; i < IN_COUNT; i++) {
       const Slots *in = &st->in[i];
       if (n->idx < in->first || n->idx >= in->first + in->len) continue;
-      int i = n->idx - in->first;
+      int i = n->idx - in->first, slot = (int)(in - st->in);
+      const char *nm = e->arg[slot] ? e->arg[slot] : in->name;
       char at[32];
+      if (e->local >> slot & 1u) { /* the fused step: a scalar local */
+        snprintf(buf, size, "%s%d", nm, i);
+        return;
+      }
       snprintf(at, sizeof at, e->lanes ? "%d + l" : "%d", e->lanes ? i * e->lanes : i);
-      if (in->scalar) snprintf(buf, size, "%s", in->name);
+      if (in->scalar) snprintf(buf, size, "%s", nm);
       else if (i < e->mod->m && (in == &st->in[IN_Q0] || in == &st->in[IN_P0])) /* name the coordinate */
-        snprintf(buf, size, "%s[%s] /* %s%s */", in->name, at, in == &st->in[IN_P0] ? "p_" : "", e->mod->coord_names[i]);
-      else snprintf(buf, size, "%s[%s]", in->name, at);
+        snprintf(buf, size, "%s[%s] /* %s%s */", nm, at, in == &st->in[IN_P0] ? "p_" : "", e->mod->coord_names[i]);
+      else snprintf(buf, size, "%s[%s]", nm, at);
       return;
     }
     internal_error("model coordinate %d reached a kernel", n->idx);
@@ -382,6 +395,12 @@ static void emit_stage_loop(Emitter *e, int loop) {
   free(mark);
 }
 
+// The indentation of a kernel's body: none in a function of its own, one
+// level inside the loop over lanes, two inside the fused step's loop.
+static const char *body_indent(const Emitter *e) {
+  return e->res ? "    " : e->lanes ? "  " : "";
+}
+
 // One line computing node id into its temporary.
 static void emit_node(Emitter *e, int id) {
   const Node *n = &e->mod->dag->nodes[id];
@@ -416,7 +435,7 @@ static void emit_node(Emitter *e, int id) {
   }
   char lhs[32];
   snprintf(lhs, sizeof lhs, e->body ? "b%d" : "t%d", e->body ? id : e->temp[id]);
-  out(e, "%s%s  const %s %s = %s;\n", e->lanes ? "  " : "", e->body ? "    " : "", real_type(e, e->wide), lhs, rhs);
+  out(e, "%s%s  const %s %s = %s;\n", body_indent(e), e->body ? "    " : "", real_type(e, e->wide), lhs, rhs);
 }
 
 // The signature of kernel k (of its part-th part when part >= 0): one
@@ -461,7 +480,7 @@ static void emit_ops(Emitter *e, const int *ops, int from, int to) {
     int id = ops[i];
     while (sec + 1 < d->marks.n && d->marks.v[sec + 1] <= id) sec++;
     if (sec >= 0 && sec != shown) {
-      if (section_here(e, sec)) out(e, "%s  /* %s */\n", e->lanes ? "  " : "", d->labels[sec]);
+      if (section_here(e, sec)) out(e, "%s  /* %s */\n", body_indent(e), d->labels[sec]);
       shown = sec;
     }
     e->temp[id] = i;
@@ -478,10 +497,11 @@ static void emit_outputs(Emitter *e, const Kernel *k, const int *outs, int nouts
     if (e->chunk && e->chunk[outs[i]] != e->part) continue;
     while (b + 1 < k->nout && k->out[b + 1].first <= i) b++;
     if (i == k->out[b].first || (e->chunk && i > 0 && e->chunk[outs[i - 1]] != e->part))
-      out(e, "%s  /* %s */\n", e->lanes ? "  " : "", k->out[b].name);
+      out(e, "%s  /* %s */\n", body_indent(e), k->out[b].name);
     char r[NAME_SIZE];
     ref(e, outs[i], r, sizeof r);
-    if (e->lanes) out(e, "    out[%d + l] = %s;\n", i * e->lanes, r);
+    if (e->res) out(e, "      %s%d = %s;\n", e->res, i, r);
+    else if (e->lanes) out(e, "    out[%d + l] = %s;\n", i * e->lanes, r);
     else out(e, "  out[%d] = %s;\n", i, r);
   }
 }
@@ -560,28 +580,48 @@ static void emit_parts(Emitter *e, const Kernel *k, const int *ops, int nops, co
   e->chunk = e->slot = NULL;
 }
 
+// The results of kernel k in out order, into a new array (to free).
+static int *kernel_outs(const Kernel *k) {
+  int *outs = xmalloc((size_t)(kernel_size(k) + 1) * sizeof(int));
+  for (int b = 0; b < k->nout; b++)
+    memcpy(outs + k->out[b].first, k->out[b].nodes, (size_t)k->out[b].len * sizeof(int));
+  return outs;
+}
+
+// The operations of kernel k, in DAG order, into *ops (to free); returns
+// their number. With ops NULL, only the number.
+static int kernel_ops(const Emitter *e, KernelId id, int **ops) {
+  const Kernel *k = &e->st->kern[id];
+  const Dag *d = e->mod->dag;
+  int nouts = kernel_size(k), top = -1, nops = 0, *outs = kernel_outs(k);
+  for (int i = 0; i < nouts; i++)
+    if (outs[i] > top) top = outs[i];
+  unsigned char *mark = xcalloc((size_t)top + 2, 1);
+  int *v = xmalloc((size_t)(top + 2) * sizeof(int));
+  dag_reach(d, outs, nouts, mark);
+  for (int i = 0; i <= top; i++) /* stage sums first: they read inputs only, and their loop runs once */
+    if (mark[i] && d->nodes[i].op == OP_SSUM) v[nops++] = i;
+  for (int i = 0; i <= top; i++)
+    if (mark[i] && d->nodes[i].a >= 0 && d->nodes[i].op != OP_VEC && d->nodes[i].op != OP_SSUM) v[nops++] = i;
+  free(outs);
+  free(mark);
+  if (ops) *ops = v;
+  else free(v);
+  return nops;
+}
+
 // Print kernel k, computing its result blocks into out[]: straight-line
 // code from the DAG, in several parts when it is large. Kernels marked wide
 // compute one precision wider under --wide-step.
 void emit_kernel(Emitter *e, KernelId id) {
   const Kernel *k = &e->st->kern[id];
-  const Dag *d = e->mod->dag;
-  int nouts = kernel_size(k), top = -1, nops = 0;
-  int *outs = xmalloc((size_t)(nouts + 1) * sizeof(int));
-  for (int b = 0; b < k->nout; b++)
-    memcpy(outs + k->out[b].first, k->out[b].nodes, (size_t)k->out[b].len * sizeof(int));
+  int *ops, nops = kernel_ops(e, id, &ops), nouts = kernel_size(k), top = -1;
+  int *outs = kernel_outs(k);
   for (int i = 0; i < nouts; i++)
     if (outs[i] > top) top = outs[i];
-  unsigned char *mark = xcalloc((size_t)top + 2, 1);
-  int *ops = xmalloc((size_t)(top + 2) * sizeof(int));
-  dag_reach(d, outs, nouts, mark);
   e->kid = id;
-  for (int i = 0; i <= top; i++) /* stage sums first: they read inputs only, and their loop runs once */
-    if (mark[i] && d->nodes[i].op == OP_SSUM) ops[nops++] = i;
-  for (int i = 0; i <= top; i++)
-    if (mark[i] && d->nodes[i].a >= 0 && d->nodes[i].op != OP_VEC && d->nodes[i].op != OP_SSUM) ops[nops++] = i;
   e->vec_part = xcalloc((size_t)top + 2, sizeof *e->vec_part);
-  e->loop_part = xcalloc((size_t)d->nloops + 1, sizeof *e->loop_part);
+  e->loop_part = xcalloc((size_t)e->mod->dag->nloops + 1, sizeof *e->loop_part);
   e->wide = e->wide_step && k->wide;
   if (e->wide) out(e, "\n/* --wide-step: the %s below computes in %s. */", k->name, real_type(e, 1));
   out(e, "\n/* %s */\n", k->what);
@@ -600,6 +640,37 @@ void emit_kernel(Emitter *e, KernelId id) {
   free(e->loop_part);
   e->vec_part = e->loop_part = NULL;
   free(outs);
-  free(mark);
   free(ops);
+}
+
+// Whether kernel k is small enough, and free of tables and stage loops, to
+// be printed as one block of the fused step (emit_kernel_inline, INLINE_NODES).
+int kernel_inlinable(const Emitter *e, KernelId id) {
+  int *ops, nops = kernel_ops(e, id, &ops), plain = nops <= INLINE_NODES;
+  for (int i = 0; plain && i < nops; i++) /* tables and stage loops only in functions of their own */
+    plain = e->mod->dag->nodes[ops[i]].op != OP_TROW && e->mod->dag->nodes[ops[i]].op != OP_SSUM;
+  free(ops);
+  return plain;
+}
+
+// The body of kernel k alone, for the fused step: its operations inside a
+// block, inputs named by e->arg / e->local and results assigned to the
+// locals e->res0, e->res1, ... Returns 0, or -1 (nothing printed) when the
+// kernel is too large to gain from it (INLINE_NODES).
+int emit_kernel_inline(Emitter *e, KernelId id) {
+  const Kernel *k = &e->st->kern[id];
+  int *ops, nops = kernel_ops(e, id, &ops);
+  if (nops > INLINE_NODES) {
+    free(ops);
+    return -1;
+  }
+  int *outs = kernel_outs(k);
+  e->kid = id;
+  out(e, "    { /* the kernel %s, inline */\n", k->name);
+  emit_ops(e, ops, 0, nops);
+  emit_outputs(e, k, outs, kernel_size(k));
+  out(e, "    }\n");
+  free(outs);
+  free(ops);
+  return 0;
 }

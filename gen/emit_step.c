@@ -9,8 +9,10 @@
  * position. */
 #include <float.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "emit.h"
 
@@ -36,9 +38,10 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "#define $P_EBADSTEP 4    /* h is zero or not finite */\n\n"
           "typedef $R $P_real;\n\n");
   out(e, "typedef struct {\n  %s_real t, q[%d], p[%d], lambda[%d];\n", e->P, m, m, nu ? nu : 1);
-  out(e, "  /* private: compensated-summation errors and the last step's polynomial */\n");
+  out(e, "  /* private: compensated-summation errors and the last two steps' polynomials */\n");
   int poly = e->st->kern[K_FACTOR].nout > 0;
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
+  out(e, "  %s_real gam2[%d], hprev2;\n", e->P, s * m);
   if (poly) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
@@ -134,6 +137,11 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   out(e, "/* E[j][i](1): the warm start of a step as long as the last one. */\n");
   emit_array(e, "E1", e1, me->s * me->s);
   free(e1);
+  if (e->st->kern[K_FACTOR].nout) { /* the polynomial family's two-step start (emit_predict) */
+    out(e, "/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i\n"
+           " * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */\n");
+    emit_array(e, "E2", me->E2, 2 * me->s * me->s);
+  }
   if (e->st->kern[K_INITIAL].nout) return; /* q0, p0 use params: the kernel "initial" computes them */
   out(e, "/* Model defaults for q0 and p0. */\n");
   emit_array(e, "q0", e->mod->q0, e->mod->m);
@@ -141,10 +149,11 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
 }
 
 // Every kernel the step built, in the Step's order.
+// (The fused step has the sweep inlined: no function of its own.)
 static void emit_kernels(Emitter *e) {
   emit_tables(e);
   for (int k = 0; k < K_COUNT; k++)
-    if (e->st->kern[k].nout) emit_kernel(e, (KernelId)k);
+    if (e->st->kern[k].nout && !(k == K_SWEEP && e->fused)) emit_kernel(e, (KernelId)k);
 }
 
 // The multiplier consistent with (x->q, x->p) at prm into x->lambda (0 where
@@ -163,7 +172,7 @@ static void emit_init(Emitter *e) {
   if (of_params) tmpl(e, "  $R v[$<initial>];\n");
   tmpl(e, "  $P_DEFAULT_PARAMS(prm)\n");
   if (of_params) tmpl(e, "  $(initial out=v);\n");
-  tmpl(e, "  x->t = x->tc = x->hprev = 0;\n"
+  tmpl(e, "  x->t = x->tc = x->hprev = x->hprev2 = 0;\n"
           "  for (i = 0; i < $P_M; i++) {\n");
   if (of_params)
     tmpl(e, "    x->q[i] = q0 ? q0[i] : v[$[initial.q0]i];\n"
@@ -173,7 +182,7 @@ static void emit_init(Emitter *e) {
             "    x->p[i] = p0 ? p0[i] : $P_p0[i];\n");
   tmpl(e, "    x->qc[i] = x->pc[i] = 0;\n  }\n"
           "  for (i = 0; i < ($P_NU ? $P_NU : 1); i++) x->lambda[i] = 0;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n");
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->gam2[i] = 0;\n");
   if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"
@@ -229,6 +238,20 @@ static void emit_factor(Emitter *e, const char *indent) {
   tmpl(e, text);
 }
 
+// The commit of the step's polynomial: the last one becomes the one before
+// (for the two-step warm start), gamma the last. One loop, except with
+// --wide-step: gcc 12 -O2 then vectorised the qc/pc loop before it wrongly
+// (qc[1] = pc[0] = 0, pendulum with --real float, check_lean); as two loops
+// without --wide-step, gcc spilled the fused iteration of Kepler's k = 16
+// sweep (20% more instructions a sweep).
+static void emit_commit_gamma(Emitter *e) {
+  if (e->wide_step)
+    tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) x->gam2[i] = x->gam[i];\n"
+            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n");
+  else
+    tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam2[i] = x->gam[i];\n    x->gam[i] = gam[i];\n  }\n");
+}
+
 // The end of a step of the polynomial family: q1 and p1 as the state will
 // hold them (compensated sums, or the wide sums with --wide-step), p1
 // projected onto the hidden constraint at q1 and rescaled to the energy H0
@@ -271,80 +294,84 @@ static void emit_end_poly(Emitter *e) {
             "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
-  tmpl(e, "  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
-          "  x->H0 = H0;\n");
+  tmpl(e, "  }\n");
+  emit_commit_gamma(e);
+  tmpl(e, "  x->H0 = H0;\n");
   emit_set_lambda(e);
-  tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
+  tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
-// The warm start, iteration and compensated update around the sweep kernel.
-// With --wide-step the iteration (gamma, the sweep's results) is in the wider
-// type, starts from the compensated state q - qc, p - pc, and the new q, p
-// and their compensations come from rounding the wide sums once.
-static void emit_step(Emitter *e) {
+// Where result block name of the sweep starts in its out[].
+static int sweep_at(const Emitter *e, const char *name) {
+  return step_block(e->st, K_SWEEP, name)->first;
+}
+
+// tmpl of a printf format's result.
+static void tmplf(Emitter *e, const char *fmt, ...) {
+  char text[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(text, sizeof text, fmt, ap);
+  va_end(ap);
+  tmpl(e, text);
+}
+
+// "if (!isfinite(sw0) || ... || !isfinite(sw{n-1})) rc = CODE;", the finiteness
+// test of the fused step's first n results.
+static void emit_all_finite(Emitter *e, int n) {
+  out(e, "    if (");
+  for (int i = 0; i < n; i++) out(e, "%s!isfinite(sw%d)", i ? (i % 6 ? " || " : " ||\n        ") : "", i);
+  tmpl(e, ") rc = $P_ENONFINITE;\n");
+}
+
+// The fused step's locals: gamma as gm0, gm1, ... (from the predicted
+// gam[]), the sweep's results as sw0, sw1, ... and, for the polynomial
+// family, the multiplier's coefficients as lm0, lm1, ...
+static void emit_fused_locals(Emitter *e) {
+  int sm = e->me->s * e->mod->m, n = kernel_size(&e->st->kern[K_SWEEP]);
+  out(e, "  /* the iteration's values in locals: gamma, the sweep's results%s */\n",
+      e->st->kern[K_FACTOR].nout ? ", the multiplier" : "");
+  for (int i = 0; i < sm; i++) out(e, "%s%s gm%d = gam[%d]", i ? "," : "  ", i ? "" : real_type(e, 0), i, i);
+  out(e, ";\n");
+  for (int i = 0; i < n; i++) out(e, "%s%s%s sw%d = 0", i ? "," : "  ", i ? "" : real_type(e, 0), i && i % 8 == 0 ? "\n   " : "", i);
+  out(e, ";\n");
+  if (e->st->kern[K_FACTOR].nout) {
+    for (int i = 0; i < e->me->s * e->mod->nu; i++) out(e, "%s%s lm%d = 0", i ? "," : "  ", i ? "" : real_type(e, 0), i);
+    out(e, ";\n");
+  }
+}
+
+// The fused step's sweep and increment: the sweep kernel's body inline,
+// reading gamma (and lambda) from locals and leaving its results in locals,
+// then the increment unrolled: the same operations in the same order as
+// the loops over sw[] and gam[] of the plain step, so the same bits.
+static void emit_fused_sweep(Emitter *e) {
+  int m = e->mod->m, sm = e->me->s * m, g = sweep_at(e, "gam");
+  e->arg[IN_Q0] = "x->q";
+  e->arg[IN_P0] = "x->p";
+  e->arg[IN_GAM] = "gm";
+  e->arg[IN_LAM] = "lm";
+  e->arg[IN_LU] = "fa";
+  e->local = 1u << IN_GAM | 1u << IN_LAM;
+  e->res = "sw";
+  emit_kernel_inline(e, K_SWEEP);
+  memset(e->arg, 0, sizeof e->arg);
+  e->local = 0;
+  e->res = NULL;
+  tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
+          "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n    {\n      $R v;\n");
+  for (int i = 0; i < m; i++)
+    tmplf(e, "      v = fabs$f(x->q[%d]) + fabs$g(h * sw%d);\n      if (v > scale) scale = v;\n", i, g + i);
+  for (int i = 0; i < sm; i++) {
+    tmplf(e, "      v = fabs$g(h * (sw%d - gm%d));\n      if (v > inc) inc = v;\n", g + i, i);
+    out(e, "      gm%d = sw%d;\n", i, g + i);
+  }
+  out(e, "    }\n    if (scale > 0) inc /= scale;\n");
+}
+
+// The plain step's sweep (a call), increment and the checks of its results.
+static void emit_sweep_checks(Emitter *e) {
   int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
-  tmpl(e, "\n/* gamma for a step of size h: extrapolated from the previous step's polynomial,\n"
-          " * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */\n"
-          "static void $P_predict(const $P_state *x, $R h, const $P_params *prm, $R *gam)\n{\n"
-          "  int i, j, l, d;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n"
-          "  if (x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n"
-          "  for (j = 0; j < $P_S; j++)\n    for (i = 0; i < $P_S; i++) {\n"
-          "      $R r = h / x->hprev, e = 0;\n"
-          "      if (h == x->hprev)\n        e = $P_E1[j * $P_S + i];\n      else\n"
-          "        for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
-          "      if (e != 0)\n        for (l = 0; l < $P_M; l++) gam[j * $P_M + l] += e * x->gam[i * $P_M + l];\n"
-          "    }\n}\n\n");
-  if (e->compensated)
-    tmpl(e, "/* a += b with the rounding error carried in *c (Kahan). */\n"
-            "static void $P_add($R *a, $R *c, $R b)\n{\n"
-            "  $R y = b - *c, t = *a + y;\n  *c = (t - *a) - y;\n  *a = t;\n}\n\n");
-  else
-    tmpl(e, "/* a += b, plainly (generated with --plain-sum: no compensated summation). */\n"
-            "static void $P_add($R *a, $R *c, $R b)\n{\n  (void)c;\n  *a += b;\n}\n\n");
-  out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
-  tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
-          "  const $R h = ($R)h_;\n"
-          "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
-          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;\n"
-          "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
-          "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
-  if (wide)
-    tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
-            "  {\n    $R guess[$P_S * $P_M];\n    $P_predict(x, h, prm, guess);\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
-            "  /* the sweep starts from the compensated state q - qc, p - pc, in $W */\n"
-            "  for (i = 0; i < $P_M; i++) {\n"
-            "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
-            "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
-  else
-    tmpl(e, "  $P_predict(x, h, prm, gam);\n");
-  if (e->mod->nu)
-    tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
-            "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
-            "   * cannot drift; below $P_GTOL, g(q0) is round-off, and kicking the momenta by it\n"
-            "   * (eps / h a step) would only add noise, so it is left out. */\n"
-            "  for (i = 0; i < $P_NU; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
-  if (poly) {
-    tmpl(e, "  $W fa[$<factor> + 1], lam[$P_S * $P_NU];\n"
-            "  int j;\n"
-            "  for (i = 0; i < $P_S * $P_NU; i++) lam[i] = 0;\n"
-            "  /* the multiplier matrix at the predicted stages, factored once for all sweeps\n"
-            "   * (again below when the iteration slows down) */\n");
-    emit_factor(e, "  ");
-  }
-  tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
-  if (poly) {
-    tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"
-            "     * small; where the increments fall by less than 8x it is refreshed at the\n"
-            "     * current gamma, which keeps the iteration converging up to the h of the\n"
-            "     * constant family (pendulum, s = 3: 2.4 instead of 0.84) */\n"
-            "    if (it > 2 && inc > inc_old / 8) {\n");
-    emit_factor(e, "      ");
-    tmpl(e, "    }\n");
-  }
   char call[128];
   snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s%s out=sw);\n", wide ? "q0w" : "x->q",
            wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "", poly ? " lam=lam lu=fa" : "");
@@ -370,6 +397,31 @@ static void emit_step(Emitter *e) {
             "    }\n"
             "    if (rc == $P_ESINGULAR) break;\n");
   if (!poly) tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+}
+
+// The same for the fused step: the sweep inline, then its checks on the
+// locals, in the plain step's order.
+static void emit_fused_checks(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
+  emit_fused_sweep(e);
+  if (poly) {
+    for (int i = 0; i < e->me->s * nu; i++) out(e, "    lm%d = sw%d;\n", i, sweep_at(e, "lam") + i);
+    emit_all_finite(e, kernel_size(&e->st->kern[K_SWEEP]));
+    return;
+  }
+  if (nu) {
+    for (int i = 0; i < nu; i++)
+      tmplf(e, "    {\n      $R piv = sw%d, dia = sw%d;\n"
+               "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
+               "    }\n", sweep_at(e, "pivot") + i, sweep_at(e, "adiag") + i);
+    tmpl(e, "    if (rc == $P_ESINGULAR) break;\n");
+  }
+  emit_all_finite(e, sweep_at(e, "pivot"));
+}
+
+// The end of an iteration: failure, convergence or a stall.
+static void emit_convergence(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
   if (poly) /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL). Iterating\n"
@@ -386,14 +438,13 @@ static void emit_step(Emitter *e) {
           "     * no failure. $P_STALL sweeps without one are a stall: converged if it is at\n"
           "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
-          "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n"
-          "  if (st) { st->iters = it > $P_MAXITER ? $P_MAXITER : it; st->increment = inc; }\n"
-          "  if (rc != $P_OK) return rc;\n"
-          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
-  if (poly) {
-    emit_end_poly(e);
-    return;
-  }
+          "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n");
+}
+
+// The end of a step of the constant family: the new state finite, then the
+// commit (compensated sums, or the wide sums rounded once with --wide-step).
+static void emit_end_const(Emitter *e) {
+  int wide = e->wide_step;
   tmpl(e, "  for (i = 0; i < $P_M; i++) /* the new state must be finite too, compensations included */\n"
           "    if (!isfinite(x->q[i] + h * sw[$[sweep.gam]i]) || !isfinite(x->p[i] + sw[$[sweep.dp]i]) ||\n"
           "        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))\n      return $P_ENONFINITE;\n");
@@ -401,8 +452,7 @@ static void emit_step(Emitter *e) {
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    $P_add(&x->q[i], &x->qc[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&x->p[i], &x->pc[i], sw[$[sweep.dp]i]);\n  }\n"
-            "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = gam[i];\n");
+            "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n");
   else {
     tmpl(e, "  /* q1 = (q - qc) + h gamma_0 and p1 = (p - pc) + (p1 - p0) in $W, rounded once into\n"
             "   * q, p; what the rounding lost is the new qc, pc */\n"
@@ -411,10 +461,113 @@ static void emit_step(Emitter *e) {
             "    x->q[i] = ($R)q1;\n    x->p[i] = ($R)p1;\n");
     if (e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1);\n    x->pc[i] = ($R)(x->p[i] - p1);\n");
     tmpl(e, "  }\n"
-            "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n");
+            "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n");
   }
-  tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
+  emit_commit_gamma(e);
+  tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
+}
+
+// NAME_predict (the warm start) and NAME_add (the compensated sum) for the step.
+static void emit_predict(Emitter *e) {
+  tmpl(e, "\n/* gamma for a step of size h: extrapolated from the last two steps' polynomials\n"
+          " * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,\n"
+          " * gamma_j = 0 (j > 0) on the first step. */\n"
+          "static void $P_predict(const $P_state *x, $R h, const $P_params *prm, $R *gam)\n{\n"
+          "  int i, j, l, d;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n"
+          "  if (x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n");
+  /* The two-step start saves 7-25% of the sweeps (bench/README.md), in the
+   * polynomial family only: it changes where the iteration stops, and the
+   * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
+   * (pendulum, h = 0.1); the polynomial family restores H every step. */
+  if (e->st->kern[K_FACTOR].nout)
+    tmpl(e, "  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */\n"
+            "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++)\n"
+            "        for (l = 0; l < $P_M; l++)\n"
+            "          gam[j * $P_M + l] += $P_E2[2 * $P_S * j + i] * x->gam[i * $P_M + l] +\n"
+            "                               $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[i * $P_M + l];\n"
+            "    return;\n  }\n");
+  tmpl(e, "  for (j = 0; j < $P_S; j++)\n    for (i = 0; i < $P_S; i++) {\n"
+          "      $R r = h / x->hprev, e = 0;\n"
+          "      if (h == x->hprev)\n        e = $P_E1[j * $P_S + i];\n      else\n"
+          "        for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
+          "      if (e != 0)\n        for (l = 0; l < $P_M; l++) gam[j * $P_M + l] += e * x->gam[i * $P_M + l];\n"
+          "    }\n}\n\n");
+  if (e->compensated)
+    tmpl(e, "/* a += b with the rounding error carried in *c (Kahan). */\n"
+            "static void $P_add($R *a, $R *c, $R b)\n{\n"
+            "  $R y = b - *c, t = *a + y;\n  *c = (t - *a) - y;\n  *a = t;\n}\n\n");
+  else
+    tmpl(e, "/* a += b, plainly (generated with --plain-sum: no compensated summation). */\n"
+            "static void $P_add($R *a, $R *c, $R b)\n{\n  (void)c;\n  *a += b;\n}\n\n");
+}
+
+// The warm start, iteration and compensated update around the sweep kernel.
+// With --wide-step the iteration (gamma, the sweep's results) is in the wider
+// type, starts from the compensated state q - qc, p - pc, and the new q, p
+// and their compensations come from rounding the wide sums once.
+static void emit_step(Emitter *e) {
+  int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
+  emit_predict(e);
+  out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
+  tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
+          "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
+          "  const $R h = ($R)h_;\n"
+          "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
+          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;\n"
+          "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
+          "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
+  if (wide)
+    tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
+            "  {\n    $R guess[$P_S * $P_M];\n    $P_predict(x, h, prm, guess);\n"
+            "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
+            "  /* the sweep starts from the compensated state q - qc, p - pc, in $W */\n"
+            "  for (i = 0; i < $P_M; i++) {\n"
+            "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
+            "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
+  else
+    tmpl(e, "  $P_predict(x, h, prm, gam);\n");
+  if (e->mod->nu)
+    tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
+            "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
+            "   * cannot drift; below $P_GTOL, g(q0) is round-off, and kicking the momenta by it\n"
+            "   * (eps / h a step) would only add noise, so it is left out. */\n"
+            "  for (i = 0; i < $P_NU; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+  if (poly) {
+    tmpl(e, e->fused ? "  $W fa[$<factor> + 1];\n" : "  $W fa[$<factor> + 1], lam[$P_S * $P_NU];\n");
+    tmpl(e, e->fused ? "  int j;\n" : "  int j;\n  for (i = 0; i < $P_S * $P_NU; i++) lam[i] = 0;\n");
+    tmpl(e, ""
+            "  /* the multiplier matrix at the predicted stages, factored once for all sweeps\n"
+            "   * (again below when the iteration slows down) */\n");
+    emit_factor(e, "  ");
+  }
+  if (e->fused) emit_fused_locals(e);
+  tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
+  if (poly) {
+    tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"
+            "     * small; where the increments fall by less than 8x it is refreshed at the\n"
+            "     * current gamma, which keeps the iteration converging up to the h of the\n"
+            "     * constant family (pendulum, s = 3: 2.4 instead of 0.84) */\n"
+            "    if (it > 2 && inc > inc_old / 8) {\n");
+    for (int i = 0; e->fused && i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
+    emit_factor(e, "      ");
+    tmpl(e, "    }\n");
+  }
+  if (e->fused) emit_fused_checks(e);
+  else emit_sweep_checks(e);
+  emit_convergence(e);
+  if (e->fused) { /* the rest of the step reads the arrays */
+    for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "  gam[%d] = gm%d;\n", i, i);
+    for (int i = 0; i < kernel_size(&e->st->kern[K_SWEEP]); i++) out(e, "  sw[%d] = sw%d;\n", i, i);
+  }
+  tmpl(e, "  if (st) { st->iters = it > $P_MAXITER ? $P_MAXITER : it; st->increment = inc; }\n"
+          "  if (rc != $P_OK) return rc;\n"
+          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
+  if (poly) {
+    emit_end_poly(e);
+    return;
+  }
+  emit_end_const(e);
 }
 
 // Check one constant the solver will print: finite, and in range of float
@@ -500,7 +653,9 @@ static void emit_project(Emitter *e) {
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
-  Emitter e = {hf, mod, me, st, o->name, NULL, o->single, o->compensated, NULL, NULL, 0, o->wide_step, 0, K_SWEEP, 0, NULL, NULL, 0};
+  Emitter e = {.f = hf, .mod = mod, .me = me, .st = st, .P = o->name, .single = o->single,
+               .compensated = o->compensated, .wide_step = o->wide_step, .kid = K_SWEEP};
+  e.fused = !o->wide_step && kernel_inlinable(&e, K_SWEEP);
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;

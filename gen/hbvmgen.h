@@ -369,6 +369,7 @@ typedef struct {
   double *Phat;       /* k x s: P_j(c_l) */
   double *xi;         /* s+1 values xi_0..xi_s */
   double *E;          /* s x s x s: warm start, E[j][i] = sum_d E[(j*s+i)*s+d] r^d */
+  double *E2;         /* s x 2s: warm start from two steps of the same size */
 } Method;
 
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why);

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include <gsl/gsl_integration.h>
+#include <gsl/gsl_linalg.h>
 
 #include "hbvmgen.h"
 
@@ -83,6 +84,47 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+// The two-step warm start for steps of equal size: the polynomial p of
+// degree 2s-1 whose Legendre coefficients on the last step [0,1] and the one
+// before [-1,0] are gamma and gamma_prev, projected on the next step [1,2]:
+// gamma_next_j = sum_i E2[j][i] gamma_i + E2[j][s + i] gamma_prev_i. With
+// p in the Legendre basis of [-1,2] (well conditioned), E2 = V C^-1 where
+// C[i][d] = int_0^1 P_i(x) phi_d(x) dx (and phi_d(x - 1) for rows s + i),
+// V[j][d] = int_0^1 P_j(x) phi_d(1 + x) dx, by Gauss with 2s nodes (exact).
+static double *two_step_table(int s) {
+  int n = 2 * s;
+  gsl_matrix *C = gsl_matrix_calloc((size_t)n, (size_t)n), *V = gsl_matrix_calloc((size_t)s, (size_t)n);
+  gsl_permutation *perm = gsl_permutation_alloc((size_t)n);
+  gsl_vector *row = gsl_vector_alloc((size_t)n);
+  gsl_integration_glfixed_table *t = gsl_integration_glfixed_table_alloc((size_t)n);
+  if (!C || !V || !perm || !row || !t) internal_error("cannot build the two-step warm start for s=%d", s);
+  for (int l = 0; l < n; l++) {
+    double x, w;
+    gsl_integration_glfixed_point(0, 1, (size_t)l, &x, &w, t);
+    for (int d = 0; d < n; d++)
+      for (int i = 0; i < s; i++) {
+        double Pi = legendre_shifted(i, x) * w;
+        *gsl_matrix_ptr(C, (size_t)d, (size_t)i) += Pi * legendre_shifted(d, (x + 1) / 3); /* C' */
+        *gsl_matrix_ptr(C, (size_t)d, (size_t)(s + i)) += Pi * legendre_shifted(d, x / 3);
+        *gsl_matrix_ptr(V, (size_t)i, (size_t)d) += Pi * legendre_shifted(d, (x + 2) / 3);
+      }
+  }
+  int sign;
+  gsl_linalg_LU_decomp(C, perm, &sign); /* of C', as filled */
+  double *E2 = arena_alloc((size_t)s * n * sizeof(double));
+  for (int j = 0; j < s; j++) { /* row j of V C^-1: C' y = V[j]' */
+    gsl_vector_view vj = gsl_matrix_row(V, (size_t)j);
+    gsl_linalg_LU_solve(C, perm, &vj.vector, row);
+    for (int i = 0; i < n; i++) E2[j * n + i] = gsl_vector_get(row, (size_t)i);
+  }
+  gsl_matrix_free(C);
+  gsl_matrix_free(V);
+  gsl_permutation_free(perm);
+  gsl_vector_free(row);
+  gsl_integration_glfixed_table_free(t);
+  return E2;
+}
+
 // Fill the constants of HBVM(k,s).
 Method *method_new(int k, int s, MultFamily family) {
   Method *me = arena_alloc(sizeof *me);
@@ -134,5 +176,6 @@ Method *method_new(int k, int s, MultFamily family) {
     }
     free(mono);
   }
+  me->E2 = two_step_table(s);
   return me;
 }

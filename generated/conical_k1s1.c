@@ -42,82 +42,6 @@ static const double conical_k1s1_E1[1] = {1.0};
 static const double conical_k1s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k1s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void conical_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const conical_k1s1_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
-  const double t3 = gam[0] * 0.5;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t2 + t5;
-  const double t7 = 0.5 * gam[1];
-  const double t8 = h * t7;
-  const double t9 = 2.0 * t8;
-  const double t10 = t1 + t9;
-  const double t11 = 0.5 * gam[2];
-  const double t12 = h * t11;
-  const double t13 = 2.0 * t12;
-  const double t14 = t0 + t13;
-  /* multiplier system A lambda = r */
-  const double t15 = t6 * t6;
-  const double t16 = t10 * t10;
-  const double t17 = t15 + t16;
-  const double t18 = t14 * t14;
-  const double t19 = t17 + t18;
-  const double t20 = 0.5 * t19;
-  const double t21 = h * t20;
-  const double t22 = 0.5 * t14;
-  const double t23 = h * t22;
-  const double t24 = t6 * p0[0] /* p_x */;
-  const double t25 = t10 * p0[1] /* p_y */;
-  const double t26 = t24 + t25;
-  const double t27 = t14 * p0[2] /* p_z */;
-  const double t28 = t26 + t27;
-  const double t29 = t28 - t23;
-  const double t30 = t29 + g0[0];
-  const double t31 = t30 / t21;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t32 = t6 * t31;
-  const double t33 = t10 * t31;
-  const double t34 = t14 * t31;
-  const double t35 = 1.0 + t34;
-  const double t36 = 0.5 * t32;
-  const double t37 = h * t36;
-  const double t38 = p0[0] /* p_x */ - t37;
-  const double t39 = 0.5 * t33;
-  const double t40 = h * t39;
-  const double t41 = p0[1] /* p_y */ - t40;
-  const double t42 = 0.5 * t35;
-  const double t43 = h * t42;
-  const double t44 = p0[2] /* p_z */ - t43;
-  const double t45 = h * t32;
-  const double t46 = -t45;
-  const double t47 = h * t33;
-  const double t48 = -t47;
-  const double t49 = h * t35;
-  const double t50 = -t49;
-  /* gam */
-  out[0] = t38;
-  out[1] = t41;
-  out[2] = t44;
-  /* dp */
-  out[3] = t46;
-  out[4] = t48;
-  out[5] = t50;
-  /* lambda */
-  out[6] = t31;
-  /* pivot */
-  out[7] = t21;
-  /* adiag */
-  out[8] = t21;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void conical_k1s1_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k1s1_params *prm, double *out)
@@ -275,14 +199,14 @@ void conical_k1s1_init_params(conical_k1s1_state *x, const conical_k1s1_real *q0
 {
   int i;
   conical_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < conical_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k1s1_NU ? conical_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[conical_k1s1_NU];
     conical_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -327,8 +251,9 @@ void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params 
   conical_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k1s1_predict(const conical_k1s1_state *x, double h, const conical_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -374,29 +299,111 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h_, const conical
    * cannot drift; below conical_k1s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < conical_k1s1_NU; i++) g0[i] = fabs(g0[i]) <= conical_k1s1_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0;
   for (it = 1; it <= conical_k1s1_MAXITER; it++) {
-    conical_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[2] /* z */;
+      const double t1 = 2.0 * x->q[1] /* y */;
+      const double t2 = 2.0 * x->q[0] /* x */;
+      const double t3 = gm0 * 0.5;
+      const double t4 = h * t3;
+      const double t5 = 2.0 * t4;
+      const double t6 = t2 + t5;
+      const double t7 = 0.5 * gm1;
+      const double t8 = h * t7;
+      const double t9 = 2.0 * t8;
+      const double t10 = t1 + t9;
+      const double t11 = 0.5 * gm2;
+      const double t12 = h * t11;
+      const double t13 = 2.0 * t12;
+      const double t14 = t0 + t13;
+      /* multiplier system A lambda = r */
+      const double t15 = t6 * t6;
+      const double t16 = t10 * t10;
+      const double t17 = t15 + t16;
+      const double t18 = t14 * t14;
+      const double t19 = t17 + t18;
+      const double t20 = 0.5 * t19;
+      const double t21 = h * t20;
+      const double t22 = 0.5 * t14;
+      const double t23 = h * t22;
+      const double t24 = t6 * x->p[0] /* p_x */;
+      const double t25 = t10 * x->p[1] /* p_y */;
+      const double t26 = t24 + t25;
+      const double t27 = t14 * x->p[2] /* p_z */;
+      const double t28 = t26 + t27;
+      const double t29 = t28 - t23;
+      const double t30 = t29 + g0[0];
+      const double t31 = t30 / t21;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t32 = t6 * t31;
+      const double t33 = t10 * t31;
+      const double t34 = t14 * t31;
+      const double t35 = 1.0 + t34;
+      const double t36 = 0.5 * t32;
+      const double t37 = h * t36;
+      const double t38 = x->p[0] /* p_x */ - t37;
+      const double t39 = 0.5 * t33;
+      const double t40 = h * t39;
+      const double t41 = x->p[1] /* p_y */ - t40;
+      const double t42 = 0.5 * t35;
+      const double t43 = h * t42;
+      const double t44 = x->p[2] /* p_z */ - t43;
+      const double t45 = h * t32;
+      const double t46 = -t45;
+      const double t47 = h * t33;
+      const double t48 = -t47;
+      const double t49 = h * t35;
+      const double t50 = -t49;
+      /* gam */
+      sw0 = t38;
+      sw1 = t41;
+      sw2 = t44;
+      /* dp */
+      sw3 = t46;
+      sw4 = t48;
+      sw5 = t50;
+      /* lambda */
+      sw6 = t31;
+      /* pivot */
+      sw7 = t21;
+      /* adiag */
+      sw8 = t21;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < conical_k1s1_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_k1s1_NU; i++) {
-      double piv = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + conical_k1s1_NU + i], dia = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 2 * conical_k1s1_NU + i];
+    {
+      double piv = sw7, dia = sw8;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k1s1_SINGTOL * fabs(dia))) rc = conical_k1s1_ESINGULAR;
     }
     if (rc == conical_k1s1_ESINGULAR) break;
-    for (i = 0; i < conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + conical_k1s1_NU; i++)
-      if (!isfinite(sw[i])) rc = conical_k1s1_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6)) rc = conical_k1s1_ENONFINITE;
     if (rc == conical_k1s1_ENONFINITE || !isfinite(inc)) { rc = conical_k1s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k1s1_TOL / 256), or
      * within 2 ulps (conical_k1s1_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -415,6 +422,18 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h_, const conical
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
   if (st) { st->iters = it > conical_k1s1_MAXITER ? conical_k1s1_MAXITER : it; st->increment = inc; }
   if (rc != conical_k1s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k1s1_ENONFINITE;
@@ -427,8 +446,12 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h_, const conical
     conical_k1s1_add(&x->p[i], &x->pc[i], sw[conical_k1s1_S * conical_k1s1_M + i]);
   }
   for (i = 0; i < conical_k1s1_NU; i++) x->lambda[i] = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + i];
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return conical_k1s1_OK;
 }

@@ -25,8 +25,9 @@ typedef double conical_k1s1_real;
 
 typedef struct {
   conical_k1s1_real t, q[3], p[3], lambda[1];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k1s1_real tc, qc[3], pc[3], gam[3], hprev;
+  conical_k1s1_real gam2[3], hprev2;
 } conical_k1s1_state;
 
 typedef struct {

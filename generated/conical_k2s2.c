@@ -43,120 +43,6 @@ static const double conical_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.999999
 static const double conical_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void conical_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const conical_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
-  const double t3 = gam[0] * 0.5;
-  const double t4 = gam[3] * 0.28867513459481292;
-  const double t5 = t3 - t4;
-  const double t6 = h * t5;
-  const double t7 = 2.0 * t6;
-  const double t8 = t2 + t7;
-  const double t9 = gam[0] * 0.28867513459481292;
-  const double t10 = h * t9;
-  const double t11 = 2.0 * t10;
-  const double t12 = 0.5 * gam[1];
-  const double t13 = 0.28867513459481292 * gam[4];
-  const double t14 = t12 - t13;
-  const double t15 = h * t14;
-  const double t16 = 2.0 * t15;
-  const double t17 = t1 + t16;
-  const double t18 = 0.28867513459481292 * gam[1];
-  const double t19 = h * t18;
-  const double t20 = 2.0 * t19;
-  const double t21 = 0.5 * gam[2];
-  const double t22 = 0.28867513459481292 * gam[5];
-  const double t23 = t21 - t22;
-  const double t24 = h * t23;
-  const double t25 = 2.0 * t24;
-  const double t26 = t0 + t25;
-  const double t27 = 0.28867513459481292 * gam[2];
-  const double t28 = h * t27;
-  const double t29 = 2.0 * t28;
-  /* multiplier system A lambda = r */
-  const double t30 = t8 * t8;
-  const double t31 = t17 * t17;
-  const double t32 = t30 + t31;
-  const double t33 = t26 * t26;
-  const double t34 = t32 + t33;
-  const double t35 = 0.5 * t34;
-  const double t36 = h * t35;
-  const double t37 = 0.5 * t26;
-  const double t38 = t28 * 0.57735026918962584;
-  const double t39 = t37 + t38;
-  const double t40 = h * t39;
-  const double t41 = t8 * p0[0] /* p_x */;
-  const double t42 = t17 * p0[1] /* p_y */;
-  const double t43 = t41 + t42;
-  const double t44 = t26 * p0[2] /* p_z */;
-  const double t45 = t43 + t44;
-  const double t46 = t45 - t40;
-  const double t47 = t46 + g0[0];
-  const double t48 = t47 / t36;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t49 = t8 * t48;
-  const double t50 = t17 * t48;
-  const double t51 = t26 * t48;
-  const double t52 = 1.0 + t51;
-  const double t53 = t11 * t48;
-  const double t54 = t20 * t48;
-  const double t55 = t29 * t48;
-  const double t56 = 0.5 * t49;
-  const double t57 = 0.28867513459481292 * t53;
-  const double t58 = t56 - t57;
-  const double t59 = h * t58;
-  const double t60 = p0[0] /* p_x */ - t59;
-  const double t61 = 0.5 * t50;
-  const double t62 = 0.28867513459481292 * t54;
-  const double t63 = t61 - t62;
-  const double t64 = h * t63;
-  const double t65 = p0[1] /* p_y */ - t64;
-  const double t66 = 0.5 * t52;
-  const double t67 = 0.28867513459481292 * t55;
-  const double t68 = t66 - t67;
-  const double t69 = h * t68;
-  const double t70 = p0[2] /* p_z */ - t69;
-  const double t71 = 0.28867513459481292 * t49;
-  const double t72 = h * t71;
-  const double t73 = -t72;
-  const double t74 = 0.28867513459481292 * t50;
-  const double t75 = h * t74;
-  const double t76 = -t75;
-  const double t77 = 0.28867513459481292 * t52;
-  const double t78 = h * t77;
-  const double t79 = -t78;
-  const double t80 = h * t49;
-  const double t81 = -t80;
-  const double t82 = h * t50;
-  const double t83 = -t82;
-  const double t84 = h * t52;
-  const double t85 = -t84;
-  /* gam */
-  out[0] = t60;
-  out[1] = t65;
-  out[2] = t70;
-  out[3] = t73;
-  out[4] = t76;
-  out[5] = t79;
-  /* dp */
-  out[6] = t81;
-  out[7] = t83;
-  out[8] = t85;
-  /* lambda */
-  out[9] = t48;
-  /* pivot */
-  out[10] = t36;
-  /* adiag */
-  out[11] = t36;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void conical_k2s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k2s2_params *prm, double *out)
@@ -314,14 +200,14 @@ void conical_k2s2_init_params(conical_k2s2_state *x, const conical_k2s2_real *q0
 {
   int i;
   conical_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < conical_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k2s2_NU ? conical_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[conical_k2s2_NU];
     conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -366,8 +252,9 @@ void conical_k2s2_hidden(const conical_k2s2_state *x, const conical_k2s2_params 
   conical_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k2s2_predict(const conical_k2s2_state *x, double h, const conical_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -413,29 +300,158 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
    * cannot drift; below conical_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < conical_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= conical_k2s2_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0;
   for (it = 1; it <= conical_k2s2_MAXITER; it++) {
-    conical_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[2] /* z */;
+      const double t1 = 2.0 * x->q[1] /* y */;
+      const double t2 = 2.0 * x->q[0] /* x */;
+      const double t3 = gm0 * 0.5;
+      const double t4 = gm3 * 0.28867513459481292;
+      const double t5 = t3 - t4;
+      const double t6 = h * t5;
+      const double t7 = 2.0 * t6;
+      const double t8 = t2 + t7;
+      const double t9 = gm0 * 0.28867513459481292;
+      const double t10 = h * t9;
+      const double t11 = 2.0 * t10;
+      const double t12 = 0.5 * gm1;
+      const double t13 = 0.28867513459481292 * gm4;
+      const double t14 = t12 - t13;
+      const double t15 = h * t14;
+      const double t16 = 2.0 * t15;
+      const double t17 = t1 + t16;
+      const double t18 = 0.28867513459481292 * gm1;
+      const double t19 = h * t18;
+      const double t20 = 2.0 * t19;
+      const double t21 = 0.5 * gm2;
+      const double t22 = 0.28867513459481292 * gm5;
+      const double t23 = t21 - t22;
+      const double t24 = h * t23;
+      const double t25 = 2.0 * t24;
+      const double t26 = t0 + t25;
+      const double t27 = 0.28867513459481292 * gm2;
+      const double t28 = h * t27;
+      const double t29 = 2.0 * t28;
+      /* multiplier system A lambda = r */
+      const double t30 = t8 * t8;
+      const double t31 = t17 * t17;
+      const double t32 = t30 + t31;
+      const double t33 = t26 * t26;
+      const double t34 = t32 + t33;
+      const double t35 = 0.5 * t34;
+      const double t36 = h * t35;
+      const double t37 = 0.5 * t26;
+      const double t38 = t28 * 0.57735026918962584;
+      const double t39 = t37 + t38;
+      const double t40 = h * t39;
+      const double t41 = t8 * x->p[0] /* p_x */;
+      const double t42 = t17 * x->p[1] /* p_y */;
+      const double t43 = t41 + t42;
+      const double t44 = t26 * x->p[2] /* p_z */;
+      const double t45 = t43 + t44;
+      const double t46 = t45 - t40;
+      const double t47 = t46 + g0[0];
+      const double t48 = t47 / t36;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t49 = t8 * t48;
+      const double t50 = t17 * t48;
+      const double t51 = t26 * t48;
+      const double t52 = 1.0 + t51;
+      const double t53 = t11 * t48;
+      const double t54 = t20 * t48;
+      const double t55 = t29 * t48;
+      const double t56 = 0.5 * t49;
+      const double t57 = 0.28867513459481292 * t53;
+      const double t58 = t56 - t57;
+      const double t59 = h * t58;
+      const double t60 = x->p[0] /* p_x */ - t59;
+      const double t61 = 0.5 * t50;
+      const double t62 = 0.28867513459481292 * t54;
+      const double t63 = t61 - t62;
+      const double t64 = h * t63;
+      const double t65 = x->p[1] /* p_y */ - t64;
+      const double t66 = 0.5 * t52;
+      const double t67 = 0.28867513459481292 * t55;
+      const double t68 = t66 - t67;
+      const double t69 = h * t68;
+      const double t70 = x->p[2] /* p_z */ - t69;
+      const double t71 = 0.28867513459481292 * t49;
+      const double t72 = h * t71;
+      const double t73 = -t72;
+      const double t74 = 0.28867513459481292 * t50;
+      const double t75 = h * t74;
+      const double t76 = -t75;
+      const double t77 = 0.28867513459481292 * t52;
+      const double t78 = h * t77;
+      const double t79 = -t78;
+      const double t80 = h * t49;
+      const double t81 = -t80;
+      const double t82 = h * t50;
+      const double t83 = -t82;
+      const double t84 = h * t52;
+      const double t85 = -t84;
+      /* gam */
+      sw0 = t60;
+      sw1 = t65;
+      sw2 = t70;
+      sw3 = t73;
+      sw4 = t76;
+      sw5 = t79;
+      /* dp */
+      sw6 = t81;
+      sw7 = t83;
+      sw8 = t85;
+      /* lambda */
+      sw9 = t48;
+      /* pivot */
+      sw10 = t36;
+      /* adiag */
+      sw11 = t36;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < conical_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_k2s2_NU; i++) {
-      double piv = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU + i], dia = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 2 * conical_k2s2_NU + i];
+    {
+      double piv = sw10, dia = sw11;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k2s2_SINGTOL * fabs(dia))) rc = conical_k2s2_ESINGULAR;
     }
     if (rc == conical_k2s2_ESINGULAR) break;
-    for (i = 0; i < conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = conical_k2s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9)) rc = conical_k2s2_ENONFINITE;
     if (rc == conical_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k2s2_TOL / 256), or
      * within 2 ulps (conical_k2s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -454,6 +470,24 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
   if (st) { st->iters = it > conical_k2s2_MAXITER ? conical_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != conical_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k2s2_ENONFINITE;
@@ -466,8 +500,12 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
     conical_k2s2_add(&x->p[i], &x->pc[i], sw[conical_k2s2_S * conical_k2s2_M + i]);
   }
   for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + i];
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return conical_k2s2_OK;
 }

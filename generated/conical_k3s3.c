@@ -44,156 +44,6 @@ static const double conical_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.4164078649
 static const double conical_k3s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k3s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void conical_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const conical_k3s3_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
-  const double t3 = gam[0] * 0.5;
-  const double t4 = gam[3] * 0.28867513459481292;
-  const double t5 = t3 - t4;
-  const double t6 = h * t5;
-  const double t7 = 2.0 * t6;
-  const double t8 = t2 + t7;
-  const double t9 = gam[0] * 0.28867513459481292;
-  const double t10 = gam[6] * 0.12909944487358055;
-  const double t11 = t9 - t10;
-  const double t12 = h * t11;
-  const double t13 = 2.0 * t12;
-  const double t14 = gam[3] * 0.12909944487358055;
-  const double t15 = h * t14;
-  const double t16 = 2.0 * t15;
-  const double t17 = 0.5 * gam[1];
-  const double t18 = 0.28867513459481292 * gam[4];
-  const double t19 = t17 - t18;
-  const double t20 = h * t19;
-  const double t21 = 2.0 * t20;
-  const double t22 = t1 + t21;
-  const double t23 = 0.28867513459481292 * gam[1];
-  const double t24 = 0.12909944487358055 * gam[7];
-  const double t25 = t23 - t24;
-  const double t26 = h * t25;
-  const double t27 = 2.0 * t26;
-  const double t28 = 0.12909944487358055 * gam[4];
-  const double t29 = h * t28;
-  const double t30 = 2.0 * t29;
-  const double t31 = 0.5 * gam[2];
-  const double t32 = 0.28867513459481292 * gam[5];
-  const double t33 = t31 - t32;
-  const double t34 = h * t33;
-  const double t35 = 2.0 * t34;
-  const double t36 = t0 + t35;
-  const double t37 = 0.28867513459481292 * gam[2];
-  const double t38 = 0.12909944487358055 * gam[8];
-  const double t39 = t37 - t38;
-  const double t40 = h * t39;
-  const double t41 = 2.0 * t40;
-  const double t42 = 0.12909944487358055 * gam[5];
-  const double t43 = h * t42;
-  const double t44 = 2.0 * t43;
-  /* multiplier system A lambda = r */
-  const double t45 = t8 * t8;
-  const double t46 = t22 * t22;
-  const double t47 = t45 + t46;
-  const double t48 = t36 * t36;
-  const double t49 = t47 + t48;
-  const double t50 = 0.5 * t49;
-  const double t51 = h * t50;
-  const double t52 = 0.5 * t36;
-  const double t53 = t40 * 0.57735026918962584;
-  const double t54 = t52 + t53;
-  const double t55 = h * t54;
-  const double t56 = t8 * p0[0] /* p_x */;
-  const double t57 = t22 * p0[1] /* p_y */;
-  const double t58 = t56 + t57;
-  const double t59 = t36 * p0[2] /* p_z */;
-  const double t60 = t58 + t59;
-  const double t61 = t60 - t55;
-  const double t62 = t61 + g0[0];
-  const double t63 = t62 / t51;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t64 = t8 * t63;
-  const double t65 = t22 * t63;
-  const double t66 = t36 * t63;
-  const double t67 = 1.0 + t66;
-  const double t68 = t13 * t63;
-  const double t69 = t27 * t63;
-  const double t70 = t41 * t63;
-  const double t71 = t16 * t63;
-  const double t72 = t30 * t63;
-  const double t73 = t44 * t63;
-  const double t74 = 0.5 * t64;
-  const double t75 = 0.28867513459481292 * t68;
-  const double t76 = t74 - t75;
-  const double t77 = h * t76;
-  const double t78 = p0[0] /* p_x */ - t77;
-  const double t79 = 0.5 * t65;
-  const double t80 = 0.28867513459481292 * t69;
-  const double t81 = t79 - t80;
-  const double t82 = h * t81;
-  const double t83 = p0[1] /* p_y */ - t82;
-  const double t84 = 0.5 * t67;
-  const double t85 = 0.28867513459481292 * t70;
-  const double t86 = t84 - t85;
-  const double t87 = h * t86;
-  const double t88 = p0[2] /* p_z */ - t87;
-  const double t89 = 0.28867513459481292 * t64;
-  const double t90 = 0.12909944487358055 * t71;
-  const double t91 = t89 - t90;
-  const double t92 = h * t91;
-  const double t93 = -t92;
-  const double t94 = 0.28867513459481292 * t65;
-  const double t95 = 0.12909944487358055 * t72;
-  const double t96 = t94 - t95;
-  const double t97 = h * t96;
-  const double t98 = -t97;
-  const double t99 = 0.28867513459481292 * t67;
-  const double t100 = 0.12909944487358055 * t73;
-  const double t101 = t99 - t100;
-  const double t102 = h * t101;
-  const double t103 = -t102;
-  const double t104 = 0.12909944487358055 * t68;
-  const double t105 = h * t104;
-  const double t106 = -t105;
-  const double t107 = 0.12909944487358055 * t69;
-  const double t108 = h * t107;
-  const double t109 = -t108;
-  const double t110 = 0.12909944487358055 * t70;
-  const double t111 = h * t110;
-  const double t112 = -t111;
-  const double t113 = h * t64;
-  const double t114 = -t113;
-  const double t115 = h * t65;
-  const double t116 = -t115;
-  const double t117 = h * t67;
-  const double t118 = -t117;
-  /* gam */
-  out[0] = t78;
-  out[1] = t83;
-  out[2] = t88;
-  out[3] = t93;
-  out[4] = t98;
-  out[5] = t103;
-  out[6] = t106;
-  out[7] = t109;
-  out[8] = t112;
-  /* dp */
-  out[9] = t114;
-  out[10] = t116;
-  out[11] = t118;
-  /* lambda */
-  out[12] = t63;
-  /* pivot */
-  out[13] = t51;
-  /* adiag */
-  out[14] = t51;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void conical_k3s3_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k3s3_params *prm, double *out)
@@ -351,14 +201,14 @@ void conical_k3s3_init_params(conical_k3s3_state *x, const conical_k3s3_real *q0
 {
   int i;
   conical_k3s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < conical_k3s3_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k3s3_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k3s3_NU ? conical_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[conical_k3s3_NU];
     conical_k3s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -403,8 +253,9 @@ void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params 
   conical_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k3s3_predict(const conical_k3s3_state *x, double h, const conical_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -450,29 +301,204 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical
    * cannot drift; below conical_k3s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < conical_k3s3_NU; i++) g0[i] = fabs(g0[i]) <= conical_k3s3_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7], gm8 = gam[8];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
   for (it = 1; it <= conical_k3s3_MAXITER; it++) {
-    conical_k3s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[2] /* z */;
+      const double t1 = 2.0 * x->q[1] /* y */;
+      const double t2 = 2.0 * x->q[0] /* x */;
+      const double t3 = gm0 * 0.5;
+      const double t4 = gm3 * 0.28867513459481292;
+      const double t5 = t3 - t4;
+      const double t6 = h * t5;
+      const double t7 = 2.0 * t6;
+      const double t8 = t2 + t7;
+      const double t9 = gm0 * 0.28867513459481292;
+      const double t10 = gm6 * 0.12909944487358055;
+      const double t11 = t9 - t10;
+      const double t12 = h * t11;
+      const double t13 = 2.0 * t12;
+      const double t14 = gm3 * 0.12909944487358055;
+      const double t15 = h * t14;
+      const double t16 = 2.0 * t15;
+      const double t17 = 0.5 * gm1;
+      const double t18 = 0.28867513459481292 * gm4;
+      const double t19 = t17 - t18;
+      const double t20 = h * t19;
+      const double t21 = 2.0 * t20;
+      const double t22 = t1 + t21;
+      const double t23 = 0.28867513459481292 * gm1;
+      const double t24 = 0.12909944487358055 * gm7;
+      const double t25 = t23 - t24;
+      const double t26 = h * t25;
+      const double t27 = 2.0 * t26;
+      const double t28 = 0.12909944487358055 * gm4;
+      const double t29 = h * t28;
+      const double t30 = 2.0 * t29;
+      const double t31 = 0.5 * gm2;
+      const double t32 = 0.28867513459481292 * gm5;
+      const double t33 = t31 - t32;
+      const double t34 = h * t33;
+      const double t35 = 2.0 * t34;
+      const double t36 = t0 + t35;
+      const double t37 = 0.28867513459481292 * gm2;
+      const double t38 = 0.12909944487358055 * gm8;
+      const double t39 = t37 - t38;
+      const double t40 = h * t39;
+      const double t41 = 2.0 * t40;
+      const double t42 = 0.12909944487358055 * gm5;
+      const double t43 = h * t42;
+      const double t44 = 2.0 * t43;
+      /* multiplier system A lambda = r */
+      const double t45 = t8 * t8;
+      const double t46 = t22 * t22;
+      const double t47 = t45 + t46;
+      const double t48 = t36 * t36;
+      const double t49 = t47 + t48;
+      const double t50 = 0.5 * t49;
+      const double t51 = h * t50;
+      const double t52 = 0.5 * t36;
+      const double t53 = t40 * 0.57735026918962584;
+      const double t54 = t52 + t53;
+      const double t55 = h * t54;
+      const double t56 = t8 * x->p[0] /* p_x */;
+      const double t57 = t22 * x->p[1] /* p_y */;
+      const double t58 = t56 + t57;
+      const double t59 = t36 * x->p[2] /* p_z */;
+      const double t60 = t58 + t59;
+      const double t61 = t60 - t55;
+      const double t62 = t61 + g0[0];
+      const double t63 = t62 / t51;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t64 = t8 * t63;
+      const double t65 = t22 * t63;
+      const double t66 = t36 * t63;
+      const double t67 = 1.0 + t66;
+      const double t68 = t13 * t63;
+      const double t69 = t27 * t63;
+      const double t70 = t41 * t63;
+      const double t71 = t16 * t63;
+      const double t72 = t30 * t63;
+      const double t73 = t44 * t63;
+      const double t74 = 0.5 * t64;
+      const double t75 = 0.28867513459481292 * t68;
+      const double t76 = t74 - t75;
+      const double t77 = h * t76;
+      const double t78 = x->p[0] /* p_x */ - t77;
+      const double t79 = 0.5 * t65;
+      const double t80 = 0.28867513459481292 * t69;
+      const double t81 = t79 - t80;
+      const double t82 = h * t81;
+      const double t83 = x->p[1] /* p_y */ - t82;
+      const double t84 = 0.5 * t67;
+      const double t85 = 0.28867513459481292 * t70;
+      const double t86 = t84 - t85;
+      const double t87 = h * t86;
+      const double t88 = x->p[2] /* p_z */ - t87;
+      const double t89 = 0.28867513459481292 * t64;
+      const double t90 = 0.12909944487358055 * t71;
+      const double t91 = t89 - t90;
+      const double t92 = h * t91;
+      const double t93 = -t92;
+      const double t94 = 0.28867513459481292 * t65;
+      const double t95 = 0.12909944487358055 * t72;
+      const double t96 = t94 - t95;
+      const double t97 = h * t96;
+      const double t98 = -t97;
+      const double t99 = 0.28867513459481292 * t67;
+      const double t100 = 0.12909944487358055 * t73;
+      const double t101 = t99 - t100;
+      const double t102 = h * t101;
+      const double t103 = -t102;
+      const double t104 = 0.12909944487358055 * t68;
+      const double t105 = h * t104;
+      const double t106 = -t105;
+      const double t107 = 0.12909944487358055 * t69;
+      const double t108 = h * t107;
+      const double t109 = -t108;
+      const double t110 = 0.12909944487358055 * t70;
+      const double t111 = h * t110;
+      const double t112 = -t111;
+      const double t113 = h * t64;
+      const double t114 = -t113;
+      const double t115 = h * t65;
+      const double t116 = -t115;
+      const double t117 = h * t67;
+      const double t118 = -t117;
+      /* gam */
+      sw0 = t78;
+      sw1 = t83;
+      sw2 = t88;
+      sw3 = t93;
+      sw4 = t98;
+      sw5 = t103;
+      sw6 = t106;
+      sw7 = t109;
+      sw8 = t112;
+      /* dp */
+      sw9 = t114;
+      sw10 = t116;
+      sw11 = t118;
+      /* lambda */
+      sw12 = t63;
+      /* pivot */
+      sw13 = t51;
+      /* adiag */
+      sw14 = t51;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < conical_k3s3_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
+      v = fabs(h * (sw6 - gm6));
+      if (v > inc) inc = v;
+      gm6 = sw6;
+      v = fabs(h * (sw7 - gm7));
+      if (v > inc) inc = v;
+      gm7 = sw7;
+      v = fabs(h * (sw8 - gm8));
+      if (v > inc) inc = v;
+      gm8 = sw8;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_k3s3_NU; i++) {
-      double piv = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU + i], dia = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 2 * conical_k3s3_NU + i];
+    {
+      double piv = sw13, dia = sw14;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k3s3_SINGTOL * fabs(dia))) rc = conical_k3s3_ESINGULAR;
     }
     if (rc == conical_k3s3_ESINGULAR) break;
-    for (i = 0; i < conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU; i++)
-      if (!isfinite(sw[i])) rc = conical_k3s3_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9) || !isfinite(sw10) || !isfinite(sw11) ||
+        !isfinite(sw12)) rc = conical_k3s3_ENONFINITE;
     if (rc == conical_k3s3_ENONFINITE || !isfinite(inc)) { rc = conical_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k3s3_TOL / 256), or
      * within 2 ulps (conical_k3s3_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -491,6 +517,30 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  gam[6] = gm6;
+  gam[7] = gm7;
+  gam[8] = gm8;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
   if (st) { st->iters = it > conical_k3s3_MAXITER ? conical_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != conical_k3s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k3s3_ENONFINITE;
@@ -503,8 +553,12 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical
     conical_k3s3_add(&x->p[i], &x->pc[i], sw[conical_k3s3_S * conical_k3s3_M + i]);
   }
   for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + i];
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k3s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return conical_k3s3_OK;
 }

@@ -45,192 +45,6 @@ static const double conical_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.416407864
 static const double conical_k4s4_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k4s4_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void conical_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const conical_k4s4_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
-  const double t3 = gam[0] * 0.5;
-  const double t4 = gam[3] * 0.28867513459481292;
-  const double t5 = t3 - t4;
-  const double t6 = h * t5;
-  const double t7 = 2.0 * t6;
-  const double t8 = t2 + t7;
-  const double t9 = gam[0] * 0.28867513459481292;
-  const double t10 = gam[6] * 0.12909944487358055;
-  const double t11 = t9 - t10;
-  const double t12 = h * t11;
-  const double t13 = 2.0 * t12;
-  const double t14 = gam[3] * 0.12909944487358055;
-  const double t15 = gam[9] * 0.084515425472851652;
-  const double t16 = t14 - t15;
-  const double t17 = h * t16;
-  const double t18 = 2.0 * t17;
-  const double t19 = gam[6] * 0.084515425472851652;
-  const double t20 = h * t19;
-  const double t21 = 2.0 * t20;
-  const double t22 = 0.5 * gam[1];
-  const double t23 = 0.28867513459481292 * gam[4];
-  const double t24 = t22 - t23;
-  const double t25 = h * t24;
-  const double t26 = 2.0 * t25;
-  const double t27 = t1 + t26;
-  const double t28 = 0.28867513459481292 * gam[1];
-  const double t29 = 0.12909944487358055 * gam[7];
-  const double t30 = t28 - t29;
-  const double t31 = h * t30;
-  const double t32 = 2.0 * t31;
-  const double t33 = 0.12909944487358055 * gam[4];
-  const double t34 = 0.084515425472851652 * gam[10];
-  const double t35 = t33 - t34;
-  const double t36 = h * t35;
-  const double t37 = 2.0 * t36;
-  const double t38 = 0.084515425472851652 * gam[7];
-  const double t39 = h * t38;
-  const double t40 = 2.0 * t39;
-  const double t41 = 0.5 * gam[2];
-  const double t42 = 0.28867513459481292 * gam[5];
-  const double t43 = t41 - t42;
-  const double t44 = h * t43;
-  const double t45 = 2.0 * t44;
-  const double t46 = t0 + t45;
-  const double t47 = 0.28867513459481292 * gam[2];
-  const double t48 = 0.12909944487358055 * gam[8];
-  const double t49 = t47 - t48;
-  const double t50 = h * t49;
-  const double t51 = 2.0 * t50;
-  const double t52 = 0.12909944487358055 * gam[5];
-  const double t53 = 0.084515425472851652 * gam[11];
-  const double t54 = t52 - t53;
-  const double t55 = h * t54;
-  const double t56 = 2.0 * t55;
-  const double t57 = 0.084515425472851652 * gam[8];
-  const double t58 = h * t57;
-  const double t59 = 2.0 * t58;
-  /* multiplier system A lambda = r */
-  const double t60 = t8 * t8;
-  const double t61 = t27 * t27;
-  const double t62 = t60 + t61;
-  const double t63 = t46 * t46;
-  const double t64 = t62 + t63;
-  const double t65 = 0.5 * t64;
-  const double t66 = h * t65;
-  const double t67 = 0.5 * t46;
-  const double t68 = t50 * 0.57735026918962584;
-  const double t69 = t67 + t68;
-  const double t70 = h * t69;
-  const double t71 = t8 * p0[0] /* p_x */;
-  const double t72 = t27 * p0[1] /* p_y */;
-  const double t73 = t71 + t72;
-  const double t74 = t46 * p0[2] /* p_z */;
-  const double t75 = t73 + t74;
-  const double t76 = t75 - t70;
-  const double t77 = t76 + g0[0];
-  const double t78 = t77 / t66;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t79 = t8 * t78;
-  const double t80 = t27 * t78;
-  const double t81 = t46 * t78;
-  const double t82 = 1.0 + t81;
-  const double t83 = t13 * t78;
-  const double t84 = t32 * t78;
-  const double t85 = t51 * t78;
-  const double t86 = t18 * t78;
-  const double t87 = t37 * t78;
-  const double t88 = t56 * t78;
-  const double t89 = t21 * t78;
-  const double t90 = t40 * t78;
-  const double t91 = t59 * t78;
-  const double t92 = 0.5 * t79;
-  const double t93 = 0.28867513459481292 * t83;
-  const double t94 = t92 - t93;
-  const double t95 = h * t94;
-  const double t96 = p0[0] /* p_x */ - t95;
-  const double t97 = 0.5 * t80;
-  const double t98 = 0.28867513459481292 * t84;
-  const double t99 = t97 - t98;
-  const double t100 = h * t99;
-  const double t101 = p0[1] /* p_y */ - t100;
-  const double t102 = 0.5 * t82;
-  const double t103 = 0.28867513459481292 * t85;
-  const double t104 = t102 - t103;
-  const double t105 = h * t104;
-  const double t106 = p0[2] /* p_z */ - t105;
-  const double t107 = 0.28867513459481292 * t79;
-  const double t108 = 0.12909944487358055 * t86;
-  const double t109 = t107 - t108;
-  const double t110 = h * t109;
-  const double t111 = -t110;
-  const double t112 = 0.28867513459481292 * t80;
-  const double t113 = 0.12909944487358055 * t87;
-  const double t114 = t112 - t113;
-  const double t115 = h * t114;
-  const double t116 = -t115;
-  const double t117 = 0.28867513459481292 * t82;
-  const double t118 = 0.12909944487358055 * t88;
-  const double t119 = t117 - t118;
-  const double t120 = h * t119;
-  const double t121 = -t120;
-  const double t122 = 0.12909944487358055 * t83;
-  const double t123 = 0.084515425472851652 * t89;
-  const double t124 = t122 - t123;
-  const double t125 = h * t124;
-  const double t126 = -t125;
-  const double t127 = 0.12909944487358055 * t84;
-  const double t128 = 0.084515425472851652 * t90;
-  const double t129 = t127 - t128;
-  const double t130 = h * t129;
-  const double t131 = -t130;
-  const double t132 = 0.12909944487358055 * t85;
-  const double t133 = 0.084515425472851652 * t91;
-  const double t134 = t132 - t133;
-  const double t135 = h * t134;
-  const double t136 = -t135;
-  const double t137 = 0.084515425472851652 * t86;
-  const double t138 = h * t137;
-  const double t139 = -t138;
-  const double t140 = 0.084515425472851652 * t87;
-  const double t141 = h * t140;
-  const double t142 = -t141;
-  const double t143 = 0.084515425472851652 * t88;
-  const double t144 = h * t143;
-  const double t145 = -t144;
-  const double t146 = h * t79;
-  const double t147 = -t146;
-  const double t148 = h * t80;
-  const double t149 = -t148;
-  const double t150 = h * t82;
-  const double t151 = -t150;
-  /* gam */
-  out[0] = t96;
-  out[1] = t101;
-  out[2] = t106;
-  out[3] = t111;
-  out[4] = t116;
-  out[5] = t121;
-  out[6] = t126;
-  out[7] = t131;
-  out[8] = t136;
-  out[9] = t139;
-  out[10] = t142;
-  out[11] = t145;
-  /* dp */
-  out[12] = t147;
-  out[13] = t149;
-  out[14] = t151;
-  /* lambda */
-  out[15] = t78;
-  /* pivot */
-  out[16] = t66;
-  /* adiag */
-  out[17] = t66;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void conical_k4s4_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k4s4_params *prm, double *out)
@@ -388,14 +202,14 @@ void conical_k4s4_init_params(conical_k4s4_state *x, const conical_k4s4_real *q0
 {
   int i;
   conical_k4s4_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < conical_k4s4_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k4s4_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k4s4_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k4s4_NU ? conical_k4s4_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[conical_k4s4_NU];
     conical_k4s4_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -440,8 +254,9 @@ void conical_k4s4_hidden(const conical_k4s4_state *x, const conical_k4s4_params 
   conical_k4s4_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void conical_k4s4_predict(const conical_k4s4_state *x, double h, const conical_k4s4_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -487,29 +302,250 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h_, const conical
    * cannot drift; below conical_k4s4_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < conical_k4s4_NU; i++) g0[i] = fabs(g0[i]) <= conical_k4s4_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7], gm8 = gam[8], gm9 = gam[9], gm10 = gam[10], gm11 = gam[11];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
+    sw16 = 0, sw17 = 0;
   for (it = 1; it <= conical_k4s4_MAXITER; it++) {
-    conical_k4s4_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[2] /* z */;
+      const double t1 = 2.0 * x->q[1] /* y */;
+      const double t2 = 2.0 * x->q[0] /* x */;
+      const double t3 = gm0 * 0.5;
+      const double t4 = gm3 * 0.28867513459481292;
+      const double t5 = t3 - t4;
+      const double t6 = h * t5;
+      const double t7 = 2.0 * t6;
+      const double t8 = t2 + t7;
+      const double t9 = gm0 * 0.28867513459481292;
+      const double t10 = gm6 * 0.12909944487358055;
+      const double t11 = t9 - t10;
+      const double t12 = h * t11;
+      const double t13 = 2.0 * t12;
+      const double t14 = gm3 * 0.12909944487358055;
+      const double t15 = gm9 * 0.084515425472851652;
+      const double t16 = t14 - t15;
+      const double t17 = h * t16;
+      const double t18 = 2.0 * t17;
+      const double t19 = gm6 * 0.084515425472851652;
+      const double t20 = h * t19;
+      const double t21 = 2.0 * t20;
+      const double t22 = 0.5 * gm1;
+      const double t23 = 0.28867513459481292 * gm4;
+      const double t24 = t22 - t23;
+      const double t25 = h * t24;
+      const double t26 = 2.0 * t25;
+      const double t27 = t1 + t26;
+      const double t28 = 0.28867513459481292 * gm1;
+      const double t29 = 0.12909944487358055 * gm7;
+      const double t30 = t28 - t29;
+      const double t31 = h * t30;
+      const double t32 = 2.0 * t31;
+      const double t33 = 0.12909944487358055 * gm4;
+      const double t34 = 0.084515425472851652 * gm10;
+      const double t35 = t33 - t34;
+      const double t36 = h * t35;
+      const double t37 = 2.0 * t36;
+      const double t38 = 0.084515425472851652 * gm7;
+      const double t39 = h * t38;
+      const double t40 = 2.0 * t39;
+      const double t41 = 0.5 * gm2;
+      const double t42 = 0.28867513459481292 * gm5;
+      const double t43 = t41 - t42;
+      const double t44 = h * t43;
+      const double t45 = 2.0 * t44;
+      const double t46 = t0 + t45;
+      const double t47 = 0.28867513459481292 * gm2;
+      const double t48 = 0.12909944487358055 * gm8;
+      const double t49 = t47 - t48;
+      const double t50 = h * t49;
+      const double t51 = 2.0 * t50;
+      const double t52 = 0.12909944487358055 * gm5;
+      const double t53 = 0.084515425472851652 * gm11;
+      const double t54 = t52 - t53;
+      const double t55 = h * t54;
+      const double t56 = 2.0 * t55;
+      const double t57 = 0.084515425472851652 * gm8;
+      const double t58 = h * t57;
+      const double t59 = 2.0 * t58;
+      /* multiplier system A lambda = r */
+      const double t60 = t8 * t8;
+      const double t61 = t27 * t27;
+      const double t62 = t60 + t61;
+      const double t63 = t46 * t46;
+      const double t64 = t62 + t63;
+      const double t65 = 0.5 * t64;
+      const double t66 = h * t65;
+      const double t67 = 0.5 * t46;
+      const double t68 = t50 * 0.57735026918962584;
+      const double t69 = t67 + t68;
+      const double t70 = h * t69;
+      const double t71 = t8 * x->p[0] /* p_x */;
+      const double t72 = t27 * x->p[1] /* p_y */;
+      const double t73 = t71 + t72;
+      const double t74 = t46 * x->p[2] /* p_z */;
+      const double t75 = t73 + t74;
+      const double t76 = t75 - t70;
+      const double t77 = t76 + g0[0];
+      const double t78 = t77 / t66;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t79 = t8 * t78;
+      const double t80 = t27 * t78;
+      const double t81 = t46 * t78;
+      const double t82 = 1.0 + t81;
+      const double t83 = t13 * t78;
+      const double t84 = t32 * t78;
+      const double t85 = t51 * t78;
+      const double t86 = t18 * t78;
+      const double t87 = t37 * t78;
+      const double t88 = t56 * t78;
+      const double t89 = t21 * t78;
+      const double t90 = t40 * t78;
+      const double t91 = t59 * t78;
+      const double t92 = 0.5 * t79;
+      const double t93 = 0.28867513459481292 * t83;
+      const double t94 = t92 - t93;
+      const double t95 = h * t94;
+      const double t96 = x->p[0] /* p_x */ - t95;
+      const double t97 = 0.5 * t80;
+      const double t98 = 0.28867513459481292 * t84;
+      const double t99 = t97 - t98;
+      const double t100 = h * t99;
+      const double t101 = x->p[1] /* p_y */ - t100;
+      const double t102 = 0.5 * t82;
+      const double t103 = 0.28867513459481292 * t85;
+      const double t104 = t102 - t103;
+      const double t105 = h * t104;
+      const double t106 = x->p[2] /* p_z */ - t105;
+      const double t107 = 0.28867513459481292 * t79;
+      const double t108 = 0.12909944487358055 * t86;
+      const double t109 = t107 - t108;
+      const double t110 = h * t109;
+      const double t111 = -t110;
+      const double t112 = 0.28867513459481292 * t80;
+      const double t113 = 0.12909944487358055 * t87;
+      const double t114 = t112 - t113;
+      const double t115 = h * t114;
+      const double t116 = -t115;
+      const double t117 = 0.28867513459481292 * t82;
+      const double t118 = 0.12909944487358055 * t88;
+      const double t119 = t117 - t118;
+      const double t120 = h * t119;
+      const double t121 = -t120;
+      const double t122 = 0.12909944487358055 * t83;
+      const double t123 = 0.084515425472851652 * t89;
+      const double t124 = t122 - t123;
+      const double t125 = h * t124;
+      const double t126 = -t125;
+      const double t127 = 0.12909944487358055 * t84;
+      const double t128 = 0.084515425472851652 * t90;
+      const double t129 = t127 - t128;
+      const double t130 = h * t129;
+      const double t131 = -t130;
+      const double t132 = 0.12909944487358055 * t85;
+      const double t133 = 0.084515425472851652 * t91;
+      const double t134 = t132 - t133;
+      const double t135 = h * t134;
+      const double t136 = -t135;
+      const double t137 = 0.084515425472851652 * t86;
+      const double t138 = h * t137;
+      const double t139 = -t138;
+      const double t140 = 0.084515425472851652 * t87;
+      const double t141 = h * t140;
+      const double t142 = -t141;
+      const double t143 = 0.084515425472851652 * t88;
+      const double t144 = h * t143;
+      const double t145 = -t144;
+      const double t146 = h * t79;
+      const double t147 = -t146;
+      const double t148 = h * t80;
+      const double t149 = -t148;
+      const double t150 = h * t82;
+      const double t151 = -t150;
+      /* gam */
+      sw0 = t96;
+      sw1 = t101;
+      sw2 = t106;
+      sw3 = t111;
+      sw4 = t116;
+      sw5 = t121;
+      sw6 = t126;
+      sw7 = t131;
+      sw8 = t136;
+      sw9 = t139;
+      sw10 = t142;
+      sw11 = t145;
+      /* dp */
+      sw12 = t147;
+      sw13 = t149;
+      sw14 = t151;
+      /* lambda */
+      sw15 = t78;
+      /* pivot */
+      sw16 = t66;
+      /* adiag */
+      sw17 = t66;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < conical_k4s4_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
+      v = fabs(h * (sw6 - gm6));
+      if (v > inc) inc = v;
+      gm6 = sw6;
+      v = fabs(h * (sw7 - gm7));
+      if (v > inc) inc = v;
+      gm7 = sw7;
+      v = fabs(h * (sw8 - gm8));
+      if (v > inc) inc = v;
+      gm8 = sw8;
+      v = fabs(h * (sw9 - gm9));
+      if (v > inc) inc = v;
+      gm9 = sw9;
+      v = fabs(h * (sw10 - gm10));
+      if (v > inc) inc = v;
+      gm10 = sw10;
+      v = fabs(h * (sw11 - gm11));
+      if (v > inc) inc = v;
+      gm11 = sw11;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_k4s4_NU; i++) {
-      double piv = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + conical_k4s4_NU + i], dia = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + 2 * conical_k4s4_NU + i];
+    {
+      double piv = sw16, dia = sw17;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k4s4_SINGTOL * fabs(dia))) rc = conical_k4s4_ESINGULAR;
     }
     if (rc == conical_k4s4_ESINGULAR) break;
-    for (i = 0; i < conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + conical_k4s4_NU; i++)
-      if (!isfinite(sw[i])) rc = conical_k4s4_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9) || !isfinite(sw10) || !isfinite(sw11) ||
+        !isfinite(sw12) || !isfinite(sw13) || !isfinite(sw14) || !isfinite(sw15)) rc = conical_k4s4_ENONFINITE;
     if (rc == conical_k4s4_ENONFINITE || !isfinite(inc)) { rc = conical_k4s4_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k4s4_TOL / 256), or
      * within 2 ulps (conical_k4s4_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -528,6 +564,36 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h_, const conical
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  gam[6] = gm6;
+  gam[7] = gm7;
+  gam[8] = gm8;
+  gam[9] = gm9;
+  gam[10] = gm10;
+  gam[11] = gm11;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
+  sw[15] = sw15;
+  sw[16] = sw16;
+  sw[17] = sw17;
   if (st) { st->iters = it > conical_k4s4_MAXITER ? conical_k4s4_MAXITER : it; st->increment = inc; }
   if (rc != conical_k4s4_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k4s4_ENONFINITE;
@@ -540,8 +606,12 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h_, const conical
     conical_k4s4_add(&x->p[i], &x->pc[i], sw[conical_k4s4_S * conical_k4s4_M + i]);
   }
   for (i = 0; i < conical_k4s4_NU; i++) x->lambda[i] = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + i];
-  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   conical_k4s4_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return conical_k4s4_OK;
 }

@@ -39,213 +39,12 @@
 static const double conical_poly_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double conical_poly_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double conical_poly_k2s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double conical_poly_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_poly_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
-
-/* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
-static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* grad g at the stages */
-  const double t0 = gam[0] * 0.21132486540518713;
-  const double t1 = gam[3] * (-0.28867513459481292);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = q0[0] /* x */ + t3;
-  const double t5 = gam[1] * 0.21132486540518713;
-  const double t6 = gam[4] * (-0.28867513459481292);
-  const double t7 = t5 + t6;
-  const double t8 = h * t7;
-  const double t9 = q0[1] /* y */ + t8;
-  const double t10 = gam[2] * 0.21132486540518713;
-  const double t11 = gam[5] * (-0.28867513459481292);
-  const double t12 = t10 + t11;
-  const double t13 = h * t12;
-  const double t14 = q0[2] /* z */ + t13;
-  const double t15 = 2.0 * t14;
-  const double t16 = 2.0 * t9;
-  const double t17 = 2.0 * t4;
-  const double t18 = gam[0] * 0.78867513459481287;
-  const double t19 = t1 + t18;
-  const double t20 = h * t19;
-  const double t21 = q0[0] /* x */ + t20;
-  const double t22 = gam[1] * 0.78867513459481287;
-  const double t23 = t6 + t22;
-  const double t24 = h * t23;
-  const double t25 = q0[1] /* y */ + t24;
-  const double t26 = gam[2] * 0.78867513459481287;
-  const double t27 = t11 + t26;
-  const double t28 = h * t27;
-  const double t29 = q0[2] /* z */ + t28;
-  const double t30 = 2.0 * t29;
-  const double t31 = 2.0 * t25;
-  const double t32 = 2.0 * t21;
-  /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-  const double t33 = (-0.99999999999999989) * lam[1];
-  const double t34 = lam[0] + t33;
-  const double t35 = t17 * t34;
-  const double t36 = t16 * t34;
-  const double t37 = t15 * t34;
-  const double t38 = 0.5 * t35;
-  const double t39 = 0.5 * t36;
-  const double t40 = 0.5 * t37;
-  const double t41 = 1.0 + t40;
-  const double t42 = (-0.49999999999999994) * t35;
-  const double t43 = (-0.49999999999999994) * t36;
-  const double t44 = (-0.49999999999999994) * t37;
-  const double t45 = 0.99999999999999989 * lam[1];
-  const double t46 = lam[0] + t45;
-  const double t47 = t32 * t46;
-  const double t48 = t31 * t46;
-  const double t49 = t30 * t46;
-  const double t50 = 0.5 * t47;
-  const double t51 = t38 + t50;
-  const double t52 = 0.5 * t48;
-  const double t53 = t39 + t52;
-  const double t54 = 0.5 * t49;
-  const double t55 = t41 + t54;
-  const double t56 = 0.49999999999999994 * t47;
-  const double t57 = t42 + t56;
-  const double t58 = 0.49999999999999994 * t48;
-  const double t59 = t43 + t58;
-  const double t60 = 0.49999999999999994 * t49;
-  const double t61 = t44 + t60;
-  const double t62 = 0.5 * t51;
-  const double t63 = 0.28867513459481292 * t57;
-  const double t64 = t62 - t63;
-  const double t65 = h * t64;
-  const double t66 = p0[0] /* p_x */ - t65;
-  const double t67 = 0.5 * t53;
-  const double t68 = 0.28867513459481292 * t59;
-  const double t69 = t67 - t68;
-  const double t70 = h * t69;
-  const double t71 = p0[1] /* p_y */ - t70;
-  const double t72 = 0.5 * t55;
-  const double t73 = 0.28867513459481292 * t61;
-  const double t74 = t72 - t73;
-  const double t75 = h * t74;
-  const double t76 = p0[2] /* p_z */ - t75;
-  const double t77 = 0.28867513459481292 * t51;
-  const double t78 = h * t77;
-  const double t79 = 0.28867513459481292 * t53;
-  const double t80 = h * t79;
-  const double t81 = 0.28867513459481292 * t55;
-  const double t82 = h * t81;
-  const double t83 = (-0.99999999999999989) * t78;
-  const double t84 = t66 - t83;
-  const double t85 = (-0.99999999999999989) * t80;
-  const double t86 = t71 - t85;
-  const double t87 = (-0.99999999999999989) * t82;
-  const double t88 = t76 - t87;
-  const double t89 = t17 * t84;
-  const double t90 = t16 * t86;
-  const double t91 = t89 + t90;
-  const double t92 = t15 * t88;
-  const double t93 = t91 + t92;
-  const double t94 = 0.5 * t93;
-  const double t95 = (-0.49999999999999994) * t93;
-  const double t96 = 0.99999999999999989 * t78;
-  const double t97 = t66 - t96;
-  const double t98 = 0.99999999999999989 * t80;
-  const double t99 = t71 - t98;
-  const double t100 = 0.99999999999999989 * t82;
-  const double t101 = t76 - t100;
-  const double t102 = t32 * t97;
-  const double t103 = t31 * t99;
-  const double t104 = t102 + t103;
-  const double t105 = t30 * t101;
-  const double t106 = t104 + t105;
-  const double t107 = 0.5 * t106;
-  const double t108 = t94 + t107;
-  const double t109 = 0.49999999999999994 * t106;
-  const double t110 = t95 + t109;
-  const double t111 = t108 + g0[0];
-  const double t112 = lu[2] * t111;
-  const double t113 = t110 - t112;
-  const double t114 = lu[3] * t113;
-  const double t115 = lu[1] * t114;
-  const double t116 = t111 - t115;
-  const double t117 = lu[0] * t116;
-  const double t118 = lam[0] + t117;
-  const double t119 = lam[1] + t114;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-  const double t120 = (-0.99999999999999989) * t119;
-  const double t121 = t118 + t120;
-  const double t122 = t17 * t121;
-  const double t123 = t16 * t121;
-  const double t124 = t15 * t121;
-  const double t125 = 0.5 * t122;
-  const double t126 = 0.5 * t123;
-  const double t127 = 0.5 * t124;
-  const double t128 = 1.0 + t127;
-  const double t129 = (-0.49999999999999994) * t122;
-  const double t130 = (-0.49999999999999994) * t123;
-  const double t131 = (-0.49999999999999994) * t124;
-  const double t132 = 0.99999999999999989 * t119;
-  const double t133 = t118 + t132;
-  const double t134 = t32 * t133;
-  const double t135 = t31 * t133;
-  const double t136 = t30 * t133;
-  const double t137 = 0.5 * t134;
-  const double t138 = t125 + t137;
-  const double t139 = 0.5 * t135;
-  const double t140 = t126 + t139;
-  const double t141 = 0.5 * t136;
-  const double t142 = t128 + t141;
-  const double t143 = 0.49999999999999994 * t134;
-  const double t144 = t129 + t143;
-  const double t145 = 0.49999999999999994 * t135;
-  const double t146 = t130 + t145;
-  const double t147 = 0.49999999999999994 * t136;
-  const double t148 = t131 + t147;
-  const double t149 = 0.5 * t138;
-  const double t150 = 0.28867513459481292 * t144;
-  const double t151 = t149 - t150;
-  const double t152 = h * t151;
-  const double t153 = p0[0] /* p_x */ - t152;
-  const double t154 = 0.5 * t140;
-  const double t155 = 0.28867513459481292 * t146;
-  const double t156 = t154 - t155;
-  const double t157 = h * t156;
-  const double t158 = p0[1] /* p_y */ - t157;
-  const double t159 = 0.5 * t142;
-  const double t160 = 0.28867513459481292 * t148;
-  const double t161 = t159 - t160;
-  const double t162 = h * t161;
-  const double t163 = p0[2] /* p_z */ - t162;
-  const double t164 = 0.28867513459481292 * t138;
-  const double t165 = h * t164;
-  const double t166 = -t165;
-  const double t167 = 0.28867513459481292 * t140;
-  const double t168 = h * t167;
-  const double t169 = -t168;
-  const double t170 = 0.28867513459481292 * t142;
-  const double t171 = h * t170;
-  const double t172 = -t171;
-  const double t173 = h * t138;
-  const double t174 = -t173;
-  const double t175 = h * t140;
-  const double t176 = -t175;
-  const double t177 = h * t142;
-  const double t178 = -t177;
-  /* gam */
-  out[0] = t153;
-  out[1] = t158;
-  out[2] = t163;
-  out[3] = t166;
-  out[4] = t169;
-  out[5] = t172;
-  /* dp */
-  out[6] = t174;
-  out[7] = t176;
-  out[8] = t178;
-  /* lam */
-  out[9] = t118;
-  out[10] = t119;
-}
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
  * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU). */
@@ -597,14 +396,14 @@ void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_pol
 {
   int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < conical_poly_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_poly_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : conical_poly_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_poly_k2s2_NU ? conical_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[conical_poly_k2s2_NU];
@@ -650,14 +449,23 @@ void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_po
   conical_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void conical_poly_k2s2_predict(const conical_poly_k2s2_state *x, double h, const conical_poly_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     conical_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < conical_poly_k2s2_S; j++)
+      for (i = 0; i < conical_poly_k2s2_S; i++)
+        for (l = 0; l < conical_poly_k2s2_M; l++)
+          gam[j * conical_poly_k2s2_M + l] += conical_poly_k2s2_E2[2 * conical_poly_k2s2_S * j + i] * x->gam[i * conical_poly_k2s2_M + l] +
+                               conical_poly_k2s2_E2[2 * conical_poly_k2s2_S * j + conical_poly_k2s2_S + i] * x->gam2[i * conical_poly_k2s2_M + l];
     return;
   }
   for (j = 0; j < conical_poly_k2s2_S; j++)
@@ -697,9 +505,8 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
    * cannot drift; below conical_poly_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < conical_poly_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= conical_poly_k2s2_GTOL ? 0 : g0[i] / h;
-  double fa[4 + 2 * conical_poly_k2s2_S * conical_poly_k2s2_NU + 1], lam[conical_poly_k2s2_S * conical_poly_k2s2_NU];
+  double fa[4 + 2 * conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
   int j;
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps
    * (again below when the iteration slows down) */
   conical_poly_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
@@ -708,12 +515,23 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
     if (!isfinite(piv) || !isfinite(dia)) return conical_poly_k2s2_ENONFINITE;
     if (!(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
   }
+  /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0;
+  double lm0 = 0, lm1 = 0;
   for (it = 1; it <= conical_poly_k2s2_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
      * small; where the increments fall by less than 8x it is refreshed at the
      * current gamma, which keeps the iteration converging up to the h of the
      * constant family (pendulum, s = 3: 2.4 instead of 0.84) */
     if (it > 2 && inc > inc_old / 8) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
       conical_poly_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
       for (j = 0; j < conical_poly_k2s2_S * conical_poly_k2s2_NU; j++) {
         double piv = fa[4 + j], dia = fa[4 + conical_poly_k2s2_S * conical_poly_k2s2_NU + j];
@@ -721,24 +539,240 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
         if (!(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
       }
     }
-    conical_poly_k2s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
+    { /* the kernel sweep, inline */
+      /* grad g at the stages */
+      const double t0 = gm0 * 0.21132486540518713;
+      const double t1 = gm3 * (-0.28867513459481292);
+      const double t2 = t0 + t1;
+      const double t3 = h * t2;
+      const double t4 = x->q[0] /* x */ + t3;
+      const double t5 = gm1 * 0.21132486540518713;
+      const double t6 = gm4 * (-0.28867513459481292);
+      const double t7 = t5 + t6;
+      const double t8 = h * t7;
+      const double t9 = x->q[1] /* y */ + t8;
+      const double t10 = gm2 * 0.21132486540518713;
+      const double t11 = gm5 * (-0.28867513459481292);
+      const double t12 = t10 + t11;
+      const double t13 = h * t12;
+      const double t14 = x->q[2] /* z */ + t13;
+      const double t15 = 2.0 * t14;
+      const double t16 = 2.0 * t9;
+      const double t17 = 2.0 * t4;
+      const double t18 = gm0 * 0.78867513459481287;
+      const double t19 = t1 + t18;
+      const double t20 = h * t19;
+      const double t21 = x->q[0] /* x */ + t20;
+      const double t22 = gm1 * 0.78867513459481287;
+      const double t23 = t6 + t22;
+      const double t24 = h * t23;
+      const double t25 = x->q[1] /* y */ + t24;
+      const double t26 = gm2 * 0.78867513459481287;
+      const double t27 = t11 + t26;
+      const double t28 = h * t27;
+      const double t29 = x->q[2] /* z */ + t28;
+      const double t30 = 2.0 * t29;
+      const double t31 = 2.0 * t25;
+      const double t32 = 2.0 * t21;
+      /* the multiplier coefficients: lambda += A^-1 C(lambda) */
+      const double t33 = (-0.99999999999999989) * lm1;
+      const double t34 = lm0 + t33;
+      const double t35 = t17 * t34;
+      const double t36 = t16 * t34;
+      const double t37 = t15 * t34;
+      const double t38 = 0.5 * t35;
+      const double t39 = 0.5 * t36;
+      const double t40 = 0.5 * t37;
+      const double t41 = 1.0 + t40;
+      const double t42 = (-0.49999999999999994) * t35;
+      const double t43 = (-0.49999999999999994) * t36;
+      const double t44 = (-0.49999999999999994) * t37;
+      const double t45 = 0.99999999999999989 * lm1;
+      const double t46 = lm0 + t45;
+      const double t47 = t32 * t46;
+      const double t48 = t31 * t46;
+      const double t49 = t30 * t46;
+      const double t50 = 0.5 * t47;
+      const double t51 = t38 + t50;
+      const double t52 = 0.5 * t48;
+      const double t53 = t39 + t52;
+      const double t54 = 0.5 * t49;
+      const double t55 = t41 + t54;
+      const double t56 = 0.49999999999999994 * t47;
+      const double t57 = t42 + t56;
+      const double t58 = 0.49999999999999994 * t48;
+      const double t59 = t43 + t58;
+      const double t60 = 0.49999999999999994 * t49;
+      const double t61 = t44 + t60;
+      const double t62 = 0.5 * t51;
+      const double t63 = 0.28867513459481292 * t57;
+      const double t64 = t62 - t63;
+      const double t65 = h * t64;
+      const double t66 = x->p[0] /* p_x */ - t65;
+      const double t67 = 0.5 * t53;
+      const double t68 = 0.28867513459481292 * t59;
+      const double t69 = t67 - t68;
+      const double t70 = h * t69;
+      const double t71 = x->p[1] /* p_y */ - t70;
+      const double t72 = 0.5 * t55;
+      const double t73 = 0.28867513459481292 * t61;
+      const double t74 = t72 - t73;
+      const double t75 = h * t74;
+      const double t76 = x->p[2] /* p_z */ - t75;
+      const double t77 = 0.28867513459481292 * t51;
+      const double t78 = h * t77;
+      const double t79 = 0.28867513459481292 * t53;
+      const double t80 = h * t79;
+      const double t81 = 0.28867513459481292 * t55;
+      const double t82 = h * t81;
+      const double t83 = (-0.99999999999999989) * t78;
+      const double t84 = t66 - t83;
+      const double t85 = (-0.99999999999999989) * t80;
+      const double t86 = t71 - t85;
+      const double t87 = (-0.99999999999999989) * t82;
+      const double t88 = t76 - t87;
+      const double t89 = t17 * t84;
+      const double t90 = t16 * t86;
+      const double t91 = t89 + t90;
+      const double t92 = t15 * t88;
+      const double t93 = t91 + t92;
+      const double t94 = 0.5 * t93;
+      const double t95 = (-0.49999999999999994) * t93;
+      const double t96 = 0.99999999999999989 * t78;
+      const double t97 = t66 - t96;
+      const double t98 = 0.99999999999999989 * t80;
+      const double t99 = t71 - t98;
+      const double t100 = 0.99999999999999989 * t82;
+      const double t101 = t76 - t100;
+      const double t102 = t32 * t97;
+      const double t103 = t31 * t99;
+      const double t104 = t102 + t103;
+      const double t105 = t30 * t101;
+      const double t106 = t104 + t105;
+      const double t107 = 0.5 * t106;
+      const double t108 = t94 + t107;
+      const double t109 = 0.49999999999999994 * t106;
+      const double t110 = t95 + t109;
+      const double t111 = t108 + g0[0];
+      const double t112 = fa[2] * t111;
+      const double t113 = t110 - t112;
+      const double t114 = fa[3] * t113;
+      const double t115 = fa[1] * t114;
+      const double t116 = t111 - t115;
+      const double t117 = fa[0] * t116;
+      const double t118 = lm0 + t117;
+      const double t119 = lm1 + t114;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
+      const double t120 = (-0.99999999999999989) * t119;
+      const double t121 = t118 + t120;
+      const double t122 = t17 * t121;
+      const double t123 = t16 * t121;
+      const double t124 = t15 * t121;
+      const double t125 = 0.5 * t122;
+      const double t126 = 0.5 * t123;
+      const double t127 = 0.5 * t124;
+      const double t128 = 1.0 + t127;
+      const double t129 = (-0.49999999999999994) * t122;
+      const double t130 = (-0.49999999999999994) * t123;
+      const double t131 = (-0.49999999999999994) * t124;
+      const double t132 = 0.99999999999999989 * t119;
+      const double t133 = t118 + t132;
+      const double t134 = t32 * t133;
+      const double t135 = t31 * t133;
+      const double t136 = t30 * t133;
+      const double t137 = 0.5 * t134;
+      const double t138 = t125 + t137;
+      const double t139 = 0.5 * t135;
+      const double t140 = t126 + t139;
+      const double t141 = 0.5 * t136;
+      const double t142 = t128 + t141;
+      const double t143 = 0.49999999999999994 * t134;
+      const double t144 = t129 + t143;
+      const double t145 = 0.49999999999999994 * t135;
+      const double t146 = t130 + t145;
+      const double t147 = 0.49999999999999994 * t136;
+      const double t148 = t131 + t147;
+      const double t149 = 0.5 * t138;
+      const double t150 = 0.28867513459481292 * t144;
+      const double t151 = t149 - t150;
+      const double t152 = h * t151;
+      const double t153 = x->p[0] /* p_x */ - t152;
+      const double t154 = 0.5 * t140;
+      const double t155 = 0.28867513459481292 * t146;
+      const double t156 = t154 - t155;
+      const double t157 = h * t156;
+      const double t158 = x->p[1] /* p_y */ - t157;
+      const double t159 = 0.5 * t142;
+      const double t160 = 0.28867513459481292 * t148;
+      const double t161 = t159 - t160;
+      const double t162 = h * t161;
+      const double t163 = x->p[2] /* p_z */ - t162;
+      const double t164 = 0.28867513459481292 * t138;
+      const double t165 = h * t164;
+      const double t166 = -t165;
+      const double t167 = 0.28867513459481292 * t140;
+      const double t168 = h * t167;
+      const double t169 = -t168;
+      const double t170 = 0.28867513459481292 * t142;
+      const double t171 = h * t170;
+      const double t172 = -t171;
+      const double t173 = h * t138;
+      const double t174 = -t173;
+      const double t175 = h * t140;
+      const double t176 = -t175;
+      const double t177 = h * t142;
+      const double t178 = -t177;
+      /* gam */
+      sw0 = t153;
+      sw1 = t158;
+      sw2 = t163;
+      sw3 = t166;
+      sw4 = t169;
+      sw5 = t172;
+      /* dp */
+      sw6 = t174;
+      sw7 = t176;
+      sw8 = t178;
+      /* lam */
+      sw9 = t118;
+      sw10 = t119;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < conical_poly_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + i];
-    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = conical_poly_k2s2_ENONFINITE;
+    lm0 = sw9;
+    lm1 = sw10;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9) || !isfinite(sw10)) rc = conical_poly_k2s2_ENONFINITE;
     if (rc == conical_poly_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_poly_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (conical_poly_k2s2_TOL). Iterating
      * further would not help H, which the rescale keeps (bench/README.md) */
@@ -755,6 +789,23 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
   if (st) { st->iters = it > conical_poly_k2s2_MAXITER ? conical_poly_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != conical_poly_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_poly_k2s2_ENONFINITE;
@@ -795,7 +846,10 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[conical_poly_k2s2_NU];
@@ -803,6 +857,7 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_
     for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   conical_poly_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return conical_poly_k2s2_OK;
 }

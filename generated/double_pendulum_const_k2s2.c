@@ -43,223 +43,6 @@ static const double double_pendulum_const_k2s2_E1[4] = {1.0, 3.4641016151377544,
 static const double double_pendulum_const_k2s2_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_const_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
-  const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
-  const double t2 = 2.0 * q0[1] /* y1 */;
-  const double t3 = 2.0 * q0[0] /* x1 */;
-  const double t4 = 2.0 * t1;
-  const double t5 = 2.0 * t0;
-  const double t6 = 0.5 * gam[0];
-  const double t7 = gam[4] * 0.28867513459481292;
-  const double t8 = t6 - t7;
-  const double t9 = h * t8;
-  const double t10 = 2.0 * t9;
-  const double t11 = t3 + t10;
-  const double t12 = gam[0] * 0.28867513459481292;
-  const double t13 = h * t12;
-  const double t14 = 2.0 * t13;
-  const double t15 = 0.5 * gam[1];
-  const double t16 = 0.28867513459481292 * gam[5];
-  const double t17 = t15 - t16;
-  const double t18 = h * t17;
-  const double t19 = 2.0 * t18;
-  const double t20 = t2 + t19;
-  const double t21 = 0.28867513459481292 * gam[1];
-  const double t22 = h * t21;
-  const double t23 = 2.0 * t22;
-  const double t24 = t10 - t5;
-  const double t25 = 0.5 * gam[2];
-  const double t26 = 0.28867513459481292 * gam[6];
-  const double t27 = t25 - t26;
-  const double t28 = h * t27;
-  const double t29 = (-2.0) * t28;
-  const double t30 = t24 + t29;
-  const double t31 = 0.28867513459481292 * gam[2];
-  const double t32 = h * t31;
-  const double t33 = (-2.0) * t32;
-  const double t34 = t14 + t33;
-  const double t35 = t19 - t4;
-  const double t36 = 0.5 * gam[3];
-  const double t37 = 0.28867513459481292 * gam[7];
-  const double t38 = t36 - t37;
-  const double t39 = h * t38;
-  const double t40 = (-2.0) * t39;
-  const double t41 = t35 + t40;
-  const double t42 = 0.28867513459481292 * gam[3];
-  const double t43 = h * t42;
-  const double t44 = (-2.0) * t43;
-  const double t45 = t23 + t44;
-  const double t46 = t9 * (-2.0);
-  const double t47 = t5 + t46;
-  const double t48 = 2.0 * t28;
-  const double t49 = t47 + t48;
-  const double t50 = t13 * (-2.0);
-  const double t51 = 2.0 * t32;
-  const double t52 = t50 + t51;
-  const double t53 = t18 * (-2.0);
-  const double t54 = t4 + t53;
-  const double t55 = 2.0 * t39;
-  const double t56 = t54 + t55;
-  const double t57 = t22 * (-2.0);
-  const double t58 = 2.0 * t43;
-  const double t59 = t57 + t58;
-  /* multiplier system A lambda = r */
-  const double t60 = t11 * t11;
-  const double t61 = t20 * t20;
-  const double t62 = t60 + t61;
-  const double t63 = 0.5 * t62;
-  const double t64 = h * t63;
-  const double t65 = t11 * t30;
-  const double t66 = t20 * t41;
-  const double t67 = t65 + t66;
-  const double t68 = 0.5 * t67;
-  const double t69 = t11 * t34;
-  const double t70 = t20 * t45;
-  const double t71 = t69 + t70;
-  const double t72 = t14 * t30;
-  const double t73 = t23 * t41;
-  const double t74 = t72 + t73;
-  const double t75 = t74 - t71;
-  const double t76 = 0.28867513459481292 * t75;
-  const double t77 = t68 + t76;
-  const double t78 = h * t77;
-  const double t79 = 0.5 * t20;
-  const double t80 = t22 * 0.57735026918962584;
-  const double t81 = t79 + t80;
-  const double t82 = h * t81;
-  const double t83 = t11 * p0[0] /* p_x1 */;
-  const double t84 = t20 * p0[1] /* p_y1 */;
-  const double t85 = t83 + t84;
-  const double t86 = t85 - t82;
-  const double t87 = t86 + g0[0];
-  const double t88 = t71 - t74;
-  const double t89 = 0.28867513459481292 * t88;
-  const double t90 = t68 + t89;
-  const double t91 = h * t90;
-  const double t92 = t30 * t30;
-  const double t93 = t41 * t41;
-  const double t94 = t92 + t93;
-  const double t95 = t49 * t49;
-  const double t96 = t94 + t95;
-  const double t97 = t56 * t56;
-  const double t98 = t96 + t97;
-  const double t99 = 0.5 * t98;
-  const double t100 = h * t99;
-  const double t101 = t41 + t56;
-  const double t102 = 0.5 * t101;
-  const double t103 = t45 + t59;
-  const double t104 = 0.28867513459481292 * t103;
-  const double t105 = t102 + t104;
-  const double t106 = h * t105;
-  const double t107 = t30 * p0[0] /* p_x1 */;
-  const double t108 = t41 * p0[1] /* p_y1 */;
-  const double t109 = t107 + t108;
-  const double t110 = t49 * p0[2] /* p_x2 */;
-  const double t111 = t109 + t110;
-  const double t112 = t56 * p0[3] /* p_y2 */;
-  const double t113 = t111 + t112;
-  const double t114 = t113 - t106;
-  const double t115 = t114 + g0[1];
-  const double t116 = t91 / t64;
-  const double t117 = t78 * t116;
-  const double t118 = t100 - t117;
-  const double t119 = t87 * t116;
-  const double t120 = t115 - t119;
-  const double t121 = t120 / t118;
-  const double t122 = t78 * t121;
-  const double t123 = t87 - t122;
-  const double t124 = t123 / t64;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t125 = t11 * t124;
-  const double t126 = t20 * t124;
-  const double t127 = 1.0 + t126;
-  const double t128 = t30 * t121;
-  const double t129 = t125 + t128;
-  const double t130 = t41 * t121;
-  const double t131 = t127 + t130;
-  const double t132 = t49 * t121;
-  const double t133 = t56 * t121;
-  const double t134 = 1.0 + t133;
-  const double t135 = t14 * t124;
-  const double t136 = t23 * t124;
-  const double t137 = t34 * t121;
-  const double t138 = t135 + t137;
-  const double t139 = t45 * t121;
-  const double t140 = t136 + t139;
-  const double t141 = t52 * t121;
-  const double t142 = t59 * t121;
-  const double t143 = 0.5 * t129;
-  const double t144 = 0.28867513459481292 * t138;
-  const double t145 = t143 - t144;
-  const double t146 = h * t145;
-  const double t147 = p0[0] /* p_x1 */ - t146;
-  const double t148 = 0.5 * t131;
-  const double t149 = 0.28867513459481292 * t140;
-  const double t150 = t148 - t149;
-  const double t151 = h * t150;
-  const double t152 = p0[1] /* p_y1 */ - t151;
-  const double t153 = 0.5 * t132;
-  const double t154 = 0.28867513459481292 * t141;
-  const double t155 = t153 - t154;
-  const double t156 = h * t155;
-  const double t157 = p0[2] /* p_x2 */ - t156;
-  const double t158 = 0.5 * t134;
-  const double t159 = 0.28867513459481292 * t142;
-  const double t160 = t158 - t159;
-  const double t161 = h * t160;
-  const double t162 = p0[3] /* p_y2 */ - t161;
-  const double t163 = 0.28867513459481292 * t129;
-  const double t164 = h * t163;
-  const double t165 = -t164;
-  const double t166 = 0.28867513459481292 * t131;
-  const double t167 = h * t166;
-  const double t168 = -t167;
-  const double t169 = 0.28867513459481292 * t132;
-  const double t170 = h * t169;
-  const double t171 = -t170;
-  const double t172 = 0.28867513459481292 * t134;
-  const double t173 = h * t172;
-  const double t174 = -t173;
-  const double t175 = h * t129;
-  const double t176 = -t175;
-  const double t177 = h * t131;
-  const double t178 = -t177;
-  const double t179 = h * t132;
-  const double t180 = -t179;
-  const double t181 = h * t134;
-  const double t182 = -t181;
-  /* gam */
-  out[0] = t147;
-  out[1] = t152;
-  out[2] = t157;
-  out[3] = t162;
-  out[4] = t165;
-  out[5] = t168;
-  out[6] = t171;
-  out[7] = t174;
-  /* dp */
-  out[8] = t176;
-  out[9] = t178;
-  out[10] = t180;
-  out[11] = t182;
-  /* lambda */
-  out[12] = t124;
-  out[13] = t121;
-  /* pivot */
-  out[14] = t64;
-  out[15] = t118;
-  /* adiag */
-  out[16] = t64;
-  out[17] = t100;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void double_pendulum_const_k2s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
@@ -505,14 +288,14 @@ void double_pendulum_const_k2s2_init_params(double_pendulum_const_k2s2_state *x,
 {
   int i;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : double_pendulum_const_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : double_pendulum_const_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_const_k2s2_NU ? double_pendulum_const_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[double_pendulum_const_k2s2_NU];
     double_pendulum_const_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -557,8 +340,9 @@ void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x
   double_pendulum_const_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void double_pendulum_const_k2s2_predict(const double_pendulum_const_k2s2_state *x, double h, const double_pendulum_const_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -604,29 +388,275 @@ int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_
    * cannot drift; below double_pendulum_const_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < double_pendulum_const_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= double_pendulum_const_k2s2_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
+    sw16 = 0, sw17 = 0;
   for (it = 1; it <= double_pendulum_const_k2s2_MAXITER; it++) {
-    double_pendulum_const_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = x->q[2] /* x2 */ - x->q[0] /* x1 */;
+      const double t1 = x->q[3] /* y2 */ - x->q[1] /* y1 */;
+      const double t2 = 2.0 * x->q[1] /* y1 */;
+      const double t3 = 2.0 * x->q[0] /* x1 */;
+      const double t4 = 2.0 * t1;
+      const double t5 = 2.0 * t0;
+      const double t6 = 0.5 * gm0;
+      const double t7 = gm4 * 0.28867513459481292;
+      const double t8 = t6 - t7;
+      const double t9 = h * t8;
+      const double t10 = 2.0 * t9;
+      const double t11 = t3 + t10;
+      const double t12 = gm0 * 0.28867513459481292;
+      const double t13 = h * t12;
+      const double t14 = 2.0 * t13;
+      const double t15 = 0.5 * gm1;
+      const double t16 = 0.28867513459481292 * gm5;
+      const double t17 = t15 - t16;
+      const double t18 = h * t17;
+      const double t19 = 2.0 * t18;
+      const double t20 = t2 + t19;
+      const double t21 = 0.28867513459481292 * gm1;
+      const double t22 = h * t21;
+      const double t23 = 2.0 * t22;
+      const double t24 = t10 - t5;
+      const double t25 = 0.5 * gm2;
+      const double t26 = 0.28867513459481292 * gm6;
+      const double t27 = t25 - t26;
+      const double t28 = h * t27;
+      const double t29 = (-2.0) * t28;
+      const double t30 = t24 + t29;
+      const double t31 = 0.28867513459481292 * gm2;
+      const double t32 = h * t31;
+      const double t33 = (-2.0) * t32;
+      const double t34 = t14 + t33;
+      const double t35 = t19 - t4;
+      const double t36 = 0.5 * gm3;
+      const double t37 = 0.28867513459481292 * gm7;
+      const double t38 = t36 - t37;
+      const double t39 = h * t38;
+      const double t40 = (-2.0) * t39;
+      const double t41 = t35 + t40;
+      const double t42 = 0.28867513459481292 * gm3;
+      const double t43 = h * t42;
+      const double t44 = (-2.0) * t43;
+      const double t45 = t23 + t44;
+      const double t46 = t9 * (-2.0);
+      const double t47 = t5 + t46;
+      const double t48 = 2.0 * t28;
+      const double t49 = t47 + t48;
+      const double t50 = t13 * (-2.0);
+      const double t51 = 2.0 * t32;
+      const double t52 = t50 + t51;
+      const double t53 = t18 * (-2.0);
+      const double t54 = t4 + t53;
+      const double t55 = 2.0 * t39;
+      const double t56 = t54 + t55;
+      const double t57 = t22 * (-2.0);
+      const double t58 = 2.0 * t43;
+      const double t59 = t57 + t58;
+      /* multiplier system A lambda = r */
+      const double t60 = t11 * t11;
+      const double t61 = t20 * t20;
+      const double t62 = t60 + t61;
+      const double t63 = 0.5 * t62;
+      const double t64 = h * t63;
+      const double t65 = t11 * t30;
+      const double t66 = t20 * t41;
+      const double t67 = t65 + t66;
+      const double t68 = 0.5 * t67;
+      const double t69 = t11 * t34;
+      const double t70 = t20 * t45;
+      const double t71 = t69 + t70;
+      const double t72 = t14 * t30;
+      const double t73 = t23 * t41;
+      const double t74 = t72 + t73;
+      const double t75 = t74 - t71;
+      const double t76 = 0.28867513459481292 * t75;
+      const double t77 = t68 + t76;
+      const double t78 = h * t77;
+      const double t79 = 0.5 * t20;
+      const double t80 = t22 * 0.57735026918962584;
+      const double t81 = t79 + t80;
+      const double t82 = h * t81;
+      const double t83 = t11 * x->p[0] /* p_x1 */;
+      const double t84 = t20 * x->p[1] /* p_y1 */;
+      const double t85 = t83 + t84;
+      const double t86 = t85 - t82;
+      const double t87 = t86 + g0[0];
+      const double t88 = t71 - t74;
+      const double t89 = 0.28867513459481292 * t88;
+      const double t90 = t68 + t89;
+      const double t91 = h * t90;
+      const double t92 = t30 * t30;
+      const double t93 = t41 * t41;
+      const double t94 = t92 + t93;
+      const double t95 = t49 * t49;
+      const double t96 = t94 + t95;
+      const double t97 = t56 * t56;
+      const double t98 = t96 + t97;
+      const double t99 = 0.5 * t98;
+      const double t100 = h * t99;
+      const double t101 = t41 + t56;
+      const double t102 = 0.5 * t101;
+      const double t103 = t45 + t59;
+      const double t104 = 0.28867513459481292 * t103;
+      const double t105 = t102 + t104;
+      const double t106 = h * t105;
+      const double t107 = t30 * x->p[0] /* p_x1 */;
+      const double t108 = t41 * x->p[1] /* p_y1 */;
+      const double t109 = t107 + t108;
+      const double t110 = t49 * x->p[2] /* p_x2 */;
+      const double t111 = t109 + t110;
+      const double t112 = t56 * x->p[3] /* p_y2 */;
+      const double t113 = t111 + t112;
+      const double t114 = t113 - t106;
+      const double t115 = t114 + g0[1];
+      const double t116 = t91 / t64;
+      const double t117 = t78 * t116;
+      const double t118 = t100 - t117;
+      const double t119 = t87 * t116;
+      const double t120 = t115 - t119;
+      const double t121 = t120 / t118;
+      const double t122 = t78 * t121;
+      const double t123 = t87 - t122;
+      const double t124 = t123 / t64;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t125 = t11 * t124;
+      const double t126 = t20 * t124;
+      const double t127 = 1.0 + t126;
+      const double t128 = t30 * t121;
+      const double t129 = t125 + t128;
+      const double t130 = t41 * t121;
+      const double t131 = t127 + t130;
+      const double t132 = t49 * t121;
+      const double t133 = t56 * t121;
+      const double t134 = 1.0 + t133;
+      const double t135 = t14 * t124;
+      const double t136 = t23 * t124;
+      const double t137 = t34 * t121;
+      const double t138 = t135 + t137;
+      const double t139 = t45 * t121;
+      const double t140 = t136 + t139;
+      const double t141 = t52 * t121;
+      const double t142 = t59 * t121;
+      const double t143 = 0.5 * t129;
+      const double t144 = 0.28867513459481292 * t138;
+      const double t145 = t143 - t144;
+      const double t146 = h * t145;
+      const double t147 = x->p[0] /* p_x1 */ - t146;
+      const double t148 = 0.5 * t131;
+      const double t149 = 0.28867513459481292 * t140;
+      const double t150 = t148 - t149;
+      const double t151 = h * t150;
+      const double t152 = x->p[1] /* p_y1 */ - t151;
+      const double t153 = 0.5 * t132;
+      const double t154 = 0.28867513459481292 * t141;
+      const double t155 = t153 - t154;
+      const double t156 = h * t155;
+      const double t157 = x->p[2] /* p_x2 */ - t156;
+      const double t158 = 0.5 * t134;
+      const double t159 = 0.28867513459481292 * t142;
+      const double t160 = t158 - t159;
+      const double t161 = h * t160;
+      const double t162 = x->p[3] /* p_y2 */ - t161;
+      const double t163 = 0.28867513459481292 * t129;
+      const double t164 = h * t163;
+      const double t165 = -t164;
+      const double t166 = 0.28867513459481292 * t131;
+      const double t167 = h * t166;
+      const double t168 = -t167;
+      const double t169 = 0.28867513459481292 * t132;
+      const double t170 = h * t169;
+      const double t171 = -t170;
+      const double t172 = 0.28867513459481292 * t134;
+      const double t173 = h * t172;
+      const double t174 = -t173;
+      const double t175 = h * t129;
+      const double t176 = -t175;
+      const double t177 = h * t131;
+      const double t178 = -t177;
+      const double t179 = h * t132;
+      const double t180 = -t179;
+      const double t181 = h * t134;
+      const double t182 = -t181;
+      /* gam */
+      sw0 = t147;
+      sw1 = t152;
+      sw2 = t157;
+      sw3 = t162;
+      sw4 = t165;
+      sw5 = t168;
+      sw6 = t171;
+      sw7 = t174;
+      /* dp */
+      sw8 = t176;
+      sw9 = t178;
+      sw10 = t180;
+      sw11 = t182;
+      /* lambda */
+      sw12 = t124;
+      sw13 = t121;
+      /* pivot */
+      sw14 = t64;
+      sw15 = t118;
+      /* adiag */
+      sw16 = t64;
+      sw17 = t100;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(x->q[3]) + fabs(h * sw3);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
+      v = fabs(h * (sw6 - gm6));
+      if (v > inc) inc = v;
+      gm6 = sw6;
+      v = fabs(h * (sw7 - gm7));
+      if (v > inc) inc = v;
+      gm7 = sw7;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_const_k2s2_NU; i++) {
-      double piv = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
+    {
+      double piv = sw14, dia = sw16;
+      if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_const_k2s2_SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
+    }
+    {
+      double piv = sw15, dia = sw17;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_const_k2s2_SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
     }
     if (rc == double_pendulum_const_k2s2_ESINGULAR) break;
-    for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = double_pendulum_const_k2s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9) || !isfinite(sw10) || !isfinite(sw11) ||
+        !isfinite(sw12) || !isfinite(sw13)) rc = double_pendulum_const_k2s2_ENONFINITE;
     if (rc == double_pendulum_const_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_const_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (double_pendulum_const_k2s2_TOL / 256), or
      * within 2 ulps (double_pendulum_const_k2s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -645,6 +675,32 @@ int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  gam[6] = gm6;
+  gam[7] = gm7;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
+  sw[15] = sw15;
+  sw[16] = sw16;
+  sw[17] = sw17;
   if (st) { st->iters = it > double_pendulum_const_k2s2_MAXITER ? double_pendulum_const_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_const_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_const_k2s2_ENONFINITE;
@@ -657,8 +713,12 @@ int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_
     double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]);
   }
   for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + i];
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return double_pendulum_const_k2s2_OK;
 }

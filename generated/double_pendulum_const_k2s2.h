@@ -25,8 +25,9 @@ typedef double double_pendulum_const_k2s2_real;
 
 typedef struct {
   double_pendulum_const_k2s2_real t, q[4], p[4], lambda[2];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_const_k2s2_real tc, qc[4], pc[4], gam[8], hprev;
+  double_pendulum_const_k2s2_real gam2[8], hprev2;
 } double_pendulum_const_k2s2_state;
 
 typedef struct {

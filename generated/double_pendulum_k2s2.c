@@ -39,331 +39,12 @@
 static const double double_pendulum_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double double_pendulum_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double double_pendulum_k2s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double double_pendulum_k2s2_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
-
-/* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
-static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* grad g at the stages */
-  const double t0 = gam[0] * 0.21132486540518713;
-  const double t1 = gam[4] * (-0.28867513459481292);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = q0[0] /* x1 */ + t3;
-  const double t5 = gam[1] * 0.21132486540518713;
-  const double t6 = gam[5] * (-0.28867513459481292);
-  const double t7 = t5 + t6;
-  const double t8 = h * t7;
-  const double t9 = q0[1] /* y1 */ + t8;
-  const double t10 = gam[2] * 0.21132486540518713;
-  const double t11 = gam[6] * (-0.28867513459481292);
-  const double t12 = t10 + t11;
-  const double t13 = h * t12;
-  const double t14 = q0[2] /* x2 */ + t13;
-  const double t15 = gam[3] * 0.21132486540518713;
-  const double t16 = gam[7] * (-0.28867513459481292);
-  const double t17 = t15 + t16;
-  const double t18 = h * t17;
-  const double t19 = q0[3] /* y2 */ + t18;
-  const double t20 = t14 - t4;
-  const double t21 = t19 - t9;
-  const double t22 = 2.0 * t9;
-  const double t23 = 2.0 * t4;
-  const double t24 = 2.0 * t21;
-  const double t25 = 2.0 * t20;
-  const double t26 = gam[0] * 0.78867513459481287;
-  const double t27 = t1 + t26;
-  const double t28 = h * t27;
-  const double t29 = q0[0] /* x1 */ + t28;
-  const double t30 = gam[1] * 0.78867513459481287;
-  const double t31 = t6 + t30;
-  const double t32 = h * t31;
-  const double t33 = q0[1] /* y1 */ + t32;
-  const double t34 = gam[2] * 0.78867513459481287;
-  const double t35 = t11 + t34;
-  const double t36 = h * t35;
-  const double t37 = q0[2] /* x2 */ + t36;
-  const double t38 = gam[3] * 0.78867513459481287;
-  const double t39 = t16 + t38;
-  const double t40 = h * t39;
-  const double t41 = q0[3] /* y2 */ + t40;
-  const double t42 = t37 - t29;
-  const double t43 = t41 - t33;
-  const double t44 = 2.0 * t33;
-  const double t45 = 2.0 * t29;
-  const double t46 = 2.0 * t43;
-  const double t47 = 2.0 * t42;
-  /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-  const double t48 = (-0.99999999999999989) * lam[2];
-  const double t49 = lam[0] + t48;
-  const double t50 = t23 * t49;
-  const double t51 = t22 * t49;
-  const double t52 = (-0.99999999999999989) * lam[3];
-  const double t53 = lam[1] + t52;
-  const double t54 = t25 * t53;
-  const double t55 = t50 - t54;
-  const double t56 = t24 * t53;
-  const double t57 = t51 - t56;
-  const double t58 = 0.5 * t55;
-  const double t59 = 0.5 * t57;
-  const double t60 = 1.0 + t59;
-  const double t61 = 0.5 * t54;
-  const double t62 = 0.5 * t56;
-  const double t63 = 1.0 + t62;
-  const double t64 = (-0.49999999999999994) * t55;
-  const double t65 = (-0.49999999999999994) * t57;
-  const double t66 = (-0.49999999999999994) * t54;
-  const double t67 = (-0.49999999999999994) * t56;
-  const double t68 = 0.99999999999999989 * lam[2];
-  const double t69 = lam[0] + t68;
-  const double t70 = t45 * t69;
-  const double t71 = t44 * t69;
-  const double t72 = 0.99999999999999989 * lam[3];
-  const double t73 = lam[1] + t72;
-  const double t74 = t47 * t73;
-  const double t75 = t70 - t74;
-  const double t76 = t46 * t73;
-  const double t77 = t71 - t76;
-  const double t78 = 0.5 * t75;
-  const double t79 = t58 + t78;
-  const double t80 = 0.5 * t77;
-  const double t81 = t60 + t80;
-  const double t82 = 0.5 * t74;
-  const double t83 = t61 + t82;
-  const double t84 = 0.5 * t76;
-  const double t85 = t63 + t84;
-  const double t86 = 0.49999999999999994 * t75;
-  const double t87 = t64 + t86;
-  const double t88 = 0.49999999999999994 * t77;
-  const double t89 = t65 + t88;
-  const double t90 = 0.49999999999999994 * t74;
-  const double t91 = t66 + t90;
-  const double t92 = 0.49999999999999994 * t76;
-  const double t93 = t67 + t92;
-  const double t94 = 0.5 * t79;
-  const double t95 = 0.28867513459481292 * t87;
-  const double t96 = t94 - t95;
-  const double t97 = h * t96;
-  const double t98 = p0[0] /* p_x1 */ - t97;
-  const double t99 = 0.5 * t81;
-  const double t100 = 0.28867513459481292 * t89;
-  const double t101 = t99 - t100;
-  const double t102 = h * t101;
-  const double t103 = p0[1] /* p_y1 */ - t102;
-  const double t104 = 0.5 * t83;
-  const double t105 = 0.28867513459481292 * t91;
-  const double t106 = t104 - t105;
-  const double t107 = h * t106;
-  const double t108 = p0[2] /* p_x2 */ - t107;
-  const double t109 = 0.5 * t85;
-  const double t110 = 0.28867513459481292 * t93;
-  const double t111 = t109 - t110;
-  const double t112 = h * t111;
-  const double t113 = p0[3] /* p_y2 */ - t112;
-  const double t114 = 0.28867513459481292 * t79;
-  const double t115 = h * t114;
-  const double t116 = 0.28867513459481292 * t81;
-  const double t117 = h * t116;
-  const double t118 = 0.28867513459481292 * t83;
-  const double t119 = h * t118;
-  const double t120 = 0.28867513459481292 * t85;
-  const double t121 = h * t120;
-  const double t122 = (-0.99999999999999989) * t115;
-  const double t123 = t98 - t122;
-  const double t124 = (-0.99999999999999989) * t117;
-  const double t125 = t103 - t124;
-  const double t126 = (-0.99999999999999989) * t119;
-  const double t127 = t108 - t126;
-  const double t128 = (-0.99999999999999989) * t121;
-  const double t129 = t113 - t128;
-  const double t130 = t23 * t123;
-  const double t131 = t22 * t125;
-  const double t132 = t130 + t131;
-  const double t133 = 0.5 * t132;
-  const double t134 = (-0.49999999999999994) * t132;
-  const double t135 = t25 * t123;
-  const double t136 = -t135;
-  const double t137 = t24 * t125;
-  const double t138 = t136 - t137;
-  const double t139 = t25 * t127;
-  const double t140 = t138 + t139;
-  const double t141 = t24 * t129;
-  const double t142 = t140 + t141;
-  const double t143 = 0.5 * t142;
-  const double t144 = (-0.49999999999999994) * t142;
-  const double t145 = 0.99999999999999989 * t115;
-  const double t146 = t98 - t145;
-  const double t147 = 0.99999999999999989 * t117;
-  const double t148 = t103 - t147;
-  const double t149 = 0.99999999999999989 * t119;
-  const double t150 = t108 - t149;
-  const double t151 = 0.99999999999999989 * t121;
-  const double t152 = t113 - t151;
-  const double t153 = t45 * t146;
-  const double t154 = t44 * t148;
-  const double t155 = t153 + t154;
-  const double t156 = 0.5 * t155;
-  const double t157 = t133 + t156;
-  const double t158 = 0.49999999999999994 * t155;
-  const double t159 = t134 + t158;
-  const double t160 = t47 * t146;
-  const double t161 = -t160;
-  const double t162 = t46 * t148;
-  const double t163 = t161 - t162;
-  const double t164 = t47 * t150;
-  const double t165 = t163 + t164;
-  const double t166 = t46 * t152;
-  const double t167 = t165 + t166;
-  const double t168 = 0.5 * t167;
-  const double t169 = t143 + t168;
-  const double t170 = 0.49999999999999994 * t167;
-  const double t171 = t144 + t170;
-  const double t172 = t157 + g0[0];
-  const double t173 = t169 + g0[1];
-  const double t174 = lu[4] * t172;
-  const double t175 = t173 - t174;
-  const double t176 = lu[8] * t172;
-  const double t177 = t159 - t176;
-  const double t178 = lu[12] * t172;
-  const double t179 = t171 - t178;
-  const double t180 = lu[9] * t175;
-  const double t181 = t177 - t180;
-  const double t182 = lu[13] * t175;
-  const double t183 = t179 - t182;
-  const double t184 = lu[14] * t181;
-  const double t185 = t183 - t184;
-  const double t186 = lu[15] * t185;
-  const double t187 = lu[11] * t186;
-  const double t188 = t181 - t187;
-  const double t189 = lu[10] * t188;
-  const double t190 = lu[6] * t189;
-  const double t191 = t175 - t190;
-  const double t192 = lu[7] * t186;
-  const double t193 = t191 - t192;
-  const double t194 = lu[5] * t193;
-  const double t195 = lu[1] * t194;
-  const double t196 = t172 - t195;
-  const double t197 = lu[2] * t189;
-  const double t198 = t196 - t197;
-  const double t199 = lu[3] * t186;
-  const double t200 = t198 - t199;
-  const double t201 = lu[0] * t200;
-  const double t202 = lam[0] + t201;
-  const double t203 = lam[1] + t194;
-  const double t204 = lam[2] + t189;
-  const double t205 = lam[3] + t186;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-  const double t206 = (-0.99999999999999989) * t204;
-  const double t207 = t202 + t206;
-  const double t208 = t23 * t207;
-  const double t209 = t22 * t207;
-  const double t210 = (-0.99999999999999989) * t205;
-  const double t211 = t203 + t210;
-  const double t212 = t25 * t211;
-  const double t213 = t208 - t212;
-  const double t214 = t24 * t211;
-  const double t215 = t209 - t214;
-  const double t216 = 0.5 * t213;
-  const double t217 = 0.5 * t215;
-  const double t218 = 1.0 + t217;
-  const double t219 = 0.5 * t212;
-  const double t220 = 0.5 * t214;
-  const double t221 = 1.0 + t220;
-  const double t222 = (-0.49999999999999994) * t213;
-  const double t223 = (-0.49999999999999994) * t215;
-  const double t224 = (-0.49999999999999994) * t212;
-  const double t225 = (-0.49999999999999994) * t214;
-  const double t226 = 0.99999999999999989 * t204;
-  const double t227 = t202 + t226;
-  const double t228 = t45 * t227;
-  const double t229 = t44 * t227;
-  const double t230 = 0.99999999999999989 * t205;
-  const double t231 = t203 + t230;
-  const double t232 = t47 * t231;
-  const double t233 = t228 - t232;
-  const double t234 = t46 * t231;
-  const double t235 = t229 - t234;
-  const double t236 = 0.5 * t233;
-  const double t237 = t216 + t236;
-  const double t238 = 0.5 * t235;
-  const double t239 = t218 + t238;
-  const double t240 = 0.5 * t232;
-  const double t241 = t219 + t240;
-  const double t242 = 0.5 * t234;
-  const double t243 = t221 + t242;
-  const double t244 = 0.49999999999999994 * t233;
-  const double t245 = t222 + t244;
-  const double t246 = 0.49999999999999994 * t235;
-  const double t247 = t223 + t246;
-  const double t248 = 0.49999999999999994 * t232;
-  const double t249 = t224 + t248;
-  const double t250 = 0.49999999999999994 * t234;
-  const double t251 = t225 + t250;
-  const double t252 = 0.5 * t237;
-  const double t253 = 0.28867513459481292 * t245;
-  const double t254 = t252 - t253;
-  const double t255 = h * t254;
-  const double t256 = p0[0] /* p_x1 */ - t255;
-  const double t257 = 0.5 * t239;
-  const double t258 = 0.28867513459481292 * t247;
-  const double t259 = t257 - t258;
-  const double t260 = h * t259;
-  const double t261 = p0[1] /* p_y1 */ - t260;
-  const double t262 = 0.5 * t241;
-  const double t263 = 0.28867513459481292 * t249;
-  const double t264 = t262 - t263;
-  const double t265 = h * t264;
-  const double t266 = p0[2] /* p_x2 */ - t265;
-  const double t267 = 0.5 * t243;
-  const double t268 = 0.28867513459481292 * t251;
-  const double t269 = t267 - t268;
-  const double t270 = h * t269;
-  const double t271 = p0[3] /* p_y2 */ - t270;
-  const double t272 = 0.28867513459481292 * t237;
-  const double t273 = h * t272;
-  const double t274 = -t273;
-  const double t275 = 0.28867513459481292 * t239;
-  const double t276 = h * t275;
-  const double t277 = -t276;
-  const double t278 = 0.28867513459481292 * t241;
-  const double t279 = h * t278;
-  const double t280 = -t279;
-  const double t281 = 0.28867513459481292 * t243;
-  const double t282 = h * t281;
-  const double t283 = -t282;
-  const double t284 = h * t237;
-  const double t285 = -t284;
-  const double t286 = h * t239;
-  const double t287 = -t286;
-  const double t288 = h * t241;
-  const double t289 = -t288;
-  const double t290 = h * t243;
-  const double t291 = -t290;
-  /* gam */
-  out[0] = t256;
-  out[1] = t261;
-  out[2] = t266;
-  out[3] = t271;
-  out[4] = t274;
-  out[5] = t277;
-  out[6] = t280;
-  out[7] = t283;
-  /* dp */
-  out[8] = t285;
-  out[9] = t287;
-  out[10] = t289;
-  out[11] = t291;
-  /* lam */
-  out[12] = t202;
-  out[13] = t203;
-  out[14] = t204;
-  out[15] = t205;
-}
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
  * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU). */
@@ -1050,14 +731,14 @@ void double_pendulum_k2s2_init_params(double_pendulum_k2s2_state *x, const doubl
 {
   int i;
   double_pendulum_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < double_pendulum_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : double_pendulum_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : double_pendulum_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k2s2_NU ? double_pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[double_pendulum_k2s2_NU];
@@ -1103,14 +784,23 @@ void double_pendulum_k2s2_hidden(const double_pendulum_k2s2_state *x, const doub
   double_pendulum_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void double_pendulum_k2s2_predict(const double_pendulum_k2s2_state *x, double h, const double_pendulum_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     double_pendulum_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < double_pendulum_k2s2_S; j++)
+      for (i = 0; i < double_pendulum_k2s2_S; i++)
+        for (l = 0; l < double_pendulum_k2s2_M; l++)
+          gam[j * double_pendulum_k2s2_M + l] += double_pendulum_k2s2_E2[2 * double_pendulum_k2s2_S * j + i] * x->gam[i * double_pendulum_k2s2_M + l] +
+                               double_pendulum_k2s2_E2[2 * double_pendulum_k2s2_S * j + double_pendulum_k2s2_S + i] * x->gam2[i * double_pendulum_k2s2_M + l];
     return;
   }
   for (j = 0; j < double_pendulum_k2s2_S; j++)
@@ -1150,9 +840,8 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
    * cannot drift; below double_pendulum_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < double_pendulum_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= double_pendulum_k2s2_GTOL ? 0 : g0[i] / h;
-  double fa[16 + 2 * double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1], lam[double_pendulum_k2s2_S * double_pendulum_k2s2_NU];
+  double fa[16 + 2 * double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
   int j;
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps
    * (again below when the iteration slows down) */
   double_pendulum_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
@@ -1161,12 +850,25 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
     if (!isfinite(piv) || !isfinite(dia)) return double_pendulum_k2s2_ENONFINITE;
     if (!(fabs(piv) > double_pendulum_k2s2_SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
   }
+  /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0;
+  double lm0 = 0, lm1 = 0, lm2 = 0, lm3 = 0;
   for (it = 1; it <= double_pendulum_k2s2_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
      * small; where the increments fall by less than 8x it is refreshed at the
      * current gamma, which keeps the iteration converging up to the h of the
      * constant family (pendulum, s = 3: 2.4 instead of 0.84) */
     if (it > 2 && inc > inc_old / 8) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
+      gam[6] = gm6;
+      gam[7] = gm7;
       double_pendulum_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
       for (j = 0; j < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; j++) {
         double piv = fa[16 + j], dia = fa[16 + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + j];
@@ -1174,24 +876,369 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
         if (!(fabs(piv) > double_pendulum_k2s2_SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
       }
     }
-    double_pendulum_k2s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
+    { /* the kernel sweep, inline */
+      /* grad g at the stages */
+      const double t0 = gm0 * 0.21132486540518713;
+      const double t1 = gm4 * (-0.28867513459481292);
+      const double t2 = t0 + t1;
+      const double t3 = h * t2;
+      const double t4 = x->q[0] /* x1 */ + t3;
+      const double t5 = gm1 * 0.21132486540518713;
+      const double t6 = gm5 * (-0.28867513459481292);
+      const double t7 = t5 + t6;
+      const double t8 = h * t7;
+      const double t9 = x->q[1] /* y1 */ + t8;
+      const double t10 = gm2 * 0.21132486540518713;
+      const double t11 = gm6 * (-0.28867513459481292);
+      const double t12 = t10 + t11;
+      const double t13 = h * t12;
+      const double t14 = x->q[2] /* x2 */ + t13;
+      const double t15 = gm3 * 0.21132486540518713;
+      const double t16 = gm7 * (-0.28867513459481292);
+      const double t17 = t15 + t16;
+      const double t18 = h * t17;
+      const double t19 = x->q[3] /* y2 */ + t18;
+      const double t20 = t14 - t4;
+      const double t21 = t19 - t9;
+      const double t22 = 2.0 * t9;
+      const double t23 = 2.0 * t4;
+      const double t24 = 2.0 * t21;
+      const double t25 = 2.0 * t20;
+      const double t26 = gm0 * 0.78867513459481287;
+      const double t27 = t1 + t26;
+      const double t28 = h * t27;
+      const double t29 = x->q[0] /* x1 */ + t28;
+      const double t30 = gm1 * 0.78867513459481287;
+      const double t31 = t6 + t30;
+      const double t32 = h * t31;
+      const double t33 = x->q[1] /* y1 */ + t32;
+      const double t34 = gm2 * 0.78867513459481287;
+      const double t35 = t11 + t34;
+      const double t36 = h * t35;
+      const double t37 = x->q[2] /* x2 */ + t36;
+      const double t38 = gm3 * 0.78867513459481287;
+      const double t39 = t16 + t38;
+      const double t40 = h * t39;
+      const double t41 = x->q[3] /* y2 */ + t40;
+      const double t42 = t37 - t29;
+      const double t43 = t41 - t33;
+      const double t44 = 2.0 * t33;
+      const double t45 = 2.0 * t29;
+      const double t46 = 2.0 * t43;
+      const double t47 = 2.0 * t42;
+      /* the multiplier coefficients: lambda += A^-1 C(lambda) */
+      const double t48 = (-0.99999999999999989) * lm2;
+      const double t49 = lm0 + t48;
+      const double t50 = t23 * t49;
+      const double t51 = t22 * t49;
+      const double t52 = (-0.99999999999999989) * lm3;
+      const double t53 = lm1 + t52;
+      const double t54 = t25 * t53;
+      const double t55 = t50 - t54;
+      const double t56 = t24 * t53;
+      const double t57 = t51 - t56;
+      const double t58 = 0.5 * t55;
+      const double t59 = 0.5 * t57;
+      const double t60 = 1.0 + t59;
+      const double t61 = 0.5 * t54;
+      const double t62 = 0.5 * t56;
+      const double t63 = 1.0 + t62;
+      const double t64 = (-0.49999999999999994) * t55;
+      const double t65 = (-0.49999999999999994) * t57;
+      const double t66 = (-0.49999999999999994) * t54;
+      const double t67 = (-0.49999999999999994) * t56;
+      const double t68 = 0.99999999999999989 * lm2;
+      const double t69 = lm0 + t68;
+      const double t70 = t45 * t69;
+      const double t71 = t44 * t69;
+      const double t72 = 0.99999999999999989 * lm3;
+      const double t73 = lm1 + t72;
+      const double t74 = t47 * t73;
+      const double t75 = t70 - t74;
+      const double t76 = t46 * t73;
+      const double t77 = t71 - t76;
+      const double t78 = 0.5 * t75;
+      const double t79 = t58 + t78;
+      const double t80 = 0.5 * t77;
+      const double t81 = t60 + t80;
+      const double t82 = 0.5 * t74;
+      const double t83 = t61 + t82;
+      const double t84 = 0.5 * t76;
+      const double t85 = t63 + t84;
+      const double t86 = 0.49999999999999994 * t75;
+      const double t87 = t64 + t86;
+      const double t88 = 0.49999999999999994 * t77;
+      const double t89 = t65 + t88;
+      const double t90 = 0.49999999999999994 * t74;
+      const double t91 = t66 + t90;
+      const double t92 = 0.49999999999999994 * t76;
+      const double t93 = t67 + t92;
+      const double t94 = 0.5 * t79;
+      const double t95 = 0.28867513459481292 * t87;
+      const double t96 = t94 - t95;
+      const double t97 = h * t96;
+      const double t98 = x->p[0] /* p_x1 */ - t97;
+      const double t99 = 0.5 * t81;
+      const double t100 = 0.28867513459481292 * t89;
+      const double t101 = t99 - t100;
+      const double t102 = h * t101;
+      const double t103 = x->p[1] /* p_y1 */ - t102;
+      const double t104 = 0.5 * t83;
+      const double t105 = 0.28867513459481292 * t91;
+      const double t106 = t104 - t105;
+      const double t107 = h * t106;
+      const double t108 = x->p[2] /* p_x2 */ - t107;
+      const double t109 = 0.5 * t85;
+      const double t110 = 0.28867513459481292 * t93;
+      const double t111 = t109 - t110;
+      const double t112 = h * t111;
+      const double t113 = x->p[3] /* p_y2 */ - t112;
+      const double t114 = 0.28867513459481292 * t79;
+      const double t115 = h * t114;
+      const double t116 = 0.28867513459481292 * t81;
+      const double t117 = h * t116;
+      const double t118 = 0.28867513459481292 * t83;
+      const double t119 = h * t118;
+      const double t120 = 0.28867513459481292 * t85;
+      const double t121 = h * t120;
+      const double t122 = (-0.99999999999999989) * t115;
+      const double t123 = t98 - t122;
+      const double t124 = (-0.99999999999999989) * t117;
+      const double t125 = t103 - t124;
+      const double t126 = (-0.99999999999999989) * t119;
+      const double t127 = t108 - t126;
+      const double t128 = (-0.99999999999999989) * t121;
+      const double t129 = t113 - t128;
+      const double t130 = t23 * t123;
+      const double t131 = t22 * t125;
+      const double t132 = t130 + t131;
+      const double t133 = 0.5 * t132;
+      const double t134 = (-0.49999999999999994) * t132;
+      const double t135 = t25 * t123;
+      const double t136 = -t135;
+      const double t137 = t24 * t125;
+      const double t138 = t136 - t137;
+      const double t139 = t25 * t127;
+      const double t140 = t138 + t139;
+      const double t141 = t24 * t129;
+      const double t142 = t140 + t141;
+      const double t143 = 0.5 * t142;
+      const double t144 = (-0.49999999999999994) * t142;
+      const double t145 = 0.99999999999999989 * t115;
+      const double t146 = t98 - t145;
+      const double t147 = 0.99999999999999989 * t117;
+      const double t148 = t103 - t147;
+      const double t149 = 0.99999999999999989 * t119;
+      const double t150 = t108 - t149;
+      const double t151 = 0.99999999999999989 * t121;
+      const double t152 = t113 - t151;
+      const double t153 = t45 * t146;
+      const double t154 = t44 * t148;
+      const double t155 = t153 + t154;
+      const double t156 = 0.5 * t155;
+      const double t157 = t133 + t156;
+      const double t158 = 0.49999999999999994 * t155;
+      const double t159 = t134 + t158;
+      const double t160 = t47 * t146;
+      const double t161 = -t160;
+      const double t162 = t46 * t148;
+      const double t163 = t161 - t162;
+      const double t164 = t47 * t150;
+      const double t165 = t163 + t164;
+      const double t166 = t46 * t152;
+      const double t167 = t165 + t166;
+      const double t168 = 0.5 * t167;
+      const double t169 = t143 + t168;
+      const double t170 = 0.49999999999999994 * t167;
+      const double t171 = t144 + t170;
+      const double t172 = t157 + g0[0];
+      const double t173 = t169 + g0[1];
+      const double t174 = fa[4] * t172;
+      const double t175 = t173 - t174;
+      const double t176 = fa[8] * t172;
+      const double t177 = t159 - t176;
+      const double t178 = fa[12] * t172;
+      const double t179 = t171 - t178;
+      const double t180 = fa[9] * t175;
+      const double t181 = t177 - t180;
+      const double t182 = fa[13] * t175;
+      const double t183 = t179 - t182;
+      const double t184 = fa[14] * t181;
+      const double t185 = t183 - t184;
+      const double t186 = fa[15] * t185;
+      const double t187 = fa[11] * t186;
+      const double t188 = t181 - t187;
+      const double t189 = fa[10] * t188;
+      const double t190 = fa[6] * t189;
+      const double t191 = t175 - t190;
+      const double t192 = fa[7] * t186;
+      const double t193 = t191 - t192;
+      const double t194 = fa[5] * t193;
+      const double t195 = fa[1] * t194;
+      const double t196 = t172 - t195;
+      const double t197 = fa[2] * t189;
+      const double t198 = t196 - t197;
+      const double t199 = fa[3] * t186;
+      const double t200 = t198 - t199;
+      const double t201 = fa[0] * t200;
+      const double t202 = lm0 + t201;
+      const double t203 = lm1 + t194;
+      const double t204 = lm2 + t189;
+      const double t205 = lm3 + t186;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
+      const double t206 = (-0.99999999999999989) * t204;
+      const double t207 = t202 + t206;
+      const double t208 = t23 * t207;
+      const double t209 = t22 * t207;
+      const double t210 = (-0.99999999999999989) * t205;
+      const double t211 = t203 + t210;
+      const double t212 = t25 * t211;
+      const double t213 = t208 - t212;
+      const double t214 = t24 * t211;
+      const double t215 = t209 - t214;
+      const double t216 = 0.5 * t213;
+      const double t217 = 0.5 * t215;
+      const double t218 = 1.0 + t217;
+      const double t219 = 0.5 * t212;
+      const double t220 = 0.5 * t214;
+      const double t221 = 1.0 + t220;
+      const double t222 = (-0.49999999999999994) * t213;
+      const double t223 = (-0.49999999999999994) * t215;
+      const double t224 = (-0.49999999999999994) * t212;
+      const double t225 = (-0.49999999999999994) * t214;
+      const double t226 = 0.99999999999999989 * t204;
+      const double t227 = t202 + t226;
+      const double t228 = t45 * t227;
+      const double t229 = t44 * t227;
+      const double t230 = 0.99999999999999989 * t205;
+      const double t231 = t203 + t230;
+      const double t232 = t47 * t231;
+      const double t233 = t228 - t232;
+      const double t234 = t46 * t231;
+      const double t235 = t229 - t234;
+      const double t236 = 0.5 * t233;
+      const double t237 = t216 + t236;
+      const double t238 = 0.5 * t235;
+      const double t239 = t218 + t238;
+      const double t240 = 0.5 * t232;
+      const double t241 = t219 + t240;
+      const double t242 = 0.5 * t234;
+      const double t243 = t221 + t242;
+      const double t244 = 0.49999999999999994 * t233;
+      const double t245 = t222 + t244;
+      const double t246 = 0.49999999999999994 * t235;
+      const double t247 = t223 + t246;
+      const double t248 = 0.49999999999999994 * t232;
+      const double t249 = t224 + t248;
+      const double t250 = 0.49999999999999994 * t234;
+      const double t251 = t225 + t250;
+      const double t252 = 0.5 * t237;
+      const double t253 = 0.28867513459481292 * t245;
+      const double t254 = t252 - t253;
+      const double t255 = h * t254;
+      const double t256 = x->p[0] /* p_x1 */ - t255;
+      const double t257 = 0.5 * t239;
+      const double t258 = 0.28867513459481292 * t247;
+      const double t259 = t257 - t258;
+      const double t260 = h * t259;
+      const double t261 = x->p[1] /* p_y1 */ - t260;
+      const double t262 = 0.5 * t241;
+      const double t263 = 0.28867513459481292 * t249;
+      const double t264 = t262 - t263;
+      const double t265 = h * t264;
+      const double t266 = x->p[2] /* p_x2 */ - t265;
+      const double t267 = 0.5 * t243;
+      const double t268 = 0.28867513459481292 * t251;
+      const double t269 = t267 - t268;
+      const double t270 = h * t269;
+      const double t271 = x->p[3] /* p_y2 */ - t270;
+      const double t272 = 0.28867513459481292 * t237;
+      const double t273 = h * t272;
+      const double t274 = -t273;
+      const double t275 = 0.28867513459481292 * t239;
+      const double t276 = h * t275;
+      const double t277 = -t276;
+      const double t278 = 0.28867513459481292 * t241;
+      const double t279 = h * t278;
+      const double t280 = -t279;
+      const double t281 = 0.28867513459481292 * t243;
+      const double t282 = h * t281;
+      const double t283 = -t282;
+      const double t284 = h * t237;
+      const double t285 = -t284;
+      const double t286 = h * t239;
+      const double t287 = -t286;
+      const double t288 = h * t241;
+      const double t289 = -t288;
+      const double t290 = h * t243;
+      const double t291 = -t290;
+      /* gam */
+      sw0 = t256;
+      sw1 = t261;
+      sw2 = t266;
+      sw3 = t271;
+      sw4 = t274;
+      sw5 = t277;
+      sw6 = t280;
+      sw7 = t283;
+      /* dp */
+      sw8 = t285;
+      sw9 = t287;
+      sw10 = t289;
+      sw11 = t291;
+      /* lam */
+      sw12 = t202;
+      sw13 = t203;
+      sw14 = t204;
+      sw15 = t205;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < double_pendulum_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(x->q[3]) + fabs(h * sw3);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
+      v = fabs(h * (sw6 - gm6));
+      if (v > inc) inc = v;
+      gm6 = sw6;
+      v = fabs(h * (sw7 - gm7));
+      if (v > inc) inc = v;
+      gm7 = sw7;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + i];
-    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = double_pendulum_k2s2_ENONFINITE;
+    lm0 = sw12;
+    lm1 = sw13;
+    lm2 = sw14;
+    lm3 = sw15;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9) || !isfinite(sw10) || !isfinite(sw11) ||
+        !isfinite(sw12) || !isfinite(sw13) || !isfinite(sw14) || !isfinite(sw15)) rc = double_pendulum_k2s2_ENONFINITE;
     if (rc == double_pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k2s2_TOL). Iterating
      * further would not help H, which the rescale keeps (bench/README.md) */
@@ -1208,6 +1255,30 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  gam[6] = gm6;
+  gam[7] = gm7;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
+  sw[15] = sw15;
   if (st) { st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != double_pendulum_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
@@ -1248,7 +1319,10 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[double_pendulum_k2s2_NU];
@@ -1256,6 +1330,7 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
     for (i = 0; i < double_pendulum_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   double_pendulum_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return double_pendulum_k2s2_OK;
 }

@@ -25,8 +25,9 @@ typedef double double_pendulum_k3s3_real;
 
 typedef struct {
   double_pendulum_k3s3_real t, q[4], p[4], lambda[2];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_k3s3_real tc, qc[4], pc[4], gam[12], hprev;
+  double_pendulum_k3s3_real gam2[12], hprev2;
   double_pendulum_k3s3_real H0;  /* the energy the step keeps */
 } double_pendulum_k3s3_state;
 

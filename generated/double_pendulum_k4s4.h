@@ -25,8 +25,9 @@ typedef double double_pendulum_k4s4_real;
 
 typedef struct {
   double_pendulum_k4s4_real t, q[4], p[4], lambda[2];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_k4s4_real tc, qc[4], pc[4], gam[16], hprev;
+  double_pendulum_k4s4_real gam2[16], hprev2;
   double_pendulum_k4s4_real H0;  /* the energy the step keeps */
 } double_pendulum_k4s4_state;
 

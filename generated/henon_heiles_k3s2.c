@@ -44,117 +44,6 @@ static const double henon_heiles_k3s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 1.0
 static const double henon_heiles_k3s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k3s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const henon_heiles_k3s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.1127016653792583;
-  const double t1 = gam[2] * (-0.17320508075688779);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = t3 + q0[0] /* x */;
-  const double t5 = 0.1127016653792583 * gam[1];
-  const double t6 = (-0.17320508075688779) * gam[3];
-  const double t7 = t5 + t6;
-  const double t8 = h * t7;
-  const double t9 = t8 + q0[1] /* y */;
-  const double t10 = t4 * t4;
-  const double t11 = t9 * t9;
-  const double t12 = 3.0 * t11;
-  const double t13 = (-0.33333333333333331) * t12;
-  const double t14 = t10 + t13;
-  const double t15 = 0.5 + t9;
-  const double t16 = t9 + t14;
-  const double t17 = 2.0 * t4;
-  const double t18 = t15 * t17;
-  const double t19 = t18 * 0.27777777777777779;
-  const double t20 = t16 * 0.27777777777777779;
-  const double t21 = t18 * (-0.37267799624996495);
-  const double t22 = t16 * (-0.37267799624996495);
-  /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t23 = 0.5 * gam[0];
-  const double t24 = gam[2] * (-0.43301270189221935);
-  const double t25 = t23 + t24;
-  const double t26 = h * t25;
-  const double t27 = q0[0] /* x */ + t26;
-  const double t28 = 0.5 * gam[1];
-  const double t29 = gam[3] * (-0.43301270189221935);
-  const double t30 = t28 + t29;
-  const double t31 = h * t30;
-  const double t32 = q0[1] /* y */ + t31;
-  const double t33 = t27 * t27;
-  const double t34 = t32 * t32;
-  const double t35 = 3.0 * t34;
-  const double t36 = (-0.33333333333333331) * t35;
-  const double t37 = t33 + t36;
-  const double t38 = 0.5 + t32;
-  const double t39 = t32 + t37;
-  const double t40 = 2.0 * t27;
-  const double t41 = t38 * t40;
-  const double t42 = t41 * 0.44444444444444442;
-  const double t43 = t19 + t42;
-  const double t44 = t39 * 0.44444444444444442;
-  const double t45 = t20 + t44;
-  /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t46 = gam[0] * 0.8872983346207417;
-  const double t47 = t1 + t46;
-  const double t48 = h * t47;
-  const double t49 = q0[0] /* x */ + t48;
-  const double t50 = gam[1] * 0.8872983346207417;
-  const double t51 = t6 + t50;
-  const double t52 = h * t51;
-  const double t53 = q0[1] /* y */ + t52;
-  const double t54 = t49 * t49;
-  const double t55 = t53 * t53;
-  const double t56 = 3.0 * t55;
-  const double t57 = (-0.33333333333333331) * t56;
-  const double t58 = t54 + t57;
-  const double t59 = 0.5 + t53;
-  const double t60 = t53 + t58;
-  const double t61 = 2.0 * t49;
-  const double t62 = t59 * t61;
-  const double t63 = 0.27777777777777779 * t62;
-  const double t64 = t43 + t63;
-  const double t65 = 0.27777777777777779 * t60;
-  const double t66 = t45 + t65;
-  const double t67 = t62 * 0.37267799624996495;
-  const double t68 = t21 + t67;
-  const double t69 = t60 * 0.37267799624996495;
-  const double t70 = t22 + t69;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t71 = 0.5 * t64;
-  const double t72 = t68 * 0.28867513459481292;
-  const double t73 = t71 - t72;
-  const double t74 = h * t73;
-  const double t75 = p0[0] /* p_x */ - t74;
-  const double t76 = 0.5 * t66;
-  const double t77 = t70 * 0.28867513459481292;
-  const double t78 = t76 - t77;
-  const double t79 = h * t78;
-  const double t80 = p0[1] /* p_y */ - t79;
-  const double t81 = t64 * 0.28867513459481292;
-  const double t82 = h * t81;
-  const double t83 = -t82;
-  const double t84 = t66 * 0.28867513459481292;
-  const double t85 = h * t84;
-  const double t86 = -t85;
-  const double t87 = h * t64;
-  const double t88 = -t87;
-  const double t89 = h * t66;
-  const double t90 = -t89;
-  /* gam */
-  out[0] = t75;
-  out[1] = t80;
-  out[2] = t83;
-  out[3] = t86;
-  /* dp */
-  out[4] = t88;
-  out[5] = t90;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void henon_heiles_k3s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const henon_heiles_k3s2_params *prm, double *out)
@@ -200,14 +89,14 @@ void henon_heiles_k3s2_init_params(henon_heiles_k3s2_state *x, const henon_heile
 {
   int i;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < henon_heiles_k3s2_M; i++) {
     x->q[i] = q0 ? q0[i] : henon_heiles_k3s2_q0[i];
     x->p[i] = p0 ? p0[i] : henon_heiles_k3s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (henon_heiles_k3s2_NU ? henon_heiles_k3s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0)
@@ -245,8 +134,9 @@ void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heil
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, const henon_heiles_k3s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -286,24 +176,140 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return henon_heiles_k3s2_EBADSTEP;
   henon_heiles_k3s2_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
   for (it = 1; it <= henon_heiles_k3s2_MAXITER; it++) {
-    henon_heiles_k3s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.1127016653792583;
+      const double t1 = gm2 * (-0.17320508075688779);
+      const double t2 = t0 + t1;
+      const double t3 = h * t2;
+      const double t4 = t3 + x->q[0] /* x */;
+      const double t5 = 0.1127016653792583 * gm1;
+      const double t6 = (-0.17320508075688779) * gm3;
+      const double t7 = t5 + t6;
+      const double t8 = h * t7;
+      const double t9 = t8 + x->q[1] /* y */;
+      const double t10 = t4 * t4;
+      const double t11 = t9 * t9;
+      const double t12 = 3.0 * t11;
+      const double t13 = (-0.33333333333333331) * t12;
+      const double t14 = t10 + t13;
+      const double t15 = 0.5 + t9;
+      const double t16 = t9 + t14;
+      const double t17 = 2.0 * t4;
+      const double t18 = t15 * t17;
+      const double t19 = t18 * 0.27777777777777779;
+      const double t20 = t16 * 0.27777777777777779;
+      const double t21 = t18 * (-0.37267799624996495);
+      const double t22 = t16 * (-0.37267799624996495);
+      /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t23 = 0.5 * gm0;
+      const double t24 = gm2 * (-0.43301270189221935);
+      const double t25 = t23 + t24;
+      const double t26 = h * t25;
+      const double t27 = x->q[0] /* x */ + t26;
+      const double t28 = 0.5 * gm1;
+      const double t29 = gm3 * (-0.43301270189221935);
+      const double t30 = t28 + t29;
+      const double t31 = h * t30;
+      const double t32 = x->q[1] /* y */ + t31;
+      const double t33 = t27 * t27;
+      const double t34 = t32 * t32;
+      const double t35 = 3.0 * t34;
+      const double t36 = (-0.33333333333333331) * t35;
+      const double t37 = t33 + t36;
+      const double t38 = 0.5 + t32;
+      const double t39 = t32 + t37;
+      const double t40 = 2.0 * t27;
+      const double t41 = t38 * t40;
+      const double t42 = t41 * 0.44444444444444442;
+      const double t43 = t19 + t42;
+      const double t44 = t39 * 0.44444444444444442;
+      const double t45 = t20 + t44;
+      /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t46 = gm0 * 0.8872983346207417;
+      const double t47 = t1 + t46;
+      const double t48 = h * t47;
+      const double t49 = x->q[0] /* x */ + t48;
+      const double t50 = gm1 * 0.8872983346207417;
+      const double t51 = t6 + t50;
+      const double t52 = h * t51;
+      const double t53 = x->q[1] /* y */ + t52;
+      const double t54 = t49 * t49;
+      const double t55 = t53 * t53;
+      const double t56 = 3.0 * t55;
+      const double t57 = (-0.33333333333333331) * t56;
+      const double t58 = t54 + t57;
+      const double t59 = 0.5 + t53;
+      const double t60 = t53 + t58;
+      const double t61 = 2.0 * t49;
+      const double t62 = t59 * t61;
+      const double t63 = 0.27777777777777779 * t62;
+      const double t64 = t43 + t63;
+      const double t65 = 0.27777777777777779 * t60;
+      const double t66 = t45 + t65;
+      const double t67 = t62 * 0.37267799624996495;
+      const double t68 = t21 + t67;
+      const double t69 = t60 * 0.37267799624996495;
+      const double t70 = t22 + t69;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t71 = 0.5 * t64;
+      const double t72 = t68 * 0.28867513459481292;
+      const double t73 = t71 - t72;
+      const double t74 = h * t73;
+      const double t75 = x->p[0] /* p_x */ - t74;
+      const double t76 = 0.5 * t66;
+      const double t77 = t70 * 0.28867513459481292;
+      const double t78 = t76 - t77;
+      const double t79 = h * t78;
+      const double t80 = x->p[1] /* p_y */ - t79;
+      const double t81 = t64 * 0.28867513459481292;
+      const double t82 = h * t81;
+      const double t83 = -t82;
+      const double t84 = t66 * 0.28867513459481292;
+      const double t85 = h * t84;
+      const double t86 = -t85;
+      const double t87 = h * t64;
+      const double t88 = -t87;
+      const double t89 = h * t66;
+      const double t90 = -t89;
+      /* gam */
+      sw0 = t75;
+      sw1 = t80;
+      sw2 = t83;
+      sw3 = t86;
+      /* dp */
+      sw4 = t88;
+      sw5 = t90;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < henon_heiles_k3s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + henon_heiles_k3s2_NU; i++)
-      if (!isfinite(sw[i])) rc = henon_heiles_k3s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5)) rc = henon_heiles_k3s2_ENONFINITE;
     if (rc == henon_heiles_k3s2_ENONFINITE || !isfinite(inc)) { rc = henon_heiles_k3s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (henon_heiles_k3s2_TOL / 256), or
      * within 2 ulps (henon_heiles_k3s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -322,6 +328,16 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
   if (st) { st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it; st->increment = inc; }
   if (rc != henon_heiles_k3s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return henon_heiles_k3s2_ENONFINITE;
@@ -334,8 +350,12 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
     henon_heiles_k3s2_add(&x->p[i], &x->pc[i], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]);
   }
   for (i = 0; i < henon_heiles_k3s2_NU; i++) x->lambda[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + i];
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return henon_heiles_k3s2_OK;
 }

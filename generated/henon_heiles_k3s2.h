@@ -25,8 +25,9 @@ typedef double henon_heiles_k3s2_real;
 
 typedef struct {
   henon_heiles_k3s2_real t, q[2], p[2], lambda[1];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   henon_heiles_k3s2_real tc, qc[2], pc[2], gam[4], hprev;
+  henon_heiles_k3s2_real gam2[4], hprev2;
 } henon_heiles_k3s2_state;
 
 typedef struct {

@@ -42,50 +42,6 @@ static const double kepler_k1s1_E1[1] = {1.0};
 static const double kepler_k1s1_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k1s1_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void kepler_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const kepler_k1s1_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = 0.5 * gam[0];
-  const double t1 = h * t0;
-  const double t2 = t1 + q0[0] /* x */;
-  const double t3 = 0.5 * gam[1];
-  const double t4 = h * t3;
-  const double t5 = t4 + q0[1] /* y */;
-  const double t6 = t2 * t2;
-  const double t7 = t5 * t5;
-  const double t8 = t6 + t7;
-  const double t9 = sqrt(t8);
-  const double t10 = 1.0 / t9;
-  const double t11 = t10 * t10;
-  const double t12 = 0.5 * t11;
-  const double t13 = t10 * t12;
-  const double t14 = 2.0 * t5;
-  const double t15 = t13 * t14;
-  const double t16 = 2.0 * t2;
-  const double t17 = t13 * t16;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t18 = 0.5 * t17;
-  const double t19 = h * t18;
-  const double t20 = p0[0] /* p_x */ - t19;
-  const double t21 = 0.5 * t15;
-  const double t22 = h * t21;
-  const double t23 = p0[1] /* p_y */ - t22;
-  const double t24 = h * t17;
-  const double t25 = -t24;
-  const double t26 = h * t15;
-  const double t27 = -t26;
-  /* gam */
-  out[0] = t20;
-  out[1] = t23;
-  /* dp */
-  out[2] = t25;
-  out[3] = t27;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void kepler_k1s1_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k1s1_params *prm, double *out)
@@ -127,14 +83,14 @@ void kepler_k1s1_init_params(kepler_k1s1_state *x, const kepler_k1s1_real *q0, c
 {
   int i;
   kepler_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k1s1_NU ? kepler_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k1s1_init(kepler_k1s1_state *x, const kepler_k1s1_real *q0, const kepler_k1s1_real *p0)
@@ -172,8 +128,9 @@ void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, const kepler_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -213,24 +170,67 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h_, const kepler_k1s
   kepler_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k1s1_EBADSTEP;
   kepler_k1s1_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0;
   for (it = 1; it <= kepler_k1s1_MAXITER; it++) {
-    kepler_k1s1_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = 0.5 * gm0;
+      const double t1 = h * t0;
+      const double t2 = t1 + x->q[0] /* x */;
+      const double t3 = 0.5 * gm1;
+      const double t4 = h * t3;
+      const double t5 = t4 + x->q[1] /* y */;
+      const double t6 = t2 * t2;
+      const double t7 = t5 * t5;
+      const double t8 = t6 + t7;
+      const double t9 = sqrt(t8);
+      const double t10 = 1.0 / t9;
+      const double t11 = t10 * t10;
+      const double t12 = 0.5 * t11;
+      const double t13 = t10 * t12;
+      const double t14 = 2.0 * t5;
+      const double t15 = t13 * t14;
+      const double t16 = 2.0 * t2;
+      const double t17 = t13 * t16;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t18 = 0.5 * t17;
+      const double t19 = h * t18;
+      const double t20 = x->p[0] /* p_x */ - t19;
+      const double t21 = 0.5 * t15;
+      const double t22 = h * t21;
+      const double t23 = x->p[1] /* p_y */ - t22;
+      const double t24 = h * t17;
+      const double t25 = -t24;
+      const double t26 = h * t15;
+      const double t27 = -t26;
+      /* gam */
+      sw0 = t20;
+      sw1 = t23;
+      /* dp */
+      sw2 = t25;
+      sw3 = t27;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < kepler_k1s1_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + kepler_k1s1_NU; i++)
-      if (!isfinite(sw[i])) rc = kepler_k1s1_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3)) rc = kepler_k1s1_ENONFINITE;
     if (rc == kepler_k1s1_ENONFINITE || !isfinite(inc)) { rc = kepler_k1s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k1s1_TOL / 256), or
      * within 2 ulps (kepler_k1s1_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -249,6 +249,12 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h_, const kepler_k1s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
   if (st) { st->iters = it > kepler_k1s1_MAXITER ? kepler_k1s1_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k1s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k1s1_ENONFINITE;
@@ -261,8 +267,12 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h_, const kepler_k1s
     kepler_k1s1_add(&x->p[i], &x->pc[i], sw[kepler_k1s1_S * kepler_k1s1_M + i]);
   }
   for (i = 0; i < kepler_k1s1_NU; i++) x->lambda[i] = sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + i];
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k1s1_OK;
 }

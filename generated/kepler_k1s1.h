@@ -25,8 +25,9 @@ typedef double kepler_k1s1_real;
 
 typedef struct {
   kepler_k1s1_real t, q[2], p[2], lambda[1];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k1s1_real tc, qc[2], pc[2], gam[2], hprev;
+  kepler_k1s1_real gam2[2], hprev2;
 } kepler_k1s1_state;
 
 typedef struct {

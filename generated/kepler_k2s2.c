@@ -43,99 +43,6 @@ static const double kepler_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.9999999
 static const double kepler_k2s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k2s2_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void kepler_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const kepler_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.21132486540518713;
-  const double t1 = gam[2] * (-0.28867513459481292);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = t3 + q0[0] /* x */;
-  const double t5 = 0.21132486540518713 * gam[1];
-  const double t6 = (-0.28867513459481292) * gam[3];
-  const double t7 = t5 + t6;
-  const double t8 = h * t7;
-  const double t9 = t8 + q0[1] /* y */;
-  const double t10 = t4 * t4;
-  const double t11 = t9 * t9;
-  const double t12 = t10 + t11;
-  const double t13 = sqrt(t12);
-  const double t14 = 1.0 / t13;
-  const double t15 = t14 * t14;
-  const double t16 = 0.5 * t15;
-  const double t17 = t14 * t16;
-  const double t18 = 2.0 * t9;
-  const double t19 = t17 * t18;
-  const double t20 = 2.0 * t4;
-  const double t21 = t17 * t20;
-  const double t22 = 0.5 * t21;
-  const double t23 = 0.5 * t19;
-  const double t24 = t21 * (-0.49999999999999994);
-  const double t25 = t19 * (-0.49999999999999994);
-  /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t26 = gam[0] * 0.78867513459481287;
-  const double t27 = t1 + t26;
-  const double t28 = h * t27;
-  const double t29 = q0[0] /* x */ + t28;
-  const double t30 = gam[1] * 0.78867513459481287;
-  const double t31 = t6 + t30;
-  const double t32 = h * t31;
-  const double t33 = q0[1] /* y */ + t32;
-  const double t34 = t29 * t29;
-  const double t35 = t33 * t33;
-  const double t36 = t34 + t35;
-  const double t37 = sqrt(t36);
-  const double t38 = 1.0 / t37;
-  const double t39 = t38 * t38;
-  const double t40 = 0.5 * t39;
-  const double t41 = t38 * t40;
-  const double t42 = 2.0 * t33;
-  const double t43 = t41 * t42;
-  const double t44 = 2.0 * t29;
-  const double t45 = t41 * t44;
-  const double t46 = 0.5 * t45;
-  const double t47 = t22 + t46;
-  const double t48 = 0.5 * t43;
-  const double t49 = t23 + t48;
-  const double t50 = t45 * 0.49999999999999994;
-  const double t51 = t24 + t50;
-  const double t52 = t43 * 0.49999999999999994;
-  const double t53 = t25 + t52;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t54 = 0.5 * t47;
-  const double t55 = t51 * 0.28867513459481292;
-  const double t56 = t54 - t55;
-  const double t57 = h * t56;
-  const double t58 = p0[0] /* p_x */ - t57;
-  const double t59 = 0.5 * t49;
-  const double t60 = t53 * 0.28867513459481292;
-  const double t61 = t59 - t60;
-  const double t62 = h * t61;
-  const double t63 = p0[1] /* p_y */ - t62;
-  const double t64 = t47 * 0.28867513459481292;
-  const double t65 = h * t64;
-  const double t66 = -t65;
-  const double t67 = t49 * 0.28867513459481292;
-  const double t68 = h * t67;
-  const double t69 = -t68;
-  const double t70 = h * t47;
-  const double t71 = -t70;
-  const double t72 = h * t49;
-  const double t73 = -t72;
-  /* gam */
-  out[0] = t58;
-  out[1] = t63;
-  out[2] = t66;
-  out[3] = t69;
-  /* dp */
-  out[4] = t71;
-  out[5] = t73;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void kepler_k2s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k2s2_params *prm, double *out)
@@ -177,14 +84,14 @@ void kepler_k2s2_init_params(kepler_k2s2_state *x, const kepler_k2s2_real *q0, c
 {
   int i;
   kepler_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k2s2_NU ? kepler_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k2s2_init(kepler_k2s2_state *x, const kepler_k2s2_real *q0, const kepler_k2s2_real *p0)
@@ -222,8 +129,9 @@ void kepler_k2s2_hidden(const kepler_k2s2_state *x, const kepler_k2s2_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k2s2_predict(const kepler_k2s2_state *x, double h, const kepler_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -263,24 +171,122 @@ int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h_, const kepler_k2s
   kepler_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k2s2_EBADSTEP;
   kepler_k2s2_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
   for (it = 1; it <= kepler_k2s2_MAXITER; it++) {
-    kepler_k2s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.21132486540518713;
+      const double t1 = gm2 * (-0.28867513459481292);
+      const double t2 = t0 + t1;
+      const double t3 = h * t2;
+      const double t4 = t3 + x->q[0] /* x */;
+      const double t5 = 0.21132486540518713 * gm1;
+      const double t6 = (-0.28867513459481292) * gm3;
+      const double t7 = t5 + t6;
+      const double t8 = h * t7;
+      const double t9 = t8 + x->q[1] /* y */;
+      const double t10 = t4 * t4;
+      const double t11 = t9 * t9;
+      const double t12 = t10 + t11;
+      const double t13 = sqrt(t12);
+      const double t14 = 1.0 / t13;
+      const double t15 = t14 * t14;
+      const double t16 = 0.5 * t15;
+      const double t17 = t14 * t16;
+      const double t18 = 2.0 * t9;
+      const double t19 = t17 * t18;
+      const double t20 = 2.0 * t4;
+      const double t21 = t17 * t20;
+      const double t22 = 0.5 * t21;
+      const double t23 = 0.5 * t19;
+      const double t24 = t21 * (-0.49999999999999994);
+      const double t25 = t19 * (-0.49999999999999994);
+      /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t26 = gm0 * 0.78867513459481287;
+      const double t27 = t1 + t26;
+      const double t28 = h * t27;
+      const double t29 = x->q[0] /* x */ + t28;
+      const double t30 = gm1 * 0.78867513459481287;
+      const double t31 = t6 + t30;
+      const double t32 = h * t31;
+      const double t33 = x->q[1] /* y */ + t32;
+      const double t34 = t29 * t29;
+      const double t35 = t33 * t33;
+      const double t36 = t34 + t35;
+      const double t37 = sqrt(t36);
+      const double t38 = 1.0 / t37;
+      const double t39 = t38 * t38;
+      const double t40 = 0.5 * t39;
+      const double t41 = t38 * t40;
+      const double t42 = 2.0 * t33;
+      const double t43 = t41 * t42;
+      const double t44 = 2.0 * t29;
+      const double t45 = t41 * t44;
+      const double t46 = 0.5 * t45;
+      const double t47 = t22 + t46;
+      const double t48 = 0.5 * t43;
+      const double t49 = t23 + t48;
+      const double t50 = t45 * 0.49999999999999994;
+      const double t51 = t24 + t50;
+      const double t52 = t43 * 0.49999999999999994;
+      const double t53 = t25 + t52;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t54 = 0.5 * t47;
+      const double t55 = t51 * 0.28867513459481292;
+      const double t56 = t54 - t55;
+      const double t57 = h * t56;
+      const double t58 = x->p[0] /* p_x */ - t57;
+      const double t59 = 0.5 * t49;
+      const double t60 = t53 * 0.28867513459481292;
+      const double t61 = t59 - t60;
+      const double t62 = h * t61;
+      const double t63 = x->p[1] /* p_y */ - t62;
+      const double t64 = t47 * 0.28867513459481292;
+      const double t65 = h * t64;
+      const double t66 = -t65;
+      const double t67 = t49 * 0.28867513459481292;
+      const double t68 = h * t67;
+      const double t69 = -t68;
+      const double t70 = h * t47;
+      const double t71 = -t70;
+      const double t72 = h * t49;
+      const double t73 = -t72;
+      /* gam */
+      sw0 = t58;
+      sw1 = t63;
+      sw2 = t66;
+      sw3 = t69;
+      /* dp */
+      sw4 = t71;
+      sw5 = t73;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < kepler_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + kepler_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = kepler_k2s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5)) rc = kepler_k2s2_ENONFINITE;
     if (rc == kepler_k2s2_ENONFINITE || !isfinite(inc)) { rc = kepler_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k2s2_TOL / 256), or
      * within 2 ulps (kepler_k2s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -299,6 +305,16 @@ int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h_, const kepler_k2s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
   if (st) { st->iters = it > kepler_k2s2_MAXITER ? kepler_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k2s2_ENONFINITE;
@@ -311,8 +327,12 @@ int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h_, const kepler_k2s
     kepler_k2s2_add(&x->p[i], &x->pc[i], sw[kepler_k2s2_S * kepler_k2s2_M + i]);
   }
   for (i = 0; i < kepler_k2s2_NU; i++) x->lambda[i] = sw[kepler_k2s2_S * kepler_k2s2_M + kepler_k2s2_M + i];
-  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k2s2_OK;
 }

@@ -44,156 +44,6 @@ static const double kepler_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.41640786499
 static const double kepler_k3s3_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k3s3_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const kepler_k3s3_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.1127016653792583;
-  const double t1 = gam[2] * (-0.17320508075688779);
-  const double t2 = t0 + t1;
-  const double t3 = gam[4] * 0.1732050807568877;
-  const double t4 = t2 + t3;
-  const double t5 = h * t4;
-  const double t6 = t5 + q0[0] /* x */;
-  const double t7 = 0.1127016653792583 * gam[1];
-  const double t8 = (-0.17320508075688779) * gam[3];
-  const double t9 = t7 + t8;
-  const double t10 = 0.1732050807568877 * gam[5];
-  const double t11 = t9 + t10;
-  const double t12 = h * t11;
-  const double t13 = t12 + q0[1] /* y */;
-  const double t14 = t6 * t6;
-  const double t15 = t13 * t13;
-  const double t16 = t14 + t15;
-  const double t17 = sqrt(t16);
-  const double t18 = 1.0 / t17;
-  const double t19 = t18 * t18;
-  const double t20 = 0.5 * t19;
-  const double t21 = t18 * t20;
-  const double t22 = 2.0 * t13;
-  const double t23 = t21 * t22;
-  const double t24 = 2.0 * t6;
-  const double t25 = t21 * t24;
-  const double t26 = t25 * 0.27777777777777779;
-  const double t27 = t23 * 0.27777777777777779;
-  const double t28 = t25 * (-0.37267799624996495);
-  const double t29 = t23 * (-0.37267799624996495);
-  const double t30 = t25 * 0.24845199749997668;
-  const double t31 = t23 * 0.24845199749997668;
-  /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t32 = 0.5 * gam[0];
-  const double t33 = gam[2] * (-0.43301270189221935);
-  const double t34 = t32 + t33;
-  const double t35 = h * t34;
-  const double t36 = q0[0] /* x */ + t35;
-  const double t37 = 0.5 * gam[1];
-  const double t38 = gam[3] * (-0.43301270189221935);
-  const double t39 = t37 + t38;
-  const double t40 = h * t39;
-  const double t41 = q0[1] /* y */ + t40;
-  const double t42 = t36 * t36;
-  const double t43 = t41 * t41;
-  const double t44 = t42 + t43;
-  const double t45 = sqrt(t44);
-  const double t46 = 1.0 / t45;
-  const double t47 = t46 * t46;
-  const double t48 = 0.5 * t47;
-  const double t49 = t46 * t48;
-  const double t50 = 2.0 * t41;
-  const double t51 = t49 * t50;
-  const double t52 = 2.0 * t36;
-  const double t53 = t49 * t52;
-  const double t54 = t53 * 0.44444444444444442;
-  const double t55 = t26 + t54;
-  const double t56 = t51 * 0.44444444444444442;
-  const double t57 = t27 + t56;
-  const double t58 = t53 * (-0.49690399499995325);
-  const double t59 = t30 + t58;
-  const double t60 = t51 * (-0.49690399499995325);
-  const double t61 = t31 + t60;
-  /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t62 = gam[0] * 0.8872983346207417;
-  const double t63 = t1 + t62;
-  const double t64 = gam[4] * (-0.1732050807568877);
-  const double t65 = t63 + t64;
-  const double t66 = h * t65;
-  const double t67 = q0[0] /* x */ + t66;
-  const double t68 = gam[1] * 0.8872983346207417;
-  const double t69 = t8 + t68;
-  const double t70 = gam[5] * (-0.1732050807568877);
-  const double t71 = t69 + t70;
-  const double t72 = h * t71;
-  const double t73 = q0[1] /* y */ + t72;
-  const double t74 = t67 * t67;
-  const double t75 = t73 * t73;
-  const double t76 = t74 + t75;
-  const double t77 = sqrt(t76);
-  const double t78 = 1.0 / t77;
-  const double t79 = t78 * t78;
-  const double t80 = 0.5 * t79;
-  const double t81 = t78 * t80;
-  const double t82 = 2.0 * t73;
-  const double t83 = t81 * t82;
-  const double t84 = 2.0 * t67;
-  const double t85 = t81 * t84;
-  const double t86 = 0.27777777777777779 * t85;
-  const double t87 = t55 + t86;
-  const double t88 = 0.27777777777777779 * t83;
-  const double t89 = t57 + t88;
-  const double t90 = t85 * 0.37267799624996495;
-  const double t91 = t28 + t90;
-  const double t92 = t83 * 0.37267799624996495;
-  const double t93 = t29 + t92;
-  const double t94 = 0.24845199749997668 * t85;
-  const double t95 = t59 + t94;
-  const double t96 = 0.24845199749997668 * t83;
-  const double t97 = t61 + t96;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t98 = 0.5 * t87;
-  const double t99 = t91 * 0.28867513459481292;
-  const double t100 = t98 - t99;
-  const double t101 = h * t100;
-  const double t102 = p0[0] /* p_x */ - t101;
-  const double t103 = 0.5 * t89;
-  const double t104 = t93 * 0.28867513459481292;
-  const double t105 = t103 - t104;
-  const double t106 = h * t105;
-  const double t107 = p0[1] /* p_y */ - t106;
-  const double t108 = t87 * 0.28867513459481292;
-  const double t109 = t95 * 0.12909944487358055;
-  const double t110 = t108 - t109;
-  const double t111 = h * t110;
-  const double t112 = -t111;
-  const double t113 = t89 * 0.28867513459481292;
-  const double t114 = t97 * 0.12909944487358055;
-  const double t115 = t113 - t114;
-  const double t116 = h * t115;
-  const double t117 = -t116;
-  const double t118 = t91 * 0.12909944487358055;
-  const double t119 = h * t118;
-  const double t120 = -t119;
-  const double t121 = t93 * 0.12909944487358055;
-  const double t122 = h * t121;
-  const double t123 = -t122;
-  const double t124 = h * t87;
-  const double t125 = -t124;
-  const double t126 = h * t89;
-  const double t127 = -t126;
-  /* gam */
-  out[0] = t102;
-  out[1] = t107;
-  out[2] = t112;
-  out[3] = t117;
-  out[4] = t120;
-  out[5] = t123;
-  /* dp */
-  out[6] = t125;
-  out[7] = t127;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void kepler_k3s3_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k3s3_params *prm, double *out)
@@ -235,14 +85,14 @@ void kepler_k3s3_init_params(kepler_k3s3_state *x, const kepler_k3s3_real *q0, c
 {
   int i;
   kepler_k3s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k3s3_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k3s3_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k3s3_NU ? kepler_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k3s3_init(kepler_k3s3_state *x, const kepler_k3s3_real *q0, const kepler_k3s3_real *p0)
@@ -280,8 +130,9 @@ void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k3s3_predict(const kepler_k3s3_state *x, double h, const kepler_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -321,24 +172,186 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h_, const kepler_k3s
   kepler_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k3s3_EBADSTEP;
   kepler_k3s3_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
   for (it = 1; it <= kepler_k3s3_MAXITER; it++) {
-    kepler_k3s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.1127016653792583;
+      const double t1 = gm2 * (-0.17320508075688779);
+      const double t2 = t0 + t1;
+      const double t3 = gm4 * 0.1732050807568877;
+      const double t4 = t2 + t3;
+      const double t5 = h * t4;
+      const double t6 = t5 + x->q[0] /* x */;
+      const double t7 = 0.1127016653792583 * gm1;
+      const double t8 = (-0.17320508075688779) * gm3;
+      const double t9 = t7 + t8;
+      const double t10 = 0.1732050807568877 * gm5;
+      const double t11 = t9 + t10;
+      const double t12 = h * t11;
+      const double t13 = t12 + x->q[1] /* y */;
+      const double t14 = t6 * t6;
+      const double t15 = t13 * t13;
+      const double t16 = t14 + t15;
+      const double t17 = sqrt(t16);
+      const double t18 = 1.0 / t17;
+      const double t19 = t18 * t18;
+      const double t20 = 0.5 * t19;
+      const double t21 = t18 * t20;
+      const double t22 = 2.0 * t13;
+      const double t23 = t21 * t22;
+      const double t24 = 2.0 * t6;
+      const double t25 = t21 * t24;
+      const double t26 = t25 * 0.27777777777777779;
+      const double t27 = t23 * 0.27777777777777779;
+      const double t28 = t25 * (-0.37267799624996495);
+      const double t29 = t23 * (-0.37267799624996495);
+      const double t30 = t25 * 0.24845199749997668;
+      const double t31 = t23 * 0.24845199749997668;
+      /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t32 = 0.5 * gm0;
+      const double t33 = gm2 * (-0.43301270189221935);
+      const double t34 = t32 + t33;
+      const double t35 = h * t34;
+      const double t36 = x->q[0] /* x */ + t35;
+      const double t37 = 0.5 * gm1;
+      const double t38 = gm3 * (-0.43301270189221935);
+      const double t39 = t37 + t38;
+      const double t40 = h * t39;
+      const double t41 = x->q[1] /* y */ + t40;
+      const double t42 = t36 * t36;
+      const double t43 = t41 * t41;
+      const double t44 = t42 + t43;
+      const double t45 = sqrt(t44);
+      const double t46 = 1.0 / t45;
+      const double t47 = t46 * t46;
+      const double t48 = 0.5 * t47;
+      const double t49 = t46 * t48;
+      const double t50 = 2.0 * t41;
+      const double t51 = t49 * t50;
+      const double t52 = 2.0 * t36;
+      const double t53 = t49 * t52;
+      const double t54 = t53 * 0.44444444444444442;
+      const double t55 = t26 + t54;
+      const double t56 = t51 * 0.44444444444444442;
+      const double t57 = t27 + t56;
+      const double t58 = t53 * (-0.49690399499995325);
+      const double t59 = t30 + t58;
+      const double t60 = t51 * (-0.49690399499995325);
+      const double t61 = t31 + t60;
+      /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t62 = gm0 * 0.8872983346207417;
+      const double t63 = t1 + t62;
+      const double t64 = gm4 * (-0.1732050807568877);
+      const double t65 = t63 + t64;
+      const double t66 = h * t65;
+      const double t67 = x->q[0] /* x */ + t66;
+      const double t68 = gm1 * 0.8872983346207417;
+      const double t69 = t8 + t68;
+      const double t70 = gm5 * (-0.1732050807568877);
+      const double t71 = t69 + t70;
+      const double t72 = h * t71;
+      const double t73 = x->q[1] /* y */ + t72;
+      const double t74 = t67 * t67;
+      const double t75 = t73 * t73;
+      const double t76 = t74 + t75;
+      const double t77 = sqrt(t76);
+      const double t78 = 1.0 / t77;
+      const double t79 = t78 * t78;
+      const double t80 = 0.5 * t79;
+      const double t81 = t78 * t80;
+      const double t82 = 2.0 * t73;
+      const double t83 = t81 * t82;
+      const double t84 = 2.0 * t67;
+      const double t85 = t81 * t84;
+      const double t86 = 0.27777777777777779 * t85;
+      const double t87 = t55 + t86;
+      const double t88 = 0.27777777777777779 * t83;
+      const double t89 = t57 + t88;
+      const double t90 = t85 * 0.37267799624996495;
+      const double t91 = t28 + t90;
+      const double t92 = t83 * 0.37267799624996495;
+      const double t93 = t29 + t92;
+      const double t94 = 0.24845199749997668 * t85;
+      const double t95 = t59 + t94;
+      const double t96 = 0.24845199749997668 * t83;
+      const double t97 = t61 + t96;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t98 = 0.5 * t87;
+      const double t99 = t91 * 0.28867513459481292;
+      const double t100 = t98 - t99;
+      const double t101 = h * t100;
+      const double t102 = x->p[0] /* p_x */ - t101;
+      const double t103 = 0.5 * t89;
+      const double t104 = t93 * 0.28867513459481292;
+      const double t105 = t103 - t104;
+      const double t106 = h * t105;
+      const double t107 = x->p[1] /* p_y */ - t106;
+      const double t108 = t87 * 0.28867513459481292;
+      const double t109 = t95 * 0.12909944487358055;
+      const double t110 = t108 - t109;
+      const double t111 = h * t110;
+      const double t112 = -t111;
+      const double t113 = t89 * 0.28867513459481292;
+      const double t114 = t97 * 0.12909944487358055;
+      const double t115 = t113 - t114;
+      const double t116 = h * t115;
+      const double t117 = -t116;
+      const double t118 = t91 * 0.12909944487358055;
+      const double t119 = h * t118;
+      const double t120 = -t119;
+      const double t121 = t93 * 0.12909944487358055;
+      const double t122 = h * t121;
+      const double t123 = -t122;
+      const double t124 = h * t87;
+      const double t125 = -t124;
+      const double t126 = h * t89;
+      const double t127 = -t126;
+      /* gam */
+      sw0 = t102;
+      sw1 = t107;
+      sw2 = t112;
+      sw3 = t117;
+      sw4 = t120;
+      sw5 = t123;
+      /* dp */
+      sw6 = t125;
+      sw7 = t127;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < kepler_k3s3_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + kepler_k3s3_NU; i++)
-      if (!isfinite(sw[i])) rc = kepler_k3s3_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7)) rc = kepler_k3s3_ENONFINITE;
     if (rc == kepler_k3s3_ENONFINITE || !isfinite(inc)) { rc = kepler_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k3s3_TOL / 256), or
      * within 2 ulps (kepler_k3s3_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -357,6 +370,20 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h_, const kepler_k3s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
   if (st) { st->iters = it > kepler_k3s3_MAXITER ? kepler_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k3s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k3s3_ENONFINITE;
@@ -369,8 +396,12 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h_, const kepler_k3s
     kepler_k3s3_add(&x->p[i], &x->pc[i], sw[kepler_k3s3_S * kepler_k3s3_M + i]);
   }
   for (i = 0; i < kepler_k3s3_NU; i++) x->lambda[i] = sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + i];
-  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k3s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k3s3_OK;
 }

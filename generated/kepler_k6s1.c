@@ -47,167 +47,6 @@ static const double kepler_k6s1_E1[1] = {1.0};
 static const double kepler_k6s1_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k6s1_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void kepler_k6s1_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const kepler_k6s1_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.033765242898423975;
-  const double t1 = h * t0;
-  const double t2 = t1 + q0[0] /* x */;
-  const double t3 = 0.033765242898423975 * gam[1];
-  const double t4 = h * t3;
-  const double t5 = t4 + q0[1] /* y */;
-  const double t6 = t2 * t2;
-  const double t7 = t5 * t5;
-  const double t8 = t6 + t7;
-  const double t9 = sqrt(t8);
-  const double t10 = 1.0 / t9;
-  const double t11 = t10 * t10;
-  const double t12 = 0.5 * t11;
-  const double t13 = t10 * t12;
-  const double t14 = 2.0 * t5;
-  const double t15 = t13 * t14;
-  const double t16 = 2.0 * t2;
-  const double t17 = t13 * t16;
-  const double t18 = t17 * 0.085662246189585178;
-  const double t19 = t15 * 0.085662246189585178;
-  /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t20 = gam[0] * 0.16939530676686776;
-  const double t21 = h * t20;
-  const double t22 = q0[0] /* x */ + t21;
-  const double t23 = gam[1] * 0.16939530676686776;
-  const double t24 = h * t23;
-  const double t25 = q0[1] /* y */ + t24;
-  const double t26 = t22 * t22;
-  const double t27 = t25 * t25;
-  const double t28 = t26 + t27;
-  const double t29 = sqrt(t28);
-  const double t30 = 1.0 / t29;
-  const double t31 = t30 * t30;
-  const double t32 = 0.5 * t31;
-  const double t33 = t30 * t32;
-  const double t34 = 2.0 * t25;
-  const double t35 = t33 * t34;
-  const double t36 = 2.0 * t22;
-  const double t37 = t33 * t36;
-  const double t38 = t37 * 0.1803807865240693;
-  const double t39 = t18 + t38;
-  const double t40 = t35 * 0.1803807865240693;
-  const double t41 = t19 + t40;
-  /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t42 = gam[0] * 0.38069040695840156;
-  const double t43 = h * t42;
-  const double t44 = q0[0] /* x */ + t43;
-  const double t45 = gam[1] * 0.38069040695840156;
-  const double t46 = h * t45;
-  const double t47 = q0[1] /* y */ + t46;
-  const double t48 = t44 * t44;
-  const double t49 = t47 * t47;
-  const double t50 = t48 + t49;
-  const double t51 = sqrt(t50);
-  const double t52 = 1.0 / t51;
-  const double t53 = t52 * t52;
-  const double t54 = 0.5 * t53;
-  const double t55 = t52 * t54;
-  const double t56 = 2.0 * t47;
-  const double t57 = t55 * t56;
-  const double t58 = 2.0 * t44;
-  const double t59 = t55 * t58;
-  const double t60 = t59 * 0.23395696728634552;
-  const double t61 = t39 + t60;
-  const double t62 = t57 * 0.23395696728634552;
-  const double t63 = t41 + t62;
-  /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t64 = gam[0] * 0.61930959304159849;
-  const double t65 = h * t64;
-  const double t66 = q0[0] /* x */ + t65;
-  const double t67 = gam[1] * 0.61930959304159849;
-  const double t68 = h * t67;
-  const double t69 = q0[1] /* y */ + t68;
-  const double t70 = t66 * t66;
-  const double t71 = t69 * t69;
-  const double t72 = t70 + t71;
-  const double t73 = sqrt(t72);
-  const double t74 = 1.0 / t73;
-  const double t75 = t74 * t74;
-  const double t76 = 0.5 * t75;
-  const double t77 = t74 * t76;
-  const double t78 = 2.0 * t69;
-  const double t79 = t77 * t78;
-  const double t80 = 2.0 * t66;
-  const double t81 = t77 * t80;
-  const double t82 = 0.23395696728634552 * t81;
-  const double t83 = t61 + t82;
-  const double t84 = 0.23395696728634552 * t79;
-  const double t85 = t63 + t84;
-  /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t86 = gam[0] * 0.83060469323313224;
-  const double t87 = h * t86;
-  const double t88 = q0[0] /* x */ + t87;
-  const double t89 = gam[1] * 0.83060469323313224;
-  const double t90 = h * t89;
-  const double t91 = q0[1] /* y */ + t90;
-  const double t92 = t88 * t88;
-  const double t93 = t91 * t91;
-  const double t94 = t92 + t93;
-  const double t95 = sqrt(t94);
-  const double t96 = 1.0 / t95;
-  const double t97 = t96 * t96;
-  const double t98 = 0.5 * t97;
-  const double t99 = t96 * t98;
-  const double t100 = 2.0 * t91;
-  const double t101 = t99 * t100;
-  const double t102 = 2.0 * t88;
-  const double t103 = t99 * t102;
-  const double t104 = 0.1803807865240693 * t103;
-  const double t105 = t83 + t104;
-  const double t106 = 0.1803807865240693 * t101;
-  const double t107 = t85 + t106;
-  /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t108 = gam[0] * 0.96623475710157603;
-  const double t109 = h * t108;
-  const double t110 = q0[0] /* x */ + t109;
-  const double t111 = gam[1] * 0.96623475710157603;
-  const double t112 = h * t111;
-  const double t113 = q0[1] /* y */ + t112;
-  const double t114 = t110 * t110;
-  const double t115 = t113 * t113;
-  const double t116 = t114 + t115;
-  const double t117 = sqrt(t116);
-  const double t118 = 1.0 / t117;
-  const double t119 = t118 * t118;
-  const double t120 = 0.5 * t119;
-  const double t121 = t118 * t120;
-  const double t122 = 2.0 * t113;
-  const double t123 = t121 * t122;
-  const double t124 = 2.0 * t110;
-  const double t125 = t121 * t124;
-  const double t126 = 0.085662246189585178 * t125;
-  const double t127 = t105 + t126;
-  const double t128 = 0.085662246189585178 * t123;
-  const double t129 = t107 + t128;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t130 = 0.5 * t127;
-  const double t131 = h * t130;
-  const double t132 = p0[0] /* p_x */ - t131;
-  const double t133 = 0.5 * t129;
-  const double t134 = h * t133;
-  const double t135 = p0[1] /* p_y */ - t134;
-  const double t136 = h * t127;
-  const double t137 = -t136;
-  const double t138 = h * t129;
-  const double t139 = -t138;
-  /* gam */
-  out[0] = t132;
-  out[1] = t135;
-  /* dp */
-  out[2] = t137;
-  out[3] = t139;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void kepler_k6s1_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k6s1_params *prm, double *out)
@@ -249,14 +88,14 @@ void kepler_k6s1_init_params(kepler_k6s1_state *x, const kepler_k6s1_real *q0, c
 {
   int i;
   kepler_k6s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k6s1_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k6s1_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k6s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k6s1_NU ? kepler_k6s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k6s1_init(kepler_k6s1_state *x, const kepler_k6s1_real *q0, const kepler_k6s1_real *p0)
@@ -294,8 +133,9 @@ void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k6s1_predict(const kepler_k6s1_state *x, double h, const kepler_k6s1_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -335,24 +175,184 @@ int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h_, const kepler_k6s
   kepler_k6s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s1_EBADSTEP;
   kepler_k6s1_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0;
   for (it = 1; it <= kepler_k6s1_MAXITER; it++) {
-    kepler_k6s1_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.033765242898423975;
+      const double t1 = h * t0;
+      const double t2 = t1 + x->q[0] /* x */;
+      const double t3 = 0.033765242898423975 * gm1;
+      const double t4 = h * t3;
+      const double t5 = t4 + x->q[1] /* y */;
+      const double t6 = t2 * t2;
+      const double t7 = t5 * t5;
+      const double t8 = t6 + t7;
+      const double t9 = sqrt(t8);
+      const double t10 = 1.0 / t9;
+      const double t11 = t10 * t10;
+      const double t12 = 0.5 * t11;
+      const double t13 = t10 * t12;
+      const double t14 = 2.0 * t5;
+      const double t15 = t13 * t14;
+      const double t16 = 2.0 * t2;
+      const double t17 = t13 * t16;
+      const double t18 = t17 * 0.085662246189585178;
+      const double t19 = t15 * 0.085662246189585178;
+      /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t20 = gm0 * 0.16939530676686776;
+      const double t21 = h * t20;
+      const double t22 = x->q[0] /* x */ + t21;
+      const double t23 = gm1 * 0.16939530676686776;
+      const double t24 = h * t23;
+      const double t25 = x->q[1] /* y */ + t24;
+      const double t26 = t22 * t22;
+      const double t27 = t25 * t25;
+      const double t28 = t26 + t27;
+      const double t29 = sqrt(t28);
+      const double t30 = 1.0 / t29;
+      const double t31 = t30 * t30;
+      const double t32 = 0.5 * t31;
+      const double t33 = t30 * t32;
+      const double t34 = 2.0 * t25;
+      const double t35 = t33 * t34;
+      const double t36 = 2.0 * t22;
+      const double t37 = t33 * t36;
+      const double t38 = t37 * 0.1803807865240693;
+      const double t39 = t18 + t38;
+      const double t40 = t35 * 0.1803807865240693;
+      const double t41 = t19 + t40;
+      /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t42 = gm0 * 0.38069040695840156;
+      const double t43 = h * t42;
+      const double t44 = x->q[0] /* x */ + t43;
+      const double t45 = gm1 * 0.38069040695840156;
+      const double t46 = h * t45;
+      const double t47 = x->q[1] /* y */ + t46;
+      const double t48 = t44 * t44;
+      const double t49 = t47 * t47;
+      const double t50 = t48 + t49;
+      const double t51 = sqrt(t50);
+      const double t52 = 1.0 / t51;
+      const double t53 = t52 * t52;
+      const double t54 = 0.5 * t53;
+      const double t55 = t52 * t54;
+      const double t56 = 2.0 * t47;
+      const double t57 = t55 * t56;
+      const double t58 = 2.0 * t44;
+      const double t59 = t55 * t58;
+      const double t60 = t59 * 0.23395696728634552;
+      const double t61 = t39 + t60;
+      const double t62 = t57 * 0.23395696728634552;
+      const double t63 = t41 + t62;
+      /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t64 = gm0 * 0.61930959304159849;
+      const double t65 = h * t64;
+      const double t66 = x->q[0] /* x */ + t65;
+      const double t67 = gm1 * 0.61930959304159849;
+      const double t68 = h * t67;
+      const double t69 = x->q[1] /* y */ + t68;
+      const double t70 = t66 * t66;
+      const double t71 = t69 * t69;
+      const double t72 = t70 + t71;
+      const double t73 = sqrt(t72);
+      const double t74 = 1.0 / t73;
+      const double t75 = t74 * t74;
+      const double t76 = 0.5 * t75;
+      const double t77 = t74 * t76;
+      const double t78 = 2.0 * t69;
+      const double t79 = t77 * t78;
+      const double t80 = 2.0 * t66;
+      const double t81 = t77 * t80;
+      const double t82 = 0.23395696728634552 * t81;
+      const double t83 = t61 + t82;
+      const double t84 = 0.23395696728634552 * t79;
+      const double t85 = t63 + t84;
+      /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t86 = gm0 * 0.83060469323313224;
+      const double t87 = h * t86;
+      const double t88 = x->q[0] /* x */ + t87;
+      const double t89 = gm1 * 0.83060469323313224;
+      const double t90 = h * t89;
+      const double t91 = x->q[1] /* y */ + t90;
+      const double t92 = t88 * t88;
+      const double t93 = t91 * t91;
+      const double t94 = t92 + t93;
+      const double t95 = sqrt(t94);
+      const double t96 = 1.0 / t95;
+      const double t97 = t96 * t96;
+      const double t98 = 0.5 * t97;
+      const double t99 = t96 * t98;
+      const double t100 = 2.0 * t91;
+      const double t101 = t99 * t100;
+      const double t102 = 2.0 * t88;
+      const double t103 = t99 * t102;
+      const double t104 = 0.1803807865240693 * t103;
+      const double t105 = t83 + t104;
+      const double t106 = 0.1803807865240693 * t101;
+      const double t107 = t85 + t106;
+      /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t108 = gm0 * 0.96623475710157603;
+      const double t109 = h * t108;
+      const double t110 = x->q[0] /* x */ + t109;
+      const double t111 = gm1 * 0.96623475710157603;
+      const double t112 = h * t111;
+      const double t113 = x->q[1] /* y */ + t112;
+      const double t114 = t110 * t110;
+      const double t115 = t113 * t113;
+      const double t116 = t114 + t115;
+      const double t117 = sqrt(t116);
+      const double t118 = 1.0 / t117;
+      const double t119 = t118 * t118;
+      const double t120 = 0.5 * t119;
+      const double t121 = t118 * t120;
+      const double t122 = 2.0 * t113;
+      const double t123 = t121 * t122;
+      const double t124 = 2.0 * t110;
+      const double t125 = t121 * t124;
+      const double t126 = 0.085662246189585178 * t125;
+      const double t127 = t105 + t126;
+      const double t128 = 0.085662246189585178 * t123;
+      const double t129 = t107 + t128;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t130 = 0.5 * t127;
+      const double t131 = h * t130;
+      const double t132 = x->p[0] /* p_x */ - t131;
+      const double t133 = 0.5 * t129;
+      const double t134 = h * t133;
+      const double t135 = x->p[1] /* p_y */ - t134;
+      const double t136 = h * t127;
+      const double t137 = -t136;
+      const double t138 = h * t129;
+      const double t139 = -t138;
+      /* gam */
+      sw0 = t132;
+      sw1 = t135;
+      /* dp */
+      sw2 = t137;
+      sw3 = t139;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < kepler_k6s1_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M + kepler_k6s1_M + kepler_k6s1_NU; i++)
-      if (!isfinite(sw[i])) rc = kepler_k6s1_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3)) rc = kepler_k6s1_ENONFINITE;
     if (rc == kepler_k6s1_ENONFINITE || !isfinite(inc)) { rc = kepler_k6s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k6s1_TOL / 256), or
      * within 2 ulps (kepler_k6s1_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -371,6 +371,12 @@ int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h_, const kepler_k6s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
   if (st) { st->iters = it > kepler_k6s1_MAXITER ? kepler_k6s1_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k6s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s1_ENONFINITE;
@@ -383,8 +389,12 @@ int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h_, const kepler_k6s
     kepler_k6s1_add(&x->p[i], &x->pc[i], sw[kepler_k6s1_S * kepler_k6s1_M + i]);
   }
   for (i = 0; i < kepler_k6s1_NU; i++) x->lambda[i] = sw[kepler_k6s1_S * kepler_k6s1_M + kepler_k6s1_M + i];
-  for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k6s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k6s1_OK;
 }

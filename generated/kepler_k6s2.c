@@ -47,221 +47,6 @@ static const double kepler_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.551115123125
 static const double kepler_k6s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k6s2_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void kepler_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const kepler_k6s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.033765242898423975;
-  const double t1 = gam[2] * (-0.056508419605012766);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = t3 + q0[0] /* x */;
-  const double t5 = 0.033765242898423975 * gam[1];
-  const double t6 = (-0.056508419605012766) * gam[3];
-  const double t7 = t5 + t6;
-  const double t8 = h * t7;
-  const double t9 = t8 + q0[1] /* y */;
-  const double t10 = t4 * t4;
-  const double t11 = t9 * t9;
-  const double t12 = t10 + t11;
-  const double t13 = sqrt(t12);
-  const double t14 = 1.0 / t13;
-  const double t15 = t14 * t14;
-  const double t16 = 0.5 * t15;
-  const double t17 = t14 * t16;
-  const double t18 = 2.0 * t9;
-  const double t19 = t17 * t18;
-  const double t20 = 2.0 * t4;
-  const double t21 = t17 * t20;
-  const double t22 = t21 * 0.085662246189585178;
-  const double t23 = t19 * 0.085662246189585178;
-  const double t24 = t21 * (-0.13835177248998257);
-  const double t25 = t19 * (-0.13835177248998257);
-  /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t26 = gam[0] * 0.16939530676686776;
-  const double t27 = gam[2] * (-0.24370047841099157);
-  const double t28 = t26 + t27;
-  const double t29 = h * t28;
-  const double t30 = q0[0] /* x */ + t29;
-  const double t31 = gam[1] * 0.16939530676686776;
-  const double t32 = gam[3] * (-0.24370047841099157);
-  const double t33 = t31 + t32;
-  const double t34 = h * t33;
-  const double t35 = q0[1] /* y */ + t34;
-  const double t36 = t30 * t30;
-  const double t37 = t35 * t35;
-  const double t38 = t36 + t37;
-  const double t39 = sqrt(t38);
-  const double t40 = 1.0 / t39;
-  const double t41 = t40 * t40;
-  const double t42 = 0.5 * t41;
-  const double t43 = t40 * t42;
-  const double t44 = 2.0 * t35;
-  const double t45 = t43 * t44;
-  const double t46 = 2.0 * t30;
-  const double t47 = t43 * t46;
-  const double t48 = t47 * 0.1803807865240693;
-  const double t49 = t22 + t48;
-  const double t50 = t45 * 0.1803807865240693;
-  const double t51 = t23 + t50;
-  const double t52 = t47 * (-0.20658078042518249);
-  const double t53 = t24 + t52;
-  const double t54 = t45 * (-0.20658078042518249);
-  const double t55 = t25 + t54;
-  /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t56 = gam[0] * 0.38069040695840156;
-  const double t57 = gam[2] * (-0.40835734144399111);
-  const double t58 = t56 + t57;
-  const double t59 = h * t58;
-  const double t60 = q0[0] /* x */ + t59;
-  const double t61 = gam[1] * 0.38069040695840156;
-  const double t62 = gam[3] * (-0.40835734144399111);
-  const double t63 = t61 + t62;
-  const double t64 = h * t63;
-  const double t65 = q0[1] /* y */ + t64;
-  const double t66 = t60 * t60;
-  const double t67 = t65 * t65;
-  const double t68 = t66 + t67;
-  const double t69 = sqrt(t68);
-  const double t70 = 1.0 / t69;
-  const double t71 = t70 * t70;
-  const double t72 = 0.5 * t71;
-  const double t73 = t70 * t72;
-  const double t74 = 2.0 * t65;
-  const double t75 = t73 * t74;
-  const double t76 = 2.0 * t60;
-  const double t77 = t73 * t76;
-  const double t78 = t77 * 0.23395696728634552;
-  const double t79 = t49 + t78;
-  const double t80 = t75 * 0.23395696728634552;
-  const double t81 = t51 + t80;
-  const double t82 = t77 * (-0.096694544181506401);
-  const double t83 = t53 + t82;
-  const double t84 = t75 * (-0.096694544181506401);
-  const double t85 = t55 + t84;
-  /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t86 = gam[0] * 0.61930959304159849;
-  const double t87 = gam[2] * (-0.40835734144399105);
-  const double t88 = t86 + t87;
-  const double t89 = h * t88;
-  const double t90 = q0[0] /* x */ + t89;
-  const double t91 = gam[1] * 0.61930959304159849;
-  const double t92 = gam[3] * (-0.40835734144399105);
-  const double t93 = t91 + t92;
-  const double t94 = h * t93;
-  const double t95 = q0[1] /* y */ + t94;
-  const double t96 = t90 * t90;
-  const double t97 = t95 * t95;
-  const double t98 = t96 + t97;
-  const double t99 = sqrt(t98);
-  const double t100 = 1.0 / t99;
-  const double t101 = t100 * t100;
-  const double t102 = 0.5 * t101;
-  const double t103 = t100 * t102;
-  const double t104 = 2.0 * t95;
-  const double t105 = t103 * t104;
-  const double t106 = 2.0 * t90;
-  const double t107 = t103 * t106;
-  const double t108 = 0.23395696728634552 * t107;
-  const double t109 = t79 + t108;
-  const double t110 = 0.23395696728634552 * t105;
-  const double t111 = t81 + t110;
-  const double t112 = t107 * 0.096694544181506442;
-  const double t113 = t83 + t112;
-  const double t114 = t105 * 0.096694544181506442;
-  const double t115 = t85 + t114;
-  /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t116 = gam[0] * 0.83060469323313224;
-  const double t117 = t27 + t116;
-  const double t118 = h * t117;
-  const double t119 = q0[0] /* x */ + t118;
-  const double t120 = gam[1] * 0.83060469323313224;
-  const double t121 = t32 + t120;
-  const double t122 = h * t121;
-  const double t123 = q0[1] /* y */ + t122;
-  const double t124 = t119 * t119;
-  const double t125 = t123 * t123;
-  const double t126 = t124 + t125;
-  const double t127 = sqrt(t126);
-  const double t128 = 1.0 / t127;
-  const double t129 = t128 * t128;
-  const double t130 = 0.5 * t129;
-  const double t131 = t128 * t130;
-  const double t132 = 2.0 * t123;
-  const double t133 = t131 * t132;
-  const double t134 = 2.0 * t119;
-  const double t135 = t131 * t134;
-  const double t136 = 0.1803807865240693 * t135;
-  const double t137 = t109 + t136;
-  const double t138 = 0.1803807865240693 * t133;
-  const double t139 = t111 + t138;
-  const double t140 = t135 * 0.20658078042518249;
-  const double t141 = t113 + t140;
-  const double t142 = t133 * 0.20658078042518249;
-  const double t143 = t115 + t142;
-  /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t144 = gam[0] * 0.96623475710157603;
-  const double t145 = t1 + t144;
-  const double t146 = h * t145;
-  const double t147 = q0[0] /* x */ + t146;
-  const double t148 = gam[1] * 0.96623475710157603;
-  const double t149 = t6 + t148;
-  const double t150 = h * t149;
-  const double t151 = q0[1] /* y */ + t150;
-  const double t152 = t147 * t147;
-  const double t153 = t151 * t151;
-  const double t154 = t152 + t153;
-  const double t155 = sqrt(t154);
-  const double t156 = 1.0 / t155;
-  const double t157 = t156 * t156;
-  const double t158 = 0.5 * t157;
-  const double t159 = t156 * t158;
-  const double t160 = 2.0 * t151;
-  const double t161 = t159 * t160;
-  const double t162 = 2.0 * t147;
-  const double t163 = t159 * t162;
-  const double t164 = 0.085662246189585178 * t163;
-  const double t165 = t137 + t164;
-  const double t166 = 0.085662246189585178 * t161;
-  const double t167 = t139 + t166;
-  const double t168 = t163 * 0.13835177248998257;
-  const double t169 = t141 + t168;
-  const double t170 = t161 * 0.13835177248998257;
-  const double t171 = t143 + t170;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t172 = 0.5 * t165;
-  const double t173 = t169 * 0.28867513459481292;
-  const double t174 = t172 - t173;
-  const double t175 = h * t174;
-  const double t176 = p0[0] /* p_x */ - t175;
-  const double t177 = 0.5 * t167;
-  const double t178 = t171 * 0.28867513459481292;
-  const double t179 = t177 - t178;
-  const double t180 = h * t179;
-  const double t181 = p0[1] /* p_y */ - t180;
-  const double t182 = t165 * 0.28867513459481292;
-  const double t183 = h * t182;
-  const double t184 = -t183;
-  const double t185 = t167 * 0.28867513459481292;
-  const double t186 = h * t185;
-  const double t187 = -t186;
-  const double t188 = h * t165;
-  const double t189 = -t188;
-  const double t190 = h * t167;
-  const double t191 = -t190;
-  /* gam */
-  out[0] = t176;
-  out[1] = t181;
-  out[2] = t184;
-  out[3] = t187;
-  /* dp */
-  out[4] = t189;
-  out[5] = t191;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void kepler_k6s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k6s2_params *prm, double *out)
@@ -303,14 +88,14 @@ void kepler_k6s2_init_params(kepler_k6s2_state *x, const kepler_k6s2_real *q0, c
 {
   int i;
   kepler_k6s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k6s2_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k6s2_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k6s2_NU ? kepler_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k6s2_init(kepler_k6s2_state *x, const kepler_k6s2_real *q0, const kepler_k6s2_real *p0)
@@ -348,8 +133,9 @@ void kepler_k6s2_hidden(const kepler_k6s2_state *x, const kepler_k6s2_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k6s2_predict(const kepler_k6s2_state *x, double h, const kepler_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -389,24 +175,244 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
   kepler_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s2_EBADSTEP;
   kepler_k6s2_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
   for (it = 1; it <= kepler_k6s2_MAXITER; it++) {
-    kepler_k6s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.033765242898423975;
+      const double t1 = gm2 * (-0.056508419605012766);
+      const double t2 = t0 + t1;
+      const double t3 = h * t2;
+      const double t4 = t3 + x->q[0] /* x */;
+      const double t5 = 0.033765242898423975 * gm1;
+      const double t6 = (-0.056508419605012766) * gm3;
+      const double t7 = t5 + t6;
+      const double t8 = h * t7;
+      const double t9 = t8 + x->q[1] /* y */;
+      const double t10 = t4 * t4;
+      const double t11 = t9 * t9;
+      const double t12 = t10 + t11;
+      const double t13 = sqrt(t12);
+      const double t14 = 1.0 / t13;
+      const double t15 = t14 * t14;
+      const double t16 = 0.5 * t15;
+      const double t17 = t14 * t16;
+      const double t18 = 2.0 * t9;
+      const double t19 = t17 * t18;
+      const double t20 = 2.0 * t4;
+      const double t21 = t17 * t20;
+      const double t22 = t21 * 0.085662246189585178;
+      const double t23 = t19 * 0.085662246189585178;
+      const double t24 = t21 * (-0.13835177248998257);
+      const double t25 = t19 * (-0.13835177248998257);
+      /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t26 = gm0 * 0.16939530676686776;
+      const double t27 = gm2 * (-0.24370047841099157);
+      const double t28 = t26 + t27;
+      const double t29 = h * t28;
+      const double t30 = x->q[0] /* x */ + t29;
+      const double t31 = gm1 * 0.16939530676686776;
+      const double t32 = gm3 * (-0.24370047841099157);
+      const double t33 = t31 + t32;
+      const double t34 = h * t33;
+      const double t35 = x->q[1] /* y */ + t34;
+      const double t36 = t30 * t30;
+      const double t37 = t35 * t35;
+      const double t38 = t36 + t37;
+      const double t39 = sqrt(t38);
+      const double t40 = 1.0 / t39;
+      const double t41 = t40 * t40;
+      const double t42 = 0.5 * t41;
+      const double t43 = t40 * t42;
+      const double t44 = 2.0 * t35;
+      const double t45 = t43 * t44;
+      const double t46 = 2.0 * t30;
+      const double t47 = t43 * t46;
+      const double t48 = t47 * 0.1803807865240693;
+      const double t49 = t22 + t48;
+      const double t50 = t45 * 0.1803807865240693;
+      const double t51 = t23 + t50;
+      const double t52 = t47 * (-0.20658078042518249);
+      const double t53 = t24 + t52;
+      const double t54 = t45 * (-0.20658078042518249);
+      const double t55 = t25 + t54;
+      /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t56 = gm0 * 0.38069040695840156;
+      const double t57 = gm2 * (-0.40835734144399111);
+      const double t58 = t56 + t57;
+      const double t59 = h * t58;
+      const double t60 = x->q[0] /* x */ + t59;
+      const double t61 = gm1 * 0.38069040695840156;
+      const double t62 = gm3 * (-0.40835734144399111);
+      const double t63 = t61 + t62;
+      const double t64 = h * t63;
+      const double t65 = x->q[1] /* y */ + t64;
+      const double t66 = t60 * t60;
+      const double t67 = t65 * t65;
+      const double t68 = t66 + t67;
+      const double t69 = sqrt(t68);
+      const double t70 = 1.0 / t69;
+      const double t71 = t70 * t70;
+      const double t72 = 0.5 * t71;
+      const double t73 = t70 * t72;
+      const double t74 = 2.0 * t65;
+      const double t75 = t73 * t74;
+      const double t76 = 2.0 * t60;
+      const double t77 = t73 * t76;
+      const double t78 = t77 * 0.23395696728634552;
+      const double t79 = t49 + t78;
+      const double t80 = t75 * 0.23395696728634552;
+      const double t81 = t51 + t80;
+      const double t82 = t77 * (-0.096694544181506401);
+      const double t83 = t53 + t82;
+      const double t84 = t75 * (-0.096694544181506401);
+      const double t85 = t55 + t84;
+      /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t86 = gm0 * 0.61930959304159849;
+      const double t87 = gm2 * (-0.40835734144399105);
+      const double t88 = t86 + t87;
+      const double t89 = h * t88;
+      const double t90 = x->q[0] /* x */ + t89;
+      const double t91 = gm1 * 0.61930959304159849;
+      const double t92 = gm3 * (-0.40835734144399105);
+      const double t93 = t91 + t92;
+      const double t94 = h * t93;
+      const double t95 = x->q[1] /* y */ + t94;
+      const double t96 = t90 * t90;
+      const double t97 = t95 * t95;
+      const double t98 = t96 + t97;
+      const double t99 = sqrt(t98);
+      const double t100 = 1.0 / t99;
+      const double t101 = t100 * t100;
+      const double t102 = 0.5 * t101;
+      const double t103 = t100 * t102;
+      const double t104 = 2.0 * t95;
+      const double t105 = t103 * t104;
+      const double t106 = 2.0 * t90;
+      const double t107 = t103 * t106;
+      const double t108 = 0.23395696728634552 * t107;
+      const double t109 = t79 + t108;
+      const double t110 = 0.23395696728634552 * t105;
+      const double t111 = t81 + t110;
+      const double t112 = t107 * 0.096694544181506442;
+      const double t113 = t83 + t112;
+      const double t114 = t105 * 0.096694544181506442;
+      const double t115 = t85 + t114;
+      /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t116 = gm0 * 0.83060469323313224;
+      const double t117 = t27 + t116;
+      const double t118 = h * t117;
+      const double t119 = x->q[0] /* x */ + t118;
+      const double t120 = gm1 * 0.83060469323313224;
+      const double t121 = t32 + t120;
+      const double t122 = h * t121;
+      const double t123 = x->q[1] /* y */ + t122;
+      const double t124 = t119 * t119;
+      const double t125 = t123 * t123;
+      const double t126 = t124 + t125;
+      const double t127 = sqrt(t126);
+      const double t128 = 1.0 / t127;
+      const double t129 = t128 * t128;
+      const double t130 = 0.5 * t129;
+      const double t131 = t128 * t130;
+      const double t132 = 2.0 * t123;
+      const double t133 = t131 * t132;
+      const double t134 = 2.0 * t119;
+      const double t135 = t131 * t134;
+      const double t136 = 0.1803807865240693 * t135;
+      const double t137 = t109 + t136;
+      const double t138 = 0.1803807865240693 * t133;
+      const double t139 = t111 + t138;
+      const double t140 = t135 * 0.20658078042518249;
+      const double t141 = t113 + t140;
+      const double t142 = t133 * 0.20658078042518249;
+      const double t143 = t115 + t142;
+      /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t144 = gm0 * 0.96623475710157603;
+      const double t145 = t1 + t144;
+      const double t146 = h * t145;
+      const double t147 = x->q[0] /* x */ + t146;
+      const double t148 = gm1 * 0.96623475710157603;
+      const double t149 = t6 + t148;
+      const double t150 = h * t149;
+      const double t151 = x->q[1] /* y */ + t150;
+      const double t152 = t147 * t147;
+      const double t153 = t151 * t151;
+      const double t154 = t152 + t153;
+      const double t155 = sqrt(t154);
+      const double t156 = 1.0 / t155;
+      const double t157 = t156 * t156;
+      const double t158 = 0.5 * t157;
+      const double t159 = t156 * t158;
+      const double t160 = 2.0 * t151;
+      const double t161 = t159 * t160;
+      const double t162 = 2.0 * t147;
+      const double t163 = t159 * t162;
+      const double t164 = 0.085662246189585178 * t163;
+      const double t165 = t137 + t164;
+      const double t166 = 0.085662246189585178 * t161;
+      const double t167 = t139 + t166;
+      const double t168 = t163 * 0.13835177248998257;
+      const double t169 = t141 + t168;
+      const double t170 = t161 * 0.13835177248998257;
+      const double t171 = t143 + t170;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t172 = 0.5 * t165;
+      const double t173 = t169 * 0.28867513459481292;
+      const double t174 = t172 - t173;
+      const double t175 = h * t174;
+      const double t176 = x->p[0] /* p_x */ - t175;
+      const double t177 = 0.5 * t167;
+      const double t178 = t171 * 0.28867513459481292;
+      const double t179 = t177 - t178;
+      const double t180 = h * t179;
+      const double t181 = x->p[1] /* p_y */ - t180;
+      const double t182 = t165 * 0.28867513459481292;
+      const double t183 = h * t182;
+      const double t184 = -t183;
+      const double t185 = t167 * 0.28867513459481292;
+      const double t186 = h * t185;
+      const double t187 = -t186;
+      const double t188 = h * t165;
+      const double t189 = -t188;
+      const double t190 = h * t167;
+      const double t191 = -t190;
+      /* gam */
+      sw0 = t176;
+      sw1 = t181;
+      sw2 = t184;
+      sw3 = t187;
+      /* dp */
+      sw4 = t189;
+      sw5 = t191;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < kepler_k6s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + kepler_k6s2_NU; i++)
-      if (!isfinite(sw[i])) rc = kepler_k6s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5)) rc = kepler_k6s2_ENONFINITE;
     if (rc == kepler_k6s2_ENONFINITE || !isfinite(inc)) { rc = kepler_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k6s2_TOL / 256), or
      * within 2 ulps (kepler_k6s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -425,6 +431,16 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
   if (st) { st->iters = it > kepler_k6s2_MAXITER ? kepler_k6s2_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k6s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s2_ENONFINITE;
@@ -437,8 +453,12 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
     kepler_k6s2_add(&x->p[i], &x->pc[i], sw[kepler_k6s2_S * kepler_k6s2_M + i]);
   }
   for (i = 0; i < kepler_k6s2_NU; i++) x->lambda[i] = sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + i];
-  for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k6s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k6s2_OK;
 }

@@ -47,279 +47,6 @@ static const double kepler_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.41640786499
 static const double kepler_k6s3_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k6s3_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void kepler_k6s3_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const kepler_k6s3_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.033765242898423975;
-  const double t1 = gam[2] * (-0.056508419605012766);
-  const double t2 = t0 + t1;
-  const double t3 = gam[4] * 0.068025568234204442;
-  const double t4 = t2 + t3;
-  const double t5 = h * t4;
-  const double t6 = t5 + q0[0] /* x */;
-  const double t7 = 0.033765242898423975 * gam[1];
-  const double t8 = (-0.056508419605012766) * gam[3];
-  const double t9 = t7 + t8;
-  const double t10 = 0.068025568234204442 * gam[5];
-  const double t11 = t9 + t10;
-  const double t12 = h * t11;
-  const double t13 = t12 + q0[1] /* y */;
-  const double t14 = t6 * t6;
-  const double t15 = t13 * t13;
-  const double t16 = t14 + t15;
-  const double t17 = sqrt(t16);
-  const double t18 = 1.0 / t17;
-  const double t19 = t18 * t18;
-  const double t20 = 0.5 * t19;
-  const double t21 = t18 * t20;
-  const double t22 = 2.0 * t13;
-  const double t23 = t21 * t22;
-  const double t24 = 2.0 * t6;
-  const double t25 = t21 * t24;
-  const double t26 = t25 * 0.085662246189585178;
-  const double t27 = t23 * 0.085662246189585178;
-  const double t28 = t25 * (-0.13835177248998257);
-  const double t29 = t23 * (-0.13835177248998257);
-  const double t30 = t25 * 0.15405118368989568;
-  const double t31 = t23 * 0.15405118368989568;
-  /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t32 = gam[0] * 0.16939530676686776;
-  const double t33 = gam[2] * (-0.24370047841099157);
-  const double t34 = t32 + t33;
-  const double t35 = gam[4] * 0.20802702904656017;
-  const double t36 = t34 + t35;
-  const double t37 = h * t36;
-  const double t38 = q0[0] /* x */ + t37;
-  const double t39 = gam[1] * 0.16939530676686776;
-  const double t40 = gam[3] * (-0.24370047841099157);
-  const double t41 = t39 + t40;
-  const double t42 = gam[5] * 0.20802702904656017;
-  const double t43 = t41 + t42;
-  const double t44 = h * t43;
-  const double t45 = q0[1] /* y */ + t44;
-  const double t46 = t38 * t38;
-  const double t47 = t45 * t45;
-  const double t48 = t46 + t47;
-  const double t49 = sqrt(t48);
-  const double t50 = 1.0 / t49;
-  const double t51 = t50 * t50;
-  const double t52 = 0.5 * t51;
-  const double t53 = t50 * t52;
-  const double t54 = 2.0 * t45;
-  const double t55 = t53 * t54;
-  const double t56 = 2.0 * t38;
-  const double t57 = t53 * t56;
-  const double t58 = t57 * 0.1803807865240693;
-  const double t59 = t26 + t58;
-  const double t60 = t55 * 0.1803807865240693;
-  const double t61 = t27 + t60;
-  const double t62 = t57 * (-0.20658078042518249);
-  const double t63 = t28 + t62;
-  const double t64 = t55 * (-0.20658078042518249);
-  const double t65 = t29 + t64;
-  const double t66 = t57 * 0.062839649419340643;
-  const double t67 = t30 + t66;
-  const double t68 = t55 * 0.062839649419340643;
-  const double t69 = t31 + t68;
-  /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t70 = gam[0] * 0.38069040695840156;
-  const double t71 = gam[2] * (-0.40835734144399111);
-  const double t72 = t70 + t71;
-  const double t73 = gam[4] * 0.1257969473866733;
-  const double t74 = t72 + t73;
-  const double t75 = h * t74;
-  const double t76 = q0[0] /* x */ + t75;
-  const double t77 = gam[1] * 0.38069040695840156;
-  const double t78 = gam[3] * (-0.40835734144399111);
-  const double t79 = t77 + t78;
-  const double t80 = gam[5] * 0.1257969473866733;
-  const double t81 = t79 + t80;
-  const double t82 = h * t81;
-  const double t83 = q0[1] /* y */ + t82;
-  const double t84 = t76 * t76;
-  const double t85 = t83 * t83;
-  const double t86 = t84 + t85;
-  const double t87 = sqrt(t86);
-  const double t88 = 1.0 / t87;
-  const double t89 = t88 * t88;
-  const double t90 = 0.5 * t89;
-  const double t91 = t88 * t90;
-  const double t92 = 2.0 * t83;
-  const double t93 = t91 * t92;
-  const double t94 = 2.0 * t76;
-  const double t95 = t91 * t94;
-  const double t96 = t95 * 0.23395696728634552;
-  const double t97 = t59 + t96;
-  const double t98 = t93 * 0.23395696728634552;
-  const double t99 = t61 + t98;
-  const double t100 = t95 * (-0.096694544181506401);
-  const double t101 = t63 + t100;
-  const double t102 = t93 * (-0.096694544181506401);
-  const double t103 = t65 + t102;
-  const double t104 = t95 * (-0.21689083310923635);
-  const double t105 = t67 + t104;
-  const double t106 = t93 * (-0.21689083310923635);
-  const double t107 = t69 + t106;
-  /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t108 = gam[0] * 0.61930959304159849;
-  const double t109 = gam[2] * (-0.40835734144399105);
-  const double t110 = t108 + t109;
-  const double t111 = gam[4] * (-0.12579694738667335);
-  const double t112 = t110 + t111;
-  const double t113 = h * t112;
-  const double t114 = q0[0] /* x */ + t113;
-  const double t115 = gam[1] * 0.61930959304159849;
-  const double t116 = gam[3] * (-0.40835734144399105);
-  const double t117 = t115 + t116;
-  const double t118 = gam[5] * (-0.12579694738667335);
-  const double t119 = t117 + t118;
-  const double t120 = h * t119;
-  const double t121 = q0[1] /* y */ + t120;
-  const double t122 = t114 * t114;
-  const double t123 = t121 * t121;
-  const double t124 = t122 + t123;
-  const double t125 = sqrt(t124);
-  const double t126 = 1.0 / t125;
-  const double t127 = t126 * t126;
-  const double t128 = 0.5 * t127;
-  const double t129 = t126 * t128;
-  const double t130 = 2.0 * t121;
-  const double t131 = t129 * t130;
-  const double t132 = 2.0 * t114;
-  const double t133 = t129 * t132;
-  const double t134 = 0.23395696728634552 * t133;
-  const double t135 = t97 + t134;
-  const double t136 = 0.23395696728634552 * t131;
-  const double t137 = t99 + t136;
-  const double t138 = t133 * 0.096694544181506442;
-  const double t139 = t101 + t138;
-  const double t140 = t131 * 0.096694544181506442;
-  const double t141 = t103 + t140;
-  const double t142 = t133 * (-0.21689083310923629);
-  const double t143 = t105 + t142;
-  const double t144 = t131 * (-0.21689083310923629);
-  const double t145 = t107 + t144;
-  /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t146 = gam[0] * 0.83060469323313224;
-  const double t147 = t33 + t146;
-  const double t148 = gam[4] * (-0.20802702904656017);
-  const double t149 = t147 + t148;
-  const double t150 = h * t149;
-  const double t151 = q0[0] /* x */ + t150;
-  const double t152 = gam[1] * 0.83060469323313224;
-  const double t153 = t40 + t152;
-  const double t154 = gam[5] * (-0.20802702904656017);
-  const double t155 = t153 + t154;
-  const double t156 = h * t155;
-  const double t157 = q0[1] /* y */ + t156;
-  const double t158 = t151 * t151;
-  const double t159 = t157 * t157;
-  const double t160 = t158 + t159;
-  const double t161 = sqrt(t160);
-  const double t162 = 1.0 / t161;
-  const double t163 = t162 * t162;
-  const double t164 = 0.5 * t163;
-  const double t165 = t162 * t164;
-  const double t166 = 2.0 * t157;
-  const double t167 = t165 * t166;
-  const double t168 = 2.0 * t151;
-  const double t169 = t165 * t168;
-  const double t170 = 0.1803807865240693 * t169;
-  const double t171 = t135 + t170;
-  const double t172 = 0.1803807865240693 * t167;
-  const double t173 = t137 + t172;
-  const double t174 = t169 * 0.20658078042518249;
-  const double t175 = t139 + t174;
-  const double t176 = t167 * 0.20658078042518249;
-  const double t177 = t141 + t176;
-  const double t178 = 0.062839649419340643 * t169;
-  const double t179 = t143 + t178;
-  const double t180 = 0.062839649419340643 * t167;
-  const double t181 = t145 + t180;
-  /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t182 = gam[0] * 0.96623475710157603;
-  const double t183 = t1 + t182;
-  const double t184 = gam[4] * (-0.068025568234204442);
-  const double t185 = t183 + t184;
-  const double t186 = h * t185;
-  const double t187 = q0[0] /* x */ + t186;
-  const double t188 = gam[1] * 0.96623475710157603;
-  const double t189 = t8 + t188;
-  const double t190 = gam[5] * (-0.068025568234204442);
-  const double t191 = t189 + t190;
-  const double t192 = h * t191;
-  const double t193 = q0[1] /* y */ + t192;
-  const double t194 = t187 * t187;
-  const double t195 = t193 * t193;
-  const double t196 = t194 + t195;
-  const double t197 = sqrt(t196);
-  const double t198 = 1.0 / t197;
-  const double t199 = t198 * t198;
-  const double t200 = 0.5 * t199;
-  const double t201 = t198 * t200;
-  const double t202 = 2.0 * t193;
-  const double t203 = t201 * t202;
-  const double t204 = 2.0 * t187;
-  const double t205 = t201 * t204;
-  const double t206 = 0.085662246189585178 * t205;
-  const double t207 = t171 + t206;
-  const double t208 = 0.085662246189585178 * t203;
-  const double t209 = t173 + t208;
-  const double t210 = t205 * 0.13835177248998257;
-  const double t211 = t175 + t210;
-  const double t212 = t203 * 0.13835177248998257;
-  const double t213 = t177 + t212;
-  const double t214 = 0.15405118368989568 * t205;
-  const double t215 = t179 + t214;
-  const double t216 = 0.15405118368989568 * t203;
-  const double t217 = t181 + t216;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t218 = 0.5 * t207;
-  const double t219 = t211 * 0.28867513459481292;
-  const double t220 = t218 - t219;
-  const double t221 = h * t220;
-  const double t222 = p0[0] /* p_x */ - t221;
-  const double t223 = 0.5 * t209;
-  const double t224 = t213 * 0.28867513459481292;
-  const double t225 = t223 - t224;
-  const double t226 = h * t225;
-  const double t227 = p0[1] /* p_y */ - t226;
-  const double t228 = t207 * 0.28867513459481292;
-  const double t229 = t215 * 0.12909944487358055;
-  const double t230 = t228 - t229;
-  const double t231 = h * t230;
-  const double t232 = -t231;
-  const double t233 = t209 * 0.28867513459481292;
-  const double t234 = t217 * 0.12909944487358055;
-  const double t235 = t233 - t234;
-  const double t236 = h * t235;
-  const double t237 = -t236;
-  const double t238 = t211 * 0.12909944487358055;
-  const double t239 = h * t238;
-  const double t240 = -t239;
-  const double t241 = t213 * 0.12909944487358055;
-  const double t242 = h * t241;
-  const double t243 = -t242;
-  const double t244 = h * t207;
-  const double t245 = -t244;
-  const double t246 = h * t209;
-  const double t247 = -t246;
-  /* gam */
-  out[0] = t222;
-  out[1] = t227;
-  out[2] = t232;
-  out[3] = t237;
-  out[4] = t240;
-  out[5] = t243;
-  /* dp */
-  out[6] = t245;
-  out[7] = t247;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void kepler_k6s3_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k6s3_params *prm, double *out)
@@ -361,14 +88,14 @@ void kepler_k6s3_init_params(kepler_k6s3_state *x, const kepler_k6s3_real *q0, c
 {
   int i;
   kepler_k6s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < kepler_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k6s3_NU ? kepler_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void kepler_k6s3_init(kepler_k6s3_state *x, const kepler_k6s3_real *q0, const kepler_k6s3_real *p0)
@@ -406,8 +133,9 @@ void kepler_k6s3_hidden(const kepler_k6s3_state *x, const kepler_k6s3_params *pr
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void kepler_k6s3_predict(const kepler_k6s3_state *x, double h, const kepler_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -447,24 +175,309 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h_, const kepler_k6s
   kepler_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s3_EBADSTEP;
   kepler_k6s3_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
   for (it = 1; it <= kepler_k6s3_MAXITER; it++) {
-    kepler_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.033765242898423975;
+      const double t1 = gm2 * (-0.056508419605012766);
+      const double t2 = t0 + t1;
+      const double t3 = gm4 * 0.068025568234204442;
+      const double t4 = t2 + t3;
+      const double t5 = h * t4;
+      const double t6 = t5 + x->q[0] /* x */;
+      const double t7 = 0.033765242898423975 * gm1;
+      const double t8 = (-0.056508419605012766) * gm3;
+      const double t9 = t7 + t8;
+      const double t10 = 0.068025568234204442 * gm5;
+      const double t11 = t9 + t10;
+      const double t12 = h * t11;
+      const double t13 = t12 + x->q[1] /* y */;
+      const double t14 = t6 * t6;
+      const double t15 = t13 * t13;
+      const double t16 = t14 + t15;
+      const double t17 = sqrt(t16);
+      const double t18 = 1.0 / t17;
+      const double t19 = t18 * t18;
+      const double t20 = 0.5 * t19;
+      const double t21 = t18 * t20;
+      const double t22 = 2.0 * t13;
+      const double t23 = t21 * t22;
+      const double t24 = 2.0 * t6;
+      const double t25 = t21 * t24;
+      const double t26 = t25 * 0.085662246189585178;
+      const double t27 = t23 * 0.085662246189585178;
+      const double t28 = t25 * (-0.13835177248998257);
+      const double t29 = t23 * (-0.13835177248998257);
+      const double t30 = t25 * 0.15405118368989568;
+      const double t31 = t23 * 0.15405118368989568;
+      /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t32 = gm0 * 0.16939530676686776;
+      const double t33 = gm2 * (-0.24370047841099157);
+      const double t34 = t32 + t33;
+      const double t35 = gm4 * 0.20802702904656017;
+      const double t36 = t34 + t35;
+      const double t37 = h * t36;
+      const double t38 = x->q[0] /* x */ + t37;
+      const double t39 = gm1 * 0.16939530676686776;
+      const double t40 = gm3 * (-0.24370047841099157);
+      const double t41 = t39 + t40;
+      const double t42 = gm5 * 0.20802702904656017;
+      const double t43 = t41 + t42;
+      const double t44 = h * t43;
+      const double t45 = x->q[1] /* y */ + t44;
+      const double t46 = t38 * t38;
+      const double t47 = t45 * t45;
+      const double t48 = t46 + t47;
+      const double t49 = sqrt(t48);
+      const double t50 = 1.0 / t49;
+      const double t51 = t50 * t50;
+      const double t52 = 0.5 * t51;
+      const double t53 = t50 * t52;
+      const double t54 = 2.0 * t45;
+      const double t55 = t53 * t54;
+      const double t56 = 2.0 * t38;
+      const double t57 = t53 * t56;
+      const double t58 = t57 * 0.1803807865240693;
+      const double t59 = t26 + t58;
+      const double t60 = t55 * 0.1803807865240693;
+      const double t61 = t27 + t60;
+      const double t62 = t57 * (-0.20658078042518249);
+      const double t63 = t28 + t62;
+      const double t64 = t55 * (-0.20658078042518249);
+      const double t65 = t29 + t64;
+      const double t66 = t57 * 0.062839649419340643;
+      const double t67 = t30 + t66;
+      const double t68 = t55 * 0.062839649419340643;
+      const double t69 = t31 + t68;
+      /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t70 = gm0 * 0.38069040695840156;
+      const double t71 = gm2 * (-0.40835734144399111);
+      const double t72 = t70 + t71;
+      const double t73 = gm4 * 0.1257969473866733;
+      const double t74 = t72 + t73;
+      const double t75 = h * t74;
+      const double t76 = x->q[0] /* x */ + t75;
+      const double t77 = gm1 * 0.38069040695840156;
+      const double t78 = gm3 * (-0.40835734144399111);
+      const double t79 = t77 + t78;
+      const double t80 = gm5 * 0.1257969473866733;
+      const double t81 = t79 + t80;
+      const double t82 = h * t81;
+      const double t83 = x->q[1] /* y */ + t82;
+      const double t84 = t76 * t76;
+      const double t85 = t83 * t83;
+      const double t86 = t84 + t85;
+      const double t87 = sqrt(t86);
+      const double t88 = 1.0 / t87;
+      const double t89 = t88 * t88;
+      const double t90 = 0.5 * t89;
+      const double t91 = t88 * t90;
+      const double t92 = 2.0 * t83;
+      const double t93 = t91 * t92;
+      const double t94 = 2.0 * t76;
+      const double t95 = t91 * t94;
+      const double t96 = t95 * 0.23395696728634552;
+      const double t97 = t59 + t96;
+      const double t98 = t93 * 0.23395696728634552;
+      const double t99 = t61 + t98;
+      const double t100 = t95 * (-0.096694544181506401);
+      const double t101 = t63 + t100;
+      const double t102 = t93 * (-0.096694544181506401);
+      const double t103 = t65 + t102;
+      const double t104 = t95 * (-0.21689083310923635);
+      const double t105 = t67 + t104;
+      const double t106 = t93 * (-0.21689083310923635);
+      const double t107 = t69 + t106;
+      /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t108 = gm0 * 0.61930959304159849;
+      const double t109 = gm2 * (-0.40835734144399105);
+      const double t110 = t108 + t109;
+      const double t111 = gm4 * (-0.12579694738667335);
+      const double t112 = t110 + t111;
+      const double t113 = h * t112;
+      const double t114 = x->q[0] /* x */ + t113;
+      const double t115 = gm1 * 0.61930959304159849;
+      const double t116 = gm3 * (-0.40835734144399105);
+      const double t117 = t115 + t116;
+      const double t118 = gm5 * (-0.12579694738667335);
+      const double t119 = t117 + t118;
+      const double t120 = h * t119;
+      const double t121 = x->q[1] /* y */ + t120;
+      const double t122 = t114 * t114;
+      const double t123 = t121 * t121;
+      const double t124 = t122 + t123;
+      const double t125 = sqrt(t124);
+      const double t126 = 1.0 / t125;
+      const double t127 = t126 * t126;
+      const double t128 = 0.5 * t127;
+      const double t129 = t126 * t128;
+      const double t130 = 2.0 * t121;
+      const double t131 = t129 * t130;
+      const double t132 = 2.0 * t114;
+      const double t133 = t129 * t132;
+      const double t134 = 0.23395696728634552 * t133;
+      const double t135 = t97 + t134;
+      const double t136 = 0.23395696728634552 * t131;
+      const double t137 = t99 + t136;
+      const double t138 = t133 * 0.096694544181506442;
+      const double t139 = t101 + t138;
+      const double t140 = t131 * 0.096694544181506442;
+      const double t141 = t103 + t140;
+      const double t142 = t133 * (-0.21689083310923629);
+      const double t143 = t105 + t142;
+      const double t144 = t131 * (-0.21689083310923629);
+      const double t145 = t107 + t144;
+      /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t146 = gm0 * 0.83060469323313224;
+      const double t147 = t33 + t146;
+      const double t148 = gm4 * (-0.20802702904656017);
+      const double t149 = t147 + t148;
+      const double t150 = h * t149;
+      const double t151 = x->q[0] /* x */ + t150;
+      const double t152 = gm1 * 0.83060469323313224;
+      const double t153 = t40 + t152;
+      const double t154 = gm5 * (-0.20802702904656017);
+      const double t155 = t153 + t154;
+      const double t156 = h * t155;
+      const double t157 = x->q[1] /* y */ + t156;
+      const double t158 = t151 * t151;
+      const double t159 = t157 * t157;
+      const double t160 = t158 + t159;
+      const double t161 = sqrt(t160);
+      const double t162 = 1.0 / t161;
+      const double t163 = t162 * t162;
+      const double t164 = 0.5 * t163;
+      const double t165 = t162 * t164;
+      const double t166 = 2.0 * t157;
+      const double t167 = t165 * t166;
+      const double t168 = 2.0 * t151;
+      const double t169 = t165 * t168;
+      const double t170 = 0.1803807865240693 * t169;
+      const double t171 = t135 + t170;
+      const double t172 = 0.1803807865240693 * t167;
+      const double t173 = t137 + t172;
+      const double t174 = t169 * 0.20658078042518249;
+      const double t175 = t139 + t174;
+      const double t176 = t167 * 0.20658078042518249;
+      const double t177 = t141 + t176;
+      const double t178 = 0.062839649419340643 * t169;
+      const double t179 = t143 + t178;
+      const double t180 = 0.062839649419340643 * t167;
+      const double t181 = t145 + t180;
+      /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t182 = gm0 * 0.96623475710157603;
+      const double t183 = t1 + t182;
+      const double t184 = gm4 * (-0.068025568234204442);
+      const double t185 = t183 + t184;
+      const double t186 = h * t185;
+      const double t187 = x->q[0] /* x */ + t186;
+      const double t188 = gm1 * 0.96623475710157603;
+      const double t189 = t8 + t188;
+      const double t190 = gm5 * (-0.068025568234204442);
+      const double t191 = t189 + t190;
+      const double t192 = h * t191;
+      const double t193 = x->q[1] /* y */ + t192;
+      const double t194 = t187 * t187;
+      const double t195 = t193 * t193;
+      const double t196 = t194 + t195;
+      const double t197 = sqrt(t196);
+      const double t198 = 1.0 / t197;
+      const double t199 = t198 * t198;
+      const double t200 = 0.5 * t199;
+      const double t201 = t198 * t200;
+      const double t202 = 2.0 * t193;
+      const double t203 = t201 * t202;
+      const double t204 = 2.0 * t187;
+      const double t205 = t201 * t204;
+      const double t206 = 0.085662246189585178 * t205;
+      const double t207 = t171 + t206;
+      const double t208 = 0.085662246189585178 * t203;
+      const double t209 = t173 + t208;
+      const double t210 = t205 * 0.13835177248998257;
+      const double t211 = t175 + t210;
+      const double t212 = t203 * 0.13835177248998257;
+      const double t213 = t177 + t212;
+      const double t214 = 0.15405118368989568 * t205;
+      const double t215 = t179 + t214;
+      const double t216 = 0.15405118368989568 * t203;
+      const double t217 = t181 + t216;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t218 = 0.5 * t207;
+      const double t219 = t211 * 0.28867513459481292;
+      const double t220 = t218 - t219;
+      const double t221 = h * t220;
+      const double t222 = x->p[0] /* p_x */ - t221;
+      const double t223 = 0.5 * t209;
+      const double t224 = t213 * 0.28867513459481292;
+      const double t225 = t223 - t224;
+      const double t226 = h * t225;
+      const double t227 = x->p[1] /* p_y */ - t226;
+      const double t228 = t207 * 0.28867513459481292;
+      const double t229 = t215 * 0.12909944487358055;
+      const double t230 = t228 - t229;
+      const double t231 = h * t230;
+      const double t232 = -t231;
+      const double t233 = t209 * 0.28867513459481292;
+      const double t234 = t217 * 0.12909944487358055;
+      const double t235 = t233 - t234;
+      const double t236 = h * t235;
+      const double t237 = -t236;
+      const double t238 = t211 * 0.12909944487358055;
+      const double t239 = h * t238;
+      const double t240 = -t239;
+      const double t241 = t213 * 0.12909944487358055;
+      const double t242 = h * t241;
+      const double t243 = -t242;
+      const double t244 = h * t207;
+      const double t245 = -t244;
+      const double t246 = h * t209;
+      const double t247 = -t246;
+      /* gam */
+      sw0 = t222;
+      sw1 = t227;
+      sw2 = t232;
+      sw3 = t237;
+      sw4 = t240;
+      sw5 = t243;
+      /* dp */
+      sw6 = t245;
+      sw7 = t247;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < kepler_k6s3_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + kepler_k6s3_NU; i++)
-      if (!isfinite(sw[i])) rc = kepler_k6s3_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7)) rc = kepler_k6s3_ENONFINITE;
     if (rc == kepler_k6s3_ENONFINITE || !isfinite(inc)) { rc = kepler_k6s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k6s3_TOL / 256), or
      * within 2 ulps (kepler_k6s3_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -483,6 +496,20 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h_, const kepler_k6s
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
   if (st) { st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it; st->increment = inc; }
   if (rc != kepler_k6s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s3_ENONFINITE;
@@ -495,8 +522,12 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h_, const kepler_k6s
     kepler_k6s3_add(&x->p[i], &x->pc[i], sw[kepler_k6s3_S * kepler_k6s3_M + i]);
   }
   for (i = 0; i < kepler_k6s3_NU; i++) x->lambda[i] = sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + i];
-  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   kepler_k6s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k6s3_OK;
 }

@@ -44,125 +44,6 @@ static const double modified_k3s1_E1[1] = {1.0};
 static const double modified_k3s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k3s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void modified_k3s1_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const modified_k3s1_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2] /* q[3] */;
-  const double t1 = gam[2] * 0.5;
-  const double t2 = h * t1;
-  const double t3 = 2.0 * t2;
-  const double t4 = t0 + t3;
-  /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t5 = gam[0] * 0.1127016653792583;
-  const double t6 = h * t5;
-  const double t7 = q0[0] /* q[1] */ + t6;
-  const double t8 = 0.1127016653792583 * gam[1];
-  const double t9 = h * t8;
-  const double t10 = q0[1] /* q[2] */ + t9;
-  const double t11 = gam[2] * 0.1127016653792583;
-  const double t12 = h * t11;
-  const double t13 = q0[2] /* q[3] */ + t12;
-  const double t14 = t13 * t13 * t13;
-  const double t15 = t10 * t10 * t10;
-  const double t16 = (t7 * t7) * (t7 * t7) * t7;
-  const double t17 = t14 * 1.1111111111111112;
-  const double t18 = t16 * 1.6666666666666667;
-  const double t19 = t15 * 1.1111111111111112;
-  /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t20 = 0.5 * gam[0];
-  const double t21 = h * t20;
-  const double t22 = q0[0] /* q[1] */ + t21;
-  const double t23 = 0.5 * gam[1];
-  const double t24 = h * t23;
-  const double t25 = q0[1] /* q[2] */ + t24;
-  const double t26 = q0[2] /* q[3] */ + t2;
-  const double t27 = t26 * t26 * t26;
-  const double t28 = t25 * t25 * t25;
-  const double t29 = (t22 * t22) * (t22 * t22) * t22;
-  const double t30 = t27 * 1.7777777777777777;
-  const double t31 = t17 + t30;
-  const double t32 = t29 * 2.6666666666666665;
-  const double t33 = t18 + t32;
-  const double t34 = t28 * 1.7777777777777777;
-  const double t35 = t19 + t34;
-  /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t36 = gam[0] * 0.8872983346207417;
-  const double t37 = h * t36;
-  const double t38 = q0[0] /* q[1] */ + t37;
-  const double t39 = gam[1] * 0.8872983346207417;
-  const double t40 = h * t39;
-  const double t41 = q0[1] /* q[2] */ + t40;
-  const double t42 = gam[2] * 0.8872983346207417;
-  const double t43 = h * t42;
-  const double t44 = q0[2] /* q[3] */ + t43;
-  const double t45 = t44 * t44 * t44;
-  const double t46 = t41 * t41 * t41;
-  const double t47 = (t38 * t38) * (t38 * t38) * t38;
-  const double t48 = 1.1111111111111112 * t45;
-  const double t49 = t31 + t48;
-  const double t50 = 1.6666666666666667 * t47;
-  const double t51 = t33 + t50;
-  const double t52 = 1.1111111111111112 * t46;
-  const double t53 = t35 + t52;
-  /* multiplier system A lambda = r */
-  const double t54 = t51 * t51;
-  const double t55 = t53 * t53;
-  const double t56 = t54 + t55;
-  const double t57 = t4 * t4;
-  const double t58 = t56 + t57;
-  const double t59 = 0.5 * t58;
-  const double t60 = h * t59;
-  const double t61 = t4 * t49;
-  const double t62 = 0.5 * t61;
-  const double t63 = h * t62;
-  const double t64 = t51 * p0[0] /* p_q[1] */;
-  const double t65 = t53 * p0[1] /* p_q[2] */;
-  const double t66 = t64 + t65;
-  const double t67 = t4 * p0[2] /* p_q[3] */;
-  const double t68 = t66 + t67;
-  const double t69 = t68 - t63;
-  const double t70 = t69 + g0[0];
-  const double t71 = t70 / t60;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t72 = t51 * t71;
-  const double t73 = t53 * t71;
-  const double t74 = t4 * t71;
-  const double t75 = t49 + t74;
-  const double t76 = 0.5 * t72;
-  const double t77 = h * t76;
-  const double t78 = p0[0] /* p_q[1] */ - t77;
-  const double t79 = 0.5 * t73;
-  const double t80 = h * t79;
-  const double t81 = p0[1] /* p_q[2] */ - t80;
-  const double t82 = 0.5 * t75;
-  const double t83 = h * t82;
-  const double t84 = p0[2] /* p_q[3] */ - t83;
-  const double t85 = h * t72;
-  const double t86 = -t85;
-  const double t87 = h * t73;
-  const double t88 = -t87;
-  const double t89 = h * t75;
-  const double t90 = -t89;
-  /* gam */
-  out[0] = t78;
-  out[1] = t81;
-  out[2] = t84;
-  /* dp */
-  out[3] = t86;
-  out[4] = t88;
-  out[5] = t90;
-  /* lambda */
-  out[6] = t71;
-  /* pivot */
-  out[7] = t60;
-  /* adiag */
-  out[8] = t60;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void modified_k3s1_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k3s1_params *prm, double *out)
@@ -336,14 +217,14 @@ void modified_k3s1_init_params(modified_k3s1_state *x, const modified_k3s1_real 
 {
   int i;
   modified_k3s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < modified_k3s1_M; i++) {
     x->q[i] = q0 ? q0[i] : modified_k3s1_q0[i];
     x->p[i] = p0 ? p0[i] : modified_k3s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k3s1_NU ? modified_k3s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[modified_k3s1_NU];
     modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -388,8 +269,9 @@ void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_para
   modified_k3s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void modified_k3s1_predict(const modified_k3s1_state *x, double h, const modified_k3s1_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -435,29 +317,154 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
    * cannot drift; below modified_k3s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < modified_k3s1_NU; i++) g0[i] = fabs(g0[i]) <= modified_k3s1_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0;
   for (it = 1; it <= modified_k3s1_MAXITER; it++) {
-    modified_k3s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[2] /* q[3] */;
+      const double t1 = gm2 * 0.5;
+      const double t2 = h * t1;
+      const double t3 = 2.0 * t2;
+      const double t4 = t0 + t3;
+      /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t5 = gm0 * 0.1127016653792583;
+      const double t6 = h * t5;
+      const double t7 = x->q[0] /* q[1] */ + t6;
+      const double t8 = 0.1127016653792583 * gm1;
+      const double t9 = h * t8;
+      const double t10 = x->q[1] /* q[2] */ + t9;
+      const double t11 = gm2 * 0.1127016653792583;
+      const double t12 = h * t11;
+      const double t13 = x->q[2] /* q[3] */ + t12;
+      const double t14 = t13 * t13 * t13;
+      const double t15 = t10 * t10 * t10;
+      const double t16 = (t7 * t7) * (t7 * t7) * t7;
+      const double t17 = t14 * 1.1111111111111112;
+      const double t18 = t16 * 1.6666666666666667;
+      const double t19 = t15 * 1.1111111111111112;
+      /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t20 = 0.5 * gm0;
+      const double t21 = h * t20;
+      const double t22 = x->q[0] /* q[1] */ + t21;
+      const double t23 = 0.5 * gm1;
+      const double t24 = h * t23;
+      const double t25 = x->q[1] /* q[2] */ + t24;
+      const double t26 = x->q[2] /* q[3] */ + t2;
+      const double t27 = t26 * t26 * t26;
+      const double t28 = t25 * t25 * t25;
+      const double t29 = (t22 * t22) * (t22 * t22) * t22;
+      const double t30 = t27 * 1.7777777777777777;
+      const double t31 = t17 + t30;
+      const double t32 = t29 * 2.6666666666666665;
+      const double t33 = t18 + t32;
+      const double t34 = t28 * 1.7777777777777777;
+      const double t35 = t19 + t34;
+      /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t36 = gm0 * 0.8872983346207417;
+      const double t37 = h * t36;
+      const double t38 = x->q[0] /* q[1] */ + t37;
+      const double t39 = gm1 * 0.8872983346207417;
+      const double t40 = h * t39;
+      const double t41 = x->q[1] /* q[2] */ + t40;
+      const double t42 = gm2 * 0.8872983346207417;
+      const double t43 = h * t42;
+      const double t44 = x->q[2] /* q[3] */ + t43;
+      const double t45 = t44 * t44 * t44;
+      const double t46 = t41 * t41 * t41;
+      const double t47 = (t38 * t38) * (t38 * t38) * t38;
+      const double t48 = 1.1111111111111112 * t45;
+      const double t49 = t31 + t48;
+      const double t50 = 1.6666666666666667 * t47;
+      const double t51 = t33 + t50;
+      const double t52 = 1.1111111111111112 * t46;
+      const double t53 = t35 + t52;
+      /* multiplier system A lambda = r */
+      const double t54 = t51 * t51;
+      const double t55 = t53 * t53;
+      const double t56 = t54 + t55;
+      const double t57 = t4 * t4;
+      const double t58 = t56 + t57;
+      const double t59 = 0.5 * t58;
+      const double t60 = h * t59;
+      const double t61 = t4 * t49;
+      const double t62 = 0.5 * t61;
+      const double t63 = h * t62;
+      const double t64 = t51 * x->p[0] /* p_q[1] */;
+      const double t65 = t53 * x->p[1] /* p_q[2] */;
+      const double t66 = t64 + t65;
+      const double t67 = t4 * x->p[2] /* p_q[3] */;
+      const double t68 = t66 + t67;
+      const double t69 = t68 - t63;
+      const double t70 = t69 + g0[0];
+      const double t71 = t70 / t60;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t72 = t51 * t71;
+      const double t73 = t53 * t71;
+      const double t74 = t4 * t71;
+      const double t75 = t49 + t74;
+      const double t76 = 0.5 * t72;
+      const double t77 = h * t76;
+      const double t78 = x->p[0] /* p_q[1] */ - t77;
+      const double t79 = 0.5 * t73;
+      const double t80 = h * t79;
+      const double t81 = x->p[1] /* p_q[2] */ - t80;
+      const double t82 = 0.5 * t75;
+      const double t83 = h * t82;
+      const double t84 = x->p[2] /* p_q[3] */ - t83;
+      const double t85 = h * t72;
+      const double t86 = -t85;
+      const double t87 = h * t73;
+      const double t88 = -t87;
+      const double t89 = h * t75;
+      const double t90 = -t89;
+      /* gam */
+      sw0 = t78;
+      sw1 = t81;
+      sw2 = t84;
+      /* dp */
+      sw3 = t86;
+      sw4 = t88;
+      sw5 = t90;
+      /* lambda */
+      sw6 = t71;
+      /* pivot */
+      sw7 = t60;
+      /* adiag */
+      sw8 = t60;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < modified_k3s1_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < modified_k3s1_NU; i++) {
-      double piv = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU + i], dia = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 2 * modified_k3s1_NU + i];
+    {
+      double piv = sw7, dia = sw8;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k3s1_SINGTOL * fabs(dia))) rc = modified_k3s1_ESINGULAR;
     }
     if (rc == modified_k3s1_ESINGULAR) break;
-    for (i = 0; i < modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU; i++)
-      if (!isfinite(sw[i])) rc = modified_k3s1_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6)) rc = modified_k3s1_ENONFINITE;
     if (rc == modified_k3s1_ENONFINITE || !isfinite(inc)) { rc = modified_k3s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k3s1_TOL / 256), or
      * within 2 ulps (modified_k3s1_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -476,6 +483,18 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
   if (st) { st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it; st->increment = inc; }
   if (rc != modified_k3s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k3s1_ENONFINITE;
@@ -488,8 +507,12 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
     modified_k3s1_add(&x->p[i], &x->pc[i], sw[modified_k3s1_S * modified_k3s1_M + i]);
   }
   for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + i];
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   modified_k3s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return modified_k3s1_OK;
 }

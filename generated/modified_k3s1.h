@@ -25,8 +25,9 @@ typedef double modified_k3s1_real;
 
 typedef struct {
   modified_k3s1_real t, q[3], p[3], lambda[1];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   modified_k3s1_real tc, qc[3], pc[3], gam[3], hprev;
+  modified_k3s1_real gam2[3], hprev2;
 } modified_k3s1_state;
 
 typedef struct {

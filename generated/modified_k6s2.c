@@ -47,285 +47,6 @@ static const double modified_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231
 static const double modified_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void modified_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const modified_k6s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[2] /* q[3] */;
-  const double t1 = gam[2] * 0.5;
-  const double t2 = gam[5] * 0.28867513459481292;
-  const double t3 = t1 - t2;
-  const double t4 = h * t3;
-  const double t5 = 2.0 * t4;
-  const double t6 = t0 + t5;
-  const double t7 = gam[2] * 0.28867513459481292;
-  const double t8 = h * t7;
-  const double t9 = 2.0 * t8;
-  /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t10 = gam[0] * 0.033765242898423975;
-  const double t11 = gam[3] * (-0.056508419605012766);
-  const double t12 = t10 + t11;
-  const double t13 = h * t12;
-  const double t14 = q0[0] /* q[1] */ + t13;
-  const double t15 = 0.033765242898423975 * gam[1];
-  const double t16 = (-0.056508419605012766) * gam[4];
-  const double t17 = t15 + t16;
-  const double t18 = h * t17;
-  const double t19 = q0[1] /* q[2] */ + t18;
-  const double t20 = gam[2] * 0.033765242898423975;
-  const double t21 = gam[5] * (-0.056508419605012766);
-  const double t22 = t20 + t21;
-  const double t23 = h * t22;
-  const double t24 = q0[2] /* q[3] */ + t23;
-  const double t25 = t24 * t24 * t24;
-  const double t26 = t19 * t19 * t19;
-  const double t27 = (t14 * t14) * (t14 * t14) * t14;
-  const double t28 = 6.0 * t27;
-  const double t29 = t25 * 0.34264898475834071;
-  const double t30 = t27 * 0.51397347713751107;
-  const double t31 = t26 * 0.34264898475834071;
-  const double t32 = t25 * (-0.55340708995993027);
-  const double t33 = t28 * (-0.13835177248998257);
-  const double t34 = t26 * (-0.55340708995993027);
-  /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t35 = gam[0] * 0.16939530676686776;
-  const double t36 = gam[3] * (-0.24370047841099157);
-  const double t37 = t35 + t36;
-  const double t38 = h * t37;
-  const double t39 = q0[0] /* q[1] */ + t38;
-  const double t40 = gam[1] * 0.16939530676686776;
-  const double t41 = gam[4] * (-0.24370047841099157);
-  const double t42 = t40 + t41;
-  const double t43 = h * t42;
-  const double t44 = q0[1] /* q[2] */ + t43;
-  const double t45 = gam[2] * 0.16939530676686776;
-  const double t46 = gam[5] * (-0.24370047841099157);
-  const double t47 = t45 + t46;
-  const double t48 = h * t47;
-  const double t49 = q0[2] /* q[3] */ + t48;
-  const double t50 = t49 * t49 * t49;
-  const double t51 = t44 * t44 * t44;
-  const double t52 = (t39 * t39) * (t39 * t39) * t39;
-  const double t53 = 6.0 * t52;
-  const double t54 = t50 * 0.72152314609627721;
-  const double t55 = t29 + t54;
-  const double t56 = t52 * 1.0822847191444158;
-  const double t57 = t30 + t56;
-  const double t58 = t51 * 0.72152314609627721;
-  const double t59 = t31 + t58;
-  const double t60 = t50 * (-0.82632312170072997);
-  const double t61 = t32 + t60;
-  const double t62 = t53 * (-0.20658078042518249);
-  const double t63 = t33 + t62;
-  const double t64 = t51 * (-0.82632312170072997);
-  const double t65 = t34 + t64;
-  /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t66 = gam[0] * 0.38069040695840156;
-  const double t67 = gam[3] * (-0.40835734144399111);
-  const double t68 = t66 + t67;
-  const double t69 = h * t68;
-  const double t70 = q0[0] /* q[1] */ + t69;
-  const double t71 = gam[1] * 0.38069040695840156;
-  const double t72 = gam[4] * (-0.40835734144399111);
-  const double t73 = t71 + t72;
-  const double t74 = h * t73;
-  const double t75 = q0[1] /* q[2] */ + t74;
-  const double t76 = gam[2] * 0.38069040695840156;
-  const double t77 = gam[5] * (-0.40835734144399111);
-  const double t78 = t76 + t77;
-  const double t79 = h * t78;
-  const double t80 = q0[2] /* q[3] */ + t79;
-  const double t81 = t80 * t80 * t80;
-  const double t82 = t75 * t75 * t75;
-  const double t83 = (t70 * t70) * (t70 * t70) * t70;
-  const double t84 = 6.0 * t83;
-  const double t85 = t81 * 0.93582786914538207;
-  const double t86 = t55 + t85;
-  const double t87 = t83 * 1.4037418037180731;
-  const double t88 = t57 + t87;
-  const double t89 = t82 * 0.93582786914538207;
-  const double t90 = t59 + t89;
-  const double t91 = t81 * (-0.3867781767260256);
-  const double t92 = t61 + t91;
-  const double t93 = t84 * (-0.096694544181506401);
-  const double t94 = t63 + t93;
-  const double t95 = t82 * (-0.3867781767260256);
-  const double t96 = t65 + t95;
-  /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t97 = gam[0] * 0.61930959304159849;
-  const double t98 = gam[3] * (-0.40835734144399105);
-  const double t99 = t97 + t98;
-  const double t100 = h * t99;
-  const double t101 = q0[0] /* q[1] */ + t100;
-  const double t102 = gam[1] * 0.61930959304159849;
-  const double t103 = gam[4] * (-0.40835734144399105);
-  const double t104 = t102 + t103;
-  const double t105 = h * t104;
-  const double t106 = q0[1] /* q[2] */ + t105;
-  const double t107 = gam[2] * 0.61930959304159849;
-  const double t108 = gam[5] * (-0.40835734144399105);
-  const double t109 = t107 + t108;
-  const double t110 = h * t109;
-  const double t111 = q0[2] /* q[3] */ + t110;
-  const double t112 = t111 * t111 * t111;
-  const double t113 = t106 * t106 * t106;
-  const double t114 = (t101 * t101) * (t101 * t101) * t101;
-  const double t115 = 6.0 * t114;
-  const double t116 = 0.93582786914538207 * t112;
-  const double t117 = t86 + t116;
-  const double t118 = 1.4037418037180731 * t114;
-  const double t119 = t88 + t118;
-  const double t120 = 0.93582786914538207 * t113;
-  const double t121 = t90 + t120;
-  const double t122 = t112 * 0.38677817672602577;
-  const double t123 = t92 + t122;
-  const double t124 = t115 * 0.096694544181506442;
-  const double t125 = t94 + t124;
-  const double t126 = t113 * 0.38677817672602577;
-  const double t127 = t96 + t126;
-  /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t128 = gam[0] * 0.83060469323313224;
-  const double t129 = t36 + t128;
-  const double t130 = h * t129;
-  const double t131 = q0[0] /* q[1] */ + t130;
-  const double t132 = gam[1] * 0.83060469323313224;
-  const double t133 = t41 + t132;
-  const double t134 = h * t133;
-  const double t135 = q0[1] /* q[2] */ + t134;
-  const double t136 = gam[2] * 0.83060469323313224;
-  const double t137 = t46 + t136;
-  const double t138 = h * t137;
-  const double t139 = q0[2] /* q[3] */ + t138;
-  const double t140 = t139 * t139 * t139;
-  const double t141 = t135 * t135 * t135;
-  const double t142 = (t131 * t131) * (t131 * t131) * t131;
-  const double t143 = 6.0 * t142;
-  const double t144 = 0.72152314609627721 * t140;
-  const double t145 = t117 + t144;
-  const double t146 = 1.0822847191444158 * t142;
-  const double t147 = t119 + t146;
-  const double t148 = 0.72152314609627721 * t141;
-  const double t149 = t121 + t148;
-  const double t150 = t140 * 0.82632312170072997;
-  const double t151 = t123 + t150;
-  const double t152 = t143 * 0.20658078042518249;
-  const double t153 = t125 + t152;
-  const double t154 = t141 * 0.82632312170072997;
-  const double t155 = t127 + t154;
-  /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t156 = gam[0] * 0.96623475710157603;
-  const double t157 = t11 + t156;
-  const double t158 = h * t157;
-  const double t159 = q0[0] /* q[1] */ + t158;
-  const double t160 = gam[1] * 0.96623475710157603;
-  const double t161 = t16 + t160;
-  const double t162 = h * t161;
-  const double t163 = q0[1] /* q[2] */ + t162;
-  const double t164 = gam[2] * 0.96623475710157603;
-  const double t165 = t21 + t164;
-  const double t166 = h * t165;
-  const double t167 = q0[2] /* q[3] */ + t166;
-  const double t168 = t167 * t167 * t167;
-  const double t169 = t163 * t163 * t163;
-  const double t170 = (t159 * t159) * (t159 * t159) * t159;
-  const double t171 = 6.0 * t170;
-  const double t172 = 0.34264898475834071 * t168;
-  const double t173 = t145 + t172;
-  const double t174 = 0.51397347713751107 * t170;
-  const double t175 = t147 + t174;
-  const double t176 = 0.34264898475834071 * t169;
-  const double t177 = t149 + t176;
-  const double t178 = t168 * 0.55340708995993027;
-  const double t179 = t151 + t178;
-  const double t180 = t171 * 0.13835177248998257;
-  const double t181 = t153 + t180;
-  const double t182 = t169 * 0.55340708995993027;
-  const double t183 = t155 + t182;
-  /* multiplier system A lambda = r */
-  const double t184 = t175 * t175;
-  const double t185 = t177 * t177;
-  const double t186 = t184 + t185;
-  const double t187 = t6 * t6;
-  const double t188 = t186 + t187;
-  const double t189 = 0.5 * t188;
-  const double t190 = h * t189;
-  const double t191 = t6 * t173;
-  const double t192 = 0.5 * t191;
-  const double t193 = t6 * t179;
-  const double t194 = t9 * t173;
-  const double t195 = t194 - t193;
-  const double t196 = 0.28867513459481292 * t195;
-  const double t197 = t192 + t196;
-  const double t198 = h * t197;
-  const double t199 = t175 * p0[0] /* p_q[1] */;
-  const double t200 = t177 * p0[1] /* p_q[2] */;
-  const double t201 = t199 + t200;
-  const double t202 = t6 * p0[2] /* p_q[3] */;
-  const double t203 = t201 + t202;
-  const double t204 = t203 - t198;
-  const double t205 = t204 + g0[0];
-  const double t206 = t205 / t190;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t207 = t175 * t206;
-  const double t208 = t177 * t206;
-  const double t209 = t6 * t206;
-  const double t210 = t173 + t209;
-  const double t211 = t181 * t206;
-  const double t212 = t183 * t206;
-  const double t213 = t9 * t206;
-  const double t214 = t179 + t213;
-  const double t215 = 0.5 * t207;
-  const double t216 = 0.28867513459481292 * t211;
-  const double t217 = t215 - t216;
-  const double t218 = h * t217;
-  const double t219 = p0[0] /* p_q[1] */ - t218;
-  const double t220 = 0.5 * t208;
-  const double t221 = 0.28867513459481292 * t212;
-  const double t222 = t220 - t221;
-  const double t223 = h * t222;
-  const double t224 = p0[1] /* p_q[2] */ - t223;
-  const double t225 = 0.5 * t210;
-  const double t226 = 0.28867513459481292 * t214;
-  const double t227 = t225 - t226;
-  const double t228 = h * t227;
-  const double t229 = p0[2] /* p_q[3] */ - t228;
-  const double t230 = 0.28867513459481292 * t207;
-  const double t231 = h * t230;
-  const double t232 = -t231;
-  const double t233 = 0.28867513459481292 * t208;
-  const double t234 = h * t233;
-  const double t235 = -t234;
-  const double t236 = 0.28867513459481292 * t210;
-  const double t237 = h * t236;
-  const double t238 = -t237;
-  const double t239 = h * t207;
-  const double t240 = -t239;
-  const double t241 = h * t208;
-  const double t242 = -t241;
-  const double t243 = h * t210;
-  const double t244 = -t243;
-  /* gam */
-  out[0] = t219;
-  out[1] = t224;
-  out[2] = t229;
-  out[3] = t232;
-  out[4] = t235;
-  out[5] = t238;
-  /* dp */
-  out[6] = t240;
-  out[7] = t242;
-  out[8] = t244;
-  /* lambda */
-  out[9] = t206;
-  /* pivot */
-  out[10] = t190;
-  /* adiag */
-  out[11] = t190;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void modified_k6s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k6s2_params *prm, double *out)
@@ -499,14 +220,14 @@ void modified_k6s2_init_params(modified_k6s2_state *x, const modified_k6s2_real 
 {
   int i;
   modified_k6s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < modified_k6s2_M; i++) {
     x->q[i] = q0 ? q0[i] : modified_k6s2_q0[i];
     x->p[i] = p0 ? p0[i] : modified_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k6s2_NU ? modified_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[modified_k6s2_NU];
     modified_k6s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -551,8 +272,9 @@ void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_para
   modified_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void modified_k6s2_predict(const modified_k6s2_state *x, double h, const modified_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -598,29 +320,323 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
    * cannot drift; below modified_k6s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < modified_k6s2_NU; i++) g0[i] = fabs(g0[i]) <= modified_k6s2_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0;
   for (it = 1; it <= modified_k6s2_MAXITER; it++) {
-    modified_k6s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[2] /* q[3] */;
+      const double t1 = gm2 * 0.5;
+      const double t2 = gm5 * 0.28867513459481292;
+      const double t3 = t1 - t2;
+      const double t4 = h * t3;
+      const double t5 = 2.0 * t4;
+      const double t6 = t0 + t5;
+      const double t7 = gm2 * 0.28867513459481292;
+      const double t8 = h * t7;
+      const double t9 = 2.0 * t8;
+      /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t10 = gm0 * 0.033765242898423975;
+      const double t11 = gm3 * (-0.056508419605012766);
+      const double t12 = t10 + t11;
+      const double t13 = h * t12;
+      const double t14 = x->q[0] /* q[1] */ + t13;
+      const double t15 = 0.033765242898423975 * gm1;
+      const double t16 = (-0.056508419605012766) * gm4;
+      const double t17 = t15 + t16;
+      const double t18 = h * t17;
+      const double t19 = x->q[1] /* q[2] */ + t18;
+      const double t20 = gm2 * 0.033765242898423975;
+      const double t21 = gm5 * (-0.056508419605012766);
+      const double t22 = t20 + t21;
+      const double t23 = h * t22;
+      const double t24 = x->q[2] /* q[3] */ + t23;
+      const double t25 = t24 * t24 * t24;
+      const double t26 = t19 * t19 * t19;
+      const double t27 = (t14 * t14) * (t14 * t14) * t14;
+      const double t28 = 6.0 * t27;
+      const double t29 = t25 * 0.34264898475834071;
+      const double t30 = t27 * 0.51397347713751107;
+      const double t31 = t26 * 0.34264898475834071;
+      const double t32 = t25 * (-0.55340708995993027);
+      const double t33 = t28 * (-0.13835177248998257);
+      const double t34 = t26 * (-0.55340708995993027);
+      /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t35 = gm0 * 0.16939530676686776;
+      const double t36 = gm3 * (-0.24370047841099157);
+      const double t37 = t35 + t36;
+      const double t38 = h * t37;
+      const double t39 = x->q[0] /* q[1] */ + t38;
+      const double t40 = gm1 * 0.16939530676686776;
+      const double t41 = gm4 * (-0.24370047841099157);
+      const double t42 = t40 + t41;
+      const double t43 = h * t42;
+      const double t44 = x->q[1] /* q[2] */ + t43;
+      const double t45 = gm2 * 0.16939530676686776;
+      const double t46 = gm5 * (-0.24370047841099157);
+      const double t47 = t45 + t46;
+      const double t48 = h * t47;
+      const double t49 = x->q[2] /* q[3] */ + t48;
+      const double t50 = t49 * t49 * t49;
+      const double t51 = t44 * t44 * t44;
+      const double t52 = (t39 * t39) * (t39 * t39) * t39;
+      const double t53 = 6.0 * t52;
+      const double t54 = t50 * 0.72152314609627721;
+      const double t55 = t29 + t54;
+      const double t56 = t52 * 1.0822847191444158;
+      const double t57 = t30 + t56;
+      const double t58 = t51 * 0.72152314609627721;
+      const double t59 = t31 + t58;
+      const double t60 = t50 * (-0.82632312170072997);
+      const double t61 = t32 + t60;
+      const double t62 = t53 * (-0.20658078042518249);
+      const double t63 = t33 + t62;
+      const double t64 = t51 * (-0.82632312170072997);
+      const double t65 = t34 + t64;
+      /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t66 = gm0 * 0.38069040695840156;
+      const double t67 = gm3 * (-0.40835734144399111);
+      const double t68 = t66 + t67;
+      const double t69 = h * t68;
+      const double t70 = x->q[0] /* q[1] */ + t69;
+      const double t71 = gm1 * 0.38069040695840156;
+      const double t72 = gm4 * (-0.40835734144399111);
+      const double t73 = t71 + t72;
+      const double t74 = h * t73;
+      const double t75 = x->q[1] /* q[2] */ + t74;
+      const double t76 = gm2 * 0.38069040695840156;
+      const double t77 = gm5 * (-0.40835734144399111);
+      const double t78 = t76 + t77;
+      const double t79 = h * t78;
+      const double t80 = x->q[2] /* q[3] */ + t79;
+      const double t81 = t80 * t80 * t80;
+      const double t82 = t75 * t75 * t75;
+      const double t83 = (t70 * t70) * (t70 * t70) * t70;
+      const double t84 = 6.0 * t83;
+      const double t85 = t81 * 0.93582786914538207;
+      const double t86 = t55 + t85;
+      const double t87 = t83 * 1.4037418037180731;
+      const double t88 = t57 + t87;
+      const double t89 = t82 * 0.93582786914538207;
+      const double t90 = t59 + t89;
+      const double t91 = t81 * (-0.3867781767260256);
+      const double t92 = t61 + t91;
+      const double t93 = t84 * (-0.096694544181506401);
+      const double t94 = t63 + t93;
+      const double t95 = t82 * (-0.3867781767260256);
+      const double t96 = t65 + t95;
+      /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t97 = gm0 * 0.61930959304159849;
+      const double t98 = gm3 * (-0.40835734144399105);
+      const double t99 = t97 + t98;
+      const double t100 = h * t99;
+      const double t101 = x->q[0] /* q[1] */ + t100;
+      const double t102 = gm1 * 0.61930959304159849;
+      const double t103 = gm4 * (-0.40835734144399105);
+      const double t104 = t102 + t103;
+      const double t105 = h * t104;
+      const double t106 = x->q[1] /* q[2] */ + t105;
+      const double t107 = gm2 * 0.61930959304159849;
+      const double t108 = gm5 * (-0.40835734144399105);
+      const double t109 = t107 + t108;
+      const double t110 = h * t109;
+      const double t111 = x->q[2] /* q[3] */ + t110;
+      const double t112 = t111 * t111 * t111;
+      const double t113 = t106 * t106 * t106;
+      const double t114 = (t101 * t101) * (t101 * t101) * t101;
+      const double t115 = 6.0 * t114;
+      const double t116 = 0.93582786914538207 * t112;
+      const double t117 = t86 + t116;
+      const double t118 = 1.4037418037180731 * t114;
+      const double t119 = t88 + t118;
+      const double t120 = 0.93582786914538207 * t113;
+      const double t121 = t90 + t120;
+      const double t122 = t112 * 0.38677817672602577;
+      const double t123 = t92 + t122;
+      const double t124 = t115 * 0.096694544181506442;
+      const double t125 = t94 + t124;
+      const double t126 = t113 * 0.38677817672602577;
+      const double t127 = t96 + t126;
+      /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t128 = gm0 * 0.83060469323313224;
+      const double t129 = t36 + t128;
+      const double t130 = h * t129;
+      const double t131 = x->q[0] /* q[1] */ + t130;
+      const double t132 = gm1 * 0.83060469323313224;
+      const double t133 = t41 + t132;
+      const double t134 = h * t133;
+      const double t135 = x->q[1] /* q[2] */ + t134;
+      const double t136 = gm2 * 0.83060469323313224;
+      const double t137 = t46 + t136;
+      const double t138 = h * t137;
+      const double t139 = x->q[2] /* q[3] */ + t138;
+      const double t140 = t139 * t139 * t139;
+      const double t141 = t135 * t135 * t135;
+      const double t142 = (t131 * t131) * (t131 * t131) * t131;
+      const double t143 = 6.0 * t142;
+      const double t144 = 0.72152314609627721 * t140;
+      const double t145 = t117 + t144;
+      const double t146 = 1.0822847191444158 * t142;
+      const double t147 = t119 + t146;
+      const double t148 = 0.72152314609627721 * t141;
+      const double t149 = t121 + t148;
+      const double t150 = t140 * 0.82632312170072997;
+      const double t151 = t123 + t150;
+      const double t152 = t143 * 0.20658078042518249;
+      const double t153 = t125 + t152;
+      const double t154 = t141 * 0.82632312170072997;
+      const double t155 = t127 + t154;
+      /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t156 = gm0 * 0.96623475710157603;
+      const double t157 = t11 + t156;
+      const double t158 = h * t157;
+      const double t159 = x->q[0] /* q[1] */ + t158;
+      const double t160 = gm1 * 0.96623475710157603;
+      const double t161 = t16 + t160;
+      const double t162 = h * t161;
+      const double t163 = x->q[1] /* q[2] */ + t162;
+      const double t164 = gm2 * 0.96623475710157603;
+      const double t165 = t21 + t164;
+      const double t166 = h * t165;
+      const double t167 = x->q[2] /* q[3] */ + t166;
+      const double t168 = t167 * t167 * t167;
+      const double t169 = t163 * t163 * t163;
+      const double t170 = (t159 * t159) * (t159 * t159) * t159;
+      const double t171 = 6.0 * t170;
+      const double t172 = 0.34264898475834071 * t168;
+      const double t173 = t145 + t172;
+      const double t174 = 0.51397347713751107 * t170;
+      const double t175 = t147 + t174;
+      const double t176 = 0.34264898475834071 * t169;
+      const double t177 = t149 + t176;
+      const double t178 = t168 * 0.55340708995993027;
+      const double t179 = t151 + t178;
+      const double t180 = t171 * 0.13835177248998257;
+      const double t181 = t153 + t180;
+      const double t182 = t169 * 0.55340708995993027;
+      const double t183 = t155 + t182;
+      /* multiplier system A lambda = r */
+      const double t184 = t175 * t175;
+      const double t185 = t177 * t177;
+      const double t186 = t184 + t185;
+      const double t187 = t6 * t6;
+      const double t188 = t186 + t187;
+      const double t189 = 0.5 * t188;
+      const double t190 = h * t189;
+      const double t191 = t6 * t173;
+      const double t192 = 0.5 * t191;
+      const double t193 = t6 * t179;
+      const double t194 = t9 * t173;
+      const double t195 = t194 - t193;
+      const double t196 = 0.28867513459481292 * t195;
+      const double t197 = t192 + t196;
+      const double t198 = h * t197;
+      const double t199 = t175 * x->p[0] /* p_q[1] */;
+      const double t200 = t177 * x->p[1] /* p_q[2] */;
+      const double t201 = t199 + t200;
+      const double t202 = t6 * x->p[2] /* p_q[3] */;
+      const double t203 = t201 + t202;
+      const double t204 = t203 - t198;
+      const double t205 = t204 + g0[0];
+      const double t206 = t205 / t190;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t207 = t175 * t206;
+      const double t208 = t177 * t206;
+      const double t209 = t6 * t206;
+      const double t210 = t173 + t209;
+      const double t211 = t181 * t206;
+      const double t212 = t183 * t206;
+      const double t213 = t9 * t206;
+      const double t214 = t179 + t213;
+      const double t215 = 0.5 * t207;
+      const double t216 = 0.28867513459481292 * t211;
+      const double t217 = t215 - t216;
+      const double t218 = h * t217;
+      const double t219 = x->p[0] /* p_q[1] */ - t218;
+      const double t220 = 0.5 * t208;
+      const double t221 = 0.28867513459481292 * t212;
+      const double t222 = t220 - t221;
+      const double t223 = h * t222;
+      const double t224 = x->p[1] /* p_q[2] */ - t223;
+      const double t225 = 0.5 * t210;
+      const double t226 = 0.28867513459481292 * t214;
+      const double t227 = t225 - t226;
+      const double t228 = h * t227;
+      const double t229 = x->p[2] /* p_q[3] */ - t228;
+      const double t230 = 0.28867513459481292 * t207;
+      const double t231 = h * t230;
+      const double t232 = -t231;
+      const double t233 = 0.28867513459481292 * t208;
+      const double t234 = h * t233;
+      const double t235 = -t234;
+      const double t236 = 0.28867513459481292 * t210;
+      const double t237 = h * t236;
+      const double t238 = -t237;
+      const double t239 = h * t207;
+      const double t240 = -t239;
+      const double t241 = h * t208;
+      const double t242 = -t241;
+      const double t243 = h * t210;
+      const double t244 = -t243;
+      /* gam */
+      sw0 = t219;
+      sw1 = t224;
+      sw2 = t229;
+      sw3 = t232;
+      sw4 = t235;
+      sw5 = t238;
+      /* dp */
+      sw6 = t240;
+      sw7 = t242;
+      sw8 = t244;
+      /* lambda */
+      sw9 = t206;
+      /* pivot */
+      sw10 = t190;
+      /* adiag */
+      sw11 = t190;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < modified_k6s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(x->q[2]) + fabs(h * sw2);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < modified_k6s2_NU; i++) {
-      double piv = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU + i], dia = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 2 * modified_k6s2_NU + i];
+    {
+      double piv = sw10, dia = sw11;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k6s2_SINGTOL * fabs(dia))) rc = modified_k6s2_ESINGULAR;
     }
     if (rc == modified_k6s2_ESINGULAR) break;
-    for (i = 0; i < modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU; i++)
-      if (!isfinite(sw[i])) rc = modified_k6s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9)) rc = modified_k6s2_ENONFINITE;
     if (rc == modified_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k6s2_TOL / 256), or
      * within 2 ulps (modified_k6s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -639,6 +655,24 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
   if (st) { st->iters = it > modified_k6s2_MAXITER ? modified_k6s2_MAXITER : it; st->increment = inc; }
   if (rc != modified_k6s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k6s2_ENONFINITE;
@@ -651,8 +685,12 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
     modified_k6s2_add(&x->p[i], &x->pc[i], sw[modified_k6s2_S * modified_k6s2_M + i]);
   }
   for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + i];
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   modified_k6s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return modified_k6s2_OK;
 }

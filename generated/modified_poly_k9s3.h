@@ -25,8 +25,9 @@ typedef double modified_poly_k9s3_real;
 
 typedef struct {
   modified_poly_k9s3_real t, q[3], p[3], lambda[1];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   modified_poly_k9s3_real tc, qc[3], pc[3], gam[9], hprev;
+  modified_poly_k9s3_real gam2[9], hprev2;
   modified_poly_k9s3_real H0;  /* the energy the step keeps */
 } modified_poly_k9s3_state;
 

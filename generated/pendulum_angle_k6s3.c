@@ -47,121 +47,6 @@ static const double pendulum_angle_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416
 static const double pendulum_angle_k6s3_q0[1] = {0.0};
 static const double pendulum_angle_k6s3_p0[1] = {1.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const pendulum_angle_k6s3_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t0 = gam[0] * 0.033765242898423975;
-  const double t1 = gam[1] * (-0.056508419605012766);
-  const double t2 = t0 + t1;
-  const double t3 = gam[2] * 0.068025568234204442;
-  const double t4 = t2 + t3;
-  const double t5 = h * t4;
-  const double t6 = t5 + q0[0] /* theta */;
-  const double t7 = sin(t6);
-  const double t8 = t7 * 0.085662246189585178;
-  const double t9 = t7 * (-0.13835177248998257);
-  const double t10 = t7 * 0.15405118368989568;
-  /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t11 = gam[0] * 0.16939530676686776;
-  const double t12 = gam[1] * (-0.24370047841099157);
-  const double t13 = t11 + t12;
-  const double t14 = gam[2] * 0.20802702904656017;
-  const double t15 = t13 + t14;
-  const double t16 = h * t15;
-  const double t17 = q0[0] /* theta */ + t16;
-  const double t18 = sin(t17);
-  const double t19 = t18 * 0.1803807865240693;
-  const double t20 = t8 + t19;
-  const double t21 = t18 * (-0.20658078042518249);
-  const double t22 = t9 + t21;
-  const double t23 = t18 * 0.062839649419340643;
-  const double t24 = t10 + t23;
-  /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t25 = gam[0] * 0.38069040695840156;
-  const double t26 = gam[1] * (-0.40835734144399111);
-  const double t27 = t25 + t26;
-  const double t28 = gam[2] * 0.1257969473866733;
-  const double t29 = t27 + t28;
-  const double t30 = h * t29;
-  const double t31 = q0[0] /* theta */ + t30;
-  const double t32 = sin(t31);
-  const double t33 = t32 * 0.23395696728634552;
-  const double t34 = t20 + t33;
-  const double t35 = t32 * (-0.096694544181506401);
-  const double t36 = t22 + t35;
-  const double t37 = t32 * (-0.21689083310923635);
-  const double t38 = t24 + t37;
-  /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t39 = gam[0] * 0.61930959304159849;
-  const double t40 = gam[1] * (-0.40835734144399105);
-  const double t41 = t39 + t40;
-  const double t42 = gam[2] * (-0.12579694738667335);
-  const double t43 = t41 + t42;
-  const double t44 = h * t43;
-  const double t45 = q0[0] /* theta */ + t44;
-  const double t46 = sin(t45);
-  const double t47 = 0.23395696728634552 * t46;
-  const double t48 = t34 + t47;
-  const double t49 = t46 * 0.096694544181506442;
-  const double t50 = t36 + t49;
-  const double t51 = t46 * (-0.21689083310923629);
-  const double t52 = t38 + t51;
-  /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t53 = gam[0] * 0.83060469323313224;
-  const double t54 = t12 + t53;
-  const double t55 = gam[2] * (-0.20802702904656017);
-  const double t56 = t54 + t55;
-  const double t57 = h * t56;
-  const double t58 = q0[0] /* theta */ + t57;
-  const double t59 = sin(t58);
-  const double t60 = 0.1803807865240693 * t59;
-  const double t61 = t48 + t60;
-  const double t62 = t59 * 0.20658078042518249;
-  const double t63 = t50 + t62;
-  const double t64 = 0.062839649419340643 * t59;
-  const double t65 = t52 + t64;
-  /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-  const double t66 = gam[0] * 0.96623475710157603;
-  const double t67 = t1 + t66;
-  const double t68 = gam[2] * (-0.068025568234204442);
-  const double t69 = t67 + t68;
-  const double t70 = h * t69;
-  const double t71 = q0[0] /* theta */ + t70;
-  const double t72 = sin(t71);
-  const double t73 = 0.085662246189585178 * t72;
-  const double t74 = t61 + t73;
-  const double t75 = t72 * 0.13835177248998257;
-  const double t76 = t63 + t75;
-  const double t77 = 0.15405118368989568 * t72;
-  const double t78 = t65 + t77;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t79 = t74 * 0.5;
-  const double t80 = t76 * 0.28867513459481292;
-  const double t81 = t79 - t80;
-  const double t82 = h * t81;
-  const double t83 = p0[0] /* p_theta */ - t82;
-  const double t84 = t74 * 0.28867513459481292;
-  const double t85 = t78 * 0.12909944487358055;
-  const double t86 = t84 - t85;
-  const double t87 = h * t86;
-  const double t88 = -t87;
-  const double t89 = t76 * 0.12909944487358055;
-  const double t90 = h * t89;
-  const double t91 = -t90;
-  const double t92 = h * t74;
-  const double t93 = -t92;
-  /* gam */
-  out[0] = t83;
-  out[1] = t88;
-  out[2] = t91;
-  /* dp */
-  out[3] = t93;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void pendulum_angle_k6s3_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_angle_k6s3_params *prm, double *out)
@@ -196,14 +81,14 @@ void pendulum_angle_k6s3_init_params(pendulum_angle_k6s3_state *x, const pendulu
 {
   int i;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_angle_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_angle_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_angle_k6s3_NU ? pendulum_angle_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = x->gam2[i] = 0;
 }
 
 void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_real *q0, const pendulum_angle_k6s3_real *p0)
@@ -241,8 +126,9 @@ void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendul
   (void)x; (void)prm; (void)gp;
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, double h, const pendulum_angle_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -282,24 +168,139 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_angle_k6s3_EBADSTEP;
   pendulum_angle_k6s3_predict(x, h, prm, gam);
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0;
   for (it = 1; it <= pendulum_angle_k6s3_MAXITER; it++) {
-    pendulum_angle_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t0 = gm0 * 0.033765242898423975;
+      const double t1 = gm1 * (-0.056508419605012766);
+      const double t2 = t0 + t1;
+      const double t3 = gm2 * 0.068025568234204442;
+      const double t4 = t2 + t3;
+      const double t5 = h * t4;
+      const double t6 = t5 + x->q[0] /* theta */;
+      const double t7 = sin(t6);
+      const double t8 = t7 * 0.085662246189585178;
+      const double t9 = t7 * (-0.13835177248998257);
+      const double t10 = t7 * 0.15405118368989568;
+      /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t11 = gm0 * 0.16939530676686776;
+      const double t12 = gm1 * (-0.24370047841099157);
+      const double t13 = t11 + t12;
+      const double t14 = gm2 * 0.20802702904656017;
+      const double t15 = t13 + t14;
+      const double t16 = h * t15;
+      const double t17 = x->q[0] /* theta */ + t16;
+      const double t18 = sin(t17);
+      const double t19 = t18 * 0.1803807865240693;
+      const double t20 = t8 + t19;
+      const double t21 = t18 * (-0.20658078042518249);
+      const double t22 = t9 + t21;
+      const double t23 = t18 * 0.062839649419340643;
+      const double t24 = t10 + t23;
+      /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t25 = gm0 * 0.38069040695840156;
+      const double t26 = gm1 * (-0.40835734144399111);
+      const double t27 = t25 + t26;
+      const double t28 = gm2 * 0.1257969473866733;
+      const double t29 = t27 + t28;
+      const double t30 = h * t29;
+      const double t31 = x->q[0] /* theta */ + t30;
+      const double t32 = sin(t31);
+      const double t33 = t32 * 0.23395696728634552;
+      const double t34 = t20 + t33;
+      const double t35 = t32 * (-0.096694544181506401);
+      const double t36 = t22 + t35;
+      const double t37 = t32 * (-0.21689083310923635);
+      const double t38 = t24 + t37;
+      /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t39 = gm0 * 0.61930959304159849;
+      const double t40 = gm1 * (-0.40835734144399105);
+      const double t41 = t39 + t40;
+      const double t42 = gm2 * (-0.12579694738667335);
+      const double t43 = t41 + t42;
+      const double t44 = h * t43;
+      const double t45 = x->q[0] /* theta */ + t44;
+      const double t46 = sin(t45);
+      const double t47 = 0.23395696728634552 * t46;
+      const double t48 = t34 + t47;
+      const double t49 = t46 * 0.096694544181506442;
+      const double t50 = t36 + t49;
+      const double t51 = t46 * (-0.21689083310923629);
+      const double t52 = t38 + t51;
+      /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t53 = gm0 * 0.83060469323313224;
+      const double t54 = t12 + t53;
+      const double t55 = gm2 * (-0.20802702904656017);
+      const double t56 = t54 + t55;
+      const double t57 = h * t56;
+      const double t58 = x->q[0] /* theta */ + t57;
+      const double t59 = sin(t58);
+      const double t60 = 0.1803807865240693 * t59;
+      const double t61 = t48 + t60;
+      const double t62 = t59 * 0.20658078042518249;
+      const double t63 = t50 + t62;
+      const double t64 = 0.062839649419340643 * t59;
+      const double t65 = t52 + t64;
+      /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
+      const double t66 = gm0 * 0.96623475710157603;
+      const double t67 = t1 + t66;
+      const double t68 = gm2 * (-0.068025568234204442);
+      const double t69 = t67 + t68;
+      const double t70 = h * t69;
+      const double t71 = x->q[0] /* theta */ + t70;
+      const double t72 = sin(t71);
+      const double t73 = 0.085662246189585178 * t72;
+      const double t74 = t61 + t73;
+      const double t75 = t72 * 0.13835177248998257;
+      const double t76 = t63 + t75;
+      const double t77 = 0.15405118368989568 * t72;
+      const double t78 = t65 + t77;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t79 = t74 * 0.5;
+      const double t80 = t76 * 0.28867513459481292;
+      const double t81 = t79 - t80;
+      const double t82 = h * t81;
+      const double t83 = x->p[0] /* p_theta */ - t82;
+      const double t84 = t74 * 0.28867513459481292;
+      const double t85 = t78 * 0.12909944487358055;
+      const double t86 = t84 - t85;
+      const double t87 = h * t86;
+      const double t88 = -t87;
+      const double t89 = t76 * 0.12909944487358055;
+      const double t90 = h * t89;
+      const double t91 = -t90;
+      const double t92 = h * t74;
+      const double t93 = -t92;
+      /* gam */
+      sw0 = t83;
+      sw1 = t88;
+      sw2 = t91;
+      /* dp */
+      sw3 = t93;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_angle_k6s3_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_angle_k6s3_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3)) rc = pendulum_angle_k6s3_ENONFINITE;
     if (rc == pendulum_angle_k6s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_angle_k6s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_angle_k6s3_TOL / 256), or
      * within 2 ulps (pendulum_angle_k6s3_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -318,6 +319,13 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
   if (st) { st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_angle_k6s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_angle_k6s3_ENONFINITE;
@@ -330,8 +338,12 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
     pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]);
   }
   for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + i];
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_angle_k6s3_OK;
 }

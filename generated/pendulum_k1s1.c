@@ -42,65 +42,6 @@ static const double pendulum_k1s1_E1[1] = {1.0};
 static const double pendulum_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k1s1_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const pendulum_k1s1_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = gam[0] * 0.5;
-  const double t3 = h * t2;
-  const double t4 = 2.0 * t3;
-  const double t5 = t1 + t4;
-  const double t6 = 0.5 * gam[1];
-  const double t7 = h * t6;
-  const double t8 = 2.0 * t7;
-  const double t9 = t0 + t8;
-  /* multiplier system A lambda = r */
-  const double t10 = t5 * t5;
-  const double t11 = t9 * t9;
-  const double t12 = t10 + t11;
-  const double t13 = 0.5 * t12;
-  const double t14 = h * t13;
-  const double t15 = 0.5 * t9;
-  const double t16 = h * t15;
-  const double t17 = t5 * p0[0] /* p_x */;
-  const double t18 = t9 * p0[1] /* p_y */;
-  const double t19 = t17 + t18;
-  const double t20 = t19 - t16;
-  const double t21 = t20 + g0[0];
-  const double t22 = t21 / t14;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t23 = t5 * t22;
-  const double t24 = t9 * t22;
-  const double t25 = 1.0 + t24;
-  const double t26 = 0.5 * t23;
-  const double t27 = h * t26;
-  const double t28 = p0[0] /* p_x */ - t27;
-  const double t29 = 0.5 * t25;
-  const double t30 = h * t29;
-  const double t31 = p0[1] /* p_y */ - t30;
-  const double t32 = h * t23;
-  const double t33 = -t32;
-  const double t34 = h * t25;
-  const double t35 = -t34;
-  /* gam */
-  out[0] = t28;
-  out[1] = t31;
-  /* dp */
-  out[2] = t33;
-  out[3] = t35;
-  /* lambda */
-  out[4] = t22;
-  /* pivot */
-  out[5] = t14;
-  /* adiag */
-  out[6] = t14;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void pendulum_k1s1_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k1s1_params *prm, double *out)
@@ -231,14 +172,14 @@ void pendulum_k1s1_init_params(pendulum_k1s1_state *x, const pendulum_k1s1_real 
 {
   int i;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k1s1_NU ? pendulum_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[pendulum_k1s1_NU];
     pendulum_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -283,8 +224,9 @@ void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_para
   pendulum_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_k1s1_predict(const pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -330,29 +272,87 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
    * cannot drift; below pendulum_k1s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < pendulum_k1s1_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_k1s1_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0;
   for (it = 1; it <= pendulum_k1s1_MAXITER; it++) {
-    pendulum_k1s1_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[1] /* y */;
+      const double t1 = 2.0 * x->q[0] /* x */;
+      const double t2 = gm0 * 0.5;
+      const double t3 = h * t2;
+      const double t4 = 2.0 * t3;
+      const double t5 = t1 + t4;
+      const double t6 = 0.5 * gm1;
+      const double t7 = h * t6;
+      const double t8 = 2.0 * t7;
+      const double t9 = t0 + t8;
+      /* multiplier system A lambda = r */
+      const double t10 = t5 * t5;
+      const double t11 = t9 * t9;
+      const double t12 = t10 + t11;
+      const double t13 = 0.5 * t12;
+      const double t14 = h * t13;
+      const double t15 = 0.5 * t9;
+      const double t16 = h * t15;
+      const double t17 = t5 * x->p[0] /* p_x */;
+      const double t18 = t9 * x->p[1] /* p_y */;
+      const double t19 = t17 + t18;
+      const double t20 = t19 - t16;
+      const double t21 = t20 + g0[0];
+      const double t22 = t21 / t14;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t23 = t5 * t22;
+      const double t24 = t9 * t22;
+      const double t25 = 1.0 + t24;
+      const double t26 = 0.5 * t23;
+      const double t27 = h * t26;
+      const double t28 = x->p[0] /* p_x */ - t27;
+      const double t29 = 0.5 * t25;
+      const double t30 = h * t29;
+      const double t31 = x->p[1] /* p_y */ - t30;
+      const double t32 = h * t23;
+      const double t33 = -t32;
+      const double t34 = h * t25;
+      const double t35 = -t34;
+      /* gam */
+      sw0 = t28;
+      sw1 = t31;
+      /* dp */
+      sw2 = t33;
+      sw3 = t35;
+      /* lambda */
+      sw4 = t22;
+      /* pivot */
+      sw5 = t14;
+      /* adiag */
+      sw6 = t14;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_k1s1_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_k1s1_NU; i++) {
-      double piv = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
+    {
+      double piv = sw5, dia = sw6;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k1s1_SINGTOL * fabs(dia))) rc = pendulum_k1s1_ESINGULAR;
     }
     if (rc == pendulum_k1s1_ESINGULAR) break;
-    for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_k1s1_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4)) rc = pendulum_k1s1_ENONFINITE;
     if (rc == pendulum_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_k1s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k1s1_TOL / 256), or
      * within 2 ulps (pendulum_k1s1_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -371,6 +371,15 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
   if (st) { st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_k1s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k1s1_ENONFINITE;
@@ -383,8 +392,12 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
     pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[pendulum_k1s1_S * pendulum_k1s1_M + i]);
   }
   for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + i];
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_k1s1_OK;
 }

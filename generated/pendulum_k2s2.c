@@ -43,91 +43,6 @@ static const double pendulum_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999
 static const double pendulum_k2s2_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k2s2_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const pendulum_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = gam[0] * 0.5;
-  const double t3 = gam[2] * 0.28867513459481292;
-  const double t4 = t2 - t3;
-  const double t5 = h * t4;
-  const double t6 = 2.0 * t5;
-  const double t7 = t1 + t6;
-  const double t8 = gam[0] * 0.28867513459481292;
-  const double t9 = h * t8;
-  const double t10 = 2.0 * t9;
-  const double t11 = 0.5 * gam[1];
-  const double t12 = 0.28867513459481292 * gam[3];
-  const double t13 = t11 - t12;
-  const double t14 = h * t13;
-  const double t15 = 2.0 * t14;
-  const double t16 = t0 + t15;
-  const double t17 = 0.28867513459481292 * gam[1];
-  const double t18 = h * t17;
-  const double t19 = 2.0 * t18;
-  /* multiplier system A lambda = r */
-  const double t20 = t7 * t7;
-  const double t21 = t16 * t16;
-  const double t22 = t20 + t21;
-  const double t23 = 0.5 * t22;
-  const double t24 = h * t23;
-  const double t25 = 0.5 * t16;
-  const double t26 = t18 * 0.57735026918962584;
-  const double t27 = t25 + t26;
-  const double t28 = h * t27;
-  const double t29 = t7 * p0[0] /* p_x */;
-  const double t30 = t16 * p0[1] /* p_y */;
-  const double t31 = t29 + t30;
-  const double t32 = t31 - t28;
-  const double t33 = t32 + g0[0];
-  const double t34 = t33 / t24;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t35 = t7 * t34;
-  const double t36 = t16 * t34;
-  const double t37 = 1.0 + t36;
-  const double t38 = t10 * t34;
-  const double t39 = t19 * t34;
-  const double t40 = 0.5 * t35;
-  const double t41 = 0.28867513459481292 * t38;
-  const double t42 = t40 - t41;
-  const double t43 = h * t42;
-  const double t44 = p0[0] /* p_x */ - t43;
-  const double t45 = 0.5 * t37;
-  const double t46 = 0.28867513459481292 * t39;
-  const double t47 = t45 - t46;
-  const double t48 = h * t47;
-  const double t49 = p0[1] /* p_y */ - t48;
-  const double t50 = 0.28867513459481292 * t35;
-  const double t51 = h * t50;
-  const double t52 = -t51;
-  const double t53 = 0.28867513459481292 * t37;
-  const double t54 = h * t53;
-  const double t55 = -t54;
-  const double t56 = h * t35;
-  const double t57 = -t56;
-  const double t58 = h * t37;
-  const double t59 = -t58;
-  /* gam */
-  out[0] = t44;
-  out[1] = t49;
-  out[2] = t52;
-  out[3] = t55;
-  /* dp */
-  out[4] = t57;
-  out[5] = t59;
-  /* lambda */
-  out[6] = t34;
-  /* pivot */
-  out[7] = t24;
-  /* adiag */
-  out[8] = t24;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void pendulum_k2s2_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k2s2_params *prm, double *out)
@@ -258,14 +173,14 @@ void pendulum_k2s2_init_params(pendulum_k2s2_state *x, const pendulum_k2s2_real 
 {
   int i;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k2s2_NU ? pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[pendulum_k2s2_NU];
     pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -310,8 +225,9 @@ void pendulum_k2s2_hidden(const pendulum_k2s2_state *x, const pendulum_k2s2_para
   pendulum_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_k2s2_predict(const pendulum_k2s2_state *x, double h, const pendulum_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -357,29 +273,121 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h_, const pend
    * cannot drift; below pendulum_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < pendulum_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_k2s2_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0;
   for (it = 1; it <= pendulum_k2s2_MAXITER; it++) {
-    pendulum_k2s2_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[1] /* y */;
+      const double t1 = 2.0 * x->q[0] /* x */;
+      const double t2 = gm0 * 0.5;
+      const double t3 = gm2 * 0.28867513459481292;
+      const double t4 = t2 - t3;
+      const double t5 = h * t4;
+      const double t6 = 2.0 * t5;
+      const double t7 = t1 + t6;
+      const double t8 = gm0 * 0.28867513459481292;
+      const double t9 = h * t8;
+      const double t10 = 2.0 * t9;
+      const double t11 = 0.5 * gm1;
+      const double t12 = 0.28867513459481292 * gm3;
+      const double t13 = t11 - t12;
+      const double t14 = h * t13;
+      const double t15 = 2.0 * t14;
+      const double t16 = t0 + t15;
+      const double t17 = 0.28867513459481292 * gm1;
+      const double t18 = h * t17;
+      const double t19 = 2.0 * t18;
+      /* multiplier system A lambda = r */
+      const double t20 = t7 * t7;
+      const double t21 = t16 * t16;
+      const double t22 = t20 + t21;
+      const double t23 = 0.5 * t22;
+      const double t24 = h * t23;
+      const double t25 = 0.5 * t16;
+      const double t26 = t18 * 0.57735026918962584;
+      const double t27 = t25 + t26;
+      const double t28 = h * t27;
+      const double t29 = t7 * x->p[0] /* p_x */;
+      const double t30 = t16 * x->p[1] /* p_y */;
+      const double t31 = t29 + t30;
+      const double t32 = t31 - t28;
+      const double t33 = t32 + g0[0];
+      const double t34 = t33 / t24;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t35 = t7 * t34;
+      const double t36 = t16 * t34;
+      const double t37 = 1.0 + t36;
+      const double t38 = t10 * t34;
+      const double t39 = t19 * t34;
+      const double t40 = 0.5 * t35;
+      const double t41 = 0.28867513459481292 * t38;
+      const double t42 = t40 - t41;
+      const double t43 = h * t42;
+      const double t44 = x->p[0] /* p_x */ - t43;
+      const double t45 = 0.5 * t37;
+      const double t46 = 0.28867513459481292 * t39;
+      const double t47 = t45 - t46;
+      const double t48 = h * t47;
+      const double t49 = x->p[1] /* p_y */ - t48;
+      const double t50 = 0.28867513459481292 * t35;
+      const double t51 = h * t50;
+      const double t52 = -t51;
+      const double t53 = 0.28867513459481292 * t37;
+      const double t54 = h * t53;
+      const double t55 = -t54;
+      const double t56 = h * t35;
+      const double t57 = -t56;
+      const double t58 = h * t37;
+      const double t59 = -t58;
+      /* gam */
+      sw0 = t44;
+      sw1 = t49;
+      sw2 = t52;
+      sw3 = t55;
+      /* dp */
+      sw4 = t57;
+      sw5 = t59;
+      /* lambda */
+      sw6 = t34;
+      /* pivot */
+      sw7 = t24;
+      /* adiag */
+      sw8 = t24;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_k2s2_NU; i++) {
-      double piv = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU + i], dia = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 2 * pendulum_k2s2_NU + i];
+    {
+      double piv = sw7, dia = sw8;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k2s2_SINGTOL * fabs(dia))) rc = pendulum_k2s2_ESINGULAR;
     }
     if (rc == pendulum_k2s2_ESINGULAR) break;
-    for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_k2s2_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6)) rc = pendulum_k2s2_ENONFINITE;
     if (rc == pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = pendulum_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k2s2_TOL / 256), or
      * within 2 ulps (pendulum_k2s2_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -398,6 +406,19 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h_, const pend
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
   if (st) { st->iters = it > pendulum_k2s2_MAXITER ? pendulum_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k2s2_ENONFINITE;
@@ -410,8 +431,12 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h_, const pend
     pendulum_k2s2_add(&x->p[i], &x->pc[i], sw[pendulum_k2s2_S * pendulum_k2s2_M + i]);
   }
   for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + i];
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_k2s2_OK;
 }

@@ -44,115 +44,6 @@ static const double pendulum_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864
 static const double pendulum_k3s3_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k3s3_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
-static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const pendulum_k3s3_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = gam[0] * 0.5;
-  const double t3 = gam[2] * 0.28867513459481292;
-  const double t4 = t2 - t3;
-  const double t5 = h * t4;
-  const double t6 = 2.0 * t5;
-  const double t7 = t1 + t6;
-  const double t8 = gam[0] * 0.28867513459481292;
-  const double t9 = gam[4] * 0.12909944487358055;
-  const double t10 = t8 - t9;
-  const double t11 = h * t10;
-  const double t12 = 2.0 * t11;
-  const double t13 = gam[2] * 0.12909944487358055;
-  const double t14 = h * t13;
-  const double t15 = 2.0 * t14;
-  const double t16 = 0.5 * gam[1];
-  const double t17 = 0.28867513459481292 * gam[3];
-  const double t18 = t16 - t17;
-  const double t19 = h * t18;
-  const double t20 = 2.0 * t19;
-  const double t21 = t0 + t20;
-  const double t22 = 0.28867513459481292 * gam[1];
-  const double t23 = 0.12909944487358055 * gam[5];
-  const double t24 = t22 - t23;
-  const double t25 = h * t24;
-  const double t26 = 2.0 * t25;
-  const double t27 = 0.12909944487358055 * gam[3];
-  const double t28 = h * t27;
-  const double t29 = 2.0 * t28;
-  /* multiplier system A lambda = r */
-  const double t30 = t7 * t7;
-  const double t31 = t21 * t21;
-  const double t32 = t30 + t31;
-  const double t33 = 0.5 * t32;
-  const double t34 = h * t33;
-  const double t35 = 0.5 * t21;
-  const double t36 = t25 * 0.57735026918962584;
-  const double t37 = t35 + t36;
-  const double t38 = h * t37;
-  const double t39 = t7 * p0[0] /* p_x */;
-  const double t40 = t21 * p0[1] /* p_y */;
-  const double t41 = t39 + t40;
-  const double t42 = t41 - t38;
-  const double t43 = t42 + g0[0];
-  const double t44 = t43 / t34;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-  const double t45 = t7 * t44;
-  const double t46 = t21 * t44;
-  const double t47 = 1.0 + t46;
-  const double t48 = t12 * t44;
-  const double t49 = t26 * t44;
-  const double t50 = t15 * t44;
-  const double t51 = t29 * t44;
-  const double t52 = 0.5 * t45;
-  const double t53 = 0.28867513459481292 * t48;
-  const double t54 = t52 - t53;
-  const double t55 = h * t54;
-  const double t56 = p0[0] /* p_x */ - t55;
-  const double t57 = 0.5 * t47;
-  const double t58 = 0.28867513459481292 * t49;
-  const double t59 = t57 - t58;
-  const double t60 = h * t59;
-  const double t61 = p0[1] /* p_y */ - t60;
-  const double t62 = 0.28867513459481292 * t45;
-  const double t63 = 0.12909944487358055 * t50;
-  const double t64 = t62 - t63;
-  const double t65 = h * t64;
-  const double t66 = -t65;
-  const double t67 = 0.28867513459481292 * t47;
-  const double t68 = 0.12909944487358055 * t51;
-  const double t69 = t67 - t68;
-  const double t70 = h * t69;
-  const double t71 = -t70;
-  const double t72 = 0.12909944487358055 * t48;
-  const double t73 = h * t72;
-  const double t74 = -t73;
-  const double t75 = 0.12909944487358055 * t49;
-  const double t76 = h * t75;
-  const double t77 = -t76;
-  const double t78 = h * t45;
-  const double t79 = -t78;
-  const double t80 = h * t47;
-  const double t81 = -t80;
-  /* gam */
-  out[0] = t56;
-  out[1] = t61;
-  out[2] = t66;
-  out[3] = t71;
-  out[4] = t74;
-  out[5] = t77;
-  /* dp */
-  out[6] = t79;
-  out[7] = t81;
-  /* lambda */
-  out[8] = t44;
-  /* pivot */
-  out[9] = t34;
-  /* adiag */
-  out[10] = t34;
-}
-
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
 static void pendulum_k3s3_minv_p(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k3s3_params *prm, double *out)
@@ -283,14 +174,14 @@ void pendulum_k3s3_init_params(pendulum_k3s3_state *x, const pendulum_k3s3_real 
 {
   int i;
   pendulum_k3s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_k3s3_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_k3s3_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k3s3_NU ? pendulum_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[pendulum_k3s3_NU];
     pendulum_k3s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -335,8 +226,9 @@ void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_para
   pendulum_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_k3s3_predict(const pendulum_k3s3_state *x, double h, const pendulum_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -382,29 +274,151 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pend
    * cannot drift; below pendulum_k3s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < pendulum_k3s3_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_k3s3_GTOL ? 0 : g0[i] / h;
+  /* the iteration's values in locals: gamma, the sweep's results */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0;
   for (it = 1; it <= pendulum_k3s3_MAXITER; it++) {
-    pendulum_k3s3_sweep(x->q, x->p, gam, h, g0, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = 2.0 * x->q[1] /* y */;
+      const double t1 = 2.0 * x->q[0] /* x */;
+      const double t2 = gm0 * 0.5;
+      const double t3 = gm2 * 0.28867513459481292;
+      const double t4 = t2 - t3;
+      const double t5 = h * t4;
+      const double t6 = 2.0 * t5;
+      const double t7 = t1 + t6;
+      const double t8 = gm0 * 0.28867513459481292;
+      const double t9 = gm4 * 0.12909944487358055;
+      const double t10 = t8 - t9;
+      const double t11 = h * t10;
+      const double t12 = 2.0 * t11;
+      const double t13 = gm2 * 0.12909944487358055;
+      const double t14 = h * t13;
+      const double t15 = 2.0 * t14;
+      const double t16 = 0.5 * gm1;
+      const double t17 = 0.28867513459481292 * gm3;
+      const double t18 = t16 - t17;
+      const double t19 = h * t18;
+      const double t20 = 2.0 * t19;
+      const double t21 = t0 + t20;
+      const double t22 = 0.28867513459481292 * gm1;
+      const double t23 = 0.12909944487358055 * gm5;
+      const double t24 = t22 - t23;
+      const double t25 = h * t24;
+      const double t26 = 2.0 * t25;
+      const double t27 = 0.12909944487358055 * gm3;
+      const double t28 = h * t27;
+      const double t29 = 2.0 * t28;
+      /* multiplier system A lambda = r */
+      const double t30 = t7 * t7;
+      const double t31 = t21 * t21;
+      const double t32 = t30 + t31;
+      const double t33 = 0.5 * t32;
+      const double t34 = h * t33;
+      const double t35 = 0.5 * t21;
+      const double t36 = t25 * 0.57735026918962584;
+      const double t37 = t35 + t36;
+      const double t38 = h * t37;
+      const double t39 = t7 * x->p[0] /* p_x */;
+      const double t40 = t21 * x->p[1] /* p_y */;
+      const double t41 = t39 + t40;
+      const double t42 = t41 - t38;
+      const double t43 = t42 + g0[0];
+      const double t44 = t43 / t34;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
+      const double t45 = t7 * t44;
+      const double t46 = t21 * t44;
+      const double t47 = 1.0 + t46;
+      const double t48 = t12 * t44;
+      const double t49 = t26 * t44;
+      const double t50 = t15 * t44;
+      const double t51 = t29 * t44;
+      const double t52 = 0.5 * t45;
+      const double t53 = 0.28867513459481292 * t48;
+      const double t54 = t52 - t53;
+      const double t55 = h * t54;
+      const double t56 = x->p[0] /* p_x */ - t55;
+      const double t57 = 0.5 * t47;
+      const double t58 = 0.28867513459481292 * t49;
+      const double t59 = t57 - t58;
+      const double t60 = h * t59;
+      const double t61 = x->p[1] /* p_y */ - t60;
+      const double t62 = 0.28867513459481292 * t45;
+      const double t63 = 0.12909944487358055 * t50;
+      const double t64 = t62 - t63;
+      const double t65 = h * t64;
+      const double t66 = -t65;
+      const double t67 = 0.28867513459481292 * t47;
+      const double t68 = 0.12909944487358055 * t51;
+      const double t69 = t67 - t68;
+      const double t70 = h * t69;
+      const double t71 = -t70;
+      const double t72 = 0.12909944487358055 * t48;
+      const double t73 = h * t72;
+      const double t74 = -t73;
+      const double t75 = 0.12909944487358055 * t49;
+      const double t76 = h * t75;
+      const double t77 = -t76;
+      const double t78 = h * t45;
+      const double t79 = -t78;
+      const double t80 = h * t47;
+      const double t81 = -t80;
+      /* gam */
+      sw0 = t56;
+      sw1 = t61;
+      sw2 = t66;
+      sw3 = t71;
+      sw4 = t74;
+      sw5 = t77;
+      /* dp */
+      sw6 = t79;
+      sw7 = t81;
+      /* lambda */
+      sw8 = t44;
+      /* pivot */
+      sw9 = t34;
+      /* adiag */
+      sw10 = t34;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_k3s3_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_k3s3_NU; i++) {
-      double piv = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + pendulum_k3s3_NU + i], dia = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 2 * pendulum_k3s3_NU + i];
+    {
+      double piv = sw9, dia = sw10;
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k3s3_SINGTOL * fabs(dia))) rc = pendulum_k3s3_ESINGULAR;
     }
     if (rc == pendulum_k3s3_ESINGULAR) break;
-    for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + pendulum_k3s3_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_k3s3_ENONFINITE;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8)) rc = pendulum_k3s3_ENONFINITE;
     if (rc == pendulum_k3s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k3s3_TOL / 256), or
      * within 2 ulps (pendulum_k3s3_TOL) and falling by less than 4x (round-off noise). Iterating
@@ -423,6 +437,23 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pend
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
   if (st) { st->iters = it > pendulum_k3s3_MAXITER ? pendulum_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_k3s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k3s3_ENONFINITE;
@@ -435,8 +466,12 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pend
     pendulum_k3s3_add(&x->p[i], &x->pc[i], sw[pendulum_k3s3_S * pendulum_k3s3_M + i]);
   }
   for (i = 0; i < pendulum_k3s3_NU; i++) x->lambda[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + i];
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   pendulum_k3s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_k3s3_OK;
 }

@@ -38,65 +38,12 @@
 static const double pendulum_poly_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_poly_k1s1_E1[1] = {1.0};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double pendulum_poly_k1s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double pendulum_poly_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k1s1_p0[2] = {1.0, 0.0};
-
-/* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
-static void pendulum_poly_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const double *lam, const double *lu, const pendulum_poly_k1s1_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = gam[0] * 0.5;
-  const double t1 = h * t0;
-  const double t2 = 0.5 * gam[1];
-  const double t3 = h * t2;
-  /* grad g at the stages */
-  const double t4 = q0[0] /* x */ + t1;
-  const double t5 = q0[1] /* y */ + t3;
-  const double t6 = 2.0 * t5;
-  const double t7 = 2.0 * t4;
-  /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-  const double t8 = t7 * lam[0];
-  const double t9 = t6 * lam[0];
-  const double t10 = 1.0 + t9;
-  const double t11 = 0.5 * t8;
-  const double t12 = h * t11;
-  const double t13 = p0[0] /* p_x */ - t12;
-  const double t14 = 0.5 * t10;
-  const double t15 = h * t14;
-  const double t16 = p0[1] /* p_y */ - t15;
-  const double t17 = t7 * t13;
-  const double t18 = t6 * t16;
-  const double t19 = t17 + t18;
-  const double t20 = t19 + g0[0];
-  const double t21 = lu[0] * t20;
-  const double t22 = lam[0] + t21;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-  const double t23 = t7 * t22;
-  const double t24 = t6 * t22;
-  const double t25 = 1.0 + t24;
-  const double t26 = 0.5 * t23;
-  const double t27 = h * t26;
-  const double t28 = p0[0] /* p_x */ - t27;
-  const double t29 = 0.5 * t25;
-  const double t30 = h * t29;
-  const double t31 = p0[1] /* p_y */ - t30;
-  const double t32 = h * t23;
-  const double t33 = -t32;
-  const double t34 = h * t25;
-  const double t35 = -t34;
-  /* gam */
-  out[0] = t28;
-  out[1] = t31;
-  /* dp */
-  out[2] = t33;
-  out[3] = t35;
-  /* lam */
-  out[4] = t22;
-}
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
  * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU). */
@@ -297,14 +244,14 @@ void pendulum_poly_k1s1_init_params(pendulum_poly_k1s1_state *x, const pendulum_
 {
   int i;
   pendulum_poly_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_poly_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k1s1_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k1s1_NU ? pendulum_poly_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[pendulum_poly_k1s1_NU];
@@ -350,14 +297,23 @@ void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum
   pendulum_poly_k1s1_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, const pendulum_poly_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k1s1_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < pendulum_poly_k1s1_S; j++)
+      for (i = 0; i < pendulum_poly_k1s1_S; i++)
+        for (l = 0; l < pendulum_poly_k1s1_M; l++)
+          gam[j * pendulum_poly_k1s1_M + l] += pendulum_poly_k1s1_E2[2 * pendulum_poly_k1s1_S * j + i] * x->gam[i * pendulum_poly_k1s1_M + l] +
+                               pendulum_poly_k1s1_E2[2 * pendulum_poly_k1s1_S * j + pendulum_poly_k1s1_S + i] * x->gam2[i * pendulum_poly_k1s1_M + l];
     return;
   }
   for (j = 0; j < pendulum_poly_k1s1_S; j++)
@@ -397,9 +353,8 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
    * cannot drift; below pendulum_poly_k1s1_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < pendulum_poly_k1s1_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_poly_k1s1_GTOL ? 0 : g0[i] / h;
-  double fa[1 + 2 * pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + 1], lam[pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU];
+  double fa[1 + 2 * pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + 1];
   int j;
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps
    * (again below when the iteration slows down) */
   pendulum_poly_k1s1_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
@@ -408,12 +363,18 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     if (!isfinite(piv) || !isfinite(dia)) return pendulum_poly_k1s1_ENONFINITE;
     if (!(fabs(piv) > pendulum_poly_k1s1_SINGTOL * fabs(dia))) return pendulum_poly_k1s1_ESINGULAR;
   }
+  /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
+  double gm0 = gam[0], gm1 = gam[1];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0;
+  double lm0 = 0;
   for (it = 1; it <= pendulum_poly_k1s1_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
      * small; where the increments fall by less than 8x it is refreshed at the
      * current gamma, which keeps the iteration converging up to the h of the
      * constant family (pendulum, s = 3: 2.4 instead of 0.84) */
     if (it > 2 && inc > inc_old / 8) {
+      gam[0] = gm0;
+      gam[1] = gm1;
       pendulum_poly_k1s1_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
       for (j = 0; j < pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; j++) {
         double piv = fa[1 + j], dia = fa[1 + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + j];
@@ -421,24 +382,76 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
         if (!(fabs(piv) > pendulum_poly_k1s1_SINGTOL * fabs(dia))) return pendulum_poly_k1s1_ESINGULAR;
       }
     }
-    pendulum_poly_k1s1_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = gm0 * 0.5;
+      const double t1 = h * t0;
+      const double t2 = 0.5 * gm1;
+      const double t3 = h * t2;
+      /* grad g at the stages */
+      const double t4 = x->q[0] /* x */ + t1;
+      const double t5 = x->q[1] /* y */ + t3;
+      const double t6 = 2.0 * t5;
+      const double t7 = 2.0 * t4;
+      /* the multiplier coefficients: lambda += A^-1 C(lambda) */
+      const double t8 = t7 * lm0;
+      const double t9 = t6 * lm0;
+      const double t10 = 1.0 + t9;
+      const double t11 = 0.5 * t8;
+      const double t12 = h * t11;
+      const double t13 = x->p[0] /* p_x */ - t12;
+      const double t14 = 0.5 * t10;
+      const double t15 = h * t14;
+      const double t16 = x->p[1] /* p_y */ - t15;
+      const double t17 = t7 * t13;
+      const double t18 = t6 * t16;
+      const double t19 = t17 + t18;
+      const double t20 = t19 + g0[0];
+      const double t21 = fa[0] * t20;
+      const double t22 = lm0 + t21;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
+      const double t23 = t7 * t22;
+      const double t24 = t6 * t22;
+      const double t25 = 1.0 + t24;
+      const double t26 = 0.5 * t23;
+      const double t27 = h * t26;
+      const double t28 = x->p[0] /* p_x */ - t27;
+      const double t29 = 0.5 * t25;
+      const double t30 = h * t29;
+      const double t31 = x->p[1] /* p_y */ - t30;
+      const double t32 = h * t23;
+      const double t33 = -t32;
+      const double t34 = h * t25;
+      const double t35 = -t34;
+      /* gam */
+      sw0 = t28;
+      sw1 = t31;
+      /* dp */
+      sw2 = t33;
+      sw3 = t35;
+      /* lam */
+      sw4 = t22;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_poly_k1s1_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++) lam[i] = sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + i];
-    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_poly_k1s1_ENONFINITE;
+    lm0 = sw4;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4)) rc = pendulum_poly_k1s1_ENONFINITE;
     if (rc == pendulum_poly_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k1s1_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k1s1_TOL). Iterating
      * further would not help H, which the rescale keeps (bench/README.md) */
@@ -455,6 +468,13 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
   if (st) { st->iters = it > pendulum_poly_k1s1_MAXITER ? pendulum_poly_k1s1_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_poly_k1s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k1s1_ENONFINITE;
@@ -495,7 +515,10 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k1s1_NU];
@@ -503,6 +526,7 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     for (i = 0; i < pendulum_poly_k1s1_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   pendulum_poly_k1s1_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_poly_k1s1_OK;
 }

@@ -39,158 +39,12 @@
 static const double pendulum_poly_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_poly_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double pendulum_poly_k2s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double pendulum_poly_k2s2_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k2s2_p0[2] = {1.0, 0.0};
-
-/* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
-static void pendulum_poly_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* grad g at the stages */
-  const double t0 = gam[0] * 0.21132486540518713;
-  const double t1 = gam[2] * (-0.28867513459481292);
-  const double t2 = t0 + t1;
-  const double t3 = h * t2;
-  const double t4 = q0[0] /* x */ + t3;
-  const double t5 = gam[1] * 0.21132486540518713;
-  const double t6 = gam[3] * (-0.28867513459481292);
-  const double t7 = t5 + t6;
-  const double t8 = h * t7;
-  const double t9 = q0[1] /* y */ + t8;
-  const double t10 = 2.0 * t9;
-  const double t11 = 2.0 * t4;
-  const double t12 = gam[0] * 0.78867513459481287;
-  const double t13 = t1 + t12;
-  const double t14 = h * t13;
-  const double t15 = q0[0] /* x */ + t14;
-  const double t16 = gam[1] * 0.78867513459481287;
-  const double t17 = t6 + t16;
-  const double t18 = h * t17;
-  const double t19 = q0[1] /* y */ + t18;
-  const double t20 = 2.0 * t19;
-  const double t21 = 2.0 * t15;
-  /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-  const double t22 = (-0.99999999999999989) * lam[1];
-  const double t23 = lam[0] + t22;
-  const double t24 = t11 * t23;
-  const double t25 = t10 * t23;
-  const double t26 = 0.5 * t24;
-  const double t27 = 0.5 * t25;
-  const double t28 = 1.0 + t27;
-  const double t29 = (-0.49999999999999994) * t24;
-  const double t30 = (-0.49999999999999994) * t25;
-  const double t31 = 0.99999999999999989 * lam[1];
-  const double t32 = lam[0] + t31;
-  const double t33 = t21 * t32;
-  const double t34 = t20 * t32;
-  const double t35 = 0.5 * t33;
-  const double t36 = t26 + t35;
-  const double t37 = 0.5 * t34;
-  const double t38 = t28 + t37;
-  const double t39 = 0.49999999999999994 * t33;
-  const double t40 = t29 + t39;
-  const double t41 = 0.49999999999999994 * t34;
-  const double t42 = t30 + t41;
-  const double t43 = 0.5 * t36;
-  const double t44 = 0.28867513459481292 * t40;
-  const double t45 = t43 - t44;
-  const double t46 = h * t45;
-  const double t47 = p0[0] /* p_x */ - t46;
-  const double t48 = 0.5 * t38;
-  const double t49 = 0.28867513459481292 * t42;
-  const double t50 = t48 - t49;
-  const double t51 = h * t50;
-  const double t52 = p0[1] /* p_y */ - t51;
-  const double t53 = 0.28867513459481292 * t36;
-  const double t54 = h * t53;
-  const double t55 = 0.28867513459481292 * t38;
-  const double t56 = h * t55;
-  const double t57 = (-0.99999999999999989) * t54;
-  const double t58 = t47 - t57;
-  const double t59 = (-0.99999999999999989) * t56;
-  const double t60 = t52 - t59;
-  const double t61 = t11 * t58;
-  const double t62 = t10 * t60;
-  const double t63 = t61 + t62;
-  const double t64 = 0.5 * t63;
-  const double t65 = (-0.49999999999999994) * t63;
-  const double t66 = 0.99999999999999989 * t54;
-  const double t67 = t47 - t66;
-  const double t68 = 0.99999999999999989 * t56;
-  const double t69 = t52 - t68;
-  const double t70 = t21 * t67;
-  const double t71 = t20 * t69;
-  const double t72 = t70 + t71;
-  const double t73 = 0.5 * t72;
-  const double t74 = t64 + t73;
-  const double t75 = 0.49999999999999994 * t72;
-  const double t76 = t65 + t75;
-  const double t77 = t74 + g0[0];
-  const double t78 = lu[2] * t77;
-  const double t79 = t76 - t78;
-  const double t80 = lu[3] * t79;
-  const double t81 = lu[1] * t80;
-  const double t82 = t77 - t81;
-  const double t83 = lu[0] * t82;
-  const double t84 = lam[0] + t83;
-  const double t85 = lam[1] + t80;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-  const double t86 = (-0.99999999999999989) * t85;
-  const double t87 = t84 + t86;
-  const double t88 = t11 * t87;
-  const double t89 = t10 * t87;
-  const double t90 = 0.5 * t88;
-  const double t91 = 0.5 * t89;
-  const double t92 = 1.0 + t91;
-  const double t93 = (-0.49999999999999994) * t88;
-  const double t94 = (-0.49999999999999994) * t89;
-  const double t95 = 0.99999999999999989 * t85;
-  const double t96 = t84 + t95;
-  const double t97 = t21 * t96;
-  const double t98 = t20 * t96;
-  const double t99 = 0.5 * t97;
-  const double t100 = t90 + t99;
-  const double t101 = 0.5 * t98;
-  const double t102 = t92 + t101;
-  const double t103 = 0.49999999999999994 * t97;
-  const double t104 = t93 + t103;
-  const double t105 = 0.49999999999999994 * t98;
-  const double t106 = t94 + t105;
-  const double t107 = 0.5 * t100;
-  const double t108 = 0.28867513459481292 * t104;
-  const double t109 = t107 - t108;
-  const double t110 = h * t109;
-  const double t111 = p0[0] /* p_x */ - t110;
-  const double t112 = 0.5 * t102;
-  const double t113 = 0.28867513459481292 * t106;
-  const double t114 = t112 - t113;
-  const double t115 = h * t114;
-  const double t116 = p0[1] /* p_y */ - t115;
-  const double t117 = 0.28867513459481292 * t100;
-  const double t118 = h * t117;
-  const double t119 = -t118;
-  const double t120 = 0.28867513459481292 * t102;
-  const double t121 = h * t120;
-  const double t122 = -t121;
-  const double t123 = h * t100;
-  const double t124 = -t123;
-  const double t125 = h * t102;
-  const double t126 = -t125;
-  /* gam */
-  out[0] = t111;
-  out[1] = t116;
-  out[2] = t119;
-  out[3] = t122;
-  /* dp */
-  out[4] = t124;
-  out[5] = t126;
-  /* lam */
-  out[6] = t84;
-  out[7] = t85;
-}
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
  * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU). */
@@ -465,14 +319,14 @@ void pendulum_poly_k2s2_init_params(pendulum_poly_k2s2_state *x, const pendulum_
 {
   int i;
   pendulum_poly_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_poly_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k2s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k2s2_NU ? pendulum_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[pendulum_poly_k2s2_NU];
@@ -518,14 +372,23 @@ void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum
   pendulum_poly_k2s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_poly_k2s2_predict(const pendulum_poly_k2s2_state *x, double h, const pendulum_poly_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < pendulum_poly_k2s2_S; j++)
+      for (i = 0; i < pendulum_poly_k2s2_S; i++)
+        for (l = 0; l < pendulum_poly_k2s2_M; l++)
+          gam[j * pendulum_poly_k2s2_M + l] += pendulum_poly_k2s2_E2[2 * pendulum_poly_k2s2_S * j + i] * x->gam[i * pendulum_poly_k2s2_M + l] +
+                               pendulum_poly_k2s2_E2[2 * pendulum_poly_k2s2_S * j + pendulum_poly_k2s2_S + i] * x->gam2[i * pendulum_poly_k2s2_M + l];
     return;
   }
   for (j = 0; j < pendulum_poly_k2s2_S; j++)
@@ -565,9 +428,8 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
    * cannot drift; below pendulum_poly_k2s2_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < pendulum_poly_k2s2_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_poly_k2s2_GTOL ? 0 : g0[i] / h;
-  double fa[4 + 2 * pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + 1], lam[pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU];
+  double fa[4 + 2 * pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + 1];
   int j;
-  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps
    * (again below when the iteration slows down) */
   pendulum_poly_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
@@ -576,12 +438,20 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
     if (!isfinite(piv) || !isfinite(dia)) return pendulum_poly_k2s2_ENONFINITE;
     if (!(fabs(piv) > pendulum_poly_k2s2_SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
   }
+  /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
+  double lm0 = 0, lm1 = 0;
   for (it = 1; it <= pendulum_poly_k2s2_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
      * small; where the increments fall by less than 8x it is refreshed at the
      * current gamma, which keeps the iteration converging up to the h of the
      * constant family (pendulum, s = 3: 2.4 instead of 0.84) */
     if (it > 2 && inc > inc_old / 8) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
       pendulum_poly_k2s2_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
       for (j = 0; j < pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; j++) {
         double piv = fa[4 + j], dia = fa[4 + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU + j];
@@ -589,24 +459,177 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
         if (!(fabs(piv) > pendulum_poly_k2s2_SINGTOL * fabs(dia))) return pendulum_poly_k2s2_ESINGULAR;
       }
     }
-    pendulum_poly_k2s2_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
+    { /* the kernel sweep, inline */
+      /* grad g at the stages */
+      const double t0 = gm0 * 0.21132486540518713;
+      const double t1 = gm2 * (-0.28867513459481292);
+      const double t2 = t0 + t1;
+      const double t3 = h * t2;
+      const double t4 = x->q[0] /* x */ + t3;
+      const double t5 = gm1 * 0.21132486540518713;
+      const double t6 = gm3 * (-0.28867513459481292);
+      const double t7 = t5 + t6;
+      const double t8 = h * t7;
+      const double t9 = x->q[1] /* y */ + t8;
+      const double t10 = 2.0 * t9;
+      const double t11 = 2.0 * t4;
+      const double t12 = gm0 * 0.78867513459481287;
+      const double t13 = t1 + t12;
+      const double t14 = h * t13;
+      const double t15 = x->q[0] /* x */ + t14;
+      const double t16 = gm1 * 0.78867513459481287;
+      const double t17 = t6 + t16;
+      const double t18 = h * t17;
+      const double t19 = x->q[1] /* y */ + t18;
+      const double t20 = 2.0 * t19;
+      const double t21 = 2.0 * t15;
+      /* the multiplier coefficients: lambda += A^-1 C(lambda) */
+      const double t22 = (-0.99999999999999989) * lm1;
+      const double t23 = lm0 + t22;
+      const double t24 = t11 * t23;
+      const double t25 = t10 * t23;
+      const double t26 = 0.5 * t24;
+      const double t27 = 0.5 * t25;
+      const double t28 = 1.0 + t27;
+      const double t29 = (-0.49999999999999994) * t24;
+      const double t30 = (-0.49999999999999994) * t25;
+      const double t31 = 0.99999999999999989 * lm1;
+      const double t32 = lm0 + t31;
+      const double t33 = t21 * t32;
+      const double t34 = t20 * t32;
+      const double t35 = 0.5 * t33;
+      const double t36 = t26 + t35;
+      const double t37 = 0.5 * t34;
+      const double t38 = t28 + t37;
+      const double t39 = 0.49999999999999994 * t33;
+      const double t40 = t29 + t39;
+      const double t41 = 0.49999999999999994 * t34;
+      const double t42 = t30 + t41;
+      const double t43 = 0.5 * t36;
+      const double t44 = 0.28867513459481292 * t40;
+      const double t45 = t43 - t44;
+      const double t46 = h * t45;
+      const double t47 = x->p[0] /* p_x */ - t46;
+      const double t48 = 0.5 * t38;
+      const double t49 = 0.28867513459481292 * t42;
+      const double t50 = t48 - t49;
+      const double t51 = h * t50;
+      const double t52 = x->p[1] /* p_y */ - t51;
+      const double t53 = 0.28867513459481292 * t36;
+      const double t54 = h * t53;
+      const double t55 = 0.28867513459481292 * t38;
+      const double t56 = h * t55;
+      const double t57 = (-0.99999999999999989) * t54;
+      const double t58 = t47 - t57;
+      const double t59 = (-0.99999999999999989) * t56;
+      const double t60 = t52 - t59;
+      const double t61 = t11 * t58;
+      const double t62 = t10 * t60;
+      const double t63 = t61 + t62;
+      const double t64 = 0.5 * t63;
+      const double t65 = (-0.49999999999999994) * t63;
+      const double t66 = 0.99999999999999989 * t54;
+      const double t67 = t47 - t66;
+      const double t68 = 0.99999999999999989 * t56;
+      const double t69 = t52 - t68;
+      const double t70 = t21 * t67;
+      const double t71 = t20 * t69;
+      const double t72 = t70 + t71;
+      const double t73 = 0.5 * t72;
+      const double t74 = t64 + t73;
+      const double t75 = 0.49999999999999994 * t72;
+      const double t76 = t65 + t75;
+      const double t77 = t74 + g0[0];
+      const double t78 = fa[2] * t77;
+      const double t79 = t76 - t78;
+      const double t80 = fa[3] * t79;
+      const double t81 = fa[1] * t80;
+      const double t82 = t77 - t81;
+      const double t83 = fa[0] * t82;
+      const double t84 = lm0 + t83;
+      const double t85 = lm1 + t80;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
+      const double t86 = (-0.99999999999999989) * t85;
+      const double t87 = t84 + t86;
+      const double t88 = t11 * t87;
+      const double t89 = t10 * t87;
+      const double t90 = 0.5 * t88;
+      const double t91 = 0.5 * t89;
+      const double t92 = 1.0 + t91;
+      const double t93 = (-0.49999999999999994) * t88;
+      const double t94 = (-0.49999999999999994) * t89;
+      const double t95 = 0.99999999999999989 * t85;
+      const double t96 = t84 + t95;
+      const double t97 = t21 * t96;
+      const double t98 = t20 * t96;
+      const double t99 = 0.5 * t97;
+      const double t100 = t90 + t99;
+      const double t101 = 0.5 * t98;
+      const double t102 = t92 + t101;
+      const double t103 = 0.49999999999999994 * t97;
+      const double t104 = t93 + t103;
+      const double t105 = 0.49999999999999994 * t98;
+      const double t106 = t94 + t105;
+      const double t107 = 0.5 * t100;
+      const double t108 = 0.28867513459481292 * t104;
+      const double t109 = t107 - t108;
+      const double t110 = h * t109;
+      const double t111 = x->p[0] /* p_x */ - t110;
+      const double t112 = 0.5 * t102;
+      const double t113 = 0.28867513459481292 * t106;
+      const double t114 = t112 - t113;
+      const double t115 = h * t114;
+      const double t116 = x->p[1] /* p_y */ - t115;
+      const double t117 = 0.28867513459481292 * t100;
+      const double t118 = h * t117;
+      const double t119 = -t118;
+      const double t120 = 0.28867513459481292 * t102;
+      const double t121 = h * t120;
+      const double t122 = -t121;
+      const double t123 = h * t100;
+      const double t124 = -t123;
+      const double t125 = h * t102;
+      const double t126 = -t125;
+      /* gam */
+      sw0 = t111;
+      sw1 = t116;
+      sw2 = t119;
+      sw3 = t122;
+      /* dp */
+      sw4 = t124;
+      sw5 = t126;
+      /* lam */
+      sw6 = t84;
+      sw7 = t85;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_poly_k2s2_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++) lam[i] = sw[pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + i];
-    for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M + pendulum_poly_k2s2_M + pendulum_poly_k2s2_S * pendulum_poly_k2s2_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_poly_k2s2_ENONFINITE;
+    lm0 = sw6;
+    lm1 = sw7;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7)) rc = pendulum_poly_k2s2_ENONFINITE;
     if (rc == pendulum_poly_k2s2_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k2s2_TOL). Iterating
      * further would not help H, which the rescale keeps (bench/README.md) */
@@ -623,6 +646,18 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
   if (st) { st->iters = it > pendulum_poly_k2s2_MAXITER ? pendulum_poly_k2s2_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_poly_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k2s2_ENONFINITE;
@@ -663,7 +698,10 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k2s2_NU];
@@ -671,6 +709,7 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
     for (i = 0; i < pendulum_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   pendulum_poly_k2s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_poly_k2s2_OK;
 }

@@ -25,8 +25,9 @@ typedef double pendulum_poly_k2s2_real;
 
 typedef struct {
   pendulum_poly_k2s2_real t, q[2], p[2], lambda[1];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_poly_k2s2_real tc, qc[2], pc[2], gam[4], hprev;
+  pendulum_poly_k2s2_real gam2[4], hprev2;
   pendulum_poly_k2s2_real H0;  /* the energy the step keeps */
 } pendulum_poly_k2s2_state;
 

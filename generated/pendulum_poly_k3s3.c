@@ -40,272 +40,12 @@
 static const double pendulum_poly_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_poly_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double pendulum_poly_k3s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double pendulum_poly_k3s3_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k3s3_p0[2] = {1.0, 0.0};
-
-/* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
-static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
-    const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
-{
-  (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* affine derivative entries, projected in closed form */
-  const double t0 = gam[0] * 0.5;
-  const double t1 = 0.5 * gam[1];
-  /* grad g at the stages */
-  const double t2 = gam[0] * 0.1127016653792583;
-  const double t3 = gam[2] * (-0.17320508075688779);
-  const double t4 = t2 + t3;
-  const double t5 = gam[4] * 0.1732050807568877;
-  const double t6 = t4 + t5;
-  const double t7 = h * t6;
-  const double t8 = q0[0] /* x */ + t7;
-  const double t9 = gam[1] * 0.1127016653792583;
-  const double t10 = gam[3] * (-0.17320508075688779);
-  const double t11 = t9 + t10;
-  const double t12 = gam[5] * 0.1732050807568877;
-  const double t13 = t11 + t12;
-  const double t14 = h * t13;
-  const double t15 = q0[1] /* y */ + t14;
-  const double t16 = 2.0 * t15;
-  const double t17 = 2.0 * t8;
-  const double t18 = gam[2] * (-0.43301270189221935);
-  const double t19 = t0 + t18;
-  const double t20 = h * t19;
-  const double t21 = q0[0] /* x */ + t20;
-  const double t22 = gam[3] * (-0.43301270189221935);
-  const double t23 = t1 + t22;
-  const double t24 = h * t23;
-  const double t25 = q0[1] /* y */ + t24;
-  const double t26 = 2.0 * t25;
-  const double t27 = 2.0 * t21;
-  const double t28 = gam[0] * 0.8872983346207417;
-  const double t29 = t3 + t28;
-  const double t30 = gam[4] * (-0.1732050807568877);
-  const double t31 = t29 + t30;
-  const double t32 = h * t31;
-  const double t33 = q0[0] /* x */ + t32;
-  const double t34 = gam[1] * 0.8872983346207417;
-  const double t35 = t10 + t34;
-  const double t36 = gam[5] * (-0.1732050807568877);
-  const double t37 = t35 + t36;
-  const double t38 = h * t37;
-  const double t39 = q0[1] /* y */ + t38;
-  const double t40 = 2.0 * t39;
-  const double t41 = 2.0 * t33;
-  /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-  const double t42 = lam[1] * (-1.3416407864998738);
-  const double t43 = lam[0] + t42;
-  const double t44 = lam[2] * 0.89442719099991597;
-  const double t45 = t43 + t44;
-  const double t46 = t17 * t45;
-  const double t47 = t16 * t45;
-  const double t48 = 0.27777777777777779 * t46;
-  const double t49 = 0.27777777777777779 * t47;
-  const double t50 = 1.0 + t49;
-  const double t51 = (-0.37267799624996495) * t46;
-  const double t52 = (-0.37267799624996495) * t47;
-  const double t53 = 0.24845199749997668 * t46;
-  const double t54 = 0.24845199749997668 * t47;
-  const double t55 = lam[2] * (-1.1180339887498949);
-  const double t56 = lam[0] + t55;
-  const double t57 = t27 * t56;
-  const double t58 = t26 * t56;
-  const double t59 = 0.44444444444444442 * t57;
-  const double t60 = t48 + t59;
-  const double t61 = 0.44444444444444442 * t58;
-  const double t62 = t50 + t61;
-  const double t63 = (-0.49690399499995325) * t57;
-  const double t64 = t53 + t63;
-  const double t65 = (-0.49690399499995325) * t58;
-  const double t66 = t54 + t65;
-  const double t67 = lam[1] * 1.3416407864998738;
-  const double t68 = lam[0] + t67;
-  const double t69 = t44 + t68;
-  const double t70 = t41 * t69;
-  const double t71 = t40 * t69;
-  const double t72 = 0.27777777777777779 * t70;
-  const double t73 = t60 + t72;
-  const double t74 = 0.27777777777777779 * t71;
-  const double t75 = t62 + t74;
-  const double t76 = 0.37267799624996495 * t70;
-  const double t77 = t51 + t76;
-  const double t78 = 0.37267799624996495 * t71;
-  const double t79 = t52 + t78;
-  const double t80 = 0.24845199749997668 * t70;
-  const double t81 = t64 + t80;
-  const double t82 = 0.24845199749997668 * t71;
-  const double t83 = t66 + t82;
-  const double t84 = 0.5 * t73;
-  const double t85 = 0.28867513459481292 * t77;
-  const double t86 = t84 - t85;
-  const double t87 = h * t86;
-  const double t88 = p0[0] /* p_x */ - t87;
-  const double t89 = 0.5 * t75;
-  const double t90 = 0.28867513459481292 * t79;
-  const double t91 = t89 - t90;
-  const double t92 = h * t91;
-  const double t93 = p0[1] /* p_y */ - t92;
-  const double t94 = 0.28867513459481292 * t73;
-  const double t95 = 0.12909944487358055 * t81;
-  const double t96 = t94 - t95;
-  const double t97 = h * t96;
-  const double t98 = 0.28867513459481292 * t75;
-  const double t99 = 0.12909944487358055 * t83;
-  const double t100 = t98 - t99;
-  const double t101 = h * t100;
-  const double t102 = 0.12909944487358055 * t77;
-  const double t103 = h * t102;
-  const double t104 = 0.12909944487358055 * t79;
-  const double t105 = h * t104;
-  const double t106 = (-1.3416407864998738) * t97;
-  const double t107 = t88 - t106;
-  const double t108 = 0.89442719099991597 * t103;
-  const double t109 = t107 - t108;
-  const double t110 = (-1.3416407864998738) * t101;
-  const double t111 = t93 - t110;
-  const double t112 = 0.89442719099991597 * t105;
-  const double t113 = t111 - t112;
-  const double t114 = t17 * t109;
-  const double t115 = t16 * t113;
-  const double t116 = t114 + t115;
-  const double t117 = 0.27777777777777779 * t116;
-  const double t118 = (-0.37267799624996495) * t116;
-  const double t119 = 0.24845199749997668 * t116;
-  const double t120 = (-1.1180339887498949) * t103;
-  const double t121 = t88 - t120;
-  const double t122 = (-1.1180339887498949) * t105;
-  const double t123 = t93 - t122;
-  const double t124 = t27 * t121;
-  const double t125 = t26 * t123;
-  const double t126 = t124 + t125;
-  const double t127 = 0.44444444444444442 * t126;
-  const double t128 = t117 + t127;
-  const double t129 = (-0.49690399499995325) * t126;
-  const double t130 = t119 + t129;
-  const double t131 = 1.3416407864998738 * t97;
-  const double t132 = t88 - t131;
-  const double t133 = t132 - t108;
-  const double t134 = 1.3416407864998738 * t101;
-  const double t135 = t93 - t134;
-  const double t136 = t135 - t112;
-  const double t137 = t41 * t133;
-  const double t138 = t40 * t136;
-  const double t139 = t137 + t138;
-  const double t140 = 0.27777777777777779 * t139;
-  const double t141 = t128 + t140;
-  const double t142 = 0.37267799624996495 * t139;
-  const double t143 = t118 + t142;
-  const double t144 = 0.24845199749997668 * t139;
-  const double t145 = t130 + t144;
-  const double t146 = t141 + g0[0];
-  const double t147 = lu[3] * t146;
-  const double t148 = t143 - t147;
-  const double t149 = lu[6] * t146;
-  const double t150 = t145 - t149;
-  const double t151 = lu[7] * t148;
-  const double t152 = t150 - t151;
-  const double t153 = lu[8] * t152;
-  const double t154 = lu[5] * t153;
-  const double t155 = t148 - t154;
-  const double t156 = lu[4] * t155;
-  const double t157 = lu[1] * t156;
-  const double t158 = t146 - t157;
-  const double t159 = lu[2] * t153;
-  const double t160 = t158 - t159;
-  const double t161 = lu[0] * t160;
-  const double t162 = lam[0] + t161;
-  const double t163 = lam[1] + t156;
-  const double t164 = lam[2] + t153;
-  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-  const double t165 = (-1.3416407864998738) * t163;
-  const double t166 = t162 + t165;
-  const double t167 = 0.89442719099991597 * t164;
-  const double t168 = t166 + t167;
-  const double t169 = t17 * t168;
-  const double t170 = t16 * t168;
-  const double t171 = 0.27777777777777779 * t169;
-  const double t172 = 0.27777777777777779 * t170;
-  const double t173 = 1.0 + t172;
-  const double t174 = (-0.37267799624996495) * t169;
-  const double t175 = (-0.37267799624996495) * t170;
-  const double t176 = 0.24845199749997668 * t169;
-  const double t177 = 0.24845199749997668 * t170;
-  const double t178 = (-1.1180339887498949) * t164;
-  const double t179 = t162 + t178;
-  const double t180 = t27 * t179;
-  const double t181 = t26 * t179;
-  const double t182 = 0.44444444444444442 * t180;
-  const double t183 = t171 + t182;
-  const double t184 = 0.44444444444444442 * t181;
-  const double t185 = t173 + t184;
-  const double t186 = (-0.49690399499995325) * t180;
-  const double t187 = t176 + t186;
-  const double t188 = (-0.49690399499995325) * t181;
-  const double t189 = t177 + t188;
-  const double t190 = 1.3416407864998738 * t163;
-  const double t191 = t162 + t190;
-  const double t192 = t167 + t191;
-  const double t193 = t41 * t192;
-  const double t194 = t40 * t192;
-  const double t195 = 0.27777777777777779 * t193;
-  const double t196 = t183 + t195;
-  const double t197 = 0.27777777777777779 * t194;
-  const double t198 = t185 + t197;
-  const double t199 = 0.37267799624996495 * t193;
-  const double t200 = t174 + t199;
-  const double t201 = 0.37267799624996495 * t194;
-  const double t202 = t175 + t201;
-  const double t203 = 0.24845199749997668 * t193;
-  const double t204 = t187 + t203;
-  const double t205 = 0.24845199749997668 * t194;
-  const double t206 = t189 + t205;
-  const double t207 = 0.5 * t196;
-  const double t208 = 0.28867513459481292 * t200;
-  const double t209 = t207 - t208;
-  const double t210 = h * t209;
-  const double t211 = p0[0] /* p_x */ - t210;
-  const double t212 = 0.5 * t198;
-  const double t213 = 0.28867513459481292 * t202;
-  const double t214 = t212 - t213;
-  const double t215 = h * t214;
-  const double t216 = p0[1] /* p_y */ - t215;
-  const double t217 = 0.28867513459481292 * t196;
-  const double t218 = 0.12909944487358055 * t204;
-  const double t219 = t217 - t218;
-  const double t220 = h * t219;
-  const double t221 = -t220;
-  const double t222 = 0.28867513459481292 * t198;
-  const double t223 = 0.12909944487358055 * t206;
-  const double t224 = t222 - t223;
-  const double t225 = h * t224;
-  const double t226 = -t225;
-  const double t227 = 0.12909944487358055 * t200;
-  const double t228 = h * t227;
-  const double t229 = -t228;
-  const double t230 = 0.12909944487358055 * t202;
-  const double t231 = h * t230;
-  const double t232 = -t231;
-  const double t233 = h * t196;
-  const double t234 = -t233;
-  const double t235 = h * t198;
-  const double t236 = -t235;
-  /* gam */
-  out[0] = t211;
-  out[1] = t216;
-  out[2] = t221;
-  out[3] = t226;
-  out[4] = t229;
-  out[5] = t232;
-  /* dp */
-  out[6] = t234;
-  out[7] = t236;
-  /* lam */
-  out[8] = t162;
-  out[9] = t163;
-  out[10] = t164;
-}
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
  * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU). */
@@ -747,14 +487,14 @@ void pendulum_poly_k3s3_init_params(pendulum_poly_k3s3_state *x, const pendulum_
 {
   int i;
   pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < pendulum_poly_k3s3_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k3s3_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k3s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k3s3_NU ? pendulum_poly_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[pendulum_poly_k3s3_NU];
@@ -800,14 +540,23 @@ void pendulum_poly_k3s3_hidden(const pendulum_poly_k3s3_state *x, const pendulum
   pendulum_poly_k3s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void pendulum_poly_k3s3_predict(const pendulum_poly_k3s3_state *x, double h, const pendulum_poly_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     pendulum_poly_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < pendulum_poly_k3s3_S; j++)
+      for (i = 0; i < pendulum_poly_k3s3_S; i++)
+        for (l = 0; l < pendulum_poly_k3s3_M; l++)
+          gam[j * pendulum_poly_k3s3_M + l] += pendulum_poly_k3s3_E2[2 * pendulum_poly_k3s3_S * j + i] * x->gam[i * pendulum_poly_k3s3_M + l] +
+                               pendulum_poly_k3s3_E2[2 * pendulum_poly_k3s3_S * j + pendulum_poly_k3s3_S + i] * x->gam2[i * pendulum_poly_k3s3_M + l];
     return;
   }
   for (j = 0; j < pendulum_poly_k3s3_S; j++)
@@ -847,9 +596,8 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
    * cannot drift; below pendulum_poly_k3s3_GTOL, g(q0) is round-off, and kicking the momenta by it
    * (eps / h a step) would only add noise, so it is left out. */
   for (i = 0; i < pendulum_poly_k3s3_NU; i++) g0[i] = fabs(g0[i]) <= pendulum_poly_k3s3_GTOL ? 0 : g0[i] / h;
-  double fa[9 + 2 * pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1], lam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU];
+  double fa[9 + 2 * pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
   int j;
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = 0;
   /* the multiplier matrix at the predicted stages, factored once for all sweeps
    * (again below when the iteration slows down) */
   pendulum_poly_k3s3_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
@@ -858,12 +606,23 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
     if (!isfinite(piv) || !isfinite(dia)) return pendulum_poly_k3s3_ENONFINITE;
     if (!(fabs(piv) > pendulum_poly_k3s3_SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
   }
+  /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
+  double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0;
+  double lm0 = 0, lm1 = 0, lm2 = 0;
   for (it = 1; it <= pendulum_poly_k3s3_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
      * small; where the increments fall by less than 8x it is refreshed at the
      * current gamma, which keeps the iteration converging up to the h of the
      * constant family (pendulum, s = 3: 2.4 instead of 0.84) */
     if (it > 2 && inc > inc_old / 8) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
       pendulum_poly_k3s3_factor(x->q, 0, gam, h, 0, 0, 0, prm, fa);
       for (j = 0; j < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; j++) {
         double piv = fa[9 + j], dia = fa[9 + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + j];
@@ -871,24 +630,298 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
         if (!(fabs(piv) > pendulum_poly_k3s3_SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
       }
     }
-    pendulum_poly_k3s3_sweep(x->q, x->p, gam, h, g0, lam, fa, prm, sw);
+    { /* the kernel sweep, inline */
+      /* affine derivative entries, projected in closed form */
+      const double t0 = gm0 * 0.5;
+      const double t1 = 0.5 * gm1;
+      /* grad g at the stages */
+      const double t2 = gm0 * 0.1127016653792583;
+      const double t3 = gm2 * (-0.17320508075688779);
+      const double t4 = t2 + t3;
+      const double t5 = gm4 * 0.1732050807568877;
+      const double t6 = t4 + t5;
+      const double t7 = h * t6;
+      const double t8 = x->q[0] /* x */ + t7;
+      const double t9 = gm1 * 0.1127016653792583;
+      const double t10 = gm3 * (-0.17320508075688779);
+      const double t11 = t9 + t10;
+      const double t12 = gm5 * 0.1732050807568877;
+      const double t13 = t11 + t12;
+      const double t14 = h * t13;
+      const double t15 = x->q[1] /* y */ + t14;
+      const double t16 = 2.0 * t15;
+      const double t17 = 2.0 * t8;
+      const double t18 = gm2 * (-0.43301270189221935);
+      const double t19 = t0 + t18;
+      const double t20 = h * t19;
+      const double t21 = x->q[0] /* x */ + t20;
+      const double t22 = gm3 * (-0.43301270189221935);
+      const double t23 = t1 + t22;
+      const double t24 = h * t23;
+      const double t25 = x->q[1] /* y */ + t24;
+      const double t26 = 2.0 * t25;
+      const double t27 = 2.0 * t21;
+      const double t28 = gm0 * 0.8872983346207417;
+      const double t29 = t3 + t28;
+      const double t30 = gm4 * (-0.1732050807568877);
+      const double t31 = t29 + t30;
+      const double t32 = h * t31;
+      const double t33 = x->q[0] /* x */ + t32;
+      const double t34 = gm1 * 0.8872983346207417;
+      const double t35 = t10 + t34;
+      const double t36 = gm5 * (-0.1732050807568877);
+      const double t37 = t35 + t36;
+      const double t38 = h * t37;
+      const double t39 = x->q[1] /* y */ + t38;
+      const double t40 = 2.0 * t39;
+      const double t41 = 2.0 * t33;
+      /* the multiplier coefficients: lambda += A^-1 C(lambda) */
+      const double t42 = lm1 * (-1.3416407864998738);
+      const double t43 = lm0 + t42;
+      const double t44 = lm2 * 0.89442719099991597;
+      const double t45 = t43 + t44;
+      const double t46 = t17 * t45;
+      const double t47 = t16 * t45;
+      const double t48 = 0.27777777777777779 * t46;
+      const double t49 = 0.27777777777777779 * t47;
+      const double t50 = 1.0 + t49;
+      const double t51 = (-0.37267799624996495) * t46;
+      const double t52 = (-0.37267799624996495) * t47;
+      const double t53 = 0.24845199749997668 * t46;
+      const double t54 = 0.24845199749997668 * t47;
+      const double t55 = lm2 * (-1.1180339887498949);
+      const double t56 = lm0 + t55;
+      const double t57 = t27 * t56;
+      const double t58 = t26 * t56;
+      const double t59 = 0.44444444444444442 * t57;
+      const double t60 = t48 + t59;
+      const double t61 = 0.44444444444444442 * t58;
+      const double t62 = t50 + t61;
+      const double t63 = (-0.49690399499995325) * t57;
+      const double t64 = t53 + t63;
+      const double t65 = (-0.49690399499995325) * t58;
+      const double t66 = t54 + t65;
+      const double t67 = lm1 * 1.3416407864998738;
+      const double t68 = lm0 + t67;
+      const double t69 = t44 + t68;
+      const double t70 = t41 * t69;
+      const double t71 = t40 * t69;
+      const double t72 = 0.27777777777777779 * t70;
+      const double t73 = t60 + t72;
+      const double t74 = 0.27777777777777779 * t71;
+      const double t75 = t62 + t74;
+      const double t76 = 0.37267799624996495 * t70;
+      const double t77 = t51 + t76;
+      const double t78 = 0.37267799624996495 * t71;
+      const double t79 = t52 + t78;
+      const double t80 = 0.24845199749997668 * t70;
+      const double t81 = t64 + t80;
+      const double t82 = 0.24845199749997668 * t71;
+      const double t83 = t66 + t82;
+      const double t84 = 0.5 * t73;
+      const double t85 = 0.28867513459481292 * t77;
+      const double t86 = t84 - t85;
+      const double t87 = h * t86;
+      const double t88 = x->p[0] /* p_x */ - t87;
+      const double t89 = 0.5 * t75;
+      const double t90 = 0.28867513459481292 * t79;
+      const double t91 = t89 - t90;
+      const double t92 = h * t91;
+      const double t93 = x->p[1] /* p_y */ - t92;
+      const double t94 = 0.28867513459481292 * t73;
+      const double t95 = 0.12909944487358055 * t81;
+      const double t96 = t94 - t95;
+      const double t97 = h * t96;
+      const double t98 = 0.28867513459481292 * t75;
+      const double t99 = 0.12909944487358055 * t83;
+      const double t100 = t98 - t99;
+      const double t101 = h * t100;
+      const double t102 = 0.12909944487358055 * t77;
+      const double t103 = h * t102;
+      const double t104 = 0.12909944487358055 * t79;
+      const double t105 = h * t104;
+      const double t106 = (-1.3416407864998738) * t97;
+      const double t107 = t88 - t106;
+      const double t108 = 0.89442719099991597 * t103;
+      const double t109 = t107 - t108;
+      const double t110 = (-1.3416407864998738) * t101;
+      const double t111 = t93 - t110;
+      const double t112 = 0.89442719099991597 * t105;
+      const double t113 = t111 - t112;
+      const double t114 = t17 * t109;
+      const double t115 = t16 * t113;
+      const double t116 = t114 + t115;
+      const double t117 = 0.27777777777777779 * t116;
+      const double t118 = (-0.37267799624996495) * t116;
+      const double t119 = 0.24845199749997668 * t116;
+      const double t120 = (-1.1180339887498949) * t103;
+      const double t121 = t88 - t120;
+      const double t122 = (-1.1180339887498949) * t105;
+      const double t123 = t93 - t122;
+      const double t124 = t27 * t121;
+      const double t125 = t26 * t123;
+      const double t126 = t124 + t125;
+      const double t127 = 0.44444444444444442 * t126;
+      const double t128 = t117 + t127;
+      const double t129 = (-0.49690399499995325) * t126;
+      const double t130 = t119 + t129;
+      const double t131 = 1.3416407864998738 * t97;
+      const double t132 = t88 - t131;
+      const double t133 = t132 - t108;
+      const double t134 = 1.3416407864998738 * t101;
+      const double t135 = t93 - t134;
+      const double t136 = t135 - t112;
+      const double t137 = t41 * t133;
+      const double t138 = t40 * t136;
+      const double t139 = t137 + t138;
+      const double t140 = 0.27777777777777779 * t139;
+      const double t141 = t128 + t140;
+      const double t142 = 0.37267799624996495 * t139;
+      const double t143 = t118 + t142;
+      const double t144 = 0.24845199749997668 * t139;
+      const double t145 = t130 + t144;
+      const double t146 = t141 + g0[0];
+      const double t147 = fa[3] * t146;
+      const double t148 = t143 - t147;
+      const double t149 = fa[6] * t146;
+      const double t150 = t145 - t149;
+      const double t151 = fa[7] * t148;
+      const double t152 = t150 - t151;
+      const double t153 = fa[8] * t152;
+      const double t154 = fa[5] * t153;
+      const double t155 = t148 - t154;
+      const double t156 = fa[4] * t155;
+      const double t157 = fa[1] * t156;
+      const double t158 = t146 - t157;
+      const double t159 = fa[2] * t153;
+      const double t160 = t158 - t159;
+      const double t161 = fa[0] * t160;
+      const double t162 = lm0 + t161;
+      const double t163 = lm1 + t156;
+      const double t164 = lm2 + t153;
+      /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
+      const double t165 = (-1.3416407864998738) * t163;
+      const double t166 = t162 + t165;
+      const double t167 = 0.89442719099991597 * t164;
+      const double t168 = t166 + t167;
+      const double t169 = t17 * t168;
+      const double t170 = t16 * t168;
+      const double t171 = 0.27777777777777779 * t169;
+      const double t172 = 0.27777777777777779 * t170;
+      const double t173 = 1.0 + t172;
+      const double t174 = (-0.37267799624996495) * t169;
+      const double t175 = (-0.37267799624996495) * t170;
+      const double t176 = 0.24845199749997668 * t169;
+      const double t177 = 0.24845199749997668 * t170;
+      const double t178 = (-1.1180339887498949) * t164;
+      const double t179 = t162 + t178;
+      const double t180 = t27 * t179;
+      const double t181 = t26 * t179;
+      const double t182 = 0.44444444444444442 * t180;
+      const double t183 = t171 + t182;
+      const double t184 = 0.44444444444444442 * t181;
+      const double t185 = t173 + t184;
+      const double t186 = (-0.49690399499995325) * t180;
+      const double t187 = t176 + t186;
+      const double t188 = (-0.49690399499995325) * t181;
+      const double t189 = t177 + t188;
+      const double t190 = 1.3416407864998738 * t163;
+      const double t191 = t162 + t190;
+      const double t192 = t167 + t191;
+      const double t193 = t41 * t192;
+      const double t194 = t40 * t192;
+      const double t195 = 0.27777777777777779 * t193;
+      const double t196 = t183 + t195;
+      const double t197 = 0.27777777777777779 * t194;
+      const double t198 = t185 + t197;
+      const double t199 = 0.37267799624996495 * t193;
+      const double t200 = t174 + t199;
+      const double t201 = 0.37267799624996495 * t194;
+      const double t202 = t175 + t201;
+      const double t203 = 0.24845199749997668 * t193;
+      const double t204 = t187 + t203;
+      const double t205 = 0.24845199749997668 * t194;
+      const double t206 = t189 + t205;
+      const double t207 = 0.5 * t196;
+      const double t208 = 0.28867513459481292 * t200;
+      const double t209 = t207 - t208;
+      const double t210 = h * t209;
+      const double t211 = x->p[0] /* p_x */ - t210;
+      const double t212 = 0.5 * t198;
+      const double t213 = 0.28867513459481292 * t202;
+      const double t214 = t212 - t213;
+      const double t215 = h * t214;
+      const double t216 = x->p[1] /* p_y */ - t215;
+      const double t217 = 0.28867513459481292 * t196;
+      const double t218 = 0.12909944487358055 * t204;
+      const double t219 = t217 - t218;
+      const double t220 = h * t219;
+      const double t221 = -t220;
+      const double t222 = 0.28867513459481292 * t198;
+      const double t223 = 0.12909944487358055 * t206;
+      const double t224 = t222 - t223;
+      const double t225 = h * t224;
+      const double t226 = -t225;
+      const double t227 = 0.12909944487358055 * t200;
+      const double t228 = h * t227;
+      const double t229 = -t228;
+      const double t230 = 0.12909944487358055 * t202;
+      const double t231 = h * t230;
+      const double t232 = -t231;
+      const double t233 = h * t196;
+      const double t234 = -t233;
+      const double t235 = h * t198;
+      const double t236 = -t235;
+      /* gam */
+      sw0 = t211;
+      sw1 = t216;
+      sw2 = t221;
+      sw3 = t226;
+      sw4 = t229;
+      sw5 = t232;
+      /* dp */
+      sw6 = t234;
+      sw7 = t236;
+      /* lam */
+      sw8 = t162;
+      sw9 = t163;
+      sw10 = t164;
+    }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
     inc = 0;
     scale = 0;
-    for (i = 0; i < pendulum_poly_k3s3_M; i++) {
-      double v = fabs(x->q[i]) + fabs(h * sw[i]);
+    {
+      double v;
+      v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-    }
-    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
-      double v = fabs(h * (sw[i] - gam[i]));
+      v = fabs(x->q[1]) + fabs(h * sw1);
+      if (v > scale) scale = v;
+      v = fabs(h * (sw0 - gm0));
       if (v > inc) inc = v;
-      gam[i] = sw[i];
+      gm0 = sw0;
+      v = fabs(h * (sw1 - gm1));
+      if (v > inc) inc = v;
+      gm1 = sw1;
+      v = fabs(h * (sw2 - gm2));
+      if (v > inc) inc = v;
+      gm2 = sw2;
+      v = fabs(h * (sw3 - gm3));
+      if (v > inc) inc = v;
+      gm3 = sw3;
+      v = fabs(h * (sw4 - gm4));
+      if (v > inc) inc = v;
+      gm4 = sw4;
+      v = fabs(h * (sw5 - gm5));
+      if (v > inc) inc = v;
+      gm5 = sw5;
     }
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + i];
-    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++)
-      if (!isfinite(sw[i])) rc = pendulum_poly_k3s3_ENONFINITE;
+    lm0 = sw8;
+    lm1 = sw9;
+    lm2 = sw10;
+    if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
+        !isfinite(sw6) || !isfinite(sw7) || !isfinite(sw8) || !isfinite(sw9) || !isfinite(sw10)) rc = pendulum_poly_k3s3_ENONFINITE;
     if (rc == pendulum_poly_k3s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k3s3_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k3s3_TOL). Iterating
      * further would not help H, which the rescale keeps (bench/README.md) */
@@ -905,6 +938,23 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
       break;
     }
   }
+  gam[0] = gm0;
+  gam[1] = gm1;
+  gam[2] = gm2;
+  gam[3] = gm3;
+  gam[4] = gm4;
+  gam[5] = gm5;
+  sw[0] = sw0;
+  sw[1] = sw1;
+  sw[2] = sw2;
+  sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
   if (st) { st->iters = it > pendulum_poly_k3s3_MAXITER ? pendulum_poly_k3s3_MAXITER : it; st->increment = inc; }
   if (rc != pendulum_poly_k3s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k3s3_ENONFINITE;
@@ -945,7 +995,10 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k3s3_NU];
@@ -953,6 +1006,7 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
     for (i = 0; i < pendulum_poly_k3s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   pendulum_poly_k3s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_poly_k3s3_OK;
 }

@@ -25,8 +25,9 @@ typedef double satellites_k6s1_real;
 
 typedef struct {
   satellites_k6s1_real t, q[9], p[9], lambda[3];
-  /* private: compensated-summation errors and the last step's polynomial */
+  /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_k6s1_real tc, qc[9], pc[9], gam[9], hprev;
+  satellites_k6s1_real gam2[9], hprev2;
 } satellites_k6s1_state;
 
 typedef struct {

@@ -2611,14 +2611,14 @@ void satellites_k6s3_init_params(satellites_k6s3_state *x, const satellites_k6s3
 {
   int i;
   satellites_k6s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < satellites_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : satellites_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : satellites_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_k6s3_NU ? satellites_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = x->gam2[i] = 0;
   {
     double lam[satellites_k6s3_NU];
     satellites_k6s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -2663,8 +2663,9 @@ void satellites_k6s3_hidden(const satellites_k6s3_state *x, const satellites_k6s
   satellites_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void satellites_k6s3_predict(const satellites_k6s3_state *x, double h, const satellites_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
@@ -2763,8 +2764,12 @@ int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h_, cons
     satellites_k6s3_add(&x->p[i], &x->pc[i], sw[satellites_k6s3_S * satellites_k6s3_M + i]);
   }
   for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + i];
-  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   satellites_k6s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return satellites_k6s3_OK;
 }

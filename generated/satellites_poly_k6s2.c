@@ -43,6 +43,9 @@
 static const double satellites_poly_k6s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 5.5511151231257827e-17, 0.0, 9.6148134319178191e-17, 0.99999999999999989};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double satellites_poly_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231257827e-17, 1.0};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double satellites_poly_k6s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double satellites_poly_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_poly_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -4878,14 +4881,14 @@ void satellites_poly_k6s2_init_params(satellites_poly_k6s2_state *x, const satel
 {
   int i;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < satellites_poly_k6s2_M; i++) {
     x->q[i] = q0 ? q0[i] : satellites_poly_k6s2_q0[i];
     x->p[i] = p0 ? p0[i] : satellites_poly_k6s2_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_poly_k6s2_NU ? satellites_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[satellites_poly_k6s2_NU];
@@ -4931,14 +4934,23 @@ void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const sate
   satellites_poly_k6s2_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, const satellites_poly_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < satellites_poly_k6s2_S; j++)
+      for (i = 0; i < satellites_poly_k6s2_S; i++)
+        for (l = 0; l < satellites_poly_k6s2_M; l++)
+          gam[j * satellites_poly_k6s2_M + l] += satellites_poly_k6s2_E2[2 * satellites_poly_k6s2_S * j + i] * x->gam[i * satellites_poly_k6s2_M + l] +
+                               satellites_poly_k6s2_E2[2 * satellites_poly_k6s2_S * j + satellites_poly_k6s2_S + i] * x->gam2[i * satellites_poly_k6s2_M + l];
     return;
   }
   for (j = 0; j < satellites_poly_k6s2_S; j++)
@@ -5076,7 +5088,10 @@ int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s2_NU];
@@ -5084,6 +5099,7 @@ int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s
     for (i = 0; i < satellites_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   satellites_poly_k6s2_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return satellites_poly_k6s2_OK;
 }

@@ -43,6 +43,9 @@
 static const double satellites_poly_k6s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995796, 5.5511151231257827e-17, 0.0, 0.0, 9.6148134319178191e-17, 0.99999999999999989, 0.0, 1.2412670766236366e-16, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0000000000000002};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double satellites_poly_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 5.5511151231257827e-17, 1.0, 7.745966692414834, 0.0, 0.0, 1.0000000000000002};
+/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
+ * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
+static const double satellites_poly_k6s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double satellites_poly_k6s3_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_poly_k6s3_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -8546,14 +8549,14 @@ void satellites_poly_k6s3_init_params(satellites_poly_k6s3_state *x, const satel
 {
   int i;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = 0;
   for (i = 0; i < satellites_poly_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : satellites_poly_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : satellites_poly_k6s3_p0[i];
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_poly_k6s3_NU ? satellites_poly_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = x->gam2[i] = 0;
   x->H0 = 0;  /* taken at the first step */
   {
     double lam[satellites_poly_k6s3_NU];
@@ -8599,14 +8602,23 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
   satellites_poly_k6s3_hidden_kernel(x->q, x->p, 0, 0, 0, 0, 0, prm, gp);
 }
 
-/* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
+/* gamma for a step of size h: extrapolated from the last two steps' polynomials
+ * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
+ * gamma_j = 0 (j > 0) on the first step. */
 static void satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, const satellites_poly_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
   if (x->hprev == 0) {
     satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (j = 0; j < satellites_poly_k6s3_S; j++)
+      for (i = 0; i < satellites_poly_k6s3_S; i++)
+        for (l = 0; l < satellites_poly_k6s3_M; l++)
+          gam[j * satellites_poly_k6s3_M + l] += satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + i] * x->gam[i * satellites_poly_k6s3_M + l] +
+                               satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + satellites_poly_k6s3_S + i] * x->gam2[i * satellites_poly_k6s3_M + l];
     return;
   }
   for (j = 0; j < satellites_poly_k6s3_S; j++)
@@ -8744,7 +8756,10 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
   }
-  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
+    x->gam2[i] = x->gam[i];
+    x->gam[i] = gam[i];
+  }
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s3_NU];
@@ -8752,6 +8767,7 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
     for (i = 0; i < satellites_poly_k6s3_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
   }
   satellites_poly_k6s3_add(&x->t, &x->tc, h);
+  x->hprev2 = x->hprev;
   x->hprev = h;
   return satellites_poly_k6s3_OK;
 }

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Install the Debian packages hbvmgen needs, if any are missing.
 #   scripts/deps.sh            build and test: bison flex libgsl-dev check libsubunit-dev pkg-config valgrind
-#   scripts/deps.sh bench      also the benchmark peers and plotting
+#   scripts/deps.sh bench      also the benchmark peers, plotting, clang and llvm-mca
 #   scripts/deps.sh embedded   also the ARM cross compiler for the embedded build check
 #   scripts/deps.sh fuzz       also clang with libFuzzer
 #   scripts/deps.sh mpi        also Open MPI (make MPI=1: ensembles across ranks)
@@ -11,7 +11,7 @@ set -eu
 pkgs="bison flex libgsl-dev check libsubunit-dev pkg-config valgrind gcc make"
 for set in "$@"; do
   case "$set" in
-    bench)    pkgs="$pkgs libsundials-dev gnuplot-nox" ;;
+    bench)    pkgs="$pkgs libsundials-dev gnuplot-nox clang llvm" ;;
     embedded) pkgs="$pkgs gcc-arm-none-eabi libnewlib-arm-none-eabi" ;;
     fuzz)     pkgs="$pkgs clang libclang-rt-14-dev" ;;
     mpi)      pkgs="$pkgs libopenmpi-dev openmpi-bin" ;;
