@@ -126,7 +126,7 @@ static int intern(Dag *d, Node proto) {
   }
   if (d->n >= MAX_NODES)
     fatal_at(d->where, "the model needs more than %d expression nodes%s", MAX_NODES,
-             d->where.line ? " (the limit was reached building this statement)" : "");
+             d->where_note ? d->where_note : d->where.line ? " (the limit was reached building this statement)" : "");
   VEC_RESERVE(d->nodes, d->n, d->cap, d->n + 1);
   proto.flags = (unsigned char)((proto.a >= 0 ? d->nodes[proto.a].flags : 0) |
                                 (proto.b >= 0 ? d->nodes[proto.b].flags : 0) | (proto.op == OP_INPUT ? DEP_INPUT : 0));

@@ -228,6 +228,7 @@ typedef struct {
   int zero;            /* the constant 0 */
   int tcap;
   Loc where;           /* what is being built, where the node limit is reported */
+  const char *where_note; /* what the limit message adds there (NULL: a statement) */
   long work;           /* nodes visited by dag_subst and ad_gradient: a cost to test, not time */
   IntVec marks;        /* section labels for the emitter: (first id, label index) */
   const char **labels;

@@ -532,7 +532,10 @@ Step *step_build(Model *mod, const Method *me) {
              "(s nu); pass --multiplier const or a smaller -s", nu, s, MAX_POLY_COEFS);
     return NULL;
   }
-  mod->dag->where = (Loc){0, 0}; /* a node limit hit here is the step's, not a statement's */
+  /* a node limit hit here is the step's: reported at the constraints (or U) */
+  mod->dag->where = nu ? mod->g_loc[0] : mod->U_loc;
+  mod->dag->where_note = " (the limit was reached building the step for these equations: "
+                         "pass --multiplier const, or a smaller -s or -k)";
   st->m = m;
   st->nu = nu;
   st->s = s;

@@ -17,6 +17,7 @@
 #include <check.h>
 #include <dirent.h>
 #include <fcntl.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -397,6 +398,34 @@ START_TEST(test_deep_chains)
 }
 END_TEST
 
+/* A model of 40 KB whose statements are small but whose step is not: a
+ * chain of 25 links coupled by a dense M, at s = 8 the poly family's
+ * multiplier system of 200 coefficients. The node limit is then reached
+ * while the step is built, and is reported at the constraints with what
+ * to do, not without a place (issue 13, item 8). */
+START_TEST(test_step_node_limit)
+{
+  enum { LINKS = 25, COORDS = 2 * LINKS };
+  Buf b = {0};
+  char num[64];
+  buf_str(&b, "# flags: -s 8\nN = 25\nvariables x[N], y[N]\nM = [");
+  for (int i = 0; i < COORDS; i++) {
+    buf_str(&b, i ? ",\n [" : "[");
+    for (int j = 0; j < COORDS; j++) {
+      snprintf(num, sizeof num, "%s%.17g", j ? ", " : "", i == j ? 3.0 : ldexp(1.0, -abs(i - j)));
+      buf_str(&b, num);
+    }
+    buf_str(&b, "]");
+  }
+  buf_str(&b, "]\nU = sum(i in 1..N, y[i])\n"
+              "g = [x[1]^2 + y[1]^2 - 1, [(x[i] - x[i-1])^2 + (y[i] - y[i-1])^2 - 1 for i in 2..N]]\n"
+              "q0 = [[i for i in 1..N], [0 for i in 1..N]]\np0 = [0 for i in 1..2*N]\n");
+  expect_rejected(&b, "a step over the node limit",
+                  "model.ham:55:22: error: the model needs more than 4000000 expression nodes "
+                  "(the limit was reached building the step for these equations: pass --multiplier const");
+}
+END_TEST
+
 START_TEST(test_huge_tokens)
 {
   Buf b = {0};
@@ -524,6 +553,7 @@ Suite *errors_suite(void)
   tcase_add_test(robust, test_deep_brackets);
   tcase_add_test(robust, test_deep_chains);
   tcase_add_test(robust, test_huge_tokens);
+  tcase_add_test(robust, test_step_node_limit);
   tcase_add_test(robust, test_random_bytes);
   tcase_add_test(robust, test_nul_bytes);
   tcase_add_test(robust, test_empty_file);
