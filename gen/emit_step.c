@@ -51,6 +51,7 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "typedef struct {\n"
           "  int iters;         /* fixed-point iterations */\n"
           "  $P_real increment; /* last scaled increment of the iteration */\n"
+          "  $P_real err_est;   /* estimate of the step's local error in q (max norm) */\n"
           "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
           " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
@@ -277,6 +278,57 @@ static void emit_end_poly(Emitter *e) {
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
+// The order of the step in q and p: 2s, but 2 for the constant multiplier
+// with constraints (docs/api.md).
+static int step_order(const Emitter *e) {
+  return e->mod->nu && e->st->kern[K_FACTOR].nout == 0 ? 2 : 2 * e->me->s;
+}
+
+// The constant of NAME_err_est: the geometric mean of true / estimate over
+// the problems of tests/check_errest.c (docs/api.md), by s for the order 2s
+// and for the constant multiplier's order 2 (s = 2; s >= 3).
+static double err_constant(const Emitter *e) {
+  static const double order2s[] = {0.068, 1.4e-3, 1.4e-6, 1.4e-7}, order2[] = {0.068, 5.6e-4, 1.5e-3};
+  int s = e->me->s;
+  if (step_order(e) == 2) return order2[s < 3 ? s - 1 : 2];
+  return order2s[s < 4 ? s - 1 : 3];
+}
+
+// NAME_err_est: the local error estimate of a converged step from what the
+// step has anyway (docs/api.md, "The local error estimate"). The Legendre
+// coefficients of the velocity of a smooth solution fall like
+// |gamma_j| ~ |v| rho^j, rho ~ h / (its time scale); the predictor's error d1
+// (the first sweep's increment, h times gamma's change) is the first
+// coefficient the extrapolation lacks, ~ h |v| rho^s, so that
+//   rho = d1 / (h |gamma_{s-1}|),  local error ~ h |v| rho^p = d1 rho^(p-s)
+// for the order p. With p < s (the constant multiplier at s >= 3) the
+// coefficient h |gamma_p| itself is of the order of the local error.
+static void emit_err_est(Emitter *e) {
+  int p = step_order(e), s = e->me->s;
+  tmpl(e, "/* The local error estimate of a step (max norm in q) from its converged gamma and\n"
+          " * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:\n");
+  if (p >= s)
+    out(e, " * d1 rho^%d, rho = min(1, d1 / max |h gamma_%d|) (docs/api.md). */\n", p - s, s - 1);
+  else
+    out(e, " * max |h gamma_%d|, the Legendre coefficient of degree %d, the order (docs/api.md). */\n", p, p);
+  tmpl(e, "#ifndef $P_ERRC\n");
+  out(e, "#define %s_ERRC %.3g  /* measured: docs/api.md */\n#endif\n", e->P, err_constant(e));
+  tmpl(e, p >= s ? "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R c = 0, rho;\n  int i;\n"
+                 : "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R c = 0;\n  int i;\n");
+  int j = p >= s ? s - 1 : p;
+  const char *g = math_suffix(e, e->wide_step);
+  out(e, "  for (i = 0; i < %s_M; i++)\n    if (fabs%s(gam[%d * %s_M + i]) > c) c = (%s)fabs%s(gam[%d * %s_M + i]);\n", e->P, g,
+      j, e->P, real_type(e, 0), g, j, e->P);
+  if (p < s) {
+    tmpl(e, "  (void)d1;\n  return $P_ERRC * fabs$f(h) * c;\n}\n\n");
+    return;
+  }
+  tmpl(e, "  c *= fabs$f(h);\n  rho = c > d1 ? d1 / c : 1;\n  c = $P_ERRC * d1;\n");
+  if (p > s) out(e, "  for (i = 0; i < %d; i++) c *= rho;\n", p - s);
+  else tmpl(e, "  (void)rho;\n");
+  tmpl(e, "  return c;\n}\n\n");
+}
+
 // The warm start, iteration and compensated update around the sweep kernel.
 // With --wide-step the iteration (gamma, the sweep's results) is in the wider
 // type, starts from the compensated state q - qc, p - pc, and the new q, p
@@ -302,12 +354,13 @@ static void emit_step(Emitter *e) {
   else
     tmpl(e, "/* a += b, plainly (generated with --plain-sum: no compensated summation). */\n"
             "static void $P_add($R *a, $R *c, $R b)\n{\n  (void)c;\n  *a += b;\n}\n\n");
+  emit_err_est(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
           "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
-          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;\n"
+          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;\n"
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
   if (wide)
@@ -357,6 +410,7 @@ static void emit_step(Emitter *e) {
           "      $R v = fabs$g(h * (sw[$[sweep.gam]i] - gam[i]));\n"
           "      if (v > inc) inc = v;\n"
           "      gam[i] = sw[$[sweep.gam]i];\n    }\n"
+          "    if (it == 1) d1 = inc;  /* the predictor's error, for $P_err_est */\n"
           "    if (scale > 0) inc /= scale;\n");
   if (poly)
     tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
@@ -386,7 +440,8 @@ static void emit_step(Emitter *e) {
           "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n"
-          "  if (st) { st->iters = it > $P_MAXITER ? $P_MAXITER : it; st->increment = inc; }\n"
+          "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
+          "    st->err_est = $P_err_est(gam, h, d1);\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
           "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
   if (poly) {

@@ -37,6 +37,7 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   double_pendulum_k3s3_real increment; /* last scaled increment of the iteration */
+  double_pendulum_k3s3_real err_est;   /* estimate of the step's local error in q (max norm) */
 } double_pendulum_k3s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

@@ -36,6 +36,7 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   kepler_k6s2_real increment; /* last scaled increment of the iteration */
+  kepler_k6s2_real err_est;   /* estimate of the step's local error in q (max norm) */
 } kepler_k6s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

@@ -436,13 +436,32 @@ static void kepler_k6s3_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * d1 rho^3, rho = min(1, d1 / max |h gamma_2|) (docs/api.md). */
+#ifndef kepler_k6s3_ERRC
+#define kepler_k6s3_ERRC 1.4e-06  /* measured: docs/api.md */
+#endif
+static double kepler_k6s3_err_est(const double *gam, double h, double d1)
+{
+  double c = 0, rho;
+  int i;
+  for (i = 0; i < kepler_k6s3_M; i++)
+    if (fabs(gam[2 * kepler_k6s3_M + i]) > c) c = (double)fabs(gam[2 * kepler_k6s3_M + i]);
+  c *= fabs(h);
+  rho = c > d1 ? d1 / c : 1;
+  c = kepler_k6s3_ERRC * d1;
+  for (i = 0; i < 3; i++) c *= rho;
+  return c;
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h_, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k6s3_S * kepler_k6s3_M], sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + 3 * kepler_k6s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
   int it, i, stall = 0, rc = kepler_k6s3_ENOCONV;
   kepler_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s3_EBADSTEP;
@@ -462,6 +481,7 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h_, const kepler_k6s
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
+    if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k6s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + kepler_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k6s3_ENONFINITE;
@@ -483,7 +503,11 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h_, const kepler_k6s
       break;
     }
   }
-  if (st) { st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it; st->increment = inc; }
+  if (st) {
+    st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it;
+    st->increment = inc;
+    st->err_est = kepler_k6s3_err_est(gam, h, d1);
+  }
   if (rc != kepler_k6s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s3_ENONFINITE;
   for (i = 0; i < kepler_k6s3_M; i++) /* the new state must be finite too, compensations included */

@@ -36,6 +36,7 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   modified_k9s3_real increment; /* last scaled increment of the iteration */
+  modified_k9s3_real err_est;   /* estimate of the step's local error in q (max norm) */
 } modified_k9s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

@@ -37,6 +37,7 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   pendulum_poly_k2s2_real increment; /* last scaled increment of the iteration */
+  pendulum_poly_k2s2_real err_est;   /* estimate of the step's local error in q (max norm) */
 } pendulum_poly_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

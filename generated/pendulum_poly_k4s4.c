@@ -1379,13 +1379,32 @@ static void pendulum_poly_k4s4_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * d1 rho^4, rho = min(1, d1 / max |h gamma_3|) (docs/api.md). */
+#ifndef pendulum_poly_k4s4_ERRC
+#define pendulum_poly_k4s4_ERRC 1.4e-07  /* measured: docs/api.md */
+#endif
+static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1)
+{
+  double c = 0, rho;
+  int i;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++)
+    if (fabs(gam[3 * pendulum_poly_k4s4_M + i]) > c) c = (double)fabs(gam[3 * pendulum_poly_k4s4_M + i]);
+  c *= fabs(h);
+  rho = c > d1 ? d1 / c : 1;
+  c = pendulum_poly_k4s4_ERRC * d1;
+  for (i = 0; i < 4; i++) c *= rho;
+  return c;
+}
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
   int it, i, stall = 0, rc = pendulum_poly_k4s4_ENOCONV;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k4s4_EBADSTEP;
@@ -1434,6 +1453,7 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
+    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + i];
     for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
@@ -1454,7 +1474,11 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
       break;
     }
   }
-  if (st) { st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it; st->increment = inc; }
+  if (st) {
+    st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it;
+    st->increment = inc;
+    st->err_est = pendulum_poly_k4s4_err_est(gam, h, d1);
+  }
   if (rc != pendulum_poly_k4s4_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k4s4_ENONFINITE;
   double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;

@@ -8629,13 +8629,32 @@ static void satellites_poly_k6s3_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * d1 rho^3, rho = min(1, d1 / max |h gamma_2|) (docs/api.md). */
+#ifndef satellites_poly_k6s3_ERRC
+#define satellites_poly_k6s3_ERRC 1.4e-06  /* measured: docs/api.md */
+#endif
+static double satellites_poly_k6s3_err_est(const double *gam, double h, double d1)
+{
+  double c = 0, rho;
+  int i;
+  for (i = 0; i < satellites_poly_k6s3_M; i++)
+    if (fabs(gam[2 * satellites_poly_k6s3_M + i]) > c) c = (double)fabs(gam[2 * satellites_poly_k6s3_M + i]);
+  c *= fabs(h);
+  rho = c > d1 ? d1 / c : 1;
+  c = satellites_poly_k6s3_ERRC * d1;
+  for (i = 0; i < 3; i++) c *= rho;
+  return c;
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
   int it, i, stall = 0, rc = satellites_poly_k6s3_ENOCONV;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s3_EBADSTEP;
@@ -8684,6 +8703,7 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
+    if (it == 1) d1 = inc;  /* the predictor's error, for satellites_poly_k6s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) lam[i] = sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + i];
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++)
@@ -8704,7 +8724,11 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
       break;
     }
   }
-  if (st) { st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it; st->increment = inc; }
+  if (st) {
+    st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it;
+    st->increment = inc;
+    st->err_est = satellites_poly_k6s3_err_est(gam, h, d1);
+  }
   if (rc != satellites_poly_k6s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
   double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 2 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
