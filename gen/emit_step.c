@@ -52,6 +52,8 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "  int iters;         /* fixed-point iterations */\n"
           "  $P_real increment; /* last scaled increment of the iteration */\n"
           "  $P_real err_est;   /* estimate of the step's local error in q (max norm) */\n"
+          "  $P_real h;         /* the step taken */\n"
+          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n"
           "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
           " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
@@ -68,6 +70,11 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "void $P_params_default($P_params *prm);\n"
           "/* One step of size h; prm and st may be NULL. Returns $P_OK or an error code. */\n"
           "int $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st);\n"
+          "/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried\n"
+          " * smaller from the unchanged state until it is; on $P_OK *h is the next step\n"
+          " * proposed, st->h the step taken. Fails (x unchanged) only below a step of\n"
+          " * $P_HMIN (1 + |t|). */\n"
+          "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st);\n"
           "const char *$P_strerror(int code);\n"
           "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
           "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
@@ -441,7 +448,7 @@ static void emit_step(Emitter *e) {
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n"
           "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
-          "    st->err_est = $P_err_est(gam, h, d1);\n  }\n"
+          "    st->err_est = $P_err_est(gam, h, d1);\n    st->h = h;\n    st->rejected = 0;\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
           "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
   if (poly) {
@@ -469,6 +476,38 @@ static void emit_step(Emitter *e) {
             "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n");
   }
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
+}
+
+// NAME_step_adaptive: NAME_step on a copy of the state, accepted when its
+// error estimate is within tol (1 + max|q|) (absolute and relative at
+// once), else retried from the unchanged state with a smaller step; the
+// next step from the standard controller of Hairer, Norsett and Wanner
+// (I.II.4), h (0.9 / err)^(1/(p+1)) within [h/5, 5h], not growing right
+// after a rejection. A failed step is retried with half the step.
+static void emit_step_adaptive(Emitter *e) {
+  out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
+      e->P, e->P, e->single ? "1e-5f" : "1e-12");
+  out(e, "/* The order of the error estimate's exponent: the step's order %d, plus one. */\n", step_order(e));
+  tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
+          "  $P_state y;\n  $P_stats s = {0, 0, 0, 0, 0};\n  $R hh = *h, err, sc, fac, grow = 5;\n  int i, rc, rejected = 0;\n"
+          "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
+          "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
+          "  for (;;) {\n    y = *x;\n    rc = $P_step(&y, hh, prm, &s);\n"
+          "    if (rc == $P_OK) {\n      sc = 0;\n"
+          "      for (i = 0; i < $P_M; i++) {\n"
+          "        if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "        if (fabs$f(y.q[i]) > sc) sc = fabs$f(y.q[i]);\n      }\n"
+          "      err = s.err_est / (tol * (1 + sc));\n");
+  out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
+      real_type(e, 0), step_order(e) + 1);
+  tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n"
+          "      if (err <= 1) {\n        *x = y;\n        *h = hh * fac;\n"
+          "        if (st) {\n          *st = s;\n          st->rejected = rejected;\n        }\n"
+          "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
+          "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
+          "      if (st) {\n        *st = s;\n        st->rejected = rejected;\n      }\n"
+          "      return rc != $P_OK ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
 }
 
 // Check one constant the solver will print: finite, and in range of float
@@ -561,6 +600,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_kernels(&e);
   emit_public(&e);
   emit_step(&e);
+  emit_step_adaptive(&e);
   emit_project(&e);
   if (o->batch) emit_batch_source(&e, o->batch);
   free(e.temp);

@@ -512,6 +512,8 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical
     st->iters = it > conical_k3s3_MAXITER ? conical_k3s3_MAXITER : it;
     st->increment = inc;
     st->err_est = conical_k3s3_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != conical_k3s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k3s3_ENONFINITE;
@@ -528,6 +530,57 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h_, const conical
   conical_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k3s3_OK;
+}
+
+#ifndef conical_k3s3_HMIN
+#define conical_k3s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 2, plus one. */
+int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, conical_k3s3_real tol, const conical_k3s3_params *prm, conical_k3s3_stats *st)
+{
+  conical_k3s3_state y;
+  conical_k3s3_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return conical_k3s3_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return conical_k3s3_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = conical_k3s3_step(&y, hh, prm, &s);
+    if (rc == conical_k3s3_OK) {
+      sc = 0;
+      for (i = 0; i < conical_k3s3_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return conical_k3s3_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < conical_k3s3_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != conical_k3s3_OK ? rc : conical_k3s3_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -1232,6 +1232,8 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
     st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it;
     st->increment = inc;
     st->err_est = double_pendulum_k2s2_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != double_pendulum_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
@@ -1282,6 +1284,57 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
   double_pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return double_pendulum_k2s2_OK;
+}
+
+#ifndef double_pendulum_k2s2_HMIN
+#define double_pendulum_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 4, plus one. */
+int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real *h, double_pendulum_k2s2_real tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
+{
+  double_pendulum_k2s2_state y;
+  double_pendulum_k2s2_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return double_pendulum_k2s2_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return double_pendulum_k2s2_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = double_pendulum_k2s2_step(&y, hh, prm, &s);
+    if (rc == double_pendulum_k2s2_OK) {
+      sc = 0;
+      for (i = 0; i < double_pendulum_k2s2_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return double_pendulum_k2s2_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < double_pendulum_k2s2_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != double_pendulum_k2s2_OK ? rc : double_pendulum_k2s2_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

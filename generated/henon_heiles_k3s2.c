@@ -346,6 +346,8 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
     st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it;
     st->increment = inc;
     st->err_est = henon_heiles_k3s2_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != henon_heiles_k3s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return henon_heiles_k3s2_ENONFINITE;
@@ -362,6 +364,57 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return henon_heiles_k3s2_OK;
+}
+
+#ifndef henon_heiles_k3s2_HMIN
+#define henon_heiles_k3s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 4, plus one. */
+int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, henon_heiles_k3s2_real tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
+{
+  henon_heiles_k3s2_state y;
+  henon_heiles_k3s2_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return henon_heiles_k3s2_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return henon_heiles_k3s2_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = henon_heiles_k3s2_step(&y, hh, prm, &s);
+    if (rc == henon_heiles_k3s2_OK) {
+      sc = 0;
+      for (i = 0; i < henon_heiles_k3s2_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return henon_heiles_k3s2_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < henon_heiles_k3s2_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != henon_heiles_k3s2_OK ? rc : henon_heiles_k3s2_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

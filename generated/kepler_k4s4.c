@@ -464,6 +464,8 @@ int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h_, const kepler_k4s
     st->iters = it > kepler_k4s4_MAXITER ? kepler_k4s4_MAXITER : it;
     st->increment = inc;
     st->err_est = kepler_k4s4_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != kepler_k4s4_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k4s4_ENONFINITE;
@@ -480,6 +482,57 @@ int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h_, const kepler_k4s
   kepler_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k4s4_OK;
+}
+
+#ifndef kepler_k4s4_HMIN
+#define kepler_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 8, plus one. */
+int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_k4s4_real tol, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
+{
+  kepler_k4s4_state y;
+  kepler_k4s4_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return kepler_k4s4_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return kepler_k4s4_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = kepler_k4s4_step(&y, hh, prm, &s);
+    if (rc == kepler_k4s4_OK) {
+      sc = 0;
+      for (i = 0; i < kepler_k4s4_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 9) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return kepler_k4s4_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < kepler_k4s4_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != kepler_k4s4_OK ? rc : kepler_k4s4_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

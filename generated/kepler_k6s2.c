@@ -449,6 +449,8 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
     st->iters = it > kepler_k6s2_MAXITER ? kepler_k6s2_MAXITER : it;
     st->increment = inc;
     st->err_est = kepler_k6s2_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != kepler_k6s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s2_ENONFINITE;
@@ -465,6 +467,57 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
   kepler_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k6s2_OK;
+}
+
+#ifndef kepler_k6s2_HMIN
+#define kepler_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 4, plus one. */
+int kepler_k6s2_step_adaptive(kepler_k6s2_state *x, kepler_k6s2_real *h, kepler_k6s2_real tol, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
+{
+  kepler_k6s2_state y;
+  kepler_k6s2_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return kepler_k6s2_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return kepler_k6s2_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = kepler_k6s2_step(&y, hh, prm, &s);
+    if (rc == kepler_k6s2_OK) {
+      sc = 0;
+      for (i = 0; i < kepler_k6s2_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return kepler_k6s2_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < kepler_k6s2_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != kepler_k6s2_OK ? rc : kepler_k6s2_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

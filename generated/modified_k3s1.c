@@ -500,6 +500,8 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
     st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it;
     st->increment = inc;
     st->err_est = modified_k3s1_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != modified_k3s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k3s1_ENONFINITE;
@@ -516,6 +518,57 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k3s1_OK;
+}
+
+#ifndef modified_k3s1_HMIN
+#define modified_k3s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 2, plus one. */
+int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
+{
+  modified_k3s1_state y;
+  modified_k3s1_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return modified_k3s1_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return modified_k3s1_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = modified_k3s1_step(&y, hh, prm, &s);
+    if (rc == modified_k3s1_OK) {
+      sc = 0;
+      for (i = 0; i < modified_k3s1_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return modified_k3s1_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < modified_k3s1_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != modified_k3s1_OK ? rc : modified_k3s1_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -444,6 +444,8 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pend
     st->iters = it > pendulum_k3s3_MAXITER ? pendulum_k3s3_MAXITER : it;
     st->increment = inc;
     st->err_est = pendulum_k3s3_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != pendulum_k3s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k3s3_ENONFINITE;
@@ -460,6 +462,57 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h_, const pend
   pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k3s3_OK;
+}
+
+#ifndef pendulum_k3s3_HMIN
+#define pendulum_k3s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 2, plus one. */
+int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, pendulum_k3s3_real tol, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
+{
+  pendulum_k3s3_state y;
+  pendulum_k3s3_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return pendulum_k3s3_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return pendulum_k3s3_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = pendulum_k3s3_step(&y, hh, prm, &s);
+    if (rc == pendulum_k3s3_OK) {
+      sc = 0;
+      for (i = 0; i < pendulum_k3s3_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return pendulum_k3s3_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < pendulum_k3s3_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != pendulum_k3s3_OK ? rc : pendulum_k3s3_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

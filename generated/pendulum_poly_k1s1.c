@@ -479,6 +479,8 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
     st->iters = it > pendulum_poly_k1s1_MAXITER ? pendulum_poly_k1s1_MAXITER : it;
     st->increment = inc;
     st->err_est = pendulum_poly_k1s1_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != pendulum_poly_k1s1_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k1s1_ENONFINITE;
@@ -529,6 +531,57 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
   pendulum_poly_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_poly_k1s1_OK;
+}
+
+#ifndef pendulum_poly_k1s1_HMIN
+#define pendulum_poly_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 2, plus one. */
+int pendulum_poly_k1s1_step_adaptive(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real *h, pendulum_poly_k1s1_real tol, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
+{
+  pendulum_poly_k1s1_state y;
+  pendulum_poly_k1s1_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k1s1_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k1s1_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = pendulum_poly_k1s1_step(&y, hh, prm, &s);
+    if (rc == pendulum_poly_k1s1_OK) {
+      sc = 0;
+      for (i = 0; i < pendulum_poly_k1s1_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return pendulum_poly_k1s1_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < pendulum_poly_k1s1_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != pendulum_poly_k1s1_OK ? rc : pendulum_poly_k1s1_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -647,6 +647,8 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
     st->iters = it > pendulum_poly_k2s2_MAXITER ? pendulum_poly_k2s2_MAXITER : it;
     st->increment = inc;
     st->err_est = pendulum_poly_k2s2_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != pendulum_poly_k2s2_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k2s2_ENONFINITE;
@@ -697,6 +699,57 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
   pendulum_poly_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_poly_k2s2_OK;
+}
+
+#ifndef pendulum_poly_k2s2_HMIN
+#define pendulum_poly_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 4, plus one. */
+int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real *h, pendulum_poly_k2s2_real tol, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
+{
+  pendulum_poly_k2s2_state y;
+  pendulum_poly_k2s2_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k2s2_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k2s2_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = pendulum_poly_k2s2_step(&y, hh, prm, &s);
+    if (rc == pendulum_poly_k2s2_OK) {
+      sc = 0;
+      for (i = 0; i < pendulum_poly_k2s2_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return pendulum_poly_k2s2_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < pendulum_poly_k2s2_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != pendulum_poly_k2s2_OK ? rc : pendulum_poly_k2s2_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -8728,6 +8728,8 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
     st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it;
     st->increment = inc;
     st->err_est = satellites_poly_k6s3_err_est(gam, h, d1);
+    st->h = h;
+    st->rejected = 0;
   }
   if (rc != satellites_poly_k6s3_OK) return rc;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
@@ -8778,6 +8780,57 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
   satellites_poly_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_poly_k6s3_OK;
+}
+
+#ifndef satellites_poly_k6s3_HMIN
+#define satellites_poly_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+/* The order of the error estimate's exponent: the step's order 6, plus one. */
+int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real *h, satellites_poly_k6s3_real tol, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+{
+  satellites_poly_k6s3_state y;
+  satellites_poly_k6s3_stats s = {0, 0, 0, 0, 0};
+  double hh = *h, err, sc, fac, grow = 5;
+  int i, rc, rejected = 0;
+  if (!(hh != 0 && isfinite(hh))) return satellites_poly_k6s3_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return satellites_poly_k6s3_EBADSTEP;
+  for (;;) {
+    y = *x;
+    rc = satellites_poly_k6s3_step(&y, hh, prm, &s);
+    if (rc == satellites_poly_k6s3_OK) {
+      sc = 0;
+      for (i = 0; i < satellites_poly_k6s3_M; i++) {
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+      }
+      err = s.err_est / (tol * (1 + sc));
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 7) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (err <= 1) {
+        *x = y;
+        *h = hh * fac;
+        if (st) {
+          *st = s;
+          st->rejected = rejected;
+        }
+        return satellites_poly_k6s3_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < satellites_poly_k6s3_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        *st = s;
+        st->rejected = rejected;
+      }
+      return rc != satellites_poly_k6s3_OK ? rc : satellites_poly_k6s3_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -24,6 +24,7 @@
 #include "errest.h"
 
 Suite *errest_suite(void);
+Suite *adaptive_suite(void);
 
 #define ROUNDOFF 1e-14
 
@@ -134,6 +135,115 @@ Suite *errest_suite(void) {
   Suite *s = suite_create("errest");
   TCase *tc = tcase_create("errest");
   tcase_add_loop_test(tc, tracks_true_error, 0, (int)(sizeof cases / sizeof cases[0]));
+  tcase_set_timeout(tc, 60);
+  suite_add_tcase(s, tc);
+  return s;
+}
+
+/* ---- NAME_step_adaptive ---- */
+
+#include "kepler_k3s3.h"
+#include "pendulum_poly_k3s3.h"
+#include "satellites_poly_k6s3.h"
+
+typedef struct {
+  double err, dH, dg, dhc; /* error at T (max over q, p), max |H - H0|, |g|, |hidden| */
+  long steps, rejected;
+} Adaptive;
+
+/* Run solver P adaptively from its model's initial values to T (the last
+ * step shortened to end on T) within tol, into *a; q, p at T in qT, pT. */
+#define RUN_ADAPTIVE(P)                                                                              \
+  static Adaptive adaptive_##P(double T, double tol, double *qT, double *pT) {                       \
+    P##_state x;                                                                                     \
+    P##_stats st;                                                                                    \
+    Adaptive a = {0, 0, 0, 0, 0, 0};                                                                 \
+    double h = 0.01, g[P##_NU + 1], hc[P##_NU + 1];                                                  \
+    P##_init(&x, NULL, NULL);                                                                        \
+    double H0 = P##_energy(&x, NULL);                                                                \
+    while (x.t != T) {                                                                               \
+      double rest = T - x.t, hn = h >= rest * (1 - 1e-12) ? rest : h;                                \
+      ck_assert_int_eq(P##_step_adaptive(&x, &hn, tol, NULL, &st), P##_OK);                          \
+      a.steps++;                                                                                     \
+      a.rejected += st.rejected;                                                                     \
+      a.dH = fmax(a.dH, fabs(P##_energy(&x, NULL) - H0));                                            \
+      P##_constraints(&x, NULL, g);                                                                  \
+      P##_hidden(&x, NULL, hc);                                                                      \
+      for (int i = 0; i < P##_NU; i++) {                                                             \
+        a.dg = fmax(a.dg, fabs(g[i]));                                                               \
+        a.dhc = fmax(a.dhc, fabs(hc[i]));                                                            \
+      }                                                                                              \
+      if (st.h == rest) break;                                                                       \
+      h = hn;                                                                                        \
+    }                                                                                                \
+    memcpy(qT, x.q, sizeof x.q);                                                                     \
+    memcpy(pT, x.p, sizeof x.p);                                                                     \
+    return a;                                                                                        \
+  }
+RUN_ADAPTIVE(kepler_k3s3)
+RUN_ADAPTIVE(pendulum_poly_k3s3)
+RUN_ADAPTIVE(satellites_poly_k6s3)
+
+static const struct {
+  const char *problem;
+  double T, bound; /* error / tol measured over 1e-6..1e-12 (docs/api.md): 1.2e5, 2e3, 1.7e4 */
+} adaptive_cases[] = {{"kepler", 6.283185307179586, 3e5}, {"pendulum", 10, 1e4}, {"satellites", 10, 5e4}};
+
+// The global error at T against tol = 1e-6 .. 1e-12, and the invariants
+// at round-off on every adaptive step.
+START_TEST(adaptive_proportional)
+{
+  const char *problem = adaptive_cases[_i].problem;
+  double T = adaptive_cases[_i].T, q[2 * 9], p[2 * 9], qT[9], pT[9];
+  int m = 0, nu = 0;
+  if (strcmp(problem, "kepler")) {
+    ck_assert_int_eq(ref_dims(problem, &m, &nu), 0);
+  } else {
+    m = 2;
+  }
+  ck_assert_int_eq(errest_reference(problem, T, 1, m, q, p), 0);
+  for (double tol = 1e-6; tol > 1e-12 / 2; tol /= 100) {
+    Adaptive a = !strcmp(problem, "kepler")     ? adaptive_kepler_k3s3(T, tol, qT, pT)
+                 : !strcmp(problem, "pendulum") ? adaptive_pendulum_poly_k3s3(T, tol, qT, pT)
+                                                : adaptive_satellites_poly_k6s3(T, tol, qT, pT);
+    for (int i = 0; i < m; i++) a.err = fmax(a.err, fmax(fabs(qT[i] - q[m + i]), fabs(pT[i] - p[m + i])));
+    if (getenv("HBVM_ERREST_TABLE"))
+      printf("%-10s tol=%-6g error at T=%.3e (%.3g tol) steps=%ld rejected=%ld max|dH|=%.1e max|g|=%.1e "
+             "max|hc|=%.1e\n", problem, tol, a.err, a.err / tol, a.steps, a.rejected, a.dH, a.dg, a.dhc);
+    ck_assert_msg(a.err <= adaptive_cases[_i].bound * tol, "%s, tol %g: error %g", problem, tol, a.err);
+    ck_assert_double_le(a.dg, 1e-13);
+    ck_assert_double_le(a.dhc, 1e-13);
+    if (strcmp(problem, "kepler")) ck_assert_double_le(a.dH, 1e-13);
+  }
+}
+END_TEST
+
+// A rejected or failed adaptive step leaves the state byte-identical: a
+// tolerance no step can meet fails at the floor with x untouched.
+START_TEST(adaptive_rejected_unchanged)
+{
+  pendulum_poly_k3s3_state x, before;
+  pendulum_poly_k3s3_stats st;
+  double h = 0.1;
+  memset(&x, 0, sizeof x);
+  pendulum_poly_k3s3_init(&x, NULL, NULL);
+  ck_assert_int_eq(pendulum_poly_k3s3_step(&x, 0.1, NULL, NULL), 0);
+  memcpy(&before, &x, sizeof x);
+  ck_assert_int_eq(pendulum_poly_k3s3_step_adaptive(&x, &h, 1e-300, NULL, &st), pendulum_poly_k3s3_ENOCONV);
+  ck_assert(st.rejected > 0);
+  ck_assert_int_eq(memcmp(&before, &x, sizeof x), 0);
+  h = 0.5; /* rejected first, then accepted: smaller than asked */
+  ck_assert_int_eq(pendulum_poly_k3s3_step_adaptive(&x, &h, 1e-10, NULL, &st), 0);
+  ck_assert(st.rejected > 0 && st.h < 0.5);
+  ck_assert_double_eq_tol(x.t, 0.1 + st.h, 1e-15);
+}
+END_TEST
+
+Suite *adaptive_suite(void) {
+  Suite *s = suite_create("adaptive");
+  TCase *tc = tcase_create("adaptive");
+  tcase_add_loop_test(tc, adaptive_proportional, 0, (int)(sizeof adaptive_cases / sizeof adaptive_cases[0]));
+  tcase_add_test(tc, adaptive_rejected_unchanged);
   tcase_set_timeout(tc, 60);
   suite_add_tcase(s, tc);
   return s;
