@@ -106,7 +106,8 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
           "#error \"compile without -ffast-math (docs/api.md), or define $P_ALLOW_FAST_MATH\"\n"
           "#endif\n\n"
           "/* Limits of the iteration; each can be set with -D (docs/api.md). */\n"
-          "#ifndef $P_MAXITER\n#define $P_MAXITER 100  /* fixed-point iterations before giving up */\n#endif\n");
+          "#ifndef $P_MAXITER\n#define $P_MAXITER 100  /* fixed-point iterations before giving up */\n#endif\n"
+          "#define $P_EREJECT (-1)  /* internal: a step over the tolerance of $P_step_adaptive */\n");
   static const char *const limits[2][5][2] = {
       {{"TOL", "4.4408920985006262e-16  /* an increment within 2 ulps ... */"},
        {"NOISETOL", "1.4210854715202004e-14  /* a stall at or below this (64 ulps) is round-off: converged */"},
@@ -364,10 +365,10 @@ static void emit_step(Emitter *e) {
   emit_err_est(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
+          "static int $P_step_within($P_state *x, $P_real h_, $R tol, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
-          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;\n"
+          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;\n"
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
   if (wide)
@@ -447,9 +448,12 @@ static void emit_step(Emitter *e) {
           "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n"
+          "  est = $P_err_est(gam, h, d1);\n"
           "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
-          "    st->err_est = $P_err_est(gam, h, d1);\n    st->h = h;\n    st->rejected = 0;\n  }\n"
+          "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
+          "  /* $P_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */\n"
+          "  if (tol > 0 && !(est <= tol * (1 + scale))) return $P_EREJECT;\n"
           "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
   if (poly) {
     emit_end_poly(e);
@@ -485,29 +489,35 @@ static void emit_step(Emitter *e) {
 // (I.II.4), h (0.9 / err)^(1/(p+1)) within [h/5, 5h], not growing right
 // after a rejection. A failed step is retried with half the step.
 static void emit_step_adaptive(Emitter *e) {
+  tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
+          "  return $P_step_within(x, h, 0, prm, st);\n}\n");
   out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
   out(e, "/* The order of the error estimate's exponent: the step's order %d, plus one. */\n", step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
-          "  $P_state y;\n  $P_stats s = {0, 0, 0, 0, 0};\n  $R hh = *h, err, sc, fac, grow = 5;\n  int i, rc, rejected = 0;\n"
+          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
-          "  for (;;) {\n    y = *x;\n    rc = $P_step(&y, hh, prm, &s);\n"
-          "    if (rc == $P_OK) {\n      sc = 0;\n"
-          "      for (i = 0; i < $P_M; i++) {\n"
-          "        if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
-          "        if (fabs$f(y.q[i]) > sc) sc = fabs$f(y.q[i]);\n      }\n"
-          "      err = s.err_est / (tol * (1 + sc));\n");
+          "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
+          "    rc = $P_step_within(x, hh, tol, prm, &s);\n"
+          "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
+          "      /* the step's error over its tolerance; scaled by tol again, as a step of h */\n"
+          "      err = rc == $P_OK ? 1 : s.err_est / tol;\n");
+  tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n        int i;\n"
+          "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "        err = s.err_est / (tol * (1 + sc));\n      }\n");
   out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
       real_type(e, 0), step_order(e) + 1);
   tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n"
-          "      if (err <= 1) {\n        *x = y;\n        *h = hh * fac;\n"
-          "        if (st) {\n          *st = s;\n          st->rejected = rejected;\n        }\n"
+          "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
+          "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
+          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
           "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
-          "      if (st) {\n        *st = s;\n        st->rejected = rejected;\n      }\n"
-          "      return rc != $P_OK ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
+          "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
+          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n      }\n"
+          "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
 }
 
 // Check one constant the solver will print: finite, and in range of float

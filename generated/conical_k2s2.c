@@ -14,6 +14,7 @@
 #ifndef conical_k2s2_MAXITER
 #define conical_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define conical_k2s2_EREJECT (-1)  /* internal: a step over the tolerance of conical_k2s2_step_adaptive */
 #ifndef conical_k2s2_TOL
 #define conical_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -417,11 +418,11 @@ static double conical_k2s2_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical_k2s2_params *prm, conical_k2s2_stats *st)
+static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_, double tol, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k2s2_ENOCONV;
   conical_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k2s2_EBADSTEP;
@@ -474,14 +475,17 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
       break;
     }
   }
+  est = conical_k2s2_err_est(gam, h, d1);
   if (st) {
     st->iters = it > conical_k2s2_MAXITER ? conical_k2s2_MAXITER : it;
     st->increment = inc;
-    st->err_est = conical_k2s2_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != conical_k2s2_OK) return rc;
+  /* conical_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k2s2_ENONFINITE;
   for (i = 0; i < conical_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k2s2_S * conical_k2s2_M + i]) ||
@@ -498,6 +502,11 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
   return conical_k2s2_OK;
 }
 
+int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h, const conical_k2s2_params *prm, conical_k2s2_stats *st)
+{
+  return conical_k2s2_step_within(x, h, 0, prm, st);
+}
+
 #ifndef conical_k2s2_HMIN
 #define conical_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -505,30 +514,35 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h_, const conical
 /* The order of the error estimate's exponent: the step's order 2, plus one. */
 int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, conical_k2s2_real tol, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
-  conical_k2s2_state y;
-  conical_k2s2_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  conical_k2s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k2s2_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = conical_k2s2_step(&y, hh, prm, &s);
-    if (rc == conical_k2s2_OK) {
-      sc = 0;
-      for (i = 0; i < conical_k2s2_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = conical_k2s2_step_within(x, hh, tol, prm, &s);
+    if (rc == conical_k2s2_OK || rc == conical_k2s2_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == conical_k2s2_OK ? 1 : s.err_est / tol;
+      if (rc == conical_k2s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < conical_k2s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == conical_k2s2_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return conical_k2s2_OK;
@@ -541,10 +555,13 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
     hh *= fac;
     if (fabs(hh) < conical_k2s2_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != conical_k2s2_OK ? rc : conical_k2s2_ENOCONV;
+      return rc != conical_k2s2_EREJECT ? rc : conical_k2s2_ENOCONV;
     }
   }
 }

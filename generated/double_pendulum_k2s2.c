@@ -14,6 +14,7 @@
 #ifndef double_pendulum_k2s2_MAXITER
 #define double_pendulum_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define double_pendulum_k2s2_EREJECT (-1)  /* internal: a step over the tolerance of double_pendulum_k2s2_step_adaptive */
 #ifndef double_pendulum_k2s2_TOL
 #define double_pendulum_k2s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -1154,11 +1155,11 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
+static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k2s2_ENOCONV;
   double_pendulum_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k2s2_EBADSTEP;
@@ -1228,14 +1229,17 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
       break;
     }
   }
+  est = double_pendulum_k2s2_err_est(gam, h, d1);
   if (st) {
     st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it;
     st->increment = inc;
-    st->err_est = double_pendulum_k2s2_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != double_pendulum_k2s2_OK) return rc;
+  /* double_pendulum_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
   double q1[double_pendulum_k2s2_M], p1[double_pendulum_k2s2_M], pr[double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k2s2_energy(x, prm);
@@ -1286,6 +1290,11 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
   return double_pendulum_k2s2_OK;
 }
 
+int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
+{
+  return double_pendulum_k2s2_step_within(x, h, 0, prm, st);
+}
+
 #ifndef double_pendulum_k2s2_HMIN
 #define double_pendulum_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -1293,30 +1302,35 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
 /* The order of the error estimate's exponent: the step's order 4, plus one. */
 int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real *h, double_pendulum_k2s2_real tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
-  double_pendulum_k2s2_state y;
-  double_pendulum_k2s2_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  double_pendulum_k2s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k2s2_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = double_pendulum_k2s2_step(&y, hh, prm, &s);
-    if (rc == double_pendulum_k2s2_OK) {
-      sc = 0;
-      for (i = 0; i < double_pendulum_k2s2_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = double_pendulum_k2s2_step_within(x, hh, tol, prm, &s);
+    if (rc == double_pendulum_k2s2_OK || rc == double_pendulum_k2s2_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == double_pendulum_k2s2_OK ? 1 : s.err_est / tol;
+      if (rc == double_pendulum_k2s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < double_pendulum_k2s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == double_pendulum_k2s2_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return double_pendulum_k2s2_OK;
@@ -1329,10 +1343,13 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
     hh *= fac;
     if (fabs(hh) < double_pendulum_k2s2_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != double_pendulum_k2s2_OK ? rc : double_pendulum_k2s2_ENOCONV;
+      return rc != double_pendulum_k2s2_EREJECT ? rc : double_pendulum_k2s2_ENOCONV;
     }
   }
 }

@@ -14,6 +14,7 @@
 #ifndef henon_heiles_k3s2_MAXITER
 #define henon_heiles_k3s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define henon_heiles_k3s2_EREJECT (-1)  /* internal: a step over the tolerance of henon_heiles_k3s2_step_adaptive */
 #ifndef henon_heiles_k3s2_TOL
 #define henon_heiles_k3s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -296,11 +297,11 @@ static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(3,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
+static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, double tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
   double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = henon_heiles_k3s2_ENOCONV;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return henon_heiles_k3s2_EBADSTEP;
@@ -342,14 +343,17 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
       break;
     }
   }
+  est = henon_heiles_k3s2_err_est(gam, h, d1);
   if (st) {
     st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it;
     st->increment = inc;
-    st->err_est = henon_heiles_k3s2_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != henon_heiles_k3s2_OK) return rc;
+  /* henon_heiles_k3s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return henon_heiles_k3s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return henon_heiles_k3s2_ENONFINITE;
   for (i = 0; i < henon_heiles_k3s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]) ||
@@ -366,6 +370,11 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
   return henon_heiles_k3s2_OK;
 }
 
+int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
+{
+  return henon_heiles_k3s2_step_within(x, h, 0, prm, st);
+}
+
 #ifndef henon_heiles_k3s2_HMIN
 #define henon_heiles_k3s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -373,30 +382,35 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_
 /* The order of the error estimate's exponent: the step's order 4, plus one. */
 int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, henon_heiles_k3s2_real tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
-  henon_heiles_k3s2_state y;
-  henon_heiles_k3s2_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  henon_heiles_k3s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return henon_heiles_k3s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return henon_heiles_k3s2_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = henon_heiles_k3s2_step(&y, hh, prm, &s);
-    if (rc == henon_heiles_k3s2_OK) {
-      sc = 0;
-      for (i = 0; i < henon_heiles_k3s2_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = henon_heiles_k3s2_step_within(x, hh, tol, prm, &s);
+    if (rc == henon_heiles_k3s2_OK || rc == henon_heiles_k3s2_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == henon_heiles_k3s2_OK ? 1 : s.err_est / tol;
+      if (rc == henon_heiles_k3s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < henon_heiles_k3s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == henon_heiles_k3s2_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return henon_heiles_k3s2_OK;
@@ -409,10 +423,13 @@ int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s
     hh *= fac;
     if (fabs(hh) < henon_heiles_k3s2_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != henon_heiles_k3s2_OK ? rc : henon_heiles_k3s2_ENOCONV;
+      return rc != henon_heiles_k3s2_EREJECT ? rc : henon_heiles_k3s2_ENOCONV;
     }
   }
 }

@@ -14,6 +14,7 @@
 #ifndef kepler_k6s2_MAXITER
 #define kepler_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define kepler_k6s2_EREJECT (-1)  /* internal: a step over the tolerance of kepler_k6s2_step_adaptive */
 #ifndef kepler_k6s2_TOL
 #define kepler_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -399,11 +400,11 @@ static double kepler_k6s2_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
+static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, double tol, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k6s2_S * kepler_k6s2_M], sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + 3 * kepler_k6s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k6s2_ENOCONV;
   kepler_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s2_EBADSTEP;
@@ -445,14 +446,17 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
       break;
     }
   }
+  est = kepler_k6s2_err_est(gam, h, d1);
   if (st) {
     st->iters = it > kepler_k6s2_MAXITER ? kepler_k6s2_MAXITER : it;
     st->increment = inc;
-    st->err_est = kepler_k6s2_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != kepler_k6s2_OK) return rc;
+  /* kepler_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s2_ENONFINITE;
   for (i = 0; i < kepler_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k6s2_S * kepler_k6s2_M + i]) ||
@@ -469,6 +473,11 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
   return kepler_k6s2_OK;
 }
 
+int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
+{
+  return kepler_k6s2_step_within(x, h, 0, prm, st);
+}
+
 #ifndef kepler_k6s2_HMIN
 #define kepler_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -476,30 +485,35 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h_, const kepler_k6s
 /* The order of the error estimate's exponent: the step's order 4, plus one. */
 int kepler_k6s2_step_adaptive(kepler_k6s2_state *x, kepler_k6s2_real *h, kepler_k6s2_real tol, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
 {
-  kepler_k6s2_state y;
-  kepler_k6s2_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  kepler_k6s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s2_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = kepler_k6s2_step(&y, hh, prm, &s);
-    if (rc == kepler_k6s2_OK) {
-      sc = 0;
-      for (i = 0; i < kepler_k6s2_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = kepler_k6s2_step_within(x, hh, tol, prm, &s);
+    if (rc == kepler_k6s2_OK || rc == kepler_k6s2_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == kepler_k6s2_OK ? 1 : s.err_est / tol;
+      if (rc == kepler_k6s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < kepler_k6s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == kepler_k6s2_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return kepler_k6s2_OK;
@@ -512,10 +526,13 @@ int kepler_k6s2_step_adaptive(kepler_k6s2_state *x, kepler_k6s2_real *h, kepler_
     hh *= fac;
     if (fabs(hh) < kepler_k6s2_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != kepler_k6s2_OK ? rc : kepler_k6s2_ENOCONV;
+      return rc != kepler_k6s2_EREJECT ? rc : kepler_k6s2_ENOCONV;
     }
   }
 }

@@ -14,6 +14,7 @@
 #ifndef modified_k3s1_MAXITER
 #define modified_k3s1_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define modified_k3s1_EREJECT (-1)  /* internal: a step over the tolerance of modified_k3s1_step_adaptive */
 #ifndef modified_k3s1_TOL
 #define modified_k3s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -439,11 +440,11 @@ static double modified_k3s1_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(3,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modified_k3s1_params *prm, modified_k3s1_stats *st)
+static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real h_, double tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k3s1_ENOCONV;
   modified_k3s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k3s1_EBADSTEP;
@@ -496,14 +497,17 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
       break;
     }
   }
+  est = modified_k3s1_err_est(gam, h, d1);
   if (st) {
     st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it;
     st->increment = inc;
-    st->err_est = modified_k3s1_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != modified_k3s1_OK) return rc;
+  /* modified_k3s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k3s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k3s1_ENONFINITE;
   for (i = 0; i < modified_k3s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k3s1_S * modified_k3s1_M + i]) ||
@@ -520,6 +524,11 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
   return modified_k3s1_OK;
 }
 
+int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modified_k3s1_params *prm, modified_k3s1_stats *st)
+{
+  return modified_k3s1_step_within(x, h, 0, prm, st);
+}
+
 #ifndef modified_k3s1_HMIN
 #define modified_k3s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -527,30 +536,35 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h_, const modi
 /* The order of the error estimate's exponent: the step's order 2, plus one. */
 int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
-  modified_k3s1_state y;
-  modified_k3s1_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  modified_k3s1_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return modified_k3s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k3s1_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = modified_k3s1_step(&y, hh, prm, &s);
-    if (rc == modified_k3s1_OK) {
-      sc = 0;
-      for (i = 0; i < modified_k3s1_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = modified_k3s1_step_within(x, hh, tol, prm, &s);
+    if (rc == modified_k3s1_OK || rc == modified_k3s1_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == modified_k3s1_OK ? 1 : s.err_est / tol;
+      if (rc == modified_k3s1_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < modified_k3s1_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == modified_k3s1_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return modified_k3s1_OK;
@@ -563,10 +577,13 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
     hh *= fac;
     if (fabs(hh) < modified_k3s1_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != modified_k3s1_OK ? rc : modified_k3s1_ENOCONV;
+      return rc != modified_k3s1_EREJECT ? rc : modified_k3s1_ENOCONV;
     }
   }
 }

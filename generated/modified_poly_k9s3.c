@@ -14,6 +14,7 @@
 #ifndef modified_poly_k9s3_MAXITER
 #define modified_poly_k9s3_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define modified_poly_k9s3_EREJECT (-1)  /* internal: a step over the tolerance of modified_poly_k9s3_step_adaptive */
 #ifndef modified_poly_k9s3_TOL
 #define modified_poly_k9s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -2157,11 +2158,11 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
+static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k9s3_ENOCONV;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_poly_k9s3_EBADSTEP;
@@ -2231,14 +2232,17 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
       break;
     }
   }
+  est = modified_poly_k9s3_err_est(gam, h, d1);
   if (st) {
     st->iters = it > modified_poly_k9s3_MAXITER ? modified_poly_k9s3_MAXITER : it;
     st->increment = inc;
-    st->err_est = modified_poly_k9s3_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != modified_poly_k9s3_OK) return rc;
+  /* modified_poly_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return modified_poly_k9s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k9s3_ENONFINITE;
   double q1[modified_poly_k9s3_M], p1[modified_poly_k9s3_M], pr[modified_poly_k9s3_M + 2 + 2 * modified_poly_k9s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k9s3_energy(x, prm);
@@ -2289,6 +2293,11 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
   return modified_poly_k9s3_OK;
 }
 
+int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real h, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
+{
+  return modified_poly_k9s3_step_within(x, h, 0, prm, st);
+}
+
 #ifndef modified_poly_k9s3_HMIN
 #define modified_poly_k9s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -2296,30 +2305,35 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
 /* The order of the error estimate's exponent: the step's order 6, plus one. */
 int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_k9s3_real *h, modified_poly_k9s3_real tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
-  modified_poly_k9s3_state y;
-  modified_poly_k9s3_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  modified_poly_k9s3_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return modified_poly_k9s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_poly_k9s3_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = modified_poly_k9s3_step(&y, hh, prm, &s);
-    if (rc == modified_poly_k9s3_OK) {
-      sc = 0;
-      for (i = 0; i < modified_poly_k9s3_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = modified_poly_k9s3_step_within(x, hh, tol, prm, &s);
+    if (rc == modified_poly_k9s3_OK || rc == modified_poly_k9s3_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == modified_poly_k9s3_OK ? 1 : s.err_est / tol;
+      if (rc == modified_poly_k9s3_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < modified_poly_k9s3_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 7) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == modified_poly_k9s3_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return modified_poly_k9s3_OK;
@@ -2332,10 +2346,13 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
     hh *= fac;
     if (fabs(hh) < modified_poly_k9s3_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != modified_poly_k9s3_OK ? rc : modified_poly_k9s3_ENOCONV;
+      return rc != modified_poly_k9s3_EREJECT ? rc : modified_poly_k9s3_ENOCONV;
     }
   }
 }

@@ -14,6 +14,7 @@
 #ifndef pendulum_poly_k1s1_MAXITER
 #define pendulum_poly_k1s1_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define pendulum_poly_k1s1_EREJECT (-1)  /* internal: a step over the tolerance of pendulum_poly_k1s1_step_adaptive */
 #ifndef pendulum_poly_k1s1_TOL
 #define pendulum_poly_k1s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -401,11 +402,11 @@ static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h_, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
+static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h_, double tol, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M], sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k1s1_ENOCONV;
   pendulum_poly_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k1s1_EBADSTEP;
@@ -475,14 +476,17 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
       break;
     }
   }
+  est = pendulum_poly_k1s1_err_est(gam, h, d1);
   if (st) {
     st->iters = it > pendulum_poly_k1s1_MAXITER ? pendulum_poly_k1s1_MAXITER : it;
     st->increment = inc;
-    st->err_est = pendulum_poly_k1s1_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != pendulum_poly_k1s1_OK) return rc;
+  /* pendulum_poly_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_poly_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k1s1_ENONFINITE;
   double q1[pendulum_poly_k1s1_M], p1[pendulum_poly_k1s1_M], pr[pendulum_poly_k1s1_M + 2 + 2 * pendulum_poly_k1s1_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k1s1_energy(x, prm);
@@ -533,6 +537,11 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
   return pendulum_poly_k1s1_OK;
 }
 
+int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
+{
+  return pendulum_poly_k1s1_step_within(x, h, 0, prm, st);
+}
+
 #ifndef pendulum_poly_k1s1_HMIN
 #define pendulum_poly_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -540,30 +549,35 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
 /* The order of the error estimate's exponent: the step's order 2, plus one. */
 int pendulum_poly_k1s1_step_adaptive(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real *h, pendulum_poly_k1s1_real tol, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
 {
-  pendulum_poly_k1s1_state y;
-  pendulum_poly_k1s1_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  pendulum_poly_k1s1_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k1s1_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = pendulum_poly_k1s1_step(&y, hh, prm, &s);
-    if (rc == pendulum_poly_k1s1_OK) {
-      sc = 0;
-      for (i = 0; i < pendulum_poly_k1s1_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = pendulum_poly_k1s1_step_within(x, hh, tol, prm, &s);
+    if (rc == pendulum_poly_k1s1_OK || rc == pendulum_poly_k1s1_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == pendulum_poly_k1s1_OK ? 1 : s.err_est / tol;
+      if (rc == pendulum_poly_k1s1_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < pendulum_poly_k1s1_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == pendulum_poly_k1s1_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return pendulum_poly_k1s1_OK;
@@ -576,10 +590,13 @@ int pendulum_poly_k1s1_step_adaptive(pendulum_poly_k1s1_state *x, pendulum_poly_
     hh *= fac;
     if (fabs(hh) < pendulum_poly_k1s1_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != pendulum_poly_k1s1_OK ? rc : pendulum_poly_k1s1_ENOCONV;
+      return rc != pendulum_poly_k1s1_EREJECT ? rc : pendulum_poly_k1s1_ENOCONV;
     }
   }
 }

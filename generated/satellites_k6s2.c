@@ -14,6 +14,7 @@
 #ifndef satellites_k6s2_MAXITER
 #define satellites_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define satellites_k6s2_EREJECT (-1)  /* internal: a step over the tolerance of satellites_k6s2_step_adaptive */
 #ifndef satellites_k6s2_TOL
 #define satellites_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -2222,11 +2223,11 @@ static double satellites_k6s2_err_est(const double *gam, double h, double d1)
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h_, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
+static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2_real h_, double tol, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_k6s2_S * satellites_k6s2_M], sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_k6s2_ENOCONV;
   satellites_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_k6s2_EBADSTEP;
@@ -2279,14 +2280,17 @@ int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h_, cons
       break;
     }
   }
+  est = satellites_k6s2_err_est(gam, h, d1);
   if (st) {
     st->iters = it > satellites_k6s2_MAXITER ? satellites_k6s2_MAXITER : it;
     st->increment = inc;
-    st->err_est = satellites_k6s2_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != satellites_k6s2_OK) return rc;
+  /* satellites_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s2_ENONFINITE;
   for (i = 0; i < satellites_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s2_S * satellites_k6s2_M + i]) ||
@@ -2303,6 +2307,11 @@ int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h_, cons
   return satellites_k6s2_OK;
 }
 
+int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
+{
+  return satellites_k6s2_step_within(x, h, 0, prm, st);
+}
+
 #ifndef satellites_k6s2_HMIN
 #define satellites_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -2310,30 +2319,35 @@ int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h_, cons
 /* The order of the error estimate's exponent: the step's order 2, plus one. */
 int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real *h, satellites_k6s2_real tol, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
-  satellites_k6s2_state y;
-  satellites_k6s2_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  satellites_k6s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s2_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = satellites_k6s2_step(&y, hh, prm, &s);
-    if (rc == satellites_k6s2_OK) {
-      sc = 0;
-      for (i = 0; i < satellites_k6s2_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = satellites_k6s2_step_within(x, hh, tol, prm, &s);
+    if (rc == satellites_k6s2_OK || rc == satellites_k6s2_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == satellites_k6s2_OK ? 1 : s.err_est / tol;
+      if (rc == satellites_k6s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < satellites_k6s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == satellites_k6s2_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return satellites_k6s2_OK;
@@ -2346,10 +2360,13 @@ int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real
     hh *= fac;
     if (fabs(hh) < satellites_k6s2_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != satellites_k6s2_OK ? rc : satellites_k6s2_ENOCONV;
+      return rc != satellites_k6s2_EREJECT ? rc : satellites_k6s2_ENOCONV;
     }
   }
 }

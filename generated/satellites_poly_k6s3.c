@@ -14,6 +14,7 @@
 #ifndef satellites_poly_k6s3_MAXITER
 #define satellites_poly_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define satellites_poly_k6s3_EREJECT (-1)  /* internal: a step over the tolerance of satellites_poly_k6s3_step_adaptive */
 #ifndef satellites_poly_k6s3_TOL
 #define satellites_poly_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -8650,11 +8651,11 @@ static double satellites_poly_k6s3_err_est(const double *gam, double h, double d
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, double tol, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale, d1 = 0;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_poly_k6s3_ENOCONV;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s3_EBADSTEP;
@@ -8724,14 +8725,17 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
       break;
     }
   }
+  est = satellites_poly_k6s3_err_est(gam, h, d1);
   if (st) {
     st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it;
     st->increment = inc;
-    st->err_est = satellites_poly_k6s3_err_est(gam, h, d1);
+    st->err_est = est;
     st->h = h;
     st->rejected = 0;
   }
   if (rc != satellites_poly_k6s3_OK) return rc;
+  /* satellites_poly_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_poly_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
   double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 2 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s3_energy(x, prm);
@@ -8782,6 +8786,11 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
   return satellites_poly_k6s3_OK;
 }
 
+int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+{
+  return satellites_poly_k6s3_step_within(x, h, 0, prm, st);
+}
+
 #ifndef satellites_poly_k6s3_HMIN
 #define satellites_poly_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
@@ -8789,30 +8798,35 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
 /* The order of the error estimate's exponent: the step's order 6, plus one. */
 int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real *h, satellites_poly_k6s3_real tol, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
-  satellites_poly_k6s3_state y;
-  satellites_poly_k6s3_stats s = {0, 0, 0, 0, 0};
-  double hh = *h, err, sc, fac, grow = 5;
-  int i, rc, rejected = 0;
+  satellites_poly_k6s3_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_poly_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_poly_k6s3_EBADSTEP;
   for (;;) {
-    y = *x;
-    rc = satellites_poly_k6s3_step(&y, hh, prm, &s);
-    if (rc == satellites_poly_k6s3_OK) {
-      sc = 0;
-      for (i = 0; i < satellites_poly_k6s3_M; i++) {
-        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        if (fabs(y.q[i]) > sc) sc = fabs(y.q[i]);
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    rc = satellites_poly_k6s3_step_within(x, hh, tol, prm, &s);
+    if (rc == satellites_poly_k6s3_OK || rc == satellites_poly_k6s3_EREJECT) {
+      /* the step's error over its tolerance; scaled by tol again, as a step of h */
+      err = rc == satellites_poly_k6s3_OK ? 1 : s.err_est / tol;
+      if (rc == satellites_poly_k6s3_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < satellites_poly_k6s3_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * (1 + sc));
       }
-      err = s.err_est / (tol * (1 + sc));
       fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 7) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
-      if (err <= 1) {
-        *x = y;
+      if (rc == satellites_poly_k6s3_OK) {
         *h = hh * fac;
         if (st) {
-          *st = s;
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
           st->rejected = rejected;
         }
         return satellites_poly_k6s3_OK;
@@ -8825,10 +8839,13 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
     hh *= fac;
     if (fabs(hh) < satellites_poly_k6s3_HMIN * (1 + fabs(x->t))) {
       if (st) {
-        *st = s;
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
         st->rejected = rejected;
       }
-      return rc != satellites_poly_k6s3_OK ? rc : satellites_poly_k6s3_ENOCONV;
+      return rc != satellites_poly_k6s3_EREJECT ? rc : satellites_poly_k6s3_ENOCONV;
     }
   }
 }
