@@ -320,7 +320,9 @@ static void emit_err_est(Emitter *e) {
   else
     out(e, " * max |h gamma_%d|, the Legendre coefficient of degree %d, the order (docs/api.md). */\n", p, p);
   tmpl(e, "#ifndef $P_ERRC\n");
-  out(e, "#define %s_ERRC %.3g  /* measured: docs/api.md */\n#endif\n", e->P, err_constant(e));
+  char c[40];
+  format_real(e, c, sizeof c, err_constant(e));
+  out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
   tmpl(e, p >= s ? "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R c = 0, rho;\n  int i;\n"
                  : "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R c = 0;\n  int i;\n");
   int j = p >= s ? s - 1 : p;

@@ -3998,7 +3998,7 @@ static void double_pendulum_k4s4_add(double *a, double *c, double b)
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * d1 rho^4, rho = min(1, d1 / max |h gamma_3|) (docs/api.md). */
 #ifndef double_pendulum_k4s4_ERRC
-#define double_pendulum_k4s4_ERRC 1.4e-07  /* measured: docs/api.md */
+#define double_pendulum_k4s4_ERRC 1.4000000000000001e-07  /* measured: docs/api.md */
 #endif
 static double double_pendulum_k4s4_err_est(const double *gam, double h, double d1)
 {

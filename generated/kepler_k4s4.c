@@ -398,7 +398,7 @@ static void kepler_k4s4_add(double *a, double *c, double b)
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * d1 rho^4, rho = min(1, d1 / max |h gamma_3|) (docs/api.md). */
 #ifndef kepler_k4s4_ERRC
-#define kepler_k4s4_ERRC 1.4e-07  /* measured: docs/api.md */
+#define kepler_k4s4_ERRC 1.4000000000000001e-07  /* measured: docs/api.md */
 #endif
 static double kepler_k4s4_err_est(const double *gam, double h, double d1)
 {

@@ -329,7 +329,7 @@ static void kepler_k6s1_add(double *a, double *c, double b)
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * d1 rho^1, rho = min(1, d1 / max |h gamma_0|) (docs/api.md). */
 #ifndef kepler_k6s1_ERRC
-#define kepler_k6s1_ERRC 0.068  /* measured: docs/api.md */
+#define kepler_k6s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
 static double kepler_k6s1_err_est(const double *gam, double h, double d1)
 {

@@ -423,7 +423,7 @@ static void modified_k3s1_add(double *a, double *c, double b)
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * d1 rho^1, rho = min(1, d1 / max |h gamma_0|) (docs/api.md). */
 #ifndef modified_k3s1_ERRC
-#define modified_k3s1_ERRC 0.068  /* measured: docs/api.md */
+#define modified_k3s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
 static double modified_k3s1_err_est(const double *gam, double h, double d1)
 {

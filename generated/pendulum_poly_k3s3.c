@@ -835,7 +835,7 @@ static void pendulum_poly_k3s3_add(double *a, double *c, double b)
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * d1 rho^3, rho = min(1, d1 / max |h gamma_2|) (docs/api.md). */
 #ifndef pendulum_poly_k3s3_ERRC
-#define pendulum_poly_k3s3_ERRC 1.4e-06  /* measured: docs/api.md */
+#define pendulum_poly_k3s3_ERRC 1.3999999999999999e-06  /* measured: docs/api.md */
 #endif
 static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1)
 {
