@@ -296,7 +296,7 @@ static int step_order(const Emitter *e) {
 // the problems of tests/check_errest.c (docs/api.md), by s for the order 2s
 // and for the constant multiplier's order 2 (s = 2; s >= 3).
 static double err_constant(const Emitter *e) {
-  static const double order2s[] = {0.068, 1.4e-3, 1.4e-6, 1.4e-7}, order2[] = {0.068, 5.6e-4, 1.5e-3};
+  static const double order2s[] = {0.068, 8.7e-3, 5.1e-4, 2.8e-5}, order2[] = {0.068, 5.6e-4, 1.5e-3};
   int s = e->me->s;
   if (step_order(e) == 2) return order2[s < 3 ? s - 1 : 2];
   return order2s[s < 4 ? s - 1 : 3];
@@ -305,38 +305,41 @@ static double err_constant(const Emitter *e) {
 // NAME_err_est: the local error estimate of a converged step from what the
 // step has anyway (docs/api.md, "The local error estimate"). The Legendre
 // coefficients of the velocity of a smooth solution fall like
-// |gamma_j| ~ |v| rho^j, rho ~ h / (its time scale); the predictor's error d1
-// (the first sweep's increment, h times gamma's change) is the first
-// coefficient the extrapolation lacks, ~ h |v| rho^s, so that
-//   rho = d1 / (h |gamma_{s-1}|),  local error ~ h |v| rho^p = d1 rho^(p-s)
-// for the order p. With p < s (the constant multiplier at s >= 3) the
-// coefficient h |gamma_p| itself is of the order of the local error.
+// |gamma_j| ~ |v| rho^j, rho ~ h / (its time scale), and the local error of
+// the order p is ~ h |v| rho^p. The predictor's error d1 (the first sweep's
+// increment) is the first coefficient the extrapolation lacks,
+// d1 ~ h |v| rho^s, so with v = max |gamma_0| (a norm over the whole vector)
+//   local error ~ h |v| (d1 / |h v|)^(p/s)  (d1^2 / |h v| for p = 2s).
+// Where the velocity vanishes (a pendulum's turning point) this is too large,
+// never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
+// With p < s (the constant multiplier at s >= 3) the coefficient h |gamma_p|
+// itself is of the order of the local error.
 static void emit_err_est(Emitter *e) {
   int p = step_order(e), s = e->me->s;
+  const char *g = math_suffix(e, e->wide_step);
   tmpl(e, "/* The local error estimate of a step (max norm in q) from its converged gamma and\n"
           " * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:\n");
   if (p >= s)
-    out(e, " * d1 rho^%d, rho = min(1, d1 / max |h gamma_%d|) (docs/api.md). */\n", p - s, s - 1);
+    out(e, " * |h v| (d1 / |h v|)^(%d/%d), v = gamma_0 (docs/api.md). */\n", p, s);
   else
     out(e, " * max |h gamma_%d|, the Legendre coefficient of degree %d, the order (docs/api.md). */\n", p, p);
   tmpl(e, "#ifndef $P_ERRC\n");
   char c[40];
   format_real(e, c, sizeof c, err_constant(e));
   out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
-  tmpl(e, p >= s ? "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R c = 0, rho;\n  int i;\n"
-                 : "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R c = 0;\n  int i;\n");
-  int j = p >= s ? s - 1 : p;
-  const char *g = math_suffix(e, e->wide_step);
-  out(e, "  for (i = 0; i < %s_M; i++)\n    if (fabs%s(gam[%d * %s_M + i]) > c) c = (%s)fabs%s(gam[%d * %s_M + i]);\n", e->P, g,
-      j, e->P, real_type(e, 0), g, j, e->P);
+  tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R v = 0, r;\n  int i;\n");
+  int j = p >= s ? 0 : p;
+  out(e, "  for (i = 0; i < %s_M; i++)\n    if (fabs%s(gam[%d * %s_M + i]) > v) v = (%s)fabs%s(gam[%d * %s_M + i]);\n",
+      e->P, g, j, e->P, real_type(e, 0), g, j, e->P);
+  tmpl(e, "  v *= fabs$f(h);\n");
   if (p < s) {
-    tmpl(e, "  (void)d1;\n  return $P_ERRC * fabs$f(h) * c;\n}\n\n");
+    tmpl(e, "  (void)d1;\n  (void)r;\n  return $P_ERRC * v;\n}\n\n");
     return;
   }
-  tmpl(e, "  c *= fabs$f(h);\n  rho = c > d1 ? d1 / c : 1;\n  c = $P_ERRC * d1;\n");
-  if (p > s) out(e, "  for (i = 0; i < %d; i++) c *= rho;\n", p - s);
-  else tmpl(e, "  (void)rho;\n");
-  tmpl(e, "  return c;\n}\n\n");
+  tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
+  /* p is 2s, or 2 at s = 2 (the constant multiplier): p / s is whole */
+  tmpl(e, "  v *= $P_ERRC;\n");
+  out(e, "  for (i = 0; i < %d; i++) v *= r;\n  return v;\n}\n\n", p / s);
 }
 
 // The warm start, iteration and compensated update around the sweep kernel.
@@ -484,32 +487,37 @@ static void emit_step(Emitter *e) {
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
-// NAME_step_adaptive: NAME_step on a copy of the state, accepted when its
-// error estimate is within tol (1 + max|q|) (absolute and relative at
-// once), else retried from the unchanged state with a smaller step; the
-// next step from the standard controller of Hairer, Norsett and Wanner
-// (I.II.4), h (0.9 / err)^(1/(p+1)) within [h/5, 5h], not growing right
-// after a rejection. A failed step is retried with half the step.
+// NAME_step_adaptive: NAME_step with its error estimate tested before the
+// commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
+// and relative at once, so that the errors of the steps up to T add up to
+// about tol T, whatever their number), else retried from the unchanged state
+// with a smaller step. The next step from the standard controller of
+// Hairer, Norsett and Wanner (I.II.4) for an error of order h^p per unit
+// step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
+// rejection. A failed step is retried with half the step.
 static void emit_step_adaptive(Emitter *e) {
   tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
           "  return $P_step_within(x, h, 0, prm, st);\n}\n");
   out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
-  out(e, "/* The order of the error estimate's exponent: the step's order %d, plus one. */\n", step_order(e));
+  out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
+      e->P, e->P, e->single ? "0.01f" : "0.01");
+  out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
           "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
+          "  tol *= $P_TOLC;\n"
           "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
-          "    rc = $P_step_within(x, hh, tol, prm, &s);\n"
+          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), prm, &s);\n"
           "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
-          "      /* the step's error over its tolerance; scaled by tol again, as a step of h */\n"
-          "      err = rc == $P_OK ? 1 : s.err_est / tol;\n");
+          "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
+          "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");
   tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n        int i;\n"
           "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
-          "        err = s.err_est / (tol * (1 + sc));\n      }\n");
+          "        err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n      }\n");
   out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
-      real_type(e, 0), step_order(e) + 1);
+      real_type(e, 0), step_order(e));
   tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n"
           "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"

@@ -120,6 +120,7 @@ START_TEST(tracks_true_error)
   if (getenv("HBVM_ERREST_TABLE"))
     printf("%-16s %-28s h=%-5g steps=%-4d ratio true/est: mean %.3g  min %.3g  max %.3g\n", cases[_i].problem,
            cases[_i].solver, cases[_i].h, r.n, r.mean, r.lo, r.hi);
+  fflush(stdout);
   ck_assert_msg(r.n > 0, "%s: no step above round-off", cases[_i].solver);
   /* the constant multiplier at s >= 2 has an error driven by the multiplier's
    * change, which the velocity's coefficients do not see: not tracked */
@@ -186,8 +187,8 @@ RUN_ADAPTIVE(satellites_poly_k6s3)
 
 static const struct {
   const char *problem;
-  double T, bound; /* error / tol measured over 1e-6..1e-12 (docs/api.md): 1.2e5, 2e3, 1.7e4 */
-} adaptive_cases[] = {{"kepler", 6.283185307179586, 3e5}, {"pendulum", 10, 1e4}, {"satellites", 10, 5e4}};
+  double T;
+} adaptive_cases[] = {{"kepler", 6.283185307179586}, {"pendulum", 10}, {"satellites", 10}};
 
 // The global error at T against tol = 1e-6 .. 1e-12, and the invariants
 // at round-off on every adaptive step.
@@ -210,7 +211,10 @@ START_TEST(adaptive_proportional)
     if (getenv("HBVM_ERREST_TABLE"))
       printf("%-10s tol=%-6g error at T=%.3e (%.3g tol) steps=%ld rejected=%ld max|dH|=%.1e max|g|=%.1e "
              "max|hc|=%.1e\n", problem, tol, a.err, a.err / tol, a.steps, a.rejected, a.dH, a.dg, a.dhc);
-    ck_assert_msg(a.err <= adaptive_cases[_i].bound * tol, "%s, tol %g: error %g", problem, tol, a.err);
+    fflush(stdout);
+    /* tolerance proportionality: within a factor 30 of tol either way (measured
+     * 0.09 to 14, docs/api.md) */
+    ck_assert_msg(a.err <= 30 * tol && a.err >= tol / 30, "%s, tol %g: error %g", problem, tol, a.err);
     ck_assert_double_le(a.dg, 1e-13);
     ck_assert_double_le(a.dhc, 1e-13);
     if (strcmp(problem, "kepler")) ck_assert_double_le(a.dH, 1e-13);
