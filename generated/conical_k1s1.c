@@ -360,21 +360,22 @@ static void conical_k1s1_add(double *a, double *c, double b)
 
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
- * d1 rho^1, rho = min(1, d1 / max |h gamma_0|) (docs/api.md). */
+ * |h v| (d1 / |h v|)^(2/1), v = gamma_0 (docs/api.md). */
 #ifndef conical_k1s1_ERRC
 #define conical_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
 static double conical_k1s1_err_est(const double *gam, double h, double d1)
 {
-  double c = 0, rho;
+  double v = 0, r;
   int i;
   for (i = 0; i < conical_k1s1_M; i++)
-    if (fabs(gam[0 * conical_k1s1_M + i]) > c) c = (double)fabs(gam[0 * conical_k1s1_M + i]);
-  c *= fabs(h);
-  rho = c > d1 ? d1 / c : 1;
-  c = conical_k1s1_ERRC * d1;
-  for (i = 0; i < 1; i++) c *= rho;
-  return c;
+    if (fabs(gam[0 * conical_k1s1_M + i]) > v) v = (double)fabs(gam[0 * conical_k1s1_M + i]);
+  v *= fabs(h);
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= conical_k1s1_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
 }
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
@@ -472,7 +473,11 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_
 #define conical_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 2, plus one. */
+#ifndef conical_k1s1_TOLC
+#define conical_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
 int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, conical_k1s1_real tol, const conical_k1s1_params *prm, conical_k1s1_stats *st)
 {
   conical_k1s1_stats s;
@@ -480,21 +485,22 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k1s1_EBADSTEP;
+  tol *= conical_k1s1_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = conical_k1s1_step_within(x, hh, tol, prm, &s);
+    rc = conical_k1s1_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == conical_k1s1_OK || rc == conical_k1s1_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == conical_k1s1_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == conical_k1s1_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == conical_k1s1_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < conical_k1s1_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == conical_k1s1_OK) {

@@ -479,12 +479,14 @@ static void conical_k4s4_add(double *a, double *c, double b)
 #endif
 static double conical_k4s4_err_est(const double *gam, double h, double d1)
 {
-  double c = 0;
+  double v = 0, r;
   int i;
   for (i = 0; i < conical_k4s4_M; i++)
-    if (fabs(gam[2 * conical_k4s4_M + i]) > c) c = (double)fabs(gam[2 * conical_k4s4_M + i]);
+    if (fabs(gam[2 * conical_k4s4_M + i]) > v) v = (double)fabs(gam[2 * conical_k4s4_M + i]);
+  v *= fabs(h);
   (void)d1;
-  return conical_k4s4_ERRC * fabs(h) * c;
+  (void)r;
+  return conical_k4s4_ERRC * v;
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
@@ -582,7 +584,11 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
 #define conical_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 2, plus one. */
+#ifndef conical_k4s4_TOLC
+#define conical_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
 int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, conical_k4s4_real tol, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   conical_k4s4_stats s;
@@ -590,21 +596,22 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k4s4_EBADSTEP;
+  tol *= conical_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = conical_k4s4_step_within(x, hh, tol, prm, &s);
+    rc = conical_k4s4_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == conical_k4s4_OK || rc == conical_k4s4_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == conical_k4s4_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == conical_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == conical_k4s4_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < conical_k4s4_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == conical_k4s4_OK) {

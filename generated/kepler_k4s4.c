@@ -401,21 +401,22 @@ static void kepler_k4s4_add(double *a, double *c, double b)
 
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
- * d1 rho^4, rho = min(1, d1 / max |h gamma_3|) (docs/api.md). */
+ * |h v| (d1 / |h v|)^(8/4), v = gamma_0 (docs/api.md). */
 #ifndef kepler_k4s4_ERRC
-#define kepler_k4s4_ERRC 1.4000000000000001e-07  /* measured: docs/api.md */
+#define kepler_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
 #endif
 static double kepler_k4s4_err_est(const double *gam, double h, double d1)
 {
-  double c = 0, rho;
+  double v = 0, r;
   int i;
   for (i = 0; i < kepler_k4s4_M; i++)
-    if (fabs(gam[3 * kepler_k4s4_M + i]) > c) c = (double)fabs(gam[3 * kepler_k4s4_M + i]);
-  c *= fabs(h);
-  rho = c > d1 ? d1 / c : 1;
-  c = kepler_k4s4_ERRC * d1;
-  for (i = 0; i < 4; i++) c *= rho;
-  return c;
+    if (fabs(gam[0 * kepler_k4s4_M + i]) > v) v = (double)fabs(gam[0 * kepler_k4s4_M + i]);
+  v *= fabs(h);
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= kepler_k4s4_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
@@ -502,7 +503,11 @@ int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h, const kepler_k4s4
 #define kepler_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 8, plus one. */
+#ifndef kepler_k4s4_TOLC
+#define kepler_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 8 (error per unit step). */
 int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_k4s4_real tol, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
 {
   kepler_k4s4_stats s;
@@ -510,21 +515,22 @@ int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k4s4_EBADSTEP;
+  tol *= kepler_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = kepler_k4s4_step_within(x, hh, tol, prm, &s);
+    rc = kepler_k4s4_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == kepler_k4s4_OK || rc == kepler_k4s4_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == kepler_k4s4_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == kepler_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == kepler_k4s4_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < kepler_k4s4_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 9) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 8) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == kepler_k4s4_OK) {

@@ -807,12 +807,14 @@ static void modified_k9s3_add(double *a, double *c, double b)
 #endif
 static double modified_k9s3_err_est(const double *gam, double h, double d1)
 {
-  double c = 0;
+  double v = 0, r;
   int i;
   for (i = 0; i < modified_k9s3_M; i++)
-    if (fabs(gam[2 * modified_k9s3_M + i]) > c) c = (double)fabs(gam[2 * modified_k9s3_M + i]);
+    if (fabs(gam[2 * modified_k9s3_M + i]) > v) v = (double)fabs(gam[2 * modified_k9s3_M + i]);
+  v *= fabs(h);
   (void)d1;
-  return modified_k9s3_ERRC * fabs(h) * c;
+  (void)r;
+  return modified_k9s3_ERRC * v;
 }
 
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
@@ -910,7 +912,11 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modif
 #define modified_k9s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 2, plus one. */
+#ifndef modified_k9s3_TOLC
+#define modified_k9s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
 int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, modified_k9s3_real tol, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   modified_k9s3_stats s;
@@ -918,21 +924,22 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return modified_k9s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k9s3_EBADSTEP;
+  tol *= modified_k9s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = modified_k9s3_step_within(x, hh, tol, prm, &s);
+    rc = modified_k9s3_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == modified_k9s3_OK || rc == modified_k9s3_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == modified_k9s3_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == modified_k9s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == modified_k9s3_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < modified_k9s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == modified_k9s3_OK) {

@@ -374,12 +374,14 @@ static void pendulum_k3s3_add(double *a, double *c, double b)
 #endif
 static double pendulum_k3s3_err_est(const double *gam, double h, double d1)
 {
-  double c = 0;
+  double v = 0, r;
   int i;
   for (i = 0; i < pendulum_k3s3_M; i++)
-    if (fabs(gam[2 * pendulum_k3s3_M + i]) > c) c = (double)fabs(gam[2 * pendulum_k3s3_M + i]);
+    if (fabs(gam[2 * pendulum_k3s3_M + i]) > v) v = (double)fabs(gam[2 * pendulum_k3s3_M + i]);
+  v *= fabs(h);
   (void)d1;
-  return pendulum_k3s3_ERRC * fabs(h) * c;
+  (void)r;
+  return pendulum_k3s3_ERRC * v;
 }
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
@@ -477,7 +479,11 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h, const pendu
 #define pendulum_k3s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 2, plus one. */
+#ifndef pendulum_k3s3_TOLC
+#define pendulum_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
 int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, pendulum_k3s3_real tol, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
   pendulum_k3s3_stats s;
@@ -485,21 +491,22 @@ int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, p
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k3s3_EBADSTEP;
+  tol *= pendulum_k3s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = pendulum_k3s3_step_within(x, hh, tol, prm, &s);
+    rc = pendulum_k3s3_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == pendulum_k3s3_OK || rc == pendulum_k3s3_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == pendulum_k3s3_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == pendulum_k3s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == pendulum_k3s3_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < pendulum_k3s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == pendulum_k3s3_OK) {

@@ -551,21 +551,22 @@ static void pendulum_poly_k2s2_add(double *a, double *c, double b)
 
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
- * d1 rho^2, rho = min(1, d1 / max |h gamma_1|) (docs/api.md). */
+ * |h v| (d1 / |h v|)^(4/2), v = gamma_0 (docs/api.md). */
 #ifndef pendulum_poly_k2s2_ERRC
-#define pendulum_poly_k2s2_ERRC 0.0014  /* measured: docs/api.md */
+#define pendulum_poly_k2s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
 static double pendulum_poly_k2s2_err_est(const double *gam, double h, double d1)
 {
-  double c = 0, rho;
+  double v = 0, r;
   int i;
   for (i = 0; i < pendulum_poly_k2s2_M; i++)
-    if (fabs(gam[1 * pendulum_poly_k2s2_M + i]) > c) c = (double)fabs(gam[1 * pendulum_poly_k2s2_M + i]);
-  c *= fabs(h);
-  rho = c > d1 ? d1 / c : 1;
-  c = pendulum_poly_k2s2_ERRC * d1;
-  for (i = 0; i < 2; i++) c *= rho;
-  return c;
+    if (fabs(gam[0 * pendulum_poly_k2s2_M + i]) > v) v = (double)fabs(gam[0 * pendulum_poly_k2s2_M + i]);
+  v *= fabs(h);
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= pendulum_poly_k2s2_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
 }
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
@@ -714,7 +715,11 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
 #define pendulum_poly_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 4, plus one. */
+#ifndef pendulum_poly_k2s2_TOLC
+#define pendulum_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 4 (error per unit step). */
 int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real *h, pendulum_poly_k2s2_real tol, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
 {
   pendulum_poly_k2s2_stats s;
@@ -722,21 +727,22 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k2s2_EBADSTEP;
+  tol *= pendulum_poly_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = pendulum_poly_k2s2_step_within(x, hh, tol, prm, &s);
+    rc = pendulum_poly_k2s2_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == pendulum_poly_k2s2_OK || rc == pendulum_poly_k2s2_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == pendulum_poly_k2s2_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == pendulum_poly_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == pendulum_poly_k2s2_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < pendulum_poly_k2s2_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 5) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 4) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == pendulum_poly_k2s2_OK) {

@@ -2702,12 +2702,14 @@ static void satellites_k6s3_add(double *a, double *c, double b)
 #endif
 static double satellites_k6s3_err_est(const double *gam, double h, double d1)
 {
-  double c = 0;
+  double v = 0, r;
   int i;
   for (i = 0; i < satellites_k6s3_M; i++)
-    if (fabs(gam[2 * satellites_k6s3_M + i]) > c) c = (double)fabs(gam[2 * satellites_k6s3_M + i]);
+    if (fabs(gam[2 * satellites_k6s3_M + i]) > v) v = (double)fabs(gam[2 * satellites_k6s3_M + i]);
+  v *= fabs(h);
   (void)d1;
-  return satellites_k6s3_ERRC * fabs(h) * c;
+  (void)r;
+  return satellites_k6s3_ERRC * v;
 }
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
@@ -2805,7 +2807,11 @@ int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h, const
 #define satellites_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
 
-/* The order of the error estimate's exponent: the step's order 2, plus one. */
+#ifndef satellites_k6s3_TOLC
+#define satellites_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
 int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real *h, satellites_k6s3_real tol, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   satellites_k6s3_stats s;
@@ -2813,21 +2819,22 @@ int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real
   int rc, rejected = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s3_EBADSTEP;
+  tol *= satellites_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = satellites_k6s3_step_within(x, hh, tol, prm, &s);
+    rc = satellites_k6s3_step_within(x, hh, tol * fabs(hh), prm, &s);
     if (rc == satellites_k6s3_OK || rc == satellites_k6s3_EREJECT) {
-      /* the step's error over its tolerance; scaled by tol again, as a step of h */
-      err = rc == satellites_k6s3_OK ? 1 : s.err_est / tol;
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == satellites_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == satellites_k6s3_OK) {
         double sc = 0;
         int i;
         for (i = 0; i < satellites_k6s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * (1 + sc));
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 3) : grow;
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == satellites_k6s3_OK) {
