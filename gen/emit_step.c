@@ -312,6 +312,9 @@ static double err_constant(const Emitter *e) {
 //   local error ~ h |v| (d1 / |h v|)^(p/s)  (d1^2 / |h v| for p = 2s).
 // Where the velocity vanishes (a pendulum's turning point) this is too large,
 // never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
+// The first step after NAME_init has no warm start: its predictor (gamma_0 =
+// M^-1 p, the rest 0) lacks the coefficient of degree 1, d1 ~ h |v| rho, and
+// the estimate is h |v| (d1 / |h v|)^p.
 // With p < s (the constant multiplier at s >= 3) the coefficient h |gamma_p|
 // itself is of the order of the local error.
 static void emit_err_est(Emitter *e) {
@@ -327,19 +330,19 @@ static void emit_err_est(Emitter *e) {
   char c[40];
   format_real(e, c, sizeof c, err_constant(e));
   out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
-  tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1)\n{\n  $R v = 0, r;\n  int i;\n");
+  tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v = 0, r;\n  int i;\n");
   int j = p >= s ? 0 : p;
   out(e, "  for (i = 0; i < %s_M; i++)\n    if (fabs%s(gam[%d * %s_M + i]) > v) v = (%s)fabs%s(gam[%d * %s_M + i]);\n",
       e->P, g, j, e->P, real_type(e, 0), g, j, e->P);
   tmpl(e, "  v *= fabs$f(h);\n");
   if (p < s) {
-    tmpl(e, "  (void)d1;\n  (void)r;\n  return $P_ERRC * v;\n}\n\n");
+    tmpl(e, "  (void)d1;\n  (void)r;\n  (void)cold;\n  return $P_ERRC * v;\n}\n\n");
     return;
   }
   tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
   /* p is 2s, or 2 at s = 2 (the constant multiplier): p / s is whole */
   tmpl(e, "  v *= $P_ERRC;\n");
-  out(e, "  for (i = 0; i < %d; i++) v *= r;\n  return v;\n}\n\n", p / s);
+  out(e, "  for (i = 0; i < (cold ? %d : %d); i++) v *= r;\n  return v;\n}\n\n", p, p / s);
 }
 
 // The warm start, iteration and compensated update around the sweep kernel.
@@ -423,7 +426,14 @@ static void emit_step(Emitter *e) {
           "      $R v = fabs$g(h * (sw[$[sweep.gam]i] - gam[i]));\n"
           "      if (v > inc) inc = v;\n"
           "      gam[i] = sw[$[sweep.gam]i];\n    }\n"
-          "    if (it == 1) d1 = inc;  /* the predictor's error, for $P_err_est */\n"
+          "    if (it == 1) {\n      d1 = inc;  /* the predictor's error, for $P_err_est */\n"
+          "      /* $P_step_adaptive: a step the first sweep already puts over the tolerance\n"
+          "       * is rejected here, not after the iteration has converged */\n"
+          "      est = $P_err_est(gam, h, d1, x->hprev == 0);\n"
+          "      if (tol > 0 && !(est <= tol * (1 + scale))) {\n"
+          "        if (st) {\n          st->iters = 1;\n          st->increment = inc;\n"
+          "          st->err_est = est;\n          st->h = h;\n          st->rejected = 0;\n        }\n"
+          "        return $P_EREJECT;\n      }\n    }\n"
           "    if (scale > 0) inc /= scale;\n");
   if (poly)
     tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
@@ -453,7 +463,7 @@ static void emit_step(Emitter *e) {
           "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n"
-          "  est = $P_err_est(gam, h, d1);\n"
+          "  est = $P_err_est(gam, h, d1, x->hprev == 0);\n"
           "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
           "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
