@@ -364,7 +364,7 @@ static void conical_k1s1_add(double *a, double *c, double b)
 #ifndef conical_k1s1_ERRC
 #define conical_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double conical_k1s1_err_est(const double *gam, double h, double d1)
+static double conical_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -374,7 +374,7 @@ static double conical_k1s1_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= conical_k1s1_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
   return v;
 }
 
@@ -410,7 +410,22 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for conical_k1s1_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for conical_k1s1_err_est */
+      /* conical_k1s1_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = conical_k1s1_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return conical_k1s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k1s1_NU; i++) {
       double piv = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + conical_k1s1_NU + i], dia = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 2 * conical_k1s1_NU + i];
@@ -437,7 +452,7 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
       break;
     }
   }
-  est = conical_k1s1_err_est(gam, h, d1);
+  est = conical_k1s1_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > conical_k1s1_MAXITER ? conical_k1s1_MAXITER : it;
     st->increment = inc;

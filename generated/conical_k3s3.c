@@ -440,7 +440,7 @@ static void conical_k3s3_add(double *a, double *c, double b)
 #ifndef conical_k3s3_ERRC
 #define conical_k3s3_ERRC 0.0015  /* measured: docs/api.md */
 #endif
-static double conical_k3s3_err_est(const double *gam, double h, double d1)
+static double conical_k3s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -449,6 +449,7 @@ static double conical_k3s3_err_est(const double *gam, double h, double d1)
   v *= fabs(h);
   (void)d1;
   (void)r;
+  (void)cold;
   return conical_k3s3_ERRC * v;
 }
 
@@ -484,7 +485,22 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for conical_k3s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for conical_k3s3_err_est */
+      /* conical_k3s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = conical_k3s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return conical_k3s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k3s3_NU; i++) {
       double piv = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU + i], dia = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 2 * conical_k3s3_NU + i];
@@ -511,7 +527,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       break;
     }
   }
-  est = conical_k3s3_err_est(gam, h, d1);
+  est = conical_k3s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > conical_k3s3_MAXITER ? conical_k3s3_MAXITER : it;
     st->increment = inc;

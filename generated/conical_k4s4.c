@@ -477,7 +477,7 @@ static void conical_k4s4_add(double *a, double *c, double b)
 #ifndef conical_k4s4_ERRC
 #define conical_k4s4_ERRC 0.0015  /* measured: docs/api.md */
 #endif
-static double conical_k4s4_err_est(const double *gam, double h, double d1)
+static double conical_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -486,6 +486,7 @@ static double conical_k4s4_err_est(const double *gam, double h, double d1)
   v *= fabs(h);
   (void)d1;
   (void)r;
+  (void)cold;
   return conical_k4s4_ERRC * v;
 }
 
@@ -521,7 +522,22 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for conical_k4s4_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for conical_k4s4_err_est */
+      /* conical_k4s4_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = conical_k4s4_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return conical_k4s4_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k4s4_NU; i++) {
       double piv = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + conical_k4s4_NU + i], dia = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + 2 * conical_k4s4_NU + i];
@@ -548,7 +564,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
       break;
     }
   }
-  est = conical_k4s4_err_est(gam, h, d1);
+  est = conical_k4s4_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > conical_k4s4_MAXITER ? conical_k4s4_MAXITER : it;
     st->increment = inc;

@@ -687,7 +687,7 @@ static void conical_poly_k2s2_add(double *a, double *c, double b)
 #ifndef conical_poly_k2s2_ERRC
 #define conical_poly_k2s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
-static double conical_poly_k2s2_err_est(const double *gam, double h, double d1)
+static double conical_poly_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -697,7 +697,7 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= conical_poly_k2s2_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 4 : 2); i++) v *= r;
   return v;
 }
 
@@ -756,7 +756,22 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for conical_poly_k2s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for conical_poly_k2s2_err_est */
+      /* conical_poly_k2s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = conical_poly_k2s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return conical_poly_k2s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + i];
     for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
@@ -777,7 +792,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
       break;
     }
   }
-  est = conical_poly_k2s2_err_est(gam, h, d1);
+  est = conical_poly_k2s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > conical_poly_k2s2_MAXITER ? conical_poly_k2s2_MAXITER : it;
     st->increment = inc;

@@ -594,7 +594,7 @@ static void double_pendulum_const_k2s2_add(double *a, double *c, double b)
 #ifndef double_pendulum_const_k2s2_ERRC
 #define double_pendulum_const_k2s2_ERRC 0.00055999999999999995  /* measured: docs/api.md */
 #endif
-static double double_pendulum_const_k2s2_err_est(const double *gam, double h, double d1)
+static double double_pendulum_const_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -604,7 +604,7 @@ static double double_pendulum_const_k2s2_err_est(const double *gam, double h, do
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= double_pendulum_const_k2s2_ERRC;
-  for (i = 0; i < 1; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 1); i++) v *= r;
   return v;
 }
 
@@ -640,7 +640,22 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_const_k2s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for double_pendulum_const_k2s2_err_est */
+      /* double_pendulum_const_k2s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = double_pendulum_const_k2s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return double_pendulum_const_k2s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < double_pendulum_const_k2s2_NU; i++) {
       double piv = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
@@ -667,7 +682,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       break;
     }
   }
-  est = double_pendulum_const_k2s2_err_est(gam, h, d1);
+  est = double_pendulum_const_k2s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_const_k2s2_MAXITER ? double_pendulum_const_k2s2_MAXITER : it;
     st->increment = inc;

@@ -1140,7 +1140,7 @@ static void double_pendulum_k2s2_add(double *a, double *c, double b)
 #ifndef double_pendulum_k2s2_ERRC
 #define double_pendulum_k2s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
-static double double_pendulum_k2s2_err_est(const double *gam, double h, double d1)
+static double double_pendulum_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -1150,7 +1150,7 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= double_pendulum_k2s2_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 4 : 2); i++) v *= r;
   return v;
 }
 
@@ -1209,7 +1209,22 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k2s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for double_pendulum_k2s2_err_est */
+      /* double_pendulum_k2s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = double_pendulum_k2s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return double_pendulum_k2s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + i];
     for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
@@ -1230,7 +1245,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
       break;
     }
   }
-  est = double_pendulum_k2s2_err_est(gam, h, d1);
+  est = double_pendulum_k2s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it;
     st->increment = inc;

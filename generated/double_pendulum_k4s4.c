@@ -4000,7 +4000,7 @@ static void double_pendulum_k4s4_add(double *a, double *c, double b)
 #ifndef double_pendulum_k4s4_ERRC
 #define double_pendulum_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
 #endif
-static double double_pendulum_k4s4_err_est(const double *gam, double h, double d1)
+static double double_pendulum_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -4010,7 +4010,7 @@ static double double_pendulum_k4s4_err_est(const double *gam, double h, double d
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= double_pendulum_k4s4_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 8 : 2); i++) v *= r;
   return v;
 }
 
@@ -4069,7 +4069,22 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k4s4_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for double_pendulum_k4s4_err_est */
+      /* double_pendulum_k4s4_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = double_pendulum_k4s4_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return double_pendulum_k4s4_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + i];
     for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++)
@@ -4090,7 +4105,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
       break;
     }
   }
-  est = double_pendulum_k4s4_err_est(gam, h, d1);
+  est = double_pendulum_k4s4_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_k4s4_MAXITER ? double_pendulum_k4s4_MAXITER : it;
     st->increment = inc;

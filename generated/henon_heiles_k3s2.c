@@ -282,7 +282,7 @@ static void henon_heiles_k3s2_add(double *a, double *c, double b)
 #ifndef henon_heiles_k3s2_ERRC
 #define henon_heiles_k3s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
-static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1)
+static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -292,7 +292,7 @@ static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= henon_heiles_k3s2_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 4 : 2); i++) v *= r;
   return v;
 }
 
@@ -322,7 +322,22 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for henon_heiles_k3s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for henon_heiles_k3s2_err_est */
+      /* henon_heiles_k3s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = henon_heiles_k3s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return henon_heiles_k3s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + henon_heiles_k3s2_NU; i++)
       if (!isfinite(sw[i])) rc = henon_heiles_k3s2_ENONFINITE;
@@ -344,7 +359,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       break;
     }
   }
-  est = henon_heiles_k3s2_err_est(gam, h, d1);
+  est = henon_heiles_k3s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it;
     st->increment = inc;

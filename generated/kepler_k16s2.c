@@ -699,7 +699,7 @@ static void kepler_k16s2_add(double *a, double *c, double b)
 #ifndef kepler_k16s2_ERRC
 #define kepler_k16s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
-static double kepler_k16s2_err_est(const double *gam, double h, double d1)
+static double kepler_k16s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -709,7 +709,7 @@ static double kepler_k16s2_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= kepler_k16s2_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 4 : 2); i++) v *= r;
   return v;
 }
 
@@ -739,7 +739,22 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k16s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for kepler_k16s2_err_est */
+      /* kepler_k16s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = kepler_k16s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return kepler_k16s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + kepler_k16s2_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k16s2_ENONFINITE;
@@ -761,7 +776,7 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       break;
     }
   }
-  est = kepler_k16s2_err_est(gam, h, d1);
+  est = kepler_k16s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it;
     st->increment = inc;

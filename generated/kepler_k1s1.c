@@ -209,7 +209,7 @@ static void kepler_k1s1_add(double *a, double *c, double b)
 #ifndef kepler_k1s1_ERRC
 #define kepler_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double kepler_k1s1_err_est(const double *gam, double h, double d1)
+static double kepler_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -219,7 +219,7 @@ static double kepler_k1s1_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= kepler_k1s1_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
   return v;
 }
 
@@ -249,7 +249,22 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k1s1_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for kepler_k1s1_err_est */
+      /* kepler_k1s1_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = kepler_k1s1_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return kepler_k1s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + kepler_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k1s1_ENONFINITE;
@@ -271,7 +286,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
       break;
     }
   }
-  est = kepler_k1s1_err_est(gam, h, d1);
+  est = kepler_k1s1_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k1s1_MAXITER ? kepler_k1s1_MAXITER : it;
     st->increment = inc;

@@ -405,7 +405,7 @@ static void kepler_k4s4_add(double *a, double *c, double b)
 #ifndef kepler_k4s4_ERRC
 #define kepler_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
 #endif
-static double kepler_k4s4_err_est(const double *gam, double h, double d1)
+static double kepler_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -415,7 +415,7 @@ static double kepler_k4s4_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= kepler_k4s4_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 8 : 2); i++) v *= r;
   return v;
 }
 
@@ -445,7 +445,22 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k4s4_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for kepler_k4s4_err_est */
+      /* kepler_k4s4_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = kepler_k4s4_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return kepler_k4s4_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_M + kepler_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k4s4_ENONFINITE;
@@ -467,7 +482,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       break;
     }
   }
-  est = kepler_k4s4_err_est(gam, h, d1);
+  est = kepler_k4s4_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k4s4_MAXITER ? kepler_k4s4_MAXITER : it;
     st->increment = inc;

@@ -425,7 +425,7 @@ static void modified_k3s1_add(double *a, double *c, double b)
 #ifndef modified_k3s1_ERRC
 #define modified_k3s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double modified_k3s1_err_est(const double *gam, double h, double d1)
+static double modified_k3s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -435,7 +435,7 @@ static double modified_k3s1_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= modified_k3s1_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
   return v;
 }
 
@@ -471,7 +471,22 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for modified_k3s1_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for modified_k3s1_err_est */
+      /* modified_k3s1_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = modified_k3s1_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return modified_k3s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k3s1_NU; i++) {
       double piv = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU + i], dia = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 2 * modified_k3s1_NU + i];
@@ -498,7 +513,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       break;
     }
   }
-  est = modified_k3s1_err_est(gam, h, d1);
+  est = modified_k3s1_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it;
     st->increment = inc;

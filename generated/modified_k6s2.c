@@ -588,7 +588,7 @@ static void modified_k6s2_add(double *a, double *c, double b)
 #ifndef modified_k6s2_ERRC
 #define modified_k6s2_ERRC 0.00055999999999999995  /* measured: docs/api.md */
 #endif
-static double modified_k6s2_err_est(const double *gam, double h, double d1)
+static double modified_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -598,7 +598,7 @@ static double modified_k6s2_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= modified_k6s2_ERRC;
-  for (i = 0; i < 1; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 1); i++) v *= r;
   return v;
 }
 
@@ -634,7 +634,22 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for modified_k6s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for modified_k6s2_err_est */
+      /* modified_k6s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = modified_k6s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return modified_k6s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k6s2_NU; i++) {
       double piv = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU + i], dia = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 2 * modified_k6s2_NU + i];
@@ -661,7 +676,7 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
       break;
     }
   }
-  est = modified_k6s2_err_est(gam, h, d1);
+  est = modified_k6s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > modified_k6s2_MAXITER ? modified_k6s2_MAXITER : it;
     st->increment = inc;

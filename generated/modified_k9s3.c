@@ -805,7 +805,7 @@ static void modified_k9s3_add(double *a, double *c, double b)
 #ifndef modified_k9s3_ERRC
 #define modified_k9s3_ERRC 0.0015  /* measured: docs/api.md */
 #endif
-static double modified_k9s3_err_est(const double *gam, double h, double d1)
+static double modified_k9s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -814,6 +814,7 @@ static double modified_k9s3_err_est(const double *gam, double h, double d1)
   v *= fabs(h);
   (void)d1;
   (void)r;
+  (void)cold;
   return modified_k9s3_ERRC * v;
 }
 
@@ -849,7 +850,22 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for modified_k9s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for modified_k9s3_err_est */
+      /* modified_k9s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = modified_k9s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return modified_k9s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k9s3_NU; i++) {
       double piv = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU + i], dia = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 2 * modified_k9s3_NU + i];
@@ -876,7 +892,7 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
       break;
     }
   }
-  est = modified_k9s3_err_est(gam, h, d1);
+  est = modified_k9s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > modified_k9s3_MAXITER ? modified_k9s3_MAXITER : it;
     st->increment = inc;

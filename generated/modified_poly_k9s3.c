@@ -2143,7 +2143,7 @@ static void modified_poly_k9s3_add(double *a, double *c, double b)
 #ifndef modified_poly_k9s3_ERRC
 #define modified_poly_k9s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
-static double modified_poly_k9s3_err_est(const double *gam, double h, double d1)
+static double modified_poly_k9s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -2153,7 +2153,7 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= modified_poly_k9s3_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 6 : 2); i++) v *= r;
   return v;
 }
 
@@ -2212,7 +2212,22 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for modified_poly_k9s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for modified_poly_k9s3_err_est */
+      /* modified_poly_k9s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = modified_poly_k9s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return modified_poly_k9s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + i];
     for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU; i++)
@@ -2233,7 +2248,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
       break;
     }
   }
-  est = modified_poly_k9s3_err_est(gam, h, d1);
+  est = modified_poly_k9s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > modified_poly_k9s3_MAXITER ? modified_poly_k9s3_MAXITER : it;
     st->increment = inc;

@@ -278,7 +278,7 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
 #ifndef pendulum_angle_k6s3_ERRC
 #define pendulum_angle_k6s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
-static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1)
+static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -288,7 +288,7 @@ static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_angle_k6s3_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 6 : 2); i++) v *= r;
   return v;
 }
 
@@ -318,7 +318,22 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
+      /* pendulum_angle_k6s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_angle_k6s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_angle_k6s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_angle_k6s3_ENONFINITE;
@@ -340,7 +355,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       break;
     }
   }
-  est = pendulum_angle_k6s3_err_est(gam, h, d1);
+  est = pendulum_angle_k6s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it;
     st->increment = inc;

@@ -320,7 +320,7 @@ static void pendulum_k1s1_add(double *a, double *c, double b)
 #ifndef pendulum_k1s1_ERRC
 #define pendulum_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double pendulum_k1s1_err_est(const double *gam, double h, double d1)
+static double pendulum_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -330,7 +330,7 @@ static double pendulum_k1s1_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_k1s1_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
   return v;
 }
 
@@ -366,7 +366,22 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
+      /* pendulum_k1s1_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_k1s1_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_k1s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k1s1_NU; i++) {
       double piv = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
@@ -393,7 +408,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       break;
     }
   }
-  est = pendulum_k1s1_err_est(gam, h, d1);
+  est = pendulum_k1s1_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it;
     st->increment = inc;

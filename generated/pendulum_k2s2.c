@@ -347,7 +347,7 @@ static void pendulum_k2s2_add(double *a, double *c, double b)
 #ifndef pendulum_k2s2_ERRC
 #define pendulum_k2s2_ERRC 0.00055999999999999995  /* measured: docs/api.md */
 #endif
-static double pendulum_k2s2_err_est(const double *gam, double h, double d1)
+static double pendulum_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -357,7 +357,7 @@ static double pendulum_k2s2_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_k2s2_ERRC;
-  for (i = 0; i < 1; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 1); i++) v *= r;
   return v;
 }
 
@@ -393,7 +393,22 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k2s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_k2s2_err_est */
+      /* pendulum_k2s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_k2s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_k2s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k2s2_NU; i++) {
       double piv = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU + i], dia = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 2 * pendulum_k2s2_NU + i];
@@ -420,7 +435,7 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       break;
     }
   }
-  est = pendulum_k2s2_err_est(gam, h, d1);
+  est = pendulum_k2s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_k2s2_MAXITER ? pendulum_k2s2_MAXITER : it;
     st->increment = inc;

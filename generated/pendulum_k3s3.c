@@ -372,7 +372,7 @@ static void pendulum_k3s3_add(double *a, double *c, double b)
 #ifndef pendulum_k3s3_ERRC
 #define pendulum_k3s3_ERRC 0.0015  /* measured: docs/api.md */
 #endif
-static double pendulum_k3s3_err_est(const double *gam, double h, double d1)
+static double pendulum_k3s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -381,6 +381,7 @@ static double pendulum_k3s3_err_est(const double *gam, double h, double d1)
   v *= fabs(h);
   (void)d1;
   (void)r;
+  (void)cold;
   return pendulum_k3s3_ERRC * v;
 }
 
@@ -416,7 +417,22 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k3s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_k3s3_err_est */
+      /* pendulum_k3s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_k3s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_k3s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k3s3_NU; i++) {
       double piv = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + pendulum_k3s3_NU + i], dia = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 2 * pendulum_k3s3_NU + i];
@@ -443,7 +459,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       break;
     }
   }
-  est = pendulum_k3s3_err_est(gam, h, d1);
+  est = pendulum_k3s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_k3s3_MAXITER ? pendulum_k3s3_MAXITER : it;
     st->increment = inc;

@@ -387,7 +387,7 @@ static void pendulum_poly_k1s1_add(double *a, double *c, double b)
 #ifndef pendulum_poly_k1s1_ERRC
 #define pendulum_poly_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1)
+static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -397,7 +397,7 @@ static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_poly_k1s1_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
   return v;
 }
 
@@ -456,7 +456,22 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k1s1_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_poly_k1s1_err_est */
+      /* pendulum_poly_k1s1_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_poly_k1s1_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_poly_k1s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++) lam[i] = sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + i];
     for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++)
@@ -477,7 +492,7 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
       break;
     }
   }
-  est = pendulum_poly_k1s1_err_est(gam, h, d1);
+  est = pendulum_poly_k1s1_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_poly_k1s1_MAXITER ? pendulum_poly_k1s1_MAXITER : it;
     st->increment = inc;

@@ -837,7 +837,7 @@ static void pendulum_poly_k3s3_add(double *a, double *c, double b)
 #ifndef pendulum_poly_k3s3_ERRC
 #define pendulum_poly_k3s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
-static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1)
+static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -847,7 +847,7 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_poly_k3s3_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 6 : 2); i++) v *= r;
   return v;
 }
 
@@ -906,7 +906,22 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k3s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_poly_k3s3_err_est */
+      /* pendulum_poly_k3s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_poly_k3s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_poly_k3s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + i];
     for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++)
@@ -927,7 +942,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
       break;
     }
   }
-  est = pendulum_poly_k3s3_err_est(gam, h, d1);
+  est = pendulum_poly_k3s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_poly_k3s3_MAXITER ? pendulum_poly_k3s3_MAXITER : it;
     st->increment = inc;

@@ -1386,7 +1386,7 @@ static void pendulum_poly_k4s4_add(double *a, double *c, double b)
 #ifndef pendulum_poly_k4s4_ERRC
 #define pendulum_poly_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
 #endif
-static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1)
+static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -1396,7 +1396,7 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_poly_k4s4_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 8 : 2); i++) v *= r;
   return v;
 }
 
@@ -1455,7 +1455,22 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
+      /* pendulum_poly_k4s4_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = pendulum_poly_k4s4_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_poly_k4s4_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + i];
     for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
@@ -1476,7 +1491,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
       break;
     }
   }
-  est = pendulum_poly_k4s4_err_est(gam, h, d1);
+  est = pendulum_poly_k4s4_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it;
     st->increment = inc;

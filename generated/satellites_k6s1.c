@@ -1731,7 +1731,7 @@ static void satellites_k6s1_add(double *a, double *c, double b)
 #ifndef satellites_k6s1_ERRC
 #define satellites_k6s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double satellites_k6s1_err_est(const double *gam, double h, double d1)
+static double satellites_k6s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -1741,7 +1741,7 @@ static double satellites_k6s1_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= satellites_k6s1_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
   return v;
 }
 
@@ -1777,7 +1777,22 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s1_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for satellites_k6s1_err_est */
+      /* satellites_k6s1_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = satellites_k6s1_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return satellites_k6s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s1_NU; i++) {
       double piv = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + satellites_k6s1_NU + i], dia = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 2 * satellites_k6s1_NU + i];
@@ -1804,7 +1819,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       break;
     }
   }
-  est = satellites_k6s1_err_est(gam, h, d1);
+  est = satellites_k6s1_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > satellites_k6s1_MAXITER ? satellites_k6s1_MAXITER : it;
     st->increment = inc;

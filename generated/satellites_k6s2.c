@@ -2208,7 +2208,7 @@ static void satellites_k6s2_add(double *a, double *c, double b)
 #ifndef satellites_k6s2_ERRC
 #define satellites_k6s2_ERRC 0.00055999999999999995  /* measured: docs/api.md */
 #endif
-static double satellites_k6s2_err_est(const double *gam, double h, double d1)
+static double satellites_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -2218,7 +2218,7 @@ static double satellites_k6s2_err_est(const double *gam, double h, double d1)
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= satellites_k6s2_ERRC;
-  for (i = 0; i < 1; i++) v *= r;
+  for (i = 0; i < (cold ? 2 : 1); i++) v *= r;
   return v;
 }
 
@@ -2254,7 +2254,22 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for satellites_k6s2_err_est */
+      /* satellites_k6s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = satellites_k6s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return satellites_k6s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s2_NU; i++) {
       double piv = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU + i], dia = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 2 * satellites_k6s2_NU + i];
@@ -2281,7 +2296,7 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
       break;
     }
   }
-  est = satellites_k6s2_err_est(gam, h, d1);
+  est = satellites_k6s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > satellites_k6s2_MAXITER ? satellites_k6s2_MAXITER : it;
     st->increment = inc;

@@ -2700,7 +2700,7 @@ static void satellites_k6s3_add(double *a, double *c, double b)
 #ifndef satellites_k6s3_ERRC
 #define satellites_k6s3_ERRC 0.0015  /* measured: docs/api.md */
 #endif
-static double satellites_k6s3_err_est(const double *gam, double h, double d1)
+static double satellites_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -2709,6 +2709,7 @@ static double satellites_k6s3_err_est(const double *gam, double h, double d1)
   v *= fabs(h);
   (void)d1;
   (void)r;
+  (void)cold;
   return satellites_k6s3_ERRC * v;
 }
 
@@ -2744,7 +2745,22 @@ static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s3_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for satellites_k6s3_err_est */
+      /* satellites_k6s3_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = satellites_k6s3_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return satellites_k6s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s3_NU; i++) {
       double piv = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + satellites_k6s3_NU + i], dia = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 2 * satellites_k6s3_NU + i];
@@ -2771,7 +2787,7 @@ static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3
       break;
     }
   }
-  est = satellites_k6s3_err_est(gam, h, d1);
+  est = satellites_k6s3_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > satellites_k6s3_MAXITER ? satellites_k6s3_MAXITER : it;
     st->increment = inc;

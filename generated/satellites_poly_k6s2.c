@@ -4968,7 +4968,7 @@ static void satellites_poly_k6s2_add(double *a, double *c, double b)
 #ifndef satellites_poly_k6s2_ERRC
 #define satellites_poly_k6s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
-static double satellites_poly_k6s2_err_est(const double *gam, double h, double d1)
+static double satellites_poly_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v = 0, r;
   int i;
@@ -4978,7 +4978,7 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= satellites_poly_k6s2_ERRC;
-  for (i = 0; i < 2; i++) v *= r;
+  for (i = 0; i < (cold ? 4 : 2); i++) v *= r;
   return v;
 }
 
@@ -5037,7 +5037,22 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) d1 = inc;  /* the predictor's error, for satellites_poly_k6s2_err_est */
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for satellites_poly_k6s2_err_est */
+      /* satellites_poly_k6s2_step_adaptive: a step the first sweep already puts over the tolerance
+       * is rejected here, not after the iteration has converged */
+      est = satellites_poly_k6s2_err_est(gam, h, d1, x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return satellites_poly_k6s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + i];
     for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++)
@@ -5058,7 +5073,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
       break;
     }
   }
-  est = satellites_poly_k6s2_err_est(gam, h, d1);
+  est = satellites_poly_k6s2_err_est(gam, h, d1, x->hprev == 0);
   if (st) {
     st->iters = it > satellites_poly_k6s2_MAXITER ? satellites_poly_k6s2_MAXITER : it;
     st->increment = inc;
