@@ -312,14 +312,19 @@ static double err_constant(const Emitter *e) {
 //   local error ~ h |v| (d1 / |h v|)^(p/s)  (d1^2 / |h v| for p = 2s).
 // Where the velocity vanishes (a pendulum's turning point) this is too large,
 // never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
-// The first step after NAME_init has no warm start: its predictor (gamma_0 =
-// M^-1 p, the rest 0) lacks the coefficient of degree 1, d1 ~ h |v| rho, and
-// the estimate is h |v| (d1 / |h v|)^p.
+// The first step after NAME_init has no warm start (its predictor is
+// gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
+// is the whole velocity): there, at s >= 2, rho is the decay of the two
+// highest coefficients, and the estimate h |gamma_{s-1}| rho^(p-s+1).
 // With p < s (the constant multiplier at s >= 3) the coefficient h |gamma_p|
 // itself is of the order of the local error.
 static void emit_err_est(Emitter *e) {
   int p = step_order(e), s = e->me->s;
   const char *g = math_suffix(e, e->wide_step);
+  tmpl(e, "/* max |gamma_j| over the coordinates */\n"
+          "static $R $P_coef(const $W *gam, int j)\n{\n  $R c = 0;\n  int i;\n  for (i = 0; i < $P_M; i++)\n");
+  out(e, "    if (fabs%s(gam[j * %s_M + i]) > c) c = (%s)fabs%s(gam[j * %s_M + i]);\n  return c;\n}\n\n", g, e->P,
+      real_type(e, 0), g, e->P);
   tmpl(e, "/* The local error estimate of a step (max norm in q) from its converged gamma and\n"
           " * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:\n");
   if (p >= s)
@@ -330,19 +335,24 @@ static void emit_err_est(Emitter *e) {
   char c[40];
   format_real(e, c, sizeof c, err_constant(e));
   out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
-  tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v = 0, r;\n  int i;\n");
-  int j = p >= s ? 0 : p;
-  out(e, "  for (i = 0; i < %s_M; i++)\n    if (fabs%s(gam[%d * %s_M + i]) > v) v = (%s)fabs%s(gam[%d * %s_M + i]);\n",
-      e->P, g, j, e->P, real_type(e, 0), g, j, e->P);
-  tmpl(e, "  v *= fabs$f(h);\n");
+  tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v, r;\n  int i;\n");
   if (p < s) {
-    tmpl(e, "  (void)d1;\n  (void)r;\n  (void)cold;\n  return $P_ERRC * v;\n}\n\n");
+    out(e, "  (void)d1;\n  (void)v;\n  (void)r;\n  (void)i;\n  (void)cold;\n  return %s_ERRC * fabs%s(h) * %s_coef(gam, %d);\n}\n\n",
+        e->P, math_suffix(e, 0), e->P, p);
     return;
   }
-  tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
+  if (s >= 2) {
+    out(e, "  if (cold) {  /* no warm start: the decay of the two highest coefficients */\n"
+           "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d);\n", real_type(e, 0), e->P, s - 1, e->P, s - 2);
+    tmpl(e, "    if (!(b > c)) return c > 0 ? d1 : 0;\n    r = c / b;\n    v = $P_ERRC * fabs$f(h) * c;\n");
+    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v;\n  }\n", p - s + 1);
+  } else
+    tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");
+  tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n"
+          "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
   /* p is 2s, or 2 at s = 2 (the constant multiplier): p / s is whole */
   tmpl(e, "  v *= $P_ERRC;\n");
-  out(e, "  for (i = 0; i < (cold ? %d : %d); i++) v *= r;\n  return v;\n}\n\n", p, p / s);
+  out(e, "  for (i = 0; i < %d; i++) v *= r;\n  return v;\n}\n\n", p / s);
 }
 
 // The warm start, iteration and compensated update around the sweep kernel.
