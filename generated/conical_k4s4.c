@@ -471,6 +471,16 @@ static void conical_k4s4_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double conical_k4s4_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < conical_k4s4_M; i++)
+    if (fabs(gam[j * conical_k4s4_M + i]) > c) c = (double)fabs(gam[j * conical_k4s4_M + i]);
+  return c;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * max |h gamma_2|, the Legendre coefficient of degree 2, the order (docs/api.md). */
@@ -479,15 +489,14 @@ static void conical_k4s4_add(double *a, double *c, double b)
 #endif
 static double conical_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
-  double v = 0, r;
+  double v, r;
   int i;
-  for (i = 0; i < conical_k4s4_M; i++)
-    if (fabs(gam[2 * conical_k4s4_M + i]) > v) v = (double)fabs(gam[2 * conical_k4s4_M + i]);
-  v *= fabs(h);
   (void)d1;
+  (void)v;
   (void)r;
+  (void)i;
   (void)cold;
-  return conical_k4s4_ERRC * v;
+  return conical_k4s4_ERRC * fabs(h) * conical_k4s4_coef(gam, 2);
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off

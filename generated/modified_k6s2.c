@@ -582,6 +582,16 @@ static void modified_k6s2_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double modified_k6s2_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < modified_k6s2_M; i++)
+    if (fabs(gam[j * modified_k6s2_M + i]) > c) c = (double)fabs(gam[j * modified_k6s2_M + i]);
+  return c;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(2/2), v = gamma_0 (docs/api.md). */
@@ -590,15 +600,21 @@ static void modified_k6s2_add(double *a, double *c, double b)
 #endif
 static double modified_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
-  double v = 0, r;
+  double v, r;
   int i;
-  for (i = 0; i < modified_k6s2_M; i++)
-    if (fabs(gam[0 * modified_k6s2_M + i]) > v) v = (double)fabs(gam[0 * modified_k6s2_M + i]);
-  v *= fabs(h);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients */
+    double c = modified_k6s2_coef(gam, 1), b = modified_k6s2_coef(gam, 0);
+    if (!(b > c)) return c > 0 ? d1 : 0;
+    r = c / b;
+    v = modified_k6s2_ERRC * fabs(h) * c;
+    for (i = 0; i < 1; i++) v *= r;
+    return v;
+  }
+  v = fabs(h) * modified_k6s2_coef(gam, 0);
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= modified_k6s2_ERRC;
-  for (i = 0; i < (cold ? 2 : 1); i++) v *= r;
+  for (i = 0; i < 1; i++) v *= r;
   return v;
 }
 

@@ -272,6 +272,16 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double pendulum_angle_k6s3_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++)
+    if (fabs(gam[j * pendulum_angle_k6s3_M + i]) > c) c = (double)fabs(gam[j * pendulum_angle_k6s3_M + i]);
+  return c;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(6/3), v = gamma_0 (docs/api.md). */
@@ -280,15 +290,21 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
 #endif
 static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
-  double v = 0, r;
+  double v, r;
   int i;
-  for (i = 0; i < pendulum_angle_k6s3_M; i++)
-    if (fabs(gam[0 * pendulum_angle_k6s3_M + i]) > v) v = (double)fabs(gam[0 * pendulum_angle_k6s3_M + i]);
-  v *= fabs(h);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients */
+    double c = pendulum_angle_k6s3_coef(gam, 2), b = pendulum_angle_k6s3_coef(gam, 1);
+    if (!(b > c)) return c > 0 ? d1 : 0;
+    r = c / b;
+    v = pendulum_angle_k6s3_ERRC * fabs(h) * c;
+    for (i = 0; i < 4; i++) v *= r;
+    return v;
+  }
+  v = fabs(h) * pendulum_angle_k6s3_coef(gam, 0);
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_angle_k6s3_ERRC;
-  for (i = 0; i < (cold ? 6 : 2); i++) v *= r;
+  for (i = 0; i < 2; i++) v *= r;
   return v;
 }
 

@@ -381,6 +381,16 @@ static void pendulum_poly_k1s1_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double pendulum_poly_k1s1_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < pendulum_poly_k1s1_M; i++)
+    if (fabs(gam[j * pendulum_poly_k1s1_M + i]) > c) c = (double)fabs(gam[j * pendulum_poly_k1s1_M + i]);
+  return c;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(2/1), v = gamma_0 (docs/api.md). */
@@ -389,15 +399,14 @@ static void pendulum_poly_k1s1_add(double *a, double *c, double b)
 #endif
 static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
-  double v = 0, r;
+  double v, r;
   int i;
-  for (i = 0; i < pendulum_poly_k1s1_M; i++)
-    if (fabs(gam[0 * pendulum_poly_k1s1_M + i]) > v) v = (double)fabs(gam[0 * pendulum_poly_k1s1_M + i]);
-  v *= fabs(h);
+  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */
+  v = fabs(h) * pendulum_poly_k1s1_coef(gam, 0);
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_poly_k1s1_ERRC;
-  for (i = 0; i < (cold ? 2 : 2); i++) v *= r;
+  for (i = 0; i < 2; i++) v *= r;
   return v;
 }
 

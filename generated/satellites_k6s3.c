@@ -2694,6 +2694,16 @@ static void satellites_k6s3_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double satellites_k6s3_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < satellites_k6s3_M; i++)
+    if (fabs(gam[j * satellites_k6s3_M + i]) > c) c = (double)fabs(gam[j * satellites_k6s3_M + i]);
+  return c;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * max |h gamma_2|, the Legendre coefficient of degree 2, the order (docs/api.md). */
@@ -2702,15 +2712,14 @@ static void satellites_k6s3_add(double *a, double *c, double b)
 #endif
 static double satellites_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
-  double v = 0, r;
+  double v, r;
   int i;
-  for (i = 0; i < satellites_k6s3_M; i++)
-    if (fabs(gam[2 * satellites_k6s3_M + i]) > v) v = (double)fabs(gam[2 * satellites_k6s3_M + i]);
-  v *= fabs(h);
   (void)d1;
+  (void)v;
   (void)r;
+  (void)i;
   (void)cold;
-  return satellites_k6s3_ERRC * v;
+  return satellites_k6s3_ERRC * fabs(h) * satellites_k6s3_coef(gam, 2);
 }
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
