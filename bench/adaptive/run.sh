@@ -38,21 +38,13 @@ kepler09 18 3 const
 kepler099 3 3 const
 kepler099 18 3 const"}
 
-hrange() {
+. bench/ranges.sh
+# the fixed steps start 4x coarser than make bench's for order 8 (as its
+# poly_range); Kepler's at make bench's h, down to 1e-5 for e = 0.99
+hrange4() {
   case $1 in
-  pendulum) echo 2:1e-5:2 ;;
-  conical) echo 4:1e-4:2 ;;
-  modified) echo 0.8:1e-5:2 ;;
-  satellites) echo 8:1e-3:2 ;;
-  chain8) echo 0.08:1e-5:2 ;;
-  double_pendulum) echo 0.8:1e-5:2 ;;
   kepler*) echo 0.2:1e-5:2 ;;
-  esac
-}
-floor() {
-  case $1 in
-  kepler* | conical) echo 1e-13 ;;
-  *) echo 3e-13 ;;
+  *) hrange "$1" | awk -F: '{ printf "%.10g:%s:%s\n", 4 * $1, $2, $3 }' ;;
   esac
 }
 model() { if [ -f "models/$1.ham" ]; then echo "models/$1.ham"; else echo "bench/adaptive/$1.ham"; fi; }
@@ -94,7 +86,7 @@ for p in $(echo "$CONFIGS" | cut -d' ' -f1 | uniq); do
   while read -r k s f; do
     if [ "$f" = poly ]; then fixed=hbvm-poly adaptive=hbvm-poly-adaptive; else fixed=hbvm adaptive=hbvm-adaptive; fi
     sweep "$p" $adaptive 1e-4:1e-13:10 -k "$k" -s "$s"
-    sweep "$p" $fixed "$(hrange "$p")" -k "$k" -s "$s"
+    sweep "$p" $fixed "$(hrange4 "$p")" -k "$k" -s "$s"
   done <"$B/configs_$p.txt"
   case $p in pendulum | conical | kepler* | double_pendulum) sweep "$p" gsl-rk8pd 1e-3:1e-14:10 ;; esac
 done
