@@ -315,7 +315,11 @@ static double err_constant(const Emitter *e) {
 // The first step after NAME_init has no warm start (its predictor is
 // gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
 // is the whole velocity): there, at s >= 2, rho is the decay of the two
-// highest coefficients, and the estimate h |gamma_{s-1}| rho^(p-s+1).
+// highest coefficients, and the estimate h |gamma_{s-1}| rho^(p-s+1), or,
+// when larger and d1 < |h v| / 4, |h v| (d1 / |h v|)^p (d1 as the miss of the
+// degree-1 coefficient; the decay alone is far too low at Kepler's perihelion,
+// where the coefficients of the odd component fall faster than rho^j; from
+// rest d1 ~ |h v| and this term would reject every step down to h ~ tol).
 // With p < s (the constant multiplier at s >= 3) the coefficient h |gamma_p|
 // itself is of the order of the local error.
 static void emit_err_est(Emitter *e) {
@@ -341,15 +345,19 @@ static void emit_err_est(Emitter *e) {
         e->P, math_suffix(e, 0), e->P, p);
     return;
   }
+  tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
   if (s >= 2) {
-    out(e, "  if (cold) {  /* no warm start: the decay of the two highest coefficients */\n"
-           "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d);\n", real_type(e, 0), e->P, s - 1, e->P, s - 2);
-    tmpl(e, "    if (!(b > c)) return c > 0 ? d1 : 0;\n    r = c / b;\n    v = $P_ERRC * fabs$f(h) * c;\n");
-    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v;\n  }\n", p - s + 1);
+    out(e, "  if (cold) {  /* no warm start: the decay of the two highest coefficients, */\n"
+           "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d), w = 0;\n", real_type(e, 0), e->P, s - 1, e->P, s - 2);
+    tmpl(e, "    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;\n"
+            "                      * not from rest, where d1 ~ |h v| */\n"
+            "      r = d1 / v;\n      w = $P_ERRC * v;\n");
+    out(e, "      for (i = 0; i < %d; i++) w *= r;\n    }\n", p);
+    tmpl(e, "    if (!(b > c)) return c > 0 ? d1 : w;\n    r = c / b;\n    v = $P_ERRC * fabs$f(h) * c;\n");
+    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v > w ? v : w;\n  }\n", p - s + 1);
   } else
     tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");
-  tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n"
-          "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
+  tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
   /* p is 2s, or 2 at s = 2 (the constant multiplier): p / s is whole */
   tmpl(e, "  v *= $P_ERRC;\n");
   out(e, "  for (i = 0; i < %d; i++) v *= r;\n  return v;\n}\n\n", p / s);
