@@ -419,15 +419,21 @@ static double kepler_k4s4_err_est(const double *gam, double h, double d1, int co
 {
   double v, r;
   int i;
-  if (cold) {  /* no warm start: the decay of the two highest coefficients */
-    double c = kepler_k4s4_coef(gam, 3), b = kepler_k4s4_coef(gam, 2);
-    if (!(b > c)) return c > 0 ? d1 : 0;
+  v = fabs(h) * kepler_k4s4_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = kepler_k4s4_coef(gam, 3), b = kepler_k4s4_coef(gam, 2), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = kepler_k4s4_ERRC * v;
+      for (i = 0; i < 8; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
     r = c / b;
     v = kepler_k4s4_ERRC * fabs(h) * c;
     for (i = 0; i < 5; i++) v *= r;
-    return v;
+    return v > w ? v : w;
   }
-  v = fabs(h) * kepler_k4s4_coef(gam, 0);
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= kepler_k4s4_ERRC;

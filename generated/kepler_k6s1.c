@@ -345,8 +345,8 @@ static double kepler_k6s1_err_est(const double *gam, double h, double d1, int co
 {
   double v, r;
   int i;
-  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */
   v = fabs(h) * kepler_k6s1_coef(gam, 0);
+  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= kepler_k6s1_ERRC;

@@ -401,8 +401,8 @@ static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1,
 {
   double v, r;
   int i;
-  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */
   v = fabs(h) * pendulum_poly_k1s1_coef(gam, 0);
+  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_poly_k1s1_ERRC;

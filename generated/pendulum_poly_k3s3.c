@@ -851,15 +851,21 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1,
 {
   double v, r;
   int i;
-  if (cold) {  /* no warm start: the decay of the two highest coefficients */
-    double c = pendulum_poly_k3s3_coef(gam, 2), b = pendulum_poly_k3s3_coef(gam, 1);
-    if (!(b > c)) return c > 0 ? d1 : 0;
+  v = fabs(h) * pendulum_poly_k3s3_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = pendulum_poly_k3s3_coef(gam, 2), b = pendulum_poly_k3s3_coef(gam, 1), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = pendulum_poly_k3s3_ERRC * v;
+      for (i = 0; i < 6; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
     r = c / b;
     v = pendulum_poly_k3s3_ERRC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
-    return v;
+    return v > w ? v : w;
   }
-  v = fabs(h) * pendulum_poly_k3s3_coef(gam, 0);
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
   v *= pendulum_poly_k3s3_ERRC;
