@@ -26,7 +26,7 @@ elapsed() { echo $(($(date +%s) - start)); }
 PROBLEMS="pendulum conical modified satellites kepler chain8 double_pendulum"
 
 # Step sizes FROM:TO:FACTOR (hrange), the error at which a line stops (floor)
-. bench/ranges.sh
+. bench/common.sh
 # the h of the callgrind count
 count_h() {
   case $1 in
@@ -122,14 +122,8 @@ while read -r p k s f; do
   "$GEN" --multiplier "$f" -k "$k" -s "$s" -n "$n" -o "$B/gen" "models/$p.ham"
   solvers="$solvers $n"
 done <"$B/configs.txt"
-{
-  echo "/* registry.c - written by bench/run.sh: the generated solvers of this build. */"
-  echo "#include \"hbvm.h\""
-  for n in $solvers; do echo "extern const GenSolver ${n}_bench;"; done
-  echo "const GenSolver *const gen_solvers[] = {"
-  for n in $solvers; do echo "  &${n}_bench,"; done
-  echo "  0};"
-} >"$B/gen/registry.c"
+# shellcheck disable=SC2086
+write_registry bench/run.sh "$B/gen" $solvers
 
 # ---- 2. build
 echo "== building $B/bench ($(elapsed) s)"

@@ -24,7 +24,8 @@ GEN=gen/hbvmgen
 # (bench/results/summary.txt, section 2): poly(4,4) at the auto k on the
 # constrained problems; on Kepler (3,3) (fastest, H to 1e-11), and s = 3 at
 # the k of -k auto (18: H at round-off for the non-polynomial U).
-# ADAPTIVE_CONFIGS="..." runs other lines (then the figures are not redrawn).
+# ADAPTIVE_CONFIGS="..." runs other lines (into build/bench-adaptive/res only:
+# bench/results and the figures are left alone).
 CONFIGS=${ADAPTIVE_CONFIGS:-"pendulum 4 4 poly
 conical 4 4 poly
 modified 12 4 poly
@@ -38,7 +39,7 @@ kepler09 18 3 const
 kepler099 3 3 const
 kepler099 18 3 const"}
 
-. bench/ranges.sh
+. bench/common.sh
 # the fixed steps start 4x coarser than make bench's for order 8 (as its
 # poly_range); Kepler's at make bench's h, down to 1e-5 for e = 0.99
 hrange4() {
@@ -62,14 +63,8 @@ echo "$CONFIGS" | {
   echo "$solvers" >"$B/solvers.txt"
 }
 solvers=$(cat "$B/solvers.txt")
-{
-  echo "/* registry.c - written by bench/adaptive/run.sh */"
-  echo "#include \"hbvm.h\""
-  for n in $solvers; do echo "extern const GenSolver ${n}_bench;"; done
-  echo "const GenSolver *const gen_solvers[] = {"
-  for n in $solvers; do echo "  &${n}_bench,"; done
-  echo "  0};"
-} >"$B/gen/registry.c"
+# shellcheck disable=SC2086
+write_registry bench/adaptive/run.sh "$B/gen" $solvers
 make --no-print-directory -f bench/bench.mk -j2 B="$B" SOLVERS="$solvers" >"$B/build.log" 2>&1 ||
   { cat "$B/build.log"; exit 1; }
 
@@ -91,9 +86,12 @@ for p in $(echo "$CONFIGS" | cut -d' ' -f1 | uniq); do
   case $p in pendulum | conical | kepler* | double_pendulum) sweep "$p" gsl-rk8pd 1e-3:1e-14:10 ;; esac
 done
 
+if [ -n "${ADAPTIVE_CONFIGS:-}" ]; then # other lines: a summary, bench/results untouched
+  bench/adaptive/summary.sh "$B/res/work_precision.csv"
+  exit 0
+fi
 cp "$B/res/work_precision.csv" "$R/adaptive.csv"
 bench/adaptive/summary.sh "$R/adaptive.csv" | tee "$R/adaptive.txt"
-[ -z "${ADAPTIVE_CONFIGS:-}" ] || exit 0
 # the figures: the last make bench's lines plus these (adaptive lines and
 # the new problems)
 mkdir -p "$B/plot/r"
