@@ -370,11 +370,11 @@ static void emit_err_est(Emitter *e) {
 static void emit_step(Emitter *e) {
   int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "\n/* gamma for a step of size h: extrapolated from the previous step's polynomial,\n"
-          " * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */\n"
-          "static void $P_predict(const $P_state *x, $R h, const $P_params *prm, $R *gam)\n{\n"
+          " * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */\n"
+          "static void $P_predict(const $P_state *x, $R h, int cold, const $P_params *prm, $R *gam)\n{\n"
           "  int i, j, l, d;\n"
           "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n"
-          "  if (x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n"
+          "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n"
           "  for (j = 0; j < $P_S; j++)\n    for (i = 0; i < $P_S; i++) {\n"
           "      $R r = h / x->hprev, e = 0;\n"
           "      if (h == x->hprev)\n        e = $P_E1[j * $P_S + i];\n      else\n"
@@ -391,7 +391,7 @@ static void emit_step(Emitter *e) {
   emit_err_est(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "static int $P_step_within($P_state *x, $P_real h_, $R tol, const $P_params *prm, $P_stats *st)\n{\n"
+          "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
           "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;\n"
@@ -399,14 +399,14 @@ static void emit_step(Emitter *e) {
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
   if (wide)
     tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
-            "  {\n    $R guess[$P_S * $P_M];\n    $P_predict(x, h, prm, guess);\n"
+            "  {\n    $R guess[$P_S * $P_M];\n    $P_predict(x, h, cold, prm, guess);\n"
             "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
             "  /* the sweep starts from the compensated state q - qc, p - pc, in $W */\n"
             "  for (i = 0; i < $P_M; i++) {\n"
             "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
             "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
   else
-    tmpl(e, "  $P_predict(x, h, prm, gam);\n");
+    tmpl(e, "  $P_predict(x, h, cold, prm, gam);\n");
   if (e->mod->nu)
     tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
             "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
@@ -447,7 +447,7 @@ static void emit_step(Emitter *e) {
           "    if (it == 1) {\n      d1 = inc;  /* the predictor's error, for $P_err_est */\n"
           "      /* $P_step_adaptive: a step the first sweep already puts over the tolerance\n"
           "       * is rejected here, not after the iteration has converged */\n"
-          "      est = $P_err_est(gam, h, d1, x->hprev == 0);\n"
+          "      est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
           "      if (tol > 0 && !(est <= tol * (1 + scale))) {\n"
           "        if (st) {\n          st->iters = 1;\n          st->increment = inc;\n"
           "          st->err_est = est;\n          st->h = h;\n          st->rejected = 0;\n        }\n"
@@ -481,7 +481,7 @@ static void emit_step(Emitter *e) {
           "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n"
-          "  est = $P_err_est(gam, h, d1, x->hprev == 0);\n"
+          "  est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
           "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
           "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
@@ -522,22 +522,27 @@ static void emit_step(Emitter *e) {
 // with a smaller step. The next step from the standard controller of
 // Hairer, Norsett and Wanner (I.II.4) for an error of order h^p per unit
 // step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
-// rejection. A failed step is retried with half the step.
+// rejection. A failed step is retried with half the step. After three tries
+// over the tolerance the tries start cold (no warm start): the warm start
+// carries the previous step's error into the estimate at every h.
 static void emit_step_adaptive(Emitter *e) {
   tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
-          "  return $P_step_within(x, h, 0, prm, st);\n}\n");
+          "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");
   out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
   out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
       e->P, e->P, e->single ? "0.01f" : "0.01");
   out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
-          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0;\n"
+          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0, misses = 0;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
           "  tol *= $P_TOLC;\n"
           "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
-          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), prm, &s);\n"
+          "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
+          "     * previous step's error, which no smaller h removes from the estimate */\n"
+          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, &s);\n"
+          "    if (rc == $P_EREJECT) misses++;\n"
           "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
           "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
           "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");
