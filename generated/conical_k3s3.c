@@ -405,12 +405,12 @@ void conical_k3s3_hidden(const conical_k3s3_state *x, const conical_k3s3_params 
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void conical_k3s3_predict(const conical_k3s3_state *x, double h, const conical_k3s3_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void conical_k3s3_predict(const conical_k3s3_state *x, double h, int cold, const conical_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     conical_k3s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -464,7 +464,7 @@ static double conical_k3s3_err_est(const double *gam, double h, double d1, int c
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_, double tol, const conical_k3s3_params *prm, conical_k3s3_stats *st)
+static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_, double tol, int cold, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[conical_k3s3_S * conical_k3s3_M], sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + 1];
@@ -472,7 +472,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
   int it, i, stall = 0, rc = conical_k3s3_ENOCONV;
   conical_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_k3s3_EBADSTEP;
-  conical_k3s3_predict(x, h, prm, gam);
+  conical_k3s3_predict(x, h, cold, prm, gam);
   double g0[conical_k3s3_NU];
   conical_k3s3_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -498,7 +498,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       d1 = inc;  /* the predictor's error, for conical_k3s3_err_est */
       /* conical_k3s3_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = conical_k3s3_err_est(gam, h, d1, x->hprev == 0);
+      est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -536,7 +536,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       break;
     }
   }
-  est = conical_k3s3_err_est(gam, h, d1, x->hprev == 0);
+  est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > conical_k3s3_MAXITER ? conical_k3s3_MAXITER : it;
     st->increment = inc;
@@ -565,7 +565,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
 
 int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
-  return conical_k3s3_step_within(x, h, 0, prm, st);
+  return conical_k3s3_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef conical_k3s3_HMIN
@@ -581,14 +581,17 @@ int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, coni
 {
   conical_k3s3_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k3s3_EBADSTEP;
   tol *= conical_k3s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = conical_k3s3_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = conical_k3s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == conical_k3s3_EREJECT) misses++;
     if (rc == conical_k3s3_OK || rc == conical_k3s3_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == conical_k3s3_OK ? 1 : s.err_est / (tol * fabs(hh));

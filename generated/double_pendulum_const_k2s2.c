@@ -559,12 +559,12 @@ void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void double_pendulum_const_k2s2_predict(const double_pendulum_const_k2s2_state *x, double h, const double_pendulum_const_k2s2_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void double_pendulum_const_k2s2_predict(const double_pendulum_const_k2s2_state *x, double h, int cold, const double_pendulum_const_k2s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     double_pendulum_const_k2s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -632,7 +632,7 @@ static double double_pendulum_const_k2s2_err_est(const double *gam, double h, do
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h_, double tol, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
+static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h_, double tol, int cold, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
@@ -640,7 +640,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
   int it, i, stall = 0, rc = double_pendulum_const_k2s2_ENOCONV;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_const_k2s2_EBADSTEP;
-  double_pendulum_const_k2s2_predict(x, h, prm, gam);
+  double_pendulum_const_k2s2_predict(x, h, cold, prm, gam);
   double g0[double_pendulum_const_k2s2_NU];
   double_pendulum_const_k2s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -666,7 +666,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       d1 = inc;  /* the predictor's error, for double_pendulum_const_k2s2_err_est */
       /* double_pendulum_const_k2s2_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = double_pendulum_const_k2s2_err_est(gam, h, d1, x->hprev == 0);
+      est = double_pendulum_const_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -704,7 +704,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       break;
     }
   }
-  est = double_pendulum_const_k2s2_err_est(gam, h, d1, x->hprev == 0);
+  est = double_pendulum_const_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_const_k2s2_MAXITER ? double_pendulum_const_k2s2_MAXITER : it;
     st->increment = inc;
@@ -733,7 +733,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
 
 int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
-  return double_pendulum_const_k2s2_step_within(x, h, 0, prm, st);
+  return double_pendulum_const_k2s2_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef double_pendulum_const_k2s2_HMIN
@@ -749,14 +749,17 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
 {
   double_pendulum_const_k2s2_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_const_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_const_k2s2_EBADSTEP;
   tol *= double_pendulum_const_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = double_pendulum_const_k2s2_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = double_pendulum_const_k2s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == double_pendulum_const_k2s2_EREJECT) misses++;
     if (rc == double_pendulum_const_k2s2_OK || rc == double_pendulum_const_k2s2_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == double_pendulum_const_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));

@@ -2050,12 +2050,12 @@ void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const doub
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, const double_pendulum_k3s3_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, int cold, const double_pendulum_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     double_pendulum_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
@@ -2123,7 +2123,7 @@ static double double_pendulum_k3s3_err_est(const double *gam, double h, double d
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
+static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, int cold, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
@@ -2131,7 +2131,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
   int it, i, stall = 0, rc = double_pendulum_k3s3_ENOCONV;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k3s3_EBADSTEP;
-  double_pendulum_k3s3_predict(x, h, prm, gam);
+  double_pendulum_k3s3_predict(x, h, cold, prm, gam);
   double g0[double_pendulum_k3s3_NU];
   double_pendulum_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -2180,7 +2180,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
       d1 = inc;  /* the predictor's error, for double_pendulum_k3s3_err_est */
       /* double_pendulum_k3s3_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = double_pendulum_k3s3_err_est(gam, h, d1, x->hprev == 0);
+      est = double_pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -2212,7 +2212,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
       break;
     }
   }
-  est = double_pendulum_k3s3_err_est(gam, h, d1, x->hprev == 0);
+  est = double_pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_k3s3_MAXITER ? double_pendulum_k3s3_MAXITER : it;
     st->increment = inc;
@@ -2275,7 +2275,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
 
 int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
-  return double_pendulum_k3s3_step_within(x, h, 0, prm, st);
+  return double_pendulum_k3s3_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef double_pendulum_k3s3_HMIN
@@ -2291,14 +2291,17 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
 {
   double_pendulum_k3s3_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k3s3_EBADSTEP;
   tol *= double_pendulum_k3s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = double_pendulum_k3s3_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = double_pendulum_k3s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == double_pendulum_k3s3_EREJECT) misses++;
     if (rc == double_pendulum_k3s3_OK || rc == double_pendulum_k3s3_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == double_pendulum_k3s3_OK ? 1 : s.err_est / (tol * fabs(hh));

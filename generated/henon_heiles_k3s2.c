@@ -247,12 +247,12 @@ void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heil
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, const henon_heiles_k3s2_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, int cold, const henon_heiles_k3s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     henon_heiles_k3s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -320,7 +320,7 @@ static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, 
 
 /* One step of HBVM(3,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, double tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
+static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, double tol, int cold, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
   double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
@@ -328,7 +328,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
   int it, i, stall = 0, rc = henon_heiles_k3s2_ENOCONV;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return henon_heiles_k3s2_EBADSTEP;
-  henon_heiles_k3s2_predict(x, h, prm, gam);
+  henon_heiles_k3s2_predict(x, h, cold, prm, gam);
   for (it = 1; it <= henon_heiles_k3s2_MAXITER; it++) {
     henon_heiles_k3s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
@@ -348,7 +348,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       d1 = inc;  /* the predictor's error, for henon_heiles_k3s2_err_est */
       /* henon_heiles_k3s2_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = henon_heiles_k3s2_err_est(gam, h, d1, x->hprev == 0);
+      est = henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -381,7 +381,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       break;
     }
   }
-  est = henon_heiles_k3s2_err_est(gam, h, d1, x->hprev == 0);
+  est = henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it;
     st->increment = inc;
@@ -410,7 +410,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
 
 int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
-  return henon_heiles_k3s2_step_within(x, h, 0, prm, st);
+  return henon_heiles_k3s2_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef henon_heiles_k3s2_HMIN
@@ -426,14 +426,17 @@ int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s
 {
   henon_heiles_k3s2_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return henon_heiles_k3s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return henon_heiles_k3s2_EBADSTEP;
   tol *= henon_heiles_k3s2_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = henon_heiles_k3s2_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = henon_heiles_k3s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == henon_heiles_k3s2_EREJECT) misses++;
     if (rc == henon_heiles_k3s2_OK || rc == henon_heiles_k3s2_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == henon_heiles_k3s2_OK ? 1 : s.err_est / (tol * fabs(hh));

@@ -174,12 +174,12 @@ void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *pr
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, const kepler_k1s1_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, int cold, const kepler_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     kepler_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -234,7 +234,7 @@ static double kepler_k1s1_err_est(const double *gam, double h, double d1, int co
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, double tol, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
+static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, double tol, int cold, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k1s1_S * kepler_k1s1_M], sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + 3 * kepler_k1s1_NU + 1];
@@ -242,7 +242,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
   int it, i, stall = 0, rc = kepler_k1s1_ENOCONV;
   kepler_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k1s1_EBADSTEP;
-  kepler_k1s1_predict(x, h, prm, gam);
+  kepler_k1s1_predict(x, h, cold, prm, gam);
   for (it = 1; it <= kepler_k1s1_MAXITER; it++) {
     kepler_k1s1_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
@@ -262,7 +262,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
       d1 = inc;  /* the predictor's error, for kepler_k1s1_err_est */
       /* kepler_k1s1_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = kepler_k1s1_err_est(gam, h, d1, x->hprev == 0);
+      est = kepler_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -295,7 +295,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
       break;
     }
   }
-  est = kepler_k1s1_err_est(gam, h, d1, x->hprev == 0);
+  est = kepler_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k1s1_MAXITER ? kepler_k1s1_MAXITER : it;
     st->increment = inc;
@@ -324,7 +324,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
 
 int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
 {
-  return kepler_k1s1_step_within(x, h, 0, prm, st);
+  return kepler_k1s1_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef kepler_k1s1_HMIN
@@ -340,14 +340,17 @@ int kepler_k1s1_step_adaptive(kepler_k1s1_state *x, kepler_k1s1_real *h, kepler_
 {
   kepler_k1s1_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k1s1_EBADSTEP;
   tol *= kepler_k1s1_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = kepler_k1s1_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = kepler_k1s1_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == kepler_k1s1_EREJECT) misses++;
     if (rc == kepler_k1s1_OK || rc == kepler_k1s1_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == kepler_k1s1_OK ? 1 : s.err_est / (tol * fabs(hh));

@@ -370,12 +370,12 @@ void kepler_k4s4_hidden(const kepler_k4s4_state *x, const kepler_k4s4_params *pr
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void kepler_k4s4_predict(const kepler_k4s4_state *x, double h, const kepler_k4s4_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void kepler_k4s4_predict(const kepler_k4s4_state *x, double h, int cold, const kepler_k4s4_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     kepler_k4s4_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -443,7 +443,7 @@ static double kepler_k4s4_err_est(const double *gam, double h, double d1, int co
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, double tol, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
+static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, double tol, int cold, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k4s4_S * kepler_k4s4_M], sw[kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_M + 3 * kepler_k4s4_NU + 1];
@@ -451,7 +451,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
   int it, i, stall = 0, rc = kepler_k4s4_ENOCONV;
   kepler_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k4s4_EBADSTEP;
-  kepler_k4s4_predict(x, h, prm, gam);
+  kepler_k4s4_predict(x, h, cold, prm, gam);
   for (it = 1; it <= kepler_k4s4_MAXITER; it++) {
     kepler_k4s4_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
@@ -471,7 +471,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       d1 = inc;  /* the predictor's error, for kepler_k4s4_err_est */
       /* kepler_k4s4_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = kepler_k4s4_err_est(gam, h, d1, x->hprev == 0);
+      est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -504,7 +504,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       break;
     }
   }
-  est = kepler_k4s4_err_est(gam, h, d1, x->hprev == 0);
+  est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k4s4_MAXITER ? kepler_k4s4_MAXITER : it;
     st->increment = inc;
@@ -533,7 +533,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
 
 int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
 {
-  return kepler_k4s4_step_within(x, h, 0, prm, st);
+  return kepler_k4s4_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef kepler_k4s4_HMIN
@@ -549,14 +549,17 @@ int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_
 {
   kepler_k4s4_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k4s4_EBADSTEP;
   tol *= kepler_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = kepler_k4s4_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = kepler_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == kepler_k4s4_EREJECT) misses++;
     if (rc == kepler_k4s4_OK || rc == kepler_k4s4_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == kepler_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));

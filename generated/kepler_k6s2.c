@@ -350,12 +350,12 @@ void kepler_k6s2_hidden(const kepler_k6s2_state *x, const kepler_k6s2_params *pr
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void kepler_k6s2_predict(const kepler_k6s2_state *x, double h, const kepler_k6s2_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void kepler_k6s2_predict(const kepler_k6s2_state *x, double h, int cold, const kepler_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     kepler_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -423,7 +423,7 @@ static double kepler_k6s2_err_est(const double *gam, double h, double d1, int co
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, double tol, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
+static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, double tol, int cold, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k6s2_S * kepler_k6s2_M], sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + 3 * kepler_k6s2_NU + 1];
@@ -431,7 +431,7 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
   int it, i, stall = 0, rc = kepler_k6s2_ENOCONV;
   kepler_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s2_EBADSTEP;
-  kepler_k6s2_predict(x, h, prm, gam);
+  kepler_k6s2_predict(x, h, cold, prm, gam);
   for (it = 1; it <= kepler_k6s2_MAXITER; it++) {
     kepler_k6s2_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
@@ -451,7 +451,7 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
       d1 = inc;  /* the predictor's error, for kepler_k6s2_err_est */
       /* kepler_k6s2_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = kepler_k6s2_err_est(gam, h, d1, x->hprev == 0);
+      est = kepler_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -484,7 +484,7 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
       break;
     }
   }
-  est = kepler_k6s2_err_est(gam, h, d1, x->hprev == 0);
+  est = kepler_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k6s2_MAXITER ? kepler_k6s2_MAXITER : it;
     st->increment = inc;
@@ -513,7 +513,7 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
 
 int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
 {
-  return kepler_k6s2_step_within(x, h, 0, prm, st);
+  return kepler_k6s2_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef kepler_k6s2_HMIN
@@ -529,14 +529,17 @@ int kepler_k6s2_step_adaptive(kepler_k6s2_state *x, kepler_k6s2_real *h, kepler_
 {
   kepler_k6s2_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s2_EBADSTEP;
   tol *= kepler_k6s2_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = kepler_k6s2_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = kepler_k6s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == kepler_k6s2_EREJECT) misses++;
     if (rc == kepler_k6s2_OK || rc == kepler_k6s2_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == kepler_k6s2_OK ? 1 : s.err_est / (tol * fabs(hh));

@@ -408,12 +408,12 @@ void kepler_k6s3_hidden(const kepler_k6s3_state *x, const kepler_k6s3_params *pr
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void kepler_k6s3_predict(const kepler_k6s3_state *x, double h, const kepler_k6s3_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void kepler_k6s3_predict(const kepler_k6s3_state *x, double h, int cold, const kepler_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     kepler_k6s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -481,7 +481,7 @@ static double kepler_k6s3_err_est(const double *gam, double h, double d1, int co
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, double tol, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
+static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, double tol, int cold, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k6s3_S * kepler_k6s3_M], sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + 3 * kepler_k6s3_NU + 1];
@@ -489,7 +489,7 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
   int it, i, stall = 0, rc = kepler_k6s3_ENOCONV;
   kepler_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k6s3_EBADSTEP;
-  kepler_k6s3_predict(x, h, prm, gam);
+  kepler_k6s3_predict(x, h, cold, prm, gam);
   for (it = 1; it <= kepler_k6s3_MAXITER; it++) {
     kepler_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
@@ -509,7 +509,7 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
       d1 = inc;  /* the predictor's error, for kepler_k6s3_err_est */
       /* kepler_k6s3_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = kepler_k6s3_err_est(gam, h, d1, x->hprev == 0);
+      est = kepler_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -542,7 +542,7 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
       break;
     }
   }
-  est = kepler_k6s3_err_est(gam, h, d1, x->hprev == 0);
+  est = kepler_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it;
     st->increment = inc;
@@ -571,7 +571,7 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
 
 int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
-  return kepler_k6s3_step_within(x, h, 0, prm, st);
+  return kepler_k6s3_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef kepler_k6s3_HMIN
@@ -587,14 +587,17 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
 {
   kepler_k6s3_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s3_EBADSTEP;
   tol *= kepler_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = kepler_k6s3_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = kepler_k6s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == kepler_k6s3_EREJECT) misses++;
     if (rc == kepler_k6s3_OK || rc == kepler_k6s3_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == kepler_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));

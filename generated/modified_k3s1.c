@@ -390,12 +390,12 @@ void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_para
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void modified_k3s1_predict(const modified_k3s1_state *x, double h, const modified_k3s1_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void modified_k3s1_predict(const modified_k3s1_state *x, double h, int cold, const modified_k3s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     modified_k3s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -450,7 +450,7 @@ static double modified_k3s1_err_est(const double *gam, double h, double d1, int 
 
 /* One step of HBVM(3,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real h_, double tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
+static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real h_, double tol, int cold, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
@@ -458,7 +458,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
   int it, i, stall = 0, rc = modified_k3s1_ENOCONV;
   modified_k3s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k3s1_EBADSTEP;
-  modified_k3s1_predict(x, h, prm, gam);
+  modified_k3s1_predict(x, h, cold, prm, gam);
   double g0[modified_k3s1_NU];
   modified_k3s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -484,7 +484,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       d1 = inc;  /* the predictor's error, for modified_k3s1_err_est */
       /* modified_k3s1_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = modified_k3s1_err_est(gam, h, d1, x->hprev == 0);
+      est = modified_k3s1_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -522,7 +522,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       break;
     }
   }
-  est = modified_k3s1_err_est(gam, h, d1, x->hprev == 0);
+  est = modified_k3s1_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > modified_k3s1_MAXITER ? modified_k3s1_MAXITER : it;
     st->increment = inc;
@@ -551,7 +551,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
 
 int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
-  return modified_k3s1_step_within(x, h, 0, prm, st);
+  return modified_k3s1_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef modified_k3s1_HMIN
@@ -567,14 +567,17 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
 {
   modified_k3s1_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return modified_k3s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k3s1_EBADSTEP;
   tol *= modified_k3s1_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = modified_k3s1_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = modified_k3s1_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == modified_k3s1_EREJECT) misses++;
     if (rc == modified_k3s1_OK || rc == modified_k3s1_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == modified_k3s1_OK ? 1 : s.err_est / (tol * fabs(hh));

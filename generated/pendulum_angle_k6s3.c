@@ -243,12 +243,12 @@ void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendul
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, double h, const pendulum_angle_k6s3_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, double h, int cold, const pendulum_angle_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_angle_k6s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -316,7 +316,7 @@ static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
+static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, int cold, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
@@ -324,7 +324,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   int it, i, stall = 0, rc = pendulum_angle_k6s3_ENOCONV;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_angle_k6s3_EBADSTEP;
-  pendulum_angle_k6s3_predict(x, h, prm, gam);
+  pendulum_angle_k6s3_predict(x, h, cold, prm, gam);
   for (it = 1; it <= pendulum_angle_k6s3_MAXITER; it++) {
     pendulum_angle_k6s3_sweep(x->q, x->p, gam, h, 0, prm, sw);
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
@@ -344,7 +344,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
       /* pendulum_angle_k6s3_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = pendulum_angle_k6s3_err_est(gam, h, d1, x->hprev == 0);
+      est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -377,7 +377,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       break;
     }
   }
-  est = pendulum_angle_k6s3_err_est(gam, h, d1, x->hprev == 0);
+  est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it;
     st->increment = inc;
@@ -406,7 +406,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
 
 int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
-  return pendulum_angle_k6s3_step_within(x, h, 0, prm, st);
+  return pendulum_angle_k6s3_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef pendulum_angle_k6s3_HMIN
@@ -422,14 +422,17 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
 {
   pendulum_angle_k6s3_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_angle_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_angle_k6s3_EBADSTEP;
   tol *= pendulum_angle_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = pendulum_angle_k6s3_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_angle_k6s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_angle_k6s3_EREJECT) misses++;
     if (rc == pendulum_angle_k6s3_OK || rc == pendulum_angle_k6s3_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == pendulum_angle_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));

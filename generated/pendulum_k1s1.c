@@ -285,12 +285,12 @@ void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_para
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_k1s1_predict(const pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void pendulum_k1s1_predict(const pendulum_k1s1_state *x, double h, int cold, const pendulum_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -345,7 +345,7 @@ static double pendulum_k1s1_err_est(const double *gam, double h, double d1, int 
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real h_, double tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
+static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real h_, double tol, int cold, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
@@ -353,7 +353,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
   int it, i, stall = 0, rc = pendulum_k1s1_ENOCONV;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_k1s1_EBADSTEP;
-  pendulum_k1s1_predict(x, h, prm, gam);
+  pendulum_k1s1_predict(x, h, cold, prm, gam);
   double g0[pendulum_k1s1_NU];
   pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -379,7 +379,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
       /* pendulum_k1s1_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = pendulum_k1s1_err_est(gam, h, d1, x->hprev == 0);
+      est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -417,7 +417,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       break;
     }
   }
-  est = pendulum_k1s1_err_est(gam, h, d1, x->hprev == 0);
+  est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it;
     st->increment = inc;
@@ -446,7 +446,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
 
 int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
-  return pendulum_k1s1_step_within(x, h, 0, prm, st);
+  return pendulum_k1s1_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef pendulum_k1s1_HMIN
@@ -462,14 +462,17 @@ int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, p
 {
   pendulum_k1s1_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k1s1_EBADSTEP;
   tol *= pendulum_k1s1_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = pendulum_k1s1_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_k1s1_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_k1s1_EREJECT) misses++;
     if (rc == pendulum_k1s1_OK || rc == pendulum_k1s1_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == pendulum_k1s1_OK ? 1 : s.err_est / (tol * fabs(hh));

@@ -802,12 +802,12 @@ void pendulum_poly_k3s3_hidden(const pendulum_poly_k3s3_state *x, const pendulum
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_poly_k3s3_predict(const pendulum_poly_k3s3_state *x, double h, const pendulum_poly_k3s3_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void pendulum_poly_k3s3_predict(const pendulum_poly_k3s3_state *x, double h, int cold, const pendulum_poly_k3s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_poly_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
@@ -875,7 +875,7 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1,
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
+static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, int cold, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
@@ -883,7 +883,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
   int it, i, stall = 0, rc = pendulum_poly_k3s3_ENOCONV;
   pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k3s3_EBADSTEP;
-  pendulum_poly_k3s3_predict(x, h, prm, gam);
+  pendulum_poly_k3s3_predict(x, h, cold, prm, gam);
   double g0[pendulum_poly_k3s3_NU];
   pendulum_poly_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -932,7 +932,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
       d1 = inc;  /* the predictor's error, for pendulum_poly_k3s3_err_est */
       /* pendulum_poly_k3s3_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = pendulum_poly_k3s3_err_est(gam, h, d1, x->hprev == 0);
+      est = pendulum_poly_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -964,7 +964,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
       break;
     }
   }
-  est = pendulum_poly_k3s3_err_est(gam, h, d1, x->hprev == 0);
+  est = pendulum_poly_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_poly_k3s3_MAXITER ? pendulum_poly_k3s3_MAXITER : it;
     st->increment = inc;
@@ -1027,7 +1027,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
 
 int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
 {
-  return pendulum_poly_k3s3_step_within(x, h, 0, prm, st);
+  return pendulum_poly_k3s3_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef pendulum_poly_k3s3_HMIN
@@ -1043,14 +1043,17 @@ int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_
 {
   pendulum_poly_k3s3_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k3s3_EBADSTEP;
   tol *= pendulum_poly_k3s3_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = pendulum_poly_k3s3_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_poly_k3s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_poly_k3s3_EREJECT) misses++;
     if (rc == pendulum_poly_k3s3_OK || rc == pendulum_poly_k3s3_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == pendulum_poly_k3s3_OK ? 1 : s.err_est / (tol * fabs(hh));

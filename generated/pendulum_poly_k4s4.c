@@ -1351,12 +1351,12 @@ void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, const pendulum_poly_k4s4_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, int cold, const pendulum_poly_k4s4_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_poly_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
@@ -1424,7 +1424,7 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1,
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
+static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, int cold, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
@@ -1432,7 +1432,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   int it, i, stall = 0, rc = pendulum_poly_k4s4_ENOCONV;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k4s4_EBADSTEP;
-  pendulum_poly_k4s4_predict(x, h, prm, gam);
+  pendulum_poly_k4s4_predict(x, h, cold, prm, gam);
   double g0[pendulum_poly_k4s4_NU];
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -1481,7 +1481,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
       d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
       /* pendulum_poly_k4s4_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = pendulum_poly_k4s4_err_est(gam, h, d1, x->hprev == 0);
+      est = pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -1513,7 +1513,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
       break;
     }
   }
-  est = pendulum_poly_k4s4_err_est(gam, h, d1, x->hprev == 0);
+  est = pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it;
     st->increment = inc;
@@ -1576,7 +1576,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
 
 int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
-  return pendulum_poly_k4s4_step_within(x, h, 0, prm, st);
+  return pendulum_poly_k4s4_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef pendulum_poly_k4s4_HMIN
@@ -1592,14 +1592,17 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
 {
   pendulum_poly_k4s4_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k4s4_EBADSTEP;
   tol *= pendulum_poly_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = pendulum_poly_k4s4_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_poly_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_poly_k4s4_EREJECT) misses++;
     if (rc == pendulum_poly_k4s4_OK || rc == pendulum_poly_k4s4_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == pendulum_poly_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));

@@ -1696,12 +1696,12 @@ void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, const satellites_k6s1_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, int cold, const satellites_k6s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     satellites_k6s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -1756,7 +1756,7 @@ static double satellites_k6s1_err_est(const double *gam, double h, double d1, in
 
 /* One step of HBVM(6,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1_real h_, double tol, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
+static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1_real h_, double tol, int cold, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_k6s1_S * satellites_k6s1_M], sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + 1];
@@ -1764,7 +1764,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
   int it, i, stall = 0, rc = satellites_k6s1_ENOCONV;
   satellites_k6s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_k6s1_EBADSTEP;
-  satellites_k6s1_predict(x, h, prm, gam);
+  satellites_k6s1_predict(x, h, cold, prm, gam);
   double g0[satellites_k6s1_NU];
   satellites_k6s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -1790,7 +1790,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       d1 = inc;  /* the predictor's error, for satellites_k6s1_err_est */
       /* satellites_k6s1_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = satellites_k6s1_err_est(gam, h, d1, x->hprev == 0);
+      est = satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -1828,7 +1828,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       break;
     }
   }
-  est = satellites_k6s1_err_est(gam, h, d1, x->hprev == 0);
+  est = satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > satellites_k6s1_MAXITER ? satellites_k6s1_MAXITER : it;
     st->increment = inc;
@@ -1857,7 +1857,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
 
 int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
-  return satellites_k6s1_step_within(x, h, 0, prm, st);
+  return satellites_k6s1_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef satellites_k6s1_HMIN
@@ -1873,14 +1873,17 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
 {
   satellites_k6s1_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s1_EBADSTEP;
   tol *= satellites_k6s1_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = satellites_k6s1_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = satellites_k6s1_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == satellites_k6s1_EREJECT) misses++;
     if (rc == satellites_k6s1_OK || rc == satellites_k6s1_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == satellites_k6s1_OK ? 1 : s.err_est / (tol * fabs(hh));

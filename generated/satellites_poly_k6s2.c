@@ -4933,12 +4933,12 @@ void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const sate
 }
 
 /* gamma for a step of size h: extrapolated from the previous step's polynomial,
- * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step. */
-static void satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, const satellites_poly_k6s2_params *prm, double *gam)
+ * or gamma_0 = M^-1 p, gamma_j = 0 (j > 0) on the first step or when cold. */
+static void satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, int cold, const satellites_poly_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     satellites_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return;
   }
@@ -5006,7 +5006,7 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
+static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, int cold, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
@@ -5014,7 +5014,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
   int it, i, stall = 0, rc = satellites_poly_k6s2_ENOCONV;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s2_EBADSTEP;
-  satellites_poly_k6s2_predict(x, h, prm, gam);
+  satellites_poly_k6s2_predict(x, h, cold, prm, gam);
   double g0[satellites_poly_k6s2_NU];
   satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -5063,7 +5063,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
       d1 = inc;  /* the predictor's error, for satellites_poly_k6s2_err_est */
       /* satellites_poly_k6s2_step_adaptive: a step the first sweep already puts over the tolerance
        * is rejected here, not after the iteration has converged */
-      est = satellites_poly_k6s2_err_est(gam, h, d1, x->hprev == 0);
+      est = satellites_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
       if (tol > 0 && !(est <= tol * (1 + scale))) {
         if (st) {
           st->iters = 1;
@@ -5095,7 +5095,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
       break;
     }
   }
-  est = satellites_poly_k6s2_err_est(gam, h, d1, x->hprev == 0);
+  est = satellites_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > satellites_poly_k6s2_MAXITER ? satellites_poly_k6s2_MAXITER : it;
     st->increment = inc;
@@ -5158,7 +5158,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
 
 int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
-  return satellites_poly_k6s2_step_within(x, h, 0, prm, st);
+  return satellites_poly_k6s2_step_within(x, h, 0, 0, prm, st);
 }
 
 #ifndef satellites_poly_k6s2_HMIN
@@ -5174,14 +5174,17 @@ int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites
 {
   satellites_poly_k6s2_stats s;
   double hh = *h, err, fac, grow = 5;
-  int rc, rejected = 0;
+  int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_poly_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_poly_k6s2_EBADSTEP;
   tol *= satellites_poly_k6s2_TOLC;
   for (;;) {
     s.iters = 0;
     s.increment = s.err_est = 0;
-    rc = satellites_poly_k6s2_step_within(x, hh, tol * fabs(hh), prm, &s);
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = satellites_poly_k6s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == satellites_poly_k6s2_EREJECT) misses++;
     if (rc == satellites_poly_k6s2_OK || rc == satellites_poly_k6s2_EREJECT) {
       /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
       err = rc == satellites_poly_k6s2_OK ? 1 : s.err_est / (tol * fabs(hh));
