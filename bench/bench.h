@@ -4,7 +4,8 @@
  * A fixed-step method (hbvm, hbvm-poly, hbvm-generic, rattle) opens a Stepper on a
  * problem at its initial values; fixedstep_run() then takes the steps and
  * watches the invariants, the same loop for all of them. An adaptive method
- * (ida, gsl-rk8pd, gsl-rk4imp) integrates to the final time itself. */
+ * (ida, gsl-rk8pd, gsl-rk4imp, hbvm-adaptive, hbvm-poly-adaptive) integrates
+ * to the final time itself. */
 #ifndef BENCH_BENCH_H
 #define BENCH_BENCH_H
 
@@ -69,5 +70,7 @@ void rattle_close(Stepper *sp);
 int ida_integrate(const Setting *set, Observer *ob, Outcome *out);
 int gsl_rk8pd_integrate(const Setting *set, Observer *ob, Outcome *out);
 int gsl_rk4imp_integrate(const Setting *set, Observer *ob, Outcome *out);
+int hbvm_adaptive_integrate(const Setting *set, Observer *ob, Outcome *out);      /* const */
+int hbvm_poly_adaptive_integrate(const Setting *set, Observer *ob, Outcome *out); /* poly */
 
 #endif

@@ -155,15 +155,19 @@ static int kep_jac(double t, const double y[], double *J, double dfdt[], void *p
   return GSL_SUCCESS;
 }
 
-static void kep_init(double *y)
+static void kep_orbit(const char *problem, double *y)
 {
   double q0[2], p0[2];
-  problem_find("kepler")->init(q0, p0);
+  problem_find(problem)->init(q0, p0);
   y[0] = q0[0];
   y[1] = q0[1];
   y[2] = p0[0];
   y[3] = p0[1];
 }
+
+static void kep_init(double *y) { kep_orbit("kepler", y); }
+static void kep09_init(double *y) { kep_orbit("kepler09", y); }
+static void kep099_init(double *y) { kep_orbit("kepler099", y); }
 
 static void kep_to_qp(const double *y, double *q, double *p)
 {
@@ -245,6 +249,8 @@ static const MinimalForm forms[] = {
     {"pendulum", 2, pend_f, pend_jac, pend_init, pend_to_qp},
     {"conical", 4, con_f, con_jac, con_init, con_to_qp},
     {"kepler", 4, kep_f, kep_jac, kep_init, kep_to_qp},
+    {"kepler09", 4, kep_f, kep_jac, kep09_init, kep_to_qp},
+    {"kepler099", 4, kep_f, kep_jac, kep099_init, kep_to_qp},
     {"double_pendulum", 4, dpend_f, dpend_jac, dpend_init, dpend_to_qp},
 };
 

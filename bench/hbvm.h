@@ -15,6 +15,9 @@ typedef struct {
   size_t size;      /* of the solver's state */
   void (*init)(void *x, const double *q0, const double *p0);
   int (*step)(void *x, double h, int *iters); /* the solver's return code */
+  /* NAME_step_adaptive: a step of at most *h within tol; *h the next one,
+   * *taken the step taken, *iters the sweeps of all tries */
+  int (*adaptive)(void *x, double *h, double tol, double *taken, int *iters);
   void (*get)(const void *x, double *q, double *p);
 } GenSolver;
 

@@ -23,6 +23,15 @@ static int step(void *x, double h, int *iters)
   return rc;
 }
 
+static int adaptive(void *x, double *h, double tol, double *taken, int *iters)
+{
+  F(_stats) st;
+  int rc = F(_step_adaptive)(x, h, tol, NULL, &st);
+  *taken = st.h;
+  *iters = st.iters;
+  return rc;
+}
+
 static void get(const void *x, double *q, double *p)
 {
   const F(_state) *st = x;
@@ -30,4 +39,5 @@ static void get(const void *x, double *q, double *p)
   memcpy(p, st->p, sizeof st->p);
 }
 
-const GenSolver F(_bench) = {STR(SOLVER), F(_M), F(_NU), F(_K), F(_S), sizeof(F(_state)), init, step, get};
+const GenSolver F(_bench) = {STR(SOLVER), F(_M), F(_NU), F(_K), F(_S), sizeof(F(_state)), init, step, adaptive,
+                              get};

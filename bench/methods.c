@@ -11,6 +11,8 @@ static const MethodDef methods[] = {
     {"ida", NULL, NULL, ida_integrate},
     {"gsl-rk8pd", NULL, NULL, gsl_rk8pd_integrate},
     {"gsl-rk4imp", NULL, NULL, gsl_rk4imp_integrate},
+    {"hbvm-adaptive", NULL, NULL, hbvm_adaptive_integrate},
+    {"hbvm-poly-adaptive", NULL, NULL, hbvm_poly_adaptive_integrate},
 };
 
 const MethodDef *method_find(const char *name)

@@ -6,6 +6,8 @@
 #                     colour, poly(k,s) (hbvm-poly, order 2s) thick, with
 #                     triangles, in a palette of its own
 #   inv_PROBLEM.png   max |H - H0| and max |g| against CPU seconds
+#                     (hbvm-adaptive, hbvm-poly-adaptive: NAME_step_adaptive over
+#                     tolerances, thick red with diamonds)
 #   iterations.png    mean fixed-point iterations per step against h
 # The series are split out of the CSVs into WORKDIR/*.dat, then drawn by
 # bench/plot.gp.
@@ -27,7 +29,7 @@ POLY_COLORS="#000080 #b22222 #006400 #ff00ff #8b4513"
 # err_g or, for iterations.csv, h, iters_per_step) and list the series as
 # "problem series" lines in order of appearance.
 split() {
-  awk -F, -v w="$W" -v kind="$2" 'NR > 1 {
+  awk -F, -v w="$W" -v kind="$2" 'NR > 1 && !(kind == "it" && $2 ~ /adaptive/) {
     key = $2 ($3 != "" ? "(" $3 "," $4 ")" : "")
     f = w "/" $1 "__" key "." kind ".dat"
     if (!(f in seen)) { seen[f] = 1; print $1, key }
@@ -46,7 +48,10 @@ lists() {
     $1 == prob {
       key = $2; method = key; ks = ""
       if (i = index(key, "(")) { method = substr(key, 1, i - 1); ks = substr(key, i) }
-      if (method == "hbvm-poly") {
+      if (method ~ /-adaptive$/) {
+        c = "#e41a1c"; d = 1; t = (method == "hbvm-poly-adaptive" ? "adaptive poly" : "adaptive") ks
+        pt = 13; lw = 3
+      } else if (method == "hbvm-poly") {
         if (!(ks in pcol)) pcol[ks] = ppal[++npk > npp ? npp : npk]
         c = pcol[ks]; d = 1; t = "poly" ks; pt = 9; lw = 2.5
       } else if (ks != "") {

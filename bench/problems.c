@@ -211,14 +211,22 @@ static void sat_hessq(const double *q, const double *v, double *hq)
  * m=2, nu=0: U = -1/|q|, e = 0.6, q0 = (1 - e, 0), p0 = (0, sqrt((1+e)/(1-e))).
  * Period 2 pi: after whole periods the exact solution is (q0, p0). */
 
-static void kep_init(double *q0, double *p0)
+static void kep_orbit(double e, double *q0, double *p0)
 {
-  const double e = 0.6;
   q0[0] = 1 - e;
   q0[1] = 0;
   p0[0] = 0;
   p0[1] = sqrt((1 + e) / (1 - e));
 }
+
+static void kep_init(double *q0, double *p0) { kep_orbit(0.6, q0, p0); }
+
+/* The eccentric orbits of the adaptive benchmark (bench/adaptive/run.sh):
+ * e = 0.9, and e = 0.99, where the speed at the perihelion is 199 times
+ * that at the aphelion and a step that keeps the error even varies by
+ * ~(1 + e)^(3/2) / (1 - e)^(3/2) ~ 2800x over an orbit. */
+static void kep09_init(double *q0, double *p0) { kep_orbit(0.9, q0, p0); }
+static void kep099_init(double *q0, double *p0) { kep_orbit(0.99, q0, p0); }
 
 static double kep_pot(const double *q) { return -1 / sqrt(q[0] * q[0] + q[1] * q[1]); }
 
@@ -365,6 +373,8 @@ static const Problem problems[] = {
     {"modified", 3, 1, 10, unit_minv, con_init, mod_pot, mod_grad, mod_cons, mod_jac, mod_hessq},
     {"satellites", 9, 3, 10, unit_minv, sat_init, sat_pot, sat_grad, sat_cons, sat_jac, sat_hessq},
     {"kepler", 2, 0, 20 * 3.14159265358979323846, unit_minv, kep_init, kep_pot, kep_grad, NULL, NULL, NULL},
+    {"kepler09", 2, 0, 20 * 3.14159265358979323846, unit_minv, kep09_init, kep_pot, kep_grad, NULL, NULL, NULL},
+    {"kepler099", 2, 0, 4 * 3.14159265358979323846, unit_minv, kep099_init, kep_pot, kep_grad, NULL, NULL, NULL},
     {"chain8", 2 * CHAIN, CHAIN, 5, unit_minv, chain_init, chain_pot, chain_grad, chain_cons, chain_jac,
      chain_hessq},
     {"double_pendulum", 4, 2, 10, unit_minv, dpend_init, dpend_pot, dpend_grad, dpend_cons, dpend_jac,

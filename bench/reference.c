@@ -78,7 +78,7 @@ int reference_final(const Problem *pb, double T, double tol, double *q, double *
 {
   double qq[2 * BENCH_MAXM], pp[2 * BENCH_MAXM], ll[2 * BENCH_MAXNU]; /* t = 0 and t = T */
   int m = pb->m;
-  if (strcmp(pb->name, "kepler") == 0) {
+  if (strncmp(pb->name, "kepler", 6) == 0) {
     double periods = T / (2 * 3.14159265358979323846);
     if (fabs(periods - floor(periods + 0.5)) > 1e-12) return -1;
     pb->init(q, p);

@@ -25,26 +25,9 @@ elapsed() { echo $(($(date +%s) - start)); }
 
 PROBLEMS="pendulum conical modified satellites kepler chain8 double_pendulum"
 
-# Step sizes FROM:TO:FACTOR (h = T/N, N from ceil(T/FROM) doubling), the
-# error at which a line stops (the reference's accuracy), and the h of the
-# callgrind count.
-hrange() {
-  case $1 in
-  pendulum) echo 0.5:1e-5:2 ;;
-  conical) echo 1:1e-4:2 ;;
-  modified) echo 0.2:1e-5:2 ;;
-  satellites) echo 2:1e-3:2 ;;
-  kepler) echo 0.2:1e-4:2 ;;
-  chain8) echo 0.02:1e-5:2 ;;
-  double_pendulum) echo 0.2:1e-5:2 ;;
-  esac
-}
-floor() {
-  case $1 in
-  kepler | conical) echo 1e-13 ;;
-  *) echo 3e-13 ;;
-  esac
-}
+# Step sizes FROM:TO:FACTOR (hrange), the error at which a line stops (floor)
+. bench/common.sh
+# the h of the callgrind count
 count_h() {
   case $1 in
   satellites) echo 0.1 ;;
@@ -139,14 +122,8 @@ while read -r p k s f; do
   "$GEN" --multiplier "$f" -k "$k" -s "$s" -n "$n" -o "$B/gen" "models/$p.ham"
   solvers="$solvers $n"
 done <"$B/configs.txt"
-{
-  echo "/* registry.c - written by bench/run.sh: the generated solvers of this build. */"
-  echo "#include \"hbvm.h\""
-  for n in $solvers; do echo "extern const GenSolver ${n}_bench;"; done
-  echo "const GenSolver *const gen_solvers[] = {"
-  for n in $solvers; do echo "  &${n}_bench,"; done
-  echo "  0};"
-} >"$B/gen/registry.c"
+# shellcheck disable=SC2086
+write_registry bench/run.sh "$B/gen" $solvers
 
 # ---- 2. build
 echo "== building $B/bench ($(elapsed) s)"

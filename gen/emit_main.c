@@ -29,7 +29,11 @@ static void emit_adapters(FILE *f, const char *P) {
           P);
   fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n");
   fprintf(f, "  %s_stats s;\n  int rc = %s_step(x, h, prm, &s);\n", P, P);
-  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  return rc;\n}\n\n");
+  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  return rc;\n}\n\n");
+  fprintf(f, "static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)\n{\n");
+  fprintf(f, "  %s_stats s;\n  int rc = %s_step_adaptive(x, h, tol, prm, &s);\n", P, P);
+  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n"
+             "  st->h = s.h;\n  st->rejected = s.rejected;\n  return rc;\n}\n\n");
 }
 
 // The same for a float solver: the runtime works in double, so it is given
@@ -66,7 +70,13 @@ static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
   fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n"
              "  %s_params r;\n  %s_stats s;\n  int rc;\n  to_real(prm, &r);\n"
              "  rc = %s_step(&((view *)x)->s, (%s_real)h, &r, &s);\n"
-             "  st->iters = s.iters;\n  st->increment = s.increment;\n  sync(x);\n  return rc;\n}\n\n", P, P, P, P);
+             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  sync(x);\n"
+             "  return rc;\n}\n\n", P, P, P, P);
+  fprintf(f, "static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)\n{\n"
+             "  %s_params r;\n  %s_stats s;\n  %s_real hr = (%s_real)*h;\n  int rc;\n  to_real(prm, &r);\n"
+             "  rc = %s_step_adaptive(&((view *)x)->s, &hr, (%s_real)tol, &r, &s);\n  *h = hr;\n"
+             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n"
+             "  st->h = s.h;\n  st->rejected = s.rejected;\n  sync(x);\n  return rc;\n}\n\n", P, P, P, P, P, P);
   fprintf(f, "static double energy(const void *x, const void *prm)\n{\n  %s_params r;\n  to_real(prm, &r);\n"
              "  return %s_energy(&((const view *)x)->s, &r);\n}\n\n", P, P);
   static const char *const fun[2] = {"constraints", "hidden"};
@@ -135,7 +145,7 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    offsetof(%s, t), offsetof(%s, q), offsetof(%s, p), offsetof(%s, lambda),\n", st, st, st, st);
   fprintf(f, "    %d, params, q0, p0,\n", mod->nparams);
   fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
-  fprintf(f, "    init_params, project, %s,\n  };\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
+  fprintf(f, "    init_params, project, %s,\n    step_adaptive,\n  };\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
   if (o->batch) {
     fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
                "batch_step, batch_observe,\n  };\n", P, P);

@@ -54,6 +54,9 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "typedef struct {\n"
           "  int iters;         /* fixed-point iterations */\n"
           "  $P_real increment; /* last scaled increment of the iteration */\n"
+          "  $P_real err_est;   /* estimate of the step's local error in q (max norm) */\n"
+          "  $P_real h;         /* the step taken */\n"
+          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n"
           "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
           " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
@@ -70,6 +73,11 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "void $P_params_default($P_params *prm);\n"
           "/* One step of size h; prm and st may be NULL. Returns $P_OK or an error code. */\n"
           "int $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st);\n"
+          "/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried\n"
+          " * smaller from the unchanged state until it is; on $P_OK *h is the next step\n"
+          " * proposed, st->h the step taken. Fails (x unchanged) only below a step of\n"
+          " * $P_HMIN (1 + |t|). */\n"
+          "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st);\n"
           "const char *$P_strerror(int code);\n"
           "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
           "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
@@ -101,7 +109,8 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
           "#error \"compile without -ffast-math (docs/api.md), or define $P_ALLOW_FAST_MATH\"\n"
           "#endif\n\n"
           "/* Limits of the iteration; each can be set with -D (docs/api.md). */\n"
-          "#ifndef $P_MAXITER\n#define $P_MAXITER 100  /* fixed-point iterations before giving up */\n#endif\n");
+          "#ifndef $P_MAXITER\n#define $P_MAXITER 100  /* fixed-point iterations before giving up */\n#endif\n"
+          "#define $P_EREJECT (-1)  /* internal: a step over the tolerance of $P_step_adaptive */\n");
   static const char *const limits[2][5][2] = {
       {{"TOL", "4.4408920985006262e-16  /* an increment within 2 ulps ... */"},
        {"NOISETOL", "1.4210854715202004e-14  /* a stall at or below this (64 ulps) is round-off: converged */"},
@@ -324,6 +333,27 @@ static void emit_all_finite(Emitter *e, int n) {
   tmpl(e, ") rc = $P_ENONFINITE;\n");
 }
 
+// After the first sweep: d1, the predictor's error (the increment; after the
+// two-step start, the one-step start's miss, which the estimate is built on),
+// and the error estimate, with which NAME_step_adaptive rejects a step the
+// first sweep already puts over its tolerance rather than after the
+// iteration has converged. gamma (gm0, ... in the fused step) is the sweep's.
+static void emit_first_sweep(Emitter *e) {
+  tmpl(e, "    if (it == 1) {\n      d1 = inc;  /* the predictor's error, for $P_err_est */\n");
+  if (e->fused)
+    for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
+  if (e->st->kern[K_FACTOR].nout)
+    tmpl(e, "      if (two)  /* the two-step start: the one-step start's miss */\n"
+            "        for (d1 = 0, i = 0; i < $P_S * $P_M; i++) {\n"
+            "          $R v = fabs$g(h * (gam[i] - ref[i]));\n"
+            "          if (v > d1) d1 = v;\n        }\n");
+  tmpl(e, "      est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
+          "      if (tol > 0 && !(est <= tol * (1 + scale))) {\n"
+          "        if (st) {\n          st->iters = 1;\n          st->increment = inc;\n"
+          "          st->err_est = est;\n          st->h = h;\n          st->rejected = 0;\n        }\n"
+          "        return $P_EREJECT;\n      }\n    }\n");
+}
+
 // The fused step's locals: gamma as gm0, gm1, ... (from the predicted
 // gam[]), the sweep's results as sw0, sw1, ... and, for the polynomial
 // family, the multiplier's coefficients as lm0, lm1, ...
@@ -366,7 +396,9 @@ static void emit_fused_sweep(Emitter *e) {
     tmplf(e, "      v = fabs$g(h * (sw%d - gm%d));\n      if (v > inc) inc = v;\n", g + i, i);
     out(e, "      gm%d = sw%d;\n", i, g + i);
   }
-  out(e, "    }\n    if (scale > 0) inc /= scale;\n");
+  out(e, "    }\n");
+  emit_first_sweep(e);
+  out(e, "    if (scale > 0) inc /= scale;\n");
 }
 
 // The plain step's sweep (a call), increment and the checks of its results.
@@ -384,8 +416,9 @@ static void emit_sweep_checks(Emitter *e) {
           "    for (i = 0; i < $P_S * $P_M; i++) {\n"
           "      $R v = fabs$g(h * (sw[$[sweep.gam]i] - gam[i]));\n"
           "      if (v > inc) inc = v;\n"
-          "      gam[i] = sw[$[sweep.gam]i];\n    }\n"
-          "    if (scale > 0) inc /= scale;\n");
+          "      gam[i] = sw[$[sweep.gam]i];\n    }\n");
+  emit_first_sweep(e);
+  tmpl(e, "    if (scale > 0) inc /= scale;\n");
   if (poly)
     tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
             "    for (i = 0; i < $<sweep>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
@@ -467,32 +500,118 @@ static void emit_end_const(Emitter *e) {
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
+// The order of the step in q and p: 2s, but 2 for the constant multiplier
+// with constraints (docs/api.md).
+static int step_order(const Emitter *e) {
+  return e->mod->nu && e->st->kern[K_FACTOR].nout == 0 ? 2 : 2 * e->me->s;
+}
+
+// The constant of NAME_err_est: the geometric mean of true / estimate over
+// the problems of tests/check_errest.c (docs/api.md), by s for the order 2s
+// and for the constant multiplier's order 2 (s = 2; s >= 3).
+static double err_constant(const Emitter *e) {
+  static const double order2s[] = {0.068, 8.7e-3, 5.1e-4, 2.8e-5}, order2[] = {0.068, 5.6e-4, 1.5e-3};
+  int s = e->me->s;
+  if (step_order(e) == 2) return order2[s < 3 ? s - 1 : 2];
+  return order2s[s < 4 ? s - 1 : 3];
+}
+
+// NAME_err_est: the local error estimate of a converged step from what the
+// step has anyway (docs/api.md, "The local error estimate"). The Legendre
+// coefficients of the velocity of a smooth solution fall like
+// |gamma_j| ~ |v| rho^j, rho ~ h / (its time scale), and the local error of
+// the order p is ~ h |v| rho^p. The predictor's error d1 (the first sweep's
+// increment) is the first coefficient the extrapolation lacks,
+// d1 ~ h |v| rho^s, so with v = max |gamma_0| (a norm over the whole vector)
+//   local error ~ h |v| (d1 / |h v|)^(p/s)  (d1^2 / |h v| for p = 2s).
+// Where the velocity vanishes (a pendulum's turning point) this is too large,
+// never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
+// The first step after NAME_init has no warm start (its predictor is
+// gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
+// is the whole velocity): there, at s >= 2, rho is the decay of the two
+// highest coefficients, and the estimate h |gamma_{s-1}| rho^(p-s+1), or,
+// when larger and d1 < |h v| / 4, |h v| (d1 / |h v|)^p (d1 as the miss of the
+// degree-1 coefficient; the decay alone is far too low at Kepler's perihelion,
+// where the coefficients of the odd component fall faster than rho^j; from
+// rest d1 ~ |h v| and this term would reject every step down to h ~ tol).
+// With p < s (the constant multiplier at s >= 3) the coefficient h |gamma_p|
+// itself is of the order of the local error.
+static void emit_err_est(Emitter *e) {
+  int p = step_order(e), s = e->me->s;
+  const char *g = math_suffix(e, e->wide_step);
+  tmpl(e, "/* max |gamma_j| over the coordinates */\n"
+          "static $R $P_coef(const $W *gam, int j)\n{\n  $R c = 0;\n  int i;\n  for (i = 0; i < $P_M; i++)\n");
+  out(e, "    if (fabs%s(gam[j * %s_M + i]) > c) c = (%s)fabs%s(gam[j * %s_M + i]);\n  return c;\n}\n\n", g, e->P,
+      real_type(e, 0), g, e->P);
+  tmpl(e, "/* The local error estimate of a step (max norm in q) from its converged gamma and\n"
+          " * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:\n");
+  if (p >= s)
+    out(e, " * |h v| (d1 / |h v|)^(%d/%d), v = gamma_0 (docs/api.md). */\n", p, s);
+  else
+    out(e, " * max |h gamma_%d|, the Legendre coefficient of degree %d, the order (docs/api.md). */\n", p, p);
+  tmpl(e, "#ifndef $P_ERRC\n");
+  char c[40];
+  format_real(e, c, sizeof c, err_constant(e));
+  out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
+  tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v, r;\n  int i;\n");
+  if (p < s) {
+    out(e, "  (void)d1;\n  (void)v;\n  (void)r;\n  (void)i;\n  (void)cold;\n  return %s_ERRC * fabs%s(h) * %s_coef(gam, %d);\n}\n\n",
+        e->P, math_suffix(e, 0), e->P, p);
+    return;
+  }
+  tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
+  if (s >= 2) {
+    out(e, "  if (cold) {  /* no warm start: the decay of the two highest coefficients, */\n"
+           "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d), w = 0;\n", real_type(e, 0), e->P, s - 1, e->P, s - 2);
+    tmpl(e, "    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;\n"
+            "                      * not from rest, where d1 ~ |h v| */\n"
+            "      r = d1 / v;\n      w = $P_ERRC * v;\n");
+    out(e, "      for (i = 0; i < %d; i++) w *= r;\n    }\n", p);
+    tmpl(e, "    if (!(b > c)) return c > 0 ? d1 : w;\n    r = c / b;\n    v = $P_ERRC * fabs$f(h) * c;\n");
+    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v > w ? v : w;\n  }\n", p - s + 1);
+  } else
+    tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");
+  tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
+  /* p is 2s, or 2 at s = 2 (the constant multiplier): p / s is whole */
+  tmpl(e, "  v *= $P_ERRC;\n");
+  out(e, "  for (i = 0; i < %d; i++) v *= r;\n  return v;\n}\n\n", p / s);
+}
+
 // NAME_predict (the warm start) and NAME_add (the compensated sum) for the step.
 static void emit_predict(Emitter *e) {
   tmpl(e, "\n/* gamma for a step of size h: extrapolated from the last two steps' polynomials\n"
           " * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,\n"
-          " * gamma_j = 0 (j > 0) on the first step. */\n"
-          "static void $P_predict(const $P_state *x, $R h, const $P_params *prm, $R *gam)\n{\n"
-          "  int i, j, l, d;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n"
-          "  if (x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n");
+          " * gamma_j = 0 (j > 0) on the first step or when cold. */\n");
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  if (poly)
+    tmpl(e, "/* Returns 1 when gam is the two-step start, ref then the one-step one (whose error\n"
+            " * $P_err_est needs), else 0. */\n"
+            "static int $P_predict(const $P_state *x, $R h, int cold, const $P_params *prm, $R *gam, $R *ref)\n{\n");
+  else
+    tmpl(e, "static void $P_predict(const $P_state *x, $R h, int cold, const $P_params *prm, $R *gam)\n{\n");
+  tmpl(e, "  int i, j, l, d;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n");
+  tmpl(e, poly ? "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return 0;\n  }\n"
+               : "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n");
   /* The two-step start saves 7-25% of the sweeps (bench/README.md), in the
    * polynomial family only: it changes where the iteration stops, and the
    * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
    * (pendulum, h = 0.1); the polynomial family restores H every step. */
-  if (e->st->kern[K_FACTOR].nout)
-    tmpl(e, "  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */\n"
-            "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++)\n"
-            "        for (l = 0; l < $P_M; l++)\n"
-            "          gam[j * $P_M + l] += $P_E2[2 * $P_S * j + i] * x->gam[i * $P_M + l] +\n"
-            "                               $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[i * $P_M + l];\n"
-            "    return;\n  }\n");
   tmpl(e, "  for (j = 0; j < $P_S; j++)\n    for (i = 0; i < $P_S; i++) {\n"
           "      $R r = h / x->hprev, e = 0;\n"
           "      if (h == x->hprev)\n        e = $P_E1[j * $P_S + i];\n      else\n"
           "        for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
           "      if (e != 0)\n        for (l = 0; l < $P_M; l++) gam[j * $P_M + l] += e * x->gam[i * $P_M + l];\n"
-          "    }\n}\n\n");
+          "    }\n");
+  if (poly)
+    tmpl(e, "  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */\n"
+            "    for (i = 0; i < $P_S * $P_M; i++) {\n      ref[i] = gam[i];\n      gam[i] = 0;\n    }\n"
+            "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++)\n"
+            "        for (l = 0; l < $P_M; l++)\n"
+            "          gam[j * $P_M + l] += $P_E2[2 * $P_S * j + i] * x->gam[i * $P_M + l] +\n"
+            "                               $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[i * $P_M + l];\n"
+            "    return 1;\n  }\n  return 0;\n");
+  tmpl(e, "}\n\n");
   if (e->compensated)
     tmpl(e, "/* a += b with the rounding error carried in *c (Kahan). */\n"
             "static void $P_add($R *a, $R *c, $R b)\n{\n"
@@ -509,24 +628,27 @@ static void emit_predict(Emitter *e) {
 static void emit_step(Emitter *e) {
   int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
   emit_predict(e);
+  emit_err_est(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "int $P_step($P_state *x, $P_real h_, const $P_params *prm, $P_stats *st)\n{\n"
+          "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
-          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;\n"
+          "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;\n"
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
-  if (wide)
+  if (poly) tmpl(e, "  $R ref[$P_S * $P_M];\n  int two;\n");
+  if (wide) {
     tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
-            "  {\n    $R guess[$P_S * $P_M];\n    $P_predict(x, h, prm, guess);\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
+            "  {\n    $R guess[$P_S * $P_M];\n");
+    tmpl(e, poly ? "    two = $P_predict(x, h, cold, prm, guess, ref);\n" : "    $P_predict(x, h, cold, prm, guess);\n");
+    tmpl(e, "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
             "  /* the sweep starts from the compensated state q - qc, p - pc, in $W */\n"
             "  for (i = 0; i < $P_M; i++) {\n"
             "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
             "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
-  else
-    tmpl(e, "  $P_predict(x, h, prm, gam);\n");
+  } else
+    tmpl(e, poly ? "  two = $P_predict(x, h, cold, prm, gam, ref);\n" : "  $P_predict(x, h, cold, prm, gam);\n");
   if (e->mod->nu)
     tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
             "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
@@ -560,8 +682,12 @@ static void emit_step(Emitter *e) {
     for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "  gam[%d] = gm%d;\n", i, i);
     for (int i = 0; i < kernel_size(&e->st->kern[K_SWEEP]); i++) out(e, "  sw[%d] = sw%d;\n", i, i);
   }
-  tmpl(e, "  if (st) { st->iters = it > $P_MAXITER ? $P_MAXITER : it; st->increment = inc; }\n"
+  tmpl(e, "  est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
+          "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
+          "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
+          "  /* $P_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */\n"
+          "  if (tol > 0 && !(est <= tol * (1 + scale))) return $P_EREJECT;\n"
           "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
   if (poly) {
     emit_end_poly(e);
@@ -651,6 +777,54 @@ static void emit_project(Emitter *e) {
   tmpl(e, "  if (dq) *dq = dqmax;\n  if (dp) *dp = dpmax;\n  return $P_OK;\n}\n");
 }
 
+// NAME_step_adaptive: NAME_step with its error estimate tested before the
+// commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
+// and relative at once, so that the errors of the steps up to T add up to
+// about tol T, whatever their number), else retried from the unchanged state
+// with a smaller step. The next step from the standard controller of
+// Hairer, Norsett and Wanner (I.II.4) for an error of order h^p per unit
+// step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
+// rejection. A failed step is retried with half the step. After three tries
+// over the tolerance the tries start cold (no warm start): the warm start
+// carries the previous step's error into the estimate at every h.
+static void emit_step_adaptive(Emitter *e) {
+  tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
+          "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");
+  out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
+      e->P, e->P, e->single ? "1e-5f" : "1e-12");
+  out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
+      e->P, e->P, e->single ? "0.01f" : "0.01");
+  out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
+  tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
+          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0, misses = 0;\n"
+          "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
+          "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
+          "  tol *= $P_TOLC;\n"
+          "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
+          "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
+          "     * previous step's error, which no smaller h removes from the estimate */\n"
+          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, &s);\n"
+          "    if (rc == $P_EREJECT) misses++;\n"
+          "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
+          "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
+          "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");
+  tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n        int i;\n"
+          "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "        err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n      }\n");
+  out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
+      real_type(e, 0), step_order(e));
+  tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n"
+          "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
+          "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
+          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n        }\n"
+          "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
+          "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
+          "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
+          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n      }\n"
+          "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
+}
+
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {.f = hf, .mod = mod, .me = me, .st = st, .P = o->name, .single = o->single,
@@ -663,6 +837,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_kernels(&e);
   emit_public(&e);
   emit_step(&e);
+  emit_step_adaptive(&e);
   emit_project(&e);
   if (o->batch) emit_batch_source(&e, o->batch);
   free(e.temp);

@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   conical_k1s1_real increment; /* last scaled increment of the iteration */
+  conical_k1s1_real err_est;   /* estimate of the step's local error in q (max norm) */
+  conical_k1s1_real h;         /* the step taken */
+  int rejected;      /* conical_k1s1_step_adaptive: tries rejected before it */
 } conical_k1s1_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int conical_k1s1_project(conical_k1s1_state *x, const conical_k1s1_params *prm, 
 void conical_k1s1_params_default(conical_k1s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_k1s1_OK or an error code. */
 int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_k1s1_params *prm, conical_k1s1_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on conical_k1s1_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * conical_k1s1_HMIN (1 + |t|). */
+int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, conical_k1s1_real tol, const conical_k1s1_params *prm, conical_k1s1_stats *st);
 const char *conical_k1s1_strerror(int code);
 conical_k1s1_real conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm);
 void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *g);   /* conical_k1s1_NU values */

@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   conical_k3s3_real increment; /* last scaled increment of the iteration */
+  conical_k3s3_real err_est;   /* estimate of the step's local error in q (max norm) */
+  conical_k3s3_real h;         /* the step taken */
+  int rejected;      /* conical_k3s3_step_adaptive: tries rejected before it */
 } conical_k3s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int conical_k3s3_project(conical_k3s3_state *x, const conical_k3s3_params *prm, 
 void conical_k3s3_params_default(conical_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_k3s3_OK or an error code. */
 int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h, const conical_k3s3_params *prm, conical_k3s3_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on conical_k3s3_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * conical_k3s3_HMIN (1 + |t|). */
+int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, conical_k3s3_real tol, const conical_k3s3_params *prm, conical_k3s3_stats *st);
 const char *conical_k3s3_strerror(int code);
 conical_k3s3_real conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm);
 void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *g);   /* conical_k3s3_NU values */

@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   conical_k4s4_real increment; /* last scaled increment of the iteration */
+  conical_k4s4_real err_est;   /* estimate of the step's local error in q (max norm) */
+  conical_k4s4_real h;         /* the step taken */
+  int rejected;      /* conical_k4s4_step_adaptive: tries rejected before it */
 } conical_k4s4_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int conical_k4s4_project(conical_k4s4_state *x, const conical_k4s4_params *prm, 
 void conical_k4s4_params_default(conical_k4s4_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_k4s4_OK or an error code. */
 int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_k4s4_params *prm, conical_k4s4_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on conical_k4s4_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * conical_k4s4_HMIN (1 + |t|). */
+int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, conical_k4s4_real tol, const conical_k4s4_params *prm, conical_k4s4_stats *st);
 const char *conical_k4s4_strerror(int code);
 conical_k4s4_real conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm);
 void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *g);   /* conical_k4s4_NU values */

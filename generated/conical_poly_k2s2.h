@@ -38,6 +38,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   conical_poly_k2s2_real increment; /* last scaled increment of the iteration */
+  conical_poly_k2s2_real err_est;   /* estimate of the step's local error in q (max norm) */
+  conical_poly_k2s2_real h;         /* the step taken */
+  int rejected;      /* conical_poly_k2s2_step_adaptive: tries rejected before it */
 } conical_poly_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -54,6 +57,11 @@ int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s
 void conical_poly_k2s2_params_default(conical_poly_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns conical_poly_k2s2_OK or an error code. */
 int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on conical_poly_k2s2_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * conical_poly_k2s2_HMIN (1 + |t|). */
+int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s2_real *h, conical_poly_k2s2_real tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
 const char *conical_poly_k2s2_strerror(int code);
 conical_poly_k2s2_real conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
 void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *g);   /* conical_poly_k2s2_NU values */

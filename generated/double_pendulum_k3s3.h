@@ -38,6 +38,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   double_pendulum_k3s3_real increment; /* last scaled increment of the iteration */
+  double_pendulum_k3s3_real err_est;   /* estimate of the step's local error in q (max norm) */
+  double_pendulum_k3s3_real h;         /* the step taken */
+  int rejected;      /* double_pendulum_k3s3_step_adaptive: tries rejected before it */
 } double_pendulum_k3s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -54,6 +57,11 @@ int double_pendulum_k3s3_project(double_pendulum_k3s3_state *x, const double_pen
 void double_pendulum_k3s3_params_default(double_pendulum_k3s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns double_pendulum_k3s3_OK or an error code. */
 int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on double_pendulum_k3s3_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * double_pendulum_k3s3_HMIN (1 + |t|). */
+int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, double_pendulum_k3s3_real tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
 const char *double_pendulum_k3s3_strerror(int code);
 double_pendulum_k3s3_real double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm);
 void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *g);   /* double_pendulum_k3s3_NU values */

@@ -14,6 +14,7 @@
 #ifndef double_pendulum_k4s4_MAXITER
 #define double_pendulum_k4s4_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define double_pendulum_k4s4_EREJECT (-1)  /* internal: a step over the tolerance of double_pendulum_k4s4_step_adaptive */
 #ifndef double_pendulum_k4s4_TOL
 #define double_pendulum_k4s4_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -2936,22 +2937,16 @@ void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const doub
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, double h, const double_pendulum_k4s4_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+/* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
+ * double_pendulum_k4s4_err_est needs), else 0. */
+static int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, double h, int cold, const double_pendulum_k4s4_params *prm, double *gam, double *ref)
 {
   int i, j, l, d;
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     double_pendulum_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < double_pendulum_k4s4_S; j++)
-      for (i = 0; i < double_pendulum_k4s4_S; i++)
-        for (l = 0; l < double_pendulum_k4s4_M; l++)
-          gam[j * double_pendulum_k4s4_M + l] += double_pendulum_k4s4_E2[2 * double_pendulum_k4s4_S * j + i] * x->gam[i * double_pendulum_k4s4_M + l] +
-                               double_pendulum_k4s4_E2[2 * double_pendulum_k4s4_S * j + double_pendulum_k4s4_S + i] * x->gam2[i * double_pendulum_k4s4_M + l];
-    return;
+    return 0;
   }
   for (j = 0; j < double_pendulum_k4s4_S; j++)
     for (i = 0; i < double_pendulum_k4s4_S; i++) {
@@ -2963,6 +2958,19 @@ static void double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, do
       if (e != 0)
         for (l = 0; l < double_pendulum_k4s4_M; l++) gam[j * double_pendulum_k4s4_M + l] += e * x->gam[i * double_pendulum_k4s4_M + l];
     }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
+      ref[i] = gam[i];
+      gam[i] = 0;
+    }
+    for (j = 0; j < double_pendulum_k4s4_S; j++)
+      for (i = 0; i < double_pendulum_k4s4_S; i++)
+        for (l = 0; l < double_pendulum_k4s4_M; l++)
+          gam[j * double_pendulum_k4s4_M + l] += double_pendulum_k4s4_E2[2 * double_pendulum_k4s4_S * j + i] * x->gam[i * double_pendulum_k4s4_M + l] +
+                               double_pendulum_k4s4_E2[2 * double_pendulum_k4s4_S * j + double_pendulum_k4s4_S + i] * x->gam2[i * double_pendulum_k4s4_M + l];
+    return 1;
+  }
+  return 0;
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */
@@ -2973,17 +2981,61 @@ static void double_pendulum_k4s4_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double double_pendulum_k4s4_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < double_pendulum_k4s4_M; i++)
+    if (fabs(gam[j * double_pendulum_k4s4_M + i]) > c) c = (double)fabs(gam[j * double_pendulum_k4s4_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(8/4), v = gamma_0 (docs/api.md). */
+#ifndef double_pendulum_k4s4_ERRC
+#define double_pendulum_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
+#endif
+static double double_pendulum_k4s4_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * double_pendulum_k4s4_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = double_pendulum_k4s4_coef(gam, 3), b = double_pendulum_k4s4_coef(gam, 2), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = double_pendulum_k4s4_ERRC * v;
+      for (i = 0; i < 8; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
+    r = c / b;
+    v = double_pendulum_k4s4_ERRC * fabs(h) * c;
+    for (i = 0; i < 5; i++) v *= r;
+    return v > w ? v : w;
+  }
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= double_pendulum_k4s4_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
+static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, int cold, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k4s4_ENOCONV;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k4s4_EBADSTEP;
-  double_pendulum_k4s4_predict(x, h, prm, gam);
+  double ref[double_pendulum_k4s4_S * double_pendulum_k4s4_M];
+  int two;
+  two = double_pendulum_k4s4_predict(x, h, cold, prm, gam, ref);
   double g0[double_pendulum_k4s4_NU];
   double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -4125,6 +4177,41 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
       if (v > inc) inc = v;
       gm15 = sw15;
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for double_pendulum_k4s4_err_est */
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
+      gam[6] = gm6;
+      gam[7] = gm7;
+      gam[8] = gm8;
+      gam[9] = gm9;
+      gam[10] = gm10;
+      gam[11] = gm11;
+      gam[12] = gm12;
+      gam[13] = gm13;
+      gam[14] = gm14;
+      gam[15] = gm15;
+      if (two)  /* the two-step start: the one-step start's miss */
+        for (d1 = 0, i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
+          double v = fabs(h * (gam[i] - ref[i]));
+          if (v > d1) d1 = v;
+        }
+      est = double_pendulum_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return double_pendulum_k4s4_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     lm0 = sw20;
     lm1 = sw21;
@@ -4199,8 +4286,17 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
   sw[25] = sw25;
   sw[26] = sw26;
   sw[27] = sw27;
-  if (st) { st->iters = it > double_pendulum_k4s4_MAXITER ? double_pendulum_k4s4_MAXITER : it; st->increment = inc; }
+  est = double_pendulum_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > double_pendulum_k4s4_MAXITER ? double_pendulum_k4s4_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != double_pendulum_k4s4_OK) return rc;
+  /* double_pendulum_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k4s4_ENONFINITE;
   double q1[double_pendulum_k4s4_M], p1[double_pendulum_k4s4_M], pr[double_pendulum_k4s4_M + 2 + 2 * double_pendulum_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k4s4_energy(x, prm);
@@ -4253,6 +4349,78 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
   x->hprev2 = x->hprev;
   x->hprev = h;
   return double_pendulum_k4s4_OK;
+}
+
+int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
+{
+  return double_pendulum_k4s4_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef double_pendulum_k4s4_HMIN
+#define double_pendulum_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef double_pendulum_k4s4_TOLC
+#define double_pendulum_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 8 (error per unit step). */
+int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real *h, double_pendulum_k4s4_real tol, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
+{
+  double_pendulum_k4s4_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return double_pendulum_k4s4_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return double_pendulum_k4s4_EBADSTEP;
+  tol *= double_pendulum_k4s4_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = double_pendulum_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == double_pendulum_k4s4_EREJECT) misses++;
+    if (rc == double_pendulum_k4s4_OK || rc == double_pendulum_k4s4_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == double_pendulum_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == double_pendulum_k4s4_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < double_pendulum_k4s4_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 8) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == double_pendulum_k4s4_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return double_pendulum_k4s4_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < double_pendulum_k4s4_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != double_pendulum_k4s4_EREJECT ? rc : double_pendulum_k4s4_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   henon_heiles_k2s2_real increment; /* last scaled increment of the iteration */
+  henon_heiles_k2s2_real err_est;   /* estimate of the step's local error in q (max norm) */
+  henon_heiles_k2s2_real h;         /* the step taken */
+  int rejected;      /* henon_heiles_k2s2_step_adaptive: tries rejected before it */
 } henon_heiles_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int henon_heiles_k2s2_project(henon_heiles_k2s2_state *x, const henon_heiles_k2s
 void henon_heiles_k2s2_params_default(henon_heiles_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns henon_heiles_k2s2_OK or an error code. */
 int henon_heiles_k2s2_step(henon_heiles_k2s2_state *x, henon_heiles_k2s2_real h, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on henon_heiles_k2s2_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * henon_heiles_k2s2_HMIN (1 + |t|). */
+int henon_heiles_k2s2_step_adaptive(henon_heiles_k2s2_state *x, henon_heiles_k2s2_real *h, henon_heiles_k2s2_real tol, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_stats *st);
 const char *henon_heiles_k2s2_strerror(int code);
 henon_heiles_k2s2_real henon_heiles_k2s2_energy(const henon_heiles_k2s2_state *x, const henon_heiles_k2s2_params *prm);
 void henon_heiles_k2s2_constraints(const henon_heiles_k2s2_state *x, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_real *g);   /* henon_heiles_k2s2_NU values */

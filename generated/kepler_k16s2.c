@@ -14,6 +14,7 @@
 #ifndef kepler_k16s2_MAXITER
 #define kepler_k16s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define kepler_k16s2_EREJECT (-1)  /* internal: a step over the tolerance of kepler_k16s2_step_adaptive */
 #ifndef kepler_k16s2_TOL
 #define kepler_k16s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -145,12 +146,12 @@ void kepler_k16s2_hidden(const kepler_k16s2_state *x, const kepler_k16s2_params 
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void kepler_k16s2_predict(const kepler_k16s2_state *x, double h, const kepler_k16s2_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+static void kepler_k16s2_predict(const kepler_k16s2_state *x, double h, int cold, const kepler_k16s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     kepler_k16s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -174,17 +175,59 @@ static void kepler_k16s2_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double kepler_k16s2_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < kepler_k16s2_M; i++)
+    if (fabs(gam[j * kepler_k16s2_M + i]) > c) c = (double)fabs(gam[j * kepler_k16s2_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(4/2), v = gamma_0 (docs/api.md). */
+#ifndef kepler_k16s2_ERRC
+#define kepler_k16s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
+#endif
+static double kepler_k16s2_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * kepler_k16s2_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = kepler_k16s2_coef(gam, 1), b = kepler_k16s2_coef(gam, 0), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = kepler_k16s2_ERRC * v;
+      for (i = 0; i < 4; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
+    r = c / b;
+    v = kepler_k16s2_ERRC * fabs(h) * c;
+    for (i = 0; i < 3; i++) v *= r;
+    return v > w ? v : w;
+  }
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= kepler_k16s2_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(16,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h_, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
+static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_, double tol, int cold, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
 {
   const double h = (double)h_;
   double gam[kepler_k16s2_S * kepler_k16s2_M], sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + 3 * kepler_k16s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k16s2_ENOCONV;
   kepler_k16s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return kepler_k16s2_EBADSTEP;
-  kepler_k16s2_predict(x, h, prm, gam);
+  kepler_k16s2_predict(x, h, cold, prm, gam);
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
@@ -725,6 +768,24 @@ int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h_, const kepler_
       if (v > inc) inc = v;
       gm3 = sw3;
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for kepler_k16s2_err_est */
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      est = kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return kepler_k16s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5)) rc = kepler_k16s2_ENONFINITE;
     if (rc == kepler_k16s2_ENONFINITE || !isfinite(inc)) { rc = kepler_k16s2_ENONFINITE; break; }
@@ -755,8 +816,17 @@ int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h_, const kepler_
   sw[3] = sw3;
   sw[4] = sw4;
   sw[5] = sw5;
-  if (st) { st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it; st->increment = inc; }
+  est = kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != kepler_k16s2_OK) return rc;
+  /* kepler_k16s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k16s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k16s2_ENONFINITE;
   for (i = 0; i < kepler_k16s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k16s2_S * kepler_k16s2_M + i]) ||
@@ -775,6 +845,78 @@ int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h_, const kepler_
   x->hprev2 = x->hprev;
   x->hprev = h;
   return kepler_k16s2_OK;
+}
+
+int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
+{
+  return kepler_k16s2_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef kepler_k16s2_HMIN
+#define kepler_k16s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef kepler_k16s2_TOLC
+#define kepler_k16s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 4 (error per unit step). */
+int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepler_k16s2_real tol, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
+{
+  kepler_k16s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return kepler_k16s2_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return kepler_k16s2_EBADSTEP;
+  tol *= kepler_k16s2_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = kepler_k16s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == kepler_k16s2_EREJECT) misses++;
+    if (rc == kepler_k16s2_OK || rc == kepler_k16s2_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == kepler_k16s2_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == kepler_k16s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < kepler_k16s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 4) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == kepler_k16s2_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return kepler_k16s2_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < kepler_k16s2_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != kepler_k16s2_EREJECT ? rc : kepler_k16s2_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

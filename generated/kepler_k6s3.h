@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   kepler_k6s3_real increment; /* last scaled increment of the iteration */
+  kepler_k6s3_real err_est;   /* estimate of the step's local error in q (max norm) */
+  kepler_k6s3_real h;         /* the step taken */
+  int rejected;      /* kepler_k6s3_step_adaptive: tries rejected before it */
 } kepler_k6s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int kepler_k6s3_project(kepler_k6s3_state *x, const kepler_k6s3_params *prm, kep
 void kepler_k6s3_params_default(kepler_k6s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns kepler_k6s3_OK or an error code. */
 int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h, const kepler_k6s3_params *prm, kepler_k6s3_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on kepler_k6s3_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * kepler_k6s3_HMIN (1 + |t|). */
+int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_k6s3_real tol, const kepler_k6s3_params *prm, kepler_k6s3_stats *st);
 const char *kepler_k6s3_strerror(int code);
 kepler_k6s3_real kepler_k6s3_energy(const kepler_k6s3_state *x, const kepler_k6s3_params *prm);
 void kepler_k6s3_constraints(const kepler_k6s3_state *x, const kepler_k6s3_params *prm, kepler_k6s3_real *g);   /* kepler_k6s3_NU values */

@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   modified_k3s1_real increment; /* last scaled increment of the iteration */
+  modified_k3s1_real err_est;   /* estimate of the step's local error in q (max norm) */
+  modified_k3s1_real h;         /* the step taken */
+  int rejected;      /* modified_k3s1_step_adaptive: tries rejected before it */
 } modified_k3s1_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *pr
 void modified_k3s1_params_default(modified_k3s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k3s1_OK or an error code. */
 int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modified_k3s1_params *prm, modified_k3s1_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on modified_k3s1_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * modified_k3s1_HMIN (1 + |t|). */
+int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st);
 const char *modified_k3s1_strerror(int code);
 modified_k3s1_real modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm);
 void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *g);   /* modified_k3s1_NU values */

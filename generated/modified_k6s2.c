@@ -14,6 +14,7 @@
 #ifndef modified_k6s2_MAXITER
 #define modified_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define modified_k6s2_EREJECT (-1)  /* internal: a step over the tolerance of modified_k6s2_step_adaptive */
 #ifndef modified_k6s2_TOL
 #define modified_k6s2_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -274,12 +275,12 @@ void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_para
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void modified_k6s2_predict(const modified_k6s2_state *x, double h, const modified_k6s2_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+static void modified_k6s2_predict(const modified_k6s2_state *x, double h, int cold, const modified_k6s2_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     modified_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -303,17 +304,59 @@ static void modified_k6s2_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double modified_k6s2_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < modified_k6s2_M; i++)
+    if (fabs(gam[j * modified_k6s2_M + i]) > c) c = (double)fabs(gam[j * modified_k6s2_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(2/2), v = gamma_0 (docs/api.md). */
+#ifndef modified_k6s2_ERRC
+#define modified_k6s2_ERRC 0.00055999999999999995  /* measured: docs/api.md */
+#endif
+static double modified_k6s2_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * modified_k6s2_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = modified_k6s2_coef(gam, 1), b = modified_k6s2_coef(gam, 0), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = modified_k6s2_ERRC * v;
+      for (i = 0; i < 2; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
+    r = c / b;
+    v = modified_k6s2_ERRC * fabs(h) * c;
+    for (i = 0; i < 1; i++) v *= r;
+    return v > w ? v : w;
+  }
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= modified_k6s2_ERRC;
+  for (i = 0; i < 1; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modified_k6s2_params *prm, modified_k6s2_stats *st)
+static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real h_, double tol, int cold, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
   double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k6s2_ENOCONV;
   modified_k6s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_k6s2_EBADSTEP;
-  modified_k6s2_predict(x, h, prm, gam);
+  modified_k6s2_predict(x, h, cold, prm, gam);
   double g0[modified_k6s2_NU];
   modified_k6s2_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -629,6 +672,26 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
       if (v > inc) inc = v;
       gm5 = sw5;
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for modified_k6s2_err_est */
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
+      est = modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return modified_k6s2_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     {
       double piv = sw10, dia = sw11;
@@ -673,8 +736,17 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
   sw[9] = sw9;
   sw[10] = sw10;
   sw[11] = sw11;
-  if (st) { st->iters = it > modified_k6s2_MAXITER ? modified_k6s2_MAXITER : it; st->increment = inc; }
+  est = modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > modified_k6s2_MAXITER ? modified_k6s2_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != modified_k6s2_OK) return rc;
+  /* modified_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k6s2_ENONFINITE;
   for (i = 0; i < modified_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k6s2_S * modified_k6s2_M + i]) ||
@@ -693,6 +765,78 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h_, const modi
   x->hprev2 = x->hprev;
   x->hprev = h;
   return modified_k6s2_OK;
+}
+
+int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h, const modified_k6s2_params *prm, modified_k6s2_stats *st)
+{
+  return modified_k6s2_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef modified_k6s2_HMIN
+#define modified_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef modified_k6s2_TOLC
+#define modified_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
+int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, modified_k6s2_real tol, const modified_k6s2_params *prm, modified_k6s2_stats *st)
+{
+  modified_k6s2_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return modified_k6s2_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return modified_k6s2_EBADSTEP;
+  tol *= modified_k6s2_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = modified_k6s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == modified_k6s2_EREJECT) misses++;
+    if (rc == modified_k6s2_OK || rc == modified_k6s2_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == modified_k6s2_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == modified_k6s2_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < modified_k6s2_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == modified_k6s2_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return modified_k6s2_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < modified_k6s2_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != modified_k6s2_EREJECT ? rc : modified_k6s2_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

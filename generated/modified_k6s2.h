@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   modified_k6s2_real increment; /* last scaled increment of the iteration */
+  modified_k6s2_real err_est;   /* estimate of the step's local error in q (max norm) */
+  modified_k6s2_real h;         /* the step taken */
+  int rejected;      /* modified_k6s2_step_adaptive: tries rejected before it */
 } modified_k6s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int modified_k6s2_project(modified_k6s2_state *x, const modified_k6s2_params *pr
 void modified_k6s2_params_default(modified_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k6s2_OK or an error code. */
 int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h, const modified_k6s2_params *prm, modified_k6s2_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on modified_k6s2_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * modified_k6s2_HMIN (1 + |t|). */
+int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, modified_k6s2_real tol, const modified_k6s2_params *prm, modified_k6s2_stats *st);
 const char *modified_k6s2_strerror(int code);
 modified_k6s2_real modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm);
 void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *g);   /* modified_k6s2_NU values */

@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   modified_k9s3_real increment; /* last scaled increment of the iteration */
+  modified_k9s3_real err_est;   /* estimate of the step's local error in q (max norm) */
+  modified_k9s3_real h;         /* the step taken */
+  int rejected;      /* modified_k9s3_step_adaptive: tries rejected before it */
 } modified_k9s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int modified_k9s3_project(modified_k9s3_state *x, const modified_k9s3_params *pr
 void modified_k9s3_params_default(modified_k9s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns modified_k9s3_OK or an error code. */
 int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modified_k9s3_params *prm, modified_k9s3_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on modified_k9s3_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * modified_k9s3_HMIN (1 + |t|). */
+int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, modified_k9s3_real tol, const modified_k9s3_params *prm, modified_k9s3_stats *st);
 const char *modified_k9s3_strerror(int code);
 modified_k9s3_real modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
 void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *g);   /* modified_k9s3_NU values */

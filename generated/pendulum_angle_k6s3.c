@@ -14,6 +14,7 @@
 #ifndef pendulum_angle_k6s3_MAXITER
 #define pendulum_angle_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define pendulum_angle_k6s3_EREJECT (-1)  /* internal: a step over the tolerance of pendulum_angle_k6s3_step_adaptive */
 #ifndef pendulum_angle_k6s3_TOL
 #define pendulum_angle_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -128,12 +129,12 @@ void pendulum_angle_k6s3_hidden(const pendulum_angle_k6s3_state *x, const pendul
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, double h, const pendulum_angle_k6s3_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+static void pendulum_angle_k6s3_predict(const pendulum_angle_k6s3_state *x, double h, int cold, const pendulum_angle_k6s3_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_angle_k6s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -157,17 +158,59 @@ static void pendulum_angle_k6s3_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double pendulum_angle_k6s3_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++)
+    if (fabs(gam[j * pendulum_angle_k6s3_M + i]) > c) c = (double)fabs(gam[j * pendulum_angle_k6s3_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(6/3), v = gamma_0 (docs/api.md). */
+#ifndef pendulum_angle_k6s3_ERRC
+#define pendulum_angle_k6s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
+#endif
+static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * pendulum_angle_k6s3_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = pendulum_angle_k6s3_coef(gam, 2), b = pendulum_angle_k6s3_coef(gam, 1), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = pendulum_angle_k6s3_ERRC * v;
+      for (i = 0; i < 6; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
+    r = c / b;
+    v = pendulum_angle_k6s3_ERRC * fabs(h) * c;
+    for (i = 0; i < 4; i++) v *= r;
+    return v > w ? v : w;
+  }
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= pendulum_angle_k6s3_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
+static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, int cold, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_angle_k6s3_ENOCONV;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_angle_k6s3_EBADSTEP;
-  pendulum_angle_k6s3_predict(x, h, prm, gam);
+  pendulum_angle_k6s3_predict(x, h, cold, prm, gam);
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0;
@@ -299,6 +342,23 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
       if (v > inc) inc = v;
       gm2 = sw2;
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_angle_k6s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3)) rc = pendulum_angle_k6s3_ENONFINITE;
     if (rc == pendulum_angle_k6s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_angle_k6s3_ENONFINITE; break; }
@@ -326,8 +386,17 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
   sw[1] = sw1;
   sw[2] = sw2;
   sw[3] = sw3;
-  if (st) { st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it; st->increment = inc; }
+  est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != pendulum_angle_k6s3_OK) return rc;
+  /* pendulum_angle_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_angle_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_angle_k6s3_ENONFINITE;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]) ||
@@ -346,6 +415,78 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
   x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_angle_k6s3_OK;
+}
+
+int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
+{
+  return pendulum_angle_k6s3_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef pendulum_angle_k6s3_HMIN
+#define pendulum_angle_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef pendulum_angle_k6s3_TOLC
+#define pendulum_angle_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 6 (error per unit step). */
+int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
+{
+  pendulum_angle_k6s3_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return pendulum_angle_k6s3_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return pendulum_angle_k6s3_EBADSTEP;
+  tol *= pendulum_angle_k6s3_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_angle_k6s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_angle_k6s3_EREJECT) misses++;
+    if (rc == pendulum_angle_k6s3_OK || rc == pendulum_angle_k6s3_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == pendulum_angle_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == pendulum_angle_k6s3_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < pendulum_angle_k6s3_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 6) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == pendulum_angle_k6s3_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return pendulum_angle_k6s3_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < pendulum_angle_k6s3_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != pendulum_angle_k6s3_EREJECT ? rc : pendulum_angle_k6s3_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

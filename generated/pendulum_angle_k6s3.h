@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   pendulum_angle_k6s3_real increment; /* last scaled increment of the iteration */
+  pendulum_angle_k6s3_real err_est;   /* estimate of the step's local error in q (max norm) */
+  pendulum_angle_k6s3_real h;         /* the step taken */
+  int rejected;      /* pendulum_angle_k6s3_step_adaptive: tries rejected before it */
 } pendulum_angle_k6s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int pendulum_angle_k6s3_project(pendulum_angle_k6s3_state *x, const pendulum_ang
 void pendulum_angle_k6s3_params_default(pendulum_angle_k6s3_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_angle_k6s3_OK or an error code. */
 int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on pendulum_angle_k6s3_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * pendulum_angle_k6s3_HMIN (1 + |t|). */
+int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
 const char *pendulum_angle_k6s3_strerror(int code);
 pendulum_angle_k6s3_real pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm);
 void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *g);   /* pendulum_angle_k6s3_NU values */

@@ -24,6 +24,19 @@ static int step(void *x, double h, const void *prm, hbvmrt_stats *st)
   int rc = pendulum_angle_k6s3_step(x, h, prm, &s);
   st->iters = s.iters;
   st->increment = s.increment;
+  st->err_est = s.err_est;
+  return rc;
+}
+
+static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)
+{
+  pendulum_angle_k6s3_stats s;
+  int rc = pendulum_angle_k6s3_step_adaptive(x, h, tol, prm, &s);
+  st->iters = s.iters;
+  st->increment = s.increment;
+  st->err_est = s.err_est;
+  st->h = s.h;
+  st->rejected = s.rejected;
   return rc;
 }
 
@@ -43,6 +56,7 @@ int main(int argc, char **argv)
     0, params, q0, p0,
     init, params_default, step, pendulum_angle_k6s3_strerror, energy, constraints, hidden, names,
     init_params, project, DBL_EPSILON,
+    step_adaptive,
   };
   return hbvmrt_main(&model, argc, argv);
 }

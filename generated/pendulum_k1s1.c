@@ -14,6 +14,7 @@
 #ifndef pendulum_k1s1_MAXITER
 #define pendulum_k1s1_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define pendulum_k1s1_EREJECT (-1)  /* internal: a step over the tolerance of pendulum_k1s1_step_adaptive */
 #ifndef pendulum_k1s1_TOL
 #define pendulum_k1s1_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -226,12 +227,12 @@ void pendulum_k1s1_hidden(const pendulum_k1s1_state *x, const pendulum_k1s1_para
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_k1s1_predict(const pendulum_k1s1_state *x, double h, const pendulum_k1s1_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+static void pendulum_k1s1_predict(const pendulum_k1s1_state *x, double h, int cold, const pendulum_k1s1_params *prm, double *gam)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
@@ -255,17 +256,46 @@ static void pendulum_k1s1_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double pendulum_k1s1_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < pendulum_k1s1_M; i++)
+    if (fabs(gam[j * pendulum_k1s1_M + i]) > c) c = (double)fabs(gam[j * pendulum_k1s1_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(2/1), v = gamma_0 (docs/api.md). */
+#ifndef pendulum_k1s1_ERRC
+#define pendulum_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
+#endif
+static double pendulum_k1s1_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * pendulum_k1s1_coef(gam, 0);
+  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= pendulum_k1s1_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
+static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real h_, double tol, int cold, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k1s1_ENOCONV;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_k1s1_EBADSTEP;
-  pendulum_k1s1_predict(x, h, prm, gam);
+  pendulum_k1s1_predict(x, h, cold, prm, gam);
   double g0[pendulum_k1s1_NU];
   pendulum_k1s1_g(x->q, x->p, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -346,6 +376,22 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
       if (v > inc) inc = v;
       gm1 = sw1;
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
+      gam[0] = gm0;
+      gam[1] = gm1;
+      est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_k1s1_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     {
       double piv = sw5, dia = sw6;
@@ -380,8 +426,17 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
   sw[4] = sw4;
   sw[5] = sw5;
   sw[6] = sw6;
-  if (st) { st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it; st->increment = inc; }
+  est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != pendulum_k1s1_OK) return rc;
+  /* pendulum_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k1s1_ENONFINITE;
   for (i = 0; i < pendulum_k1s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k1s1_S * pendulum_k1s1_M + i]) ||
@@ -400,6 +455,78 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h_, const pend
   x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_k1s1_OK;
+}
+
+int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
+{
+  return pendulum_k1s1_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef pendulum_k1s1_HMIN
+#define pendulum_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef pendulum_k1s1_TOLC
+#define pendulum_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 2 (error per unit step). */
+int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, pendulum_k1s1_real tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
+{
+  pendulum_k1s1_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return pendulum_k1s1_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return pendulum_k1s1_EBADSTEP;
+  tol *= pendulum_k1s1_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_k1s1_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_k1s1_EREJECT) misses++;
+    if (rc == pendulum_k1s1_OK || rc == pendulum_k1s1_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == pendulum_k1s1_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == pendulum_k1s1_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < pendulum_k1s1_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == pendulum_k1s1_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return pendulum_k1s1_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < pendulum_k1s1_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != pendulum_k1s1_EREJECT ? rc : pendulum_k1s1_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

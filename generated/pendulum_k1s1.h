@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   pendulum_k1s1_real increment; /* last scaled increment of the iteration */
+  pendulum_k1s1_real err_est;   /* estimate of the step's local error in q (max norm) */
+  pendulum_k1s1_real h;         /* the step taken */
+  int rejected;      /* pendulum_k1s1_step_adaptive: tries rejected before it */
 } pendulum_k1s1_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int pendulum_k1s1_project(pendulum_k1s1_state *x, const pendulum_k1s1_params *pr
 void pendulum_k1s1_params_default(pendulum_k1s1_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k1s1_OK or an error code. */
 int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on pendulum_k1s1_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * pendulum_k1s1_HMIN (1 + |t|). */
+int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, pendulum_k1s1_real tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st);
 const char *pendulum_k1s1_strerror(int code);
 pendulum_k1s1_real pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm);
 void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *g);   /* pendulum_k1s1_NU values */

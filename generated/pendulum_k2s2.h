@@ -37,6 +37,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   pendulum_k2s2_real increment; /* last scaled increment of the iteration */
+  pendulum_k2s2_real err_est;   /* estimate of the step's local error in q (max norm) */
+  pendulum_k2s2_real h;         /* the step taken */
+  int rejected;      /* pendulum_k2s2_step_adaptive: tries rejected before it */
 } pendulum_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -53,6 +56,11 @@ int pendulum_k2s2_project(pendulum_k2s2_state *x, const pendulum_k2s2_params *pr
 void pendulum_k2s2_params_default(pendulum_k2s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_k2s2_OK or an error code. */
 int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on pendulum_k2s2_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * pendulum_k2s2_HMIN (1 + |t|). */
+int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, pendulum_k2s2_real tol, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st);
 const char *pendulum_k2s2_strerror(int code);
 pendulum_k2s2_real pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm);
 void pendulum_k2s2_constraints(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *g);   /* pendulum_k2s2_NU values */

@@ -14,6 +14,7 @@
 #ifndef pendulum_poly_k4s4_MAXITER
 #define pendulum_poly_k4s4_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define pendulum_poly_k4s4_EREJECT (-1)  /* internal: a step over the tolerance of pendulum_poly_k4s4_step_adaptive */
 #ifndef pendulum_poly_k4s4_TOL
 #define pendulum_poly_k4s4_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -885,22 +886,16 @@ void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, const pendulum_poly_k4s4_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+/* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
+ * pendulum_poly_k4s4_err_est needs), else 0. */
+static int pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, int cold, const pendulum_poly_k4s4_params *prm, double *gam, double *ref)
 {
   int i, j, l, d;
   for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     pendulum_poly_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < pendulum_poly_k4s4_S; j++)
-      for (i = 0; i < pendulum_poly_k4s4_S; i++)
-        for (l = 0; l < pendulum_poly_k4s4_M; l++)
-          gam[j * pendulum_poly_k4s4_M + l] += pendulum_poly_k4s4_E2[2 * pendulum_poly_k4s4_S * j + i] * x->gam[i * pendulum_poly_k4s4_M + l] +
-                               pendulum_poly_k4s4_E2[2 * pendulum_poly_k4s4_S * j + pendulum_poly_k4s4_S + i] * x->gam2[i * pendulum_poly_k4s4_M + l];
-    return;
+    return 0;
   }
   for (j = 0; j < pendulum_poly_k4s4_S; j++)
     for (i = 0; i < pendulum_poly_k4s4_S; i++) {
@@ -912,6 +907,19 @@ static void pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double
       if (e != 0)
         for (l = 0; l < pendulum_poly_k4s4_M; l++) gam[j * pendulum_poly_k4s4_M + l] += e * x->gam[i * pendulum_poly_k4s4_M + l];
     }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
+      ref[i] = gam[i];
+      gam[i] = 0;
+    }
+    for (j = 0; j < pendulum_poly_k4s4_S; j++)
+      for (i = 0; i < pendulum_poly_k4s4_S; i++)
+        for (l = 0; l < pendulum_poly_k4s4_M; l++)
+          gam[j * pendulum_poly_k4s4_M + l] += pendulum_poly_k4s4_E2[2 * pendulum_poly_k4s4_S * j + i] * x->gam[i * pendulum_poly_k4s4_M + l] +
+                               pendulum_poly_k4s4_E2[2 * pendulum_poly_k4s4_S * j + pendulum_poly_k4s4_S + i] * x->gam2[i * pendulum_poly_k4s4_M + l];
+    return 1;
+  }
+  return 0;
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */
@@ -922,17 +930,61 @@ static void pendulum_poly_k4s4_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double pendulum_poly_k4s4_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++)
+    if (fabs(gam[j * pendulum_poly_k4s4_M + i]) > c) c = (double)fabs(gam[j * pendulum_poly_k4s4_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(8/4), v = gamma_0 (docs/api.md). */
+#ifndef pendulum_poly_k4s4_ERRC
+#define pendulum_poly_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
+#endif
+static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * pendulum_poly_k4s4_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = pendulum_poly_k4s4_coef(gam, 3), b = pendulum_poly_k4s4_coef(gam, 2), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = pendulum_poly_k4s4_ERRC * v;
+      for (i = 0; i < 8; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
+    r = c / b;
+    v = pendulum_poly_k4s4_ERRC * fabs(h) * c;
+    for (i = 0; i < 5; i++) v *= r;
+    return v > w ? v : w;
+  }
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= pendulum_poly_k4s4_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
+static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, int cold, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
   double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k4s4_ENOCONV;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k4s4_EBADSTEP;
-  pendulum_poly_k4s4_predict(x, h, prm, gam);
+  double ref[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M];
+  int two;
+  two = pendulum_poly_k4s4_predict(x, h, cold, prm, gam, ref);
   double g0[pendulum_poly_k4s4_NU];
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -1473,6 +1525,33 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
       if (v > inc) inc = v;
       gm7 = sw7;
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
+      gam[6] = gm6;
+      gam[7] = gm7;
+      if (two)  /* the two-step start: the one-step start's miss */
+        for (d1 = 0, i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
+          double v = fabs(h * (gam[i] - ref[i]));
+          if (v > d1) d1 = v;
+        }
+      est = pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return pendulum_poly_k4s4_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     lm0 = sw10;
     lm1 = sw11;
@@ -1519,8 +1598,17 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
   sw[11] = sw11;
   sw[12] = sw12;
   sw[13] = sw13;
-  if (st) { st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it; st->increment = inc; }
+  est = pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != pendulum_poly_k4s4_OK) return rc;
+  /* pendulum_poly_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_poly_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k4s4_ENONFINITE;
   double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k4s4_energy(x, prm);
@@ -1573,6 +1661,78 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
   x->hprev2 = x->hprev;
   x->hprev = h;
   return pendulum_poly_k4s4_OK;
+}
+
+int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
+{
+  return pendulum_poly_k4s4_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef pendulum_poly_k4s4_HMIN
+#define pendulum_poly_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef pendulum_poly_k4s4_TOLC
+#define pendulum_poly_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 8 (error per unit step). */
+int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, pendulum_poly_k4s4_real tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
+{
+  pendulum_poly_k4s4_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k4s4_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k4s4_EBADSTEP;
+  tol *= pendulum_poly_k4s4_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = pendulum_poly_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == pendulum_poly_k4s4_EREJECT) misses++;
+    if (rc == pendulum_poly_k4s4_OK || rc == pendulum_poly_k4s4_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == pendulum_poly_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == pendulum_poly_k4s4_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < pendulum_poly_k4s4_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 8) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == pendulum_poly_k4s4_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return pendulum_poly_k4s4_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < pendulum_poly_k4s4_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != pendulum_poly_k4s4_EREJECT ? rc : pendulum_poly_k4s4_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -38,6 +38,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   pendulum_poly_k4s4_real increment; /* last scaled increment of the iteration */
+  pendulum_poly_k4s4_real err_est;   /* estimate of the step's local error in q (max norm) */
+  pendulum_poly_k4s4_real h;         /* the step taken */
+  int rejected;      /* pendulum_poly_k4s4_step_adaptive: tries rejected before it */
 } pendulum_poly_k4s4_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -54,6 +57,11 @@ int pendulum_poly_k4s4_project(pendulum_poly_k4s4_state *x, const pendulum_poly_
 void pendulum_poly_k4s4_params_default(pendulum_poly_k4s4_params *prm);
 /* One step of size h; prm and st may be NULL. Returns pendulum_poly_k4s4_OK or an error code. */
 int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on pendulum_poly_k4s4_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * pendulum_poly_k4s4_HMIN (1 + |t|). */
+int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, pendulum_poly_k4s4_real tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
 const char *pendulum_poly_k4s4_strerror(int code);
 pendulum_poly_k4s4_real pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm);
 void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *g);   /* pendulum_poly_k4s4_NU values */

@@ -38,6 +38,9 @@ typedef struct {
 typedef struct {
   int iters;         /* fixed-point iterations */
   satellites_poly_k6s2_real increment; /* last scaled increment of the iteration */
+  satellites_poly_k6s2_real err_est;   /* estimate of the step's local error in q (max norm) */
+  satellites_poly_k6s2_real h;         /* the step taken */
+  int rejected;      /* satellites_poly_k6s2_step_adaptive: tries rejected before it */
 } satellites_poly_k6s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the
@@ -54,6 +57,11 @@ int satellites_poly_k6s2_project(satellites_poly_k6s2_state *x, const satellites
 void satellites_poly_k6s2_params_default(satellites_poly_k6s2_params *prm);
 /* One step of size h; prm and st may be NULL. Returns satellites_poly_k6s2_OK or an error code. */
 int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st);
+/* One step of at most *h whose error estimate is within tol (1 + max|q|): retried
+ * smaller from the unchanged state until it is; on satellites_poly_k6s2_OK *h is the next step
+ * proposed, st->h the step taken. Fails (x unchanged) only below a step of
+ * satellites_poly_k6s2_HMIN (1 + |t|). */
+int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real *h, satellites_poly_k6s2_real tol, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st);
 const char *satellites_poly_k6s2_strerror(int code);
 satellites_poly_k6s2_real satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm);
 void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_real *g);   /* satellites_poly_k6s2_NU values */

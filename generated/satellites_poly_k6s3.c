@@ -14,6 +14,7 @@
 #ifndef satellites_poly_k6s3_MAXITER
 #define satellites_poly_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
 #endif
+#define satellites_poly_k6s3_EREJECT (-1)  /* internal: a step over the tolerance of satellites_poly_k6s3_step_adaptive */
 #ifndef satellites_poly_k6s3_TOL
 #define satellites_poly_k6s3_TOL 4.4408920985006262e-16  /* an increment within 2 ulps ... */
 #endif
@@ -8604,22 +8605,16 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
 
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
- * gamma_j = 0 (j > 0) on the first step. */
-static void satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, const satellites_poly_k6s3_params *prm, double *gam)
+ * gamma_j = 0 (j > 0) on the first step or when cold. */
+/* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
+ * satellites_poly_k6s3_err_est needs), else 0. */
+static int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, int cold, const satellites_poly_k6s3_params *prm, double *gam, double *ref)
 {
   int i, j, l, d;
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
-  if (x->hprev == 0) {
+  if (cold || x->hprev == 0) {
     satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
-    for (j = 0; j < satellites_poly_k6s3_S; j++)
-      for (i = 0; i < satellites_poly_k6s3_S; i++)
-        for (l = 0; l < satellites_poly_k6s3_M; l++)
-          gam[j * satellites_poly_k6s3_M + l] += satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + i] * x->gam[i * satellites_poly_k6s3_M + l] +
-                               satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + satellites_poly_k6s3_S + i] * x->gam2[i * satellites_poly_k6s3_M + l];
-    return;
+    return 0;
   }
   for (j = 0; j < satellites_poly_k6s3_S; j++)
     for (i = 0; i < satellites_poly_k6s3_S; i++) {
@@ -8631,6 +8626,19 @@ static void satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, do
       if (e != 0)
         for (l = 0; l < satellites_poly_k6s3_M; l++) gam[j * satellites_poly_k6s3_M + l] += e * x->gam[i * satellites_poly_k6s3_M + l];
     }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
+      ref[i] = gam[i];
+      gam[i] = 0;
+    }
+    for (j = 0; j < satellites_poly_k6s3_S; j++)
+      for (i = 0; i < satellites_poly_k6s3_S; i++)
+        for (l = 0; l < satellites_poly_k6s3_M; l++)
+          gam[j * satellites_poly_k6s3_M + l] += satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + i] * x->gam[i * satellites_poly_k6s3_M + l] +
+                               satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + satellites_poly_k6s3_S + i] * x->gam2[i * satellites_poly_k6s3_M + l];
+    return 1;
+  }
+  return 0;
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */
@@ -8641,17 +8649,61 @@ static void satellites_poly_k6s3_add(double *a, double *c, double b)
   *a = t;
 }
 
+/* max |gamma_j| over the coordinates */
+static double satellites_poly_k6s3_coef(const double *gam, int j)
+{
+  double c = 0;
+  int i;
+  for (i = 0; i < satellites_poly_k6s3_M; i++)
+    if (fabs(gam[j * satellites_poly_k6s3_M + i]) > c) c = (double)fabs(gam[j * satellites_poly_k6s3_M + i]);
+  return c;
+}
+
+/* The local error estimate of a step (max norm in q) from its converged gamma and
+ * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
+ * |h v| (d1 / |h v|)^(6/3), v = gamma_0 (docs/api.md). */
+#ifndef satellites_poly_k6s3_ERRC
+#define satellites_poly_k6s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
+#endif
+static double satellites_poly_k6s3_err_est(const double *gam, double h, double d1, int cold)
+{
+  double v, r;
+  int i;
+  v = fabs(h) * satellites_poly_k6s3_coef(gam, 0);
+  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
+    double c = satellites_poly_k6s3_coef(gam, 2), b = satellites_poly_k6s3_coef(gam, 1), w = 0;
+    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
+                      * not from rest, where d1 ~ |h v| */
+      r = d1 / v;
+      w = satellites_poly_k6s3_ERRC * v;
+      for (i = 0; i < 6; i++) w *= r;
+    }
+    if (!(b > c)) return c > 0 ? d1 : w;
+    r = c / b;
+    v = satellites_poly_k6s3_ERRC * fabs(h) * c;
+    for (i = 0; i < 4; i++) v *= r;
+    return v > w ? v : w;
+  }
+  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
+  r = d1 / v;
+  v *= satellites_poly_k6s3_ERRC;
+  for (i = 0; i < 2; i++) v *= r;
+  return v;
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
-int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, double tol, int cold, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   const double h = (double)h_;
   double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
-  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale;
+  double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_poly_k6s3_ENOCONV;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s3_EBADSTEP;
-  satellites_poly_k6s3_predict(x, h, prm, gam);
+  double ref[satellites_poly_k6s3_S * satellites_poly_k6s3_M];
+  int two;
+  two = satellites_poly_k6s3_predict(x, h, cold, prm, gam, ref);
   double g0[satellites_poly_k6s3_NU];
   satellites_poly_k6s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
@@ -8696,6 +8748,25 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
+    if (it == 1) {
+      d1 = inc;  /* the predictor's error, for satellites_poly_k6s3_err_est */
+      if (two)  /* the two-step start: the one-step start's miss */
+        for (d1 = 0, i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
+          double v = fabs(h * (gam[i] - ref[i]));
+          if (v > d1) d1 = v;
+        }
+      est = satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+      if (tol > 0 && !(est <= tol * (1 + scale))) {
+        if (st) {
+          st->iters = 1;
+          st->increment = inc;
+          st->err_est = est;
+          st->h = h;
+          st->rejected = 0;
+        }
+        return satellites_poly_k6s3_EREJECT;
+      }
+    }
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) lam[i] = sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + i];
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++)
@@ -8716,8 +8787,17 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
       break;
     }
   }
-  if (st) { st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it; st->increment = inc; }
+  est = satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  if (st) {
+    st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it;
+    st->increment = inc;
+    st->err_est = est;
+    st->h = h;
+    st->rejected = 0;
+  }
   if (rc != satellites_poly_k6s3_OK) return rc;
+  /* satellites_poly_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
+  if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_poly_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
   double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 2 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s3_energy(x, prm);
@@ -8770,6 +8850,78 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
   x->hprev2 = x->hprev;
   x->hprev = h;
   return satellites_poly_k6s3_OK;
+}
+
+int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+{
+  return satellites_poly_k6s3_step_within(x, h, 0, 0, prm, st);
+}
+
+#ifndef satellites_poly_k6s3_HMIN
+#define satellites_poly_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
+#endif
+
+#ifndef satellites_poly_k6s3_TOLC
+#define satellites_poly_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
+/* The exponent of the controller: the step's order 6 (error per unit step). */
+int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real *h, satellites_poly_k6s3_real tol, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
+{
+  satellites_poly_k6s3_stats s;
+  double hh = *h, err, fac, grow = 5;
+  int rc, rejected = 0, misses = 0;
+  if (!(hh != 0 && isfinite(hh))) return satellites_poly_k6s3_EBADSTEP;
+  if (!(tol > 0 && isfinite(tol))) return satellites_poly_k6s3_EBADSTEP;
+  tol *= satellites_poly_k6s3_TOLC;
+  for (;;) {
+    s.iters = 0;
+    s.increment = s.err_est = 0;
+    /* after 3 tries over the tolerance the warm start is dropped: it carries the
+     * previous step's error, which no smaller h removes from the estimate */
+    rc = satellites_poly_k6s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
+    if (rc == satellites_poly_k6s3_EREJECT) misses++;
+    if (rc == satellites_poly_k6s3_OK || rc == satellites_poly_k6s3_EREJECT) {
+      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
+      err = rc == satellites_poly_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
+      if (rc == satellites_poly_k6s3_OK) {
+        double sc = 0;
+        int i;
+        for (i = 0; i < satellites_poly_k6s3_M; i++)
+          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+        err = s.err_est / (tol * fabs(hh) * (1 + sc));
+      }
+      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 6) : grow;
+      if (fac > grow) fac = grow;
+      if (fac < (double)0.2) fac = (double)0.2;
+      if (rc == satellites_poly_k6s3_OK) {
+        *h = hh * fac;
+        if (st) {
+          st->iters = s.iters;
+          st->increment = s.increment;
+          st->err_est = s.err_est;
+          st->h = hh;
+          st->rejected = rejected;
+        }
+        return satellites_poly_k6s3_OK;
+      }
+    } else {
+      fac = (double)0.5;
+    }
+    rejected++;
+    grow = 1;
+    hh *= fac;
+    if (fabs(hh) < satellites_poly_k6s3_HMIN * (1 + fabs(x->t))) {
+      if (st) {
+        st->iters = s.iters;
+        st->increment = s.increment;
+        st->err_est = s.err_est;
+        st->h = 0;
+        st->rejected = rejected;
+      }
+      return rc != satellites_poly_k6s3_EREJECT ? rc : satellites_poly_k6s3_ENOCONV;
+    }
+  }
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -20,7 +20,7 @@
 
 typedef enum {
   OPT_STEP, OPT_TIME, OPT_STEPS, OPT_EVERY, OPT_Q0, OPT_P0, OPT_PARAM,
-  OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT
+  OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT, OPT_TOL
 } OptId;
 
 typedef struct {
@@ -34,6 +34,7 @@ static const Option options[] = {
   {"--every", OPT_EVERY, 1}, {"--q0", OPT_Q0, 1},    {"--p0", OPT_P0, 1},
   {"--param", OPT_PARAM, 1}, {"--csv", OPT_CSV, 1},  {"--quiet", OPT_QUIET, 0},
   {"--help", OPT_HELP, 0},   {"--project", OPT_PROJECT, 0},
+  {"--tol", OPT_TOL, 1},
 };
 
 /* What was seen on the way, for the checks that need all options. */
@@ -235,7 +236,7 @@ static int print_help(const hbvmrt_model *md, FILE *out)
   fprintf(out,
     "usage: %s [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..]\n"
     "       %*s [--p0 a,b,..] [--param name=value] [--project] [--csv FILE]\n"
-    "       %*s [--quiet]\n"
+    "       %*s [--tol TOL] [--quiet]\n"
     "\n"
     "Integrates the model %s (m=%d coordinates, nu=%d constraints) with the\n"
     "HBVM(k=%d,s=%d) line integral method, N steps of the constant step h.\n"
@@ -262,6 +263,10 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "                     are refused\n"
     "  --csv FILE         write the rows t,x..,p_x..,lambda_1..,H,g_1..,hc_1.. to\n"
     "                     FILE ('-' for stdout); no CSV without it\n"
+    "  --tol TOL          adaptive steps: each step's error estimate within\n"
+    "                     0.01 TOL |h| (1 + max|q|), so that the error at T is\n"
+    "                     about TOL T (1 + max|q|); -h is the first step, -T is\n"
+    "                     hit exactly; --every K counts the steps taken\n"
     "  --quiet            no progress line on a terminal\n"
     "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
     "                     (coordinates, p_ and a coordinate, params) and a row\n"
@@ -338,6 +343,19 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
   case OPT_PROJECT:
     o->project = 1;
     return 0;
+  case OPT_TOL:
+    if (parse_number(md, op->name, val, &o->tol) != 0)
+      return -1;
+    if (!(o->tol > 0)) {
+      hbvmrt_error(md, "--tol must be > 0 (got %s)", val);
+      return -1;
+    }
+    if (!md->step_adaptive) {
+      hbvmrt_error(md, "--tol needs a driver generated with error control "
+                   "(hbvmgen 0.1.0 or later, --main)");
+      return -1;
+    }
+    return 0;
   case OPT_HELP:
     break;
   }
@@ -351,6 +369,10 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
 
   if (seen->have_T && seen->have_N) {
     hbvmrt_error(md, "-T and -N cannot be used together");
+    return -1;
+  }
+  if (seen->have_N && o->tol > 0) {
+    hbvmrt_error(md, "--tol takes the span from -T, not -N");
     return -1;
   }
   if (seen->have_N)

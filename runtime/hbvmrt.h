@@ -19,6 +19,10 @@ extern "C" {
 typedef struct {
   int iters;          /* fixed-point iterations of the step */
   double increment;   /* final scaled increment */
+  /* Filled by drivers from hbvmgen with error control (0 from older ones). */
+  double err_est;     /* the step's local error estimate */
+  double h;           /* the step taken (step_adaptive) */
+  int rejected;       /* tries rejected before it (step_adaptive) */
 } hbvmrt_stats;
 
 /* One run-time parameter: its name and where it lives in the params block. */
@@ -58,6 +62,9 @@ typedef struct {
   void (*init_params)(void *x, const double *q0, const double *p0, const void *prm);
   int (*project)(void *x, const void *prm, double *dq, double *dp);
   double eps;
+  /* NAME_step_adaptive (NULL in drivers generated before it: no --tol): a
+   * step of at most *h within tol, *h the next step proposed on return. */
+  int (*step_adaptive)(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st);
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status

@@ -38,6 +38,7 @@ typedef struct {
   long nsteps;         /* N >= 0 (from -N, or from -T and h) */
   double T;            /* with to_T: the span, hit exactly (last step shortened) */
   int to_T;            /* the span came from -T or its default, not -N */
+  double tol;          /* --tol: adaptive steps within it (h the first); 0: fixed h */
   long every;          /* K >= 1: a CSV row every K steps */
   double *q0, *p0;     /* m values each; NULL when the option was not given */
   double *param_val;   /* nparams values from --param ... */

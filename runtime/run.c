@@ -269,6 +269,7 @@ static void progress_start(Progress *pg, const Run *r)
 static void progress_tick(Progress *pg, const Run *r, long n)
 {
   double t = now(), since = t - pg->last_check;
+  double done = (double)n / (double)r->o->nsteps;
   char line[160];
   int len;
 
@@ -281,8 +282,13 @@ static void progress_tick(Progress *pg, const Run *r, long n)
   if (t - pg->start < 1.0 || t - pg->last_draw < 0.1)
     return;
   pg->last_draw = t;
+  if (r->o->tol > 0 && r->o->T > 0) {   /* adaptive: the share of the span */
+    double t;
+    memcpy(&t, (const char *)r->x + r->md->off_t, sizeof t);
+    done = fabs(t) / r->o->T;
+  }
   len = snprintf(line, sizeof line, "%s: %5.1f%%  %.0f steps/s  |H-H0|=%.2e",
-                 r->md->name, 100.0 * (double)n / (double)r->o->nsteps,
+                 r->md->name, 100.0 * done,
                  (double)n / (t - pg->start), fabs(r->H - r->H0));
   if (len > (int)sizeof line - 1)
     len = (int)sizeof line - 1;
@@ -329,9 +335,12 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
 static int advance(Run *r, double h, int depth)
 {
   const hbvmrt_model *md = r->md;
-  hbvmrt_stats st = {0, 0.0};
+  hbvmrt_stats st;
   double target = state_t(r) + h;
-  int code = md->step(r->x, h, r->prm, &st);
+  int code;
+
+  memset(&st, 0, sizeof st);
+  code = md->step(r->x, h, r->prm, &st);
 
   if (code == 0) {
     taken(r, &st, h);
@@ -347,6 +356,50 @@ static int advance(Run *r, double h, int depth)
   if ((code = advance(r, h / 2, depth + 1)) != 0)
     return code;
   return advance(r, target - state_t(r), depth + 1);
+}
+
+/* --tol: adaptive steps from h until -T, hit exactly: a step that would
+ * pass it is shortened to end on it (and one within 1e-12 of it too, so
+ * that no sliver of a step is left).  Rows at t=0, every K steps taken and
+ * at T; stops at the first failed step (its code in r->fail_code). */
+static void loop_adaptive(Run *r, Progress *pg)
+{
+  const hbvmrt_model *md = r->md;
+  long n = 0, K = r->o->every;
+  double h = r->o->h, t_end = h < 0 ? -r->o->T : r->o->T;
+
+  observe(r);
+  if (write_row(r) != 0)
+    return;
+  while (state_t(r) != t_end) {
+    double rest = t_end - state_t(r), hn = h;
+    hbvmrt_stats st;
+    int last = fabs(hn) >= fabs(rest) * (1 - 1e-12), code;
+
+    memset(&st, 0, sizeof st);
+    if (last)
+      hn = rest;
+    code = md->step_adaptive(r->x, &hn, r->o->tol, r->prm, &st);
+    r->rejected += st.rejected;
+    if (code != 0) {
+      r->fail_code = code;
+      if (n % K != 0)
+        write_row(r);
+      return;
+    }
+    n++;
+    taken(r, &st, st.h);
+    if (last && st.h == rest) {         /* taken whole: it ended on T */
+      write_row(r);
+      return;
+    }
+    h = hn;
+    if (n % K == 0 && write_row(r) != 0)
+      return;
+    if (pg->on && n >= pg->next)
+      progress_tick(pg, r, n);
+  }
+  write_row(r);
 }
 
 /* Rows at t=0, every K steps and at the last step taken; stops at the
@@ -416,7 +469,10 @@ static int simulate(Run *r)
   int out_failed;
 
   progress_start(&pg, r);
-  loop(r, &pg);
+  if (r->o->tol > 0)
+    loop_adaptive(r, &pg);
+  else
+    loop(r, &pg);
   seconds = now() - pg.start;
   progress_clear(&pg);
   if (r->fail_code != 0)

@@ -20,6 +20,8 @@ Suite *mass_suite(void);
 Suite *batch_suite(void);
 Suite *ensemble_suite(void);
 Suite *rolled_suite(void);
+Suite *errest_suite(void);
+Suite *adaptive_suite(void);
 
 int main(void) {
   SRunner *sr = srunner_create(parser_suite());
@@ -40,6 +42,8 @@ int main(void) {
   srunner_add_suite(sr, batch_suite());
   srunner_add_suite(sr, ensemble_suite());
   srunner_add_suite(sr, rolled_suite());
+  srunner_add_suite(sr, errest_suite());
+  srunner_add_suite(sr, adaptive_suite());
   srunner_run_all(sr, CK_NORMAL);
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);

@@ -114,7 +114,8 @@ static const hbvmrt_model osc = {
   osc_init, osc_params_default, osc_step, osc_strerror, osc_energy,
   NULL, NULL,                   /* nu = 0: never called */
   NULL,                         /* no names: the numbered CSV header */
-  NULL, NULL, 0                 /* as a driver of hbvmgen 0.1: no projection */
+  NULL, NULL, 0,                /* as a driver of hbvmgen 0.1: no projection */
+  NULL                          /* nor error control */
 };
 
 /* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
@@ -212,7 +213,8 @@ static const hbvmrt_model ring = {
   ring_init, ring_params_default, ring_step, ring_strerror, ring_energy,
   ring_constraints, ring_hidden,
   NULL,
-  NULL, NULL, 0
+  NULL, NULL, 0,
+  NULL
 };
 
 /* ring with the fields of hbvmgen 0.2 drivers: init at the run's params
@@ -859,6 +861,7 @@ static const struct {
   {&osc, "- --csv @"},
   {&osc, "-x 1 --csv @"},
   {&osc, "--csv /nonexistent-dir/x.csv"},
+  {&osc, "--tol 1e-8 --csv @"},           /* no step_adaptive: an old driver */
 };
 
 START_TEST(bad_args)
@@ -949,6 +952,7 @@ START_TEST(help)
   ck_assert_ptr_nonnull(strstr(r.out, "nu=1 "));
   ck_assert_ptr_nonnull(strstr(r.out, "k=3,s=2"));
   ck_assert_ptr_nonnull(strstr(r.out, "end at TIME exactly"));
+  ck_assert_ptr_nonnull(strstr(r.out, "--tol TOL"));
   ck_assert_ptr_nonnull(strstr(r.out, "  k = 1\n"));
   ck_assert_ptr_nonnull(strstr(r.out, "default 1,0)"));     /* q0 */
   done(&r);

@@ -25,6 +25,7 @@
 #include "kepler_k6s2.h"
 #include "kepler_k6s3.h"
 #include "kepler_k16s2.h"
+#include "kepler_k4s4.h"
 #include "henon_heiles_k2s2.h"
 #include "henon_heiles_k3s2.h"
 #include "pendulum_poly_k1s1.h"
@@ -45,7 +46,7 @@
   X(pendulum_k1s1) X(pendulum_k2s2) X(pendulum_k3s3) X(conical_k1s1) X(conical_k2s2) X(conical_k3s3)       \
   X(conical_k4s4) X(modified_k3s1) X(modified_k6s2) X(modified_k9s3) X(satellites_k6s1) X(satellites_k6s2) \
   X(satellites_k6s3) X(kepler_k1s1) X(kepler_k2s2) X(kepler_k3s3) X(kepler_k6s1) X(kepler_k6s2) X(kepler_k6s3)   \
-  X(kepler_k16s2) X(henon_heiles_k2s2) X(henon_heiles_k3s2) X(pendulum_poly_k1s1) X(pendulum_poly_k2s2)               \
+  X(kepler_k16s2) X(kepler_k4s4) X(henon_heiles_k2s2) X(henon_heiles_k3s2) X(pendulum_poly_k1s1) X(pendulum_poly_k2s2)               \
   X(pendulum_poly_k3s3) X(pendulum_poly_k4s4) X(double_pendulum_k2s2) X(double_pendulum_k3s3) X(double_pendulum_k4s4)    \
   X(double_pendulum_const_k2s2) X(conical_poly_k2s2) X(modified_poly_k6s2) X(modified_poly_k9s3)                        \
   X(satellites_poly_k6s2) X(satellites_poly_k6s3)

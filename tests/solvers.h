@@ -15,6 +15,7 @@ typedef struct {
   double (*energy)(const void *x);
   void (*constraints)(const void *x, double *g);
   void (*hidden)(const void *x, double *hc);
+  int (*step_est)(void *x, double h, double *err_est); /* a step, and its NAME_stats.err_est */
 } Solver;
 
 /* The adapters of a generated solver with prefix P (its header included),
@@ -30,11 +31,17 @@ typedef struct {
   }                                                                                          \
   static double P##_energy_(const void *x) { return P##_energy(x, NULL); }                   \
   static void P##_g_(const void *x, double *g) { P##_constraints(x, NULL, g); }              \
-  static void P##_hc_(const void *x, double *hc) { P##_hidden(x, NULL, hc); }
+  static void P##_hc_(const void *x, double *hc) { P##_hidden(x, NULL, hc); }                \
+  static int P##_step_est_(void *x, double h, double *err_est) {                             \
+    P##_stats st;                                                                            \
+    int rc = P##_step(x, h, NULL, &st);                                                      \
+    *err_est = st.err_est;                                                                   \
+    return rc;                                                                               \
+  }
 #define SOLVER_ENTRY(P)                                                                                         \
   {#P,           P##_M,       P##_NU,    P##_K,      P##_S,         sizeof(P##_state),                         \
    offsetof(P##_state, t), offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda),          \
-   P##_init_,    P##_step_,   P##_energy_, P##_g_,   P##_hc_},
+   P##_init_,    P##_step_,   P##_energy_, P##_g_,   P##_hc_,      P##_step_est_},
 
 /* The solver of that name, or NULL. */
 const Solver *solver_find(const char *name);

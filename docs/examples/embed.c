@@ -9,7 +9,7 @@
 int main(void)
 {
   pendulum_state x;
-  pendulum_stats st = {0, 0};
+  pendulum_stats st = {0};
   double h = 0.01, H0, g[pendulum_NU];
   int n, rc;
 
