@@ -39,7 +39,11 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  /* private: compensated-summation errors and the last step's polynomial */\n");
   int poly = e->st->kern[K_FACTOR].nout > 0;
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
-  if (poly) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+  out(e, "  %s_real pinc[%d];  /* p's increments over the last step, for %s_dense */\n", e->P, s * m, e->P);
+  if (poly) {
+    out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+    out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
+  }
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
     char v[40];
@@ -75,6 +79,11 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           " * proposed, st->h the step taken. Fails (x unchanged) only below a step of\n"
           " * $P_HMIN (1 + |t|). */\n"
           "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st);\n"
+          "/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from\n"
+          " * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal\n"
+          " * to the state at theta = 1 and to the state before the step at theta = 0. Before\n"
+          " * any step (or after $P_project) it gives the state. */\n"
+          "void $P_dense(const $P_state *x, $P_real theta, $P_real *q, $P_real *p);\n"
           "const char *$P_strerror(int code);\n"
           "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
           "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
@@ -181,8 +190,9 @@ static void emit_init(Emitter *e) {
             "    x->p[i] = p0 ? p0[i] : $P_p0[i];\n");
   tmpl(e, "    x->qc[i] = x->pc[i] = 0;\n  }\n"
           "  for (i = 0; i < ($P_NU ? $P_NU : 1); i++) x->lambda[i] = 0;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n");
-  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->pinc[i] = 0;\n");
+  if (e->st->kern[K_FACTOR].nout)
+    tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"
           "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0)\n{\n"
@@ -253,6 +263,8 @@ static void emit_end_poly(Emitter *e) {
             "    q1[i] = x->q[i];\n    qc1[i] = x->qc[i];\n    p1[i] = x->p[i];\n    pc1[i] = x->pc[i];\n"
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
+  tmpl(e, "  $W phat[$P_M];  /* p1 before the projection, the end of p's polynomial */\n"
+          "  for (i = 0; i < $P_M; i++) phat[i] = p1[i];\n");
   tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
           "  $(project_p1 q0=q1 p0=p1 out=pr);\n"
           "  for (i = 0; i < $P_NU; i++) {\n"
@@ -279,8 +291,8 @@ static void emit_end_poly(Emitter *e) {
             "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
-  tmpl(e, "  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
+  tmpl(e, "    x->pcorr[i] = ($R)(p1[i] - phat[i]);\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam[i] = ($R)gam[i];\n    x->pinc[i] = ($R)sw[$[sweep.dp]i];\n  }\n"
           "  x->H0 = H0;\n");
   emit_set_lambda(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
@@ -469,7 +481,7 @@ static void emit_step(Emitter *e) {
             "    $P_add(&x->q[i], &x->qc[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&x->p[i], &x->pc[i], sw[$[sweep.dp]i]);\n  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = gam[i];\n");
+            "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam[i] = gam[i];\n    x->pinc[i] = sw[$[sweep.dp]i];\n  }\n");
   else {
     tmpl(e, "  /* q1 = (q - qc) + h gamma_0 and p1 = (p - pc) + (p1 - p0) in $W, rounded once into\n"
             "   * q, p; what the rounding lost is the new qc, pc */\n"
@@ -479,7 +491,7 @@ static void emit_step(Emitter *e) {
     if (e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1);\n    x->pc[i] = ($R)(x->p[i] - p1);\n");
     tmpl(e, "  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n");
+            "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam[i] = ($R)gam[i];\n    x->pinc[i] = ($R)sw[$[sweep.dp]i];\n  }\n");
   }
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
@@ -595,11 +607,35 @@ static void emit_project(Emitter *e) {
           "    if (fabs$f(p[i] - x->p[i]) > dpmax) dpmax = fabs$f(p[i] - x->p[i]);\n  }\n"
           "  for (i = 0; i < $P_M; i++) {\n"
           "    x->q[i] = q[i];\n    x->p[i] = p[i];\n    x->qc[i] = x->pc[i] = 0;\n  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->pinc[i] = 0;\n"
           "  x->hprev = 0;  /* the next step starts afresh, as after init */\n");
-  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;\n");
+  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
   emit_set_lambda(e);
   tmpl(e, "  if (dq) *dq = dqmax;\n  if (dp) *dp = dpmax;\n  return $P_OK;\n}\n");
+}
+
+// NAME_dense: q and p inside the last step from its polynomials, written
+// from the end of the step backwards so that theta = 1 gives the state
+// exactly. q(c) = q0 + h sum_j gamma_j int_0^c P_j and p(c) = p0 +
+// sum_j pinc_j int_0^c P_j are the step's polynomials of degree S (uniformly
+// of order S+1); with int_0^c P_j = (L_{j+1} - L_{j-1}) (2c-1) / (2 sqrt(2j+1))
+// for j >= 1 (Legendre L_j), which vanishes at c = 0 and 1. The poly family's
+// projection and rescale of p1 (pcorr) is spread linearly over the step, so
+// theta = 0 gives the previous state: it is of the size of the local error.
+static void emit_dense(Emitter *e) {
+  tmpl(e, "\nvoid $P_dense(const $P_state *x, $P_real theta, $P_real *q, $P_real *p)\n{\n"
+          "  $R L[$P_S + 1], w[$P_S], u = 2 * theta - 1;\n  int i, j;\n"
+          "  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */\n"
+          "  L[0] = 1;\n  L[1] = u;\n"
+          "  for (j = 1; j < $P_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);\n"
+          "  w[0] = 1 - theta;\n"
+          "  for (j = 1; j < $P_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt$f(($R)(2 * j + 1)));\n"
+          "  for (i = 0; i < $P_M; i++) {\n    $R dq = 0, dp = 0;\n"
+          "    for (j = 0; j < $P_S; j++) {\n"
+          "      dq += w[j] * x->gam[j * $P_M + i];\n      dp += w[j] * x->pinc[j * $P_M + i];\n    }\n"
+          "    q[i] = x->q[i] - x->hprev * dq;\n");
+  tmpl(e, e->st->kern[K_FACTOR].nout ? "    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];\n  }\n}\n"
+                                     : "    p[i] = x->p[i] - dp;\n  }\n}\n");
 }
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
@@ -614,6 +650,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_step(&e);
   emit_step_adaptive(&e);
   emit_project(&e);
+  emit_dense(&e);
   if (o->batch) emit_batch_source(&e, o->batch);
   free(e.temp);
   return ferror(hf) || ferror(cf) ? -1 : 0;

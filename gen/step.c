@@ -217,7 +217,9 @@ static void build_minv_products(Build *b) {
 }
 
 // gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i] (s*m nodes in gam)
-// and p1 - p0 = -h Theta_0 (m nodes in dp).
+// and -h Theta_j (s*m nodes in dp): p's polynomial on the step is
+// p0 + sum_j dp_j int_0^c P_j, so dp_0 = p1 - p0 (before the poly family's
+// projection), and the rest is what NAME_dense needs for p.
 void step_gamma(Build *b, int **theta, int *gam, int *dp) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
@@ -229,15 +231,16 @@ void step_gamma(Build *b, int **theta, int *gam, int *dp) {
     }
     minv_apply(b->mod, d, v, gam + j * m);
   }
-  for (int i = 0; i < m; i++) dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
+  for (int j = 0; j < s; j++)
+    for (int i = 0; i < m; i++) dp[j * m + i] = dag_neg(d, dag_mul(d, b->h, theta[j][i]));
 }
 
 // step_gamma, as the sweep's results "gam" and "dp".
 void step_gamma_update(Build *b, int **theta) {
-  int *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->m);
+  int *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->s * b->m);
   step_gamma(b, theta, gam, dp);
   step_result(b->st, K_SWEEP, "gam", SZ_SM, 1, b->s * b->m, gam);
-  step_result(b->st, K_SWEEP, "dp", SZ_M, 1, b->m, dp);
+  step_result(b->st, K_SWEEP, "dp", SZ_SM, 1, b->s * b->m, dp);
 }
 
 // The dense columns G[a] (m nodes each) of grad g at the point q.

@@ -21,6 +21,7 @@ Suite *batch_suite(void);
 Suite *ensemble_suite(void);
 Suite *errest_suite(void);
 Suite *adaptive_suite(void);
+Suite *dense_suite(void);
 
 int main(void) {
   SRunner *sr = srunner_create(parser_suite());
@@ -42,6 +43,7 @@ int main(void) {
   srunner_add_suite(sr, ensemble_suite());
   srunner_add_suite(sr, errest_suite());
   srunner_add_suite(sr, adaptive_suite());
+  srunner_add_suite(sr, dense_suite());
   srunner_run_all(sr, CK_NORMAL);
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);
