@@ -43,8 +43,8 @@ static const double conical_k1s1_E1[1] = {1.0};
 static const double conical_k1s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k1s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void conical_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
@@ -283,7 +283,7 @@ void conical_k1s1_init_params(conical_k1s1_state *x, const conical_k1s1_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k1s1_NU ? conical_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[conical_k1s1_NU];
     conical_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -382,7 +382,7 @@ static double conical_k1s1_err_est(const double *gam, double h, double d1)
 static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_, double tol, const conical_k1s1_params *prm, conical_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k1s1_S * conical_k1s1_M], sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 3 * conical_k1s1_NU + 1];
+  double gam[conical_k1s1_S * conical_k1s1_M], sw[2 * conical_k1s1_S * conical_k1s1_M + 3 * conical_k1s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k1s1_ENOCONV;
   conical_k1s1_DEFAULT_PARAMS(prm)
@@ -412,11 +412,11 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_k1s1_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k1s1_NU; i++) {
-      double piv = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + conical_k1s1_NU + i], dia = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 2 * conical_k1s1_NU + i];
+      double piv = sw[2 * conical_k1s1_S * conical_k1s1_M + conical_k1s1_NU + i], dia = sw[2 * conical_k1s1_S * conical_k1s1_M + 2 * conical_k1s1_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k1s1_SINGTOL * fabs(dia))) rc = conical_k1s1_ESINGULAR;
     }
     if (rc == conical_k1s1_ESINGULAR) break;
-    for (i = 0; i < conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + conical_k1s1_NU; i++)
+    for (i = 0; i < 2 * conical_k1s1_S * conical_k1s1_M + conical_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k1s1_ENONFINITE;
     if (rc == conical_k1s1_ENONFINITE || !isfinite(inc)) { rc = conical_k1s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k1s1_TOL / 256), or
@@ -456,8 +456,11 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
     conical_k1s1_add(&x->q[i], &x->qc[i], h * sw[i]);
     conical_k1s1_add(&x->p[i], &x->pc[i], sw[conical_k1s1_S * conical_k1s1_M + i]);
   }
-  for (i = 0; i < conical_k1s1_NU; i++) x->lambda[i] = sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + i];
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k1s1_NU; i++) x->lambda[i] = sw[2 * conical_k1s1_S * conical_k1s1_M + i];
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[conical_k1s1_S * conical_k1s1_M + i];
+  }
   conical_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k1s1_OK;
@@ -574,7 +577,7 @@ int conical_k1s1_project(conical_k1s1_state *x, const conical_k1s1_params *prm, 
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[conical_k1s1_NU];
@@ -584,4 +587,25 @@ int conical_k1s1_project(conical_k1s1_state *x, const conical_k1s1_params *prm, 
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_k1s1_OK;
+}
+
+void conical_k1s1_dense(const conical_k1s1_state *x, conical_k1s1_real theta, conical_k1s1_real *q, conical_k1s1_real *p)
+{
+  double L[conical_k1s1_S + 1], w[conical_k1s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_k1s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_k1s1_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < conical_k1s1_S; j++) {
+      dq += w[j] * x->gam[j * conical_k1s1_M + i];
+      dp += w[j] * x->pinc[j * conical_k1s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -44,8 +44,8 @@ static const double conical_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.999999
 static const double conical_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void conical_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
@@ -139,6 +139,12 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t83 = -t82;
   const double t84 = h * t52;
   const double t85 = -t84;
+  const double t86 = h * t53;
+  const double t87 = -t86;
+  const double t88 = h * t54;
+  const double t89 = -t88;
+  const double t90 = h * t55;
+  const double t91 = -t90;
   /* gam */
   out[0] = t60;
   out[1] = t65;
@@ -150,12 +156,15 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   out[6] = t81;
   out[7] = t83;
   out[8] = t85;
+  out[9] = t87;
+  out[10] = t89;
+  out[11] = t91;
   /* lambda */
-  out[9] = t48;
+  out[12] = t48;
   /* pivot */
-  out[10] = t36;
+  out[13] = t36;
   /* adiag */
-  out[11] = t36;
+  out[14] = t36;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -322,7 +331,7 @@ void conical_k2s2_init_params(conical_k2s2_state *x, const conical_k2s2_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k2s2_NU ? conical_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[conical_k2s2_NU];
     conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -421,7 +430,7 @@ static double conical_k2s2_err_est(const double *gam, double h, double d1)
 static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_, double tol, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + 1];
+  double gam[conical_k2s2_S * conical_k2s2_M], sw[2 * conical_k2s2_S * conical_k2s2_M + 3 * conical_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k2s2_ENOCONV;
   conical_k2s2_DEFAULT_PARAMS(prm)
@@ -451,11 +460,11 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_k2s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k2s2_NU; i++) {
-      double piv = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU + i], dia = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 2 * conical_k2s2_NU + i];
+      double piv = sw[2 * conical_k2s2_S * conical_k2s2_M + conical_k2s2_NU + i], dia = sw[2 * conical_k2s2_S * conical_k2s2_M + 2 * conical_k2s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k2s2_SINGTOL * fabs(dia))) rc = conical_k2s2_ESINGULAR;
     }
     if (rc == conical_k2s2_ESINGULAR) break;
-    for (i = 0; i < conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU; i++)
+    for (i = 0; i < 2 * conical_k2s2_S * conical_k2s2_M + conical_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k2s2_ENONFINITE;
     if (rc == conical_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k2s2_TOL / 256), or
@@ -495,8 +504,11 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     conical_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     conical_k2s2_add(&x->p[i], &x->pc[i], sw[conical_k2s2_S * conical_k2s2_M + i]);
   }
-  for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + i];
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[2 * conical_k2s2_S * conical_k2s2_M + i];
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[conical_k2s2_S * conical_k2s2_M + i];
+  }
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k2s2_OK;
@@ -613,7 +625,7 @@ int conical_k2s2_project(conical_k2s2_state *x, const conical_k2s2_params *prm, 
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[conical_k2s2_NU];
@@ -623,4 +635,25 @@ int conical_k2s2_project(conical_k2s2_state *x, const conical_k2s2_params *prm, 
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_k2s2_OK;
+}
+
+void conical_k2s2_dense(const conical_k2s2_state *x, conical_k2s2_real theta, conical_k2s2_real *q, conical_k2s2_real *p)
+{
+  double L[conical_k2s2_S + 1], w[conical_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_k2s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < conical_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * conical_k2s2_M + i];
+      dp += w[j] * x->pinc[j * conical_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -45,8 +45,8 @@ static const double conical_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.4164078649
 static const double conical_k3s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k3s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void conical_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k3s3_params *prm, double *out)
 {
@@ -173,6 +173,18 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t116 = -t115;
   const double t117 = h * t67;
   const double t118 = -t117;
+  const double t119 = h * t68;
+  const double t120 = -t119;
+  const double t121 = h * t69;
+  const double t122 = -t121;
+  const double t123 = h * t70;
+  const double t124 = -t123;
+  const double t125 = h * t71;
+  const double t126 = -t125;
+  const double t127 = h * t72;
+  const double t128 = -t127;
+  const double t129 = h * t73;
+  const double t130 = -t129;
   /* gam */
   out[0] = t78;
   out[1] = t83;
@@ -187,12 +199,18 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   out[9] = t114;
   out[10] = t116;
   out[11] = t118;
+  out[12] = t120;
+  out[13] = t122;
+  out[14] = t124;
+  out[15] = t126;
+  out[16] = t128;
+  out[17] = t130;
   /* lambda */
-  out[12] = t63;
+  out[18] = t63;
   /* pivot */
-  out[13] = t51;
+  out[19] = t51;
   /* adiag */
-  out[14] = t51;
+  out[20] = t51;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -359,7 +377,7 @@ void conical_k3s3_init_params(conical_k3s3_state *x, const conical_k3s3_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k3s3_NU ? conical_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[conical_k3s3_NU];
     conical_k3s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -455,7 +473,7 @@ static double conical_k3s3_err_est(const double *gam, double h, double d1)
 static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_, double tol, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k3s3_S * conical_k3s3_M], sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + 1];
+  double gam[conical_k3s3_S * conical_k3s3_M], sw[2 * conical_k3s3_S * conical_k3s3_M + 3 * conical_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k3s3_ENOCONV;
   conical_k3s3_DEFAULT_PARAMS(prm)
@@ -485,11 +503,11 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_k3s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k3s3_NU; i++) {
-      double piv = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU + i], dia = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 2 * conical_k3s3_NU + i];
+      double piv = sw[2 * conical_k3s3_S * conical_k3s3_M + conical_k3s3_NU + i], dia = sw[2 * conical_k3s3_S * conical_k3s3_M + 2 * conical_k3s3_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k3s3_SINGTOL * fabs(dia))) rc = conical_k3s3_ESINGULAR;
     }
     if (rc == conical_k3s3_ESINGULAR) break;
-    for (i = 0; i < conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU; i++)
+    for (i = 0; i < 2 * conical_k3s3_S * conical_k3s3_M + conical_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k3s3_ENONFINITE;
     if (rc == conical_k3s3_ENONFINITE || !isfinite(inc)) { rc = conical_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k3s3_TOL / 256), or
@@ -529,8 +547,11 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     conical_k3s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     conical_k3s3_add(&x->p[i], &x->pc[i], sw[conical_k3s3_S * conical_k3s3_M + i]);
   }
-  for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + i];
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[2 * conical_k3s3_S * conical_k3s3_M + i];
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[conical_k3s3_S * conical_k3s3_M + i];
+  }
   conical_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k3s3_OK;
@@ -647,7 +668,7 @@ int conical_k3s3_project(conical_k3s3_state *x, const conical_k3s3_params *prm, 
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[conical_k3s3_NU];
@@ -657,4 +678,25 @@ int conical_k3s3_project(conical_k3s3_state *x, const conical_k3s3_params *prm, 
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_k3s3_OK;
+}
+
+void conical_k3s3_dense(const conical_k3s3_state *x, conical_k3s3_real theta, conical_k3s3_real *q, conical_k3s3_real *p)
+{
+  double L[conical_k3s3_S + 1], w[conical_k3s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_k3s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_k3s3_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < conical_k3s3_S; j++) {
+      dq += w[j] * x->gam[j * conical_k3s3_M + i];
+      dp += w[j] * x->pinc[j * conical_k3s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

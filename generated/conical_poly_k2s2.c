@@ -45,7 +45,7 @@ static const double conical_poly_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.707
 static const double conical_poly_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
@@ -232,6 +232,12 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   const double t176 = -t175;
   const double t177 = h * t142;
   const double t178 = -t177;
+  const double t179 = h * t144;
+  const double t180 = -t179;
+  const double t181 = h * t146;
+  const double t182 = -t181;
+  const double t183 = h * t148;
+  const double t184 = -t183;
   /* gam */
   out[0] = t153;
   out[1] = t158;
@@ -243,9 +249,12 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   out[6] = t174;
   out[7] = t176;
   out[8] = t178;
+  out[9] = t180;
+  out[10] = t182;
+  out[11] = t184;
   /* lam */
-  out[9] = t118;
-  out[10] = t119;
+  out[12] = t118;
+  out[13] = t119;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -605,8 +614,9 @@ void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_pol
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_poly_k2s2_NU ? conical_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < conical_poly_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[conical_poly_k2s2_NU];
     conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -705,7 +715,7 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1)
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
+  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[2 * conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_poly_k2s2_ENOCONV;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -757,8 +767,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_poly_k2s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + i];
-    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
+    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[2 * conical_poly_k2s2_S * conical_poly_k2s2_M + i];
+    for (i = 0; i < 2 * conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = conical_poly_k2s2_ENONFINITE;
     if (rc == conical_poly_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_poly_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (conical_poly_k2s2_TOL). Iterating
@@ -799,6 +809,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     conical_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
   }
+  double phat[conical_poly_k2s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < conical_poly_k2s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   conical_poly_k2s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < conical_poly_k2s2_NU; i++) {
@@ -824,8 +836,12 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
+  }
   x->H0 = H0;
   {
     double lam[conical_poly_k2s2_NU];
@@ -948,9 +964,10 @@ int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < conical_poly_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[conical_poly_k2s2_NU];
     conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -959,4 +976,25 @@ int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_poly_k2s2_OK;
+}
+
+void conical_poly_k2s2_dense(const conical_poly_k2s2_state *x, conical_poly_k2s2_real theta, conical_poly_k2s2_real *q, conical_poly_k2s2_real *p)
+{
+  double L[conical_poly_k2s2_S + 1], w[conical_poly_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_poly_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_poly_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < conical_poly_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * conical_poly_k2s2_M + i];
+      dp += w[j] * x->pinc[j * conical_poly_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -44,8 +44,8 @@ static const double double_pendulum_const_k2s2_E1[4] = {1.0, 3.4641016151377544,
 static const double double_pendulum_const_k2s2_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_const_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
 {
@@ -236,6 +236,14 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t180 = -t179;
   const double t181 = h * t134;
   const double t182 = -t181;
+  const double t183 = h * t138;
+  const double t184 = -t183;
+  const double t185 = h * t140;
+  const double t186 = -t185;
+  const double t187 = h * t141;
+  const double t188 = -t187;
+  const double t189 = h * t142;
+  const double t190 = -t189;
   /* gam */
   out[0] = t147;
   out[1] = t152;
@@ -250,15 +258,19 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   out[9] = t178;
   out[10] = t180;
   out[11] = t182;
+  out[12] = t184;
+  out[13] = t186;
+  out[14] = t188;
+  out[15] = t190;
   /* lambda */
-  out[12] = t124;
-  out[13] = t121;
+  out[16] = t124;
+  out[17] = t121;
   /* pivot */
-  out[14] = t64;
-  out[15] = t118;
+  out[18] = t64;
+  out[19] = t118;
   /* adiag */
-  out[16] = t64;
-  out[17] = t100;
+  out[20] = t64;
+  out[21] = t100;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -513,7 +525,7 @@ void double_pendulum_const_k2s2_init_params(double_pendulum_const_k2s2_state *x,
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_const_k2s2_NU ? double_pendulum_const_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[double_pendulum_const_k2s2_NU];
     double_pendulum_const_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -612,7 +624,7 @@ static double double_pendulum_const_k2s2_err_est(const double *gam, double h, do
 static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h_, double tol, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
+  double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_const_k2s2_ENOCONV;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
@@ -642,11 +654,11 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_const_k2s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < double_pendulum_const_k2s2_NU; i++) {
-      double piv = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
+      double piv = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_const_k2s2_SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
     }
     if (rc == double_pendulum_const_k2s2_ESINGULAR) break;
-    for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU; i++)
+    for (i = 0; i < 2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_const_k2s2_ENONFINITE;
     if (rc == double_pendulum_const_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_const_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (double_pendulum_const_k2s2_TOL / 256), or
@@ -686,8 +698,11 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     double_pendulum_const_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]);
   }
-  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + i];
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
+  }
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return double_pendulum_const_k2s2_OK;
@@ -804,7 +819,7 @@ int double_pendulum_const_k2s2_project(double_pendulum_const_k2s2_state *x, cons
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[double_pendulum_const_k2s2_NU];
@@ -814,4 +829,25 @@ int double_pendulum_const_k2s2_project(double_pendulum_const_k2s2_state *x, cons
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return double_pendulum_const_k2s2_OK;
+}
+
+void double_pendulum_const_k2s2_dense(const double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real theta, double_pendulum_const_k2s2_real *q, double_pendulum_const_k2s2_real *p)
+{
+  double L[double_pendulum_const_k2s2_S + 1], w[double_pendulum_const_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < double_pendulum_const_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < double_pendulum_const_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < double_pendulum_const_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * double_pendulum_const_k2s2_M + i];
+      dp += w[j] * x->pinc[j * double_pendulum_const_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

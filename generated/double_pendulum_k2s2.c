@@ -45,7 +45,7 @@ static const double double_pendulum_k2s2_q0[4] = {0.47942553860420301, (-0.87758
 static const double double_pendulum_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
@@ -345,6 +345,14 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t289 = -t288;
   const double t290 = h * t243;
   const double t291 = -t290;
+  const double t292 = h * t245;
+  const double t293 = -t292;
+  const double t294 = h * t247;
+  const double t295 = -t294;
+  const double t296 = h * t249;
+  const double t297 = -t296;
+  const double t298 = h * t251;
+  const double t299 = -t298;
   /* gam */
   out[0] = t256;
   out[1] = t261;
@@ -359,11 +367,15 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   out[9] = t287;
   out[10] = t289;
   out[11] = t291;
+  out[12] = t293;
+  out[13] = t295;
+  out[14] = t297;
+  out[15] = t299;
   /* lam */
-  out[12] = t202;
-  out[13] = t203;
-  out[14] = t204;
-  out[15] = t205;
+  out[16] = t202;
+  out[17] = t203;
+  out[18] = t204;
+  out[19] = t205;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -1058,8 +1070,9 @@ void double_pendulum_k2s2_init_params(double_pendulum_k2s2_state *x, const doubl
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k2s2_NU ? double_pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < double_pendulum_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k2s2_NU];
     double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1158,7 +1171,7 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
 static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
+  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[2 * double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k2s2_ENOCONV;
   double_pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -1210,8 +1223,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k2s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + i];
-    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
+    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[2 * double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
+    for (i = 0; i < 2 * double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k2s2_ENONFINITE;
     if (rc == double_pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k2s2_TOL). Iterating
@@ -1252,6 +1265,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     double_pendulum_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k2s2_add(&p1[i], &pc1[i], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i]);
   }
+  double phat[double_pendulum_k2s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < double_pendulum_k2s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k2s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_k2s2_NU; i++) {
@@ -1277,8 +1292,12 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
+  }
   x->H0 = H0;
   {
     double lam[double_pendulum_k2s2_NU];
@@ -1401,9 +1420,10 @@ int double_pendulum_k2s2_project(double_pendulum_k2s2_state *x, const double_pen
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < double_pendulum_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k2s2_NU];
     double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1412,4 +1432,25 @@ int double_pendulum_k2s2_project(double_pendulum_k2s2_state *x, const double_pen
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return double_pendulum_k2s2_OK;
+}
+
+void double_pendulum_k2s2_dense(const double_pendulum_k2s2_state *x, double_pendulum_k2s2_real theta, double_pendulum_k2s2_real *q, double_pendulum_k2s2_real *p)
+{
+  double L[double_pendulum_k2s2_S + 1], w[double_pendulum_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < double_pendulum_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < double_pendulum_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < double_pendulum_k2s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < double_pendulum_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * double_pendulum_k2s2_M + i];
+      dp += w[j] * x->pinc[j * double_pendulum_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -47,7 +47,7 @@ static const double double_pendulum_k4s4_q0[4] = {0.47942553860420301, (-0.87758
 static const double double_pendulum_k4s4_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
@@ -1045,6 +1045,30 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t987 = -t986;
   const double t988 = h * t885;
   const double t989 = -t988;
+  const double t990 = h * t887;
+  const double t991 = -t990;
+  const double t992 = h * t889;
+  const double t993 = -t992;
+  const double t994 = h * t891;
+  const double t995 = -t994;
+  const double t996 = h * t893;
+  const double t997 = -t996;
+  const double t998 = h * t895;
+  const double t999 = -t998;
+  const double t1000 = h * t897;
+  const double t1001 = -t1000;
+  const double t1002 = h * t899;
+  const double t1003 = -t1002;
+  const double t1004 = h * t901;
+  const double t1005 = -t1004;
+  const double t1006 = h * t903;
+  const double t1007 = -t1006;
+  const double t1008 = h * t905;
+  const double t1009 = -t1008;
+  const double t1010 = h * t907;
+  const double t1011 = -t1010;
+  const double t1012 = h * t909;
+  const double t1013 = -t1012;
   /* gam */
   out[0] = t914;
   out[1] = t919;
@@ -1067,15 +1091,27 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   out[17] = t985;
   out[18] = t987;
   out[19] = t989;
+  out[20] = t991;
+  out[21] = t993;
+  out[22] = t995;
+  out[23] = t997;
+  out[24] = t999;
+  out[25] = t1001;
+  out[26] = t1003;
+  out[27] = t1005;
+  out[28] = t1007;
+  out[29] = t1009;
+  out[30] = t1011;
+  out[31] = t1013;
   /* lam */
-  out[20] = t718;
-  out[21] = t719;
-  out[22] = t720;
-  out[23] = t721;
-  out[24] = t722;
-  out[25] = t723;
-  out[26] = t724;
-  out[27] = t725;
+  out[32] = t718;
+  out[33] = t719;
+  out[34] = t720;
+  out[35] = t721;
+  out[36] = t722;
+  out[37] = t723;
+  out[38] = t724;
+  out[39] = t725;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -3918,8 +3954,9 @@ void double_pendulum_k4s4_init_params(double_pendulum_k4s4_state *x, const doubl
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k4s4_NU ? double_pendulum_k4s4_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < double_pendulum_k4s4_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k4s4_NU];
     double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -4018,7 +4055,7 @@ static double double_pendulum_k4s4_err_est(const double *gam, double h, double d
 static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
+  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[2 * double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k4s4_ENOCONV;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
@@ -4070,8 +4107,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k4s4_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + i];
-    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++)
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = sw[2 * double_pendulum_k4s4_S * double_pendulum_k4s4_M + i];
+    for (i = 0; i < 2 * double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k4s4_ENONFINITE;
     if (rc == double_pendulum_k4s4_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k4s4_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k4s4_TOL). Iterating
@@ -4112,6 +4149,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     double_pendulum_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k4s4_add(&p1[i], &pc1[i], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i]);
   }
+  double phat[double_pendulum_k4s4_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < double_pendulum_k4s4_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k4s4_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_k4s4_NU; i++) {
@@ -4137,8 +4176,12 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i];
+  }
   x->H0 = H0;
   {
     double lam[double_pendulum_k4s4_NU];
@@ -4261,9 +4304,10 @@ int double_pendulum_k4s4_project(double_pendulum_k4s4_state *x, const double_pen
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < double_pendulum_k4s4_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k4s4_NU];
     double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -4272,4 +4316,25 @@ int double_pendulum_k4s4_project(double_pendulum_k4s4_state *x, const double_pen
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return double_pendulum_k4s4_OK;
+}
+
+void double_pendulum_k4s4_dense(const double_pendulum_k4s4_state *x, double_pendulum_k4s4_real theta, double_pendulum_k4s4_real *q, double_pendulum_k4s4_real *p)
+{
+  double L[double_pendulum_k4s4_S + 1], w[double_pendulum_k4s4_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < double_pendulum_k4s4_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < double_pendulum_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < double_pendulum_k4s4_S; j++) {
+      dq += w[j] * x->gam[j * double_pendulum_k4s4_M + i];
+      dp += w[j] * x->pinc[j * double_pendulum_k4s4_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -27,7 +27,9 @@ typedef struct {
   double_pendulum_k4s4_real t, q[4], p[4], lambda[2];
   /* private: compensated-summation errors and the last step's polynomial */
   double_pendulum_k4s4_real tc, qc[4], pc[4], gam[16], hprev;
+  double_pendulum_k4s4_real pinc[16];  /* p's increments over the last step, for double_pendulum_k4s4_dense */
   double_pendulum_k4s4_real H0;  /* the energy the step keeps */
+  double_pendulum_k4s4_real pcorr[4];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } double_pendulum_k4s4_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * double_pendulum_k4s4_HMIN (1 + |t|). */
 int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real *h, double_pendulum_k4s4_real tol, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after double_pendulum_k4s4_project) it gives the state. */
+void double_pendulum_k4s4_dense(const double_pendulum_k4s4_state *x, double_pendulum_k4s4_real theta, double_pendulum_k4s4_real *q, double_pendulum_k4s4_real *p);
 const char *double_pendulum_k4s4_strerror(int code);
 double_pendulum_k4s4_real double_pendulum_k4s4_energy(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm);
 void double_pendulum_k4s4_constraints(const double_pendulum_k4s4_state *x, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_real *g);   /* double_pendulum_k4s4_NU values */

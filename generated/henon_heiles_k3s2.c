@@ -45,8 +45,8 @@ static const double henon_heiles_k3s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 1.0
 static const double henon_heiles_k3s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k3s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const henon_heiles_k3s2_params *prm, double *out)
 {
@@ -146,6 +146,10 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   const double t88 = -t87;
   const double t89 = h * t66;
   const double t90 = -t89;
+  const double t91 = h * t68;
+  const double t92 = -t91;
+  const double t93 = h * t70;
+  const double t94 = -t93;
   /* gam */
   out[0] = t75;
   out[1] = t80;
@@ -154,6 +158,8 @@ static void henon_heiles_k3s2_sweep(const double *q0, const double *p0, const do
   /* dp */
   out[4] = t88;
   out[5] = t90;
+  out[6] = t92;
+  out[7] = t94;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -208,7 +214,7 @@ void henon_heiles_k3s2_init_params(henon_heiles_k3s2_state *x, const henon_heile
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (henon_heiles_k3s2_NU ? henon_heiles_k3s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = x->pinc[i] = 0;
 }
 
 void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0)
@@ -300,7 +306,7 @@ static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1)
 static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, double tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
+  double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[2 * henon_heiles_k3s2_S * henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = henon_heiles_k3s2_ENOCONV;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
@@ -323,7 +329,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for henon_heiles_k3s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + henon_heiles_k3s2_NU; i++)
+    for (i = 0; i < 2 * henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_NU; i++)
       if (!isfinite(sw[i])) rc = henon_heiles_k3s2_ENONFINITE;
     if (rc == henon_heiles_k3s2_ENONFINITE || !isfinite(inc)) { rc = henon_heiles_k3s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (henon_heiles_k3s2_TOL / 256), or
@@ -363,8 +369,11 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
     henon_heiles_k3s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     henon_heiles_k3s2_add(&x->p[i], &x->pc[i], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]);
   }
-  for (i = 0; i < henon_heiles_k3s2_NU; i++) x->lambda[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + i];
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < henon_heiles_k3s2_NU; i++) x->lambda[i] = sw[2 * henon_heiles_k3s2_S * henon_heiles_k3s2_M + i];
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i];
+  }
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return henon_heiles_k3s2_OK;
@@ -444,4 +453,25 @@ int henon_heiles_k3s2_project(henon_heiles_k3s2_state *x, const henon_heiles_k3s
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return henon_heiles_k3s2_OK;
+}
+
+void henon_heiles_k3s2_dense(const henon_heiles_k3s2_state *x, henon_heiles_k3s2_real theta, henon_heiles_k3s2_real *q, henon_heiles_k3s2_real *p)
+{
+  double L[henon_heiles_k3s2_S + 1], w[henon_heiles_k3s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < henon_heiles_k3s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < henon_heiles_k3s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < henon_heiles_k3s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < henon_heiles_k3s2_S; j++) {
+      dq += w[j] * x->gam[j * henon_heiles_k3s2_M + i];
+      dp += w[j] * x->pinc[j * henon_heiles_k3s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -45,8 +45,8 @@ static const double modified_k3s1_E1[1] = {1.0};
 static const double modified_k3s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k3s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void modified_k3s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k3s1_params *prm, double *out)
 {
@@ -344,7 +344,7 @@ void modified_k3s1_init_params(modified_k3s1_state *x, const modified_k3s1_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k3s1_NU ? modified_k3s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[modified_k3s1_NU];
     modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -443,7 +443,7 @@ static double modified_k3s1_err_est(const double *gam, double h, double d1)
 static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real h_, double tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
+  double gam[modified_k3s1_S * modified_k3s1_M], sw[2 * modified_k3s1_S * modified_k3s1_M + 3 * modified_k3s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k3s1_ENOCONV;
   modified_k3s1_DEFAULT_PARAMS(prm)
@@ -473,11 +473,11 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_k3s1_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k3s1_NU; i++) {
-      double piv = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU + i], dia = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 2 * modified_k3s1_NU + i];
+      double piv = sw[2 * modified_k3s1_S * modified_k3s1_M + modified_k3s1_NU + i], dia = sw[2 * modified_k3s1_S * modified_k3s1_M + 2 * modified_k3s1_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k3s1_SINGTOL * fabs(dia))) rc = modified_k3s1_ESINGULAR;
     }
     if (rc == modified_k3s1_ESINGULAR) break;
-    for (i = 0; i < modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU; i++)
+    for (i = 0; i < 2 * modified_k3s1_S * modified_k3s1_M + modified_k3s1_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k3s1_ENONFINITE;
     if (rc == modified_k3s1_ENONFINITE || !isfinite(inc)) { rc = modified_k3s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k3s1_TOL / 256), or
@@ -517,8 +517,11 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     modified_k3s1_add(&x->q[i], &x->qc[i], h * sw[i]);
     modified_k3s1_add(&x->p[i], &x->pc[i], sw[modified_k3s1_S * modified_k3s1_M + i]);
   }
-  for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + i];
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[2 * modified_k3s1_S * modified_k3s1_M + i];
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[modified_k3s1_S * modified_k3s1_M + i];
+  }
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k3s1_OK;
@@ -635,7 +638,7 @@ int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[modified_k3s1_NU];
@@ -645,4 +648,25 @@ int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_k3s1_OK;
+}
+
+void modified_k3s1_dense(const modified_k3s1_state *x, modified_k3s1_real theta, modified_k3s1_real *q, modified_k3s1_real *p)
+{
+  double L[modified_k3s1_S + 1], w[modified_k3s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_k3s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_k3s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_k3s1_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < modified_k3s1_S; j++) {
+      dq += w[j] * x->gam[j * modified_k3s1_M + i];
+      dp += w[j] * x->pinc[j * modified_k3s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

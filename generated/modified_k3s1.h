@@ -27,6 +27,7 @@ typedef struct {
   modified_k3s1_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last step's polynomial */
   modified_k3s1_real tc, qc[3], pc[3], gam[3], hprev;
+  modified_k3s1_real pinc[3];  /* p's increments over the last step, for modified_k3s1_dense */
 } modified_k3s1_state;
 
 typedef struct {
@@ -60,6 +61,11 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modif
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_k3s1_HMIN (1 + |t|). */
 int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_k3s1_project) it gives the state. */
+void modified_k3s1_dense(const modified_k3s1_state *x, modified_k3s1_real theta, modified_k3s1_real *q, modified_k3s1_real *p);
 const char *modified_k3s1_strerror(int code);
 modified_k3s1_real modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm);
 void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *g);   /* modified_k3s1_NU values */

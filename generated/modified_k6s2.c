@@ -48,8 +48,8 @@ static const double modified_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231
 static const double modified_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void modified_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k6s2_params *prm, double *out)
 {
@@ -308,6 +308,12 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t242 = -t241;
   const double t243 = h * t210;
   const double t244 = -t243;
+  const double t245 = h * t211;
+  const double t246 = -t245;
+  const double t247 = h * t212;
+  const double t248 = -t247;
+  const double t249 = h * t214;
+  const double t250 = -t249;
   /* gam */
   out[0] = t219;
   out[1] = t224;
@@ -319,12 +325,15 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   out[6] = t240;
   out[7] = t242;
   out[8] = t244;
+  out[9] = t246;
+  out[10] = t248;
+  out[11] = t250;
   /* lambda */
-  out[9] = t206;
+  out[12] = t206;
   /* pivot */
-  out[10] = t190;
+  out[13] = t190;
   /* adiag */
-  out[11] = t190;
+  out[14] = t190;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -507,7 +516,7 @@ void modified_k6s2_init_params(modified_k6s2_state *x, const modified_k6s2_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k6s2_NU ? modified_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[modified_k6s2_NU];
     modified_k6s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -606,7 +615,7 @@ static double modified_k6s2_err_est(const double *gam, double h, double d1)
 static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real h_, double tol, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + 1];
+  double gam[modified_k6s2_S * modified_k6s2_M], sw[2 * modified_k6s2_S * modified_k6s2_M + 3 * modified_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k6s2_ENOCONV;
   modified_k6s2_DEFAULT_PARAMS(prm)
@@ -636,11 +645,11 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_k6s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k6s2_NU; i++) {
-      double piv = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU + i], dia = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 2 * modified_k6s2_NU + i];
+      double piv = sw[2 * modified_k6s2_S * modified_k6s2_M + modified_k6s2_NU + i], dia = sw[2 * modified_k6s2_S * modified_k6s2_M + 2 * modified_k6s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k6s2_SINGTOL * fabs(dia))) rc = modified_k6s2_ESINGULAR;
     }
     if (rc == modified_k6s2_ESINGULAR) break;
-    for (i = 0; i < modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU; i++)
+    for (i = 0; i < 2 * modified_k6s2_S * modified_k6s2_M + modified_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k6s2_ENONFINITE;
     if (rc == modified_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k6s2_TOL / 256), or
@@ -680,8 +689,11 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     modified_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     modified_k6s2_add(&x->p[i], &x->pc[i], sw[modified_k6s2_S * modified_k6s2_M + i]);
   }
-  for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + i];
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[2 * modified_k6s2_S * modified_k6s2_M + i];
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[modified_k6s2_S * modified_k6s2_M + i];
+  }
   modified_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k6s2_OK;
@@ -798,7 +810,7 @@ int modified_k6s2_project(modified_k6s2_state *x, const modified_k6s2_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[modified_k6s2_NU];
@@ -808,4 +820,25 @@ int modified_k6s2_project(modified_k6s2_state *x, const modified_k6s2_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_k6s2_OK;
+}
+
+void modified_k6s2_dense(const modified_k6s2_state *x, modified_k6s2_real theta, modified_k6s2_real *q, modified_k6s2_real *p)
+{
+  double L[modified_k6s2_S + 1], w[modified_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_k6s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < modified_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * modified_k6s2_M + i];
+      dp += w[j] * x->pinc[j * modified_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -51,8 +51,8 @@ static const double modified_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864
 static const double modified_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void modified_k9s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k9s3_params *prm, double *out)
 {
@@ -522,6 +522,18 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t450 = -t449;
   const double t451 = h * t399;
   const double t452 = -t451;
+  const double t453 = h * t400;
+  const double t454 = -t453;
+  const double t455 = h * t401;
+  const double t456 = -t455;
+  const double t457 = h * t403;
+  const double t458 = -t457;
+  const double t459 = h * t404;
+  const double t460 = -t459;
+  const double t461 = h * t405;
+  const double t462 = -t461;
+  const double t463 = h * t407;
+  const double t464 = -t463;
   /* gam */
   out[0] = t412;
   out[1] = t417;
@@ -536,12 +548,18 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   out[9] = t448;
   out[10] = t450;
   out[11] = t452;
+  out[12] = t454;
+  out[13] = t456;
+  out[14] = t458;
+  out[15] = t460;
+  out[16] = t462;
+  out[17] = t464;
   /* lambda */
-  out[12] = t395;
+  out[18] = t395;
   /* pivot */
-  out[13] = t374;
+  out[19] = t374;
   /* adiag */
-  out[14] = t374;
+  out[20] = t374;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -724,7 +742,7 @@ void modified_k9s3_init_params(modified_k9s3_state *x, const modified_k9s3_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k9s3_NU ? modified_k9s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[modified_k9s3_NU];
     modified_k9s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -820,7 +838,7 @@ static double modified_k9s3_err_est(const double *gam, double h, double d1)
 static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real h_, double tol, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k9s3_S * modified_k9s3_M], sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 3 * modified_k9s3_NU + 1];
+  double gam[modified_k9s3_S * modified_k9s3_M], sw[2 * modified_k9s3_S * modified_k9s3_M + 3 * modified_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k9s3_ENOCONV;
   modified_k9s3_DEFAULT_PARAMS(prm)
@@ -850,11 +868,11 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_k9s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k9s3_NU; i++) {
-      double piv = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU + i], dia = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 2 * modified_k9s3_NU + i];
+      double piv = sw[2 * modified_k9s3_S * modified_k9s3_M + modified_k9s3_NU + i], dia = sw[2 * modified_k9s3_S * modified_k9s3_M + 2 * modified_k9s3_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k9s3_SINGTOL * fabs(dia))) rc = modified_k9s3_ESINGULAR;
     }
     if (rc == modified_k9s3_ESINGULAR) break;
-    for (i = 0; i < modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU; i++)
+    for (i = 0; i < 2 * modified_k9s3_S * modified_k9s3_M + modified_k9s3_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k9s3_ENONFINITE;
     if (rc == modified_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_k9s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k9s3_TOL / 256), or
@@ -894,8 +912,11 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
     modified_k9s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     modified_k9s3_add(&x->p[i], &x->pc[i], sw[modified_k9s3_S * modified_k9s3_M + i]);
   }
-  for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + i];
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[2 * modified_k9s3_S * modified_k9s3_M + i];
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[modified_k9s3_S * modified_k9s3_M + i];
+  }
   modified_k9s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k9s3_OK;
@@ -1012,7 +1033,7 @@ int modified_k9s3_project(modified_k9s3_state *x, const modified_k9s3_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[modified_k9s3_NU];
@@ -1022,4 +1043,25 @@ int modified_k9s3_project(modified_k9s3_state *x, const modified_k9s3_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_k9s3_OK;
+}
+
+void modified_k9s3_dense(const modified_k9s3_state *x, modified_k9s3_real theta, modified_k9s3_real *q, modified_k9s3_real *p)
+{
+  double L[modified_k9s3_S + 1], w[modified_k9s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_k9s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_k9s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_k9s3_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < modified_k9s3_S; j++) {
+      dq += w[j] * x->gam[j * modified_k9s3_M + i];
+      dp += w[j] * x->pinc[j * modified_k9s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -27,6 +27,7 @@ typedef struct {
   modified_k9s3_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last step's polynomial */
   modified_k9s3_real tc, qc[3], pc[3], gam[9], hprev;
+  modified_k9s3_real pinc[9];  /* p's increments over the last step, for modified_k9s3_dense */
 } modified_k9s3_state;
 
 typedef struct {
@@ -60,6 +61,11 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modif
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_k9s3_HMIN (1 + |t|). */
 int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, modified_k9s3_real tol, const modified_k9s3_params *prm, modified_k9s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_k9s3_project) it gives the state. */
+void modified_k9s3_dense(const modified_k9s3_state *x, modified_k9s3_real theta, modified_k9s3_real *q, modified_k9s3_real *p);
 const char *modified_k9s3_strerror(int code);
 modified_k9s3_real modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
 void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *g);   /* modified_k9s3_NU values */

@@ -49,7 +49,7 @@ static const double modified_poly_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70
 static const double modified_poly_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
@@ -549,6 +549,12 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t483 = -t482;
   const double t484 = h * t449;
   const double t485 = -t484;
+  const double t486 = h * t451;
+  const double t487 = -t486;
+  const double t488 = h * t453;
+  const double t489 = -t488;
+  const double t490 = h * t455;
+  const double t491 = -t490;
   /* gam */
   out[0] = t460;
   out[1] = t465;
@@ -560,9 +566,12 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   out[6] = t481;
   out[7] = t483;
   out[8] = t485;
+  out[9] = t487;
+  out[10] = t489;
+  out[11] = t491;
   /* lam */
-  out[9] = t356;
-  out[10] = t357;
+  out[12] = t356;
+  out[13] = t357;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -1099,8 +1108,9 @@ void modified_poly_k6s2_init_params(modified_poly_k6s2_state *x, const modified_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_poly_k6s2_NU ? modified_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < modified_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k6s2_NU];
     modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1199,7 +1209,7 @@ static double modified_poly_k6s2_err_est(const double *gam, double h, double d1)
 static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, double tol, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
+  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[2 * modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k6s2_ENOCONV;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -1251,8 +1261,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_poly_k6s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) lam[i] = sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + i];
-    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU; i++)
+    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) lam[i] = sw[2 * modified_poly_k6s2_S * modified_poly_k6s2_M + i];
+    for (i = 0; i < 2 * modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = modified_poly_k6s2_ENONFINITE;
     if (rc == modified_poly_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_poly_k6s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (modified_poly_k6s2_TOL). Iterating
@@ -1293,6 +1303,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     modified_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k6s2_add(&p1[i], &pc1[i], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i]);
   }
+  double phat[modified_poly_k6s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < modified_poly_k6s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   modified_poly_k6s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < modified_poly_k6s2_NU; i++) {
@@ -1318,8 +1330,12 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
+  }
   x->H0 = H0;
   {
     double lam[modified_poly_k6s2_NU];
@@ -1442,9 +1458,10 @@ int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < modified_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k6s2_NU];
     modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1453,4 +1470,25 @@ int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_poly_k6s2_OK;
+}
+
+void modified_poly_k6s2_dense(const modified_poly_k6s2_state *x, modified_poly_k6s2_real theta, modified_poly_k6s2_real *q, modified_poly_k6s2_real *p)
+{
+  double L[modified_poly_k6s2_S + 1], w[modified_poly_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_poly_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_poly_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < modified_poly_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * modified_poly_k6s2_M + i];
+      dp += w[j] * x->pinc[j * modified_poly_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -52,7 +52,7 @@ static const double modified_poly_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70
 static const double modified_poly_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
@@ -1047,6 +1047,18 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t974 = -t973;
   const double t975 = h * t919;
   const double t976 = -t975;
+  const double t977 = h * t921;
+  const double t978 = -t977;
+  const double t979 = h * t923;
+  const double t980 = -t979;
+  const double t981 = h * t925;
+  const double t982 = -t981;
+  const double t983 = h * t927;
+  const double t984 = -t983;
+  const double t985 = h * t929;
+  const double t986 = -t985;
+  const double t987 = h * t931;
+  const double t988 = -t987;
   /* gam */
   out[0] = t936;
   out[1] = t941;
@@ -1061,10 +1073,16 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   out[9] = t972;
   out[10] = t974;
   out[11] = t976;
+  out[12] = t978;
+  out[13] = t980;
+  out[14] = t982;
+  out[15] = t984;
+  out[16] = t986;
+  out[17] = t988;
   /* lam */
-  out[12] = t721;
-  out[13] = t722;
-  out[14] = t723;
+  out[18] = t721;
+  out[19] = t722;
+  out[20] = t723;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -2061,8 +2079,9 @@ void modified_poly_k9s3_init_params(modified_poly_k9s3_state *x, const modified_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_poly_k9s3_NU ? modified_poly_k9s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < modified_poly_k9s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k9s3_NU];
     modified_poly_k9s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -2161,7 +2180,7 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1)
 static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
+  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[2 * modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k9s3_ENOCONV;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
@@ -2213,8 +2232,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_poly_k9s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + i];
-    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU; i++)
+    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = sw[2 * modified_poly_k9s3_S * modified_poly_k9s3_M + i];
+    for (i = 0; i < 2 * modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU; i++)
       if (!isfinite(sw[i])) rc = modified_poly_k9s3_ENONFINITE;
     if (rc == modified_poly_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_poly_k9s3_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (modified_poly_k9s3_TOL). Iterating
@@ -2255,6 +2274,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     modified_poly_k9s3_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k9s3_add(&p1[i], &pc1[i], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i]);
   }
+  double phat[modified_poly_k9s3_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < modified_poly_k9s3_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   modified_poly_k9s3_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < modified_poly_k9s3_NU; i++) {
@@ -2280,8 +2301,12 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i];
+  }
   x->H0 = H0;
   {
     double lam[modified_poly_k9s3_NU];
@@ -2404,9 +2429,10 @@ int modified_poly_k9s3_project(modified_poly_k9s3_state *x, const modified_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < modified_poly_k9s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k9s3_NU];
     modified_poly_k9s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -2415,4 +2441,25 @@ int modified_poly_k9s3_project(modified_poly_k9s3_state *x, const modified_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_poly_k9s3_OK;
+}
+
+void modified_poly_k9s3_dense(const modified_poly_k9s3_state *x, modified_poly_k9s3_real theta, modified_poly_k9s3_real *q, modified_poly_k9s3_real *p)
+{
+  double L[modified_poly_k9s3_S + 1], w[modified_poly_k9s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_poly_k9s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_poly_k9s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_poly_k9s3_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < modified_poly_k9s3_S; j++) {
+      dq += w[j] * x->gam[j * modified_poly_k9s3_M + i];
+      dp += w[j] * x->pinc[j * modified_poly_k9s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -27,7 +27,9 @@ typedef struct {
   modified_poly_k9s3_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last step's polynomial */
   modified_poly_k9s3_real tc, qc[3], pc[3], gam[9], hprev;
+  modified_poly_k9s3_real pinc[9];  /* p's increments over the last step, for modified_poly_k9s3_dense */
   modified_poly_k9s3_real H0;  /* the energy the step keeps */
+  modified_poly_k9s3_real pcorr[3];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } modified_poly_k9s3_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_poly_k9s3_HMIN (1 + |t|). */
 int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_k9s3_real *h, modified_poly_k9s3_real tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_poly_k9s3_project) it gives the state. */
+void modified_poly_k9s3_dense(const modified_poly_k9s3_state *x, modified_poly_k9s3_real theta, modified_poly_k9s3_real *q, modified_poly_k9s3_real *p);
 const char *modified_poly_k9s3_strerror(int code);
 modified_poly_k9s3_real modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm);
 void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, modified_poly_k9s3_real *g);   /* modified_poly_k9s3_NU values */

@@ -48,8 +48,8 @@ static const double pendulum_angle_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416
 static const double pendulum_angle_k6s3_q0[1] = {0.0};
 static const double pendulum_angle_k6s3_p0[1] = {1.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_angle_k6s3_params *prm, double *out)
 {
@@ -155,12 +155,18 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t91 = -t90;
   const double t92 = h * t74;
   const double t93 = -t92;
+  const double t94 = h * t76;
+  const double t95 = -t94;
+  const double t96 = h * t78;
+  const double t97 = -t96;
   /* gam */
   out[0] = t83;
   out[1] = t88;
   out[2] = t91;
   /* dp */
   out[3] = t93;
+  out[4] = t95;
+  out[5] = t97;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -204,7 +210,7 @@ void pendulum_angle_k6s3_init_params(pendulum_angle_k6s3_state *x, const pendulu
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_angle_k6s3_NU ? pendulum_angle_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = x->pinc[i] = 0;
 }
 
 void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_real *q0, const pendulum_angle_k6s3_real *p0)
@@ -296,7 +302,7 @@ static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1
 static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
+  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_angle_k6s3_ENOCONV;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
@@ -319,7 +325,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
+    for (i = 0; i < 2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_angle_k6s3_ENONFINITE;
     if (rc == pendulum_angle_k6s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_angle_k6s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_angle_k6s3_TOL / 256), or
@@ -359,8 +365,11 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     pendulum_angle_k6s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]);
   }
-  for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + i];
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
+  }
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_angle_k6s3_OK;
@@ -440,4 +449,25 @@ int pendulum_angle_k6s3_project(pendulum_angle_k6s3_state *x, const pendulum_ang
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return pendulum_angle_k6s3_OK;
+}
+
+void pendulum_angle_k6s3_dense(const pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real theta, pendulum_angle_k6s3_real *q, pendulum_angle_k6s3_real *p)
+{
+  double L[pendulum_angle_k6s3_S + 1], w[pendulum_angle_k6s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_angle_k6s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_angle_k6s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < pendulum_angle_k6s3_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_angle_k6s3_M + i];
+      dp += w[j] * x->pinc[j * pendulum_angle_k6s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -43,8 +43,8 @@ static const double pendulum_k1s1_E1[1] = {1.0};
 static const double pendulum_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k1s1_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
@@ -239,7 +239,7 @@ void pendulum_k1s1_init_params(pendulum_k1s1_state *x, const pendulum_k1s1_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k1s1_NU ? pendulum_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[pendulum_k1s1_NU];
     pendulum_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -338,7 +338,7 @@ static double pendulum_k1s1_err_est(const double *gam, double h, double d1)
 static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real h_, double tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
+  double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k1s1_ENOCONV;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
@@ -368,11 +368,11 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k1s1_NU; i++) {
-      double piv = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
+      double piv = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k1s1_SINGTOL * fabs(dia))) rc = pendulum_k1s1_ESINGULAR;
     }
     if (rc == pendulum_k1s1_ESINGULAR) break;
-    for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU; i++)
+    for (i = 0; i < 2 * pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_k1s1_ENONFINITE;
     if (rc == pendulum_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_k1s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k1s1_TOL / 256), or
@@ -412,8 +412,11 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     pendulum_k1s1_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[pendulum_k1s1_S * pendulum_k1s1_M + i]);
   }
-  for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + i];
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + i];
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + i];
+  }
   pendulum_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k1s1_OK;
@@ -530,7 +533,7 @@ int pendulum_k1s1_project(pendulum_k1s1_state *x, const pendulum_k1s1_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[pendulum_k1s1_NU];
@@ -540,4 +543,25 @@ int pendulum_k1s1_project(pendulum_k1s1_state *x, const pendulum_k1s1_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_k1s1_OK;
+}
+
+void pendulum_k1s1_dense(const pendulum_k1s1_state *x, pendulum_k1s1_real theta, pendulum_k1s1_real *q, pendulum_k1s1_real *p)
+{
+  double L[pendulum_k1s1_S + 1], w[pendulum_k1s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_k1s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_k1s1_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < pendulum_k1s1_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_k1s1_M + i];
+      dp += w[j] * x->pinc[j * pendulum_k1s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -44,8 +44,8 @@ static const double pendulum_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999
 static const double pendulum_k2s2_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k2s2_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
@@ -113,6 +113,10 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   const double t57 = -t56;
   const double t58 = h * t37;
   const double t59 = -t58;
+  const double t60 = h * t38;
+  const double t61 = -t60;
+  const double t62 = h * t39;
+  const double t63 = -t62;
   /* gam */
   out[0] = t44;
   out[1] = t49;
@@ -121,12 +125,14 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   /* dp */
   out[4] = t57;
   out[5] = t59;
+  out[6] = t61;
+  out[7] = t63;
   /* lambda */
-  out[6] = t34;
+  out[8] = t34;
   /* pivot */
-  out[7] = t24;
+  out[9] = t24;
   /* adiag */
-  out[8] = t24;
+  out[10] = t24;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -266,7 +272,7 @@ void pendulum_k2s2_init_params(pendulum_k2s2_state *x, const pendulum_k2s2_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k2s2_NU ? pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[pendulum_k2s2_NU];
     pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -365,7 +371,7 @@ static double pendulum_k2s2_err_est(const double *gam, double h, double d1)
 static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real h_, double tol, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];
+  double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k2s2_ENOCONV;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -395,11 +401,11 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k2s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k2s2_NU; i++) {
-      double piv = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU + i], dia = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 2 * pendulum_k2s2_NU + i];
+      double piv = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_NU + i], dia = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + 2 * pendulum_k2s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k2s2_SINGTOL * fabs(dia))) rc = pendulum_k2s2_ESINGULAR;
     }
     if (rc == pendulum_k2s2_ESINGULAR) break;
-    for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU; i++)
+    for (i = 0; i < 2 * pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_k2s2_ENONFINITE;
     if (rc == pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = pendulum_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k2s2_TOL / 256), or
@@ -439,8 +445,11 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     pendulum_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_k2s2_add(&x->p[i], &x->pc[i], sw[pendulum_k2s2_S * pendulum_k2s2_M + i]);
   }
-  for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + i];
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + i];
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + i];
+  }
   pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k2s2_OK;
@@ -557,7 +566,7 @@ int pendulum_k2s2_project(pendulum_k2s2_state *x, const pendulum_k2s2_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[pendulum_k2s2_NU];
@@ -567,4 +576,25 @@ int pendulum_k2s2_project(pendulum_k2s2_state *x, const pendulum_k2s2_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_k2s2_OK;
+}
+
+void pendulum_k2s2_dense(const pendulum_k2s2_state *x, pendulum_k2s2_real theta, pendulum_k2s2_real *q, pendulum_k2s2_real *p)
+{
+  double L[pendulum_k2s2_S + 1], w[pendulum_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_k2s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < pendulum_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_k2s2_M + i];
+      dp += w[j] * x->pinc[j * pendulum_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -46,7 +46,7 @@ static const double pendulum_poly_k3s3_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k3s3_p0[2] = {1.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k3s3_params *prm, double *out)
 {
@@ -292,6 +292,14 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   const double t234 = -t233;
   const double t235 = h * t198;
   const double t236 = -t235;
+  const double t237 = h * t200;
+  const double t238 = -t237;
+  const double t239 = h * t202;
+  const double t240 = -t239;
+  const double t241 = h * t204;
+  const double t242 = -t241;
+  const double t243 = h * t206;
+  const double t244 = -t243;
   /* gam */
   out[0] = t211;
   out[1] = t216;
@@ -302,10 +310,14 @@ static void pendulum_poly_k3s3_sweep(const double *q0, const double *p0, const d
   /* dp */
   out[6] = t234;
   out[7] = t236;
+  out[8] = t238;
+  out[9] = t240;
+  out[10] = t242;
+  out[11] = t244;
   /* lam */
-  out[8] = t162;
-  out[9] = t163;
-  out[10] = t164;
+  out[12] = t162;
+  out[13] = t163;
+  out[14] = t164;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -755,8 +767,9 @@ void pendulum_poly_k3s3_init_params(pendulum_poly_k3s3_state *x, const pendulum_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k3s3_NU ? pendulum_poly_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k3s3_NU];
     pendulum_poly_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -855,7 +868,7 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1)
 static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
+  double gam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M], sw[2 * pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k3s3_ENOCONV;
   pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
@@ -907,8 +920,8 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k3s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + i];
-    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++)
+    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++) lam[i] = sw[2 * pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i];
+    for (i = 0; i < 2 * pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k3s3_ENONFINITE;
     if (rc == pendulum_poly_k3s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k3s3_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k3s3_TOL). Iterating
@@ -949,6 +962,8 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     pendulum_poly_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k3s3_add(&p1[i], &pc1[i], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i]);
   }
+  double phat[pendulum_poly_k3s3_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k3s3_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < pendulum_poly_k3s3_NU; i++) {
@@ -974,8 +989,12 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k3s3_NU];
@@ -1098,9 +1117,10 @@ int pendulum_poly_k3s3_project(pendulum_poly_k3s3_state *x, const pendulum_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k3s3_NU];
     pendulum_poly_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1109,4 +1129,25 @@ int pendulum_poly_k3s3_project(pendulum_poly_k3s3_state *x, const pendulum_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_poly_k3s3_OK;
+}
+
+void pendulum_poly_k3s3_dense(const pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real theta, pendulum_poly_k3s3_real *q, pendulum_poly_k3s3_real *p)
+{
+  double L[pendulum_poly_k3s3_S + 1], w[pendulum_poly_k3s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_poly_k3s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_poly_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < pendulum_poly_k3s3_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_poly_k3s3_M + i];
+      dp += w[j] * x->pinc[j * pendulum_poly_k3s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

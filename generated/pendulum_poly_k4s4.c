@@ -47,7 +47,7 @@ static const double pendulum_poly_k4s4_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k4s4_p0[2] = {1.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
@@ -496,6 +496,18 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t438 = -t437;
   const double t439 = h * t388;
   const double t440 = -t439;
+  const double t441 = h * t390;
+  const double t442 = -t441;
+  const double t443 = h * t392;
+  const double t444 = -t443;
+  const double t445 = h * t394;
+  const double t446 = -t445;
+  const double t447 = h * t396;
+  const double t448 = -t447;
+  const double t449 = h * t398;
+  const double t450 = -t449;
+  const double t451 = h * t400;
+  const double t452 = -t451;
   /* gam */
   out[0] = t405;
   out[1] = t410;
@@ -508,11 +520,17 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   /* dp */
   out[8] = t438;
   out[9] = t440;
+  out[10] = t442;
+  out[11] = t444;
+  out[12] = t446;
+  out[13] = t448;
+  out[14] = t450;
+  out[15] = t452;
   /* lam */
-  out[10] = t309;
-  out[11] = t310;
-  out[12] = t311;
-  out[13] = t312;
+  out[16] = t309;
+  out[17] = t310;
+  out[18] = t311;
+  out[19] = t312;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -1304,8 +1322,9 @@ void pendulum_poly_k4s4_init_params(pendulum_poly_k4s4_state *x, const pendulum_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k4s4_NU ? pendulum_poly_k4s4_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k4s4_NU];
     pendulum_poly_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1404,7 +1423,7 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1)
 static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
+  double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k4s4_ENOCONV;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
@@ -1456,8 +1475,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + i];
-    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
+    for (i = 0; i < 2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k4s4_ENONFINITE;
     if (rc == pendulum_poly_k4s4_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k4s4_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k4s4_TOL). Iterating
@@ -1498,6 +1517,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     pendulum_poly_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k4s4_add(&p1[i], &pc1[i], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i]);
   }
+  double phat[pendulum_poly_k4s4_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k4s4_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < pendulum_poly_k4s4_NU; i++) {
@@ -1523,8 +1544,12 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
+  }
   x->H0 = H0;
   {
     double lam[pendulum_poly_k4s4_NU];
@@ -1647,9 +1672,10 @@ int pendulum_poly_k4s4_project(pendulum_poly_k4s4_state *x, const pendulum_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k4s4_NU];
     pendulum_poly_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1658,4 +1684,25 @@ int pendulum_poly_k4s4_project(pendulum_poly_k4s4_state *x, const pendulum_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_poly_k4s4_OK;
+}
+
+void pendulum_poly_k4s4_dense(const pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real theta, pendulum_poly_k4s4_real *q, pendulum_poly_k4s4_real *p)
+{
+  double L[pendulum_poly_k4s4_S + 1], w[pendulum_poly_k4s4_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_poly_k4s4_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_poly_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < pendulum_poly_k4s4_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_poly_k4s4_M + i];
+      dp += w[j] * x->pinc[j * pendulum_poly_k4s4_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -48,8 +48,8 @@ static const double satellites_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.55111512
 static const double satellites_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
+ * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
 static void satellites_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
@@ -1417,6 +1417,24 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t1351 = -t1350;
   const double t1352 = h * t1227;
   const double t1353 = -t1352;
+  const double t1354 = h * t1253;
+  const double t1355 = -t1354;
+  const double t1356 = h * t1255;
+  const double t1357 = -t1356;
+  const double t1358 = h * t1257;
+  const double t1359 = -t1358;
+  const double t1360 = h * t1241;
+  const double t1361 = -t1360;
+  const double t1362 = h * t1243;
+  const double t1363 = -t1362;
+  const double t1364 = h * t1245;
+  const double t1365 = -t1364;
+  const double t1366 = h * t1259;
+  const double t1367 = -t1366;
+  const double t1368 = h * t1261;
+  const double t1369 = -t1368;
+  const double t1370 = h * t1263;
+  const double t1371 = -t1370;
   /* gam */
   out[0] = t1268;
   out[1] = t1273;
@@ -1446,18 +1464,27 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   out[24] = t1349;
   out[25] = t1351;
   out[26] = t1353;
+  out[27] = t1355;
+  out[28] = t1357;
+  out[29] = t1359;
+  out[30] = t1361;
+  out[31] = t1363;
+  out[32] = t1365;
+  out[33] = t1367;
+  out[34] = t1369;
+  out[35] = t1371;
   /* lambda */
-  out[27] = t1191;
-  out[28] = t1186;
-  out[29] = t1183;
+  out[36] = t1191;
+  out[37] = t1186;
+  out[38] = t1183;
   /* pivot */
-  out[30] = t912;
-  out[31] = t1166;
-  out[32] = t1180;
+  out[39] = t912;
+  out[40] = t1166;
+  out[41] = t1180;
   /* adiag */
-  out[33] = t912;
-  out[34] = t1020;
-  out[35] = t1108;
+  out[42] = t912;
+  out[43] = t1020;
+  out[44] = t1108;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -2127,7 +2154,7 @@ void satellites_k6s2_init_params(satellites_k6s2_state *x, const satellites_k6s2
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_k6s2_NU ? satellites_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   {
     double lam[satellites_k6s2_NU];
     satellites_k6s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -2226,7 +2253,7 @@ static double satellites_k6s2_err_est(const double *gam, double h, double d1)
 static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2_real h_, double tol, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
+  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[2 * satellites_k6s2_S * satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_k6s2_ENOCONV;
   satellites_k6s2_DEFAULT_PARAMS(prm)
@@ -2256,11 +2283,11 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s2_NU; i++) {
-      double piv = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU + i], dia = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 2 * satellites_k6s2_NU + i];
+      double piv = sw[2 * satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_NU + i], dia = sw[2 * satellites_k6s2_S * satellites_k6s2_M + 2 * satellites_k6s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s2_SINGTOL * fabs(dia))) rc = satellites_k6s2_ESINGULAR;
     }
     if (rc == satellites_k6s2_ESINGULAR) break;
-    for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU; i++)
+    for (i = 0; i < 2 * satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s2_ENONFINITE;
     if (rc == satellites_k6s2_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (satellites_k6s2_TOL / 256), or
@@ -2300,8 +2327,11 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     satellites_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     satellites_k6s2_add(&x->p[i], &x->pc[i], sw[satellites_k6s2_S * satellites_k6s2_M + i]);
   }
-  for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + i];
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = sw[2 * satellites_k6s2_S * satellites_k6s2_M + i];
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) {
+    x->gam[i] = gam[i];
+    x->pinc[i] = sw[satellites_k6s2_S * satellites_k6s2_M + i];
+  }
   satellites_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s2_OK;
@@ -2418,7 +2448,7 @@ int satellites_k6s2_project(satellites_k6s2_state *x, const satellites_k6s2_para
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[satellites_k6s2_NU];
@@ -2428,4 +2458,25 @@ int satellites_k6s2_project(satellites_k6s2_state *x, const satellites_k6s2_para
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return satellites_k6s2_OK;
+}
+
+void satellites_k6s2_dense(const satellites_k6s2_state *x, satellites_k6s2_real theta, satellites_k6s2_real *q, satellites_k6s2_real *p)
+{
+  double L[satellites_k6s2_S + 1], w[satellites_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < satellites_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < satellites_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < satellites_k6s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < satellites_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * satellites_k6s2_M + i];
+      dp += w[j] * x->pinc[j * satellites_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp;
+  }
 }

@@ -49,7 +49,7 @@ static const double satellites_poly_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 2
 static const double satellites_poly_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
 static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *w, double *out)
 {
@@ -2106,12 +2106,12 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t1999 = t1939 + t1998;
   w[41] = t1999;
   /* lam */
-  out[27] = t1716;
-  out[28] = t1717;
-  out[29] = t1718;
-  out[30] = t1719;
-  out[31] = t1720;
-  out[32] = t1721;
+  out[36] = t1716;
+  out[37] = t1717;
+  out[38] = t1718;
+  out[39] = t1719;
+  out[40] = t1720;
+  out[41] = t1721;
 }
 
 static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0, const double *gam, double h,
@@ -2291,6 +2291,24 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   const double t2169 = -t2168;
   const double t2170 = h * t2063;
   const double t2171 = -t2170;
+  const double t2172 = h * t2065;
+  const double t2173 = -t2172;
+  const double t2174 = h * t2067;
+  const double t2175 = -t2174;
+  const double t2176 = h * t2069;
+  const double t2177 = -t2176;
+  const double t2178 = h * t2071;
+  const double t2179 = -t2178;
+  const double t2180 = h * t2073;
+  const double t2181 = -t2180;
+  const double t2182 = h * t2075;
+  const double t2183 = -t2182;
+  const double t2184 = h * t2077;
+  const double t2185 = -t2184;
+  const double t2186 = h * t2079;
+  const double t2187 = -t2186;
+  const double t2188 = h * t2081;
+  const double t2189 = -t2188;
   /* gam */
   out[0] = t2086;
   out[1] = t2091;
@@ -2320,6 +2338,15 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   out[24] = t2167;
   out[25] = t2169;
   out[26] = t2171;
+  out[27] = t2173;
+  out[28] = t2175;
+  out[29] = t2177;
+  out[30] = t2179;
+  out[31] = t2181;
+  out[32] = t2183;
+  out[33] = t2185;
+  out[34] = t2187;
+  out[35] = t2189;
 }
 
 /* sweep: the 2 parts above in order */
@@ -4886,8 +4913,9 @@ void satellites_poly_k6s2_init_params(satellites_poly_k6s2_state *x, const satel
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_poly_k6s2_NU ? satellites_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < satellites_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[satellites_poly_k6s2_NU];
     satellites_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -4986,7 +5014,7 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
 static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
+  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[2 * satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_poly_k6s2_ENOCONV;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -5038,8 +5066,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_poly_k6s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + i];
-    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++)
+    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = sw[2 * satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
+    for (i = 0; i < 2 * satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_poly_k6s2_ENONFINITE;
     if (rc == satellites_poly_k6s2_ENONFINITE || !isfinite(inc)) { rc = satellites_poly_k6s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (satellites_poly_k6s2_TOL). Iterating
@@ -5080,6 +5108,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     satellites_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     satellites_poly_k6s2_add(&p1[i], &pc1[i], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i]);
   }
+  double phat[satellites_poly_k6s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < satellites_poly_k6s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   satellites_poly_k6s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < satellites_poly_k6s2_NU; i++) {
@@ -5105,8 +5135,12 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
+    x->gam[i] = (double)gam[i];
+    x->pinc[i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
+  }
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s2_NU];
@@ -5229,9 +5263,10 @@ int satellites_poly_k6s2_project(satellites_poly_k6s2_state *x, const satellites
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < satellites_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[satellites_poly_k6s2_NU];
     satellites_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -5240,4 +5275,25 @@ int satellites_poly_k6s2_project(satellites_poly_k6s2_state *x, const satellites
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return satellites_poly_k6s2_OK;
+}
+
+void satellites_poly_k6s2_dense(const satellites_poly_k6s2_state *x, satellites_poly_k6s2_real theta, satellites_poly_k6s2_real *q, satellites_poly_k6s2_real *p)
+{
+  double L[satellites_poly_k6s2_S + 1], w[satellites_poly_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < satellites_poly_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < satellites_poly_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
+    double dq = 0, dp = 0;
+    for (j = 0; j < satellites_poly_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * satellites_poly_k6s2_M + i];
+      dp += w[j] * x->pinc[j * satellites_poly_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+  }
 }
