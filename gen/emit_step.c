@@ -27,7 +27,8 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "#define %s_M %d      /* coordinates */\n#define %s_NU %d     /* constraints */\n", e->P, m, e->P, nu);
   out(e, "#define %s_K %d      /* Gauss-Legendre nodes */\n#define %s_S %d      /* polynomial degree */\n", e->P, e->me->k,
       e->P, s);
-  out(e, "#define %s_NPARAMS %d\n\n", e->P, mod->nparams);
+  out(e, "#define %s_NPARAMS %d\n", e->P, mod->nparams);
+  out(e, "#define %s_NEVENTS %d  /* event functions (docs/language.md) */\n\n", e->P, mod->nevents);
   tmpl(e, "/* Return codes of $P_step; on any nonzero code the state is unchanged. */\n"
           "#define $P_OK 0\n"
           "#define $P_ENOCONV 1     /* the fixed-point iteration did not converge: reduce h */\n"
@@ -88,6 +89,12 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
           "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
           "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp);       /* grad g' M^-1 p */\n\n");
+  if (mod->nevents)
+    tmpl(e, "/* The model's events, in the order written: their names, which sign changes count\n"
+            " * (0: any; 1: rising, - to +; -1: falling, + to -), and their values at the state. */\n"
+            "extern const char *const $P_event_names[$P_NEVENTS];\n"
+            "extern const int $P_event_dirs[$P_NEVENTS];\n"
+            "void $P_events(const $P_state *x, const $P_params *prm, $P_real *values);\n\n");
   if (o->batch) emit_batch_header(e, o->batch);
   tmpl(e, "#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
 }
@@ -231,6 +238,19 @@ static void emit_public(Emitter *e) {
             "  (void)x; (void)prm; (void)gp;\n}\n");
 }
 
+// The events of the model (none: nothing is emitted): their names and
+// directions as tables, their values through the kernel "events_kernel".
+static void emit_events(Emitter *e) {
+  const Model *mod = e->mod;
+  if (!mod->nevents) return;
+  tmpl(e, "\nconst char *const $P_event_names[$P_NEVENTS] = {");
+  for (int i = 0; i < mod->nevents; i++) out(e, "%s\"%s\"", i ? ", " : "", mod->event_names[i]);
+  tmpl(e, "};\nconst int $P_event_dirs[$P_NEVENTS] = {");
+  for (int i = 0; i < mod->nevents; i++) out(e, "%s%d", i ? ", " : "", mod->event_dirs[i]);
+  tmpl(e, "};\n\nvoid $P_events(const $P_state *x, const $P_params *prm, $P_real *values)\n{\n"
+          "  $P_DEFAULT_PARAMS(prm)\n  $(events_kernel q0=x->q p0=x->p out=values);\n}\n");
+}
+
 // Factor the polynomial family's multiplier matrix at the current gamma
 // into fa[], returning from the step when a pivot is not finite or is
 // negligible (the system is singular). indent: the code's indentation.
@@ -292,7 +312,8 @@ static void emit_end_poly(Emitter *e) {
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
   tmpl(e, "    x->pcorr[i] = ($R)(p1[i] - phat[i]);\n  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam[i] = ($R)gam[i];\n    x->pinc[i] = ($R)sw[$[sweep.dp]i];\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n"
           "  x->H0 = H0;\n");
   emit_set_lambda(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
@@ -352,6 +373,9 @@ static void emit_err_est(Emitter *e) {
 }
 
 // The warm start, iteration and compensated update around the sweep kernel.
+// pinc is stored in a loop of its own: in one loop with gam, GCC 12's SLP
+// vectoriser (-O2) folded the float --wide-step commit's pc to 0 (caught by
+// check_lean's float_wide_step_holds_H).
 // With --wide-step the iteration (gamma, the sweep's results) is in the wider
 // type, starts from the compensated state q - qc, p - pc, and the new q, p
 // and their compensations come from rounding the wide sums once.
@@ -481,7 +505,8 @@ static void emit_step(Emitter *e) {
             "    $P_add(&x->q[i], &x->qc[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&x->p[i], &x->pc[i], sw[$[sweep.dp]i]);\n  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam[i] = gam[i];\n    x->pinc[i] = sw[$[sweep.dp]i];\n  }\n");
+            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = gam[i];\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->pinc[i] = sw[$[sweep.dp]i];\n");
   else {
     tmpl(e, "  /* q1 = (q - qc) + h gamma_0 and p1 = (p - pc) + (p1 - p0) in $W, rounded once into\n"
             "   * q, p; what the rounding lost is the new qc, pc */\n"
@@ -491,7 +516,8 @@ static void emit_step(Emitter *e) {
     if (e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1);\n    x->pc[i] = ($R)(x->p[i] - p1);\n");
     tmpl(e, "  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n"
-            "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam[i] = ($R)gam[i];\n    x->pinc[i] = ($R)sw[$[sweep.dp]i];\n  }\n");
+            "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n");
   }
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
@@ -647,6 +673,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_prelude(&e, o);
   emit_kernels(&e);
   emit_public(&e);
+  emit_events(&e);
   emit_step(&e);
   emit_step_adaptive(&e);
   emit_project(&e);

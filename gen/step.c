@@ -417,6 +417,15 @@ static void build_diagnostics(Build *b) {
     for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, G[a][col->e[e].coord], v[col->e[e].coord]));
     hidden[a] = acc;
   }
+  if (mod->nevents) { /* the model's inputs m..2m-1 are the momenta of the events */
+    int *qp = step_nodes(2 * m), *ev = step_nodes(mod->nevents);
+    memcpy(qp, q, (size_t)m * sizeof(int));
+    memcpy(qp + m, p, (size_t)m * sizeof(int));
+    b->owners = 1u << K_EVENTS;
+    step_section(b, "events");
+    dag_subst(d, mod->event_nodes, mod->nevents, qp, 2 * m, ev);
+    step_result(b->st, K_EVENTS, "values", SZ_ONE, mod->nevents, mod->nevents, ev);
+  }
   step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);
   step_result(b->st, K_ENERGY, "H", SZ_ONE, 1, 1, &H);
   build_initial_values(b);
@@ -498,6 +507,7 @@ static const struct {
                       " * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0)",
                       0},
     [K_INITIAL] = {"initial", "out = the model's q0 (M) and p0 (M) at the parameters prm", 0},
+    [K_EVENTS] = {"events_kernel", "out = the model's event functions at (q0, p0), in the order written", 0},
 };
 
 Step *step_build(Model *mod, const Method *me) {
