@@ -457,10 +457,8 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
     conical_k1s1_add(&x->p[i], &x->pc[i], sw[conical_k1s1_S * conical_k1s1_M + i]);
   }
   for (i = 0; i < conical_k1s1_NU; i++) x->lambda[i] = sw[2 * conical_k1s1_S * conical_k1s1_M + i];
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[conical_k1s1_S * conical_k1s1_M + i];
-  }
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->pinc[i] = sw[conical_k1s1_S * conical_k1s1_M + i];
   conical_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k1s1_OK;

@@ -13,6 +13,7 @@ extern "C" {
 #define conical_k1s1_K 1      /* Gauss-Legendre nodes */
 #define conical_k1s1_S 1      /* polynomial degree */
 #define conical_k1s1_NPARAMS 0
+#define conical_k1s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_k1s1_step; on any nonzero code the state is unchanged. */
 #define conical_k1s1_OK 0

@@ -505,10 +505,8 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     conical_k2s2_add(&x->p[i], &x->pc[i], sw[conical_k2s2_S * conical_k2s2_M + i]);
   }
   for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[2 * conical_k2s2_S * conical_k2s2_M + i];
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[conical_k2s2_S * conical_k2s2_M + i];
-  }
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->pinc[i] = sw[conical_k2s2_S * conical_k2s2_M + i];
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k2s2_OK;

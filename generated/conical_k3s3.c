@@ -548,10 +548,8 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     conical_k3s3_add(&x->p[i], &x->pc[i], sw[conical_k3s3_S * conical_k3s3_M + i]);
   }
   for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[2 * conical_k3s3_S * conical_k3s3_M + i];
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[conical_k3s3_S * conical_k3s3_M + i];
-  }
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->pinc[i] = sw[conical_k3s3_S * conical_k3s3_M + i];
   conical_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k3s3_OK;

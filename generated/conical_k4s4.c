@@ -594,10 +594,8 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
     conical_k4s4_add(&x->p[i], &x->pc[i], sw[conical_k4s4_S * conical_k4s4_M + i]);
   }
   for (i = 0; i < conical_k4s4_NU; i++) x->lambda[i] = sw[2 * conical_k4s4_S * conical_k4s4_M + i];
-  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[conical_k4s4_S * conical_k4s4_M + i];
-  }
+  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->pinc[i] = sw[conical_k4s4_S * conical_k4s4_M + i];
   conical_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k4s4_OK;

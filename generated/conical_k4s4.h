@@ -13,6 +13,7 @@ extern "C" {
 #define conical_k4s4_K 4      /* Gauss-Legendre nodes */
 #define conical_k4s4_S 4      /* polynomial degree */
 #define conical_k4s4_NPARAMS 0
+#define conical_k4s4_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_k4s4_step; on any nonzero code the state is unchanged. */
 #define conical_k4s4_OK 0

@@ -838,10 +838,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
-  }
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
   x->H0 = H0;
   {
     double lam[conical_poly_k2s2_NU];

@@ -13,6 +13,7 @@ extern "C" {
 #define conical_poly_k2s2_K 2      /* Gauss-Legendre nodes */
 #define conical_poly_k2s2_S 2      /* polynomial degree */
 #define conical_poly_k2s2_NPARAMS 0
+#define conical_poly_k2s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_poly_k2s2_step; on any nonzero code the state is unchanged. */
 #define conical_poly_k2s2_OK 0

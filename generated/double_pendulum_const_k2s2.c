@@ -699,10 +699,8 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]);
   }
   for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
-  }
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->pinc[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return double_pendulum_const_k2s2_OK;

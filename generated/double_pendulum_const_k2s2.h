@@ -13,6 +13,7 @@ extern "C" {
 #define double_pendulum_const_k2s2_K 2      /* Gauss-Legendre nodes */
 #define double_pendulum_const_k2s2_S 2      /* polynomial degree */
 #define double_pendulum_const_k2s2_NPARAMS 0
+#define double_pendulum_const_k2s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of double_pendulum_const_k2s2_step; on any nonzero code the state is unchanged. */
 #define double_pendulum_const_k2s2_OK 0

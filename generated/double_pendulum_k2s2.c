@@ -1294,10 +1294,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
-  }
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k2s2_NU];

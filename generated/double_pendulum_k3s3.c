@@ -2251,10 +2251,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i];
-  }
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->pinc[i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k3s3_NU];

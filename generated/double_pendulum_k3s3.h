@@ -13,6 +13,7 @@ extern "C" {
 #define double_pendulum_k3s3_K 3      /* Gauss-Legendre nodes */
 #define double_pendulum_k3s3_S 3      /* polynomial degree */
 #define double_pendulum_k3s3_NPARAMS 0
+#define double_pendulum_k3s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of double_pendulum_k3s3_step; on any nonzero code the state is unchanged. */
 #define double_pendulum_k3s3_OK 0

@@ -370,10 +370,8 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
     henon_heiles_k3s2_add(&x->p[i], &x->pc[i], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]);
   }
   for (i = 0; i < henon_heiles_k3s2_NU; i++) x->lambda[i] = sw[2 * henon_heiles_k3s2_S * henon_heiles_k3s2_M + i];
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i];
-  }
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->pinc[i] = sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i];
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return henon_heiles_k3s2_OK;

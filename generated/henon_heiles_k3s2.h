@@ -13,6 +13,7 @@ extern "C" {
 #define henon_heiles_k3s2_K 3      /* Gauss-Legendre nodes */
 #define henon_heiles_k3s2_S 2      /* polynomial degree */
 #define henon_heiles_k3s2_NPARAMS 0
+#define henon_heiles_k3s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of henon_heiles_k3s2_step; on any nonzero code the state is unchanged. */
 #define henon_heiles_k3s2_OK 0

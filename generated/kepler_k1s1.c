@@ -291,10 +291,8 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
     kepler_k1s1_add(&x->p[i], &x->pc[i], sw[kepler_k1s1_S * kepler_k1s1_M + i]);
   }
   for (i = 0; i < kepler_k1s1_NU; i++) x->lambda[i] = sw[2 * kepler_k1s1_S * kepler_k1s1_M + i];
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[kepler_k1s1_S * kepler_k1s1_M + i];
-  }
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->pinc[i] = sw[kepler_k1s1_S * kepler_k1s1_M + i];
   kepler_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k1s1_OK;

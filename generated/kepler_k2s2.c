@@ -347,10 +347,8 @@ static int kepler_k2s2_step_within(kepler_k2s2_state *x, kepler_k2s2_real h_, do
     kepler_k2s2_add(&x->p[i], &x->pc[i], sw[kepler_k2s2_S * kepler_k2s2_M + i]);
   }
   for (i = 0; i < kepler_k2s2_NU; i++) x->lambda[i] = sw[2 * kepler_k2s2_S * kepler_k2s2_M + i];
-  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[kepler_k2s2_S * kepler_k2s2_M + i];
-  }
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k2s2_S * kepler_k2s2_M; i++) x->pinc[i] = sw[kepler_k2s2_S * kepler_k2s2_M + i];
   kepler_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k2s2_OK;

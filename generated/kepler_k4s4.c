@@ -505,10 +505,8 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
     kepler_k4s4_add(&x->p[i], &x->pc[i], sw[kepler_k4s4_S * kepler_k4s4_M + i]);
   }
   for (i = 0; i < kepler_k4s4_NU; i++) x->lambda[i] = sw[2 * kepler_k4s4_S * kepler_k4s4_M + i];
-  for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[kepler_k4s4_S * kepler_k4s4_M + i];
-  }
+  for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) x->pinc[i] = sw[kepler_k4s4_S * kepler_k4s4_M + i];
   kepler_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k4s4_OK;

@@ -13,6 +13,7 @@ extern "C" {
 #define kepler_k6s2_K 6      /* Gauss-Legendre nodes */
 #define kepler_k6s2_S 2      /* polynomial degree */
 #define kepler_k6s2_NPARAMS 0
+#define kepler_k6s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of kepler_k6s2_step; on any nonzero code the state is unchanged. */
 #define kepler_k6s2_OK 0

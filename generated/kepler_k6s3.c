@@ -537,10 +537,8 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
     kepler_k6s3_add(&x->p[i], &x->pc[i], sw[kepler_k6s3_S * kepler_k6s3_M + i]);
   }
   for (i = 0; i < kepler_k6s3_NU; i++) x->lambda[i] = sw[2 * kepler_k6s3_S * kepler_k6s3_M + i];
-  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[kepler_k6s3_S * kepler_k6s3_M + i];
-  }
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->pinc[i] = sw[kepler_k6s3_S * kepler_k6s3_M + i];
   kepler_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k6s3_OK;

@@ -518,10 +518,8 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     modified_k3s1_add(&x->p[i], &x->pc[i], sw[modified_k3s1_S * modified_k3s1_M + i]);
   }
   for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[2 * modified_k3s1_S * modified_k3s1_M + i];
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[modified_k3s1_S * modified_k3s1_M + i];
-  }
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->pinc[i] = sw[modified_k3s1_S * modified_k3s1_M + i];
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k3s1_OK;

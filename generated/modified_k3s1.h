@@ -13,6 +13,7 @@ extern "C" {
 #define modified_k3s1_K 3      /* Gauss-Legendre nodes */
 #define modified_k3s1_S 1      /* polynomial degree */
 #define modified_k3s1_NPARAMS 0
+#define modified_k3s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of modified_k3s1_step; on any nonzero code the state is unchanged. */
 #define modified_k3s1_OK 0

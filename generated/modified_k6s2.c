@@ -690,10 +690,8 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     modified_k6s2_add(&x->p[i], &x->pc[i], sw[modified_k6s2_S * modified_k6s2_M + i]);
   }
   for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[2 * modified_k6s2_S * modified_k6s2_M + i];
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[modified_k6s2_S * modified_k6s2_M + i];
-  }
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->pinc[i] = sw[modified_k6s2_S * modified_k6s2_M + i];
   modified_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k6s2_OK;

@@ -913,10 +913,8 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
     modified_k9s3_add(&x->p[i], &x->pc[i], sw[modified_k9s3_S * modified_k9s3_M + i]);
   }
   for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[2 * modified_k9s3_S * modified_k9s3_M + i];
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[modified_k9s3_S * modified_k9s3_M + i];
-  }
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->pinc[i] = sw[modified_k9s3_S * modified_k9s3_M + i];
   modified_k9s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k9s3_OK;

@@ -13,6 +13,7 @@ extern "C" {
 #define modified_k9s3_K 9      /* Gauss-Legendre nodes */
 #define modified_k9s3_S 3      /* polynomial degree */
 #define modified_k9s3_NPARAMS 0
+#define modified_k9s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of modified_k9s3_step; on any nonzero code the state is unchanged. */
 #define modified_k9s3_OK 0

@@ -1332,10 +1332,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
-  }
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
   x->H0 = H0;
   {
     double lam[modified_poly_k6s2_NU];

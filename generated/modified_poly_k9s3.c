@@ -2303,10 +2303,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i];
-  }
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->pinc[i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i];
   x->H0 = H0;
   {
     double lam[modified_poly_k9s3_NU];

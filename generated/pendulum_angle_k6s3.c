@@ -366,10 +366,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]);
   }
   for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
-  }
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->pinc[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_angle_k6s3_OK;

@@ -413,10 +413,8 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[pendulum_k1s1_S * pendulum_k1s1_M + i]);
   }
   for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + i];
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + i];
-  }
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->pinc[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + i];
   pendulum_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k1s1_OK;

@@ -446,10 +446,8 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     pendulum_k2s2_add(&x->p[i], &x->pc[i], sw[pendulum_k2s2_S * pendulum_k2s2_M + i]);
   }
   for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + i];
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + i];
-  }
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->pinc[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + i];
   pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k2s2_OK;

@@ -474,10 +474,8 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
     pendulum_k3s3_add(&x->p[i], &x->pc[i], sw[pendulum_k3s3_S * pendulum_k3s3_M + i]);
   }
   for (i = 0; i < pendulum_k3s3_NU; i++) x->lambda[i] = sw[2 * pendulum_k3s3_S * pendulum_k3s3_M + i];
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + i];
-  }
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->pinc[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + i];
   pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k3s3_OK;

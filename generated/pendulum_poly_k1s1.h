@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_poly_k1s1_K 1      /* Gauss-Legendre nodes */
 #define pendulum_poly_k1s1_S 1      /* polynomial degree */
 #define pendulum_poly_k1s1_NPARAMS 0
+#define pendulum_poly_k1s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_poly_k1s1_step; on any nonzero code the state is unchanged. */
 #define pendulum_poly_k1s1_OK 0

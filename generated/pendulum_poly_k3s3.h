@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_poly_k3s3_K 3      /* Gauss-Legendre nodes */
 #define pendulum_poly_k3s3_S 3      /* polynomial degree */
 #define pendulum_poly_k3s3_NPARAMS 0
+#define pendulum_poly_k3s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_poly_k3s3_step; on any nonzero code the state is unchanged. */
 #define pendulum_poly_k3s3_OK 0

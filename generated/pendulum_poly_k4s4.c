@@ -1546,10 +1546,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
-  }
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
   x->H0 = H0;
   {
     double lam[pendulum_poly_k4s4_NU];

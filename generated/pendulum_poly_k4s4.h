@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_poly_k4s4_K 4      /* Gauss-Legendre nodes */
 #define pendulum_poly_k4s4_S 4      /* polynomial degree */
 #define pendulum_poly_k4s4_NPARAMS 0
+#define pendulum_poly_k4s4_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_poly_k4s4_step; on any nonzero code the state is unchanged. */
 #define pendulum_poly_k4s4_OK 0

@@ -1824,10 +1824,8 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
     satellites_k6s1_add(&x->p[i], &x->pc[i], sw[satellites_k6s1_S * satellites_k6s1_M + i]);
   }
   for (i = 0; i < satellites_k6s1_NU; i++) x->lambda[i] = sw[2 * satellites_k6s1_S * satellites_k6s1_M + i];
-  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) {
-    x->gam[i] = gam[i];
-    x->pinc[i] = sw[satellites_k6s1_S * satellites_k6s1_M + i];
-  }
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = gam[i];
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->pinc[i] = sw[satellites_k6s1_S * satellites_k6s1_M + i];
   satellites_k6s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s1_OK;

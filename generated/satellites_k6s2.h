@@ -13,6 +13,7 @@ extern "C" {
 #define satellites_k6s2_K 6      /* Gauss-Legendre nodes */
 #define satellites_k6s2_S 2      /* polynomial degree */
 #define satellites_k6s2_NPARAMS 0
+#define satellites_k6s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of satellites_k6s2_step; on any nonzero code the state is unchanged. */
 #define satellites_k6s2_OK 0

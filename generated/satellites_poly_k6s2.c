@@ -5137,10 +5137,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
-  }
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s2_NU];

@@ -8832,10 +8832,8 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     x->pc[i] = pc1[i];
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
-  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
-    x->gam[i] = (double)gam[i];
-    x->pinc[i] = (double)sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i];
-  }
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = (double)gam[i];
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i];
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s3_NU];
