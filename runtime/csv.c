@@ -82,3 +82,23 @@ int hbvmrt_csv_row(FILE *f, const hbvmrt_model *md, const void *x, double H,
   fputc('\n', f);
   return ferror(f) ? -1 : 0;
 }
+
+/* The events CSV: event,t,x..,p_x.. (q1.., p1.. without names). */
+int hbvmrt_csv_event_header(FILE *f, const hbvmrt_model *md)
+{
+  fputs("event,t", f);
+  coords(f, md->names ? "" : "q", md);
+  coords(f, md->names ? "p_" : "p", md);
+  fputc('\n', f);
+  return ferror(f) ? -1 : 0;
+}
+
+/* One event's row: its name, the time and q, p of the state x at it. */
+int hbvmrt_csv_event_row(FILE *f, const hbvmrt_model *md, const char *name, const void *x)
+{
+  fprintf(f, "%s,%.17g", name, *at(x, md->off_t));
+  values(f, at(x, md->off_q), md->m);
+  values(f, at(x, md->off_p), md->m);
+  fputc('\n', f);
+  return ferror(f) ? -1 : 0;
+}

@@ -405,7 +405,7 @@ static void run_scalar(const Ens *e, Work *w, long first, long n)
       observe(e, r, H0, H0, w->g, w->hc, 1);
     }
     for (k = 1; r[0] == 0 && k <= e->o.nsteps; k++) {
-      hbvmrt_stats st = {0, 0.0};
+      hbvmrt_stats st = {0, 0.0, 0.0, 0.0, 0};
       int code = md->step(w->x, e->o.h, w->prm, &st);
       if (code != 0) {
         r[0] = code;
