@@ -146,7 +146,7 @@ int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_o
   if (!o->events)
     return 0;
   ev->path = o->events;
-  ev->f = strcmp(o->events, "-") == 0 ? stdout : fopen(o->events, "w");
+  ev->f = hbvmrt_out_open(o->events);
   if (!ev->f) {
     hbvmrt_error(md, "cannot open '%s': %s", o->events, strerror(errno));
     return -1;
@@ -201,13 +201,8 @@ int hbvmrt_events_step(hbvmrt_events *ev, const void *x0, void *x, double h)
 
 int hbvmrt_events_close(hbvmrt_events *ev)
 {
-  int err = ev->ferr;
+  int err = ev->f ? hbvmrt_out_close(ev->f, ev->ferr) : 0;
 
-  if (ev->f) {
-    errno = 0;
-    if (ev->f == stdout ? fflush(stdout) != 0 || ferror(stdout) : fclose(ev->f) != 0)
-      err = err ? err : errno ? errno : EIO;
-  }
   if (err)
     hbvmrt_error(ev->md, "cannot write '%s': %s", strcmp(ev->path, "-") == 0 ? "standard output" : ev->path,
                  strerror(err));

@@ -73,7 +73,10 @@ int hbvmrt_csv_header(FILE *f, const hbvmrt_model *md);
 int hbvmrt_csv_row(FILE *f, const hbvmrt_model *md, const void *x, double H,
                    const double *g, const double *hc);
 
-/* csv.c: the events CSV, event,t,x..,p_x.. */
+/* csv.c: the events CSV, event,t,x..,p_x..; opening and closing an output */
+
+FILE *hbvmrt_out_open(const char *path);
+int hbvmrt_out_close(FILE *f, int err);
 
 int hbvmrt_csv_event_header(FILE *f, const hbvmrt_model *md);
 int hbvmrt_csv_event_row(FILE *f, const hbvmrt_model *md, const char *name, const void *x);

@@ -234,7 +234,7 @@ static int open_csv(Run *r)
 
   if (!path)
     return 0;
-  r->csv = strcmp(path, "-") == 0 ? stdout : fopen(path, "w");
+  r->csv = hbvmrt_out_open(path);
   if (!r->csv) {
     hbvmrt_error(r->md, "cannot open '%s': %s", path, strerror(errno));
     return -1;
@@ -259,14 +259,11 @@ static int write_row(Run *r)
  * whether it happened now or during the loop. */
 static int close_csv(Run *r)
 {
-  int err = r->csv_errno;
+  int err;
 
   if (!r->csv)
     return 0;
-  errno = 0;
-  if (r->csv == stdout ? fflush(stdout) != 0 || ferror(stdout)
-                       : fclose(r->csv) != 0)
-    err = err ? err : errno ? errno : EIO;
+  err = hbvmrt_out_close(r->csv, r->csv_errno);
   r->csv = NULL;
   if (!err)
     return 0;

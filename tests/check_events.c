@@ -101,7 +101,13 @@ static int run(const hbvmrt_model *md, const char *args, Row *ev, int *nev, doub
   fclose(saved);
   FILE *f = fopen(evpath, "r");
   ck_assert(f != NULL);
-  *nev = 0;
+  *nev = *nrows = 0;
+  if (status != 0) { /* refused: nothing written */
+    fclose(f);
+    unlink(evpath);
+    unlink(csvpath);
+    return status;
+  }
   ck_assert(fgets(line, sizeof line, f) != NULL);
   ck_assert_str_eq(line, "event,t,x,y,p_x,p_y\n");
   while (*nev < max && fgets(line, sizeof line, f)) {
@@ -246,6 +252,25 @@ START_TEST(dt_grid)
 }
 END_TEST
 
+/* The options are checked before the run: an unknown event, a grid step
+ * that is not positive, events asked of a model without any. */
+START_TEST(bad_options)
+{
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  hbvmrt_model none = pendulum_events_k4s4_model;
+  none.nevents = 0;
+  none.event_names = NULL;
+  none.event_dirs = NULL;
+  none.events = NULL;
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --stop-at nosuch", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --stop-at cross:0", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --dt 0", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_int_eq(run(&none, "-N 3", ev, &nev, rows, 9, &nrows, 8), 1); /* run() passes --events */
+}
+END_TEST
+
 Suite *events_suite(void) {
   Suite *s = suite_create("events");
   TCase *tc = tcase_create("events");
@@ -253,6 +278,7 @@ Suite *events_suite(void) {
   tcase_add_loop_test(tc, pendulum_crossings, 0, sizeof pendulum_runs / sizeof pendulum_runs[0]);
   tcase_add_loop_test(tc, kepler_crossings, 0, sizeof kepler_runs / sizeof kepler_runs[0]);
   tcase_add_test(tc, stop_at_event);
+  tcase_add_test(tc, bad_options);
   tcase_add_loop_test(tc, dt_grid, 0, sizeof dt_runs / sizeof dt_runs[0]);
   suite_add_tcase(s, tc);
   return s;
