@@ -135,7 +135,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "  if (scale > 0) inc[l] /= scale;\n");
   if (poly)
     tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++) lam[i * $P_W + l] = sw[($[sweep.lam]i) * $P_W + l];\n"
-            "  for (i = 0; i < $<sweep>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
+            "  for (i = 0; i < $<sweep.theta>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
   else if (e->mod->nu)
     tmpl(e, "  for (i = 0; i < $P_NU; i++) {\n"
             "    $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
@@ -169,9 +169,10 @@ static void emit_commit(Emitter *e, int poly) {
             "      $P_add(&x->q[i * $P_W + l], &x->qc[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
             "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n    }\n"
             "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = fin[($[sweep.lambda]i) * $P_W + l];\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) {\n"
-            "      x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
-            "      x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n    }\n"
+            "    for (i = 0; i < $P_S * $P_M; i++) x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
+            "    for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
+            "    for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
+            "      x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
             "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev[l] = h;\n  }\n");
     return;
   }
@@ -208,9 +209,10 @@ static void emit_commit(Emitter *e, int poly) {
           "        x->q[i * $P_W + l] = q1[i * $P_W + l];\n        x->p[i * $P_W + l] = p1[i * $P_W + l];\n"
           "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n"
           "        x->pcorr[i * $P_W + l] = pco[i * $P_W + l];\n      }\n"
-          "      for (i = 0; i < $P_S * $P_M; i++) {\n"
-          "        x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
-          "        x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n      }\n"
+          "      for (i = 0; i < $P_S * $P_M; i++) x->gam[i * $P_W + l] = gam[i * $P_W + l];\n"
+          "      for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
+          "      for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
+          "        x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
           "      x->H0[l] = H0;\n    }\n"
           "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
           "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"

@@ -40,7 +40,7 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  /* private: compensated-summation errors and the last step's polynomial */\n");
   int poly = e->st->kern[K_FACTOR].nout > 0;
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
-  out(e, "  %s_real pinc[%d];  /* p's increments over the last step, for %s_dense */\n", e->P, s * m, e->P);
+  out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
   if (poly) {
     out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
     out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
@@ -313,7 +313,8 @@ static void emit_end_poly(Emitter *e) {
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
   tmpl(e, "    x->pcorr[i] = ($R)(p1[i] - phat[i]);\n  }\n"
           "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n"
+          "  for (i = 0; i < $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n"
+          "  for (i = 0; i < ($P_S - 1) * $P_M; i++) x->pinc[$P_M + i] = ($R)sw[$[sweep.theta]i];\n"
           "  x->H0 = H0;\n");
   emit_set_lambda(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
@@ -460,7 +461,7 @@ static void emit_step(Emitter *e) {
           "    if (scale > 0) inc /= scale;\n");
   if (poly)
     tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
-            "    for (i = 0; i < $<sweep>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+            "    for (i = 0; i < $<sweep.theta>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
   else if (e->mod->nu) /* before the finiteness test: a zero pivot makes lambda 0/0 */
     tmpl(e, "    for (i = 0; i < $P_NU; i++) {\n"
             "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
@@ -492,7 +493,9 @@ static void emit_step(Emitter *e) {
           "  if (rc != $P_OK) return rc;\n"
           "  /* $P_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */\n"
           "  if (tol > 0 && !(est <= tol * (1 + scale))) return $P_EREJECT;\n"
-          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
+          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n"
+          "  for (i = 0; i < ($P_S - 1) * $P_M; i++) /* the rest of p's polynomial, for $P_dense */\n"
+          "    if (!isfinite(sw[$[sweep.theta]i])) return $P_ENONFINITE;\n");
   if (poly) {
     emit_end_poly(e);
     return;
@@ -506,7 +509,8 @@ static void emit_step(Emitter *e) {
             "    $P_add(&x->p[i], &x->pc[i], sw[$[sweep.dp]i]);\n  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n"
             "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = gam[i];\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->pinc[i] = sw[$[sweep.dp]i];\n");
+          "  for (i = 0; i < $P_M; i++) x->pinc[i] = sw[$[sweep.dp]i];\n"
+            "  for (i = 0; i < ($P_S - 1) * $P_M; i++) x->pinc[$P_M + i] = sw[$[sweep.theta]i];\n");
   else {
     tmpl(e, "  /* q1 = (q - qc) + h gamma_0 and p1 = (p - pc) + (p1 - p0) in $W, rounded once into\n"
             "   * q, p; what the rounding lost is the new qc, pc */\n"
@@ -517,7 +521,8 @@ static void emit_step(Emitter *e) {
     tmpl(e, "  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n"
             "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = ($R)gam[i];\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n");
+          "  for (i = 0; i < $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n"
+            "  for (i = 0; i < ($P_S - 1) * $P_M; i++) x->pinc[$P_M + i] = ($R)sw[$[sweep.theta]i];\n");
   }
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
@@ -642,9 +647,10 @@ static void emit_project(Emitter *e) {
 
 // NAME_dense: q and p inside the last step from its polynomials, written
 // from the end of the step backwards so that theta = 1 gives the state
-// exactly. q(c) = q0 + h sum_j gamma_j int_0^c P_j and p(c) = p0 +
-// sum_j pinc_j int_0^c P_j are the step's polynomials of degree S (uniformly
-// of order S+1); with int_0^c P_j = (L_{j+1} - L_{j-1}) (2c-1) / (2 sqrt(2j+1))
+// exactly. q(c) = q0 + h sum_j gamma_j int_0^c P_j and p(c) = p0 + pinc_0 c -
+// h sum_{j>=1} Theta_j int_0^c P_j (pinc_0 = p1 - p0, then the Theta_j) are
+// the step's polynomials of degree S (uniformly of order S+1); with
+// int_0^c P_j = (L_{j+1} - L_{j-1}) (2c-1) / (2 sqrt(2j+1))
 // for j >= 1 (Legendre L_j), which vanishes at c = 0 and 1. The poly family's
 // projection and rescale of p1 (pcorr) is spread linearly over the step, so
 // theta = 0 gives the previous state: it is of the size of the local error.
@@ -656,12 +662,13 @@ static void emit_dense(Emitter *e) {
           "  for (j = 1; j < $P_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);\n"
           "  w[0] = 1 - theta;\n"
           "  for (j = 1; j < $P_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt$f(($R)(2 * j + 1)));\n"
-          "  for (i = 0; i < $P_M; i++) {\n    $R dq = 0, dp = 0;\n"
-          "    for (j = 0; j < $P_S; j++) {\n"
+          "  for (i = 0; i < $P_M; i++) {\n    $R dq = w[0] * x->gam[i], dp = 0;\n"
+          "    for (j = 1; j < $P_S; j++) {\n"
           "      dq += w[j] * x->gam[j * $P_M + i];\n      dp += w[j] * x->pinc[j * $P_M + i];\n    }\n"
           "    q[i] = x->q[i] - x->hprev * dq;\n");
-  tmpl(e, e->st->kern[K_FACTOR].nout ? "    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];\n  }\n}\n"
-                                     : "    p[i] = x->p[i] - dp;\n  }\n}\n");
+  tmpl(e, e->st->kern[K_FACTOR].nout
+              ? "    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];\n  }\n}\n"
+              : "    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);\n  }\n}\n");
 }
 
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.

@@ -217,9 +217,7 @@ static void build_minv_products(Build *b) {
 }
 
 // gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i] (s*m nodes in gam)
-// and -h Theta_j (s*m nodes in dp): p's polynomial on the step is
-// p0 + sum_j dp_j int_0^c P_j, so dp_0 = p1 - p0 (before the poly family's
-// projection), and the rest is what NAME_dense needs for p.
+// and p1 - p0 = -h Theta_0 (m nodes in dp).
 void step_gamma(Build *b, int **theta, int *gam, int *dp) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
@@ -231,16 +229,28 @@ void step_gamma(Build *b, int **theta, int *gam, int *dp) {
     }
     minv_apply(b->mod, d, v, gam + j * m);
   }
-  for (int j = 0; j < s; j++)
-    for (int i = 0; i < m; i++) dp[j * m + i] = dag_neg(d, dag_mul(d, b->h, theta[j][i]));
+  for (int i = 0; i < m; i++) dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
 }
 
-// step_gamma, as the sweep's results "gam" and "dp".
+// step_gamma, as the sweep's results "gam" and "dp"; theta is kept for
+// step_theta_result.
 void step_gamma_update(Build *b, int **theta) {
-  int *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->s * b->m);
+  int *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->m);
   step_gamma(b, theta, gam, dp);
   step_result(b->st, K_SWEEP, "gam", SZ_SM, 1, b->s * b->m, gam);
-  step_result(b->st, K_SWEEP, "dp", SZ_SM, 1, b->s * b->m, dp);
+  step_result(b->st, K_SWEEP, "dp", SZ_M, 1, b->m, dp);
+  b->theta = theta;
+}
+
+// The sweep's last result "theta": Theta_1 .. Theta_{s-1} ((s-1) m nodes the
+// sweep has computed anyway, so only stores), with dp the Legendre
+// coefficients of p's polynomial on the step (p0 + dp int_0^c P_0 -
+// h sum_{j>=1} Theta_j int_0^c P_j), which NAME_dense evaluates. Last, so
+// that the iteration's finiteness tests stop before it.
+void step_theta_result(Build *b) {
+  int n = (b->s - 1) * b->m, *v = step_nodes(n + 1);
+  for (int j = 1; j < b->s; j++) memcpy(v + (j - 1) * b->m, b->theta[j], (size_t)b->m * sizeof(int));
+  step_result(b->st, K_SWEEP, "theta", SZ_M, b->s - 1, n, v);
 }
 
 // The dense columns G[a] (m nodes each) of grad g at the point q.
@@ -528,7 +538,7 @@ Step *step_build(Model *mod, const Method *me) {
     st->kern[k].wide = kernel_spec[k].wide;
   }
   layout_inputs(st, m, nu, s, 0, 0);
-  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL};
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL, NULL};
   b.h = step_in(&b, IN_H, 0);
   int poly = me->family == MULT_POLY && nu;
   if (poly) layout_inputs(st, m, nu, s, s * nu, 0); /* the factor's length is known once it is built */

@@ -252,14 +252,15 @@ void build_poly_multiplier(Build *b) {
   step_section(b, "the multiplier coefficients: lambda += A^-1 C(lambda)");
   int *lam = step_nodes(n), *delta = step_nodes(n), *lam1 = step_nodes(n);
   for (int t = 0; t < n; t++) lam[t] = step_in(b, IN_LAM, t);
-  int *gam = step_nodes(s * m), *dp = step_nodes(s * m);
+  int *gam = step_nodes(s * m), *dp = step_nodes(m);
   step_gamma(b, force_coefficients(b, G, lam), gam, dp);
   lu_apply(d, &in, conditions(b, G, gam), delta);
   for (int t = 0; t < n; t++) lam1[t] = dag_add(d, lam[t], delta[t]);
   step_section(b, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)]");
   step_gamma_update(b, force_coefficients(b, G, lam1));
   step_result(st, K_SWEEP, "lam", SZ_SNU, 1, n, lam1);
+  step_theta_result(b);
   st->kern[K_SWEEP].what = "One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),\n"
-                           " * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU).";
+                           " * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)).";
   build_projection(b);
 }
