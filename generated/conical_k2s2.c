@@ -44,8 +44,8 @@ static const double conical_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.999999
 static const double conical_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void conical_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
@@ -139,12 +139,6 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   const double t83 = -t82;
   const double t84 = h * t52;
   const double t85 = -t84;
-  const double t86 = h * t53;
-  const double t87 = -t86;
-  const double t88 = h * t54;
-  const double t89 = -t88;
-  const double t90 = h * t55;
-  const double t91 = -t90;
   /* gam */
   out[0] = t60;
   out[1] = t65;
@@ -156,15 +150,16 @@ static void conical_k2s2_sweep(const double *q0, const double *p0, const double 
   out[6] = t81;
   out[7] = t83;
   out[8] = t85;
-  out[9] = t87;
-  out[10] = t89;
-  out[11] = t91;
   /* lambda */
-  out[12] = t48;
+  out[9] = t48;
   /* pivot */
-  out[13] = t36;
+  out[10] = t36;
   /* adiag */
-  out[14] = t36;
+  out[11] = t36;
+  /* theta */
+  out[12] = t53;
+  out[13] = t54;
+  out[14] = t55;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -430,7 +425,7 @@ static double conical_k2s2_err_est(const double *gam, double h, double d1)
 static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_, double tol, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k2s2_S * conical_k2s2_M], sw[2 * conical_k2s2_S * conical_k2s2_M + 3 * conical_k2s2_NU + 1];
+  double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + 2 * conical_k2s2_M + 3 * conical_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k2s2_ENOCONV;
   conical_k2s2_DEFAULT_PARAMS(prm)
@@ -460,11 +455,11 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_k2s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k2s2_NU; i++) {
-      double piv = sw[2 * conical_k2s2_S * conical_k2s2_M + conical_k2s2_NU + i], dia = sw[2 * conical_k2s2_S * conical_k2s2_M + 2 * conical_k2s2_NU + i];
+      double piv = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU + i], dia = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 2 * conical_k2s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k2s2_SINGTOL * fabs(dia))) rc = conical_k2s2_ESINGULAR;
     }
     if (rc == conical_k2s2_ESINGULAR) break;
-    for (i = 0; i < 2 * conical_k2s2_S * conical_k2s2_M + conical_k2s2_NU; i++)
+    for (i = 0; i < conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + conical_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k2s2_ENONFINITE;
     if (rc == conical_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k2s2_TOL / 256), or
@@ -496,6 +491,8 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
   /* conical_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k2s2_ENONFINITE;
+  for (i = 0; i < (conical_k2s2_S - 1) * conical_k2s2_M; i++) /* the rest of p's polynomial, for conical_k2s2_dense */
+    if (!isfinite(sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + i])) return conical_k2s2_ENONFINITE;
   for (i = 0; i < conical_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k2s2_S * conical_k2s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -504,9 +501,10 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     conical_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     conical_k2s2_add(&x->p[i], &x->pc[i], sw[conical_k2s2_S * conical_k2s2_M + i]);
   }
-  for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[2 * conical_k2s2_S * conical_k2s2_M + i];
+  for (i = 0; i < conical_k2s2_NU; i++) x->lambda[i] = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + i];
   for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->pinc[i] = sw[conical_k2s2_S * conical_k2s2_M + i];
+  for (i = 0; i < conical_k2s2_M; i++) x->pinc[i] = sw[conical_k2s2_S * conical_k2s2_M + i];
+  for (i = 0; i < (conical_k2s2_S - 1) * conical_k2s2_M; i++) x->pinc[conical_k2s2_M + i] = sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + i];
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k2s2_OK;
@@ -646,12 +644,12 @@ void conical_k2s2_dense(const conical_k2s2_state *x, conical_k2s2_real theta, co
   w[0] = 1 - theta;
   for (j = 1; j < conical_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < conical_k2s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < conical_k2s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_k2s2_S; j++) {
       dq += w[j] * x->gam[j * conical_k2s2_M + i];
       dp += w[j] * x->pinc[j * conical_k2s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

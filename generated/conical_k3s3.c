@@ -45,8 +45,8 @@ static const double conical_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.4164078649
 static const double conical_k3s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k3s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void conical_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k3s3_params *prm, double *out)
 {
@@ -173,18 +173,6 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   const double t116 = -t115;
   const double t117 = h * t67;
   const double t118 = -t117;
-  const double t119 = h * t68;
-  const double t120 = -t119;
-  const double t121 = h * t69;
-  const double t122 = -t121;
-  const double t123 = h * t70;
-  const double t124 = -t123;
-  const double t125 = h * t71;
-  const double t126 = -t125;
-  const double t127 = h * t72;
-  const double t128 = -t127;
-  const double t129 = h * t73;
-  const double t130 = -t129;
   /* gam */
   out[0] = t78;
   out[1] = t83;
@@ -199,18 +187,19 @@ static void conical_k3s3_sweep(const double *q0, const double *p0, const double 
   out[9] = t114;
   out[10] = t116;
   out[11] = t118;
-  out[12] = t120;
-  out[13] = t122;
-  out[14] = t124;
-  out[15] = t126;
-  out[16] = t128;
-  out[17] = t130;
   /* lambda */
-  out[18] = t63;
+  out[12] = t63;
   /* pivot */
-  out[19] = t51;
+  out[13] = t51;
   /* adiag */
-  out[20] = t51;
+  out[14] = t51;
+  /* theta */
+  out[15] = t68;
+  out[16] = t69;
+  out[17] = t70;
+  out[18] = t71;
+  out[19] = t72;
+  out[20] = t73;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -473,7 +462,7 @@ static double conical_k3s3_err_est(const double *gam, double h, double d1)
 static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_, double tol, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k3s3_S * conical_k3s3_M], sw[2 * conical_k3s3_S * conical_k3s3_M + 3 * conical_k3s3_NU + 1];
+  double gam[conical_k3s3_S * conical_k3s3_M], sw[conical_k3s3_S * conical_k3s3_M + 3 * conical_k3s3_M + 3 * conical_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k3s3_ENOCONV;
   conical_k3s3_DEFAULT_PARAMS(prm)
@@ -503,11 +492,11 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_k3s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k3s3_NU; i++) {
-      double piv = sw[2 * conical_k3s3_S * conical_k3s3_M + conical_k3s3_NU + i], dia = sw[2 * conical_k3s3_S * conical_k3s3_M + 2 * conical_k3s3_NU + i];
+      double piv = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU + i], dia = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 2 * conical_k3s3_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k3s3_SINGTOL * fabs(dia))) rc = conical_k3s3_ESINGULAR;
     }
     if (rc == conical_k3s3_ESINGULAR) break;
-    for (i = 0; i < 2 * conical_k3s3_S * conical_k3s3_M + conical_k3s3_NU; i++)
+    for (i = 0; i < conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + conical_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k3s3_ENONFINITE;
     if (rc == conical_k3s3_ENONFINITE || !isfinite(inc)) { rc = conical_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k3s3_TOL / 256), or
@@ -539,6 +528,8 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
   /* conical_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k3s3_ENONFINITE;
+  for (i = 0; i < (conical_k3s3_S - 1) * conical_k3s3_M; i++) /* the rest of p's polynomial, for conical_k3s3_dense */
+    if (!isfinite(sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + i])) return conical_k3s3_ENONFINITE;
   for (i = 0; i < conical_k3s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k3s3_S * conical_k3s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -547,9 +538,10 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     conical_k3s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     conical_k3s3_add(&x->p[i], &x->pc[i], sw[conical_k3s3_S * conical_k3s3_M + i]);
   }
-  for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[2 * conical_k3s3_S * conical_k3s3_M + i];
+  for (i = 0; i < conical_k3s3_NU; i++) x->lambda[i] = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + i];
   for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->pinc[i] = sw[conical_k3s3_S * conical_k3s3_M + i];
+  for (i = 0; i < conical_k3s3_M; i++) x->pinc[i] = sw[conical_k3s3_S * conical_k3s3_M + i];
+  for (i = 0; i < (conical_k3s3_S - 1) * conical_k3s3_M; i++) x->pinc[conical_k3s3_M + i] = sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + i];
   conical_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k3s3_OK;
@@ -689,12 +681,12 @@ void conical_k3s3_dense(const conical_k3s3_state *x, conical_k3s3_real theta, co
   w[0] = 1 - theta;
   for (j = 1; j < conical_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < conical_k3s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < conical_k3s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_k3s3_S; j++) {
       dq += w[j] * x->gam[j * conical_k3s3_M + i];
       dp += w[j] * x->pinc[j * conical_k3s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -46,8 +46,8 @@ static const double conical_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.416407864
 static const double conical_k4s4_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double conical_k4s4_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void conical_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const conical_k4s4_params *prm, double *out)
 {
@@ -207,24 +207,6 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   const double t149 = -t148;
   const double t150 = h * t82;
   const double t151 = -t150;
-  const double t152 = h * t83;
-  const double t153 = -t152;
-  const double t154 = h * t84;
-  const double t155 = -t154;
-  const double t156 = h * t85;
-  const double t157 = -t156;
-  const double t158 = h * t86;
-  const double t159 = -t158;
-  const double t160 = h * t87;
-  const double t161 = -t160;
-  const double t162 = h * t88;
-  const double t163 = -t162;
-  const double t164 = h * t89;
-  const double t165 = -t164;
-  const double t166 = h * t90;
-  const double t167 = -t166;
-  const double t168 = h * t91;
-  const double t169 = -t168;
   /* gam */
   out[0] = t96;
   out[1] = t101;
@@ -242,21 +224,22 @@ static void conical_k4s4_sweep(const double *q0, const double *p0, const double 
   out[12] = t147;
   out[13] = t149;
   out[14] = t151;
-  out[15] = t153;
-  out[16] = t155;
-  out[17] = t157;
-  out[18] = t159;
-  out[19] = t161;
-  out[20] = t163;
-  out[21] = t165;
-  out[22] = t167;
-  out[23] = t169;
   /* lambda */
-  out[24] = t78;
+  out[15] = t78;
   /* pivot */
-  out[25] = t66;
+  out[16] = t66;
   /* adiag */
-  out[26] = t66;
+  out[17] = t66;
+  /* theta */
+  out[18] = t83;
+  out[19] = t84;
+  out[20] = t85;
+  out[21] = t86;
+  out[22] = t87;
+  out[23] = t88;
+  out[24] = t89;
+  out[25] = t90;
+  out[26] = t91;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -519,7 +502,7 @@ static double conical_k4s4_err_est(const double *gam, double h, double d1)
 static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_, double tol, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k4s4_S * conical_k4s4_M], sw[2 * conical_k4s4_S * conical_k4s4_M + 3 * conical_k4s4_NU + 1];
+  double gam[conical_k4s4_S * conical_k4s4_M], sw[conical_k4s4_S * conical_k4s4_M + 4 * conical_k4s4_M + 3 * conical_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k4s4_ENOCONV;
   conical_k4s4_DEFAULT_PARAMS(prm)
@@ -549,11 +532,11 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_k4s4_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < conical_k4s4_NU; i++) {
-      double piv = sw[2 * conical_k4s4_S * conical_k4s4_M + conical_k4s4_NU + i], dia = sw[2 * conical_k4s4_S * conical_k4s4_M + 2 * conical_k4s4_NU + i];
+      double piv = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + conical_k4s4_NU + i], dia = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + 2 * conical_k4s4_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_k4s4_SINGTOL * fabs(dia))) rc = conical_k4s4_ESINGULAR;
     }
     if (rc == conical_k4s4_ESINGULAR) break;
-    for (i = 0; i < 2 * conical_k4s4_S * conical_k4s4_M + conical_k4s4_NU; i++)
+    for (i = 0; i < conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + conical_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = conical_k4s4_ENONFINITE;
     if (rc == conical_k4s4_ENONFINITE || !isfinite(inc)) { rc = conical_k4s4_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (conical_k4s4_TOL / 256), or
@@ -585,6 +568,8 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
   /* conical_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k4s4_ENONFINITE;
+  for (i = 0; i < (conical_k4s4_S - 1) * conical_k4s4_M; i++) /* the rest of p's polynomial, for conical_k4s4_dense */
+    if (!isfinite(sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + 3 * conical_k4s4_NU + i])) return conical_k4s4_ENONFINITE;
   for (i = 0; i < conical_k4s4_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k4s4_S * conical_k4s4_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -593,9 +578,10 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
     conical_k4s4_add(&x->q[i], &x->qc[i], h * sw[i]);
     conical_k4s4_add(&x->p[i], &x->pc[i], sw[conical_k4s4_S * conical_k4s4_M + i]);
   }
-  for (i = 0; i < conical_k4s4_NU; i++) x->lambda[i] = sw[2 * conical_k4s4_S * conical_k4s4_M + i];
+  for (i = 0; i < conical_k4s4_NU; i++) x->lambda[i] = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + i];
   for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < conical_k4s4_S * conical_k4s4_M; i++) x->pinc[i] = sw[conical_k4s4_S * conical_k4s4_M + i];
+  for (i = 0; i < conical_k4s4_M; i++) x->pinc[i] = sw[conical_k4s4_S * conical_k4s4_M + i];
+  for (i = 0; i < (conical_k4s4_S - 1) * conical_k4s4_M; i++) x->pinc[conical_k4s4_M + i] = sw[conical_k4s4_S * conical_k4s4_M + conical_k4s4_M + 3 * conical_k4s4_NU + i];
   conical_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;
   return conical_k4s4_OK;
@@ -735,12 +721,12 @@ void conical_k4s4_dense(const conical_k4s4_state *x, conical_k4s4_real theta, co
   w[0] = 1 - theta;
   for (j = 1; j < conical_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < conical_k4s4_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < conical_k4s4_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_k4s4_S; j++) {
       dq += w[j] * x->gam[j * conical_k4s4_M + i];
       dp += w[j] * x->pinc[j * conical_k4s4_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -45,7 +45,7 @@ static const double conical_poly_k2s2_q0[3] = {0.70710678118654757, 0.0, (-0.707
 static const double conical_poly_k2s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
@@ -232,12 +232,6 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   const double t176 = -t175;
   const double t177 = h * t142;
   const double t178 = -t177;
-  const double t179 = h * t144;
-  const double t180 = -t179;
-  const double t181 = h * t146;
-  const double t182 = -t181;
-  const double t183 = h * t148;
-  const double t184 = -t183;
   /* gam */
   out[0] = t153;
   out[1] = t158;
@@ -249,12 +243,13 @@ static void conical_poly_k2s2_sweep(const double *q0, const double *p0, const do
   out[6] = t174;
   out[7] = t176;
   out[8] = t178;
-  out[9] = t180;
-  out[10] = t182;
-  out[11] = t184;
   /* lam */
-  out[12] = t118;
-  out[13] = t119;
+  out[9] = t118;
+  out[10] = t119;
+  /* theta */
+  out[11] = t144;
+  out[12] = t146;
+  out[13] = t148;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -715,7 +710,7 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1)
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[2 * conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
+  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + 2 * conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_poly_k2s2_ENOCONV;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -767,8 +762,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for conical_poly_k2s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[2 * conical_poly_k2s2_S * conical_poly_k2s2_M + i];
-    for (i = 0; i < 2 * conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
+    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_NU; i++) lam[i] = sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + i];
+    for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = conical_poly_k2s2_ENONFINITE;
     if (rc == conical_poly_k2s2_ENONFINITE || !isfinite(inc)) { rc = conical_poly_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (conical_poly_k2s2_TOL). Iterating
@@ -798,6 +793,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   /* conical_poly_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_poly_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_poly_k2s2_ENONFINITE;
+  for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) /* the rest of p's polynomial, for conical_poly_k2s2_dense */
+    if (!isfinite(sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i])) return conical_poly_k2s2_ENONFINITE;
   double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 2 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = conical_poly_k2s2_energy(x, prm);
   double qc1[conical_poly_k2s2_M], pc1[conical_poly_k2s2_M];
@@ -839,7 +836,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
+  for (i = 0; i < conical_poly_k2s2_M; i++) x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
+  for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) x->pinc[conical_poly_k2s2_M + i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i];
   x->H0 = H0;
   {
     double lam[conical_poly_k2s2_NU];
@@ -987,12 +985,12 @@ void conical_poly_k2s2_dense(const conical_poly_k2s2_state *x, conical_poly_k2s2
   w[0] = 1 - theta;
   for (j = 1; j < conical_poly_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < conical_poly_k2s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < conical_poly_k2s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_poly_k2s2_S; j++) {
       dq += w[j] * x->gam[j * conical_poly_k2s2_M + i];
       dp += w[j] * x->pinc[j * conical_poly_k2s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

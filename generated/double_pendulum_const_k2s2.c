@@ -44,8 +44,8 @@ static const double double_pendulum_const_k2s2_E1[4] = {1.0, 3.4641016151377544,
 static const double double_pendulum_const_k2s2_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_const_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double_pendulum_const_k2s2_params *prm, double *out)
 {
@@ -236,14 +236,6 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   const double t180 = -t179;
   const double t181 = h * t134;
   const double t182 = -t181;
-  const double t183 = h * t138;
-  const double t184 = -t183;
-  const double t185 = h * t140;
-  const double t186 = -t185;
-  const double t187 = h * t141;
-  const double t188 = -t187;
-  const double t189 = h * t142;
-  const double t190 = -t189;
   /* gam */
   out[0] = t147;
   out[1] = t152;
@@ -258,19 +250,20 @@ static void double_pendulum_const_k2s2_sweep(const double *q0, const double *p0,
   out[9] = t178;
   out[10] = t180;
   out[11] = t182;
-  out[12] = t184;
-  out[13] = t186;
-  out[14] = t188;
-  out[15] = t190;
   /* lambda */
-  out[16] = t124;
-  out[17] = t121;
+  out[12] = t124;
+  out[13] = t121;
   /* pivot */
-  out[18] = t64;
-  out[19] = t118;
+  out[14] = t64;
+  out[15] = t118;
   /* adiag */
-  out[20] = t64;
-  out[21] = t100;
+  out[16] = t64;
+  out[17] = t100;
+  /* theta */
+  out[18] = t138;
+  out[19] = t140;
+  out[20] = t141;
+  out[21] = t142;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -624,7 +617,7 @@ static double double_pendulum_const_k2s2_err_est(const double *gam, double h, do
 static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_state *x, double_pendulum_const_k2s2_real h_, double tol, const double_pendulum_const_k2s2_params *prm, double_pendulum_const_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
+  double gam[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_const_k2s2_ENOCONV;
   double_pendulum_const_k2s2_DEFAULT_PARAMS(prm)
@@ -654,11 +647,11 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_const_k2s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < double_pendulum_const_k2s2_NU; i++) {
-      double piv = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
+      double piv = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU + i], dia = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_const_k2s2_SINGTOL * fabs(dia))) rc = double_pendulum_const_k2s2_ESINGULAR;
     }
     if (rc == double_pendulum_const_k2s2_ESINGULAR) break;
-    for (i = 0; i < 2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU; i++)
+    for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_const_k2s2_ENONFINITE;
     if (rc == double_pendulum_const_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_const_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (double_pendulum_const_k2s2_TOL / 256), or
@@ -690,6 +683,8 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
   /* double_pendulum_const_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_const_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_const_k2s2_ENONFINITE;
+  for (i = 0; i < (double_pendulum_const_k2s2_S - 1) * double_pendulum_const_k2s2_M; i++) /* the rest of p's polynomial, for double_pendulum_const_k2s2_dense */
+    if (!isfinite(sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + i])) return double_pendulum_const_k2s2_ENONFINITE;
   for (i = 0; i < double_pendulum_const_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -698,9 +693,10 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     double_pendulum_const_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     double_pendulum_const_k2s2_add(&x->p[i], &x->pc[i], sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i]);
   }
-  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[2 * double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
+  for (i = 0; i < double_pendulum_const_k2s2_NU; i++) x->lambda[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + i];
   for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) x->pinc[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) x->pinc[i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + i];
+  for (i = 0; i < (double_pendulum_const_k2s2_S - 1) * double_pendulum_const_k2s2_M; i++) x->pinc[double_pendulum_const_k2s2_M + i] = sw[double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M + double_pendulum_const_k2s2_M + 3 * double_pendulum_const_k2s2_NU + i];
   double_pendulum_const_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return double_pendulum_const_k2s2_OK;
@@ -840,12 +836,12 @@ void double_pendulum_const_k2s2_dense(const double_pendulum_const_k2s2_state *x,
   w[0] = 1 - theta;
   for (j = 1; j < double_pendulum_const_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < double_pendulum_const_k2s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_const_k2s2_S; j++) {
       dq += w[j] * x->gam[j * double_pendulum_const_k2s2_M + i];
       dp += w[j] * x->pinc[j * double_pendulum_const_k2s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -45,7 +45,7 @@ static const double double_pendulum_k2s2_q0[4] = {0.47942553860420301, (-0.87758
 static const double double_pendulum_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
@@ -345,14 +345,6 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   const double t289 = -t288;
   const double t290 = h * t243;
   const double t291 = -t290;
-  const double t292 = h * t245;
-  const double t293 = -t292;
-  const double t294 = h * t247;
-  const double t295 = -t294;
-  const double t296 = h * t249;
-  const double t297 = -t296;
-  const double t298 = h * t251;
-  const double t299 = -t298;
   /* gam */
   out[0] = t256;
   out[1] = t261;
@@ -367,15 +359,16 @@ static void double_pendulum_k2s2_sweep(const double *q0, const double *p0, const
   out[9] = t287;
   out[10] = t289;
   out[11] = t291;
-  out[12] = t293;
-  out[13] = t295;
-  out[14] = t297;
-  out[15] = t299;
   /* lam */
-  out[16] = t202;
-  out[17] = t203;
-  out[18] = t204;
-  out[19] = t205;
+  out[12] = t202;
+  out[13] = t203;
+  out[14] = t204;
+  out[15] = t205;
+  /* theta */
+  out[16] = t245;
+  out[17] = t247;
+  out[18] = t249;
+  out[19] = t251;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -1171,7 +1164,7 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
 static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[2 * double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
+  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + 2 * double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k2s2_ENOCONV;
   double_pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -1223,8 +1216,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k2s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[2 * double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
-    for (i = 0; i < 2 * double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
+    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++) lam[i] = sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + i];
+    for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k2s2_ENONFINITE;
     if (rc == double_pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k2s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k2s2_TOL). Iterating
@@ -1254,6 +1247,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   /* double_pendulum_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
+  for (i = 0; i < (double_pendulum_k2s2_S - 1) * double_pendulum_k2s2_M; i++) /* the rest of p's polynomial, for double_pendulum_k2s2_dense */
+    if (!isfinite(sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i])) return double_pendulum_k2s2_ENONFINITE;
   double q1[double_pendulum_k2s2_M], p1[double_pendulum_k2s2_M], pr[double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k2s2_energy(x, prm);
   double qc1[double_pendulum_k2s2_M], pc1[double_pendulum_k2s2_M];
@@ -1295,7 +1290,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
+  for (i = 0; i < double_pendulum_k2s2_M; i++) x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
+  for (i = 0; i < (double_pendulum_k2s2_S - 1) * double_pendulum_k2s2_M; i++) x->pinc[double_pendulum_k2s2_M + i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k2s2_NU];
@@ -1443,12 +1439,12 @@ void double_pendulum_k2s2_dense(const double_pendulum_k2s2_state *x, double_pend
   w[0] = 1 - theta;
   for (j = 1; j < double_pendulum_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < double_pendulum_k2s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < double_pendulum_k2s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_k2s2_S; j++) {
       dq += w[j] * x->gam[j * double_pendulum_k2s2_M + i];
       dp += w[j] * x->pinc[j * double_pendulum_k2s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

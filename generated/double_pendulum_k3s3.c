@@ -46,7 +46,7 @@ static const double double_pendulum_k3s3_q0[4] = {0.47942553860420301, (-0.87758
 static const double double_pendulum_k3s3_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k3s3_params *prm, double *out)
 {
@@ -598,22 +598,6 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   const double t540 = -t539;
   const double t541 = h * t466;
   const double t542 = -t541;
-  const double t543 = h * t468;
-  const double t544 = -t543;
-  const double t545 = h * t470;
-  const double t546 = -t545;
-  const double t547 = h * t472;
-  const double t548 = -t547;
-  const double t549 = h * t474;
-  const double t550 = -t549;
-  const double t551 = h * t476;
-  const double t552 = -t551;
-  const double t553 = h * t478;
-  const double t554 = -t553;
-  const double t555 = h * t480;
-  const double t556 = -t555;
-  const double t557 = h * t482;
-  const double t558 = -t557;
   /* gam */
   out[0] = t487;
   out[1] = t492;
@@ -632,21 +616,22 @@ static void double_pendulum_k3s3_sweep(const double *q0, const double *p0, const
   out[13] = t538;
   out[14] = t540;
   out[15] = t542;
-  out[16] = t544;
-  out[17] = t546;
-  out[18] = t548;
-  out[19] = t550;
-  out[20] = t552;
-  out[21] = t554;
-  out[22] = t556;
-  out[23] = t558;
   /* lam */
-  out[24] = t387;
-  out[25] = t388;
-  out[26] = t389;
-  out[27] = t390;
-  out[28] = t391;
-  out[29] = t392;
+  out[16] = t387;
+  out[17] = t388;
+  out[18] = t389;
+  out[19] = t390;
+  out[20] = t391;
+  out[21] = t392;
+  /* theta */
+  out[22] = t468;
+  out[23] = t470;
+  out[24] = t472;
+  out[25] = t474;
+  out[26] = t476;
+  out[27] = t478;
+  out[28] = t480;
+  out[29] = t482;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -2128,7 +2113,7 @@ static double double_pendulum_k3s3_err_est(const double *gam, double h, double d
 static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[2 * double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
+  double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + 3 * double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k3s3_ENOCONV;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
@@ -2180,8 +2165,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k3s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++) lam[i] = sw[2 * double_pendulum_k3s3_S * double_pendulum_k3s3_M + i];
-    for (i = 0; i < 2 * double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++)
+    for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++) lam[i] = sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + i];
+    for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k3s3_ENONFINITE;
     if (rc == double_pendulum_k3s3_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k3s3_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k3s3_TOL). Iterating
@@ -2211,6 +2196,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
   /* double_pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k3s3_ENONFINITE;
+  for (i = 0; i < (double_pendulum_k3s3_S - 1) * double_pendulum_k3s3_M; i++) /* the rest of p's polynomial, for double_pendulum_k3s3_dense */
+    if (!isfinite(sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + i])) return double_pendulum_k3s3_ENONFINITE;
   double q1[double_pendulum_k3s3_M], p1[double_pendulum_k3s3_M], pr[double_pendulum_k3s3_M + 2 + 2 * double_pendulum_k3s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k3s3_energy(x, prm);
   double qc1[double_pendulum_k3s3_M], pc1[double_pendulum_k3s3_M];
@@ -2252,7 +2239,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->pinc[i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i];
+  for (i = 0; i < double_pendulum_k3s3_M; i++) x->pinc[i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i];
+  for (i = 0; i < (double_pendulum_k3s3_S - 1) * double_pendulum_k3s3_M; i++) x->pinc[double_pendulum_k3s3_M + i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k3s3_NU];
@@ -2400,12 +2388,12 @@ void double_pendulum_k3s3_dense(const double_pendulum_k3s3_state *x, double_pend
   w[0] = 1 - theta;
   for (j = 1; j < double_pendulum_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < double_pendulum_k3s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < double_pendulum_k3s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_k3s3_S; j++) {
       dq += w[j] * x->gam[j * double_pendulum_k3s3_M + i];
       dp += w[j] * x->pinc[j * double_pendulum_k3s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

@@ -47,7 +47,7 @@ static const double double_pendulum_k4s4_q0[4] = {0.47942553860420301, (-0.87758
 static const double double_pendulum_k4s4_p0[4] = {0.0, 0.0, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
@@ -1045,30 +1045,6 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   const double t987 = -t986;
   const double t988 = h * t885;
   const double t989 = -t988;
-  const double t990 = h * t887;
-  const double t991 = -t990;
-  const double t992 = h * t889;
-  const double t993 = -t992;
-  const double t994 = h * t891;
-  const double t995 = -t994;
-  const double t996 = h * t893;
-  const double t997 = -t996;
-  const double t998 = h * t895;
-  const double t999 = -t998;
-  const double t1000 = h * t897;
-  const double t1001 = -t1000;
-  const double t1002 = h * t899;
-  const double t1003 = -t1002;
-  const double t1004 = h * t901;
-  const double t1005 = -t1004;
-  const double t1006 = h * t903;
-  const double t1007 = -t1006;
-  const double t1008 = h * t905;
-  const double t1009 = -t1008;
-  const double t1010 = h * t907;
-  const double t1011 = -t1010;
-  const double t1012 = h * t909;
-  const double t1013 = -t1012;
   /* gam */
   out[0] = t914;
   out[1] = t919;
@@ -1091,27 +1067,28 @@ static void double_pendulum_k4s4_sweep(const double *q0, const double *p0, const
   out[17] = t985;
   out[18] = t987;
   out[19] = t989;
-  out[20] = t991;
-  out[21] = t993;
-  out[22] = t995;
-  out[23] = t997;
-  out[24] = t999;
-  out[25] = t1001;
-  out[26] = t1003;
-  out[27] = t1005;
-  out[28] = t1007;
-  out[29] = t1009;
-  out[30] = t1011;
-  out[31] = t1013;
   /* lam */
-  out[32] = t718;
-  out[33] = t719;
-  out[34] = t720;
-  out[35] = t721;
-  out[36] = t722;
-  out[37] = t723;
-  out[38] = t724;
-  out[39] = t725;
+  out[20] = t718;
+  out[21] = t719;
+  out[22] = t720;
+  out[23] = t721;
+  out[24] = t722;
+  out[25] = t723;
+  out[26] = t724;
+  out[27] = t725;
+  /* theta */
+  out[28] = t887;
+  out[29] = t889;
+  out[30] = t891;
+  out[31] = t893;
+  out[32] = t895;
+  out[33] = t897;
+  out[34] = t899;
+  out[35] = t901;
+  out[36] = t903;
+  out[37] = t905;
+  out[38] = t907;
+  out[39] = t909;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -4055,7 +4032,7 @@ static double double_pendulum_k4s4_err_est(const double *gam, double h, double d
 static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[2 * double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
+  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + 4 * double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k4s4_ENOCONV;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
@@ -4107,8 +4084,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for double_pendulum_k4s4_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = sw[2 * double_pendulum_k4s4_S * double_pendulum_k4s4_M + i];
-    for (i = 0; i < 2 * double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++)
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++) lam[i] = sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + i];
+    for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = double_pendulum_k4s4_ENONFINITE;
     if (rc == double_pendulum_k4s4_ENONFINITE || !isfinite(inc)) { rc = double_pendulum_k4s4_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k4s4_TOL). Iterating
@@ -4138,6 +4115,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   /* double_pendulum_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k4s4_ENONFINITE;
+  for (i = 0; i < (double_pendulum_k4s4_S - 1) * double_pendulum_k4s4_M; i++) /* the rest of p's polynomial, for double_pendulum_k4s4_dense */
+    if (!isfinite(sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + i])) return double_pendulum_k4s4_ENONFINITE;
   double q1[double_pendulum_k4s4_M], p1[double_pendulum_k4s4_M], pr[double_pendulum_k4s4_M + 2 + 2 * double_pendulum_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k4s4_energy(x, prm);
   double qc1[double_pendulum_k4s4_M], pc1[double_pendulum_k4s4_M];
@@ -4179,7 +4158,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->pinc[i] = (double)sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i];
+  for (i = 0; i < double_pendulum_k4s4_M; i++) x->pinc[i] = (double)sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i];
+  for (i = 0; i < (double_pendulum_k4s4_S - 1) * double_pendulum_k4s4_M; i++) x->pinc[double_pendulum_k4s4_M + i] = (double)sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k4s4_NU];
@@ -4327,12 +4307,12 @@ void double_pendulum_k4s4_dense(const double_pendulum_k4s4_state *x, double_pend
   w[0] = 1 - theta;
   for (j = 1; j < double_pendulum_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < double_pendulum_k4s4_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < double_pendulum_k4s4_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_k4s4_S; j++) {
       dq += w[j] * x->gam[j * double_pendulum_k4s4_M + i];
       dp += w[j] * x->pinc[j * double_pendulum_k4s4_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

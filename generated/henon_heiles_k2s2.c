@@ -44,8 +44,8 @@ static const double henon_heiles_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.9
 static const double henon_heiles_k2s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k2s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void henon_heiles_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const henon_heiles_k2s2_params *prm, double *out)
 {
@@ -121,10 +121,6 @@ static void henon_heiles_k2s2_sweep(const double *q0, const double *p0, const do
   const double t65 = -t64;
   const double t66 = h * t43;
   const double t67 = -t66;
-  const double t68 = h * t45;
-  const double t69 = -t68;
-  const double t70 = h * t47;
-  const double t71 = -t70;
   /* gam */
   out[0] = t52;
   out[1] = t57;
@@ -133,8 +129,9 @@ static void henon_heiles_k2s2_sweep(const double *q0, const double *p0, const do
   /* dp */
   out[4] = t65;
   out[5] = t67;
-  out[6] = t69;
-  out[7] = t71;
+  /* theta */
+  out[6] = t45;
+  out[7] = t47;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -281,7 +278,7 @@ static double henon_heiles_k2s2_err_est(const double *gam, double h, double d1)
 static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heiles_k2s2_real h_, double tol, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[henon_heiles_k2s2_S * henon_heiles_k2s2_M], sw[2 * henon_heiles_k2s2_S * henon_heiles_k2s2_M + 3 * henon_heiles_k2s2_NU + 1];
+  double gam[henon_heiles_k2s2_S * henon_heiles_k2s2_M], sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + 2 * henon_heiles_k2s2_M + 3 * henon_heiles_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = henon_heiles_k2s2_ENOCONV;
   henon_heiles_k2s2_DEFAULT_PARAMS(prm)
@@ -304,7 +301,7 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for henon_heiles_k2s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < 2 * henon_heiles_k2s2_S * henon_heiles_k2s2_M + henon_heiles_k2s2_NU; i++)
+    for (i = 0; i < henon_heiles_k2s2_S * henon_heiles_k2s2_M + henon_heiles_k2s2_M + henon_heiles_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = henon_heiles_k2s2_ENONFINITE;
     if (rc == henon_heiles_k2s2_ENONFINITE || !isfinite(inc)) { rc = henon_heiles_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (henon_heiles_k2s2_TOL / 256), or
@@ -336,6 +333,8 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
   /* henon_heiles_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return henon_heiles_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return henon_heiles_k2s2_ENONFINITE;
+  for (i = 0; i < (henon_heiles_k2s2_S - 1) * henon_heiles_k2s2_M; i++) /* the rest of p's polynomial, for henon_heiles_k2s2_dense */
+    if (!isfinite(sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + henon_heiles_k2s2_M + 3 * henon_heiles_k2s2_NU + i])) return henon_heiles_k2s2_ENONFINITE;
   for (i = 0; i < henon_heiles_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -344,9 +343,10 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
     henon_heiles_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     henon_heiles_k2s2_add(&x->p[i], &x->pc[i], sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + i]);
   }
-  for (i = 0; i < henon_heiles_k2s2_NU; i++) x->lambda[i] = sw[2 * henon_heiles_k2s2_S * henon_heiles_k2s2_M + i];
+  for (i = 0; i < henon_heiles_k2s2_NU; i++) x->lambda[i] = sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + henon_heiles_k2s2_M + i];
   for (i = 0; i < henon_heiles_k2s2_S * henon_heiles_k2s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < henon_heiles_k2s2_S * henon_heiles_k2s2_M; i++) x->pinc[i] = sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + i];
+  for (i = 0; i < henon_heiles_k2s2_M; i++) x->pinc[i] = sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + i];
+  for (i = 0; i < (henon_heiles_k2s2_S - 1) * henon_heiles_k2s2_M; i++) x->pinc[henon_heiles_k2s2_M + i] = sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + henon_heiles_k2s2_M + 3 * henon_heiles_k2s2_NU + i];
   henon_heiles_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return henon_heiles_k2s2_OK;
@@ -439,12 +439,12 @@ void henon_heiles_k2s2_dense(const henon_heiles_k2s2_state *x, henon_heiles_k2s2
   w[0] = 1 - theta;
   for (j = 1; j < henon_heiles_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < henon_heiles_k2s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < henon_heiles_k2s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < henon_heiles_k2s2_S; j++) {
       dq += w[j] * x->gam[j * henon_heiles_k2s2_M + i];
       dp += w[j] * x->pinc[j * henon_heiles_k2s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

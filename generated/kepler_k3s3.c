@@ -45,8 +45,8 @@ static const double kepler_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.41640786499
 static const double kepler_k3s3_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k3s3_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k3s3_params *prm, double *out)
 {
@@ -183,14 +183,6 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   const double t125 = -t124;
   const double t126 = h * t89;
   const double t127 = -t126;
-  const double t128 = h * t91;
-  const double t129 = -t128;
-  const double t130 = h * t93;
-  const double t131 = -t130;
-  const double t132 = h * t95;
-  const double t133 = -t132;
-  const double t134 = h * t97;
-  const double t135 = -t134;
   /* gam */
   out[0] = t102;
   out[1] = t107;
@@ -201,10 +193,11 @@ static void kepler_k3s3_sweep(const double *q0, const double *p0, const double *
   /* dp */
   out[6] = t125;
   out[7] = t127;
-  out[8] = t129;
-  out[9] = t131;
-  out[10] = t133;
-  out[11] = t135;
+  /* theta */
+  out[8] = t91;
+  out[9] = t93;
+  out[10] = t95;
+  out[11] = t97;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -347,7 +340,7 @@ static double kepler_k3s3_err_est(const double *gam, double h, double d1)
 static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, double tol, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[kepler_k3s3_S * kepler_k3s3_M], sw[2 * kepler_k3s3_S * kepler_k3s3_M + 3 * kepler_k3s3_NU + 1];
+  double gam[kepler_k3s3_S * kepler_k3s3_M], sw[kepler_k3s3_S * kepler_k3s3_M + 3 * kepler_k3s3_M + 3 * kepler_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k3s3_ENOCONV;
   kepler_k3s3_DEFAULT_PARAMS(prm)
@@ -370,7 +363,7 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k3s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < 2 * kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_NU; i++)
+    for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + kepler_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k3s3_ENONFINITE;
     if (rc == kepler_k3s3_ENONFINITE || !isfinite(inc)) { rc = kepler_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k3s3_TOL / 256), or
@@ -402,6 +395,8 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
   /* kepler_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k3s3_ENONFINITE;
+  for (i = 0; i < (kepler_k3s3_S - 1) * kepler_k3s3_M; i++) /* the rest of p's polynomial, for kepler_k3s3_dense */
+    if (!isfinite(sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + 3 * kepler_k3s3_NU + i])) return kepler_k3s3_ENONFINITE;
   for (i = 0; i < kepler_k3s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k3s3_S * kepler_k3s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -410,9 +405,10 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
     kepler_k3s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     kepler_k3s3_add(&x->p[i], &x->pc[i], sw[kepler_k3s3_S * kepler_k3s3_M + i]);
   }
-  for (i = 0; i < kepler_k3s3_NU; i++) x->lambda[i] = sw[2 * kepler_k3s3_S * kepler_k3s3_M + i];
+  for (i = 0; i < kepler_k3s3_NU; i++) x->lambda[i] = sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + i];
   for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) x->pinc[i] = sw[kepler_k3s3_S * kepler_k3s3_M + i];
+  for (i = 0; i < kepler_k3s3_M; i++) x->pinc[i] = sw[kepler_k3s3_S * kepler_k3s3_M + i];
+  for (i = 0; i < (kepler_k3s3_S - 1) * kepler_k3s3_M; i++) x->pinc[kepler_k3s3_M + i] = sw[kepler_k3s3_S * kepler_k3s3_M + kepler_k3s3_M + 3 * kepler_k3s3_NU + i];
   kepler_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k3s3_OK;
@@ -505,12 +501,12 @@ void kepler_k3s3_dense(const kepler_k3s3_state *x, kepler_k3s3_real theta, keple
   w[0] = 1 - theta;
   for (j = 1; j < kepler_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < kepler_k3s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < kepler_k3s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < kepler_k3s3_S; j++) {
       dq += w[j] * x->gam[j * kepler_k3s3_M + i];
       dp += w[j] * x->pinc[j * kepler_k3s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

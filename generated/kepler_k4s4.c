@@ -46,8 +46,8 @@ static const double kepler_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.4164078649
 static const double kepler_k4s4_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k4s4_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void kepler_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k4s4_params *prm, double *out)
 {
@@ -269,18 +269,6 @@ static void kepler_k4s4_sweep(const double *q0, const double *p0, const double *
   const double t209 = -t208;
   const double t210 = h * t159;
   const double t211 = -t210;
-  const double t212 = h * t161;
-  const double t213 = -t212;
-  const double t214 = h * t163;
-  const double t215 = -t214;
-  const double t216 = h * t165;
-  const double t217 = -t216;
-  const double t218 = h * t167;
-  const double t219 = -t218;
-  const double t220 = h * t169;
-  const double t221 = -t220;
-  const double t222 = h * t171;
-  const double t223 = -t222;
   /* gam */
   out[0] = t176;
   out[1] = t181;
@@ -293,12 +281,13 @@ static void kepler_k4s4_sweep(const double *q0, const double *p0, const double *
   /* dp */
   out[8] = t209;
   out[9] = t211;
-  out[10] = t213;
-  out[11] = t215;
-  out[12] = t217;
-  out[13] = t219;
-  out[14] = t221;
-  out[15] = t223;
+  /* theta */
+  out[10] = t161;
+  out[11] = t163;
+  out[12] = t165;
+  out[13] = t167;
+  out[14] = t169;
+  out[15] = t171;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -441,7 +430,7 @@ static double kepler_k4s4_err_est(const double *gam, double h, double d1)
 static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, double tol, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[kepler_k4s4_S * kepler_k4s4_M], sw[2 * kepler_k4s4_S * kepler_k4s4_M + 3 * kepler_k4s4_NU + 1];
+  double gam[kepler_k4s4_S * kepler_k4s4_M], sw[kepler_k4s4_S * kepler_k4s4_M + 4 * kepler_k4s4_M + 3 * kepler_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k4s4_ENOCONV;
   kepler_k4s4_DEFAULT_PARAMS(prm)
@@ -464,7 +453,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k4s4_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < 2 * kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_NU; i++)
+    for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_M + kepler_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k4s4_ENONFINITE;
     if (rc == kepler_k4s4_ENONFINITE || !isfinite(inc)) { rc = kepler_k4s4_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k4s4_TOL / 256), or
@@ -496,6 +485,8 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
   /* kepler_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k4s4_ENONFINITE;
+  for (i = 0; i < (kepler_k4s4_S - 1) * kepler_k4s4_M; i++) /* the rest of p's polynomial, for kepler_k4s4_dense */
+    if (!isfinite(sw[kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_M + 3 * kepler_k4s4_NU + i])) return kepler_k4s4_ENONFINITE;
   for (i = 0; i < kepler_k4s4_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k4s4_S * kepler_k4s4_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -504,9 +495,10 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
     kepler_k4s4_add(&x->q[i], &x->qc[i], h * sw[i]);
     kepler_k4s4_add(&x->p[i], &x->pc[i], sw[kepler_k4s4_S * kepler_k4s4_M + i]);
   }
-  for (i = 0; i < kepler_k4s4_NU; i++) x->lambda[i] = sw[2 * kepler_k4s4_S * kepler_k4s4_M + i];
+  for (i = 0; i < kepler_k4s4_NU; i++) x->lambda[i] = sw[kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_M + i];
   for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) x->pinc[i] = sw[kepler_k4s4_S * kepler_k4s4_M + i];
+  for (i = 0; i < kepler_k4s4_M; i++) x->pinc[i] = sw[kepler_k4s4_S * kepler_k4s4_M + i];
+  for (i = 0; i < (kepler_k4s4_S - 1) * kepler_k4s4_M; i++) x->pinc[kepler_k4s4_M + i] = sw[kepler_k4s4_S * kepler_k4s4_M + kepler_k4s4_M + 3 * kepler_k4s4_NU + i];
   kepler_k4s4_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k4s4_OK;
@@ -599,12 +591,12 @@ void kepler_k4s4_dense(const kepler_k4s4_state *x, kepler_k4s4_real theta, keple
   w[0] = 1 - theta;
   for (j = 1; j < kepler_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < kepler_k4s4_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < kepler_k4s4_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < kepler_k4s4_S; j++) {
       dq += w[j] * x->gam[j * kepler_k4s4_M + i];
       dp += w[j] * x->pinc[j * kepler_k4s4_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -48,8 +48,8 @@ static const double kepler_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.551115123125
 static const double kepler_k6s2_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k6s2_p0[2] = {0.0, 2.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void kepler_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const kepler_k6s2_params *prm, double *out)
 {
@@ -253,10 +253,6 @@ static void kepler_k6s2_sweep(const double *q0, const double *p0, const double *
   const double t189 = -t188;
   const double t190 = h * t167;
   const double t191 = -t190;
-  const double t192 = h * t169;
-  const double t193 = -t192;
-  const double t194 = h * t171;
-  const double t195 = -t194;
   /* gam */
   out[0] = t176;
   out[1] = t181;
@@ -265,8 +261,9 @@ static void kepler_k6s2_sweep(const double *q0, const double *p0, const double *
   /* dp */
   out[4] = t189;
   out[5] = t191;
-  out[6] = t193;
-  out[7] = t195;
+  /* theta */
+  out[6] = t169;
+  out[7] = t171;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -409,7 +406,7 @@ static double kepler_k6s2_err_est(const double *gam, double h, double d1)
 static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, double tol, const kepler_k6s2_params *prm, kepler_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[kepler_k6s2_S * kepler_k6s2_M], sw[2 * kepler_k6s2_S * kepler_k6s2_M + 3 * kepler_k6s2_NU + 1];
+  double gam[kepler_k6s2_S * kepler_k6s2_M], sw[kepler_k6s2_S * kepler_k6s2_M + 2 * kepler_k6s2_M + 3 * kepler_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k6s2_ENOCONV;
   kepler_k6s2_DEFAULT_PARAMS(prm)
@@ -432,7 +429,7 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for kepler_k6s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < 2 * kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_NU; i++)
+    for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + kepler_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = kepler_k6s2_ENONFINITE;
     if (rc == kepler_k6s2_ENONFINITE || !isfinite(inc)) { rc = kepler_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (kepler_k6s2_TOL / 256), or
@@ -464,6 +461,8 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
   /* kepler_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s2_ENONFINITE;
+  for (i = 0; i < (kepler_k6s2_S - 1) * kepler_k6s2_M; i++) /* the rest of p's polynomial, for kepler_k6s2_dense */
+    if (!isfinite(sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + 3 * kepler_k6s2_NU + i])) return kepler_k6s2_ENONFINITE;
   for (i = 0; i < kepler_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k6s2_S * kepler_k6s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -472,9 +471,10 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
     kepler_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     kepler_k6s2_add(&x->p[i], &x->pc[i], sw[kepler_k6s2_S * kepler_k6s2_M + i]);
   }
-  for (i = 0; i < kepler_k6s2_NU; i++) x->lambda[i] = sw[2 * kepler_k6s2_S * kepler_k6s2_M + i];
+  for (i = 0; i < kepler_k6s2_NU; i++) x->lambda[i] = sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + i];
   for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < kepler_k6s2_S * kepler_k6s2_M; i++) x->pinc[i] = sw[kepler_k6s2_S * kepler_k6s2_M + i];
+  for (i = 0; i < kepler_k6s2_M; i++) x->pinc[i] = sw[kepler_k6s2_S * kepler_k6s2_M + i];
+  for (i = 0; i < (kepler_k6s2_S - 1) * kepler_k6s2_M; i++) x->pinc[kepler_k6s2_M + i] = sw[kepler_k6s2_S * kepler_k6s2_M + kepler_k6s2_M + 3 * kepler_k6s2_NU + i];
   kepler_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return kepler_k6s2_OK;
@@ -567,12 +567,12 @@ void kepler_k6s2_dense(const kepler_k6s2_state *x, kepler_k6s2_real theta, keple
   w[0] = 1 - theta;
   for (j = 1; j < kepler_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < kepler_k6s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < kepler_k6s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < kepler_k6s2_S; j++) {
       dq += w[j] * x->gam[j * kepler_k6s2_M + i];
       dp += w[j] * x->pinc[j * kepler_k6s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

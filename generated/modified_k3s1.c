@@ -45,8 +45,8 @@ static const double modified_k3s1_E1[1] = {1.0};
 static const double modified_k3s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k3s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void modified_k3s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k3s1_params *prm, double *out)
 {
@@ -443,7 +443,7 @@ static double modified_k3s1_err_est(const double *gam, double h, double d1)
 static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real h_, double tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k3s1_S * modified_k3s1_M], sw[2 * modified_k3s1_S * modified_k3s1_M + 3 * modified_k3s1_NU + 1];
+  double gam[modified_k3s1_S * modified_k3s1_M], sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k3s1_ENOCONV;
   modified_k3s1_DEFAULT_PARAMS(prm)
@@ -473,11 +473,11 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_k3s1_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k3s1_NU; i++) {
-      double piv = sw[2 * modified_k3s1_S * modified_k3s1_M + modified_k3s1_NU + i], dia = sw[2 * modified_k3s1_S * modified_k3s1_M + 2 * modified_k3s1_NU + i];
+      double piv = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU + i], dia = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 2 * modified_k3s1_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k3s1_SINGTOL * fabs(dia))) rc = modified_k3s1_ESINGULAR;
     }
     if (rc == modified_k3s1_ESINGULAR) break;
-    for (i = 0; i < 2 * modified_k3s1_S * modified_k3s1_M + modified_k3s1_NU; i++)
+    for (i = 0; i < modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + modified_k3s1_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k3s1_ENONFINITE;
     if (rc == modified_k3s1_ENONFINITE || !isfinite(inc)) { rc = modified_k3s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k3s1_TOL / 256), or
@@ -509,6 +509,8 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
   /* modified_k3s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k3s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k3s1_ENONFINITE;
+  for (i = 0; i < (modified_k3s1_S - 1) * modified_k3s1_M; i++) /* the rest of p's polynomial, for modified_k3s1_dense */
+    if (!isfinite(sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + i])) return modified_k3s1_ENONFINITE;
   for (i = 0; i < modified_k3s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k3s1_S * modified_k3s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -517,9 +519,10 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     modified_k3s1_add(&x->q[i], &x->qc[i], h * sw[i]);
     modified_k3s1_add(&x->p[i], &x->pc[i], sw[modified_k3s1_S * modified_k3s1_M + i]);
   }
-  for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[2 * modified_k3s1_S * modified_k3s1_M + i];
+  for (i = 0; i < modified_k3s1_NU; i++) x->lambda[i] = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + i];
   for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->pinc[i] = sw[modified_k3s1_S * modified_k3s1_M + i];
+  for (i = 0; i < modified_k3s1_M; i++) x->pinc[i] = sw[modified_k3s1_S * modified_k3s1_M + i];
+  for (i = 0; i < (modified_k3s1_S - 1) * modified_k3s1_M; i++) x->pinc[modified_k3s1_M + i] = sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + i];
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k3s1_OK;
@@ -659,12 +662,12 @@ void modified_k3s1_dense(const modified_k3s1_state *x, modified_k3s1_real theta,
   w[0] = 1 - theta;
   for (j = 1; j < modified_k3s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < modified_k3s1_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < modified_k3s1_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_k3s1_S; j++) {
       dq += w[j] * x->gam[j * modified_k3s1_M + i];
       dp += w[j] * x->pinc[j * modified_k3s1_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

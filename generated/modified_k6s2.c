@@ -48,8 +48,8 @@ static const double modified_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231
 static const double modified_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void modified_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k6s2_params *prm, double *out)
 {
@@ -308,12 +308,6 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   const double t242 = -t241;
   const double t243 = h * t210;
   const double t244 = -t243;
-  const double t245 = h * t211;
-  const double t246 = -t245;
-  const double t247 = h * t212;
-  const double t248 = -t247;
-  const double t249 = h * t214;
-  const double t250 = -t249;
   /* gam */
   out[0] = t219;
   out[1] = t224;
@@ -325,15 +319,16 @@ static void modified_k6s2_sweep(const double *q0, const double *p0, const double
   out[6] = t240;
   out[7] = t242;
   out[8] = t244;
-  out[9] = t246;
-  out[10] = t248;
-  out[11] = t250;
   /* lambda */
-  out[12] = t206;
+  out[9] = t206;
   /* pivot */
-  out[13] = t190;
+  out[10] = t190;
   /* adiag */
-  out[14] = t190;
+  out[11] = t190;
+  /* theta */
+  out[12] = t211;
+  out[13] = t212;
+  out[14] = t214;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -615,7 +610,7 @@ static double modified_k6s2_err_est(const double *gam, double h, double d1)
 static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real h_, double tol, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k6s2_S * modified_k6s2_M], sw[2 * modified_k6s2_S * modified_k6s2_M + 3 * modified_k6s2_NU + 1];
+  double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + 2 * modified_k6s2_M + 3 * modified_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k6s2_ENOCONV;
   modified_k6s2_DEFAULT_PARAMS(prm)
@@ -645,11 +640,11 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_k6s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k6s2_NU; i++) {
-      double piv = sw[2 * modified_k6s2_S * modified_k6s2_M + modified_k6s2_NU + i], dia = sw[2 * modified_k6s2_S * modified_k6s2_M + 2 * modified_k6s2_NU + i];
+      double piv = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU + i], dia = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 2 * modified_k6s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k6s2_SINGTOL * fabs(dia))) rc = modified_k6s2_ESINGULAR;
     }
     if (rc == modified_k6s2_ESINGULAR) break;
-    for (i = 0; i < 2 * modified_k6s2_S * modified_k6s2_M + modified_k6s2_NU; i++)
+    for (i = 0; i < modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + modified_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k6s2_ENONFINITE;
     if (rc == modified_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k6s2_TOL / 256), or
@@ -681,6 +676,8 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
   /* modified_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k6s2_ENONFINITE;
+  for (i = 0; i < (modified_k6s2_S - 1) * modified_k6s2_M; i++) /* the rest of p's polynomial, for modified_k6s2_dense */
+    if (!isfinite(sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + i])) return modified_k6s2_ENONFINITE;
   for (i = 0; i < modified_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k6s2_S * modified_k6s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -689,9 +686,10 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     modified_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     modified_k6s2_add(&x->p[i], &x->pc[i], sw[modified_k6s2_S * modified_k6s2_M + i]);
   }
-  for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[2 * modified_k6s2_S * modified_k6s2_M + i];
+  for (i = 0; i < modified_k6s2_NU; i++) x->lambda[i] = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + i];
   for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->pinc[i] = sw[modified_k6s2_S * modified_k6s2_M + i];
+  for (i = 0; i < modified_k6s2_M; i++) x->pinc[i] = sw[modified_k6s2_S * modified_k6s2_M + i];
+  for (i = 0; i < (modified_k6s2_S - 1) * modified_k6s2_M; i++) x->pinc[modified_k6s2_M + i] = sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + i];
   modified_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k6s2_OK;
@@ -831,12 +829,12 @@ void modified_k6s2_dense(const modified_k6s2_state *x, modified_k6s2_real theta,
   w[0] = 1 - theta;
   for (j = 1; j < modified_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < modified_k6s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < modified_k6s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_k6s2_S; j++) {
       dq += w[j] * x->gam[j * modified_k6s2_M + i];
       dp += w[j] * x->pinc[j * modified_k6s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -51,8 +51,8 @@ static const double modified_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864
 static const double modified_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void modified_k9s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const modified_k9s3_params *prm, double *out)
 {
@@ -522,18 +522,6 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   const double t450 = -t449;
   const double t451 = h * t399;
   const double t452 = -t451;
-  const double t453 = h * t400;
-  const double t454 = -t453;
-  const double t455 = h * t401;
-  const double t456 = -t455;
-  const double t457 = h * t403;
-  const double t458 = -t457;
-  const double t459 = h * t404;
-  const double t460 = -t459;
-  const double t461 = h * t405;
-  const double t462 = -t461;
-  const double t463 = h * t407;
-  const double t464 = -t463;
   /* gam */
   out[0] = t412;
   out[1] = t417;
@@ -548,18 +536,19 @@ static void modified_k9s3_sweep(const double *q0, const double *p0, const double
   out[9] = t448;
   out[10] = t450;
   out[11] = t452;
-  out[12] = t454;
-  out[13] = t456;
-  out[14] = t458;
-  out[15] = t460;
-  out[16] = t462;
-  out[17] = t464;
   /* lambda */
-  out[18] = t395;
+  out[12] = t395;
   /* pivot */
-  out[19] = t374;
+  out[13] = t374;
   /* adiag */
-  out[20] = t374;
+  out[14] = t374;
+  /* theta */
+  out[15] = t400;
+  out[16] = t401;
+  out[17] = t403;
+  out[18] = t404;
+  out[19] = t405;
+  out[20] = t407;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -838,7 +827,7 @@ static double modified_k9s3_err_est(const double *gam, double h, double d1)
 static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real h_, double tol, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k9s3_S * modified_k9s3_M], sw[2 * modified_k9s3_S * modified_k9s3_M + 3 * modified_k9s3_NU + 1];
+  double gam[modified_k9s3_S * modified_k9s3_M], sw[modified_k9s3_S * modified_k9s3_M + 3 * modified_k9s3_M + 3 * modified_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k9s3_ENOCONV;
   modified_k9s3_DEFAULT_PARAMS(prm)
@@ -868,11 +857,11 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_k9s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < modified_k9s3_NU; i++) {
-      double piv = sw[2 * modified_k9s3_S * modified_k9s3_M + modified_k9s3_NU + i], dia = sw[2 * modified_k9s3_S * modified_k9s3_M + 2 * modified_k9s3_NU + i];
+      double piv = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU + i], dia = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 2 * modified_k9s3_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_k9s3_SINGTOL * fabs(dia))) rc = modified_k9s3_ESINGULAR;
     }
     if (rc == modified_k9s3_ESINGULAR) break;
-    for (i = 0; i < 2 * modified_k9s3_S * modified_k9s3_M + modified_k9s3_NU; i++)
+    for (i = 0; i < modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + modified_k9s3_NU; i++)
       if (!isfinite(sw[i])) rc = modified_k9s3_ENONFINITE;
     if (rc == modified_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_k9s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (modified_k9s3_TOL / 256), or
@@ -904,6 +893,8 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
   /* modified_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k9s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k9s3_ENONFINITE;
+  for (i = 0; i < (modified_k9s3_S - 1) * modified_k9s3_M; i++) /* the rest of p's polynomial, for modified_k9s3_dense */
+    if (!isfinite(sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 3 * modified_k9s3_NU + i])) return modified_k9s3_ENONFINITE;
   for (i = 0; i < modified_k9s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k9s3_S * modified_k9s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -912,9 +903,10 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
     modified_k9s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     modified_k9s3_add(&x->p[i], &x->pc[i], sw[modified_k9s3_S * modified_k9s3_M + i]);
   }
-  for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[2 * modified_k9s3_S * modified_k9s3_M + i];
+  for (i = 0; i < modified_k9s3_NU; i++) x->lambda[i] = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + i];
   for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) x->pinc[i] = sw[modified_k9s3_S * modified_k9s3_M + i];
+  for (i = 0; i < modified_k9s3_M; i++) x->pinc[i] = sw[modified_k9s3_S * modified_k9s3_M + i];
+  for (i = 0; i < (modified_k9s3_S - 1) * modified_k9s3_M; i++) x->pinc[modified_k9s3_M + i] = sw[modified_k9s3_S * modified_k9s3_M + modified_k9s3_M + 3 * modified_k9s3_NU + i];
   modified_k9s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return modified_k9s3_OK;
@@ -1054,12 +1046,12 @@ void modified_k9s3_dense(const modified_k9s3_state *x, modified_k9s3_real theta,
   w[0] = 1 - theta;
   for (j = 1; j < modified_k9s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < modified_k9s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < modified_k9s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_k9s3_S; j++) {
       dq += w[j] * x->gam[j * modified_k9s3_M + i];
       dp += w[j] * x->pinc[j * modified_k9s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

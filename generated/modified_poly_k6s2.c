@@ -49,7 +49,7 @@ static const double modified_poly_k6s2_q0[3] = {0.70710678118654757, 0.0, (-0.70
 static const double modified_poly_k6s2_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
@@ -549,12 +549,6 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   const double t483 = -t482;
   const double t484 = h * t449;
   const double t485 = -t484;
-  const double t486 = h * t451;
-  const double t487 = -t486;
-  const double t488 = h * t453;
-  const double t489 = -t488;
-  const double t490 = h * t455;
-  const double t491 = -t490;
   /* gam */
   out[0] = t460;
   out[1] = t465;
@@ -566,12 +560,13 @@ static void modified_poly_k6s2_sweep(const double *q0, const double *p0, const d
   out[6] = t481;
   out[7] = t483;
   out[8] = t485;
-  out[9] = t487;
-  out[10] = t489;
-  out[11] = t491;
   /* lam */
-  out[12] = t356;
-  out[13] = t357;
+  out[9] = t356;
+  out[10] = t357;
+  /* theta */
+  out[11] = t451;
+  out[12] = t453;
+  out[13] = t455;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -1209,7 +1204,7 @@ static double modified_poly_k6s2_err_est(const double *gam, double h, double d1)
 static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, double tol, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[2 * modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
+  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + 2 * modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k6s2_ENOCONV;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -1261,8 +1256,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_poly_k6s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) lam[i] = sw[2 * modified_poly_k6s2_S * modified_poly_k6s2_M + i];
-    for (i = 0; i < 2 * modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU; i++)
+    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_NU; i++) lam[i] = sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + i];
+    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = modified_poly_k6s2_ENONFINITE;
     if (rc == modified_poly_k6s2_ENONFINITE || !isfinite(inc)) { rc = modified_poly_k6s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (modified_poly_k6s2_TOL). Iterating
@@ -1292,6 +1287,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   /* modified_poly_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_poly_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k6s2_ENONFINITE;
+  for (i = 0; i < (modified_poly_k6s2_S - 1) * modified_poly_k6s2_M; i++) /* the rest of p's polynomial, for modified_poly_k6s2_dense */
+    if (!isfinite(sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + i])) return modified_poly_k6s2_ENONFINITE;
   double q1[modified_poly_k6s2_M], p1[modified_poly_k6s2_M], pr[modified_poly_k6s2_M + 2 + 2 * modified_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k6s2_energy(x, prm);
   double qc1[modified_poly_k6s2_M], pc1[modified_poly_k6s2_M];
@@ -1333,7 +1330,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
+  for (i = 0; i < modified_poly_k6s2_M; i++) x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
+  for (i = 0; i < (modified_poly_k6s2_S - 1) * modified_poly_k6s2_M; i++) x->pinc[modified_poly_k6s2_M + i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + i];
   x->H0 = H0;
   {
     double lam[modified_poly_k6s2_NU];
@@ -1481,12 +1479,12 @@ void modified_poly_k6s2_dense(const modified_poly_k6s2_state *x, modified_poly_k
   w[0] = 1 - theta;
   for (j = 1; j < modified_poly_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < modified_poly_k6s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < modified_poly_k6s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_poly_k6s2_S; j++) {
       dq += w[j] * x->gam[j * modified_poly_k6s2_M + i];
       dp += w[j] * x->pinc[j * modified_poly_k6s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

@@ -52,7 +52,7 @@ static const double modified_poly_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70
 static const double modified_poly_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
@@ -1047,18 +1047,6 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   const double t974 = -t973;
   const double t975 = h * t919;
   const double t976 = -t975;
-  const double t977 = h * t921;
-  const double t978 = -t977;
-  const double t979 = h * t923;
-  const double t980 = -t979;
-  const double t981 = h * t925;
-  const double t982 = -t981;
-  const double t983 = h * t927;
-  const double t984 = -t983;
-  const double t985 = h * t929;
-  const double t986 = -t985;
-  const double t987 = h * t931;
-  const double t988 = -t987;
   /* gam */
   out[0] = t936;
   out[1] = t941;
@@ -1073,16 +1061,17 @@ static void modified_poly_k9s3_sweep(const double *q0, const double *p0, const d
   out[9] = t972;
   out[10] = t974;
   out[11] = t976;
-  out[12] = t978;
-  out[13] = t980;
-  out[14] = t982;
-  out[15] = t984;
-  out[16] = t986;
-  out[17] = t988;
   /* lam */
-  out[18] = t721;
-  out[19] = t722;
-  out[20] = t723;
+  out[12] = t721;
+  out[13] = t722;
+  out[14] = t723;
+  /* theta */
+  out[15] = t921;
+  out[16] = t923;
+  out[17] = t925;
+  out[18] = t927;
+  out[19] = t929;
+  out[20] = t931;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -2180,7 +2169,7 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1)
 static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[2 * modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
+  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + 3 * modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k9s3_ENOCONV;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
@@ -2232,8 +2221,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for modified_poly_k9s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = sw[2 * modified_poly_k9s3_S * modified_poly_k9s3_M + i];
-    for (i = 0; i < 2 * modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU; i++)
+    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_NU; i++) lam[i] = sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + i];
+    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU; i++)
       if (!isfinite(sw[i])) rc = modified_poly_k9s3_ENONFINITE;
     if (rc == modified_poly_k9s3_ENONFINITE || !isfinite(inc)) { rc = modified_poly_k9s3_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (modified_poly_k9s3_TOL). Iterating
@@ -2263,6 +2252,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   /* modified_poly_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_poly_k9s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k9s3_ENONFINITE;
+  for (i = 0; i < (modified_poly_k9s3_S - 1) * modified_poly_k9s3_M; i++) /* the rest of p's polynomial, for modified_poly_k9s3_dense */
+    if (!isfinite(sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + i])) return modified_poly_k9s3_ENONFINITE;
   double q1[modified_poly_k9s3_M], p1[modified_poly_k9s3_M], pr[modified_poly_k9s3_M + 2 + 2 * modified_poly_k9s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k9s3_energy(x, prm);
   double qc1[modified_poly_k9s3_M], pc1[modified_poly_k9s3_M];
@@ -2304,7 +2295,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->pinc[i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i];
+  for (i = 0; i < modified_poly_k9s3_M; i++) x->pinc[i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i];
+  for (i = 0; i < (modified_poly_k9s3_S - 1) * modified_poly_k9s3_M; i++) x->pinc[modified_poly_k9s3_M + i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + i];
   x->H0 = H0;
   {
     double lam[modified_poly_k9s3_NU];
@@ -2452,12 +2444,12 @@ void modified_poly_k9s3_dense(const modified_poly_k9s3_state *x, modified_poly_k
   w[0] = 1 - theta;
   for (j = 1; j < modified_poly_k9s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < modified_poly_k9s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < modified_poly_k9s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_poly_k9s3_S; j++) {
       dq += w[j] * x->gam[j * modified_poly_k9s3_M + i];
       dp += w[j] * x->pinc[j * modified_poly_k9s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

@@ -48,8 +48,8 @@ static const double pendulum_angle_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416
 static const double pendulum_angle_k6s3_q0[1] = {0.0};
 static const double pendulum_angle_k6s3_p0[1] = {1.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_angle_k6s3_params *prm, double *out)
 {
@@ -155,18 +155,15 @@ static void pendulum_angle_k6s3_sweep(const double *q0, const double *p0, const 
   const double t91 = -t90;
   const double t92 = h * t74;
   const double t93 = -t92;
-  const double t94 = h * t76;
-  const double t95 = -t94;
-  const double t96 = h * t78;
-  const double t97 = -t96;
   /* gam */
   out[0] = t83;
   out[1] = t88;
   out[2] = t91;
   /* dp */
   out[3] = t93;
-  out[4] = t95;
-  out[5] = t97;
+  /* theta */
+  out[4] = t76;
+  out[5] = t78;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -302,7 +299,7 @@ static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1
 static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
+  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_angle_k6s3_ENOCONV;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
@@ -325,7 +322,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < 2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
+    for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + pendulum_angle_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_angle_k6s3_ENONFINITE;
     if (rc == pendulum_angle_k6s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_angle_k6s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_angle_k6s3_TOL / 256), or
@@ -357,6 +354,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   /* pendulum_angle_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_angle_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_angle_k6s3_ENONFINITE;
+  for (i = 0; i < (pendulum_angle_k6s3_S - 1) * pendulum_angle_k6s3_M; i++) /* the rest of p's polynomial, for pendulum_angle_k6s3_dense */
+    if (!isfinite(sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + i])) return pendulum_angle_k6s3_ENONFINITE;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -365,9 +364,10 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     pendulum_angle_k6s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_angle_k6s3_add(&x->p[i], &x->pc[i], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]);
   }
-  for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[2 * pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
+  for (i = 0; i < pendulum_angle_k6s3_NU; i++) x->lambda[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + i];
   for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->pinc[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) x->pinc[i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
+  for (i = 0; i < (pendulum_angle_k6s3_S - 1) * pendulum_angle_k6s3_M; i++) x->pinc[pendulum_angle_k6s3_M + i] = sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + i];
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_angle_k6s3_OK;
@@ -460,12 +460,12 @@ void pendulum_angle_k6s3_dense(const pendulum_angle_k6s3_state *x, pendulum_angl
   w[0] = 1 - theta;
   for (j = 1; j < pendulum_angle_k6s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < pendulum_angle_k6s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_angle_k6s3_S; j++) {
       dq += w[j] * x->gam[j * pendulum_angle_k6s3_M + i];
       dp += w[j] * x->pinc[j * pendulum_angle_k6s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -43,8 +43,8 @@ static const double pendulum_k1s1_E1[1] = {1.0};
 static const double pendulum_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k1s1_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void pendulum_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
@@ -338,7 +338,7 @@ static double pendulum_k1s1_err_est(const double *gam, double h, double d1)
 static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real h_, double tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
+  double gam[pendulum_k1s1_S * pendulum_k1s1_M], sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k1s1_ENOCONV;
   pendulum_k1s1_DEFAULT_PARAMS(prm)
@@ -368,11 +368,11 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k1s1_NU; i++) {
-      double piv = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
+      double piv = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU + i], dia = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 2 * pendulum_k1s1_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k1s1_SINGTOL * fabs(dia))) rc = pendulum_k1s1_ESINGULAR;
     }
     if (rc == pendulum_k1s1_ESINGULAR) break;
-    for (i = 0; i < 2 * pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_NU; i++)
+    for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + pendulum_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_k1s1_ENONFINITE;
     if (rc == pendulum_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_k1s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k1s1_TOL / 256), or
@@ -404,6 +404,8 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
   /* pendulum_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k1s1_ENONFINITE;
+  for (i = 0; i < (pendulum_k1s1_S - 1) * pendulum_k1s1_M; i++) /* the rest of p's polynomial, for pendulum_k1s1_dense */
+    if (!isfinite(sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + i])) return pendulum_k1s1_ENONFINITE;
   for (i = 0; i < pendulum_k1s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k1s1_S * pendulum_k1s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -412,9 +414,10 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     pendulum_k1s1_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_k1s1_add(&x->p[i], &x->pc[i], sw[pendulum_k1s1_S * pendulum_k1s1_M + i]);
   }
-  for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[2 * pendulum_k1s1_S * pendulum_k1s1_M + i];
+  for (i = 0; i < pendulum_k1s1_NU; i++) x->lambda[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + i];
   for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->pinc[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + i];
+  for (i = 0; i < pendulum_k1s1_M; i++) x->pinc[i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + i];
+  for (i = 0; i < (pendulum_k1s1_S - 1) * pendulum_k1s1_M; i++) x->pinc[pendulum_k1s1_M + i] = sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + i];
   pendulum_k1s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k1s1_OK;
@@ -554,12 +557,12 @@ void pendulum_k1s1_dense(const pendulum_k1s1_state *x, pendulum_k1s1_real theta,
   w[0] = 1 - theta;
   for (j = 1; j < pendulum_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < pendulum_k1s1_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < pendulum_k1s1_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_k1s1_S; j++) {
       dq += w[j] * x->gam[j * pendulum_k1s1_M + i];
       dp += w[j] * x->pinc[j * pendulum_k1s1_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -44,8 +44,8 @@ static const double pendulum_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999
 static const double pendulum_k2s2_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k2s2_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
@@ -113,10 +113,6 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   const double t57 = -t56;
   const double t58 = h * t37;
   const double t59 = -t58;
-  const double t60 = h * t38;
-  const double t61 = -t60;
-  const double t62 = h * t39;
-  const double t63 = -t62;
   /* gam */
   out[0] = t44;
   out[1] = t49;
@@ -125,14 +121,15 @@ static void pendulum_k2s2_sweep(const double *q0, const double *p0, const double
   /* dp */
   out[4] = t57;
   out[5] = t59;
-  out[6] = t61;
-  out[7] = t63;
   /* lambda */
-  out[8] = t34;
+  out[6] = t34;
   /* pivot */
-  out[9] = t24;
+  out[7] = t24;
   /* adiag */
-  out[10] = t24;
+  out[8] = t24;
+  /* theta */
+  out[9] = t38;
+  out[10] = t39;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -371,7 +368,7 @@ static double pendulum_k2s2_err_est(const double *gam, double h, double d1)
 static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real h_, double tol, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];
+  double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[pendulum_k2s2_S * pendulum_k2s2_M + 2 * pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k2s2_ENOCONV;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -401,11 +398,11 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k2s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k2s2_NU; i++) {
-      double piv = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_NU + i], dia = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + 2 * pendulum_k2s2_NU + i];
+      double piv = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU + i], dia = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 2 * pendulum_k2s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k2s2_SINGTOL * fabs(dia))) rc = pendulum_k2s2_ESINGULAR;
     }
     if (rc == pendulum_k2s2_ESINGULAR) break;
-    for (i = 0; i < 2 * pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_NU; i++)
+    for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + pendulum_k2s2_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_k2s2_ENONFINITE;
     if (rc == pendulum_k2s2_ENONFINITE || !isfinite(inc)) { rc = pendulum_k2s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k2s2_TOL / 256), or
@@ -437,6 +434,8 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
   /* pendulum_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k2s2_ENONFINITE;
+  for (i = 0; i < (pendulum_k2s2_S - 1) * pendulum_k2s2_M; i++) /* the rest of p's polynomial, for pendulum_k2s2_dense */
+    if (!isfinite(sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + i])) return pendulum_k2s2_ENONFINITE;
   for (i = 0; i < pendulum_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k2s2_S * pendulum_k2s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -445,9 +444,10 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     pendulum_k2s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_k2s2_add(&x->p[i], &x->pc[i], sw[pendulum_k2s2_S * pendulum_k2s2_M + i]);
   }
-  for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[2 * pendulum_k2s2_S * pendulum_k2s2_M + i];
+  for (i = 0; i < pendulum_k2s2_NU; i++) x->lambda[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + i];
   for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->pinc[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + i];
+  for (i = 0; i < pendulum_k2s2_M; i++) x->pinc[i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + i];
+  for (i = 0; i < (pendulum_k2s2_S - 1) * pendulum_k2s2_M; i++) x->pinc[pendulum_k2s2_M + i] = sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + i];
   pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k2s2_OK;
@@ -587,12 +587,12 @@ void pendulum_k2s2_dense(const pendulum_k2s2_state *x, pendulum_k2s2_real theta,
   w[0] = 1 - theta;
   for (j = 1; j < pendulum_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < pendulum_k2s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < pendulum_k2s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_k2s2_S; j++) {
       dq += w[j] * x->gam[j * pendulum_k2s2_M + i];
       dp += w[j] * x->pinc[j * pendulum_k2s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

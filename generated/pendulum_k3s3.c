@@ -45,8 +45,8 @@ static const double pendulum_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864
 static const double pendulum_k3s3_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k3s3_p0[2] = {1.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const pendulum_k3s3_params *prm, double *out)
 {
@@ -136,14 +136,6 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   const double t79 = -t78;
   const double t80 = h * t47;
   const double t81 = -t80;
-  const double t82 = h * t48;
-  const double t83 = -t82;
-  const double t84 = h * t49;
-  const double t85 = -t84;
-  const double t86 = h * t50;
-  const double t87 = -t86;
-  const double t88 = h * t51;
-  const double t89 = -t88;
   /* gam */
   out[0] = t56;
   out[1] = t61;
@@ -154,16 +146,17 @@ static void pendulum_k3s3_sweep(const double *q0, const double *p0, const double
   /* dp */
   out[6] = t79;
   out[7] = t81;
-  out[8] = t83;
-  out[9] = t85;
-  out[10] = t87;
-  out[11] = t89;
   /* lambda */
-  out[12] = t44;
+  out[8] = t44;
   /* pivot */
-  out[13] = t34;
+  out[9] = t34;
   /* adiag */
-  out[14] = t34;
+  out[10] = t34;
+  /* theta */
+  out[11] = t48;
+  out[12] = t49;
+  out[13] = t50;
+  out[14] = t51;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -399,7 +392,7 @@ static double pendulum_k3s3_err_est(const double *gam, double h, double d1)
 static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real h_, double tol, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k3s3_S * pendulum_k3s3_M], sw[2 * pendulum_k3s3_S * pendulum_k3s3_M + 3 * pendulum_k3s3_NU + 1];
+  double gam[pendulum_k3s3_S * pendulum_k3s3_M], sw[pendulum_k3s3_S * pendulum_k3s3_M + 3 * pendulum_k3s3_M + 3 * pendulum_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k3s3_ENOCONV;
   pendulum_k3s3_DEFAULT_PARAMS(prm)
@@ -429,11 +422,11 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_k3s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < pendulum_k3s3_NU; i++) {
-      double piv = sw[2 * pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_NU + i], dia = sw[2 * pendulum_k3s3_S * pendulum_k3s3_M + 2 * pendulum_k3s3_NU + i];
+      double piv = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + pendulum_k3s3_NU + i], dia = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 2 * pendulum_k3s3_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_k3s3_SINGTOL * fabs(dia))) rc = pendulum_k3s3_ESINGULAR;
     }
     if (rc == pendulum_k3s3_ESINGULAR) break;
-    for (i = 0; i < 2 * pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_NU; i++)
+    for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + pendulum_k3s3_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_k3s3_ENONFINITE;
     if (rc == pendulum_k3s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_k3s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (pendulum_k3s3_TOL / 256), or
@@ -465,6 +458,8 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
   /* pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k3s3_ENONFINITE;
+  for (i = 0; i < (pendulum_k3s3_S - 1) * pendulum_k3s3_M; i++) /* the rest of p's polynomial, for pendulum_k3s3_dense */
+    if (!isfinite(sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 3 * pendulum_k3s3_NU + i])) return pendulum_k3s3_ENONFINITE;
   for (i = 0; i < pendulum_k3s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k3s3_S * pendulum_k3s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -473,9 +468,10 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
     pendulum_k3s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     pendulum_k3s3_add(&x->p[i], &x->pc[i], sw[pendulum_k3s3_S * pendulum_k3s3_M + i]);
   }
-  for (i = 0; i < pendulum_k3s3_NU; i++) x->lambda[i] = sw[2 * pendulum_k3s3_S * pendulum_k3s3_M + i];
+  for (i = 0; i < pendulum_k3s3_NU; i++) x->lambda[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + i];
   for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->pinc[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + i];
+  for (i = 0; i < pendulum_k3s3_M; i++) x->pinc[i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + i];
+  for (i = 0; i < (pendulum_k3s3_S - 1) * pendulum_k3s3_M; i++) x->pinc[pendulum_k3s3_M + i] = sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 3 * pendulum_k3s3_NU + i];
   pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return pendulum_k3s3_OK;
@@ -615,12 +611,12 @@ void pendulum_k3s3_dense(const pendulum_k3s3_state *x, pendulum_k3s3_real theta,
   w[0] = 1 - theta;
   for (j = 1; j < pendulum_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < pendulum_k3s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < pendulum_k3s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_k3s3_S; j++) {
       dq += w[j] * x->gam[j * pendulum_k3s3_M + i];
       dp += w[j] * x->pinc[j * pendulum_k3s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -44,7 +44,7 @@ static const double pendulum_poly_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k1s1_p0[2] = {1.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void pendulum_poly_k1s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k1s1_params *prm, double *out)
 {
@@ -406,7 +406,7 @@ static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1)
 static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h_, double tol, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M], sw[2 * pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + 1];
+  double gam[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M], sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k1s1_ENOCONV;
   pendulum_poly_k1s1_DEFAULT_PARAMS(prm)
@@ -458,8 +458,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k1s1_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++) lam[i] = sw[2 * pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + i];
-    for (i = 0; i < 2 * pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++)
+    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++) lam[i] = sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + i];
+    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k1s1_ENONFINITE;
     if (rc == pendulum_poly_k1s1_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k1s1_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k1s1_TOL). Iterating
@@ -489,6 +489,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
   /* pendulum_poly_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_poly_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k1s1_ENONFINITE;
+  for (i = 0; i < (pendulum_poly_k1s1_S - 1) * pendulum_poly_k1s1_M; i++) /* the rest of p's polynomial, for pendulum_poly_k1s1_dense */
+    if (!isfinite(sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + i])) return pendulum_poly_k1s1_ENONFINITE;
   double q1[pendulum_poly_k1s1_M], p1[pendulum_poly_k1s1_M], pr[pendulum_poly_k1s1_M + 2 + 2 * pendulum_poly_k1s1_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k1s1_energy(x, prm);
   double qc1[pendulum_poly_k1s1_M], pc1[pendulum_poly_k1s1_M];
@@ -530,7 +532,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + i];
+  for (i = 0; i < pendulum_poly_k1s1_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + i];
+  for (i = 0; i < (pendulum_poly_k1s1_S - 1) * pendulum_poly_k1s1_M; i++) x->pinc[pendulum_poly_k1s1_M + i] = (double)sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + i];
   x->H0 = H0;
   {
     double lam[pendulum_poly_k1s1_NU];
@@ -678,12 +681,12 @@ void pendulum_poly_k1s1_dense(const pendulum_poly_k1s1_state *x, pendulum_poly_k
   w[0] = 1 - theta;
   for (j = 1; j < pendulum_poly_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < pendulum_poly_k1s1_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < pendulum_poly_k1s1_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_poly_k1s1_S; j++) {
       dq += w[j] * x->gam[j * pendulum_poly_k1s1_M + i];
       dp += w[j] * x->pinc[j * pendulum_poly_k1s1_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

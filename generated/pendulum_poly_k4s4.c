@@ -47,7 +47,7 @@ static const double pendulum_poly_k4s4_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k4s4_p0[2] = {1.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
@@ -496,18 +496,6 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   const double t438 = -t437;
   const double t439 = h * t388;
   const double t440 = -t439;
-  const double t441 = h * t390;
-  const double t442 = -t441;
-  const double t443 = h * t392;
-  const double t444 = -t443;
-  const double t445 = h * t394;
-  const double t446 = -t445;
-  const double t447 = h * t396;
-  const double t448 = -t447;
-  const double t449 = h * t398;
-  const double t450 = -t449;
-  const double t451 = h * t400;
-  const double t452 = -t451;
   /* gam */
   out[0] = t405;
   out[1] = t410;
@@ -520,17 +508,18 @@ static void pendulum_poly_k4s4_sweep(const double *q0, const double *p0, const d
   /* dp */
   out[8] = t438;
   out[9] = t440;
-  out[10] = t442;
-  out[11] = t444;
-  out[12] = t446;
-  out[13] = t448;
-  out[14] = t450;
-  out[15] = t452;
   /* lam */
-  out[16] = t309;
-  out[17] = t310;
-  out[18] = t311;
-  out[19] = t312;
+  out[10] = t309;
+  out[11] = t310;
+  out[12] = t311;
+  out[13] = t312;
+  /* theta */
+  out[14] = t390;
+  out[15] = t392;
+  out[16] = t394;
+  out[17] = t396;
+  out[18] = t398;
+  out[19] = t400;
 }
 
 /* The multiplier matrix A at the predicted stages, factored once per step: out = its
@@ -1423,7 +1412,7 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1)
 static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
+  double gam[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + 4 * pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k4s4_ENOCONV;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
@@ -1475,8 +1464,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
-    for (i = 0; i < 2 * pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++) lam[i] = sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + i];
+    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU; i++)
       if (!isfinite(sw[i])) rc = pendulum_poly_k4s4_ENONFINITE;
     if (rc == pendulum_poly_k4s4_ENONFINITE || !isfinite(inc)) { rc = pendulum_poly_k4s4_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k4s4_TOL). Iterating
@@ -1506,6 +1495,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   /* pendulum_poly_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_poly_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k4s4_ENONFINITE;
+  for (i = 0; i < (pendulum_poly_k4s4_S - 1) * pendulum_poly_k4s4_M; i++) /* the rest of p's polynomial, for pendulum_poly_k4s4_dense */
+    if (!isfinite(sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + i])) return pendulum_poly_k4s4_ENONFINITE;
   double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k4s4_energy(x, prm);
   double qc1[pendulum_poly_k4s4_M], pc1[pendulum_poly_k4s4_M];
@@ -1547,7 +1538,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
+  for (i = 0; i < (pendulum_poly_k4s4_S - 1) * pendulum_poly_k4s4_M; i++) x->pinc[pendulum_poly_k4s4_M + i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + i];
   x->H0 = H0;
   {
     double lam[pendulum_poly_k4s4_NU];
@@ -1695,12 +1687,12 @@ void pendulum_poly_k4s4_dense(const pendulum_poly_k4s4_state *x, pendulum_poly_k
   w[0] = 1 - theta;
   for (j = 1; j < pendulum_poly_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < pendulum_poly_k4s4_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_poly_k4s4_S; j++) {
       dq += w[j] * x->gam[j * pendulum_poly_k4s4_M + i];
       dp += w[j] * x->pinc[j * pendulum_poly_k4s4_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

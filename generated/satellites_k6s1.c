@@ -48,8 +48,8 @@ static const double satellites_k6s1_E1[1] = {1.0};
 static const double satellites_k6s1_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s1_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void satellites_k6s1_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const satellites_k6s1_params *prm, double *out)
 {
@@ -1749,7 +1749,7 @@ static double satellites_k6s1_err_est(const double *gam, double h, double d1)
 static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1_real h_, double tol, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_k6s1_S * satellites_k6s1_M], sw[2 * satellites_k6s1_S * satellites_k6s1_M + 3 * satellites_k6s1_NU + 1];
+  double gam[satellites_k6s1_S * satellites_k6s1_M], sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_k6s1_ENOCONV;
   satellites_k6s1_DEFAULT_PARAMS(prm)
@@ -1779,11 +1779,11 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s1_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s1_NU; i++) {
-      double piv = sw[2 * satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_NU + i], dia = sw[2 * satellites_k6s1_S * satellites_k6s1_M + 2 * satellites_k6s1_NU + i];
+      double piv = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + satellites_k6s1_NU + i], dia = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 2 * satellites_k6s1_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s1_SINGTOL * fabs(dia))) rc = satellites_k6s1_ESINGULAR;
     }
     if (rc == satellites_k6s1_ESINGULAR) break;
-    for (i = 0; i < 2 * satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_NU; i++)
+    for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + satellites_k6s1_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s1_ENONFINITE;
     if (rc == satellites_k6s1_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s1_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (satellites_k6s1_TOL / 256), or
@@ -1815,6 +1815,8 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
   /* satellites_k6s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_k6s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s1_ENONFINITE;
+  for (i = 0; i < (satellites_k6s1_S - 1) * satellites_k6s1_M; i++) /* the rest of p's polynomial, for satellites_k6s1_dense */
+    if (!isfinite(sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + i])) return satellites_k6s1_ENONFINITE;
   for (i = 0; i < satellites_k6s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s1_S * satellites_k6s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -1823,9 +1825,10 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
     satellites_k6s1_add(&x->q[i], &x->qc[i], h * sw[i]);
     satellites_k6s1_add(&x->p[i], &x->pc[i], sw[satellites_k6s1_S * satellites_k6s1_M + i]);
   }
-  for (i = 0; i < satellites_k6s1_NU; i++) x->lambda[i] = sw[2 * satellites_k6s1_S * satellites_k6s1_M + i];
+  for (i = 0; i < satellites_k6s1_NU; i++) x->lambda[i] = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + i];
   for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->pinc[i] = sw[satellites_k6s1_S * satellites_k6s1_M + i];
+  for (i = 0; i < satellites_k6s1_M; i++) x->pinc[i] = sw[satellites_k6s1_S * satellites_k6s1_M + i];
+  for (i = 0; i < (satellites_k6s1_S - 1) * satellites_k6s1_M; i++) x->pinc[satellites_k6s1_M + i] = sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + i];
   satellites_k6s1_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s1_OK;
@@ -1965,12 +1968,12 @@ void satellites_k6s1_dense(const satellites_k6s1_state *x, satellites_k6s1_real 
   w[0] = 1 - theta;
   for (j = 1; j < satellites_k6s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < satellites_k6s1_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < satellites_k6s1_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_k6s1_S; j++) {
       dq += w[j] * x->gam[j * satellites_k6s1_M + i];
       dp += w[j] * x->pinc[j * satellites_k6s1_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -48,8 +48,8 @@ static const double satellites_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.55111512
 static const double satellites_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void satellites_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
@@ -1417,24 +1417,6 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   const double t1351 = -t1350;
   const double t1352 = h * t1227;
   const double t1353 = -t1352;
-  const double t1354 = h * t1253;
-  const double t1355 = -t1354;
-  const double t1356 = h * t1255;
-  const double t1357 = -t1356;
-  const double t1358 = h * t1257;
-  const double t1359 = -t1358;
-  const double t1360 = h * t1241;
-  const double t1361 = -t1360;
-  const double t1362 = h * t1243;
-  const double t1363 = -t1362;
-  const double t1364 = h * t1245;
-  const double t1365 = -t1364;
-  const double t1366 = h * t1259;
-  const double t1367 = -t1366;
-  const double t1368 = h * t1261;
-  const double t1369 = -t1368;
-  const double t1370 = h * t1263;
-  const double t1371 = -t1370;
   /* gam */
   out[0] = t1268;
   out[1] = t1273;
@@ -1464,27 +1446,28 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   out[24] = t1349;
   out[25] = t1351;
   out[26] = t1353;
-  out[27] = t1355;
-  out[28] = t1357;
-  out[29] = t1359;
-  out[30] = t1361;
-  out[31] = t1363;
-  out[32] = t1365;
-  out[33] = t1367;
-  out[34] = t1369;
-  out[35] = t1371;
   /* lambda */
-  out[36] = t1191;
-  out[37] = t1186;
-  out[38] = t1183;
+  out[27] = t1191;
+  out[28] = t1186;
+  out[29] = t1183;
   /* pivot */
-  out[39] = t912;
-  out[40] = t1166;
-  out[41] = t1180;
+  out[30] = t912;
+  out[31] = t1166;
+  out[32] = t1180;
   /* adiag */
-  out[42] = t912;
-  out[43] = t1020;
-  out[44] = t1108;
+  out[33] = t912;
+  out[34] = t1020;
+  out[35] = t1108;
+  /* theta */
+  out[36] = t1253;
+  out[37] = t1255;
+  out[38] = t1257;
+  out[39] = t1241;
+  out[40] = t1243;
+  out[41] = t1245;
+  out[42] = t1259;
+  out[43] = t1261;
+  out[44] = t1263;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -2253,7 +2236,7 @@ static double satellites_k6s2_err_est(const double *gam, double h, double d1)
 static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2_real h_, double tol, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[2 * satellites_k6s2_S * satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
+  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[satellites_k6s2_S * satellites_k6s2_M + 2 * satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_k6s2_ENOCONV;
   satellites_k6s2_DEFAULT_PARAMS(prm)
@@ -2283,11 +2266,11 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s2_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s2_NU; i++) {
-      double piv = sw[2 * satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_NU + i], dia = sw[2 * satellites_k6s2_S * satellites_k6s2_M + 2 * satellites_k6s2_NU + i];
+      double piv = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU + i], dia = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 2 * satellites_k6s2_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s2_SINGTOL * fabs(dia))) rc = satellites_k6s2_ESINGULAR;
     }
     if (rc == satellites_k6s2_ESINGULAR) break;
-    for (i = 0; i < 2 * satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_NU; i++)
+    for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + satellites_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s2_ENONFINITE;
     if (rc == satellites_k6s2_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s2_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (satellites_k6s2_TOL / 256), or
@@ -2319,6 +2302,8 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
   /* satellites_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s2_ENONFINITE;
+  for (i = 0; i < (satellites_k6s2_S - 1) * satellites_k6s2_M; i++) /* the rest of p's polynomial, for satellites_k6s2_dense */
+    if (!isfinite(sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + i])) return satellites_k6s2_ENONFINITE;
   for (i = 0; i < satellites_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s2_S * satellites_k6s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -2327,9 +2312,10 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     satellites_k6s2_add(&x->q[i], &x->qc[i], h * sw[i]);
     satellites_k6s2_add(&x->p[i], &x->pc[i], sw[satellites_k6s2_S * satellites_k6s2_M + i]);
   }
-  for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = sw[2 * satellites_k6s2_S * satellites_k6s2_M + i];
+  for (i = 0; i < satellites_k6s2_NU; i++) x->lambda[i] = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + i];
   for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->pinc[i] = sw[satellites_k6s2_S * satellites_k6s2_M + i];
+  for (i = 0; i < satellites_k6s2_M; i++) x->pinc[i] = sw[satellites_k6s2_S * satellites_k6s2_M + i];
+  for (i = 0; i < (satellites_k6s2_S - 1) * satellites_k6s2_M; i++) x->pinc[satellites_k6s2_M + i] = sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + i];
   satellites_k6s2_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s2_OK;
@@ -2469,12 +2455,12 @@ void satellites_k6s2_dense(const satellites_k6s2_state *x, satellites_k6s2_real 
   w[0] = 1 - theta;
   for (j = 1; j < satellites_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < satellites_k6s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < satellites_k6s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_k6s2_S; j++) {
       dq += w[j] * x->gam[j * satellites_k6s2_M + i];
       dp += w[j] * x->pinc[j * satellites_k6s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -48,8 +48,8 @@ static const double satellites_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.4164078
 static const double satellites_k6s3_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s3_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
-/* One fixed-point sweep: out = new gamma (S*M), p's increments -h Theta_j
- * (S*M, the first p1 - p0), lambda (NU), pivots of the LU of A (NU), diagonal of A (NU). */
+/* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void satellites_k6s3_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const satellites_k6s3_params *prm, double *out)
 {
@@ -1900,42 +1900,6 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   const double t1834 = -t1833;
   const double t1835 = h * t1629;
   const double t1836 = -t1835;
-  const double t1837 = h * t1655;
-  const double t1838 = -t1837;
-  const double t1839 = h * t1657;
-  const double t1840 = -t1839;
-  const double t1841 = h * t1659;
-  const double t1842 = -t1841;
-  const double t1843 = h * t1643;
-  const double t1844 = -t1843;
-  const double t1845 = h * t1645;
-  const double t1846 = -t1845;
-  const double t1847 = h * t1647;
-  const double t1848 = -t1847;
-  const double t1849 = h * t1661;
-  const double t1850 = -t1849;
-  const double t1851 = h * t1663;
-  const double t1852 = -t1851;
-  const double t1853 = h * t1665;
-  const double t1854 = -t1853;
-  const double t1855 = h * t1691;
-  const double t1856 = -t1855;
-  const double t1857 = h * t1693;
-  const double t1858 = -t1857;
-  const double t1859 = h * t1695;
-  const double t1860 = -t1859;
-  const double t1861 = h * t1679;
-  const double t1862 = -t1861;
-  const double t1863 = h * t1681;
-  const double t1864 = -t1863;
-  const double t1865 = h * t1683;
-  const double t1866 = -t1865;
-  const double t1867 = h * t1697;
-  const double t1868 = -t1867;
-  const double t1869 = h * t1699;
-  const double t1870 = -t1869;
-  const double t1871 = h * t1701;
-  const double t1872 = -t1871;
   /* gam */
   out[0] = t1706;
   out[1] = t1711;
@@ -1974,36 +1938,37 @@ static void satellites_k6s3_sweep(const double *q0, const double *p0, const doub
   out[33] = t1832;
   out[34] = t1834;
   out[35] = t1836;
-  out[36] = t1838;
-  out[37] = t1840;
-  out[38] = t1842;
-  out[39] = t1844;
-  out[40] = t1846;
-  out[41] = t1848;
-  out[42] = t1850;
-  out[43] = t1852;
-  out[44] = t1854;
-  out[45] = t1856;
-  out[46] = t1858;
-  out[47] = t1860;
-  out[48] = t1862;
-  out[49] = t1864;
-  out[50] = t1866;
-  out[51] = t1868;
-  out[52] = t1870;
-  out[53] = t1872;
   /* lambda */
-  out[54] = t1593;
-  out[55] = t1588;
-  out[56] = t1585;
+  out[36] = t1593;
+  out[37] = t1588;
+  out[38] = t1585;
   /* pivot */
-  out[57] = t1191;
-  out[58] = t1568;
-  out[59] = t1582;
+  out[39] = t1191;
+  out[40] = t1568;
+  out[41] = t1582;
   /* adiag */
-  out[60] = t1191;
-  out[61] = t1353;
-  out[62] = t1482;
+  out[42] = t1191;
+  out[43] = t1353;
+  out[44] = t1482;
+  /* theta */
+  out[45] = t1655;
+  out[46] = t1657;
+  out[47] = t1659;
+  out[48] = t1643;
+  out[49] = t1645;
+  out[50] = t1647;
+  out[51] = t1661;
+  out[52] = t1663;
+  out[53] = t1665;
+  out[54] = t1691;
+  out[55] = t1693;
+  out[56] = t1695;
+  out[57] = t1679;
+  out[58] = t1681;
+  out[59] = t1683;
+  out[60] = t1697;
+  out[61] = t1699;
+  out[62] = t1701;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -2769,7 +2734,7 @@ static double satellites_k6s3_err_est(const double *gam, double h, double d1)
 static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3_real h_, double tol, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_k6s3_S * satellites_k6s3_M], sw[2 * satellites_k6s3_S * satellites_k6s3_M + 3 * satellites_k6s3_NU + 1];
+  double gam[satellites_k6s3_S * satellites_k6s3_M], sw[satellites_k6s3_S * satellites_k6s3_M + 3 * satellites_k6s3_M + 3 * satellites_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_k6s3_ENOCONV;
   satellites_k6s3_DEFAULT_PARAMS(prm)
@@ -2799,11 +2764,11 @@ static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_k6s3_err_est */
     if (scale > 0) inc /= scale;
     for (i = 0; i < satellites_k6s3_NU; i++) {
-      double piv = sw[2 * satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_NU + i], dia = sw[2 * satellites_k6s3_S * satellites_k6s3_M + 2 * satellites_k6s3_NU + i];
+      double piv = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + satellites_k6s3_NU + i], dia = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 2 * satellites_k6s3_NU + i];
       if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_k6s3_SINGTOL * fabs(dia))) rc = satellites_k6s3_ESINGULAR;
     }
     if (rc == satellites_k6s3_ESINGULAR) break;
-    for (i = 0; i < 2 * satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_NU; i++)
+    for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + satellites_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_k6s3_ENONFINITE;
     if (rc == satellites_k6s3_ENONFINITE || !isfinite(inc)) { rc = satellites_k6s3_ENONFINITE; break; }
     /* converged: the increment is far below an ulp of the state (satellites_k6s3_TOL / 256), or
@@ -2835,6 +2800,8 @@ static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3
   /* satellites_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s3_ENONFINITE;
+  for (i = 0; i < (satellites_k6s3_S - 1) * satellites_k6s3_M; i++) /* the rest of p's polynomial, for satellites_k6s3_dense */
+    if (!isfinite(sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 3 * satellites_k6s3_NU + i])) return satellites_k6s3_ENONFINITE;
   for (i = 0; i < satellites_k6s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s3_S * satellites_k6s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -2843,9 +2810,10 @@ static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3
     satellites_k6s3_add(&x->q[i], &x->qc[i], h * sw[i]);
     satellites_k6s3_add(&x->p[i], &x->pc[i], sw[satellites_k6s3_S * satellites_k6s3_M + i]);
   }
-  for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = sw[2 * satellites_k6s3_S * satellites_k6s3_M + i];
+  for (i = 0; i < satellites_k6s3_NU; i++) x->lambda[i] = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + i];
   for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->gam[i] = gam[i];
-  for (i = 0; i < satellites_k6s3_S * satellites_k6s3_M; i++) x->pinc[i] = sw[satellites_k6s3_S * satellites_k6s3_M + i];
+  for (i = 0; i < satellites_k6s3_M; i++) x->pinc[i] = sw[satellites_k6s3_S * satellites_k6s3_M + i];
+  for (i = 0; i < (satellites_k6s3_S - 1) * satellites_k6s3_M; i++) x->pinc[satellites_k6s3_M + i] = sw[satellites_k6s3_S * satellites_k6s3_M + satellites_k6s3_M + 3 * satellites_k6s3_NU + i];
   satellites_k6s3_add(&x->t, &x->tc, h);
   x->hprev = h;
   return satellites_k6s3_OK;
@@ -2985,12 +2953,12 @@ void satellites_k6s3_dense(const satellites_k6s3_state *x, satellites_k6s3_real 
   w[0] = 1 - theta;
   for (j = 1; j < satellites_k6s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < satellites_k6s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < satellites_k6s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_k6s3_S; j++) {
       dq += w[j] * x->gam[j * satellites_k6s3_M + i];
       dp += w[j] * x->pinc[j * satellites_k6s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
   }
 }

@@ -49,7 +49,7 @@ static const double satellites_poly_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 2
 static const double satellites_poly_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *w, double *out)
 {
@@ -2106,12 +2106,12 @@ static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0,
   const double t1999 = t1939 + t1998;
   w[41] = t1999;
   /* lam */
-  out[36] = t1716;
-  out[37] = t1717;
-  out[38] = t1718;
-  out[39] = t1719;
-  out[40] = t1720;
-  out[41] = t1721;
+  out[27] = t1716;
+  out[28] = t1717;
+  out[29] = t1718;
+  out[30] = t1719;
+  out[31] = t1720;
+  out[32] = t1721;
 }
 
 static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0, const double *gam, double h,
@@ -2291,24 +2291,6 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   const double t2169 = -t2168;
   const double t2170 = h * t2063;
   const double t2171 = -t2170;
-  const double t2172 = h * t2065;
-  const double t2173 = -t2172;
-  const double t2174 = h * t2067;
-  const double t2175 = -t2174;
-  const double t2176 = h * t2069;
-  const double t2177 = -t2176;
-  const double t2178 = h * t2071;
-  const double t2179 = -t2178;
-  const double t2180 = h * t2073;
-  const double t2181 = -t2180;
-  const double t2182 = h * t2075;
-  const double t2183 = -t2182;
-  const double t2184 = h * t2077;
-  const double t2185 = -t2184;
-  const double t2186 = h * t2079;
-  const double t2187 = -t2186;
-  const double t2188 = h * t2081;
-  const double t2189 = -t2188;
   /* gam */
   out[0] = t2086;
   out[1] = t2091;
@@ -2338,15 +2320,16 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   out[24] = t2167;
   out[25] = t2169;
   out[26] = t2171;
-  out[27] = t2173;
-  out[28] = t2175;
-  out[29] = t2177;
-  out[30] = t2179;
-  out[31] = t2181;
-  out[32] = t2183;
-  out[33] = t2185;
-  out[34] = t2187;
-  out[35] = t2189;
+  /* theta */
+  out[33] = t2065;
+  out[34] = t2067;
+  out[35] = t2069;
+  out[36] = t2071;
+  out[37] = t2073;
+  out[38] = t2075;
+  out[39] = t2077;
+  out[40] = t2079;
+  out[41] = t2081;
 }
 
 /* sweep: the 2 parts above in order */
@@ -5014,7 +4997,7 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
 static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[2 * satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
+  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + 2 * satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_poly_k6s2_ENOCONV;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -5066,8 +5049,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_poly_k6s2_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = sw[2 * satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
-    for (i = 0; i < 2 * satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++)
+    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++) lam[i] = sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + i];
+    for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_poly_k6s2_ENONFINITE;
     if (rc == satellites_poly_k6s2_ENONFINITE || !isfinite(inc)) { rc = satellites_poly_k6s2_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (satellites_poly_k6s2_TOL). Iterating
@@ -5097,6 +5080,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
   /* satellites_poly_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_poly_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s2_ENONFINITE;
+  for (i = 0; i < (satellites_poly_k6s2_S - 1) * satellites_poly_k6s2_M; i++) /* the rest of p's polynomial, for satellites_poly_k6s2_dense */
+    if (!isfinite(sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + i])) return satellites_poly_k6s2_ENONFINITE;
   double q1[satellites_poly_k6s2_M], p1[satellites_poly_k6s2_M], pr[satellites_poly_k6s2_M + 2 + 2 * satellites_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s2_energy(x, prm);
   double qc1[satellites_poly_k6s2_M], pc1[satellites_poly_k6s2_M];
@@ -5138,7 +5123,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
+  for (i = 0; i < satellites_poly_k6s2_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
+  for (i = 0; i < (satellites_poly_k6s2_S - 1) * satellites_poly_k6s2_M; i++) x->pinc[satellites_poly_k6s2_M + i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + i];
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s2_NU];
@@ -5286,12 +5272,12 @@ void satellites_poly_k6s2_dense(const satellites_poly_k6s2_state *x, satellites_
   w[0] = 1 - theta;
   for (j = 1; j < satellites_poly_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < satellites_poly_k6s2_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < satellites_poly_k6s2_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_poly_k6s2_S; j++) {
       dq += w[j] * x->gam[j * satellites_poly_k6s2_M + i];
       dp += w[j] * x->pinc[j * satellites_poly_k6s2_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }

@@ -49,7 +49,7 @@ static const double satellites_poly_k6s3_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 2
 static const double satellites_poly_k6s3_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p's increments -h Theta_j (S*M, the first p1 - p0), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void satellites_poly_k6s3_sweep_part0(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *w, double *out)
 {
@@ -3146,42 +3146,6 @@ static void satellites_poly_k6s3_sweep_part1(const double *q0, const double *p0,
   const double t2946 = -t2945;
   const double t2947 = h * t2777;
   const double t2948 = -t2947;
-  const double t2949 = h * t2779;
-  const double t2950 = -t2949;
-  const double t2951 = h * t2781;
-  const double t2952 = -t2951;
-  const double t2953 = h * t2783;
-  const double t2954 = -t2953;
-  const double t2955 = h * t2785;
-  const double t2956 = -t2955;
-  const double t2957 = h * t2787;
-  const double t2958 = -t2957;
-  const double t2959 = h * t2789;
-  const double t2960 = -t2959;
-  const double t2961 = h * t2791;
-  const double t2962 = -t2961;
-  const double t2963 = h * t2793;
-  const double t2964 = -t2963;
-  const double t2965 = h * t2795;
-  const double t2966 = -t2965;
-  const double t2967 = h * t2797;
-  const double t2968 = -t2967;
-  const double t2969 = h * t2799;
-  const double t2970 = -t2969;
-  const double t2971 = h * t2801;
-  const double t2972 = -t2971;
-  const double t2973 = h * t2803;
-  const double t2974 = -t2973;
-  const double t2975 = h * t2805;
-  const double t2976 = -t2975;
-  const double t2977 = h * t2807;
-  const double t2978 = -t2977;
-  const double t2979 = h * t2809;
-  const double t2980 = -t2979;
-  const double t2981 = h * t2811;
-  const double t2982 = -t2981;
-  const double t2983 = h * t2813;
-  const double t2984 = -t2983;
   /* gam */
   out[0] = t2818;
   out[1] = t2823;
@@ -3220,34 +3184,35 @@ static void satellites_poly_k6s3_sweep_part1(const double *q0, const double *p0,
   out[33] = t2944;
   out[34] = t2946;
   out[35] = t2948;
-  out[36] = t2950;
-  out[37] = t2952;
-  out[38] = t2954;
-  out[39] = t2956;
-  out[40] = t2958;
-  out[41] = t2960;
-  out[42] = t2962;
-  out[43] = t2964;
-  out[44] = t2966;
-  out[45] = t2968;
-  out[46] = t2970;
-  out[47] = t2972;
-  out[48] = t2974;
-  out[49] = t2976;
-  out[50] = t2978;
-  out[51] = t2980;
-  out[52] = t2982;
-  out[53] = t2984;
   /* lam */
-  out[54] = t2307;
-  out[55] = t2308;
-  out[56] = t2309;
-  out[57] = t2310;
-  out[58] = t2311;
-  out[59] = t2312;
-  out[60] = t2313;
-  out[61] = t2314;
-  out[62] = t2315;
+  out[36] = t2307;
+  out[37] = t2308;
+  out[38] = t2309;
+  out[39] = t2310;
+  out[40] = t2311;
+  out[41] = t2312;
+  out[42] = t2313;
+  out[43] = t2314;
+  out[44] = t2315;
+  /* theta */
+  out[45] = t2779;
+  out[46] = t2781;
+  out[47] = t2783;
+  out[48] = t2785;
+  out[49] = t2787;
+  out[50] = t2789;
+  out[51] = t2791;
+  out[52] = t2793;
+  out[53] = t2795;
+  out[54] = t2797;
+  out[55] = t2799;
+  out[56] = t2801;
+  out[57] = t2803;
+  out[58] = t2805;
+  out[59] = t2807;
+  out[60] = t2809;
+  out[61] = t2811;
+  out[62] = t2813;
 }
 
 /* sweep: the 2 parts above in order */
@@ -8709,7 +8674,7 @@ static double satellites_poly_k6s3_err_est(const double *gam, double h, double d
 static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, double tol, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[2 * satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
+  double gam[satellites_poly_k6s3_S * satellites_poly_k6s3_M], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + 3 * satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_poly_k6s3_ENOCONV;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
@@ -8761,8 +8726,8 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     }
     if (it == 1) d1 = inc;  /* the predictor's error, for satellites_poly_k6s3_err_est */
     if (scale > 0) inc /= scale;
-    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) lam[i] = sw[2 * satellites_poly_k6s3_S * satellites_poly_k6s3_M + i];
-    for (i = 0; i < 2 * satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++)
+    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++) lam[i] = sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + i];
+    for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU; i++)
       if (!isfinite(sw[i])) rc = satellites_poly_k6s3_ENONFINITE;
     if (rc == satellites_poly_k6s3_ENONFINITE || !isfinite(inc)) { rc = satellites_poly_k6s3_ENONFINITE; break; }
     /* converged: the increment is within 2 ulps of the state (satellites_poly_k6s3_TOL). Iterating
@@ -8792,6 +8757,8 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
   /* satellites_poly_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_poly_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
+  for (i = 0; i < (satellites_poly_k6s3_S - 1) * satellites_poly_k6s3_M; i++) /* the rest of p's polynomial, for satellites_poly_k6s3_dense */
+    if (!isfinite(sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + i])) return satellites_poly_k6s3_ENONFINITE;
   double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 2 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s3_energy(x, prm);
   double qc1[satellites_poly_k6s3_M], pc1[satellites_poly_k6s3_M];
@@ -8833,7 +8800,8 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->gam[i] = (double)gam[i];
-  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i];
+  for (i = 0; i < satellites_poly_k6s3_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i];
+  for (i = 0; i < (satellites_poly_k6s3_S - 1) * satellites_poly_k6s3_M; i++) x->pinc[satellites_poly_k6s3_M + i] = (double)sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + i];
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s3_NU];
@@ -8981,12 +8949,12 @@ void satellites_poly_k6s3_dense(const satellites_poly_k6s3_state *x, satellites_
   w[0] = 1 - theta;
   for (j = 1; j < satellites_poly_k6s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
   for (i = 0; i < satellites_poly_k6s3_M; i++) {
-    double dq = 0, dp = 0;
-    for (j = 0; j < satellites_poly_k6s3_S; j++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_poly_k6s3_S; j++) {
       dq += w[j] * x->gam[j * satellites_poly_k6s3_M + i];
       dp += w[j] * x->pinc[j * satellites_poly_k6s3_M + i];
     }
     q[i] = x->q[i] - x->hprev * dq;
-    p[i] = x->p[i] - dp - (1 - theta) * x->pcorr[i];
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
   }
 }
