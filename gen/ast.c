@@ -7,7 +7,9 @@
  * as constants while their body is lowered, so arrays, sums and
  * comprehensions are fully expanded. M, q0 and p0 depend on the final
  * number of coordinates and are lowered after the last statement (still
- * seeing only the names defined before them).
+ * seeing only the names defined before them). So are the events, whose
+ * expressions may also use the momenta p[1] .. p[m] (DAG inputs m .. 2m-1,
+ * which only they use).
  *
  * Every lowering function returns a node id, or -1 after reporting an
  * error; analysis goes on with the next statement so several errors can be
@@ -25,6 +27,7 @@
 #define MAX_WORK 20000000L   /* terms expanded by sum/for over the whole model */
 #endif
 #define MAX_INDEX 1000000000L
+#define MAX_EVENTS 1000
 
 typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_VALUES, SYM_PARAM, SYM_INDEX } SymKind;
 
@@ -58,6 +61,8 @@ typedef struct {
   Param *params;
   int nparams, pcap;
   const Stmt *prog;  /* all statements, to find a name defined too late */
+  IntVec events;     /* the event statements, by number */
+  int momenta;       /* lowering an event: p[i] is momentum i */
 } Ctx;
 
 // Give n the depth one more than its deepest child. The first node deeper
@@ -227,9 +232,17 @@ static Sym *resolve(Ctx *cx, const char *name, Loc loc) {
   return NULL;
 }
 
+// Whether name is the momenta of an event expression: p, unless the model
+// gives p a meaning of its own.
+static int is_momenta(Ctx *cx, const char *name) { return cx->momenta && !strcmp(name, "p") && !lookup(cx, name); }
+
 // Resolve a plain name in an expression.
 static int lower_name(Ctx *cx, const Ast *e) {
   if (!strcmp(e->name, "pi")) return dag_const(cx->d, 3.14159265358979323846);
+  if (is_momenta(cx, e->name)) {
+    error_at(e->loc, "'p' is the array of the %d momenta in an event: index it, as in p[1]", cx->mod->m);
+    return -1;
+  }
   Sym *s = resolve(cx, e->name, e->loc);
   if (!s) return -1;
   s->used = 1;
@@ -252,6 +265,15 @@ static int lower_name(Ctx *cx, const Ast *e) {
 // Lower name[i], of coordinates or of values: i must fold to an integer
 // within the array's bounds.
 static int lower_index(Ctx *cx, const Ast *e) {
+  if (is_momenta(cx, e->name)) {
+    long i;
+    if (lower_int(cx, e->a, "an index", &i) < 0) return -1;
+    if (i < 1 || i > cx->mod->m) {
+      error_at(e->a->loc, "index %ld out of range: the momenta 'p' have indices 1..%d", i, cx->mod->m);
+      return -1;
+    }
+    return dag_input(cx->d, cx->mod->m + (int)i - 1);
+  }
   Sym *s = resolve(cx, e->name, e->loc);
   if (!s) return -1;
   if (s->kind != SYM_ARRAY && s->kind != SYM_VALUES) {
@@ -688,6 +710,48 @@ static double *initial_values(Ctx *cx, Stmt *st, int stmt, const char *what, Loc
   return v;
 }
 
+// The events, after the last statement (the number of momenta is known):
+// each a scalar expression of q, p and params with a name of its own that C
+// can use, and that depends on q or p.
+static void lower_events(Ctx *cx) {
+  Model *mod = cx->mod;
+  int n = cx->events.n;
+  mod->event_names = arena_alloc((size_t)(n + 1) * sizeof *mod->event_names);
+  mod->event_nodes = arena_alloc((size_t)(n + 1) * sizeof(int));
+  mod->event_dirs = arena_alloc((size_t)(n + 1) * sizeof(int));
+  const Stmt **seen = arena_alloc((size_t)(n + 1) * sizeof *seen);
+  cx->momenta = 1;
+  for (int k = 0; k < n; k++) {
+    const Stmt *st = cx->prog;
+    for (int i = 0; i < cx->events.v[k]; i++) st = st->next;
+    seen[k] = st;
+    cx->stmt = cx->events.v[k];
+    const char *problem = c_name_problem(st->name);
+    int dup = -1;
+    for (int j = 0; j < k && dup < 0; j++)
+      if (!strcmp(seen[j]->name, st->name)) dup = j;
+    if (problem) error_at(st->name_loc, "'%s' cannot name an event: it is %s, which the generated C cannot use",
+                          st->name, problem);
+    else if (dup >= 0)
+      error_at(st->name_loc, "event '%s' is defined twice (first at line %d, column %d)", st->name,
+               seen[dup]->name_loc.line, seen[dup]->name_loc.col);
+    int node = lower(cx, st->expr);
+    if (node < 0 || problem || dup >= 0) continue;
+    if (!(cx->d->nodes[node].flags & DEP_INPUT)) {
+      error_at(st->expr->loc, "event '%s' does not depend on q or p: its sign never changes", st->name);
+      continue;
+    }
+    if (mod->nevents >= MAX_EVENTS) {
+      error_at(st->loc, "too many events: at most %d are supported", MAX_EVENTS);
+      break;
+    }
+    mod->event_names[mod->nevents] = st->name;
+    mod->event_nodes[mod->nevents] = node;
+    mod->event_dirs[mod->nevents++] = st->dir;
+  }
+  cx->momenta = 0;
+}
+
 static int by_location(const void *a, const void *b) {
   const Sym *x = *(const Sym *const *)a, *y = *(const Sym *const *)b;
   return x->loc.line != y->loc.line ? (x->loc.line > y->loc.line) - (x->loc.line < y->loc.line)
@@ -738,6 +802,7 @@ Model *analyse(const char *file, Stmt *prog) {
     case S_MASS: once(&cx->mass, &cx->mass_stmt, st, stmt, "M"); break;
     case S_Q0: once(&cx->q0, &cx->q0_stmt, st, stmt, "q0"); break;
     case S_P0: once(&cx->p0, &cx->p0_stmt, st, stmt, "p0"); break;
+    case S_EVENT: intvec_push(&cx->events, stmt); break;
     }
   }
   if (mod->m == 0 && !diag_error_count()) error_at((Loc){1, 1}, "the model declares no coordinates: add 'variables x, ...'");
@@ -745,6 +810,7 @@ Model *analyse(const char *file, Stmt *prog) {
     lower_mass(cx);
     mod->q0 = initial_values(cx, cx->q0, cx->q0_stmt, "q0", &mod->q0_loc, &mod->q0n);
     mod->p0 = initial_values(cx, cx->p0, cx->p0_stmt, "p0", &mod->p0_loc, &mod->p0n);
+    lower_events(cx);
   }
   mod->nu = cx->g.n;
   mod->g = cx->g.v;

@@ -25,8 +25,9 @@ void emit_batch_header(Emitter *e, int lanes) {
   tmpl(e, "  unsigned char idle[$P_W];  /* nonzero: the lane is not stepped (cleared by $P_batch_set) */\n"
           "  /* private, per lane as in $P_state */\n"
           "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n"
-          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W];\n");
-  if (poly) tmpl(e, "  $P_real H0[$P_W];\n");
+          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W];\n"
+          "  $P_real pinc[$P_S * $P_M * $P_W];\n");
+  if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
   tmpl(e, "} $P_batch;\n\n"
           "typedef struct {\n"
           "  int code[$P_W];            /* the lane's return code, as $P_step's ($P_OK for idle lanes) */\n"
@@ -50,7 +51,7 @@ void emit_batch_header(Emitter *e, int lanes) {
 static void emit_set_get(Emitter *e) {
   static const char *const scalar[] = {"t", "tc", "hprev", "hprev2", "H0"}, *const array[][2] = {
       {"q", "$P_M"},   {"p", "$P_M"},   {"qc", "$P_M"}, {"pc", "$P_M"}, {"gam", "$P_S * $P_M"}, {"gam2", "$P_S * $P_M"},
-      {"lambda", "$P_NU"}};
+      {"lambda", "$P_NU"}, {"pinc", "$P_S * $P_M"}, {"pcorr", "$P_M"}};
   int poly = e->st->kern[K_FACTOR].nout > 0;
   char line[160];
   for (int get = 0; get < 2; get++) {
@@ -58,7 +59,7 @@ static void emit_set_get(Emitter *e) {
                 : "void $P_batch_set($P_batch *x, int l, const $P_state *s)\n{\n  int i;\n");
     for (int f = 0; f < (poly ? 5 : 4); f++)
       out(e, get ? "  s->%s = x->%s[l];\n" : "  x->%s[l] = s->%s;\n", scalar[f], scalar[f]);
-    for (int f = 0; f < 7; f++) {
+    for (int f = 0; f < (poly ? 9 : 8); f++) {
       const char *n = array[f][0];
       if (get) snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) s->%s[i] = x->%s[i * $P_W + l];\n", array[f][1], n, n);
       else snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) x->%s[i * $P_W + l] = s->%s[i];\n", array[f][1], n, n);
@@ -142,7 +143,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "  if (scale > 0) inc[l] /= scale;\n");
   if (poly)
     tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++) lam[i * $P_W + l] = sw[($[sweep.lam]i) * $P_W + l];\n"
-            "  for (i = 0; i < $<sweep>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
+            "  for (i = 0; i < $<sweep.theta>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
   else if (e->mod->nu)
     tmpl(e, "  for (i = 0; i < $P_NU; i++) {\n"
             "    $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
@@ -177,12 +178,15 @@ static void emit_commit(Emitter *e, int poly) {
             "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n    }\n"
             "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = fin[($[sweep.lambda]i) * $P_W + l];\n"
             "    for (i = 0; i < $P_S * $P_M; i++) {\n      x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n      x->gam[i * $P_W + l] = gam[i * $P_W + l];\n    }\n"
+            "    for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
+            "    for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
+            "      x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
             "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev2[l] = x->hprev[l];\n    x->hprev[l] = h;\n  }\n");
     return;
   }
   tmpl(e, "  {\n"
           "    $R q1[$P_M * $P_W], p1[$P_M * $P_W], qc1[$P_M * $P_W], pc1[$P_M * $P_W];\n"
-          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam0[$P_NU * $P_W];\n"
+          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam0[$P_NU * $P_W], pco[$P_M * $P_W];\n"
           "    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n"
           "    for (i = 0; i < $P_M * $P_W; i++) {\n"
           "      q1[i] = x->q[i];\n      qc1[i] = x->qc[i];\n      p1[i] = x->p[i];\n      pc1[i] = x->pc[i];\n    }\n"
@@ -203,15 +207,20 @@ static void emit_commit(Emitter *e, int poly) {
           "      H0 = x->hprev[l] != 0 && fabs$f(Hn[l] - x->H0[l]) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0[l] : Hn[l];\n"
           "      if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
           "      for (i = 0; i < $P_M; i++) {\n"
-          "        $R d = pr[($[project_p1.dp]i) * $P_W + l];\n"
+          "        $R d = pr[($[project_p1.dp]i) * $P_W + l], ph = p1[i * $P_W + l];\n"
           "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], d + (beta - 1) * (p1[i * $P_W + l] + d));\n"
+          "        pco[i * $P_W + l] = p1[i * $P_W + l] - ph;\n"
           "        if (!isfinite(q1[i * $P_W + l]) || !isfinite(p1[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n"
           "      }\n"
           "      if (rc[l] != $P_OK) continue;\n"
           "      for (i = 0; i < $P_M; i++) {\n"
           "        x->q[i * $P_W + l] = q1[i * $P_W + l];\n        x->p[i * $P_W + l] = p1[i * $P_W + l];\n"
-          "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n      }\n"
+          "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n"
+          "        x->pcorr[i * $P_W + l] = pco[i * $P_W + l];\n      }\n"
           "      for (i = 0; i < $P_S * $P_M; i++) {\n        x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n        x->gam[i * $P_W + l] = gam[i * $P_W + l];\n      }\n"
+          "      for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
+          "      for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
+          "        x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
           "      x->H0[l] = H0;\n    }\n"
           "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
           "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"

@@ -36,6 +36,29 @@ static void emit_adapters(FILE *f, const char *P) {
              "  st->h = s.h;\n  st->rejected = s.rejected;\n  return rc;\n}\n\n");
 }
 
+// The adapters of dense output and events (events only when the model has
+// some): dense gives a state block y, x at theta inside its last step, for
+// the runtime's functions of a state (double solver: its own state; float:
+// the view, its double fields synchronised).
+static void emit_dense_adapters(FILE *f, const Model *mod, const char *P, int single) {
+  fprintf(f, "static void dense(const void *x, double theta, void *y)\n{\n");
+  if (single)
+    fprintf(f, "  const %s_state *a = &((const view *)x)->s;\n  %s_state *b = &((view *)y)->s;\n"
+               "  *b = *a;\n  %s_dense(a, (%s_real)theta, b->q, b->p);\n  b->t = a->t - a->hprev * (1 - (%s_real)theta);\n"
+               "  sync(y);\n}\n\n", P, P, P, P, P);
+  else
+    fprintf(f, "  const %s_state *a = x;\n  %s_state *b = y;\n  *b = *a;\n  %s_dense(a, theta, b->q, b->p);\n"
+               "  b->t = a->t - a->hprev * (1 - theta);\n}\n\n", P, P, P);
+  if (!mod->nevents) return;
+  fprintf(f, "static void events(const void *x, const void *prm, double *values)\n{\n");
+  if (single)
+    fprintf(f, "  %s_params r;\n  %s_real v[%s_NEVENTS];\n  int i;\n  to_real(prm, &r);\n"
+               "  %s_events(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_NEVENTS; i++) values[i] = v[i];\n}\n\n",
+            P, P, P, P, P);
+  else
+    fprintf(f, "  %s_events(x, prm, values);\n}\n\n", P);
+}
+
 // The same for a float solver: the runtime works in double, so it is given
 // a view (the state's public fields in double beside the float state, and
 // the params in double), converted at every call.
@@ -123,6 +146,7 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "#include <float.h>\n#include <stddef.h>\n\n#include \"hbvmrt.h\"\n#include \"%s.h\"\n\n", P);
   if (o->single) emit_float_adapters(f, mod, P);
   else emit_adapters(f, P);
+  emit_dense_adapters(f, mod, P, o->single);
   if (o->batch) emit_batch_adapters(f, P, o->single);
   /* what the runtime sees: the solver's state and params, or their double view */
   size_t n = strlen(P) + 16;
@@ -145,7 +169,11 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    offsetof(%s, t), offsetof(%s, q), offsetof(%s, p), offsetof(%s, lambda),\n", st, st, st, st);
   fprintf(f, "    %d, params, q0, p0,\n", mod->nparams);
   fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
-  fprintf(f, "    init_params, project, %s,\n    step_adaptive,\n  };\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
+  fprintf(f, "    init_params, project, %s,\n    step_adaptive,\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
+  if (mod->nevents)
+    fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n  };\n", P, P, P);
+  else
+    fprintf(f, "    dense, 0, NULL, NULL, NULL,\n  };\n");
   if (o->batch) {
     fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
                "batch_step, batch_observe,\n  };\n", P, P);

@@ -29,7 +29,8 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "#define %s_M %d      /* coordinates */\n#define %s_NU %d     /* constraints */\n", e->P, m, e->P, nu);
   out(e, "#define %s_K %d      /* Gauss-Legendre nodes */\n#define %s_S %d      /* polynomial degree */\n", e->P, e->me->k,
       e->P, s);
-  out(e, "#define %s_NPARAMS %d\n\n", e->P, mod->nparams);
+  out(e, "#define %s_NPARAMS %d\n", e->P, mod->nparams);
+  out(e, "#define %s_NEVENTS %d  /* event functions (docs/language.md) */\n\n", e->P, mod->nevents);
   tmpl(e, "/* Return codes of $P_step; on any nonzero code the state is unchanged. */\n"
           "#define $P_OK 0\n"
           "#define $P_ENOCONV 1     /* the fixed-point iteration did not converge: reduce h */\n"
@@ -42,7 +43,11 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
   out(e, "  %s_real gam2[%d], hprev2;\n", e->P, s * m);
-  if (poly) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+  out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
+  if (poly) {
+    out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+    out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
+  }
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
     char v[40];
@@ -78,10 +83,21 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           " * proposed, st->h the step taken. Fails (x unchanged) only below a step of\n"
           " * $P_HMIN (1 + |t|). */\n"
           "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st);\n"
+          "/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from\n"
+          " * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal\n"
+          " * to the state at theta = 1 and to the state before the step at theta = 0. Before\n"
+          " * any step (or after $P_project) it gives the state. */\n"
+          "void $P_dense(const $P_state *x, $P_real theta, $P_real *q, $P_real *p);\n"
           "const char *$P_strerror(int code);\n"
           "$P_real $P_energy(const $P_state *x, const $P_params *prm);\n"
           "void $P_constraints(const $P_state *x, const $P_params *prm, $P_real *g);   /* $P_NU values */\n"
           "void $P_hidden(const $P_state *x, const $P_params *prm, $P_real *gp);       /* grad g' M^-1 p */\n\n");
+  if (mod->nevents)
+    tmpl(e, "/* The model's events, in the order written: their names, which sign changes count\n"
+            " * (0: any; 1: rising, - to +; -1: falling, + to -), and their values at the state. */\n"
+            "extern const char *const $P_event_names[$P_NEVENTS];\n"
+            "extern const int $P_event_dirs[$P_NEVENTS];\n"
+            "void $P_events(const $P_state *x, const $P_params *prm, $P_real *values);\n\n");
   if (o->batch) emit_batch_header(e, o->batch);
   tmpl(e, "#ifdef __cplusplus\n}\n#endif\n\n#endif\n");
 }
@@ -191,8 +207,9 @@ static void emit_init(Emitter *e) {
             "    x->p[i] = p0 ? p0[i] : $P_p0[i];\n");
   tmpl(e, "    x->qc[i] = x->pc[i] = 0;\n  }\n"
           "  for (i = 0; i < ($P_NU ? $P_NU : 1); i++) x->lambda[i] = 0;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->gam2[i] = 0;\n");
-  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;\n");
+  if (e->st->kern[K_FACTOR].nout)
+    tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"
           "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0)\n{\n"
@@ -231,6 +248,19 @@ static void emit_public(Emitter *e) {
             "  (void)x; (void)prm; (void)gp;\n}\n");
 }
 
+// The events of the model (none: nothing is emitted): their names and
+// directions as tables, their values through the kernel "events_kernel".
+static void emit_events(Emitter *e) {
+  const Model *mod = e->mod;
+  if (!mod->nevents) return;
+  tmpl(e, "\nconst char *const $P_event_names[$P_NEVENTS] = {");
+  for (int i = 0; i < mod->nevents; i++) out(e, "%s\"%s\"", i ? ", " : "", mod->event_names[i]);
+  tmpl(e, "};\nconst int $P_event_dirs[$P_NEVENTS] = {");
+  for (int i = 0; i < mod->nevents; i++) out(e, "%s%d", i ? ", " : "", mod->event_dirs[i]);
+  tmpl(e, "};\n\nvoid $P_events(const $P_state *x, const $P_params *prm, $P_real *values)\n{\n"
+          "  $P_DEFAULT_PARAMS(prm)\n  $(events_kernel q0=x->q p0=x->p out=values);\n}\n");
+}
+
 // Factor the polynomial family's multiplier matrix at the current gamma
 // into fa[], returning from the step when a pivot is not finite or is
 // negligible (the system is singular). indent: the code's indentation.
@@ -261,6 +291,15 @@ static void emit_commit_gamma(Emitter *e) {
     tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) {\n    x->gam2[i] = x->gam[i];\n    x->gam[i] = gam[i];\n  }\n");
 }
 
+// The commit of p's polynomial over the step (pinc: p1 - p0, then the
+// Theta_j) for NAME_dense, in loops of their own: in one loop with gamma's,
+// GCC 12's SLP vectoriser (-O2) folded the float --wide-step commit's pc to 0
+// (caught by check_lean's float_wide_step_holds_H).
+static void emit_commit_pinc(Emitter *e) {
+  tmpl(e, "  for (i = 0; i < $P_M; i++) x->pinc[i] = ($R)sw[$[sweep.dp]i];\n"
+          "  for (i = 0; i < ($P_S - 1) * $P_M; i++) x->pinc[$P_M + i] = ($R)sw[$[sweep.theta]i];\n");
+}
+
 // The end of a step of the polynomial family: q1 and p1 as the state will
 // hold them (compensated sums, or the wide sums with --wide-step), p1
 // projected onto the hidden constraint at q1 and rescaled to the energy H0
@@ -277,6 +316,8 @@ static void emit_end_poly(Emitter *e) {
             "    q1[i] = x->q[i];\n    qc1[i] = x->qc[i];\n    p1[i] = x->p[i];\n    pc1[i] = x->pc[i];\n"
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
+  tmpl(e, "  $W phat[$P_M];  /* p1 before the projection, the end of p's polynomial */\n"
+          "  for (i = 0; i < $P_M; i++) phat[i] = p1[i];\n");
   tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
           "  $(project_p1 q0=q1 p0=p1 out=pr);\n"
           "  for (i = 0; i < $P_NU; i++) {\n"
@@ -303,8 +344,9 @@ static void emit_end_poly(Emitter *e) {
             "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
-  tmpl(e, "  }\n");
+  tmpl(e, "    x->pcorr[i] = ($R)(p1[i] - phat[i]);\n  }\n");
   emit_commit_gamma(e);
+  emit_commit_pinc(e);
   tmpl(e, "  x->H0 = H0;\n");
   emit_set_lambda(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
@@ -421,7 +463,7 @@ static void emit_sweep_checks(Emitter *e) {
   tmpl(e, "    if (scale > 0) inc /= scale;\n");
   if (poly)
     tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
-            "    for (i = 0; i < $<sweep>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+            "    for (i = 0; i < $<sweep.theta>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
   else if (e->mod->nu) /* before the finiteness test: a zero pivot makes lambda 0/0 */
     tmpl(e, "    for (i = 0; i < $P_NU; i++) {\n"
             "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
@@ -439,7 +481,7 @@ static void emit_fused_checks(Emitter *e) {
   emit_fused_sweep(e);
   if (poly) {
     for (int i = 0; i < e->me->s * nu; i++) out(e, "    lm%d = sw%d;\n", i, sweep_at(e, "lam") + i);
-    emit_all_finite(e, kernel_size(&e->st->kern[K_SWEEP]));
+    emit_all_finite(e, sweep_at(e, "theta"));
     return;
   }
   if (nu) {
@@ -497,6 +539,7 @@ static void emit_end_const(Emitter *e) {
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = ($R)sw[$[sweep.lambda]i];\n");
   }
   emit_commit_gamma(e);
+  emit_commit_pinc(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
@@ -688,7 +731,9 @@ static void emit_step(Emitter *e) {
           "  if (rc != $P_OK) return rc;\n"
           "  /* $P_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */\n"
           "  if (tol > 0 && !(est <= tol * (1 + scale))) return $P_EREJECT;\n"
-          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n");
+          "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n"
+          "  for (i = 0; i < ($P_S - 1) * $P_M; i++) /* the rest of p's polynomial, for $P_dense */\n"
+          "    if (!isfinite(sw[$[sweep.theta]i])) return $P_ENONFINITE;\n");
   if (poly) {
     emit_end_poly(e);
     return;
@@ -770,9 +815,9 @@ static void emit_project(Emitter *e) {
           "    if (fabs$f(p[i] - x->p[i]) > dpmax) dpmax = fabs$f(p[i] - x->p[i]);\n  }\n"
           "  for (i = 0; i < $P_M; i++) {\n"
           "    x->q[i] = q[i];\n    x->p[i] = p[i];\n    x->qc[i] = x->pc[i] = 0;\n  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = 0;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->pinc[i] = 0;\n"
           "  x->hprev = 0;  /* the next step starts afresh, as after init */\n");
-  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;\n");
+  if (e->st->kern[K_FACTOR].nout) tmpl(e, "  x->H0 = 0;\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
   emit_set_lambda(e);
   tmpl(e, "  if (dq) *dq = dqmax;\n  if (dp) *dp = dpmax;\n  return $P_OK;\n}\n");
 }
@@ -825,6 +870,32 @@ static void emit_step_adaptive(Emitter *e) {
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
 }
 
+// NAME_dense: q and p inside the last step from its polynomials, written
+// from the end of the step backwards so that theta = 1 gives the state
+// exactly. q(c) = q0 + h sum_j gamma_j int_0^c P_j and p(c) = p0 + pinc_0 c -
+// h sum_{j>=1} Theta_j int_0^c P_j (pinc_0 = p1 - p0, then the Theta_j) are
+// the step's polynomials of degree S (uniformly of order S+1); with
+// int_0^c P_j = (L_{j+1} - L_{j-1}) (2c-1) / (2 sqrt(2j+1))
+// for j >= 1 (Legendre L_j), which vanishes at c = 0 and 1. The poly family's
+// projection and rescale of p1 (pcorr) is spread linearly over the step, so
+// theta = 0 gives the previous state: it is of the size of the local error.
+static void emit_dense(Emitter *e) {
+  tmpl(e, "\nvoid $P_dense(const $P_state *x, $P_real theta, $P_real *q, $P_real *p)\n{\n"
+          "  $R L[$P_S + 1], w[$P_S], u = 2 * theta - 1;\n  int i, j;\n"
+          "  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */\n"
+          "  L[0] = 1;\n  L[1] = u;\n"
+          "  for (j = 1; j < $P_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);\n"
+          "  w[0] = 1 - theta;\n"
+          "  for (j = 1; j < $P_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt$f(($R)(2 * j + 1)));\n"
+          "  for (i = 0; i < $P_M; i++) {\n    $R dq = w[0] * x->gam[i], dp = 0;\n"
+          "    for (j = 1; j < $P_S; j++) {\n"
+          "      dq += w[j] * x->gam[j * $P_M + i];\n      dp += w[j] * x->pinc[j * $P_M + i];\n    }\n"
+          "    q[i] = x->q[i] - x->hprev * dq;\n");
+  tmpl(e, e->st->kern[K_FACTOR].nout
+              ? "    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];\n  }\n}\n"
+              : "    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);\n  }\n}\n");
+}
+
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {.f = hf, .mod = mod, .me = me, .st = st, .P = o->name, .single = o->single,
@@ -836,9 +907,11 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_prelude(&e, o);
   emit_kernels(&e);
   emit_public(&e);
+  emit_events(&e);
   emit_step(&e);
   emit_step_adaptive(&e);
   emit_project(&e);
+  emit_dense(&e);
   if (o->batch) emit_batch_source(&e, o->batch);
   free(e.temp);
   return ferror(hf) || ferror(cf) ? -1 : 0;

@@ -98,7 +98,7 @@ struct Ast {
   int depth;         /* nesting depth, bounded by MAX_AST_DEPTH */
 };
 
-typedef enum { S_VARIABLES, S_DEF, S_PARAM, S_MASS, S_POTENTIAL, S_CONSTRAINTS, S_Q0, S_P0 } StmtKind;
+typedef enum { S_VARIABLES, S_DEF, S_PARAM, S_MASS, S_POTENTIAL, S_CONSTRAINTS, S_Q0, S_P0, S_EVENT } StmtKind;
 
 typedef struct Decl Decl;
 struct Decl {          /* one name of a variables statement */
@@ -112,9 +112,10 @@ typedef struct Stmt Stmt;
 struct Stmt {
   StmtKind kind;
   Loc loc;
-  const char *name;    /* S_DEF, S_PARAM */
+  const char *name;    /* S_DEF, S_PARAM, S_EVENT */
   Loc name_loc;
   Ast *expr;
+  int dir;             /* S_EVENT: the sign changes that count, 0 both, 1 rising, -1 falling */
   Decl *decls;         /* S_VARIABLES */
   Stmt *next;
 };
@@ -337,6 +338,11 @@ typedef struct {
                                * operations or more are a loop (--stage-loop) */
   long mass_loop;             /* a product M^-1 v of a dense constant M with this many
                                * multiplications or more is a loop over a table (--mass-loop) */
+  /* events (ast.c): nodes of q (inputs 0..m-1), p (inputs m..2m-1) and params;
+   * dirs 0 (any sign change), 1 (rising), -1 (falling) */
+  int nevents;
+  const char **event_names;
+  int *event_nodes, *event_dirs;
 } Model;
 
 /* The default of Model.mass_loop, from the measurements in docs/embedding.md. */
@@ -403,6 +409,7 @@ typedef enum {
   K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_LAMBDA0, K_PROJECT,
   K_CONSISTENT, /* NAME_project: a Newton step onto g = 0, p projected onto the hidden constraint */
   K_INITIAL,    /* the model's q0, p0 as functions of the params (when they use any) */
+  K_EVENTS,     /* the model's event functions at (q0, p0) (when it has events) */
   K_COUNT
 } KernelId;
 

@@ -123,12 +123,13 @@ static Ast *list_reverse(Ast *list) {
 %token <str> FUNC "function name"
 %token <str> VARIABLES "'variables'" PARAM "'param'" KW_M "'M'" KW_U "'U'" KW_G "'g'"
 %token <str> Q0 "'q0'" P0 "'p0'" IDENTITY "'identity'" DIAG "'diag'" SUM "'sum'"
-%token <str> FOR "'for'" IN "'in'"
+%token <str> FOR "'for'" IN "'in'" EVENT "'event'" RISING "'rising'" FALLING "'falling'"
 %token DOTDOT "'..'"
 
 %type <ast> expr primary args arglist
 %type <decl> decls decl
 %type <str> name reserved stmt_reserved
+%type <num> direction
 
 %left '+' '-'
 %left '*' '/'
@@ -153,7 +154,17 @@ stmt
   | KW_G '=' expr               { add_stmt(ps, S_CONSTRAINTS, @1, $3); }
   | Q0 '=' expr                 { add_stmt(ps, S_Q0, @1, $3); }
   | P0 '=' expr                 { add_stmt(ps, S_P0, @1, $3); }
+  | EVENT name '=' expr direction
+                                { add_stmt(ps, S_EVENT, @1, $4); ps->last->name = $2; ps->last->name_loc = loc_of(@2);
+                                  ps->last->dir = (int)$5; }
   | stmt_reserved '=' expr      { reserved_name(@1, $1); }
+  ;
+
+/* Which sign changes of an event count: both (0), rising (1), falling (-1). */
+direction
+  : %empty                      { $$ = 0; }
+  | RISING                      { $$ = 1; }
+  | FALLING                     { $$ = -1; }
   ;
 
 /* Where a name is wanted, a reserved word is an error, not a syntax error. */
@@ -163,7 +174,7 @@ name
   ;
 
 reserved
-  : stmt_reserved | VARIABLES | PARAM | KW_M | KW_U | KW_G | Q0 | P0
+  : stmt_reserved | VARIABLES | PARAM | KW_M | KW_U | KW_G | Q0 | P0 | EVENT | RISING | FALLING
   ;
 
 /* The reserved words that cannot start a statement. */
@@ -236,7 +247,8 @@ static int is_reserved(yysymbol_kind_t k) {
   switch (k) {
   case YYSYMBOL_FUNC: case YYSYMBOL_VARIABLES: case YYSYMBOL_PARAM: case YYSYMBOL_KW_M: case YYSYMBOL_KW_U:
   case YYSYMBOL_KW_G: case YYSYMBOL_Q0: case YYSYMBOL_P0: case YYSYMBOL_IDENTITY: case YYSYMBOL_DIAG:
-  case YYSYMBOL_SUM: case YYSYMBOL_FOR: case YYSYMBOL_IN: return 1;
+  case YYSYMBOL_SUM: case YYSYMBOL_FOR: case YYSYMBOL_IN: case YYSYMBOL_EVENT: case YYSYMBOL_RISING:
+  case YYSYMBOL_FALLING: return 1;
   default: return 0;
   }
 }

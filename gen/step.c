@@ -259,12 +259,25 @@ void step_gamma(Build *b, int **theta, int *gam, int *dp) {
   for (int i = 0; i < m; i++) dp[i] = dag_neg(d, dag_mul(d, b->h, theta[0][i]));
 }
 
-// step_gamma, as the sweep's results "gam" and "dp".
+// step_gamma, as the sweep's results "gam" and "dp"; theta is kept for
+// step_theta_result.
 void step_gamma_update(Build *b, int **theta) {
   int *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->m);
   step_gamma(b, theta, gam, dp);
   step_result(b->st, K_SWEEP, "gam", SZ_SM, 1, b->s * b->m, gam);
   step_result(b->st, K_SWEEP, "dp", SZ_M, 1, b->m, dp);
+  b->theta = theta;
+}
+
+// The sweep's last result "theta": Theta_1 .. Theta_{s-1} ((s-1) m nodes the
+// sweep has computed anyway, so only stores), with dp the Legendre
+// coefficients of p's polynomial on the step (p0 + dp int_0^c P_0 -
+// h sum_{j>=1} Theta_j int_0^c P_j), which NAME_dense evaluates. Last, so
+// that the iteration's finiteness tests stop before it.
+void step_theta_result(Build *b) {
+  int n = (b->s - 1) * b->m, *v = step_nodes(n + 1);
+  for (int j = 1; j < b->s; j++) memcpy(v + (j - 1) * b->m, b->theta[j], (size_t)b->m * sizeof(int));
+  step_result(b->st, K_SWEEP, "theta", SZ_M, b->s - 1, n, v);
 }
 
 // The dense columns G[a] (m nodes each) of grad g at the point q.
@@ -441,6 +454,15 @@ static void build_diagnostics(Build *b) {
     for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, G[a][col->e[e].coord], v[col->e[e].coord]));
     hidden[a] = acc;
   }
+  if (mod->nevents) { /* the model's inputs m..2m-1 are the momenta of the events */
+    int *qp = step_nodes(2 * m), *ev = step_nodes(mod->nevents);
+    memcpy(qp, q, (size_t)m * sizeof(int));
+    memcpy(qp + m, p, (size_t)m * sizeof(int));
+    b->owners = 1u << K_EVENTS;
+    step_section(b, "events");
+    dag_subst(d, mod->event_nodes, mod->nevents, qp, 2 * m, ev);
+    step_result(b->st, K_EVENTS, "values", SZ_ONE, mod->nevents, mod->nevents, ev);
+  }
   step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);
   step_result(b->st, K_ENERGY, "H", SZ_ONE, 1, 1, &H);
   build_initial_values(b);
@@ -522,6 +544,7 @@ static const struct {
                       " * pivots (NU) and diagonal (NU) of G' M^-1 G; G = grad g(q0)",
                       0},
     [K_INITIAL] = {"initial", "out = the model's q0 (M) and p0 (M) at the parameters prm", 0},
+    [K_EVENTS] = {"events_kernel", "out = the model's event functions at (q0, p0), in the order written", 0},
 };
 
 Step *step_build(Model *mod, const Method *me) {
@@ -545,7 +568,7 @@ Step *step_build(Model *mod, const Method *me) {
     st->kern[k].wide = kernel_spec[k].wide;
   }
   layout_inputs(st, m, nu, s, 0, 0);
-  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL};
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL, NULL};
   b.h = step_in(&b, IN_H, 0);
   int poly = me->family == MULT_POLY && nu;
   if (poly) layout_inputs(st, m, nu, s, s * nu, 0); /* the factor's length is known once it is built */

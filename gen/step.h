@@ -22,6 +22,7 @@ typedef struct {
   int ***rho;     /* s x nu x (entries of jac[a]): the same with grad g_a */
   int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
   int **vpsi;     /* s x m: M^-1 psi_j */
+  int **theta;    /* s x m: the force's coefficients Theta_j of the sweep's result */
 } Build;
 
 int *step_nodes(int n);
@@ -31,6 +32,7 @@ int step_apply_x(Build *b, int j, int i, int **v);     /* sum_r X[j][r] v[r][i] 
 void step_stage_point(Build *b, int l, int *Q);       /* Q_l, m nodes */
 void step_gamma(Build *b, int **theta, int *gam, int *dp); /* gamma_j and p1 - p0 from Theta_i */
 void step_gamma_update(Build *b, int **theta);        /* the same, as the sweep's results */
+void step_theta_result(Build *b);                      /* the sweep's last result: Theta_1.. for NAME_dense */
 int **step_jacobian_at(Build *b, const int *q);       /* dense columns of grad g at q */
 void step_gram(Build *b, int **G, int *B);            /* B = G' M^-1 G */
 void step_project_momenta(Build *b, int **G, const int *B, const int *p, int *dp, int *pivot, int *adiag);

@@ -87,6 +87,7 @@ void build_const_multiplier(Build *b) {
   step_result(b->st, K_SWEEP, "lambda", SZ_NU, 1, nu, lambda);
   step_result(b->st, K_SWEEP, "pivot", SZ_NU, 1, nu, pivot);
   step_result(b->st, K_SWEEP, "adiag", SZ_NU, 1, nu, adiag);
+  step_theta_result(b);
   b->st->kern[K_SWEEP].what = "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
-                              " * pivots of the LU of A (NU), diagonal of A (NU).";
+                              " * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)).";
 }

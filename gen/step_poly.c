@@ -259,7 +259,8 @@ void build_poly_multiplier(Build *b) {
   step_section(b, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)]");
   step_gamma_update(b, force_coefficients(b, G, lam1));
   step_result(st, K_SWEEP, "lam", SZ_SNU, 1, n, lam1);
+  step_theta_result(b);
   st->kern[K_SWEEP].what = "One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),\n"
-                           " * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU).";
+                           " * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)).";
   build_projection(b);
 }

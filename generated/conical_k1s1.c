@@ -207,7 +207,7 @@ void conical_k1s1_init_params(conical_k1s1_state *x, const conical_k1s1_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k1s1_NU ? conical_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[conical_k1s1_NU];
     conical_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -493,6 +493,8 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
   /* conical_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k1s1_ENONFINITE;
+  for (i = 0; i < (conical_k1s1_S - 1) * conical_k1s1_M; i++) /* the rest of p's polynomial, for conical_k1s1_dense */
+    if (!isfinite(sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 3 * conical_k1s1_NU + i])) return conical_k1s1_ENONFINITE;
   for (i = 0; i < conical_k1s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k1s1_S * conical_k1s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -506,6 +508,8 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < conical_k1s1_M; i++) x->pinc[i] = (double)sw[conical_k1s1_S * conical_k1s1_M + i];
+  for (i = 0; i < (conical_k1s1_S - 1) * conical_k1s1_M; i++) x->pinc[conical_k1s1_M + i] = (double)sw[conical_k1s1_S * conical_k1s1_M + conical_k1s1_M + 3 * conical_k1s1_NU + i];
   conical_k1s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -631,7 +635,7 @@ int conical_k1s1_project(conical_k1s1_state *x, const conical_k1s1_params *prm, 
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[conical_k1s1_NU];
@@ -641,4 +645,25 @@ int conical_k1s1_project(conical_k1s1_state *x, const conical_k1s1_params *prm, 
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_k1s1_OK;
+}
+
+void conical_k1s1_dense(const conical_k1s1_state *x, conical_k1s1_real theta, conical_k1s1_real *q, conical_k1s1_real *p)
+{
+  double L[conical_k1s1_S + 1], w[conical_k1s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_k1s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_k1s1_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_k1s1_S; j++) {
+      dq += w[j] * x->gam[j * conical_k1s1_M + i];
+      dp += w[j] * x->pinc[j * conical_k1s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define conical_k1s1_K 1      /* Gauss-Legendre nodes */
 #define conical_k1s1_S 1      /* polynomial degree */
 #define conical_k1s1_NPARAMS 0
+#define conical_k1s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_k1s1_step; on any nonzero code the state is unchanged. */
 #define conical_k1s1_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k1s1_real tc, qc[3], pc[3], gam[3], hprev;
   conical_k1s1_real gam2[3], hprev2;
+  conical_k1s1_real pinc[3];  /* p's polynomial over the last step, for conical_k1s1_dense */
 } conical_k1s1_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * conical_k1s1_HMIN (1 + |t|). */
 int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, conical_k1s1_real tol, const conical_k1s1_params *prm, conical_k1s1_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after conical_k1s1_project) it gives the state. */
+void conical_k1s1_dense(const conical_k1s1_state *x, conical_k1s1_real theta, conical_k1s1_real *q, conical_k1s1_real *p);
 const char *conical_k1s1_strerror(int code);
 conical_k1s1_real conical_k1s1_energy(const conical_k1s1_state *x, const conical_k1s1_params *prm);
 void conical_k1s1_constraints(const conical_k1s1_state *x, const conical_k1s1_params *prm, conical_k1s1_real *g);   /* conical_k1s1_NU values */

@@ -208,7 +208,7 @@ void conical_k2s2_init_params(conical_k2s2_state *x, const conical_k2s2_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k2s2_NU ? conical_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[conical_k2s2_NU];
     conical_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -331,7 +331,7 @@ static double conical_k2s2_err_est(const double *gam, double h, double d1, int c
 static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_, double tol, int cold, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + 1];
+  double gam[conical_k2s2_S * conical_k2s2_M], sw[conical_k2s2_S * conical_k2s2_M + 2 * conical_k2s2_M + 3 * conical_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k2s2_ENOCONV;
   conical_k2s2_DEFAULT_PARAMS(prm)
@@ -346,7 +346,7 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
   for (it = 1; it <= conical_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
@@ -455,6 +455,10 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
       sw10 = t36;
       /* adiag */
       sw11 = t36;
+      /* theta */
+      sw12 = t53;
+      sw13 = t54;
+      sw14 = t55;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -551,6 +555,9 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
   sw[9] = sw9;
   sw[10] = sw10;
   sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
   est = conical_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > conical_k2s2_MAXITER ? conical_k2s2_MAXITER : it;
@@ -563,6 +570,8 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
   /* conical_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k2s2_ENONFINITE;
+  for (i = 0; i < (conical_k2s2_S - 1) * conical_k2s2_M; i++) /* the rest of p's polynomial, for conical_k2s2_dense */
+    if (!isfinite(sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + i])) return conical_k2s2_ENONFINITE;
   for (i = 0; i < conical_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k2s2_S * conical_k2s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -576,6 +585,8 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < conical_k2s2_M; i++) x->pinc[i] = (double)sw[conical_k2s2_S * conical_k2s2_M + i];
+  for (i = 0; i < (conical_k2s2_S - 1) * conical_k2s2_M; i++) x->pinc[conical_k2s2_M + i] = (double)sw[conical_k2s2_S * conical_k2s2_M + conical_k2s2_M + 3 * conical_k2s2_NU + i];
   conical_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -701,7 +712,7 @@ int conical_k2s2_project(conical_k2s2_state *x, const conical_k2s2_params *prm, 
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k2s2_S * conical_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[conical_k2s2_NU];
@@ -711,4 +722,25 @@ int conical_k2s2_project(conical_k2s2_state *x, const conical_k2s2_params *prm, 
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_k2s2_OK;
+}
+
+void conical_k2s2_dense(const conical_k2s2_state *x, conical_k2s2_real theta, conical_k2s2_real *q, conical_k2s2_real *p)
+{
+  double L[conical_k2s2_S + 1], w[conical_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_k2s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * conical_k2s2_M + i];
+      dp += w[j] * x->pinc[j * conical_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

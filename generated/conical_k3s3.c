@@ -209,7 +209,7 @@ void conical_k3s3_init_params(conical_k3s3_state *x, const conical_k3s3_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_k3s3_NU ? conical_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[conical_k3s3_NU];
     conical_k3s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -318,7 +318,7 @@ static double conical_k3s3_err_est(const double *gam, double h, double d1, int c
 static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_, double tol, int cold, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_k3s3_S * conical_k3s3_M], sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + 1];
+  double gam[conical_k3s3_S * conical_k3s3_M], sw[conical_k3s3_S * conical_k3s3_M + 3 * conical_k3s3_M + 3 * conical_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_k3s3_ENOCONV;
   conical_k3s3_DEFAULT_PARAMS(prm)
@@ -333,7 +333,8 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7], gm8 = gam[8];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
+    sw16 = 0, sw17 = 0, sw18 = 0, sw19 = 0, sw20 = 0;
   for (it = 1; it <= conical_k3s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
@@ -478,6 +479,13 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       sw13 = t51;
       /* adiag */
       sw14 = t51;
+      /* theta */
+      sw15 = t68;
+      sw16 = t69;
+      sw17 = t70;
+      sw18 = t71;
+      sw19 = t72;
+      sw20 = t73;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -593,6 +601,12 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
   sw[12] = sw12;
   sw[13] = sw13;
   sw[14] = sw14;
+  sw[15] = sw15;
+  sw[16] = sw16;
+  sw[17] = sw17;
+  sw[18] = sw18;
+  sw[19] = sw19;
+  sw[20] = sw20;
   est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > conical_k3s3_MAXITER ? conical_k3s3_MAXITER : it;
@@ -605,6 +619,8 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
   /* conical_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_k3s3_ENONFINITE;
+  for (i = 0; i < (conical_k3s3_S - 1) * conical_k3s3_M; i++) /* the rest of p's polynomial, for conical_k3s3_dense */
+    if (!isfinite(sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + i])) return conical_k3s3_ENONFINITE;
   for (i = 0; i < conical_k3s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[conical_k3s3_S * conical_k3s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -618,6 +634,8 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < conical_k3s3_M; i++) x->pinc[i] = (double)sw[conical_k3s3_S * conical_k3s3_M + i];
+  for (i = 0; i < (conical_k3s3_S - 1) * conical_k3s3_M; i++) x->pinc[conical_k3s3_M + i] = (double)sw[conical_k3s3_S * conical_k3s3_M + conical_k3s3_M + 3 * conical_k3s3_NU + i];
   conical_k3s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -743,7 +761,7 @@ int conical_k3s3_project(conical_k3s3_state *x, const conical_k3s3_params *prm, 
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_k3s3_S * conical_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[conical_k3s3_NU];
@@ -753,4 +771,25 @@ int conical_k3s3_project(conical_k3s3_state *x, const conical_k3s3_params *prm, 
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_k3s3_OK;
+}
+
+void conical_k3s3_dense(const conical_k3s3_state *x, conical_k3s3_real theta, conical_k3s3_real *q, conical_k3s3_real *p)
+{
+  double L[conical_k3s3_S + 1], w[conical_k3s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_k3s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_k3s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_k3s3_S; j++) {
+      dq += w[j] * x->gam[j * conical_k3s3_M + i];
+      dp += w[j] * x->pinc[j * conical_k3s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define conical_k3s3_K 3      /* Gauss-Legendre nodes */
 #define conical_k3s3_S 3      /* polynomial degree */
 #define conical_k3s3_NPARAMS 0
+#define conical_k3s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_k3s3_step; on any nonzero code the state is unchanged. */
 #define conical_k3s3_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k3s3_real tc, qc[3], pc[3], gam[9], hprev;
   conical_k3s3_real gam2[9], hprev2;
+  conical_k3s3_real pinc[9];  /* p's polynomial over the last step, for conical_k3s3_dense */
 } conical_k3s3_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h, const conical_
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * conical_k3s3_HMIN (1 + |t|). */
 int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, conical_k3s3_real tol, const conical_k3s3_params *prm, conical_k3s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after conical_k3s3_project) it gives the state. */
+void conical_k3s3_dense(const conical_k3s3_state *x, conical_k3s3_real theta, conical_k3s3_real *q, conical_k3s3_real *p);
 const char *conical_k3s3_strerror(int code);
 conical_k3s3_real conical_k3s3_energy(const conical_k3s3_state *x, const conical_k3s3_params *prm);
 void conical_k3s3_constraints(const conical_k3s3_state *x, const conical_k3s3_params *prm, conical_k3s3_real *g);   /* conical_k3s3_NU values */

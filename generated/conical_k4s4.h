@@ -13,6 +13,7 @@ extern "C" {
 #define conical_k4s4_K 4      /* Gauss-Legendre nodes */
 #define conical_k4s4_S 4      /* polynomial degree */
 #define conical_k4s4_NPARAMS 0
+#define conical_k4s4_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_k4s4_step; on any nonzero code the state is unchanged. */
 #define conical_k4s4_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k4s4_real tc, qc[3], pc[3], gam[12], hprev;
   conical_k4s4_real gam2[12], hprev2;
+  conical_k4s4_real pinc[12];  /* p's polynomial over the last step, for conical_k4s4_dense */
 } conical_k4s4_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * conical_k4s4_HMIN (1 + |t|). */
 int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, conical_k4s4_real tol, const conical_k4s4_params *prm, conical_k4s4_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after conical_k4s4_project) it gives the state. */
+void conical_k4s4_dense(const conical_k4s4_state *x, conical_k4s4_real theta, conical_k4s4_real *q, conical_k4s4_real *p);
 const char *conical_k4s4_strerror(int code);
 conical_k4s4_real conical_k4s4_energy(const conical_k4s4_state *x, const conical_k4s4_params *prm);
 void conical_k4s4_constraints(const conical_k4s4_state *x, const conical_k4s4_params *prm, conical_k4s4_real *g);   /* conical_k4s4_NU values */

@@ -404,8 +404,9 @@ void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_pol
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (conical_poly_k2s2_NU ? conical_poly_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < conical_poly_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[conical_poly_k2s2_NU];
     conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -543,7 +544,7 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1, 
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, int cold, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
+  double gam[conical_poly_k2s2_S * conical_poly_k2s2_M], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + 2 * conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = conical_poly_k2s2_ENOCONV;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
@@ -570,7 +571,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0;
   double lm0 = 0, lm1 = 0;
   for (it = 1; it <= conical_poly_k2s2_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -788,6 +789,10 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
       /* lam */
       sw9 = t118;
       sw10 = t119;
+      /* theta */
+      sw11 = t144;
+      sw12 = t146;
+      sw13 = t148;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -883,6 +888,9 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   sw[8] = sw8;
   sw[9] = sw9;
   sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
   est = conical_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > conical_poly_k2s2_MAXITER ? conical_poly_k2s2_MAXITER : it;
@@ -895,6 +903,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   /* conical_poly_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return conical_poly_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_poly_k2s2_ENONFINITE;
+  for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) /* the rest of p's polynomial, for conical_poly_k2s2_dense */
+    if (!isfinite(sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i])) return conical_poly_k2s2_ENONFINITE;
   double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 2 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = conical_poly_k2s2_energy(x, prm);
   double qc1[conical_poly_k2s2_M], pc1[conical_poly_k2s2_M];
@@ -906,6 +916,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     conical_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
   }
+  double phat[conical_poly_k2s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < conical_poly_k2s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   conical_poly_k2s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < conical_poly_k2s2_NU; i++) {
@@ -931,11 +943,14 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < conical_poly_k2s2_M; i++) x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
+  for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) x->pinc[conical_poly_k2s2_M + i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i];
   x->H0 = H0;
   {
     double lam[conical_poly_k2s2_NU];
@@ -1067,9 +1082,10 @@ int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < conical_poly_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[conical_poly_k2s2_NU];
     conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1078,4 +1094,25 @@ int conical_poly_k2s2_project(conical_poly_k2s2_state *x, const conical_poly_k2s
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return conical_poly_k2s2_OK;
+}
+
+void conical_poly_k2s2_dense(const conical_poly_k2s2_state *x, conical_poly_k2s2_real theta, conical_poly_k2s2_real *q, conical_poly_k2s2_real *p)
+{
+  double L[conical_poly_k2s2_S + 1], w[conical_poly_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < conical_poly_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < conical_poly_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < conical_poly_k2s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < conical_poly_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * conical_poly_k2s2_M + i];
+      dp += w[j] * x->pinc[j * conical_poly_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

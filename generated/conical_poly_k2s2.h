@@ -13,6 +13,7 @@ extern "C" {
 #define conical_poly_k2s2_K 2      /* Gauss-Legendre nodes */
 #define conical_poly_k2s2_S 2      /* polynomial degree */
 #define conical_poly_k2s2_NPARAMS 0
+#define conical_poly_k2s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of conical_poly_k2s2_step; on any nonzero code the state is unchanged. */
 #define conical_poly_k2s2_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_poly_k2s2_real tc, qc[3], pc[3], gam[6], hprev;
   conical_poly_k2s2_real gam2[6], hprev2;
+  conical_poly_k2s2_real pinc[6];  /* p's polynomial over the last step, for conical_poly_k2s2_dense */
   conical_poly_k2s2_real H0;  /* the energy the step keeps */
+  conical_poly_k2s2_real pcorr[3];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } conical_poly_k2s2_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h,
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * conical_poly_k2s2_HMIN (1 + |t|). */
 int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s2_real *h, conical_poly_k2s2_real tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after conical_poly_k2s2_project) it gives the state. */
+void conical_poly_k2s2_dense(const conical_poly_k2s2_state *x, conical_poly_k2s2_real theta, conical_poly_k2s2_real *q, conical_poly_k2s2_real *p);
 const char *conical_poly_k2s2_strerror(int code);
 conical_poly_k2s2_real conical_poly_k2s2_energy(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm);
 void conical_poly_k2s2_constraints(const conical_poly_k2s2_state *x, const conical_poly_k2s2_params *prm, conical_poly_k2s2_real *g);   /* conical_poly_k2s2_NU values */

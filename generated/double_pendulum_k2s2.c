@@ -739,8 +739,9 @@ void double_pendulum_k2s2_init_params(double_pendulum_k2s2_state *x, const doubl
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k2s2_NU ? double_pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < double_pendulum_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k2s2_NU];
     double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -878,7 +879,7 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
 static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, int cold, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
+  double gam[double_pendulum_k2s2_S * double_pendulum_k2s2_M], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + 2 * double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k2s2_ENOCONV;
   double_pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -905,7 +906,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
+    sw16 = 0, sw17 = 0, sw18 = 0, sw19 = 0;
   double lm0 = 0, lm1 = 0, lm2 = 0, lm3 = 0;
   for (it = 1; it <= double_pendulum_k2s2_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -1243,6 +1245,11 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
       sw13 = t203;
       sw14 = t204;
       sw15 = t205;
+      /* theta */
+      sw16 = t245;
+      sw17 = t247;
+      sw18 = t249;
+      sw19 = t251;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -1358,6 +1365,10 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   sw[13] = sw13;
   sw[14] = sw14;
   sw[15] = sw15;
+  sw[16] = sw16;
+  sw[17] = sw17;
+  sw[18] = sw18;
+  sw[19] = sw19;
   est = double_pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it;
@@ -1370,6 +1381,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   /* double_pendulum_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
+  for (i = 0; i < (double_pendulum_k2s2_S - 1) * double_pendulum_k2s2_M; i++) /* the rest of p's polynomial, for double_pendulum_k2s2_dense */
+    if (!isfinite(sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i])) return double_pendulum_k2s2_ENONFINITE;
   double q1[double_pendulum_k2s2_M], p1[double_pendulum_k2s2_M], pr[double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k2s2_energy(x, prm);
   double qc1[double_pendulum_k2s2_M], pc1[double_pendulum_k2s2_M];
@@ -1381,6 +1394,8 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     double_pendulum_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k2s2_add(&p1[i], &pc1[i], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i]);
   }
+  double phat[double_pendulum_k2s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < double_pendulum_k2s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k2s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_k2s2_NU; i++) {
@@ -1406,11 +1421,14 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < double_pendulum_k2s2_M; i++) x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
+  for (i = 0; i < (double_pendulum_k2s2_S - 1) * double_pendulum_k2s2_M; i++) x->pinc[double_pendulum_k2s2_M + i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k2s2_NU];
@@ -1542,9 +1560,10 @@ int double_pendulum_k2s2_project(double_pendulum_k2s2_state *x, const double_pen
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < double_pendulum_k2s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k2s2_NU];
     double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1553,4 +1572,25 @@ int double_pendulum_k2s2_project(double_pendulum_k2s2_state *x, const double_pen
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return double_pendulum_k2s2_OK;
+}
+
+void double_pendulum_k2s2_dense(const double_pendulum_k2s2_state *x, double_pendulum_k2s2_real theta, double_pendulum_k2s2_real *q, double_pendulum_k2s2_real *p)
+{
+  double L[double_pendulum_k2s2_S + 1], w[double_pendulum_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < double_pendulum_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < double_pendulum_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < double_pendulum_k2s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * double_pendulum_k2s2_M + i];
+      dp += w[j] * x->pinc[j * double_pendulum_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

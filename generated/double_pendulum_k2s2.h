@@ -13,6 +13,7 @@ extern "C" {
 #define double_pendulum_k2s2_K 2      /* Gauss-Legendre nodes */
 #define double_pendulum_k2s2_S 2      /* polynomial degree */
 #define double_pendulum_k2s2_NPARAMS 0
+#define double_pendulum_k2s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of double_pendulum_k2s2_step; on any nonzero code the state is unchanged. */
 #define double_pendulum_k2s2_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_k2s2_real tc, qc[4], pc[4], gam[8], hprev;
   double_pendulum_k2s2_real gam2[8], hprev2;
+  double_pendulum_k2s2_real pinc[8];  /* p's polynomial over the last step, for double_pendulum_k2s2_dense */
   double_pendulum_k2s2_real H0;  /* the energy the step keeps */
+  double_pendulum_k2s2_real pcorr[4];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } double_pendulum_k2s2_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * double_pendulum_k2s2_HMIN (1 + |t|). */
 int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real *h, double_pendulum_k2s2_real tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after double_pendulum_k2s2_project) it gives the state. */
+void double_pendulum_k2s2_dense(const double_pendulum_k2s2_state *x, double_pendulum_k2s2_real theta, double_pendulum_k2s2_real *q, double_pendulum_k2s2_real *p);
 const char *double_pendulum_k2s2_strerror(int code);
 double_pendulum_k2s2_real double_pendulum_k2s2_energy(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm);
 void double_pendulum_k2s2_constraints(const double_pendulum_k2s2_state *x, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_real *g);   /* double_pendulum_k2s2_NU values */

@@ -1426,8 +1426,9 @@ void double_pendulum_k3s3_init_params(double_pendulum_k3s3_state *x, const doubl
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k3s3_NU ? double_pendulum_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < double_pendulum_k3s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k3s3_NU];
     double_pendulum_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1565,7 +1566,7 @@ static double double_pendulum_k3s3_err_est(const double *gam, double h, double d
 static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, int cold, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
+  double gam[double_pendulum_k3s3_S * double_pendulum_k3s3_M], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + 3 * double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k3s3_ENOCONV;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
@@ -1593,7 +1594,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7], gm8 = gam[8], gm9 = gam[9], gm10 = gam[10], gm11 = gam[11];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
     sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
-    sw16 = 0, sw17 = 0, sw18 = 0, sw19 = 0, sw20 = 0, sw21 = 0;
+    sw16 = 0, sw17 = 0, sw18 = 0, sw19 = 0, sw20 = 0, sw21 = 0, sw22 = 0, sw23 = 0,
+    sw24 = 0, sw25 = 0, sw26 = 0, sw27 = 0, sw28 = 0, sw29 = 0;
   double lm0 = 0, lm1 = 0, lm2 = 0, lm3 = 0, lm4 = 0, lm5 = 0;
   for (it = 1; it <= double_pendulum_k3s3_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -2193,6 +2195,15 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
       sw19 = t390;
       sw20 = t391;
       sw21 = t392;
+      /* theta */
+      sw22 = t468;
+      sw23 = t470;
+      sw24 = t472;
+      sw25 = t474;
+      sw26 = t476;
+      sw27 = t478;
+      sw28 = t480;
+      sw29 = t482;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -2337,6 +2348,14 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
   sw[19] = sw19;
   sw[20] = sw20;
   sw[21] = sw21;
+  sw[22] = sw22;
+  sw[23] = sw23;
+  sw[24] = sw24;
+  sw[25] = sw25;
+  sw[26] = sw26;
+  sw[27] = sw27;
+  sw[28] = sw28;
+  sw[29] = sw29;
   est = double_pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_k3s3_MAXITER ? double_pendulum_k3s3_MAXITER : it;
@@ -2349,6 +2368,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
   /* double_pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k3s3_ENONFINITE;
+  for (i = 0; i < (double_pendulum_k3s3_S - 1) * double_pendulum_k3s3_M; i++) /* the rest of p's polynomial, for double_pendulum_k3s3_dense */
+    if (!isfinite(sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + i])) return double_pendulum_k3s3_ENONFINITE;
   double q1[double_pendulum_k3s3_M], p1[double_pendulum_k3s3_M], pr[double_pendulum_k3s3_M + 2 + 2 * double_pendulum_k3s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k3s3_energy(x, prm);
   double qc1[double_pendulum_k3s3_M], pc1[double_pendulum_k3s3_M];
@@ -2360,6 +2381,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     double_pendulum_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k3s3_add(&p1[i], &pc1[i], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i]);
   }
+  double phat[double_pendulum_k3s3_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < double_pendulum_k3s3_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k3s3_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_k3s3_NU; i++) {
@@ -2385,11 +2408,14 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < double_pendulum_k3s3_M; i++) x->pinc[i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i];
+  for (i = 0; i < (double_pendulum_k3s3_S - 1) * double_pendulum_k3s3_M; i++) x->pinc[double_pendulum_k3s3_M + i] = (double)sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + double_pendulum_k3s3_M + double_pendulum_k3s3_S * double_pendulum_k3s3_NU + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k3s3_NU];
@@ -2521,9 +2547,10 @@ int double_pendulum_k3s3_project(double_pendulum_k3s3_state *x, const double_pen
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < double_pendulum_k3s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k3s3_NU];
     double_pendulum_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -2532,4 +2559,25 @@ int double_pendulum_k3s3_project(double_pendulum_k3s3_state *x, const double_pen
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return double_pendulum_k3s3_OK;
+}
+
+void double_pendulum_k3s3_dense(const double_pendulum_k3s3_state *x, double_pendulum_k3s3_real theta, double_pendulum_k3s3_real *q, double_pendulum_k3s3_real *p)
+{
+  double L[double_pendulum_k3s3_S + 1], w[double_pendulum_k3s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < double_pendulum_k3s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < double_pendulum_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < double_pendulum_k3s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_k3s3_S; j++) {
+      dq += w[j] * x->gam[j * double_pendulum_k3s3_M + i];
+      dp += w[j] * x->pinc[j * double_pendulum_k3s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define double_pendulum_k3s3_K 3      /* Gauss-Legendre nodes */
 #define double_pendulum_k3s3_S 3      /* polynomial degree */
 #define double_pendulum_k3s3_NPARAMS 0
+#define double_pendulum_k3s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of double_pendulum_k3s3_step; on any nonzero code the state is unchanged. */
 #define double_pendulum_k3s3_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_k3s3_real tc, qc[4], pc[4], gam[12], hprev;
   double_pendulum_k3s3_real gam2[12], hprev2;
+  double_pendulum_k3s3_real pinc[12];  /* p's polynomial over the last step, for double_pendulum_k3s3_dense */
   double_pendulum_k3s3_real H0;  /* the energy the step keeps */
+  double_pendulum_k3s3_real pcorr[4];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } double_pendulum_k3s3_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * double_pendulum_k3s3_HMIN (1 + |t|). */
 int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, double_pendulum_k3s3_real tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after double_pendulum_k3s3_project) it gives the state. */
+void double_pendulum_k3s3_dense(const double_pendulum_k3s3_state *x, double_pendulum_k3s3_real theta, double_pendulum_k3s3_real *q, double_pendulum_k3s3_real *p);
 const char *double_pendulum_k3s3_strerror(int code);
 double_pendulum_k3s3_real double_pendulum_k3s3_energy(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm);
 void double_pendulum_k3s3_constraints(const double_pendulum_k3s3_state *x, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_real *g);   /* double_pendulum_k3s3_NU values */

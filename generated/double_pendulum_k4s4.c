@@ -2889,8 +2889,9 @@ void double_pendulum_k4s4_init_params(double_pendulum_k4s4_state *x, const doubl
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (double_pendulum_k4s4_NU ? double_pendulum_k4s4_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < double_pendulum_k4s4_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k4s4_NU];
     double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -3028,7 +3029,7 @@ static double double_pendulum_k4s4_err_est(const double *gam, double h, double d
 static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, int cold, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   const double h = (double)h_;
-  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
+  double gam[double_pendulum_k4s4_S * double_pendulum_k4s4_M], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + 4 * double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = double_pendulum_k4s4_ENOCONV;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
@@ -3057,7 +3058,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
     sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
     sw16 = 0, sw17 = 0, sw18 = 0, sw19 = 0, sw20 = 0, sw21 = 0, sw22 = 0, sw23 = 0,
-    sw24 = 0, sw25 = 0, sw26 = 0, sw27 = 0;
+    sw24 = 0, sw25 = 0, sw26 = 0, sw27 = 0, sw28 = 0, sw29 = 0, sw30 = 0, sw31 = 0,
+    sw32 = 0, sw33 = 0, sw34 = 0, sw35 = 0, sw36 = 0, sw37 = 0, sw38 = 0, sw39 = 0;
   double lm0 = 0, lm1 = 0, lm2 = 0, lm3 = 0, lm4 = 0, lm5 = 0, lm6 = 0, lm7 = 0;
   for (it = 1; it <= double_pendulum_k4s4_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -4113,6 +4115,19 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
       sw25 = t723;
       sw26 = t724;
       sw27 = t725;
+      /* theta */
+      sw28 = t887;
+      sw29 = t889;
+      sw30 = t891;
+      sw31 = t893;
+      sw32 = t895;
+      sw33 = t897;
+      sw34 = t899;
+      sw35 = t901;
+      sw36 = t903;
+      sw37 = t905;
+      sw38 = t907;
+      sw39 = t909;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -4286,6 +4301,18 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   sw[25] = sw25;
   sw[26] = sw26;
   sw[27] = sw27;
+  sw[28] = sw28;
+  sw[29] = sw29;
+  sw[30] = sw30;
+  sw[31] = sw31;
+  sw[32] = sw32;
+  sw[33] = sw33;
+  sw[34] = sw34;
+  sw[35] = sw35;
+  sw[36] = sw36;
+  sw[37] = sw37;
+  sw[38] = sw38;
+  sw[39] = sw39;
   est = double_pendulum_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > double_pendulum_k4s4_MAXITER ? double_pendulum_k4s4_MAXITER : it;
@@ -4298,6 +4325,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   /* double_pendulum_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return double_pendulum_k4s4_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k4s4_ENONFINITE;
+  for (i = 0; i < (double_pendulum_k4s4_S - 1) * double_pendulum_k4s4_M; i++) /* the rest of p's polynomial, for double_pendulum_k4s4_dense */
+    if (!isfinite(sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + i])) return double_pendulum_k4s4_ENONFINITE;
   double q1[double_pendulum_k4s4_M], p1[double_pendulum_k4s4_M], pr[double_pendulum_k4s4_M + 2 + 2 * double_pendulum_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k4s4_energy(x, prm);
   double qc1[double_pendulum_k4s4_M], pc1[double_pendulum_k4s4_M];
@@ -4309,6 +4338,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     double_pendulum_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k4s4_add(&p1[i], &pc1[i], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i]);
   }
+  double phat[double_pendulum_k4s4_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < double_pendulum_k4s4_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   double_pendulum_k4s4_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_k4s4_NU; i++) {
@@ -4334,11 +4365,14 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < double_pendulum_k4s4_M; i++) x->pinc[i] = (double)sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i];
+  for (i = 0; i < (double_pendulum_k4s4_S - 1) * double_pendulum_k4s4_M; i++) x->pinc[double_pendulum_k4s4_M + i] = (double)sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + i];
   x->H0 = H0;
   {
     double lam[double_pendulum_k4s4_NU];
@@ -4470,9 +4504,10 @@ int double_pendulum_k4s4_project(double_pendulum_k4s4_state *x, const double_pen
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = 0;
+  for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < double_pendulum_k4s4_M; i++) x->pcorr[i] = 0;
   {
     double lam[double_pendulum_k4s4_NU];
     double_pendulum_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -4481,4 +4516,25 @@ int double_pendulum_k4s4_project(double_pendulum_k4s4_state *x, const double_pen
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return double_pendulum_k4s4_OK;
+}
+
+void double_pendulum_k4s4_dense(const double_pendulum_k4s4_state *x, double_pendulum_k4s4_real theta, double_pendulum_k4s4_real *q, double_pendulum_k4s4_real *p)
+{
+  double L[double_pendulum_k4s4_S + 1], w[double_pendulum_k4s4_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < double_pendulum_k4s4_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < double_pendulum_k4s4_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < double_pendulum_k4s4_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < double_pendulum_k4s4_S; j++) {
+      dq += w[j] * x->gam[j * double_pendulum_k4s4_M + i];
+      dp += w[j] * x->pinc[j * double_pendulum_k4s4_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -97,7 +97,7 @@ void henon_heiles_k3s2_init_params(henon_heiles_k3s2_state *x, const henon_heile
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (henon_heiles_k3s2_NU ? henon_heiles_k3s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
 }
 
 void henon_heiles_k3s2_init(henon_heiles_k3s2_state *x, const henon_heiles_k3s2_real *q0, const henon_heiles_k3s2_real *p0)
@@ -213,7 +213,7 @@ static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, 
 static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, double tol, int cold, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
+  double gam[henon_heiles_k3s2_S * henon_heiles_k3s2_M], sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + 2 * henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = henon_heiles_k3s2_ENOCONV;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
@@ -221,7 +221,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
   henon_heiles_k3s2_predict(x, h, cold, prm, gam);
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
-  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
   for (it = 1; it <= henon_heiles_k3s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -327,6 +327,9 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       /* dp */
       sw4 = t88;
       sw5 = t90;
+      /* theta */
+      sw6 = t68;
+      sw7 = t70;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -399,6 +402,8 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
   sw[3] = sw3;
   sw[4] = sw4;
   sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
   est = henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it;
@@ -411,6 +416,8 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
   /* henon_heiles_k3s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return henon_heiles_k3s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return henon_heiles_k3s2_ENONFINITE;
+  for (i = 0; i < (henon_heiles_k3s2_S - 1) * henon_heiles_k3s2_M; i++) /* the rest of p's polynomial, for henon_heiles_k3s2_dense */
+    if (!isfinite(sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + i])) return henon_heiles_k3s2_ENONFINITE;
   for (i = 0; i < henon_heiles_k3s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -424,6 +431,8 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < henon_heiles_k3s2_M; i++) x->pinc[i] = (double)sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + i];
+  for (i = 0; i < (henon_heiles_k3s2_S - 1) * henon_heiles_k3s2_M; i++) x->pinc[henon_heiles_k3s2_M + i] = (double)sw[henon_heiles_k3s2_S * henon_heiles_k3s2_M + henon_heiles_k3s2_M + 3 * henon_heiles_k3s2_NU + i];
   henon_heiles_k3s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -512,4 +521,25 @@ int henon_heiles_k3s2_project(henon_heiles_k3s2_state *x, const henon_heiles_k3s
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return henon_heiles_k3s2_OK;
+}
+
+void henon_heiles_k3s2_dense(const henon_heiles_k3s2_state *x, henon_heiles_k3s2_real theta, henon_heiles_k3s2_real *q, henon_heiles_k3s2_real *p)
+{
+  double L[henon_heiles_k3s2_S + 1], w[henon_heiles_k3s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < henon_heiles_k3s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < henon_heiles_k3s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < henon_heiles_k3s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < henon_heiles_k3s2_S; j++) {
+      dq += w[j] * x->gam[j * henon_heiles_k3s2_M + i];
+      dp += w[j] * x->pinc[j * henon_heiles_k3s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

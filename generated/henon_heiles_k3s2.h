@@ -13,6 +13,7 @@ extern "C" {
 #define henon_heiles_k3s2_K 3      /* Gauss-Legendre nodes */
 #define henon_heiles_k3s2_S 2      /* polynomial degree */
 #define henon_heiles_k3s2_NPARAMS 0
+#define henon_heiles_k3s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of henon_heiles_k3s2_step; on any nonzero code the state is unchanged. */
 #define henon_heiles_k3s2_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   henon_heiles_k3s2_real tc, qc[2], pc[2], gam[4], hprev;
   henon_heiles_k3s2_real gam2[4], hprev2;
+  henon_heiles_k3s2_real pinc[4];  /* p's polynomial over the last step, for henon_heiles_k3s2_dense */
 } henon_heiles_k3s2_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h,
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * henon_heiles_k3s2_HMIN (1 + |t|). */
 int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, henon_heiles_k3s2_real tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after henon_heiles_k3s2_project) it gives the state. */
+void henon_heiles_k3s2_dense(const henon_heiles_k3s2_state *x, henon_heiles_k3s2_real theta, henon_heiles_k3s2_real *q, henon_heiles_k3s2_real *p);
 const char *henon_heiles_k3s2_strerror(int code);
 henon_heiles_k3s2_real henon_heiles_k3s2_energy(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm);
 void henon_heiles_k3s2_constraints(const henon_heiles_k3s2_state *x, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_real *g);   /* henon_heiles_k3s2_NU values */

@@ -106,7 +106,7 @@ void kepler_k16s2_init_params(kepler_k16s2_state *x, const kepler_k16s2_real *q0
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k16s2_NU ? kepler_k16s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < kepler_k16s2_S * kepler_k16s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
 }
 
 void kepler_k16s2_init(kepler_k16s2_state *x, const kepler_k16s2_real *q0, const kepler_k16s2_real *p0)
@@ -222,7 +222,7 @@ static double kepler_k16s2_err_est(const double *gam, double h, double d1, int c
 static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_, double tol, int cold, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[kepler_k16s2_S * kepler_k16s2_M], sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + 3 * kepler_k16s2_NU + 1];
+  double gam[kepler_k16s2_S * kepler_k16s2_M], sw[kepler_k16s2_S * kepler_k16s2_M + 2 * kepler_k16s2_M + 3 * kepler_k16s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k16s2_ENOCONV;
   kepler_k16s2_DEFAULT_PARAMS(prm)
@@ -230,7 +230,7 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
   kepler_k16s2_predict(x, h, cold, prm, gam);
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
-  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
   for (it = 1; it <= kepler_k16s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 16: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -744,6 +744,9 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       /* dp */
       sw4 = t483;
       sw5 = t485;
+      /* theta */
+      sw6 = t463;
+      sw7 = t465;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -816,6 +819,8 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
   sw[3] = sw3;
   sw[4] = sw4;
   sw[5] = sw5;
+  sw[6] = sw6;
+  sw[7] = sw7;
   est = kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it;
@@ -828,6 +833,8 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
   /* kepler_k16s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k16s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k16s2_ENONFINITE;
+  for (i = 0; i < (kepler_k16s2_S - 1) * kepler_k16s2_M; i++) /* the rest of p's polynomial, for kepler_k16s2_dense */
+    if (!isfinite(sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + 3 * kepler_k16s2_NU + i])) return kepler_k16s2_ENONFINITE;
   for (i = 0; i < kepler_k16s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k16s2_S * kepler_k16s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -841,6 +848,8 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < kepler_k16s2_M; i++) x->pinc[i] = (double)sw[kepler_k16s2_S * kepler_k16s2_M + i];
+  for (i = 0; i < (kepler_k16s2_S - 1) * kepler_k16s2_M; i++) x->pinc[kepler_k16s2_M + i] = (double)sw[kepler_k16s2_S * kepler_k16s2_M + kepler_k16s2_M + 3 * kepler_k16s2_NU + i];
   kepler_k16s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -929,4 +938,25 @@ int kepler_k16s2_project(kepler_k16s2_state *x, const kepler_k16s2_params *prm, 
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return kepler_k16s2_OK;
+}
+
+void kepler_k16s2_dense(const kepler_k16s2_state *x, kepler_k16s2_real theta, kepler_k16s2_real *q, kepler_k16s2_real *p)
+{
+  double L[kepler_k16s2_S + 1], w[kepler_k16s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < kepler_k16s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < kepler_k16s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < kepler_k16s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < kepler_k16s2_S; j++) {
+      dq += w[j] * x->gam[j * kepler_k16s2_M + i];
+      dp += w[j] * x->pinc[j * kepler_k16s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -91,7 +91,7 @@ void kepler_k1s1_init_params(kepler_k1s1_state *x, const kepler_k1s1_real *q0, c
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k1s1_NU ? kepler_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
 }
 
 void kepler_k1s1_init(kepler_k1s1_state *x, const kepler_k1s1_real *q0, const kepler_k1s1_real *p0)
@@ -313,6 +313,8 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
   /* kepler_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k1s1_ENONFINITE;
+  for (i = 0; i < (kepler_k1s1_S - 1) * kepler_k1s1_M; i++) /* the rest of p's polynomial, for kepler_k1s1_dense */
+    if (!isfinite(sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + 3 * kepler_k1s1_NU + i])) return kepler_k1s1_ENONFINITE;
   for (i = 0; i < kepler_k1s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k1s1_S * kepler_k1s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -326,6 +328,8 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < kepler_k1s1_M; i++) x->pinc[i] = (double)sw[kepler_k1s1_S * kepler_k1s1_M + i];
+  for (i = 0; i < (kepler_k1s1_S - 1) * kepler_k1s1_M; i++) x->pinc[kepler_k1s1_M + i] = (double)sw[kepler_k1s1_S * kepler_k1s1_M + kepler_k1s1_M + 3 * kepler_k1s1_NU + i];
   kepler_k1s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -414,4 +418,25 @@ int kepler_k1s1_project(kepler_k1s1_state *x, const kepler_k1s1_params *prm, kep
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return kepler_k1s1_OK;
+}
+
+void kepler_k1s1_dense(const kepler_k1s1_state *x, kepler_k1s1_real theta, kepler_k1s1_real *q, kepler_k1s1_real *p)
+{
+  double L[kepler_k1s1_S + 1], w[kepler_k1s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < kepler_k1s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < kepler_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < kepler_k1s1_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < kepler_k1s1_S; j++) {
+      dq += w[j] * x->gam[j * kepler_k1s1_M + i];
+      dp += w[j] * x->pinc[j * kepler_k1s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define kepler_k1s1_K 1      /* Gauss-Legendre nodes */
 #define kepler_k1s1_S 1      /* polynomial degree */
 #define kepler_k1s1_NPARAMS 0
+#define kepler_k1s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of kepler_k1s1_step; on any nonzero code the state is unchanged. */
 #define kepler_k1s1_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k1s1_real tc, qc[2], pc[2], gam[2], hprev;
   kepler_k1s1_real gam2[2], hprev2;
+  kepler_k1s1_real pinc[2];  /* p's polynomial over the last step, for kepler_k1s1_dense */
 } kepler_k1s1_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h, const kepler_k1s1
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * kepler_k1s1_HMIN (1 + |t|). */
 int kepler_k1s1_step_adaptive(kepler_k1s1_state *x, kepler_k1s1_real *h, kepler_k1s1_real tol, const kepler_k1s1_params *prm, kepler_k1s1_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after kepler_k1s1_project) it gives the state. */
+void kepler_k1s1_dense(const kepler_k1s1_state *x, kepler_k1s1_real theta, kepler_k1s1_real *q, kepler_k1s1_real *p);
 const char *kepler_k1s1_strerror(int code);
 kepler_k1s1_real kepler_k1s1_energy(const kepler_k1s1_state *x, const kepler_k1s1_params *prm);
 void kepler_k1s1_constraints(const kepler_k1s1_state *x, const kepler_k1s1_params *prm, kepler_k1s1_real *g);   /* kepler_k1s1_NU values */

@@ -13,6 +13,7 @@ extern "C" {
 #define kepler_k3s3_K 3      /* Gauss-Legendre nodes */
 #define kepler_k3s3_S 3      /* polynomial degree */
 #define kepler_k3s3_NPARAMS 0
+#define kepler_k3s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of kepler_k3s3_step; on any nonzero code the state is unchanged. */
 #define kepler_k3s3_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k3s3_real tc, qc[2], pc[2], gam[6], hprev;
   kepler_k3s3_real gam2[6], hprev2;
+  kepler_k3s3_real pinc[6];  /* p's polynomial over the last step, for kepler_k3s3_dense */
 } kepler_k3s3_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h, const kepler_k3s3
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * kepler_k3s3_HMIN (1 + |t|). */
 int kepler_k3s3_step_adaptive(kepler_k3s3_state *x, kepler_k3s3_real *h, kepler_k3s3_real tol, const kepler_k3s3_params *prm, kepler_k3s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after kepler_k3s3_project) it gives the state. */
+void kepler_k3s3_dense(const kepler_k3s3_state *x, kepler_k3s3_real theta, kepler_k3s3_real *q, kepler_k3s3_real *p);
 const char *kepler_k3s3_strerror(int code);
 kepler_k3s3_real kepler_k3s3_energy(const kepler_k3s3_state *x, const kepler_k3s3_params *prm);
 void kepler_k3s3_constraints(const kepler_k3s3_state *x, const kepler_k3s3_params *prm, kepler_k3s3_real *g);   /* kepler_k3s3_NU values */

@@ -13,6 +13,7 @@ extern "C" {
 #define kepler_k4s4_K 4      /* Gauss-Legendre nodes */
 #define kepler_k4s4_S 4      /* polynomial degree */
 #define kepler_k4s4_NPARAMS 0
+#define kepler_k4s4_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of kepler_k4s4_step; on any nonzero code the state is unchanged. */
 #define kepler_k4s4_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k4s4_real tc, qc[2], pc[2], gam[8], hprev;
   kepler_k4s4_real gam2[8], hprev2;
+  kepler_k4s4_real pinc[8];  /* p's polynomial over the last step, for kepler_k4s4_dense */
 } kepler_k4s4_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h, const kepler_k4s4
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * kepler_k4s4_HMIN (1 + |t|). */
 int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_k4s4_real tol, const kepler_k4s4_params *prm, kepler_k4s4_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after kepler_k4s4_project) it gives the state. */
+void kepler_k4s4_dense(const kepler_k4s4_state *x, kepler_k4s4_real theta, kepler_k4s4_real *q, kepler_k4s4_real *p);
 const char *kepler_k4s4_strerror(int code);
 kepler_k4s4_real kepler_k4s4_energy(const kepler_k4s4_state *x, const kepler_k4s4_params *prm);
 void kepler_k4s4_constraints(const kepler_k4s4_state *x, const kepler_k4s4_params *prm, kepler_k4s4_real *g);   /* kepler_k4s4_NU values */

@@ -13,6 +13,7 @@ extern "C" {
 #define kepler_k6s2_K 6      /* Gauss-Legendre nodes */
 #define kepler_k6s2_S 2      /* polynomial degree */
 #define kepler_k6s2_NPARAMS 0
+#define kepler_k6s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of kepler_k6s2_step; on any nonzero code the state is unchanged. */
 #define kepler_k6s2_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k6s2_real tc, qc[2], pc[2], gam[4], hprev;
   kepler_k6s2_real gam2[4], hprev2;
+  kepler_k6s2_real pinc[4];  /* p's polynomial over the last step, for kepler_k6s2_dense */
 } kepler_k6s2_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int kepler_k6s2_step(kepler_k6s2_state *x, kepler_k6s2_real h, const kepler_k6s2
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * kepler_k6s2_HMIN (1 + |t|). */
 int kepler_k6s2_step_adaptive(kepler_k6s2_state *x, kepler_k6s2_real *h, kepler_k6s2_real tol, const kepler_k6s2_params *prm, kepler_k6s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after kepler_k6s2_project) it gives the state. */
+void kepler_k6s2_dense(const kepler_k6s2_state *x, kepler_k6s2_real theta, kepler_k6s2_real *q, kepler_k6s2_real *p);
 const char *kepler_k6s2_strerror(int code);
 kepler_k6s2_real kepler_k6s2_energy(const kepler_k6s2_state *x, const kepler_k6s2_params *prm);
 void kepler_k6s2_constraints(const kepler_k6s2_state *x, const kepler_k6s2_params *prm, kepler_k6s2_real *g);   /* kepler_k6s2_NU values */

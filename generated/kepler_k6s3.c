@@ -96,7 +96,7 @@ void kepler_k6s3_init_params(kepler_k6s3_state *x, const kepler_k6s3_real *q0, c
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (kepler_k6s3_NU ? kepler_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < kepler_k6s3_S * kepler_k6s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
 }
 
 void kepler_k6s3_init(kepler_k6s3_state *x, const kepler_k6s3_real *q0, const kepler_k6s3_real *p0)
@@ -212,7 +212,7 @@ static double kepler_k6s3_err_est(const double *gam, double h, double d1, int co
 static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, double tol, int cold, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[kepler_k6s3_S * kepler_k6s3_M], sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + 3 * kepler_k6s3_NU + 1];
+  double gam[kepler_k6s3_S * kepler_k6s3_M], sw[kepler_k6s3_S * kepler_k6s3_M + 3 * kepler_k6s3_M + 3 * kepler_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = kepler_k6s3_ENOCONV;
   kepler_k6s3_DEFAULT_PARAMS(prm)
@@ -220,7 +220,8 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
   kepler_k6s3_predict(x, h, cold, prm, gam);
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
-  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0;
   for (it = 1; it <= kepler_k6s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -488,6 +489,11 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
       /* dp */
       sw6 = t245;
       sw7 = t247;
+      /* theta */
+      sw8 = t211;
+      sw9 = t213;
+      sw10 = t215;
+      sw11 = t217;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -573,6 +579,10 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
   sw[5] = sw5;
   sw[6] = sw6;
   sw[7] = sw7;
+  sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
+  sw[11] = sw11;
   est = kepler_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it;
@@ -585,6 +595,8 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
   /* kepler_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return kepler_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return kepler_k6s3_ENONFINITE;
+  for (i = 0; i < (kepler_k6s3_S - 1) * kepler_k6s3_M; i++) /* the rest of p's polynomial, for kepler_k6s3_dense */
+    if (!isfinite(sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + 3 * kepler_k6s3_NU + i])) return kepler_k6s3_ENONFINITE;
   for (i = 0; i < kepler_k6s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[kepler_k6s3_S * kepler_k6s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -598,6 +610,8 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < kepler_k6s3_M; i++) x->pinc[i] = (double)sw[kepler_k6s3_S * kepler_k6s3_M + i];
+  for (i = 0; i < (kepler_k6s3_S - 1) * kepler_k6s3_M; i++) x->pinc[kepler_k6s3_M + i] = (double)sw[kepler_k6s3_S * kepler_k6s3_M + kepler_k6s3_M + 3 * kepler_k6s3_NU + i];
   kepler_k6s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -686,4 +700,25 @@ int kepler_k6s3_project(kepler_k6s3_state *x, const kepler_k6s3_params *prm, kep
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return kepler_k6s3_OK;
+}
+
+void kepler_k6s3_dense(const kepler_k6s3_state *x, kepler_k6s3_real theta, kepler_k6s3_real *q, kepler_k6s3_real *p)
+{
+  double L[kepler_k6s3_S + 1], w[kepler_k6s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < kepler_k6s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < kepler_k6s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < kepler_k6s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < kepler_k6s3_S; j++) {
+      dq += w[j] * x->gam[j * kepler_k6s3_M + i];
+      dp += w[j] * x->pinc[j * kepler_k6s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

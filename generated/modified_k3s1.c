@@ -225,7 +225,7 @@ void modified_k3s1_init_params(modified_k3s1_state *x, const modified_k3s1_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k3s1_NU ? modified_k3s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[modified_k3s1_NU];
     modified_k3s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -554,6 +554,8 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
   /* modified_k3s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k3s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k3s1_ENONFINITE;
+  for (i = 0; i < (modified_k3s1_S - 1) * modified_k3s1_M; i++) /* the rest of p's polynomial, for modified_k3s1_dense */
+    if (!isfinite(sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + i])) return modified_k3s1_ENONFINITE;
   for (i = 0; i < modified_k3s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k3s1_S * modified_k3s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -567,6 +569,8 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < modified_k3s1_M; i++) x->pinc[i] = (double)sw[modified_k3s1_S * modified_k3s1_M + i];
+  for (i = 0; i < (modified_k3s1_S - 1) * modified_k3s1_M; i++) x->pinc[modified_k3s1_M + i] = (double)sw[modified_k3s1_S * modified_k3s1_M + modified_k3s1_M + 3 * modified_k3s1_NU + i];
   modified_k3s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -692,7 +696,7 @@ int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[modified_k3s1_NU];
@@ -702,4 +706,25 @@ int modified_k3s1_project(modified_k3s1_state *x, const modified_k3s1_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_k3s1_OK;
+}
+
+void modified_k3s1_dense(const modified_k3s1_state *x, modified_k3s1_real theta, modified_k3s1_real *q, modified_k3s1_real *p)
+{
+  double L[modified_k3s1_S + 1], w[modified_k3s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_k3s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_k3s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_k3s1_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_k3s1_S; j++) {
+      dq += w[j] * x->gam[j * modified_k3s1_M + i];
+      dp += w[j] * x->pinc[j * modified_k3s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

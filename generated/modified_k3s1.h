@@ -13,6 +13,7 @@ extern "C" {
 #define modified_k3s1_K 3      /* Gauss-Legendre nodes */
 #define modified_k3s1_S 1      /* polynomial degree */
 #define modified_k3s1_NPARAMS 0
+#define modified_k3s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of modified_k3s1_step; on any nonzero code the state is unchanged. */
 #define modified_k3s1_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_k3s1_real tc, qc[3], pc[3], gam[3], hprev;
   modified_k3s1_real gam2[3], hprev2;
+  modified_k3s1_real pinc[3];  /* p's polynomial over the last step, for modified_k3s1_dense */
 } modified_k3s1_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modif
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_k3s1_HMIN (1 + |t|). */
 int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_k3s1_project) it gives the state. */
+void modified_k3s1_dense(const modified_k3s1_state *x, modified_k3s1_real theta, modified_k3s1_real *q, modified_k3s1_real *p);
 const char *modified_k3s1_strerror(int code);
 modified_k3s1_real modified_k3s1_energy(const modified_k3s1_state *x, const modified_k3s1_params *prm);
 void modified_k3s1_constraints(const modified_k3s1_state *x, const modified_k3s1_params *prm, modified_k3s1_real *g);   /* modified_k3s1_NU values */

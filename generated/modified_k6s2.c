@@ -228,7 +228,7 @@ void modified_k6s2_init_params(modified_k6s2_state *x, const modified_k6s2_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_k6s2_NU ? modified_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[modified_k6s2_NU];
     modified_k6s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -351,7 +351,7 @@ static double modified_k6s2_err_est(const double *gam, double h, double d1, int 
 static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real h_, double tol, int cold, const modified_k6s2_params *prm, modified_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + 1];
+  double gam[modified_k6s2_S * modified_k6s2_M], sw[modified_k6s2_S * modified_k6s2_M + 2 * modified_k6s2_M + 3 * modified_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_k6s2_ENOCONV;
   modified_k6s2_DEFAULT_PARAMS(prm)
@@ -366,7 +366,7 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
   for (it = 1; it <= modified_k6s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
@@ -640,6 +640,10 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
       sw10 = t190;
       /* adiag */
       sw11 = t190;
+      /* theta */
+      sw12 = t211;
+      sw13 = t212;
+      sw14 = t214;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -736,6 +740,9 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
   sw[9] = sw9;
   sw[10] = sw10;
   sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
   est = modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > modified_k6s2_MAXITER ? modified_k6s2_MAXITER : it;
@@ -748,6 +755,8 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
   /* modified_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_k6s2_ENONFINITE;
+  for (i = 0; i < (modified_k6s2_S - 1) * modified_k6s2_M; i++) /* the rest of p's polynomial, for modified_k6s2_dense */
+    if (!isfinite(sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + i])) return modified_k6s2_ENONFINITE;
   for (i = 0; i < modified_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[modified_k6s2_S * modified_k6s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -761,6 +770,8 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < modified_k6s2_M; i++) x->pinc[i] = (double)sw[modified_k6s2_S * modified_k6s2_M + i];
+  for (i = 0; i < (modified_k6s2_S - 1) * modified_k6s2_M; i++) x->pinc[modified_k6s2_M + i] = (double)sw[modified_k6s2_S * modified_k6s2_M + modified_k6s2_M + 3 * modified_k6s2_NU + i];
   modified_k6s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -886,7 +897,7 @@ int modified_k6s2_project(modified_k6s2_state *x, const modified_k6s2_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[modified_k6s2_NU];
@@ -896,4 +907,25 @@ int modified_k6s2_project(modified_k6s2_state *x, const modified_k6s2_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_k6s2_OK;
+}
+
+void modified_k6s2_dense(const modified_k6s2_state *x, modified_k6s2_real theta, modified_k6s2_real *q, modified_k6s2_real *p)
+{
+  double L[modified_k6s2_S + 1], w[modified_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_k6s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * modified_k6s2_M + i];
+      dp += w[j] * x->pinc[j * modified_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

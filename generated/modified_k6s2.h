@@ -13,6 +13,7 @@ extern "C" {
 #define modified_k6s2_K 6      /* Gauss-Legendre nodes */
 #define modified_k6s2_S 2      /* polynomial degree */
 #define modified_k6s2_NPARAMS 0
+#define modified_k6s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of modified_k6s2_step; on any nonzero code the state is unchanged. */
 #define modified_k6s2_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_k6s2_real tc, qc[3], pc[3], gam[6], hprev;
   modified_k6s2_real gam2[6], hprev2;
+  modified_k6s2_real pinc[6];  /* p's polynomial over the last step, for modified_k6s2_dense */
 } modified_k6s2_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h, const modif
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_k6s2_HMIN (1 + |t|). */
 int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, modified_k6s2_real tol, const modified_k6s2_params *prm, modified_k6s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_k6s2_project) it gives the state. */
+void modified_k6s2_dense(const modified_k6s2_state *x, modified_k6s2_real theta, modified_k6s2_real *q, modified_k6s2_real *p);
 const char *modified_k6s2_strerror(int code);
 modified_k6s2_real modified_k6s2_energy(const modified_k6s2_state *x, const modified_k6s2_params *prm);
 void modified_k6s2_constraints(const modified_k6s2_state *x, const modified_k6s2_params *prm, modified_k6s2_real *g);   /* modified_k6s2_NU values */

@@ -13,6 +13,7 @@ extern "C" {
 #define modified_k9s3_K 9      /* Gauss-Legendre nodes */
 #define modified_k9s3_S 3      /* polynomial degree */
 #define modified_k9s3_NPARAMS 0
+#define modified_k9s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of modified_k9s3_step; on any nonzero code the state is unchanged. */
 #define modified_k9s3_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_k9s3_real tc, qc[3], pc[3], gam[9], hprev;
   modified_k9s3_real gam2[9], hprev2;
+  modified_k9s3_real pinc[9];  /* p's polynomial over the last step, for modified_k9s3_dense */
 } modified_k9s3_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modif
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_k9s3_HMIN (1 + |t|). */
 int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, modified_k9s3_real tol, const modified_k9s3_params *prm, modified_k9s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_k9s3_project) it gives the state. */
+void modified_k9s3_dense(const modified_k9s3_state *x, modified_k9s3_real theta, modified_k9s3_real *q, modified_k9s3_real *p);
 const char *modified_k9s3_strerror(int code);
 modified_k9s3_real modified_k9s3_energy(const modified_k9s3_state *x, const modified_k9s3_params *prm);
 void modified_k9s3_constraints(const modified_k9s3_state *x, const modified_k9s3_params *prm, modified_k9s3_real *g);   /* modified_k9s3_NU values */

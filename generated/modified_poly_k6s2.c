@@ -585,8 +585,9 @@ void modified_poly_k6s2_init_params(modified_poly_k6s2_state *x, const modified_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_poly_k6s2_NU ? modified_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < modified_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k6s2_NU];
     modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -724,7 +725,7 @@ static double modified_poly_k6s2_err_est(const double *gam, double h, double d1,
 static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, double tol, int cold, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
+  double gam[modified_poly_k6s2_S * modified_poly_k6s2_M], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + 2 * modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k6s2_ENOCONV;
   modified_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -751,7 +752,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0;
   double lm0 = 0, lm1 = 0;
   for (it = 1; it <= modified_poly_k6s2_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -1282,6 +1283,10 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
       /* lam */
       sw9 = t356;
       sw10 = t357;
+      /* theta */
+      sw11 = t451;
+      sw12 = t453;
+      sw13 = t455;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -1377,6 +1382,9 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   sw[8] = sw8;
   sw[9] = sw9;
   sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
   est = modified_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > modified_poly_k6s2_MAXITER ? modified_poly_k6s2_MAXITER : it;
@@ -1389,6 +1397,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   /* modified_poly_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_poly_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k6s2_ENONFINITE;
+  for (i = 0; i < (modified_poly_k6s2_S - 1) * modified_poly_k6s2_M; i++) /* the rest of p's polynomial, for modified_poly_k6s2_dense */
+    if (!isfinite(sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + i])) return modified_poly_k6s2_ENONFINITE;
   double q1[modified_poly_k6s2_M], p1[modified_poly_k6s2_M], pr[modified_poly_k6s2_M + 2 + 2 * modified_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k6s2_energy(x, prm);
   double qc1[modified_poly_k6s2_M], pc1[modified_poly_k6s2_M];
@@ -1400,6 +1410,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     modified_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k6s2_add(&p1[i], &pc1[i], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i]);
   }
+  double phat[modified_poly_k6s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < modified_poly_k6s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   modified_poly_k6s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < modified_poly_k6s2_NU; i++) {
@@ -1425,11 +1437,14 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < modified_poly_k6s2_M; i++) x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
+  for (i = 0; i < (modified_poly_k6s2_S - 1) * modified_poly_k6s2_M; i++) x->pinc[modified_poly_k6s2_M + i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + i];
   x->H0 = H0;
   {
     double lam[modified_poly_k6s2_NU];
@@ -1561,9 +1576,10 @@ int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < modified_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k6s2_NU];
     modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1572,4 +1588,25 @@ int modified_poly_k6s2_project(modified_poly_k6s2_state *x, const modified_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_poly_k6s2_OK;
+}
+
+void modified_poly_k6s2_dense(const modified_poly_k6s2_state *x, modified_poly_k6s2_real theta, modified_poly_k6s2_real *q, modified_poly_k6s2_real *p)
+{
+  double L[modified_poly_k6s2_S + 1], w[modified_poly_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_poly_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_poly_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_poly_k6s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_poly_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * modified_poly_k6s2_M + i];
+      dp += w[j] * x->pinc[j * modified_poly_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

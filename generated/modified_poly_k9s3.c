@@ -1048,8 +1048,9 @@ void modified_poly_k9s3_init_params(modified_poly_k9s3_state *x, const modified_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (modified_poly_k9s3_NU ? modified_poly_k9s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < modified_poly_k9s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k9s3_NU];
     modified_poly_k9s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1187,7 +1188,7 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1,
 static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, int cold, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
+  double gam[modified_poly_k9s3_S * modified_poly_k9s3_M], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + 3 * modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = modified_poly_k9s3_ENOCONV;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
@@ -1214,7 +1215,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5], gm6 = gam[6], gm7 = gam[7], gm8 = gam[8];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0, sw15 = 0,
+    sw16 = 0, sw17 = 0, sw18 = 0, sw19 = 0, sw20 = 0;
   double lm0 = 0, lm1 = 0, lm2 = 0;
   for (it = 1; it <= modified_poly_k9s3_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -2247,6 +2249,13 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
       sw12 = t721;
       sw13 = t722;
       sw14 = t723;
+      /* theta */
+      sw15 = t921;
+      sw16 = t923;
+      sw17 = t925;
+      sw18 = t927;
+      sw19 = t929;
+      sw20 = t931;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -2363,6 +2372,12 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   sw[12] = sw12;
   sw[13] = sw13;
   sw[14] = sw14;
+  sw[15] = sw15;
+  sw[16] = sw16;
+  sw[17] = sw17;
+  sw[18] = sw18;
+  sw[19] = sw19;
+  sw[20] = sw20;
   est = modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > modified_poly_k9s3_MAXITER ? modified_poly_k9s3_MAXITER : it;
@@ -2375,6 +2390,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   /* modified_poly_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return modified_poly_k9s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k9s3_ENONFINITE;
+  for (i = 0; i < (modified_poly_k9s3_S - 1) * modified_poly_k9s3_M; i++) /* the rest of p's polynomial, for modified_poly_k9s3_dense */
+    if (!isfinite(sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + i])) return modified_poly_k9s3_ENONFINITE;
   double q1[modified_poly_k9s3_M], p1[modified_poly_k9s3_M], pr[modified_poly_k9s3_M + 2 + 2 * modified_poly_k9s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k9s3_energy(x, prm);
   double qc1[modified_poly_k9s3_M], pc1[modified_poly_k9s3_M];
@@ -2386,6 +2403,8 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     modified_poly_k9s3_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k9s3_add(&p1[i], &pc1[i], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i]);
   }
+  double phat[modified_poly_k9s3_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < modified_poly_k9s3_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   modified_poly_k9s3_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < modified_poly_k9s3_NU; i++) {
@@ -2411,11 +2430,14 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < modified_poly_k9s3_M; i++) x->pinc[i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i];
+  for (i = 0; i < (modified_poly_k9s3_S - 1) * modified_poly_k9s3_M; i++) x->pinc[modified_poly_k9s3_M + i] = (double)sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + i];
   x->H0 = H0;
   {
     double lam[modified_poly_k9s3_NU];
@@ -2547,9 +2569,10 @@ int modified_poly_k9s3_project(modified_poly_k9s3_state *x, const modified_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < modified_poly_k9s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[modified_poly_k9s3_NU];
     modified_poly_k9s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -2558,4 +2581,25 @@ int modified_poly_k9s3_project(modified_poly_k9s3_state *x, const modified_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return modified_poly_k9s3_OK;
+}
+
+void modified_poly_k9s3_dense(const modified_poly_k9s3_state *x, modified_poly_k9s3_real theta, modified_poly_k9s3_real *q, modified_poly_k9s3_real *p)
+{
+  double L[modified_poly_k9s3_S + 1], w[modified_poly_k9s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < modified_poly_k9s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < modified_poly_k9s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < modified_poly_k9s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < modified_poly_k9s3_S; j++) {
+      dq += w[j] * x->gam[j * modified_poly_k9s3_M + i];
+      dp += w[j] * x->pinc[j * modified_poly_k9s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

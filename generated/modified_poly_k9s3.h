@@ -13,6 +13,7 @@ extern "C" {
 #define modified_poly_k9s3_K 9      /* Gauss-Legendre nodes */
 #define modified_poly_k9s3_S 3      /* polynomial degree */
 #define modified_poly_k9s3_NPARAMS 0
+#define modified_poly_k9s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of modified_poly_k9s3_step; on any nonzero code the state is unchanged. */
 #define modified_poly_k9s3_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_poly_k9s3_real tc, qc[3], pc[3], gam[9], hprev;
   modified_poly_k9s3_real gam2[9], hprev2;
+  modified_poly_k9s3_real pinc[9];  /* p's polynomial over the last step, for modified_poly_k9s3_dense */
   modified_poly_k9s3_real H0;  /* the energy the step keeps */
+  modified_poly_k9s3_real pcorr[3];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } modified_poly_k9s3_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_poly_k9s3_HMIN (1 + |t|). */
 int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_k9s3_real *h, modified_poly_k9s3_real tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after modified_poly_k9s3_project) it gives the state. */
+void modified_poly_k9s3_dense(const modified_poly_k9s3_state *x, modified_poly_k9s3_real theta, modified_poly_k9s3_real *q, modified_poly_k9s3_real *p);
 const char *modified_poly_k9s3_strerror(int code);
 modified_poly_k9s3_real modified_poly_k9s3_energy(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm);
 void modified_poly_k9s3_constraints(const modified_poly_k9s3_state *x, const modified_poly_k9s3_params *prm, modified_poly_k9s3_real *g);   /* modified_poly_k9s3_NU values */

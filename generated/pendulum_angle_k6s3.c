@@ -89,7 +89,7 @@ void pendulum_angle_k6s3_init_params(pendulum_angle_k6s3_state *x, const pendulu
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_angle_k6s3_NU ? pendulum_angle_k6s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < pendulum_angle_k6s3_S * pendulum_angle_k6s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
 }
 
 void pendulum_angle_k6s3_init(pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_real *q0, const pendulum_angle_k6s3_real *p0)
@@ -205,7 +205,7 @@ static double pendulum_angle_k6s3_err_est(const double *gam, double h, double d1
 static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, int cold, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
+  double gam[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M], sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_angle_k6s3_ENOCONV;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
@@ -213,7 +213,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   pendulum_angle_k6s3_predict(x, h, cold, prm, gam);
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2];
-  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0;
+  double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
   for (it = 1; it <= pendulum_angle_k6s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -323,6 +323,9 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       sw2 = t91;
       /* dp */
       sw3 = t93;
+      /* theta */
+      sw4 = t76;
+      sw5 = t78;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -386,6 +389,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   sw[1] = sw1;
   sw[2] = sw2;
   sw[3] = sw3;
+  sw[4] = sw4;
+  sw[5] = sw5;
   est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it;
@@ -398,6 +403,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   /* pendulum_angle_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_angle_k6s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_angle_k6s3_ENONFINITE;
+  for (i = 0; i < (pendulum_angle_k6s3_S - 1) * pendulum_angle_k6s3_M; i++) /* the rest of p's polynomial, for pendulum_angle_k6s3_dense */
+    if (!isfinite(sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + i])) return pendulum_angle_k6s3_ENONFINITE;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -411,6 +418,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) x->pinc[i] = (double)sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
+  for (i = 0; i < (pendulum_angle_k6s3_S - 1) * pendulum_angle_k6s3_M; i++) x->pinc[pendulum_angle_k6s3_M + i] = (double)sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + pendulum_angle_k6s3_M + 3 * pendulum_angle_k6s3_NU + i];
   pendulum_angle_k6s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -499,4 +508,25 @@ int pendulum_angle_k6s3_project(pendulum_angle_k6s3_state *x, const pendulum_ang
   if (dq) *dq = 0;
   if (dp) *dp = 0;
   return pendulum_angle_k6s3_OK;
+}
+
+void pendulum_angle_k6s3_dense(const pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real theta, pendulum_angle_k6s3_real *q, pendulum_angle_k6s3_real *p)
+{
+  double L[pendulum_angle_k6s3_S + 1], w[pendulum_angle_k6s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_angle_k6s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_angle_k6s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_angle_k6s3_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_angle_k6s3_M + i];
+      dp += w[j] * x->pinc[j * pendulum_angle_k6s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

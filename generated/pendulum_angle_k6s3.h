@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_angle_k6s3_K 6      /* Gauss-Legendre nodes */
 #define pendulum_angle_k6s3_S 3      /* polynomial degree */
 #define pendulum_angle_k6s3_NPARAMS 0
+#define pendulum_angle_k6s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_angle_k6s3_step; on any nonzero code the state is unchanged. */
 #define pendulum_angle_k6s3_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_angle_k6s3_real tc, qc[1], pc[1], gam[3], hprev;
   pendulum_angle_k6s3_real gam2[3], hprev2;
+  pendulum_angle_k6s3_real pinc[3];  /* p's polynomial over the last step, for pendulum_angle_k6s3_dense */
 } pendulum_angle_k6s3_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * pendulum_angle_k6s3_HMIN (1 + |t|). */
 int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after pendulum_angle_k6s3_project) it gives the state. */
+void pendulum_angle_k6s3_dense(const pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real theta, pendulum_angle_k6s3_real *q, pendulum_angle_k6s3_real *p);
 const char *pendulum_angle_k6s3_strerror(int code);
 pendulum_angle_k6s3_real pendulum_angle_k6s3_energy(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm);
 void pendulum_angle_k6s3_constraints(const pendulum_angle_k6s3_state *x, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_real *g);   /* pendulum_angle_k6s3_NU values */

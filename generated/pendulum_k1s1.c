@@ -180,7 +180,7 @@ void pendulum_k1s1_init_params(pendulum_k1s1_state *x, const pendulum_k1s1_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k1s1_NU ? pendulum_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[pendulum_k1s1_NU];
     pendulum_k1s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -438,6 +438,8 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
   /* pendulum_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k1s1_ENONFINITE;
+  for (i = 0; i < (pendulum_k1s1_S - 1) * pendulum_k1s1_M; i++) /* the rest of p's polynomial, for pendulum_k1s1_dense */
+    if (!isfinite(sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + i])) return pendulum_k1s1_ENONFINITE;
   for (i = 0; i < pendulum_k1s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k1s1_S * pendulum_k1s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -451,6 +453,8 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < pendulum_k1s1_M; i++) x->pinc[i] = (double)sw[pendulum_k1s1_S * pendulum_k1s1_M + i];
+  for (i = 0; i < (pendulum_k1s1_S - 1) * pendulum_k1s1_M; i++) x->pinc[pendulum_k1s1_M + i] = (double)sw[pendulum_k1s1_S * pendulum_k1s1_M + pendulum_k1s1_M + 3 * pendulum_k1s1_NU + i];
   pendulum_k1s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -576,7 +580,7 @@ int pendulum_k1s1_project(pendulum_k1s1_state *x, const pendulum_k1s1_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k1s1_S * pendulum_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[pendulum_k1s1_NU];
@@ -586,4 +590,25 @@ int pendulum_k1s1_project(pendulum_k1s1_state *x, const pendulum_k1s1_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_k1s1_OK;
+}
+
+void pendulum_k1s1_dense(const pendulum_k1s1_state *x, pendulum_k1s1_real theta, pendulum_k1s1_real *q, pendulum_k1s1_real *p)
+{
+  double L[pendulum_k1s1_S + 1], w[pendulum_k1s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_k1s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_k1s1_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_k1s1_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_k1s1_M + i];
+      dp += w[j] * x->pinc[j * pendulum_k1s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

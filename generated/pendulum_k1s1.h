@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_k1s1_K 1      /* Gauss-Legendre nodes */
 #define pendulum_k1s1_S 1      /* polynomial degree */
 #define pendulum_k1s1_NPARAMS 0
+#define pendulum_k1s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_k1s1_step; on any nonzero code the state is unchanged. */
 #define pendulum_k1s1_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_k1s1_real tc, qc[2], pc[2], gam[2], hprev;
   pendulum_k1s1_real gam2[2], hprev2;
+  pendulum_k1s1_real pinc[2];  /* p's polynomial over the last step, for pendulum_k1s1_dense */
 } pendulum_k1s1_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendu
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * pendulum_k1s1_HMIN (1 + |t|). */
 int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, pendulum_k1s1_real tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after pendulum_k1s1_project) it gives the state. */
+void pendulum_k1s1_dense(const pendulum_k1s1_state *x, pendulum_k1s1_real theta, pendulum_k1s1_real *q, pendulum_k1s1_real *p);
 const char *pendulum_k1s1_strerror(int code);
 pendulum_k1s1_real pendulum_k1s1_energy(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm);
 void pendulum_k1s1_constraints(const pendulum_k1s1_state *x, const pendulum_k1s1_params *prm, pendulum_k1s1_real *g);   /* pendulum_k1s1_NU values */

@@ -181,7 +181,7 @@ void pendulum_k2s2_init_params(pendulum_k2s2_state *x, const pendulum_k2s2_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k2s2_NU ? pendulum_k2s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[pendulum_k2s2_NU];
     pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -304,7 +304,7 @@ static double pendulum_k2s2_err_est(const double *gam, double h, double d1, int 
 static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real h_, double tol, int cold, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];
+  double gam[pendulum_k2s2_S * pendulum_k2s2_M], sw[pendulum_k2s2_S * pendulum_k2s2_M + 2 * pendulum_k2s2_M + 3 * pendulum_k2s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k2s2_ENOCONV;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
@@ -319,7 +319,7 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0;
   for (it = 1; it <= pendulum_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
@@ -399,6 +399,9 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       sw7 = t24;
       /* adiag */
       sw8 = t24;
+      /* theta */
+      sw9 = t38;
+      sw10 = t39;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -480,6 +483,8 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
   sw[6] = sw6;
   sw[7] = sw7;
   sw[8] = sw8;
+  sw[9] = sw9;
+  sw[10] = sw10;
   est = pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_k2s2_MAXITER ? pendulum_k2s2_MAXITER : it;
@@ -492,6 +497,8 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
   /* pendulum_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k2s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k2s2_ENONFINITE;
+  for (i = 0; i < (pendulum_k2s2_S - 1) * pendulum_k2s2_M; i++) /* the rest of p's polynomial, for pendulum_k2s2_dense */
+    if (!isfinite(sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + i])) return pendulum_k2s2_ENONFINITE;
   for (i = 0; i < pendulum_k2s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k2s2_S * pendulum_k2s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -505,6 +512,8 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < pendulum_k2s2_M; i++) x->pinc[i] = (double)sw[pendulum_k2s2_S * pendulum_k2s2_M + i];
+  for (i = 0; i < (pendulum_k2s2_S - 1) * pendulum_k2s2_M; i++) x->pinc[pendulum_k2s2_M + i] = (double)sw[pendulum_k2s2_S * pendulum_k2s2_M + pendulum_k2s2_M + 3 * pendulum_k2s2_NU + i];
   pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -630,7 +639,7 @@ int pendulum_k2s2_project(pendulum_k2s2_state *x, const pendulum_k2s2_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k2s2_S * pendulum_k2s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[pendulum_k2s2_NU];
@@ -640,4 +649,25 @@ int pendulum_k2s2_project(pendulum_k2s2_state *x, const pendulum_k2s2_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_k2s2_OK;
+}
+
+void pendulum_k2s2_dense(const pendulum_k2s2_state *x, pendulum_k2s2_real theta, pendulum_k2s2_real *q, pendulum_k2s2_real *p)
+{
+  double L[pendulum_k2s2_S + 1], w[pendulum_k2s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_k2s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_k2s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_k2s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_k2s2_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_k2s2_M + i];
+      dp += w[j] * x->pinc[j * pendulum_k2s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_k2s2_K 2      /* Gauss-Legendre nodes */
 #define pendulum_k2s2_S 2      /* polynomial degree */
 #define pendulum_k2s2_NPARAMS 0
+#define pendulum_k2s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_k2s2_step; on any nonzero code the state is unchanged. */
 #define pendulum_k2s2_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_k2s2_real tc, qc[2], pc[2], gam[4], hprev;
   pendulum_k2s2_real gam2[4], hprev2;
+  pendulum_k2s2_real pinc[4];  /* p's polynomial over the last step, for pendulum_k2s2_dense */
 } pendulum_k2s2_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h, const pendu
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * pendulum_k2s2_HMIN (1 + |t|). */
 int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, pendulum_k2s2_real tol, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after pendulum_k2s2_project) it gives the state. */
+void pendulum_k2s2_dense(const pendulum_k2s2_state *x, pendulum_k2s2_real theta, pendulum_k2s2_real *q, pendulum_k2s2_real *p);
 const char *pendulum_k2s2_strerror(int code);
 pendulum_k2s2_real pendulum_k2s2_energy(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm);
 void pendulum_k2s2_constraints(const pendulum_k2s2_state *x, const pendulum_k2s2_params *prm, pendulum_k2s2_real *g);   /* pendulum_k2s2_NU values */

@@ -40,6 +40,15 @@ static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt
   return rc;
 }
 
+static void dense(const void *x, double theta, void *y)
+{
+  const pendulum_k2s2_state *a = x;
+  pendulum_k2s2_state *b = y;
+  *b = *a;
+  pendulum_k2s2_dense(a, theta, b->q, b->p);
+  b->t = a->t - a->hprev * (1 - theta);
+}
+
 static const hbvmrt_param params[] = {
   {NULL, 0},
 };
@@ -57,6 +66,7 @@ int main(int argc, char **argv)
     init, params_default, step, pendulum_k2s2_strerror, energy, constraints, hidden, names,
     init_params, project, DBL_EPSILON,
     step_adaptive,
+    dense, 0, NULL, NULL, NULL,
   };
   return hbvmrt_main(&model, argc, argv);
 }

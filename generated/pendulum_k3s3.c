@@ -182,7 +182,7 @@ void pendulum_k3s3_init_params(pendulum_k3s3_state *x, const pendulum_k3s3_real 
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_k3s3_NU ? pendulum_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[pendulum_k3s3_NU];
     pendulum_k3s3_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -291,7 +291,7 @@ static double pendulum_k3s3_err_est(const double *gam, double h, double d1, int 
 static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real h_, double tol, int cold, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_k3s3_S * pendulum_k3s3_M], sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 3 * pendulum_k3s3_NU + 1];
+  double gam[pendulum_k3s3_S * pendulum_k3s3_M], sw[pendulum_k3s3_S * pendulum_k3s3_M + 3 * pendulum_k3s3_M + 3 * pendulum_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_k3s3_ENOCONV;
   pendulum_k3s3_DEFAULT_PARAMS(prm)
@@ -306,7 +306,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
   for (it = 1; it <= pendulum_k3s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
@@ -410,6 +410,11 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       sw9 = t34;
       /* adiag */
       sw10 = t34;
+      /* theta */
+      sw11 = t48;
+      sw12 = t49;
+      sw13 = t50;
+      sw14 = t51;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -503,6 +508,10 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
   sw[8] = sw8;
   sw[9] = sw9;
   sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
   est = pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_k3s3_MAXITER ? pendulum_k3s3_MAXITER : it;
@@ -515,6 +524,8 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
   /* pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_k3s3_ENONFINITE;
+  for (i = 0; i < (pendulum_k3s3_S - 1) * pendulum_k3s3_M; i++) /* the rest of p's polynomial, for pendulum_k3s3_dense */
+    if (!isfinite(sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 3 * pendulum_k3s3_NU + i])) return pendulum_k3s3_ENONFINITE;
   for (i = 0; i < pendulum_k3s3_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[pendulum_k3s3_S * pendulum_k3s3_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -528,6 +539,8 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < pendulum_k3s3_M; i++) x->pinc[i] = (double)sw[pendulum_k3s3_S * pendulum_k3s3_M + i];
+  for (i = 0; i < (pendulum_k3s3_S - 1) * pendulum_k3s3_M; i++) x->pinc[pendulum_k3s3_M + i] = (double)sw[pendulum_k3s3_S * pendulum_k3s3_M + pendulum_k3s3_M + 3 * pendulum_k3s3_NU + i];
   pendulum_k3s3_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -653,7 +666,7 @@ int pendulum_k3s3_project(pendulum_k3s3_state *x, const pendulum_k3s3_params *pr
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[pendulum_k3s3_NU];
@@ -663,4 +676,25 @@ int pendulum_k3s3_project(pendulum_k3s3_state *x, const pendulum_k3s3_params *pr
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_k3s3_OK;
+}
+
+void pendulum_k3s3_dense(const pendulum_k3s3_state *x, pendulum_k3s3_real theta, pendulum_k3s3_real *q, pendulum_k3s3_real *p)
+{
+  double L[pendulum_k3s3_S + 1], w[pendulum_k3s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_k3s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_k3s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_k3s3_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_k3s3_M + i];
+      dp += w[j] * x->pinc[j * pendulum_k3s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -252,8 +252,9 @@ void pendulum_poly_k1s1_init_params(pendulum_poly_k1s1_state *x, const pendulum_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k1s1_NU ? pendulum_poly_k1s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < pendulum_poly_k1s1_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k1s1_NU];
     pendulum_poly_k1s1_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -547,6 +548,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
   /* pendulum_poly_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_poly_k1s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k1s1_ENONFINITE;
+  for (i = 0; i < (pendulum_poly_k1s1_S - 1) * pendulum_poly_k1s1_M; i++) /* the rest of p's polynomial, for pendulum_poly_k1s1_dense */
+    if (!isfinite(sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + i])) return pendulum_poly_k1s1_ENONFINITE;
   double q1[pendulum_poly_k1s1_M], p1[pendulum_poly_k1s1_M], pr[pendulum_poly_k1s1_M + 2 + 2 * pendulum_poly_k1s1_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k1s1_energy(x, prm);
   double qc1[pendulum_poly_k1s1_M], pc1[pendulum_poly_k1s1_M];
@@ -558,6 +561,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
     pendulum_poly_k1s1_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k1s1_add(&p1[i], &pc1[i], sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + i]);
   }
+  double phat[pendulum_poly_k1s1_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < pendulum_poly_k1s1_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k1s1_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < pendulum_poly_k1s1_NU; i++) {
@@ -583,11 +588,14 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < pendulum_poly_k1s1_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + i];
+  for (i = 0; i < (pendulum_poly_k1s1_S - 1) * pendulum_poly_k1s1_M; i++) x->pinc[pendulum_poly_k1s1_M + i] = (double)sw[pendulum_poly_k1s1_S * pendulum_poly_k1s1_M + pendulum_poly_k1s1_M + pendulum_poly_k1s1_S * pendulum_poly_k1s1_NU + i];
   x->H0 = H0;
   {
     double lam[pendulum_poly_k1s1_NU];
@@ -719,9 +727,10 @@ int pendulum_poly_k1s1_project(pendulum_poly_k1s1_state *x, const pendulum_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < pendulum_poly_k1s1_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k1s1_NU];
     pendulum_poly_k1s1_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -730,4 +739,25 @@ int pendulum_poly_k1s1_project(pendulum_poly_k1s1_state *x, const pendulum_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_poly_k1s1_OK;
+}
+
+void pendulum_poly_k1s1_dense(const pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real theta, pendulum_poly_k1s1_real *q, pendulum_poly_k1s1_real *p)
+{
+  double L[pendulum_poly_k1s1_S + 1], w[pendulum_poly_k1s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_poly_k1s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_poly_k1s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_poly_k1s1_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_poly_k1s1_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_poly_k1s1_M + i];
+      dp += w[j] * x->pinc[j * pendulum_poly_k1s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

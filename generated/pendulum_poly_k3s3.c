@@ -495,8 +495,9 @@ void pendulum_poly_k3s3_init_params(pendulum_poly_k3s3_state *x, const pendulum_
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (pendulum_poly_k3s3_NU ? pendulum_poly_k3s3_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k3s3_NU];
     pendulum_poly_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -634,7 +635,7 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1,
 static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, int cold, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
 {
   const double h = (double)h_;
-  double gam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
+  double gam[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + 3 * pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = pendulum_poly_k3s3_ENOCONV;
   pendulum_poly_k3s3_DEFAULT_PARAMS(prm)
@@ -661,7 +662,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
   /* the iteration's values in locals: gamma, the sweep's results, the multiplier */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
-    sw8 = 0, sw9 = 0, sw10 = 0;
+    sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0, sw12 = 0, sw13 = 0, sw14 = 0;
   double lm0 = 0, lm1 = 0, lm2 = 0;
   for (it = 1; it <= pendulum_poly_k3s3_MAXITER; it++) {
     /* the frozen factor converges as fast as a fresh one every sweep while h is
@@ -938,6 +939,11 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
       sw8 = t162;
       sw9 = t163;
       sw10 = t164;
+      /* theta */
+      sw11 = t200;
+      sw12 = t202;
+      sw13 = t204;
+      sw14 = t206;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;
@@ -1032,6 +1038,10 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
   sw[8] = sw8;
   sw[9] = sw9;
   sw[10] = sw10;
+  sw[11] = sw11;
+  sw[12] = sw12;
+  sw[13] = sw13;
+  sw[14] = sw14;
   est = pendulum_poly_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
   if (st) {
     st->iters = it > pendulum_poly_k3s3_MAXITER ? pendulum_poly_k3s3_MAXITER : it;
@@ -1044,6 +1054,8 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
   /* pendulum_poly_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return pendulum_poly_k3s3_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k3s3_ENONFINITE;
+  for (i = 0; i < (pendulum_poly_k3s3_S - 1) * pendulum_poly_k3s3_M; i++) /* the rest of p's polynomial, for pendulum_poly_k3s3_dense */
+    if (!isfinite(sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + i])) return pendulum_poly_k3s3_ENONFINITE;
   double q1[pendulum_poly_k3s3_M], p1[pendulum_poly_k3s3_M], pr[pendulum_poly_k3s3_M + 2 + 2 * pendulum_poly_k3s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k3s3_energy(x, prm);
   double qc1[pendulum_poly_k3s3_M], pc1[pendulum_poly_k3s3_M];
@@ -1055,6 +1067,8 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     pendulum_poly_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k3s3_add(&p1[i], &pc1[i], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i]);
   }
+  double phat[pendulum_poly_k3s3_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   pendulum_poly_k3s3_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < pendulum_poly_k3s3_NU; i++) {
@@ -1080,11 +1094,14 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i];
+  for (i = 0; i < (pendulum_poly_k3s3_S - 1) * pendulum_poly_k3s3_M; i++) x->pinc[pendulum_poly_k3s3_M + i] = (double)sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + pendulum_poly_k3s3_M + pendulum_poly_k3s3_S * pendulum_poly_k3s3_NU + i];
   x->H0 = H0;
   {
     double lam[pendulum_poly_k3s3_NU];
@@ -1216,9 +1233,10 @@ int pendulum_poly_k3s3_project(pendulum_poly_k3s3_state *x, const pendulum_poly_
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = 0;
+  for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) x->pcorr[i] = 0;
   {
     double lam[pendulum_poly_k3s3_NU];
     pendulum_poly_k3s3_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -1227,4 +1245,25 @@ int pendulum_poly_k3s3_project(pendulum_poly_k3s3_state *x, const pendulum_poly_
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return pendulum_poly_k3s3_OK;
+}
+
+void pendulum_poly_k3s3_dense(const pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real theta, pendulum_poly_k3s3_real *q, pendulum_poly_k3s3_real *p)
+{
+  double L[pendulum_poly_k3s3_S + 1], w[pendulum_poly_k3s3_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < pendulum_poly_k3s3_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < pendulum_poly_k3s3_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < pendulum_poly_k3s3_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < pendulum_poly_k3s3_S; j++) {
+      dq += w[j] * x->gam[j * pendulum_poly_k3s3_M + i];
+      dp += w[j] * x->pinc[j * pendulum_poly_k3s3_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_poly_k3s3_K 3      /* Gauss-Legendre nodes */
 #define pendulum_poly_k3s3_S 3      /* polynomial degree */
 #define pendulum_poly_k3s3_NPARAMS 0
+#define pendulum_poly_k3s3_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_poly_k3s3_step; on any nonzero code the state is unchanged. */
 #define pendulum_poly_k3s3_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_poly_k3s3_real tc, qc[2], pc[2], gam[6], hprev;
   pendulum_poly_k3s3_real gam2[6], hprev2;
+  pendulum_poly_k3s3_real pinc[6];  /* p's polynomial over the last step, for pendulum_poly_k3s3_dense */
   pendulum_poly_k3s3_real H0;  /* the energy the step keeps */
+  pendulum_poly_k3s3_real pcorr[2];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } pendulum_poly_k3s3_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * pendulum_poly_k3s3_HMIN (1 + |t|). */
 int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real *h, pendulum_poly_k3s3_real tol, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after pendulum_poly_k3s3_project) it gives the state. */
+void pendulum_poly_k3s3_dense(const pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real theta, pendulum_poly_k3s3_real *q, pendulum_poly_k3s3_real *p);
 const char *pendulum_poly_k3s3_strerror(int code);
 pendulum_poly_k3s3_real pendulum_poly_k3s3_energy(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm);
 void pendulum_poly_k3s3_constraints(const pendulum_poly_k3s3_state *x, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_real *g);   /* pendulum_poly_k3s3_NU values */

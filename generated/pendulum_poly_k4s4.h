@@ -13,6 +13,7 @@ extern "C" {
 #define pendulum_poly_k4s4_K 4      /* Gauss-Legendre nodes */
 #define pendulum_poly_k4s4_S 4      /* polynomial degree */
 #define pendulum_poly_k4s4_NPARAMS 0
+#define pendulum_poly_k4s4_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of pendulum_poly_k4s4_step; on any nonzero code the state is unchanged. */
 #define pendulum_poly_k4s4_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_poly_k4s4_real tc, qc[2], pc[2], gam[8], hprev;
   pendulum_poly_k4s4_real gam2[8], hprev2;
+  pendulum_poly_k4s4_real pinc[8];  /* p's polynomial over the last step, for pendulum_poly_k4s4_dense */
   pendulum_poly_k4s4_real H0;  /* the energy the step keeps */
+  pendulum_poly_k4s4_real pcorr[2];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } pendulum_poly_k4s4_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * pendulum_poly_k4s4_HMIN (1 + |t|). */
 int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, pendulum_poly_k4s4_real tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after pendulum_poly_k4s4_project) it gives the state. */
+void pendulum_poly_k4s4_dense(const pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real theta, pendulum_poly_k4s4_real *q, pendulum_poly_k4s4_real *p);
 const char *pendulum_poly_k4s4_strerror(int code);
 pendulum_poly_k4s4_real pendulum_poly_k4s4_energy(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm);
 void pendulum_poly_k4s4_constraints(const pendulum_poly_k4s4_state *x, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_real *g);   /* pendulum_poly_k4s4_NU values */

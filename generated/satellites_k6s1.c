@@ -715,7 +715,7 @@ void satellites_k6s1_init_params(satellites_k6s1_state *x, const satellites_k6s1
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_k6s1_NU ? satellites_k6s1_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[satellites_k6s1_NU];
     satellites_k6s1_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -1932,6 +1932,8 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
   /* satellites_k6s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_k6s1_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s1_ENONFINITE;
+  for (i = 0; i < (satellites_k6s1_S - 1) * satellites_k6s1_M; i++) /* the rest of p's polynomial, for satellites_k6s1_dense */
+    if (!isfinite(sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + i])) return satellites_k6s1_ENONFINITE;
   for (i = 0; i < satellites_k6s1_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s1_S * satellites_k6s1_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -1945,6 +1947,8 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < satellites_k6s1_M; i++) x->pinc[i] = (double)sw[satellites_k6s1_S * satellites_k6s1_M + i];
+  for (i = 0; i < (satellites_k6s1_S - 1) * satellites_k6s1_M; i++) x->pinc[satellites_k6s1_M + i] = (double)sw[satellites_k6s1_S * satellites_k6s1_M + satellites_k6s1_M + 3 * satellites_k6s1_NU + i];
   satellites_k6s1_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -2070,7 +2074,7 @@ int satellites_k6s1_project(satellites_k6s1_state *x, const satellites_k6s1_para
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[satellites_k6s1_NU];
@@ -2080,4 +2084,25 @@ int satellites_k6s1_project(satellites_k6s1_state *x, const satellites_k6s1_para
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return satellites_k6s1_OK;
+}
+
+void satellites_k6s1_dense(const satellites_k6s1_state *x, satellites_k6s1_real theta, satellites_k6s1_real *q, satellites_k6s1_real *p)
+{
+  double L[satellites_k6s1_S + 1], w[satellites_k6s1_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < satellites_k6s1_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < satellites_k6s1_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < satellites_k6s1_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_k6s1_S; j++) {
+      dq += w[j] * x->gam[j * satellites_k6s1_M + i];
+      dp += w[j] * x->pinc[j * satellites_k6s1_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define satellites_k6s1_K 6      /* Gauss-Legendre nodes */
 #define satellites_k6s1_S 1      /* polynomial degree */
 #define satellites_k6s1_NPARAMS 0
+#define satellites_k6s1_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of satellites_k6s1_step; on any nonzero code the state is unchanged. */
 #define satellites_k6s1_OK 0
@@ -28,6 +29,7 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_k6s1_real tc, qc[9], pc[9], gam[9], hprev;
   satellites_k6s1_real gam2[9], hprev2;
+  satellites_k6s1_real pinc[9];  /* p's polynomial over the last step, for satellites_k6s1_dense */
 } satellites_k6s1_state;
 
 typedef struct {
@@ -61,6 +63,11 @@ int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h, const
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * satellites_k6s1_HMIN (1 + |t|). */
 int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real *h, satellites_k6s1_real tol, const satellites_k6s1_params *prm, satellites_k6s1_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after satellites_k6s1_project) it gives the state. */
+void satellites_k6s1_dense(const satellites_k6s1_state *x, satellites_k6s1_real theta, satellites_k6s1_real *q, satellites_k6s1_real *p);
 const char *satellites_k6s1_strerror(int code);
 satellites_k6s1_real satellites_k6s1_energy(const satellites_k6s1_state *x, const satellites_k6s1_params *prm);
 void satellites_k6s1_constraints(const satellites_k6s1_state *x, const satellites_k6s1_params *prm, satellites_k6s1_real *g);   /* satellites_k6s1_NU values */

@@ -49,7 +49,7 @@ static const double satellites_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 
 static const double satellites_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
 /* One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),
- * pivots of the LU of A (NU), diagonal of A (NU). */
+ * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)). */
 static void satellites_k6s2_sweep(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const satellites_k6s2_params *prm, double *out)
 {
@@ -1458,6 +1458,16 @@ static void satellites_k6s2_sweep(const double *q0, const double *p0, const doub
   out[33] = t912;
   out[34] = t1020;
   out[35] = t1108;
+  /* theta */
+  out[36] = t1253;
+  out[37] = t1255;
+  out[38] = t1257;
+  out[39] = t1241;
+  out[40] = t1243;
+  out[41] = t1245;
+  out[42] = t1259;
+  out[43] = t1261;
+  out[44] = t1263;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -2127,7 +2137,7 @@ void satellites_k6s2_init_params(satellites_k6s2_state *x, const satellites_k6s2
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_k6s2_NU ? satellites_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   {
     double lam[satellites_k6s2_NU];
     satellites_k6s2_lambda0(x->q, x->p, 0, 0, 0, prm, lam);
@@ -2250,7 +2260,7 @@ static double satellites_k6s2_err_est(const double *gam, double h, double d1, in
 static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2_real h_, double tol, int cold, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
+  double gam[satellites_k6s2_S * satellites_k6s2_M], sw[satellites_k6s2_S * satellites_k6s2_M + 2 * satellites_k6s2_M + 3 * satellites_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_k6s2_ENOCONV;
   satellites_k6s2_DEFAULT_PARAMS(prm)
@@ -2329,6 +2339,8 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
   /* satellites_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_k6s2_ENONFINITE;
+  for (i = 0; i < (satellites_k6s2_S - 1) * satellites_k6s2_M; i++) /* the rest of p's polynomial, for satellites_k6s2_dense */
+    if (!isfinite(sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + i])) return satellites_k6s2_ENONFINITE;
   for (i = 0; i < satellites_k6s2_M; i++) /* the new state must be finite too, compensations included */
     if (!isfinite(x->q[i] + h * sw[i]) || !isfinite(x->p[i] + sw[satellites_k6s2_S * satellites_k6s2_M + i]) ||
         !isfinite(x->qc[i]) || !isfinite(x->pc[i]))
@@ -2342,6 +2354,8 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < satellites_k6s2_M; i++) x->pinc[i] = (double)sw[satellites_k6s2_S * satellites_k6s2_M + i];
+  for (i = 0; i < (satellites_k6s2_S - 1) * satellites_k6s2_M; i++) x->pinc[satellites_k6s2_M + i] = (double)sw[satellites_k6s2_S * satellites_k6s2_M + satellites_k6s2_M + 3 * satellites_k6s2_NU + i];
   satellites_k6s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
   x->hprev = h;
@@ -2467,7 +2481,7 @@ int satellites_k6s2_project(satellites_k6s2_state *x, const satellites_k6s2_para
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   {
     double lam[satellites_k6s2_NU];
@@ -2477,4 +2491,25 @@ int satellites_k6s2_project(satellites_k6s2_state *x, const satellites_k6s2_para
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return satellites_k6s2_OK;
+}
+
+void satellites_k6s2_dense(const satellites_k6s2_state *x, satellites_k6s2_real theta, satellites_k6s2_real *q, satellites_k6s2_real *p)
+{
+  double L[satellites_k6s2_S + 1], w[satellites_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < satellites_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < satellites_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < satellites_k6s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * satellites_k6s2_M + i];
+      dp += w[j] * x->pinc[j * satellites_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp);
+  }
 }

@@ -52,7 +52,7 @@ static const double satellites_poly_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 2
 static const double satellites_poly_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
 
 /* One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),
- * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU). */
+ * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)). */
 static void satellites_poly_k6s2_sweep_part0(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s2_params *prm, double *w, double *out)
 {
@@ -2323,6 +2323,16 @@ static void satellites_poly_k6s2_sweep_part1(const double *q0, const double *p0,
   out[24] = t2167;
   out[25] = t2169;
   out[26] = t2171;
+  /* theta */
+  out[33] = t2065;
+  out[34] = t2067;
+  out[35] = t2069;
+  out[36] = t2071;
+  out[37] = t2073;
+  out[38] = t2075;
+  out[39] = t2077;
+  out[40] = t2079;
+  out[41] = t2081;
 }
 
 /* sweep: the 2 parts above in order */
@@ -4889,8 +4899,9 @@ void satellites_poly_k6s2_init_params(satellites_poly_k6s2_state *x, const satel
     x->qc[i] = x->pc[i] = 0;
   }
   for (i = 0; i < (satellites_poly_k6s2_NU ? satellites_poly_k6s2_NU : 1); i++) x->lambda[i] = 0;
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = x->gam2[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;
   x->H0 = 0;  /* taken at the first step */
+  for (i = 0; i < satellites_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[satellites_poly_k6s2_NU];
     satellites_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -5028,7 +5039,7 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
 static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, int cold, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   const double h = (double)h_;
-  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
+  double gam[satellites_poly_k6s2_S * satellites_poly_k6s2_M], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + 2 * satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + 1];
   double inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;
   int it, i, stall = 0, rc = satellites_poly_k6s2_ENOCONV;
   satellites_poly_k6s2_DEFAULT_PARAMS(prm)
@@ -5131,6 +5142,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
   /* satellites_poly_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
   if (tol > 0 && !(est <= tol * (1 + scale))) return satellites_poly_k6s2_EREJECT;
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s2_ENONFINITE;
+  for (i = 0; i < (satellites_poly_k6s2_S - 1) * satellites_poly_k6s2_M; i++) /* the rest of p's polynomial, for satellites_poly_k6s2_dense */
+    if (!isfinite(sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + i])) return satellites_poly_k6s2_ENONFINITE;
   double q1[satellites_poly_k6s2_M], p1[satellites_poly_k6s2_M], pr[satellites_poly_k6s2_M + 2 + 2 * satellites_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s2_energy(x, prm);
   double qc1[satellites_poly_k6s2_M], pc1[satellites_poly_k6s2_M];
@@ -5142,6 +5155,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     satellites_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     satellites_poly_k6s2_add(&p1[i], &pc1[i], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i]);
   }
+  double phat[satellites_poly_k6s2_M];  /* p1 before the projection, the end of p's polynomial */
+  for (i = 0; i < satellites_poly_k6s2_M; i++) phat[i] = p1[i];
   /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */
   satellites_poly_k6s2_project_p1(q1, p1, 0, 0, 0, 0, 0, prm, pr);
   for (i = 0; i < satellites_poly_k6s2_NU; i++) {
@@ -5167,11 +5182,14 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     x->p[i] = p1[i];
     x->qc[i] = qc1[i];
     x->pc[i] = pc1[i];
+    x->pcorr[i] = (double)(p1[i] - phat[i]);
   }
   for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
     x->gam2[i] = x->gam[i];
     x->gam[i] = gam[i];
   }
+  for (i = 0; i < satellites_poly_k6s2_M; i++) x->pinc[i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i];
+  for (i = 0; i < (satellites_poly_k6s2_S - 1) * satellites_poly_k6s2_M; i++) x->pinc[satellites_poly_k6s2_M + i] = (double)sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + satellites_poly_k6s2_M + satellites_poly_k6s2_S * satellites_poly_k6s2_NU + i];
   x->H0 = H0;
   {
     double lam[satellites_poly_k6s2_NU];
@@ -5303,9 +5321,10 @@ int satellites_poly_k6s2_project(satellites_poly_k6s2_state *x, const satellites
     x->p[i] = p[i];
     x->qc[i] = x->pc[i] = 0;
   }
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = 0;
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) x->gam[i] = x->pinc[i] = 0;
   x->hprev = 0;  /* the next step starts afresh, as after init */
   x->H0 = 0;
+  for (i = 0; i < satellites_poly_k6s2_M; i++) x->pcorr[i] = 0;
   {
     double lam[satellites_poly_k6s2_NU];
     satellites_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
@@ -5314,4 +5333,25 @@ int satellites_poly_k6s2_project(satellites_poly_k6s2_state *x, const satellites
   if (dq) *dq = dqmax;
   if (dp) *dp = dpmax;
   return satellites_poly_k6s2_OK;
+}
+
+void satellites_poly_k6s2_dense(const satellites_poly_k6s2_state *x, satellites_poly_k6s2_real theta, satellites_poly_k6s2_real *q, satellites_poly_k6s2_real *p)
+{
+  double L[satellites_poly_k6s2_S + 1], w[satellites_poly_k6s2_S], u = 2 * theta - 1;
+  int i, j;
+  /* w_j = int_theta^1 P_j: 1 - theta, and (L_{j-1} - L_{j+1}) / (2 sqrt(2j+1)) */
+  L[0] = 1;
+  L[1] = u;
+  for (j = 1; j < satellites_poly_k6s2_S; j++) L[j + 1] = ((2 * j + 1) * u * L[j] - j * L[j - 1]) / (j + 1);
+  w[0] = 1 - theta;
+  for (j = 1; j < satellites_poly_k6s2_S; j++) w[j] = (L[j - 1] - L[j + 1]) / (2 * sqrt((double)(2 * j + 1)));
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
+    double dq = w[0] * x->gam[i], dp = 0;
+    for (j = 1; j < satellites_poly_k6s2_S; j++) {
+      dq += w[j] * x->gam[j * satellites_poly_k6s2_M + i];
+      dp += w[j] * x->pinc[j * satellites_poly_k6s2_M + i];
+    }
+    q[i] = x->q[i] - x->hprev * dq;
+    p[i] = x->p[i] - (w[0] * x->pinc[i] - x->hprev * dp) - (1 - theta) * x->pcorr[i];
+  }
 }

@@ -13,6 +13,7 @@ extern "C" {
 #define satellites_poly_k6s2_K 6      /* Gauss-Legendre nodes */
 #define satellites_poly_k6s2_S 2      /* polynomial degree */
 #define satellites_poly_k6s2_NPARAMS 0
+#define satellites_poly_k6s2_NEVENTS 0  /* event functions (docs/language.md) */
 
 /* Return codes of satellites_poly_k6s2_step; on any nonzero code the state is unchanged. */
 #define satellites_poly_k6s2_OK 0
@@ -28,7 +29,9 @@ typedef struct {
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_poly_k6s2_real tc, qc[9], pc[9], gam[18], hprev;
   satellites_poly_k6s2_real gam2[18], hprev2;
+  satellites_poly_k6s2_real pinc[18];  /* p's polynomial over the last step, for satellites_poly_k6s2_dense */
   satellites_poly_k6s2_real H0;  /* the energy the step keeps */
+  satellites_poly_k6s2_real pcorr[9];  /* p1 minus p's polynomial at the end: the projection and rescale */
 } satellites_poly_k6s2_state;
 
 typedef struct {
@@ -62,6 +65,11 @@ int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * satellites_poly_k6s2_HMIN (1 + |t|). */
 int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real *h, satellites_poly_k6s2_real tol, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st);
+/* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
+ * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
+ * to the state at theta = 1 and to the state before the step at theta = 0. Before
+ * any step (or after satellites_poly_k6s2_project) it gives the state. */
+void satellites_poly_k6s2_dense(const satellites_poly_k6s2_state *x, satellites_poly_k6s2_real theta, satellites_poly_k6s2_real *q, satellites_poly_k6s2_real *p);
 const char *satellites_poly_k6s2_strerror(int code);
 satellites_poly_k6s2_real satellites_poly_k6s2_energy(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm);
 void satellites_poly_k6s2_constraints(const satellites_poly_k6s2_state *x, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_real *g);   /* satellites_poly_k6s2_NU values */

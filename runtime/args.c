@@ -1,7 +1,8 @@
 /* args.c - the standalone driver's options (SPEC section 4).
  *
  *   NAME [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..] [--p0 a,b,..]
- *        [--param name=value] [--project] [--csv FILE] [--quiet] [--help]
+ *        [--param name=value] [--project] [--csv FILE] [--tol TOL] [--dt DT]
+ *        [--events FILE] [--stop-at NAME[:COUNT]] [--quiet] [--help]
  *
  * Options are read left to right; a repeated option overrides the earlier one
  * (--param per name).  A value is the next argument, so `-h -0.01` works; it
@@ -20,7 +21,8 @@
 
 typedef enum {
   OPT_STEP, OPT_TIME, OPT_STEPS, OPT_EVERY, OPT_Q0, OPT_P0, OPT_PARAM,
-  OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT, OPT_TOL
+  OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT, OPT_TOL, OPT_DT, OPT_EVENTS,
+  OPT_STOP_AT
 } OptId;
 
 typedef struct {
@@ -34,7 +36,8 @@ static const Option options[] = {
   {"--every", OPT_EVERY, 1}, {"--q0", OPT_Q0, 1},    {"--p0", OPT_P0, 1},
   {"--param", OPT_PARAM, 1}, {"--csv", OPT_CSV, 1},  {"--quiet", OPT_QUIET, 0},
   {"--help", OPT_HELP, 0},   {"--project", OPT_PROJECT, 0},
-  {"--tol", OPT_TOL, 1},
+  {"--tol", OPT_TOL, 1},      {"--dt", OPT_DT, 1},    {"--events", OPT_EVENTS, 1},
+  {"--stop-at", OPT_STOP_AT, 1},
 };
 
 /* What was seen on the way, for the checks that need all options. */
@@ -236,7 +239,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
   fprintf(out,
     "usage: %s [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..]\n"
     "       %*s [--p0 a,b,..] [--param name=value] [--project] [--csv FILE]\n"
-    "       %*s [--tol TOL] [--quiet]\n"
+    "       %*s [--tol TOL] [--dt DT] [--events FILE] [--stop-at NAME[:COUNT]]\n"
+    "       %*s [--quiet]\n"
     "\n"
     "Integrates the model %s (m=%d coordinates, nu=%d constraints) with the\n"
     "HBVM(k=%d,s=%d) line integral method, N steps of the constant step h.\n"
@@ -249,7 +253,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --every K          a CSV row every K steps, K >= 1; t=0 and the last\n"
     "                     step are always written (default 1)\n"
     "  --q0 a,b,..        initial positions, %d values (default ",
-    md->name, (int)strlen(md->name), "", (int)strlen(md->name), "", md->name, md->m, md->nu, md->k,
+    md->name, (int)strlen(md->name), "", (int)strlen(md->name), "", (int)strlen(md->name), "", md->name, md->m,
+    md->nu, md->k,
     md->s, HBVMRT_DEFAULT_H, HBVMRT_DEFAULT_T, md->m);
   print_vector(out, md->q0, md->m);
   fprintf(out, ")\n  --p0 a,b,..        initial momenta, %d values (default ",
@@ -267,6 +272,15 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "                     0.01 TOL |h| (1 + max|q|), so that the error at T is\n"
     "                     about TOL T (1 + max|q|); -h is the first step, -T is\n"
     "                     hit exactly; --every K counts the steps taken\n"
+    "  --dt DT            CSV rows at t = 0, DT, 2 DT, .. (DT > 0) from the\n"
+    "                     dense output inside the steps, whatever the steps\n"
+    "                     are, instead of a row per step (--every)\n"
+    "  --events FILE      write each event of the model when it occurs, as\n"
+    "                     rows event,t,x..,p_x.. ('-' for stdout), located to\n"
+    "                     1e-12 relative in t\n"
+    "  --stop-at NAME[:COUNT]  end the run at the COUNT-th (default 1st)\n"
+    "                     occurrence of the event NAME, its state the last\n"
+    "                     state of the run\n"
     "  --quiet            no progress line on a terminal\n"
     "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
     "                     (coordinates, p_ and a coordinate, params) and a row\n"
@@ -299,6 +313,39 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     return -1;
   }
   return 0;
+}
+
+/* An option that needs what the driver may lack: -1 after saying so. */
+static int needs(const hbvmrt_model *md, const char *opt, int have, const char *what)
+{
+  if (have)
+    return 0;
+  hbvmrt_error(md, "%s needs a model with %s and a driver from hbvmgen with them", opt, what);
+  return -1;
+}
+
+/* --stop-at NAME[:COUNT]: an event of the model, COUNT >= 1 (default 1). */
+static int parse_stop_at(const hbvmrt_model *md, const char *val, hbvmrt_opts *o)
+{
+  const char *colon = strchr(val, ':');
+  size_t len = colon ? (size_t)(colon - val) : strlen(val);
+  int i;
+
+  if (needs(md, "--stop-at", md->nevents > 0, "events ('event NAME = ...' in the model)") != 0)
+    return -1;
+  o->stop_count = 1;
+  if (colon && parse_count(md, "--stop-at", colon + 1, 1, &o->stop_count) != 0)
+    return -1;
+  for (i = 0; i < md->nevents; i++)
+    if (strlen(md->event_names[i]) == len && !strncmp(md->event_names[i], val, len)) {
+      o->stop_event = i;
+      return 0;
+    }
+  fprintf(stderr, "%s: error: --stop-at: the model has no event '%.*s'; its events:", md->name, (int)len, val);
+  for (i = 0; i < md->nevents; i++)
+    fprintf(stderr, " %s", md->event_names[i]);
+  fputc('\n', stderr);
+  return -1;
 }
 
 /* Store one option's value in o (or seen); -1 after reporting an error. */
@@ -356,6 +403,19 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
       return -1;
     }
     return 0;
+  case OPT_DT:
+    if (parse_number(md, op->name, val, &o->dt) != 0)
+      return -1;
+    if (!(o->dt > 0)) {
+      hbvmrt_error(md, "--dt must be > 0 (got %s)", val);
+      return -1;
+    }
+    return needs(md, op->name, md->dense != NULL, "dense output");
+  case OPT_EVENTS:
+    o->events = val;
+    return needs(md, op->name, md->nevents > 0, "events ('event NAME = ...' in the model)");
+  case OPT_STOP_AT:
+    return parse_stop_at(md, val, o);
   case OPT_HELP:
     break;
   }
@@ -406,6 +466,7 @@ int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
   memset(o, 0, sizeof *o);
   o->h = HBVMRT_DEFAULT_H;
   o->every = 1;
+  o->stop_event = -1;
   o->param_val = calloc(np, sizeof *o->param_val);
   o->param_set = calloc(np, 1);
   if (!o->param_val || !o->param_set) {

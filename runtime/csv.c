@@ -9,7 +9,9 @@
  * reads back to the same doubles.  Errors are
  * not reported here: the functions return -1 once the stream is in error and
  * the caller says what failed. */
+#include <errno.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "hbvmrt_internal.h"
 
@@ -81,4 +83,41 @@ int hbvmrt_csv_row(FILE *f, const hbvmrt_model *md, const void *x, double H,
   values(f, hc, md->nu);
   fputc('\n', f);
   return ferror(f) ? -1 : 0;
+}
+
+/* The events CSV: event,t,x..,p_x.. (q1.., p1.. without names). */
+int hbvmrt_csv_event_header(FILE *f, const hbvmrt_model *md)
+{
+  fputs("event,t", f);
+  coords(f, md->names ? "" : "q", md);
+  coords(f, md->names ? "p_" : "p", md);
+  fputc('\n', f);
+  return ferror(f) ? -1 : 0;
+}
+
+/* One event's row: its name, the time and q, p of the state x at it. */
+int hbvmrt_csv_event_row(FILE *f, const hbvmrt_model *md, const char *name, const void *x)
+{
+  fprintf(f, "%s,%.17g", name, *at(x, md->off_t));
+  values(f, at(x, md->off_q), md->m);
+  values(f, at(x, md->off_p), md->m);
+  fputc('\n', f);
+  return ferror(f) ? -1 : 0;
+}
+
+/* An output file of the driver: path, or stdout for "-"; NULL (errno set)
+ * when it cannot be opened. */
+FILE *hbvmrt_out_open(const char *path)
+{
+  return strcmp(path, "-") == 0 ? stdout : fopen(path, "w");
+}
+
+/* Close it (stdout: flush); err, the errno of an earlier failed write or 0,
+ * is kept, else that of the close. Returns the errno of the failure, or 0. */
+int hbvmrt_out_close(FILE *f, int err)
+{
+  errno = 0;
+  if (f == stdout ? fflush(stdout) != 0 || ferror(stdout) : fclose(f) != 0)
+    err = err ? err : errno ? errno : EIO;
+  return err;
 }

@@ -65,6 +65,17 @@ typedef struct {
   /* NAME_step_adaptive (NULL in drivers generated before it: no --tol): a
    * step of at most *h within tol, *h the next step proposed on return. */
   int (*step_adaptive)(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st);
+  /* Dense output and events (NULL and 0 in drivers generated before them:
+   * no --dt, --events, --stop-at).  dense: y (a state block) becomes x at
+   * t - h (1 - theta), 0 <= theta <= 1, inside the last step h, its q and p
+   * from NAME_dense (y is for the functions above, never stepped); events:
+   * the nevents values of NAME_events at the state x; event_dirs: 0 any
+   * sign change counts, 1 rising only, -1 falling only. */
+  void (*dense)(const void *x, double theta, void *y);
+  int nevents;
+  const char *const *event_names;
+  const int *event_dirs;
+  void (*events)(const void *x, const void *prm, double *values);
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status

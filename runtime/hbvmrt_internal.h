@@ -46,6 +46,10 @@ typedef struct {
   const char *csv;     /* NULL: no CSV; "-": stdout */
   int quiet;           /* no progress line */
   int project;         /* --project: move q0, p0 onto the constraints */
+  double dt;           /* --dt: CSV rows on this grid of t from dense output (0: per step) */
+  const char *events;  /* --events FILE: the events CSV ("-": stdout), or NULL */
+  int stop_event;      /* --stop-at: the event that ends the run, or -1 */
+  long stop_count;     /* ... at its stop_count-th occurrence */
 } hbvmrt_opts;
 
 /* What hbvmrt_parse_args tells the caller to do next. */
@@ -68,6 +72,42 @@ void hbvmrt_error(const hbvmrt_model *md, const char *fmt, ...)
 int hbvmrt_csv_header(FILE *f, const hbvmrt_model *md);
 int hbvmrt_csv_row(FILE *f, const hbvmrt_model *md, const void *x, double H,
                    const double *g, const double *hc);
+
+/* csv.c: the events CSV, event,t,x..,p_x..; opening and closing an output */
+
+FILE *hbvmrt_out_open(const char *path);
+int hbvmrt_out_close(FILE *f, int err);
+
+int hbvmrt_csv_event_header(FILE *f, const hbvmrt_model *md);
+int hbvmrt_csv_event_row(FILE *f, const hbvmrt_model *md, const char *name, const void *x);
+
+/* events.c: the model's events inside the steps (--events, --stop-at) */
+
+typedef struct {
+  const hbvmrt_model *md;   /* NULL: events not wanted */
+  const void *prm;
+  double *v0, *v1, *vt;     /* the values at the step's start, end, scratch */
+  double *theta;            /* per event found in the step: where */
+  int *found;               /* the events found in the step, in time order */
+  long *count;              /* occurrences so far, per event */
+  void *y, *z;              /* scratch states: dense output, the event's state */
+  int stop_event;           /* --stop-at, or -1 */
+  long stop_count;
+  FILE *f;                  /* --events, or NULL */
+  const char *path;
+  int ferr;                 /* errno of the first failed write, or 0 */
+} hbvmrt_events;
+
+/* Set up for --events / --stop-at (nothing when neither is given) at the
+ * initial state x: 0, or -1 after reporting. */
+int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_opts *o, const void *prm,
+                       const void *x);
+/* After a step h from x0 to x: the events inside it written in time order;
+ * returns 1 when the --stop-at event occurred (x is then the state at it),
+ * -1 once writing failed, else 0. */
+int hbvmrt_events_step(hbvmrt_events *ev, const void *x0, void *x, double h);
+/* Close the events CSV: 0, or -1 after reporting a write error. */
+int hbvmrt_events_close(hbvmrt_events *ev);
 
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 

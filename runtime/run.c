@@ -11,6 +11,12 @@
  * halved stops the loop: the state it left is the last good one, written as
  * the final row, and the exit status is 2.
  *
+ * With --dt the rows are those of the grid t = k DT instead, from the dense
+ * output of the step that contains each (grid_rows); with --events or
+ * --stop-at each step is searched for events (events.c), which needs the
+ * state before the step (x0), and --stop-at ends the loop at the state of
+ * its event.
+ *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
  * a failed step), 2 a failed step. */
@@ -42,6 +48,10 @@ typedef struct {
   int fail_code;              /* the failed step's code, or 0 */
   FILE *csv;                  /* NULL: no CSV */
   int csv_errno;              /* errno of the first failed write, or 0 */
+  void *x0, *y;               /* the state before the step, a dense state (--dt, events) */
+  long grid_k;                /* --dt: the next row is at t = grid_k DT */
+  hbvmrt_events ev;           /* --events, --stop-at */
+  int stopped;                /* the --stop-at event ended the run */
 } Run;
 
 /* The progress line: drawn only on a terminal, after a second, at most ten
@@ -165,12 +175,21 @@ static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
   int status;
 
   memset(r, 0, sizeof *r);
+  r->grid_k = 1;              /* the row at t = 0 is the first */
   r->md = md;
   r->o = o;
   r->x = calloc(1, md->state_size + 1);
   r->prm = calloc(1, md->params_size + 1);
   r->g = calloc(nu + 1, sizeof *r->g);
   r->hc = calloc(nu + 1, sizeof *r->hc);
+  if (o->dt > 0 || o->events || o->stop_event >= 0) {
+    r->x0 = calloc(1, md->state_size + 1);
+    r->y = calloc(1, md->state_size + 1);
+    if (!r->x0 || !r->y) {
+      hbvmrt_error(md, "out of memory");
+      return 1;
+    }
+  }
   if (!r->x || !r->prm || !r->g || !r->hc) {
     hbvmrt_error(md, "out of memory");
     return 1;
@@ -198,6 +217,8 @@ static void teardown(Run *r)
   free(r->prm);
   free(r->g);
   free(r->hc);
+  free(r->x0);
+  free(r->y);
 }
 
 static const char *csv_name(const Run *r)
@@ -213,7 +234,7 @@ static int open_csv(Run *r)
 
   if (!path)
     return 0;
-  r->csv = strcmp(path, "-") == 0 ? stdout : fopen(path, "w");
+  r->csv = hbvmrt_out_open(path);
   if (!r->csv) {
     hbvmrt_error(r->md, "cannot open '%s': %s", path, strerror(errno));
     return -1;
@@ -238,14 +259,11 @@ static int write_row(Run *r)
  * whether it happened now or during the loop. */
 static int close_csv(Run *r)
 {
-  int err = r->csv_errno;
+  int err;
 
   if (!r->csv)
     return 0;
-  errno = 0;
-  if (r->csv == stdout ? fflush(stdout) != 0 || ferror(stdout)
-                       : fclose(r->csv) != 0)
-    err = err ? err : errno ? errno : EIO;
+  err = hbvmrt_out_close(r->csv, r->csv_errno);
   r->csv = NULL;
   if (!err)
     return 0;
@@ -313,7 +331,51 @@ static double state_t(const Run *r)
   return t;
 }
 
-/* A step of size h was taken: its figures into the run's. */
+/* A row per step, unless --dt writes the rows on its grid. */
+static int step_row(Run *r)
+{
+  return r->o->dt > 0 ? 0 : write_row(r);
+}
+
+/* --dt: the rows of the grid t = k DT (k = grid_k, ...) inside the step just
+ * taken, from r->x0 to r->x, through its dense output; the time written is
+ * the grid's (a point within round-off past the step's end is its end). */
+static void grid_rows(Run *r)
+{
+  const hbvmrt_model *md = r->md;
+  double t0, t1 = state_t(r), dt = r->o->dt;
+  int i;
+
+  memcpy(&t0, (const char *)r->x0 + md->off_t, sizeof t0);
+  for (;;) {
+    double dir = t1 < t0 ? -1 : 1, tk = dir * (double)r->grid_k * dt, theta, H;
+    if ((tk - t1) * dir > 1e-12 * (fabs(t1) + dt) || t1 == t0)
+      return;
+    theta = (tk - t0) / (t1 - t0);
+    md->dense(r->x, theta < 0 ? 0 : theta > 1 ? 1 : theta, r->y);
+    memcpy((char *)r->y + md->off_t, &tk, sizeof tk);
+    H = md->energy(r->y, r->prm);
+    for (i = 0; i < md->nu; i++)
+      r->g[i] = r->hc[i] = 0;
+    if (md->nu > 0) {
+      md->constraints(r->y, r->prm, r->g);
+      md->hidden(r->y, r->prm, r->hc);
+    }
+    if (r->csv && r->csv_errno == 0 && hbvmrt_csv_row(r->csv, md, r->y, H, r->g, r->hc) != 0)
+      r->csv_errno = errno ? errno : EIO;
+    r->grid_k++;
+  }
+}
+
+/* Before a step: the state it starts from, when events or --dt need it. */
+static void before_step(Run *r)
+{
+  if (r->x0)
+    memcpy(r->x0, r->x, r->md->state_size);
+}
+
+/* A step of size h was taken: its figures into the run's, its events (the
+ * --stop-at event moves the state back to it), its rows of the --dt grid. */
 static void taken(Run *r, const hbvmrt_stats *st, double h)
 {
   r->steps++;
@@ -324,7 +386,11 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
     r->h_min = fabs(h);
   if (fabs(h) > r->h_max)
     r->h_max = fabs(h);
+  if (r->ev.md && hbvmrt_events_step(&r->ev, r->x0, r->x, h) == 1)
+    r->stopped = 1;
   observe(r);
+  if (r->o->dt > 0)
+    grid_rows(r);
 }
 
 /* Advance the state by h: one step, or, when it fails, two halves, each of
@@ -340,6 +406,7 @@ static int advance(Run *r, double h, int depth)
   int code;
 
   memset(&st, 0, sizeof st);
+  before_step(r);
   code = md->step(r->x, h, r->prm, &st);
 
   if (code == 0) {
@@ -353,7 +420,7 @@ static int advance(Run *r, double h, int depth)
     fprintf(stderr, "%s: step h=%.6g failed at t=%.15g (%s): retrying with "
             "halved steps\n", md->name, h, state_t(r),
             md->strerror ? md->strerror(code) : "failed");
-  if ((code = advance(r, h / 2, depth + 1)) != 0)
+  if ((code = advance(r, h / 2, depth + 1)) != 0 || r->stopped)
     return code;
   return advance(r, target - state_t(r), depth + 1);
 }
@@ -379,27 +446,28 @@ static void loop_adaptive(Run *r, Progress *pg)
     memset(&st, 0, sizeof st);
     if (last)
       hn = rest;
+    before_step(r);
     code = md->step_adaptive(r->x, &hn, r->o->tol, r->prm, &st);
     r->rejected += st.rejected;
     if (code != 0) {
       r->fail_code = code;
       if (n % K != 0)
-        write_row(r);
+        step_row(r);
       return;
     }
     n++;
     taken(r, &st, st.h);
-    if (last && st.h == rest) {         /* taken whole: it ended on T */
-      write_row(r);
+    if (r->stopped || (last && st.h == rest)) {   /* at the event, or on T */
+      step_row(r);
       return;
     }
     h = hn;
-    if (n % K == 0 && write_row(r) != 0)
+    if (n % K == 0 && step_row(r) != 0)
       return;
     if (pg->on && n >= pg->next)
       progress_tick(pg, r, n);
   }
-  write_row(r);
+  step_row(r);
 }
 
 /* Rows at t=0, every K steps and at the last step taken; stops at the
@@ -419,10 +487,14 @@ static void loop(Run *r, Progress *pg)
     if (code != 0) {
       r->fail_code = code;
       if ((n - 1) % K != 0)
-        write_row(r);          /* the state the failed step left */
+        step_row(r);           /* the state the failed step left */
       return;
     }
-    if ((n % K == 0 || n == N) && write_row(r) != 0)
+    if (r->stopped) {          /* at the --stop-at event */
+      step_row(r);
+      return;
+    }
+    if ((n % K == 0 || n == N) && step_row(r) != 0)
       return;
     if (pg->on && n >= pg->next)
       progress_tick(pg, r, n);
@@ -478,6 +550,8 @@ static int simulate(Run *r)
   if (r->fail_code != 0)
     report_failure(r);
   out_failed = close_csv(r) != 0;
+  if (r->ev.md && hbvmrt_events_close(&r->ev) != 0)
+    out_failed = 1;
   summary(r, seconds);
   return out_failed ? 1 : r->fail_code != 0 ? 2 : 0;
 }
@@ -498,7 +572,9 @@ int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv)
   }
   status = setup(&r, model, &o);
   if (status == 0)
-    status = open_csv(&r) == 0 ? simulate(&r) : 1;
+    status = open_csv(&r) == 0 && hbvmrt_events_open(&r.ev, model, &o, r.prm, r.x) == 0 ? simulate(&r) : 1;
+  if (r.ev.md && status == 1)
+    hbvmrt_events_close(&r.ev);
   teardown(&r);
   hbvmrt_opts_free(&o);
   return status;

@@ -99,6 +99,24 @@ START_TEST(no_multiplier_code_without_constraints) {
 }
 END_TEST
 
+// A model without events has no event code (NAME_NEVENTS 0, no kernel,
+// no tables); one event adds one kernel result and one function.
+START_TEST(no_event_code_without_events) {
+  const char *model = "variables x, y\nU = y\ng = x^2 + y^2 - 1\nq0 = [0, -1]\np0 = [1, 0]\n";
+  char *src = generate_source(model, "-s 2");
+  ck_assert_ptr_nonnull(src);
+  ck_assert_msg(!strstr(src, "event"), "event code in a model without events");
+  free(src);
+  char with[256];
+  snprintf(with, sizeof with, "%sevent cross = x + p[2]\n", model);
+  src = generate_source(with, "-s 2");
+  ck_assert_ptr_nonnull(src);
+  ck_assert_msg(strstr(src, "_events(const") != NULL, "no NAME_events");
+  ck_assert_msg(strstr(src, "q0[0] /* x */ + p0[1] /* p_y */"), "the event is not x + p_y");
+  free(src);
+}
+END_TEST
+
 START_TEST(no_force_code_without_potential) {
   /* a free particle: gamma_0 = p0, nothing to compute in the sweep */
   char *src = generate_source("variables x, y, z\nq0 = [0, 0, 0]\np0 = [1, 2, 3]\n", "-s 3");
@@ -328,6 +346,7 @@ Suite *lean_suite(void) {
   tcase_set_timeout(tc, 180); /* the corpus compile takes ~20 s, more under the sanitizers */
   tcase_add_test(tc, equal_mass_matrices_give_equal_code);
   tcase_add_test(tc, dense_mass_is_a_table);
+  tcase_add_test(tc, no_event_code_without_events);
   tcase_add_test(tc, corpus_models_compile);
   tcase_add_test(tc, limits_settable_with_D);
   tcase_add_test(tc, no_multiplier_code_without_constraints);

@@ -22,6 +22,8 @@ Suite *ensemble_suite(void);
 Suite *rolled_suite(void);
 Suite *errest_suite(void);
 Suite *adaptive_suite(void);
+Suite *dense_suite(void);
+Suite *events_suite(void);
 
 int main(void) {
   SRunner *sr = srunner_create(parser_suite());
@@ -44,6 +46,8 @@ int main(void) {
   srunner_add_suite(sr, rolled_suite());
   srunner_add_suite(sr, errest_suite());
   srunner_add_suite(sr, adaptive_suite());
+  srunner_add_suite(sr, dense_suite());
+  srunner_add_suite(sr, events_suite());
   srunner_run_all(sr, CK_NORMAL);
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);

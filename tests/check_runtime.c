@@ -115,7 +115,8 @@ static const hbvmrt_model osc = {
   NULL, NULL,                   /* nu = 0: never called */
   NULL,                         /* no names: the numbered CSV header */
   NULL, NULL, 0,                /* as a driver of hbvmgen 0.1: no projection */
-  NULL                          /* nor error control */
+  NULL,                         /* nor error control */
+  NULL, 0, NULL, NULL, NULL     /* nor dense output and events */
 };
 
 /* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
@@ -214,7 +215,8 @@ static const hbvmrt_model ring = {
   ring_constraints, ring_hidden,
   NULL,
   NULL, NULL, 0,
-  NULL
+  NULL,
+  NULL, 0, NULL, NULL, NULL
 };
 
 /* ring with the fields of hbvmgen 0.2 drivers: init at the run's params

@@ -16,6 +16,7 @@ typedef struct {
   void (*constraints)(const void *x, double *g);
   void (*hidden)(const void *x, double *hc);
   int (*step_est)(void *x, double h, double *err_est); /* a step, and its NAME_stats.err_est */
+  void (*dense)(const void *x, double theta, double *q, double *p); /* NAME_dense */
 } Solver;
 
 /* The adapters of a generated solver with prefix P (its header included),
@@ -37,11 +38,14 @@ typedef struct {
     int rc = P##_step(x, h, NULL, &st);                                                      \
     *err_est = st.err_est;                                                                   \
     return rc;                                                                               \
+  }                                                                                          \
+  static void P##_dense_(const void *x, double theta, double *q, double *p) {                \
+    P##_dense(x, theta, q, p);                                                               \
   }
 #define SOLVER_ENTRY(P)                                                                                         \
   {#P,           P##_M,       P##_NU,    P##_K,      P##_S,         sizeof(P##_state),                         \
    offsetof(P##_state, t), offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda),          \
-   P##_init_,    P##_step_,   P##_energy_, P##_g_,   P##_hc_,      P##_step_est_},
+   P##_init_,    P##_step_,   P##_energy_, P##_g_,   P##_hc_,      P##_step_est_, P##_dense_},
 
 /* The solver of that name, or NULL. */
 const Solver *solver_find(const char *name);

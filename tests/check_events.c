@@ -1,0 +1,285 @@
+/* check_events.c - events, --stop-at and --dt in the driver, on solvers of
+ * tests/models/pendulum_events.ham and kepler_events.ham run through hbvmrt_main as a generated driver
+ * runs them (the adapters below are emit_main.c's).
+ *
+ *   pendulum  x = 0 is crossed every half period 2 K(1/2) (amplitude pi/3,
+ *             K the complete elliptic integral, GSL's gsl_sf_ellint_Kcomp):
+ *             every crossing located to 1e-10 absolute, with fixed steps and
+ *             with --tol, rising and falling ones apart;
+ *   kepler    e = 0.6: y = 0 at t = n pi and the aphelia (p_x = 0 rising) at
+ *             odd multiples of pi, to 1e-10 absolute, with --tol and fixed h;
+ *   --stop-at ends on the state of its event; --dt writes rows at exactly
+ *             k DT, with fixed and adaptive steps, that match the closed
+ *             form of Kepler to the dense output's accuracy. */
+#define _POSIX_C_SOURCE 200809L
+#include <check.h>
+#include <gsl/gsl_sf_ellint.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <float.h>
+
+#include "errest.h"
+#include "hbvmrt.h"
+#include "kepler_events_k4s4.h"
+#include "pendulum_events_k4s4.h"
+
+Suite *events_suite(void);
+
+#define PI 3.14159265358979323846
+
+/* The driver's adapters and model description of solver P (as emit_main.c
+ * writes them for a double solver without parameters). */
+#define EV_MODEL(P)                                                                                                 \
+  static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); }                        \
+  static void P##_pd_(void *prm) { P##_params_default(prm); }                                                       \
+  static int P##_step_(void *x, double h, const void *prm, hbvmrt_stats *st) {                                      \
+    P##_stats s;                                                                                                    \
+    int rc = P##_step(x, h, prm, &s);                                                                               \
+    st->iters = s.iters;                                                                                            \
+    return rc;                                                                                                      \
+  }                                                                                                                 \
+  static int P##_adapt_(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st) {                        \
+    P##_stats s;                                                                                                    \
+    int rc = P##_step_adaptive(x, h, tol, prm, &s);                                                                 \
+    st->iters = s.iters;                                                                                            \
+    st->h = s.h;                                                                                                    \
+    st->rejected = s.rejected;                                                                                      \
+    return rc;                                                                                                      \
+  }                                                                                                                 \
+  static double P##_energy_(const void *x, const void *prm) { return P##_energy(x, prm); }                          \
+  static void P##_g_(const void *x, const void *prm, double *g) { P##_constraints(x, prm, g); }                     \
+  static void P##_hc_(const void *x, const void *prm, double *g) { P##_hidden(x, prm, g); }                         \
+  static void P##_dense_(const void *x, double theta, void *y) {                                                    \
+    const P##_state *a = x;                                                                                         \
+    P##_state *b = y;                                                                                               \
+    *b = *a;                                                                                                        \
+    P##_dense(a, theta, b->q, b->p);                                                                                \
+    b->t = a->t - a->hprev * (1 - theta);                                                                           \
+  }                                                                                                                 \
+  static void P##_events_(const void *x, const void *prm, double *v) { P##_events(x, prm, v); }                     \
+  static const hbvmrt_model P##_model = {                                                                           \
+      #P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), sizeof(P##_params), offsetof(P##_state, t),               \
+      offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda), 0, NULL, NULL, NULL, P##_init_,   \
+      P##_pd_, P##_step_, P##_strerror, P##_energy_, P##_g_, P##_hc_, names_xy, NULL, NULL, DBL_EPSILON, P##_adapt_,      \
+      P##_dense_, P##_NEVENTS, P##_event_names, P##_event_dirs, P##_events_};
+
+static const char *const names_xy[] = {"x", "y"};
+
+EV_MODEL(pendulum_events_k4s4)
+EV_MODEL(kepler_events_k4s4)
+
+typedef struct {
+  char name[32];
+  double t, q[2], p[2];
+} Row;
+
+/* Run the driver of md with the options in args (spaces between), the
+ * events CSV and the CSV into temporary files read back into ev[] and
+ * rows[] (at most max each, counts in *nev, *nrows). Returns the status. */
+static int run(const hbvmrt_model *md, const char *args, Row *ev, int *nev, double *rows, int ncol, int *nrows,
+               int max) {
+  char evpath[] = "/tmp/hbvm-events-XXXXXX", csvpath[] = "/tmp/hbvm-csv-XXXXXX", line[2048], buf[512];
+  int fe = mkstemp(evpath), fc = mkstemp(csvpath);
+  ck_assert(fe >= 0 && fc >= 0);
+  close(fe);
+  close(fc);
+  snprintf(buf, sizeof buf, "%s --quiet --events %s --csv %s %s", md->name, evpath, csvpath, args);
+  char *argv[32];
+  int argc = 0;
+  for (char *tok = strtok(buf, " "); tok && argc < 31; tok = strtok(NULL, " ")) argv[argc++] = tok;
+  argv[argc] = NULL;
+  FILE *saved = fopen("/dev/null", "w");
+  int err = dup(2);
+  dup2(fileno(saved), 2); /* the summary line */
+  int status = hbvmrt_main(md, argc, argv);
+  dup2(err, 2);
+  close(err);
+  fclose(saved);
+  FILE *f = fopen(evpath, "r");
+  ck_assert(f != NULL);
+  *nev = *nrows = 0;
+  if (status != 0) { /* refused: nothing written */
+    fclose(f);
+    unlink(evpath);
+    unlink(csvpath);
+    return status;
+  }
+  ck_assert(fgets(line, sizeof line, f) != NULL);
+  ck_assert_str_eq(line, "event,t,x,y,p_x,p_y\n");
+  while (*nev < max && fgets(line, sizeof line, f)) {
+    Row *r = &ev[*nev];
+    char *c = strchr(line, ',');
+    ck_assert(c && c - line < (int)sizeof r->name);
+    memcpy(r->name, line, (size_t)(c - line));
+    r->name[c - line] = 0;
+    ck_assert_int_eq(sscanf(c + 1, "%lf,%lf,%lf,%lf,%lf", &r->t, &r->q[0], &r->q[1], &r->p[0], &r->p[1]), 5);
+    (*nev)++;
+  }
+  fclose(f);
+  f = fopen(csvpath, "r");
+  ck_assert(f != NULL);
+  *nrows = 0;
+  ck_assert(fgets(line, sizeof line, f) != NULL);
+  while (*nrows < max && fgets(line, sizeof line, f)) {
+    char *s = line;
+    for (int k = 0; k < ncol; k++) {
+      rows[*nrows * ncol + k] = strtod(s, &s);
+      if (*s == ',') s++;
+    }
+    (*nrows)++;
+  }
+  fclose(f);
+  unlink(evpath);
+  unlink(csvpath);
+  return status;
+}
+
+#define MAXROWS 4000
+
+/* The pendulum's half period: 2 K(k), k = sin(pi/6) = 1/2. */
+static double half_period(void) { return 2 * gsl_sf_ellint_Kcomp(0.5, GSL_PREC_DOUBLE); }
+
+/* the method's own error at the crossings is below 1e-11 in these runs (s = 4;
+ * -h 0.25 gives 3e-9, --tol 1e-11 2e-10: the steps' error, not the location's) */
+static const char *const pendulum_runs[] = {"-h 0.1 -T 30", "-h 0.07 -T 30", "--tol 1e-12 -h 0.1 -T 30"};
+
+START_TEST(pendulum_crossings)
+{
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, pendulum_runs[_i], ev, &nev, rows, 9, &nrows, MAXROWS), 0);
+  double P = half_period(), worst = 0;
+  int n = 0, right = 0, left = 0;
+  for (int i = 0; i < nev; i++) {
+    if (!strcmp(ev[i].name, "cross")) {
+      n++;
+      worst = fmax(worst, fabs(ev[i].t - n * P));
+      ck_assert_msg(fabs(ev[i].q[0]) < 1e-10, "x = %g at the crossing", ev[i].q[0]);
+    } else {
+      ck_assert_msg(fabs(ev[i].t - n * P) < 1e-10, "%s at %.17g, not with crossing %d", ev[i].name, ev[i].t, n);
+      ck_assert_msg(!strcmp(ev[i].name, n % 2 ? "left" : "right"), "%s at crossing %d", ev[i].name, n);
+      right += ev[i].name[0] == 'r';
+      left += ev[i].name[0] == 'l';
+    }
+  }
+  ck_assert_int_eq(n, (int)(30 / P));
+  ck_assert_int_eq(right, n / 2);
+  ck_assert_int_eq(left, (n + 1) / 2);
+  if (getenv("HBVM_EVENTS_TABLE"))
+    printf("pendulum %-26s %d crossings, max |t - n 2K(1/2)| = %.2e\n", pendulum_runs[_i], n, worst);
+  ck_assert_msg(worst <= 1e-10, "%s: crossings off by %g", pendulum_runs[_i], worst);
+}
+END_TEST
+
+/* (--tol 1e-12 leaves a global error of 4e-10 at t = 20, 1e-13 5e-12) */
+static const char *const kepler_runs[] = {"--tol 1e-13 -h 0.01 -T 20", "-h 0.005 -T 20"};
+
+START_TEST(kepler_crossings)
+{
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 6];
+  int nev, nrows;
+  ck_assert_int_eq(run(&kepler_events_k4s4_model, kepler_runs[_i], ev, &nev, rows, 6, &nrows, MAXROWS), 0);
+  double worst = 0;
+  int n = 0, aph = 0;
+  for (int i = 0; i < nev; i++) {
+    if (!strcmp(ev[i].name, "ycross")) {
+      n++;
+      worst = fmax(worst, fabs(ev[i].t - n * PI));
+    } else {
+      aph++;
+      worst = fmax(worst, fabs(ev[i].t - (2 * aph - 1) * PI));
+    }
+  }
+  ck_assert_int_eq(n, 6);
+  ck_assert_int_eq(aph, 3);
+  if (getenv("HBVM_EVENTS_TABLE"))
+    printf("kepler   %-26s %d crossings, max |t - n pi| = %.2e\n", kepler_runs[_i], n, worst);
+  ck_assert_msg(worst <= 1e-10, "%s: crossings off by %g", kepler_runs[_i], worst);
+}
+END_TEST
+
+/* --stop-at cross:3 ends the run at the third crossing: the last row is its state. */
+START_TEST(stop_at_event)
+{
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-h 0.1 -T 30 --stop-at cross:3", ev, &nev, rows, 9, &nrows,
+                       MAXROWS), 0);
+  double P = half_period();
+  ck_assert_int_eq(nev, 5); /* cross, left; cross, right; cross (and nothing after it) */
+  ck_assert_str_eq(ev[nev - 1].name, "cross");
+  const double *last = rows + (nrows - 1) * 9;
+  ck_assert_msg(fabs(last[0] - 3 * P) <= 1e-10, "the run ended at t = %.17g, not %.17g", last[0], 3 * P);
+  ck_assert_msg(last[0] == ev[nev - 1].t && last[1] == ev[nev - 1].q[0], "the last row is not the event's state");
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-h 0.1 -T 30 --stop-at right:2", ev, &nev, rows, 9, &nrows,
+                       MAXROWS), 0);
+  ck_assert_msg(fabs(rows[(nrows - 1) * 9] - 4 * P) <= 1e-10, "right:2 ended at %.17g", rows[(nrows - 1) * 9]);
+}
+END_TEST
+
+/* --dt 0.1: rows at exactly k / 10 whatever the steps, matching Kepler's
+ * closed form to the dense output's accuracy: of order s+1 = 5 inside the
+ * steps (check_dense.c), 2.2e-8 measured for h = 0.03, but 1.1e-5 for the
+ * longer steps of --tol 1e-10, chosen for the step's order 2s = 8. */
+static const struct {
+  const char *args;
+  double bound;
+} dt_runs[] = {{"-h 0.03 -T 7 --dt 0.1", 1e-7}, {"--tol 1e-10 -h 0.01 -T 7 --dt 0.1", 1e-4}};
+
+START_TEST(dt_grid)
+{
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 6];
+  int nev, nrows;
+  ck_assert_int_eq(run(&kepler_events_k4s4_model, dt_runs[_i].args, ev, &nev, rows, 6, &nrows, MAXROWS), 0);
+  ck_assert_int_eq(nrows, 71);
+  double worst = 0;
+  for (int k = 0; k < nrows; k++) {
+    double q[2], p[2], *r = rows + k * 6;
+    ck_assert_msg(r[0] == (double)k * 0.1, "row %d at t = %.17g", k, r[0]);
+    kepler_exact(r[0], q, p);
+    for (int i = 0; i < 2; i++) worst = fmax(worst, fmax(fabs(r[1 + i] - q[i]), fabs(r[3 + i] - p[i])));
+  }
+  if (getenv("HBVM_EVENTS_TABLE")) printf("kepler   %-26s --dt rows: max error %.2e\n", dt_runs[_i].args, worst);
+  ck_assert_msg(worst <= dt_runs[_i].bound, "%s: rows off the closed form by %g", dt_runs[_i].args, worst);
+}
+END_TEST
+
+/* The options are checked before the run: an unknown event, a grid step
+ * that is not positive, events asked of a model without any. */
+START_TEST(bad_options)
+{
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  hbvmrt_model none = pendulum_events_k4s4_model;
+  none.nevents = 0;
+  none.event_names = NULL;
+  none.event_dirs = NULL;
+  none.events = NULL;
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --stop-at nosuch", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --stop-at cross:0", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --dt 0", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_int_eq(run(&none, "-N 3", ev, &nev, rows, 9, &nrows, 8), 1); /* run() passes --events */
+}
+END_TEST
+
+Suite *events_suite(void) {
+  Suite *s = suite_create("events");
+  TCase *tc = tcase_create("events");
+  tcase_set_timeout(tc, 60);
+  tcase_add_loop_test(tc, pendulum_crossings, 0, sizeof pendulum_runs / sizeof pendulum_runs[0]);
+  tcase_add_loop_test(tc, kepler_crossings, 0, sizeof kepler_runs / sizeof kepler_runs[0]);
+  tcase_add_test(tc, stop_at_event);
+  tcase_add_test(tc, bad_options);
+  tcase_add_loop_test(tc, dt_grid, 0, sizeof dt_runs / sizeof dt_runs[0]);
+  suite_add_tcase(s, tc);
+  return s;
+}
