@@ -189,6 +189,10 @@ fi
 echo "== figures ($(elapsed) s)"
 bench/plot.sh "$R" "$B/plot"
 bench/summary.sh "$R"
+# the adaptive lines (issue 11): NAME_step_adaptive against the best fixed
+# step and rk8pd, side by side, added to the figures just drawn
+echo "== adaptive steps ($(elapsed) s)"
+bench/adaptive/run.sh || echo "bench: the adaptive benchmark failed"
 
 # ---- 7. the other measurements that live in make bench: long runs
 # (Brouwer's law, issue 6), instructions per step and chain scaling of the
