@@ -46,7 +46,7 @@ typedef struct {
   const char *csv;     /* NULL: no CSV; "-": stdout */
   int quiet;           /* no progress line */
   int project;         /* --project: move q0, p0 onto the constraints */
-  double dt;           /* --dt: CSV rows on this grid of t from dense output (0: per step) */
+  double dt;           /* --dt: CSV rows on this grid of t, steps from the step's start (0: per step) */
   const char *events;  /* --events FILE: the events CSV ("-": stdout), or NULL */
   int stop_event;      /* --stop-at: the event that ends the run, or -1 */
   long stop_count;     /* ... at its stop_count-th occurrence */
