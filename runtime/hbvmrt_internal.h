@@ -13,11 +13,6 @@
 #define HBVMRT_PRINTF(f, a) __attribute__((format(printf, f, a)))
 #else
 #define HBVMRT_PRINTF(f, a)
-/* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
-
-int hbvmrt_ensemble_wanted(int argc, char **argv);
-int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int argc, char **argv);
-
 #endif
 
 /* args.c */
