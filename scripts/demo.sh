@@ -1,7 +1,7 @@
 #!/bin/sh
 # make demo: generate, build and run the planar pendulum with HBVM(2,2) in both
-# multiplier families, and show what a user wants to see: errors, conservation,
-# iterations per step.
+# multiplier families, fixed and adaptive steps, and show what a user wants to
+# see: errors, conservation, iterations and steps.
 set -eu
 out=demo
 mkdir -p "$out"
@@ -21,28 +21,46 @@ echo "   and $out/pendulum_const, the paper's method (--multiplier const), to co
 echo "== reference: theta'' = -sin(theta) by HBVM(6,3), h = 1e-3 (its error is below 1e-13)"
 "$out/pendulum_angle" -h 0.001 -T 10 --every 100 --quiet --csv "$out/reference.csv" 2>/dev/null
 
+# row SOLVER LABEL CSV ARGS..: run the solver on [0,10] with ARGS (rows at
+# t = 0, 0.1, ..), print its error against the reference, conservation and
+# sweeps per step (and, adaptive, its steps)
+row() {
+  solver=$1 label=$2 csv=$3
+  shift 3
+  summary=$("$out/$solver" -T 10 --quiet --csv "$csv" "$@" 2>&1)
+  err=$(awk -F, 'NR == FNR { if (FNR > 1) { th[FNR] = $2; w[FNR] = $3 } next }
+                 FNR > 1 { x = sin(th[FNR]); y = -cos(th[FNR]); px = cos(th[FNR]) * w[FNR]; py = sin(th[FNR]) * w[FNR]
+                           e = $2 - x; if (e < 0) e = -e; if (e > m) m = e
+                           e = $3 - y; if (e < 0) e = -e; if (e > m) m = e
+                           e = $4 - px; if (e < 0) e = -e; if (e > m) m = e
+                           e = $5 - py; if (e < 0) e = -e; if (e > m) m = e }
+                 END { printf "%.3e", m }' "$out/reference.csv" "$csv")
+  field() { echo "$summary" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
+  printf "   %-9s %-12s %-12s %-12s %-12s %-10s %s\n" "$label" "$err" "$(field max_dH)" "$(field max_g)" "$(field max_hc)" \
+    "$(field iters_mean)" "$(field steps)"
+}
+header() {
+  printf "   %-9s %-12s %-12s %-12s %-12s %-10s %s\n" "$1" "err(q,p)" "max|H-H0|" "max|g|" "max|hidden|" "iters/step" steps
+}
+
 # table SOLVER TITLE: errors, conservation and sweeps per step for four h
 table() {
   echo "== pendulum in Cartesian coordinates, HBVM(2,2) on [0,10], $2"
-  printf "   %-9s %-12s %-12s %-12s %-12s %s\n" h "err(q,p)" "max|H-H0|" "max|g|" "max|hidden|" "iters/step"
+  header h
   for h in 0.1 0.05 0.025 0.0125; do
     every=$(awk -v h="$h" 'BEGIN { printf "%d", 0.1 / h + 0.5 }')
-    csv="$out/$1_h$h.csv"
-    summary=$("$out/$1" -h "$h" -T 10 --every "$every" --quiet --csv "$csv" 2>&1)
-    err=$(awk -F, 'NR == FNR { if (FNR > 1) { th[FNR] = $2; w[FNR] = $3 } next }
-                   FNR > 1 { x = sin(th[FNR]); y = -cos(th[FNR]); px = cos(th[FNR]) * w[FNR]; py = sin(th[FNR]) * w[FNR]
-                             e = $2 - x; if (e < 0) e = -e; if (e > m) m = e
-                             e = $3 - y; if (e < 0) e = -e; if (e > m) m = e
-                             e = $4 - px; if (e < 0) e = -e; if (e > m) m = e
-                             e = $5 - py; if (e < 0) e = -e; if (e > m) m = e }
-                   END { printf "%.3e", m }' "$out/reference.csv" "$csv")
-    field() { echo "$summary" | tr ' ' '\n' | sed -n "s/^$1=//p"; }
-    printf "   %-9s %-12s %-12s %-12s %-12s %s\n" "$h" "$err" "$(field max_dH)" "$(field max_g)" "$(field max_hc)" "$(field iters_mean)"
+    row "$1" "$h" "$out/$1_h$h.csv" -h "$h" --every "$every"
   done
 }
 table pendulum "polynomial multiplier (default)"
 echo "   Order 4 = 2s in q, p (and lambda); H, g and the hidden constraint at round-off."
 table pendulum_const "constant multiplier (the paper's method)"
 echo "   Order 2 in q, p and the hidden constraint; H and g at round-off (paper, table tab0)."
+echo "== the same, adaptive steps: --tol TOL (-h 0.1 the first step), rows at t = 0, 0.1, .. (--dt 0.1)"
+header tol
+for tol in 1e-6 1e-8 1e-10; do
+  row pendulum "$tol" "$out/pendulum_tol$tol.csv" --tol "$tol" -h 0.1 --dt 0.1
+done
+echo "   The error follows the tolerance; H, g and the hidden constraint stay at round-off."
 echo "   err(q,p): max over t = 0, 0.1, ..., 10 of the largest error in x, y, px, py."
 echo "== CSV (t,x,y,p_x,p_y,lambda_1,H,g_1,hc_1) in $out/pendulum_h*.csv; run $out/pendulum --help for options"
