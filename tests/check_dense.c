@@ -73,11 +73,7 @@ static DenseErr measure(const char *problem, const char *solver, double h, long 
   return r;
 }
 
-static const struct {
-  const char *problem, *solver;
-  double h;
-  long N;
-} cases[] = {
+static const StepCase cases[] = {
     {"pendulum", "pendulum_poly_k1s1", 0.1, 40}, {"pendulum", "pendulum_poly_k2s2", 0.2, 20},
     {"pendulum", "pendulum_poly_k3s3", 0.4, 10}, {"pendulum", "pendulum_poly_k4s4", 0.4, 10},
     {"kepler", "kepler_k1s1", 0.02, 100},       {"kepler", "kepler_k2s2", 0.02, 100},

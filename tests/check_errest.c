@@ -96,11 +96,7 @@ static Ratios measure(const char *problem, const char *solver, double h, long N)
   return r;
 }
 
-static const struct {
-  const char *problem, *solver;
-  double h;
-  long N;
-} cases[] = {
+static const StepCase cases[] = {
     {"pendulum", "pendulum_poly_k1s1", 0.05, 200},       {"pendulum", "pendulum_poly_k2s2", 0.1, 100},
     {"pendulum", "pendulum_poly_k3s3", 0.2, 50},         {"pendulum", "pendulum_poly_k4s4", 0.4, 25},
     {"pendulum", "pendulum_k2s2", 0.1, 100},             {"pendulum", "pendulum_k3s3", 0.1, 100},

@@ -7,6 +7,13 @@ typedef struct {
   int n;               /* steps measured */
 } Ratios;
 
+/* A solver stepped N times by h on a problem with a reference (below). */
+typedef struct {
+  const char *problem, *solver;
+  double h;
+  long N;
+} StepCase;
+
 /* Kepler, e = 0.6 (models/kepler.ham), exactly at time t. */
 void kepler_exact(double t, double *q, double *p);
 /* The reference at t_n = n h, n = 0..N: tests/ref.c, or Kepler's closed form. */
