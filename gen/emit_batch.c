@@ -9,8 +9,10 @@
  * lane's own increment is at round-off, the same tests and the same
  * compensated update, so each lane is bitwise the scalar NAME_step from the
  * same state. The sweep runs over all lanes while any of them iterates; a
- * lane that has stopped keeps its last sweep (fin[]) and ignores the rest.
- * A lane that fails is not written. */
+ * lane that has stopped keeps its gamma, so the later sweeps repeat its last
+ * one bitwise and the step ends with every lane's last sweep in sw[]. The
+ * control between sweeps is loops over the lanes with selects, no per-lane
+ * branch, which the compiler vectorises. A lane that fails is not written. */
 #include "emit.h"
 
 // The batch declarations of NAME.h.
@@ -123,42 +125,50 @@ static void emit_predict(Emitter *e) {
           "      }\n  }\n}\n\n");
 }
 
-// The iteration's tests for lane l after a sweep, as in $P_step: sets rc[l]
-// and returns 1 when the lane stops.
+// The iteration's tests after a sweep, as in $P_step, for every lane at
+// once: loops over the lanes with selects (no per-lane branch, so they
+// vectorise). act[l]: lane l iterates; a lane that stops gets rc[l] and
+// iters[l] = it and keeps its gamma (and multiplier), so the sweeps that the
+// other lanes still need recompute its last sweep bitwise. Returns the
+// number of lanes that iterate on.
 static void emit_lane_test(Emitter *e, int poly) {
-  tmpl(e, "/* After a sweep: lane l's increment and tests, those of $P_step; 1 when it stops\n"
-          " * (rc[l] then says why). */\n"
-          "static int $P_batch_test(const $P_batch *x, $R h, const $R *sw, $R *gam, $R *lam, int l,\n"
-          "    $R *inc, $R *incp, $R *inc_min, int *stall, int *rc)\n{\n"
-          "  $R inc_old = inc[l], scale = 0;\n  int i;\n  (void)lam;\n"
-          "  incp[l] = inc_old;\n"
-          "  inc[l] = 0;\n"
-          "  for (i = 0; i < $P_M; i++) {\n"
-          "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
-          "    if (v > scale) scale = v;\n  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) {\n"
-          "    $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
-          "    if (v > inc[l]) inc[l] = v;\n"
-          "    gam[i * $P_W + l] = sw[($[sweep.gam]i) * $P_W + l];\n  }\n"
-          "  if (scale > 0) inc[l] /= scale;\n");
+  int nu = e->mod->nu;
+  tmpl(e, "/* After a sweep: the increment and tests of $P_step in every lane that iterates (act);\n"
+          " * a lane that stops gets rc, iters = it and keeps its gamma, so the next sweeps repeat\n"
+          " * its last one. Returns the number of lanes that iterate on. */\n"
+          "static int $P_batch_test(const $P_batch *x, $R h, int it, const $R *sw, $R *gam, $R *lam,\n"
+          "    const int *act, $R *inc, $R *incp, $R *inc_min, int *stall, int *rc, int *iters)\n{\n"
+          "  $R scale[$P_W], incn[$P_W];\n  int bad[$P_W], sing[$P_W], run[$P_W], i, l, nrun = 0;\n  (void)lam;\n"
+          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
+          "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+          "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
+          "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n");
+  if (!poly && nu)
+    tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+            "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
+            "      sing[l] |= isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia));\n    }\n");
+  tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
+  tmpl(e, "    for (l = 0; l < $P_W; l++) bad[l] |= !isfinite(sw[i * $P_W + l]);\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    $R in = incn[l] / (scale[l] > 0 ? scale[l] : 1), old = inc[l];\n"
+          "    int nf = bad[l] || !isfinite(in), better = in < inc_min[l], stl = better ? 0 : stall[l] + 1;\n");
+  tmpl(e, poly ? "    int ok = !nf && in <= $P_TOL;\n"
+               : "    int ok = !nf && (in <= $P_TOL / 256 || (in <= $P_TOL && 4 * in > old));\n");
+  tmpl(e, "    int stop = sing[l] || nf || ok || stl >= $P_STALL, a = act[l];\n"
+          "    int code = sing[l] ? $P_ESINGULAR : nf ? $P_ENONFINITE : ok || inc_min[l] <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n"
+          "    incp[l] = a ? old : incp[l];\n    inc[l] = a ? in : old;\n"
+          "    inc_min[l] = a && better ? in : inc_min[l];\n    stall[l] = a ? stl : stall[l];\n"
+          "    rc[l] = a && stop ? code : rc[l];\n    iters[l] = a && stop ? it : iters[l];\n"
+          "    run[l] = a && !stop;\n    nrun += run[l];\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++)\n"
+          "      gam[i * $P_W + l] = run[l] ? sw[($[sweep.gam]i) * $P_W + l] : gam[i * $P_W + l];\n");
   if (poly)
-    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++) lam[i * $P_W + l] = sw[($[sweep.lam]i) * $P_W + l];\n"
-            "  for (i = 0; i < $<sweep.theta>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
-  else if (e->mod->nu)
-    tmpl(e, "  for (i = 0; i < $P_NU; i++) {\n"
-            "    $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
-            "    if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
-            "  }\n"
-            "  if (rc[l] == $P_ESINGULAR) return 1;\n");
-  if (!poly) tmpl(e, "  for (i = 0; i < $<sweep.pivot>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
-  tmpl(e, "  if (rc[l] == $P_ENONFINITE || !isfinite(inc[l])) {\n    rc[l] = $P_ENONFINITE;\n    return 1;\n  }\n");
-  tmpl(e, poly ? "  if (inc[l] <= $P_TOL) {\n"
-               : "  if (inc[l] <= $P_TOL / 256 || (inc[l] <= $P_TOL && 4 * inc[l] > inc_old)) {\n");
-  tmpl(e, "    rc[l] = $P_OK;\n    return 1;\n  }\n"
-          "  if (inc[l] < inc_min[l]) {\n    inc_min[l] = inc[l];\n    stall[l] = 0;\n"
-          "  } else if (++stall[l] >= $P_STALL) {\n"
-          "    rc[l] = inc_min[l] <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n    return 1;\n  }\n"
-          "  return 0;\n}\n\n");
+    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++)\n"
+            "      lam[i * $P_W + l] = run[l] ? sw[($[sweep.lam]i) * $P_W + l] : lam[i * $P_W + l];\n");
+  tmpl(e, "  return nrun;\n}\n\n");
 }
 
 // The end of the step for the lanes whose iteration converged (go[l]):
@@ -168,19 +178,19 @@ static void emit_commit(Emitter *e, int poly) {
   if (!poly) {
     tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    if (!go[l]) continue;\n"
             "    for (i = 0; i < $P_M; i++)\n"
-            "      if (!isfinite(x->q[i * $P_W + l] + h * fin[($[sweep.gam]i) * $P_W + l]) ||\n"
-            "          !isfinite(x->p[i * $P_W + l] + fin[($[sweep.dp]i) * $P_W + l]) ||\n"
+            "      if (!isfinite(x->q[i * $P_W + l] + h * sw[($[sweep.gam]i) * $P_W + l]) ||\n"
+            "          !isfinite(x->p[i * $P_W + l] + sw[($[sweep.dp]i) * $P_W + l]) ||\n"
             "          !isfinite(x->qc[i * $P_W + l]) || !isfinite(x->pc[i * $P_W + l]))\n"
             "        rc[l] = $P_ENONFINITE;\n"
             "    if (rc[l] != $P_OK) continue;\n"
             "    for (i = 0; i < $P_M; i++) {\n"
-            "      $P_add(&x->q[i * $P_W + l], &x->qc[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
-            "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n    }\n"
-            "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = fin[($[sweep.lambda]i) * $P_W + l];\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) {\n      x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n      x->gam[i * $P_W + l] = gam[i * $P_W + l];\n    }\n"
-            "    for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
+            "      $P_add(&x->q[i * $P_W + l], &x->qc[i * $P_W + l], h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+            "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], sw[($[sweep.dp]i) * $P_W + l]);\n    }\n"
+            "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = sw[($[sweep.lambda]i) * $P_W + l];\n"
+            "    for (i = 0; i < $P_S * $P_M; i++) {\n      x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n      x->gam[i * $P_W + l] = sw[($[sweep.gam]i) * $P_W + l];\n    }\n"
+            "    for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = sw[($[sweep.dp]i) * $P_W + l];\n"
             "    for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
-            "      x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
+            "      x->pinc[($P_M + i) * $P_W + l] = sw[($[sweep.theta]i) * $P_W + l];\n"
             "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev2[l] = x->hprev[l];\n    x->hprev[l] = h;\n  }\n");
     return;
   }
@@ -191,8 +201,8 @@ static void emit_commit(Emitter *e, int poly) {
           "    for (i = 0; i < $P_M * $P_W; i++) {\n"
           "      q1[i] = x->q[i];\n      qc1[i] = x->qc[i];\n      p1[i] = x->p[i];\n      pc1[i] = x->pc[i];\n    }\n"
           "    for (l = 0; l < $P_W; l++)\n      for (i = 0; go[l] && i < $P_M; i++) {\n"
-          "        $P_add(&q1[i * $P_W + l], &qc1[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
-          "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n      }\n"
+          "        $P_add(&q1[i * $P_W + l], &qc1[i * $P_W + l], h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+          "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], sw[($[sweep.dp]i) * $P_W + l]);\n      }\n"
           "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
           "    for (l = 0; l < $P_W; l++) {\n"
           "      $R K, U1, H0, beta = 1;\n      if (!go[l]) continue;\n"
@@ -217,10 +227,10 @@ static void emit_commit(Emitter *e, int poly) {
           "        x->q[i * $P_W + l] = q1[i * $P_W + l];\n        x->p[i * $P_W + l] = p1[i * $P_W + l];\n"
           "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n"
           "        x->pcorr[i * $P_W + l] = pco[i * $P_W + l];\n      }\n"
-          "      for (i = 0; i < $P_S * $P_M; i++) {\n        x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n        x->gam[i * $P_W + l] = gam[i * $P_W + l];\n      }\n"
-          "      for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
+          "      for (i = 0; i < $P_S * $P_M; i++) {\n        x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n        x->gam[i * $P_W + l] = sw[($[sweep.gam]i) * $P_W + l];\n      }\n"
+          "      for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = sw[($[sweep.dp]i) * $P_W + l];\n"
           "      for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
-          "        x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
+          "        x->pinc[($P_M + i) * $P_W + l] = sw[($[sweep.theta]i) * $P_W + l];\n"
           "      x->H0[l] = H0;\n    }\n"
           "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
           "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"
@@ -237,16 +247,16 @@ static void emit_batch_step(Emitter *e) {
   tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
-          "  $R sw[($<sweep> + 1) * $P_W], fin[($<sweep> + 1) * $P_W];\n"
+          "  $R sw[($<sweep> + 1) * $P_W];\n"
           "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n"
-          "  int rc[$P_W], go[$P_W], stall[$P_W], iters[$P_W];\n"
+          "  int rc[$P_W], go[$P_W], act[$P_W], stall[$P_W], iters[$P_W];\n"
           "  int it, i, l, nrun = 0, nfail = 0;\n"
           "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n"
           "    rc[l] = x->idle[l] ? $P_OK : !(h != 0 && isfinite(h)) ? $P_EBADSTEP : $P_ENOCONV;\n"
           "    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n  }\n"
-          "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) fin[i] = 0;\n"
+          "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
           "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n"
           "  $P_batch_predict(x, h, par, gam);\n");
   if (nu)
@@ -282,10 +292,8 @@ static void emit_batch_step(Emitter *e) {
             "            iters[l] = it;\n            nrun--;\n          }\n"
             "        }\n      }\n    }\n");
   tmpl(e, call);
-  tmpl(e, "    for (l = 0; l < $P_W; l++) {\n"
-          "      if (!go[l] || iters[l] || !$P_batch_test(x, h, sw, gam, lam, l, inc, incp, inc_min, stall, rc)) continue;\n"
-          "      iters[l] = it;\n      nrun--;\n"
-          "      for (i = 0; i < $<sweep>; i++) fin[i * $P_W + l] = sw[i * $P_W + l];\n    }\n  }\n"
+  tmpl(e, "    for (l = 0; l < $P_W; l++) act[l] = go[l] && !iters[l];\n"
+          "    nrun = $P_batch_test(x, h, it, sw, gam, lam, act, inc, incp, inc_min, stall, rc, iters);\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    if (go[l] && !iters[l]) iters[l] = $P_MAXITER;  /* did not converge: rc[l] is $P_ENOCONV */\n"
           "    go[l] = go[l] && rc[l] == $P_OK;  /* now: the lane is committed */\n"
