@@ -138,7 +138,8 @@ static void emit_lane_test(Emitter *e, int poly) {
           " * its last one. Returns the number of lanes that iterate on. */\n"
           "static int $P_batch_test(const $P_batch *x, $R h, int it, const $R *sw, $R *gam, $R *lam,\n"
           "    const int *act, $R *inc, $R *incp, $R *inc_min, int *stall, int *rc, int *iters)\n{\n"
-          "  $R scale[$P_W], incn[$P_W];\n  int bad[$P_W], sing[$P_W], run[$P_W], i, l, nrun = 0;\n  (void)lam;\n"
+          "  $R scale[$P_W], incn[$P_W];\n"
+          "  int bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W], i, l, nrun = 0;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
           "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
@@ -149,25 +150,29 @@ static void emit_lane_test(Emitter *e, int poly) {
   if (!poly && nu)
     tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
-            "      sing[l] |= isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia));\n    }\n");
+            "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
   tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
+  /* the floating-point tests in a loop of their own, the integer logic in a second: a
+   * comparison the compiler could sink under a condition would be a branch (it may trap) */
   tmpl(e, "    for (l = 0; l < $P_W; l++) bad[l] |= !isfinite(sw[i * $P_W + l]);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
-          "    $R in = incn[l] / (scale[l] > 0 ? scale[l] : 1), old = inc[l];\n"
-          "    int nf = bad[l] || !isfinite(in), better = in < inc_min[l], stl = better ? 0 : stall[l] + 1;\n");
-  tmpl(e, poly ? "    int ok = !nf && in <= $P_TOL;\n"
-               : "    int ok = !nf && (in <= $P_TOL / 256 || (in <= $P_TOL && 4 * in > old));\n");
-  tmpl(e, "    int stop = sing[l] || nf || ok || stl >= $P_STALL, a = act[l];\n"
-          "    int code = sing[l] ? $P_ESINGULAR : nf ? $P_ENONFINITE : ok || inc_min[l] <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n"
-          "    incp[l] = a ? old : incp[l];\n    inc[l] = a ? in : old;\n"
-          "    inc_min[l] = a && better ? in : inc_min[l];\n    stall[l] = a ? stl : stall[l];\n"
-          "    rc[l] = a && stop ? code : rc[l];\n    iters[l] = a && stop ? it : iters[l];\n"
-          "    run[l] = a && !stop;\n    nrun += run[l];\n  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++)\n"
-          "      gam[i * $P_W + l] = run[l] ? sw[($[sweep.gam]i) * $P_W + l] : gam[i * $P_W + l];\n");
+          "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
+          "    bad[l] |= !isfinite(in);\n");
+  tmpl(e, poly ? "    ok[l] = in <= $P_TOL;\n" : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
+  tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n"
+          "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
+          "    inc_min[l] = act[l] & better[l] ? in : inc_min[l];\n  }\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    int stl = better[l] ? 0 : stall[l] + 1, a = act[l], okl = (bad[l] == 0) & ok[l];\n"
+          "    int stop = sing[l] | bad[l] | okl | (stl >= $P_STALL);\n"
+          "    int code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : okl | noise[l] ? $P_OK : $P_ENOCONV;\n"
+          "    stall[l] = a ? stl : stall[l];\n    rc[l] = a & stop ? code : rc[l];\n"
+          "    iters[l] = a & stop ? it : iters[l];\n    run[l] = a & !stop;\n    nrun += run[l];\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R s = sw[($[sweep.gam]i) * $P_W + l], g = gam[i * $P_W + l];\n      gam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
   if (poly)
-    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++)\n"
-            "      lam[i * $P_W + l] = run[l] ? sw[($[sweep.lam]i) * $P_W + l] : lam[i * $P_W + l];\n");
+    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+            "      $R s = sw[($[sweep.lam]i) * $P_W + l], g = lam[i * $P_W + l];\n      lam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
   tmpl(e, "  return nrun;\n}\n\n");
 }
 
