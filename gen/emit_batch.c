@@ -100,29 +100,41 @@ static void emit_params_observers(Emitter *e) {
             "  (void)x; (void)prm; (void)gp;\n}\n\n");
 }
 
-// $P_predict, lane by lane.
+// $P_predict over the lanes with selects: every lane's one-step
+// extrapolation (coefficients E1 when h is unchanged, else the polynomial in
+// h / hprev), the polynomial family's two-step start, and the cold start
+// (gamma_1 = M^-1 p) are all computed and the lane's own one chosen.
 static void emit_predict(Emitter *e) {
-  tmpl(e, "static void $P_batch_predict(const $P_batch *x, $R h, const $R *par, $R *gam)\n{\n"
-          "  $R mp[$P_M * $P_W];\n  int i, j, l, m, d;\n"
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  tmpl(e, "static void $P_batch_predict(const $P_batch *restrict x, $R h, const $R *restrict par, $R *restrict gam)\n{\n"
+          "  $R mp[$P_M * $P_W], r[$P_W], ec[$P_S * $P_S * $P_W];\n  $M cold[$P_W], two[$P_W], same[$P_W];\n"
+          "  int i, j, l, m, d, all2 = $P_W > 0;\n"
           "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
-          "    for (i = 0; i < $P_S * $P_M; i++) gam[i * $P_W + l] = 0;\n"
-          "    if (x->hprev[l] == 0) {\n"
-          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n");
-  if (e->st->kern[K_FACTOR].nout) /* the polynomial family's two-step start, as $P_predict's */
-    tmpl(e, "    if (h == x->hprev[l] && h == x->hprev2[l]) {\n"
-            "      for (j = 0; j < $P_S; j++)\n        for (i = 0; i < $P_S; i++)\n"
-            "          for (m = 0; m < $P_M; m++)\n"
-            "            gam[(j * $P_M + m) * $P_W + l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
-            "                                             $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n"
-            "      continue;\n    }\n");
-  tmpl(e, "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
-          "        $R r = h / x->hprev[l], e = 0;\n"
-          "        if (h == x->hprev[l])\n          e = $P_E1[j * $P_S + i];\n        else\n"
-          "          for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
-          "        if (e != 0)\n"
-          "          for (m = 0; m < $P_M; m++) gam[(j * $P_M + m) * $P_W + l] += e * x->gam[(i * $P_M + m) * $P_W + l];\n"
-          "      }\n  }\n}\n\n");
+          "    $R hp = x->hprev[l], hq = x->hprev2[l];\n"
+          "    cold[l] = hp == 0;\n    same[l] = h == hp;\n    r[l] = h / (hp != 0 ? hp : 1);\n    (void)hq;\n");
+  /* the polynomial family's two-step start, as $P_predict's */
+  tmpl(e, poly ? "    two[l] = (hp != 0) & (h == hp) & (h == hq);\n  }\n" : "    two[l] = 0;\n  }\n");
+  tmpl(e, ""
+          "  for (l = 0; l < $P_W; l++) all2 &= (int)two[l];\n"
+          "  if (!all2) /* the one-step coefficients, when a lane needs them */\n"
+          "    for (j = 0; j < $P_S * $P_S; j++) {\n"
+          "      $R c[$P_W];\n      for (l = 0; l < $P_W; l++) c[l] = 0;\n"
+          "      for (d = $P_S - 1; d >= 0; d--)\n        for (l = 0; l < $P_W; l++) c[l] = c[l] * r[l] + $P_E[j * $P_S + d];\n"
+          "      for (l = 0; l < $P_W; l++) ec[j * $P_W + l] = same[l] ? $P_E1[j] : c[l];\n    }\n"
+          "  for (j = 0; j < $P_S; j++)\n    for (m = 0; m < $P_M; m++) {\n"
+          "      $R a[$P_W], b[$P_W];\n"
+          "      for (l = 0; l < $P_W; l++) a[l] = b[l] = 0;\n"
+          "      for (i = 0; !all2 && i < $P_S; i++)\n        for (l = 0; l < $P_W; l++) {\n"
+          "          $R ei = ec[(j * $P_S + i) * $P_W + l], t = a[l] + ei * x->gam[(i * $P_M + m) * $P_W + l];\n"
+          "          a[l] = ei != 0 ? t : a[l];\n        }\n");
+  if (poly)
+    tmpl(e, "      for (i = 0; i < $P_S; i++)\n        for (l = 0; l < $P_W; l++)\n"
+            "          b[l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
+            "                  $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n");
+  tmpl(e, "      for (l = 0; l < $P_W; l++) {\n");
+  tmpl(e, poly ? "        $R c = two[l] ? b[l] : a[l];\n" : "        $R c = a[l];\n");
+  tmpl(e, "        gam[(j * $P_M + m) * $P_W + l] = cold[l] ? (j == 0 ? mp[m * $P_W + l] : 0) : c;\n      }\n    }\n}\n\n");
 }
 
 // The iteration's tests after a sweep, as in $P_step, for every lane at
