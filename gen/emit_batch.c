@@ -129,8 +129,9 @@ static void emit_predict(Emitter *e) {
             "          b[l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
             "                  $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n");
   tmpl(e, "      for (l = 0; l < $P_W; l++) {\n");
-  tmpl(e, poly ? "        $R c = two[l] ? b[l] : a[l];\n" : "        $R c = a[l];\n");
-  tmpl(e, "        gam[(j * $P_M + m) * $P_W + l] = cold[l] ? (j == 0 ? mp[m * $P_W + l] : 0) : c;\n      }\n    }\n}\n\n");
+  tmpl(e, poly ? "        $R c = two[l] ? b[l] : a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n"
+               : "        $R c = a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n");
+  tmpl(e, "        gam[(j * $P_M + m) * $P_W + l] = cold[l] ? g : c;\n      }\n    }\n}\n\n");
 }
 
 // The batch half of NAME.c: the kernels over lanes, then the functions.
