@@ -23,7 +23,7 @@ static void emit_pivots(Emitter *e) {
           "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
           "      $M nf = !isfinite(piv) | !isfinite(dia), sg = (fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0;\n"
           "      int code = nf ? $P_ENONFINITE : sg ? $P_ESINGULAR : $P_ENOCONV;\n"
-          "      rc[l] = sel[l] & (rc[l] == $P_ENOCONV) ? code : rc[l];\n    }\n}\n\n");
+          "      rc[l] = (sel[l] & (rc[l] == $P_ENOCONV)) ? code : rc[l];\n    }\n}\n\n");
 }
 
 // The iteration's tests after a sweep, as in $P_step, for every lane at
@@ -61,13 +61,13 @@ static void emit_lane_test(Emitter *e, int poly) {
   tmpl(e, poly ? "    ok[l] = in <= $P_TOL;\n" : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n"
           "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
-          "    inc_min[l] = act[l] & better[l] ? in : inc_min[l];\n  }\n"
+          "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    int stl = better[l] ? 0 : stall[l] + 1;\n    $M a = act[l], okl = (bad[l] == 0) & ok[l];\n"
           "    $M stop = sing[l] | bad[l] | okl | (stl >= $P_STALL);\n"
-          "    int code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : okl | noise[l] ? $P_OK : $P_ENOCONV;\n"
-          "    stall[l] = a ? stl : stall[l];\n    rc[l] = a & stop ? code : rc[l];\n"
-          "    iters[l] = a & stop ? it : iters[l];\n    run[l] = a & (stop == 0);\n    nrun += (int)run[l];\n  }\n"
+          "    int code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : (okl | noise[l]) ? $P_OK : $P_ENOCONV;\n"
+          "    stall[l] = a ? stl : stall[l];\n    rc[l] = (a & stop) ? code : rc[l];\n"
+          "    iters[l] = (a & stop) ? it : iters[l];\n    run[l] = a & (stop == 0);\n    nrun += (int)run[l];\n  }\n"
           "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R s = sw[($[sweep.gam]i) * $P_W + l], g = gam[i * $P_W + l];\n      gam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
   if (poly)
@@ -105,7 +105,7 @@ static void emit_commit(Emitter *e, int poly) {
             "                 !isfinite(x->p[i * $P_W + l] + sw[($[sweep.dp]i) * $P_W + l]) |\n"
             "                 !isfinite(x->qc[i * $P_W + l]) | !isfinite(x->pc[i * $P_W + l]);\n"
             "    for (l = 0; l < $P_W; l++) {\n"
-            "      rc[l] = go[l] & nf[l] ? $P_ENONFINITE : rc[l];\n      cm[l] = go[l] & (nf[l] == 0);\n    }\n"
+            "      rc[l] = (go[l] & nf[l]) ? $P_ENONFINITE : rc[l];\n      cm[l] = go[l] & (nf[l] == 0);\n    }\n"
             "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
             "        $R q = x->q[i * $P_W + l], qc = x->qc[i * $P_W + l], p = x->p[i * $P_W + l], pc = x->pc[i * $P_W + l];\n"
             "        $P_add(&q, &qc, h * sw[($[sweep.gam]i) * $P_W + l]);\n"
@@ -219,8 +219,8 @@ void emit_batch_step(Emitter *e) {
           "  for (l = 0; l < $P_W; l++) {  /* a lane still iterating did not converge: rc is $P_ENOCONV */\n"
           "    $R t = x->t[l] + h, tc = x->tc[l];\n"
           "    $M ok = go[l] & (rc[l] == $P_OK), tbad = !isfinite(t) | !isfinite(tc);\n"
-          "    iters[l] = go[l] & (iters[l] == 0) ? $P_MAXITER : iters[l];\n"
-          "    rc[l] = ok & tbad ? $P_ENONFINITE : rc[l];\n"
+          "    iters[l] = (go[l] & (iters[l] == 0)) ? $P_MAXITER : iters[l];\n"
+          "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
           "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
   emit_commit(e, poly);
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
