@@ -50,5 +50,7 @@ int emit_kernel_inline(Emitter *e, KernelId k);
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);
 void emit_batch_source(Emitter *e, int lanes);
+/* emit_batch_step.c: NAME_batch_step, its lane control as masked loops */
+void emit_batch_step(Emitter *e);
 
 #endif

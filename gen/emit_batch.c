@@ -8,9 +8,7 @@
  * (emit_step.c) lane by lane: the same prediction, the same sweeps until the
  * lane's own increment is at round-off, the same tests and the same
  * compensated update, so each lane is bitwise the scalar NAME_step from the
- * same state. The sweep runs over all lanes while any of them iterates; a
- * lane that has stopped keeps its last sweep (fin[]) and ignores the rest.
- * A lane that fails is not written. */
+ * same state (NAME_batch_step: emit_batch_step.c). */
 #include "emit.h"
 
 // The batch declarations of NAME.h.
@@ -98,205 +96,42 @@ static void emit_params_observers(Emitter *e) {
             "  (void)x; (void)prm; (void)gp;\n}\n\n");
 }
 
-// $P_predict, lane by lane.
+// $P_predict over the lanes with selects: every lane's one-step
+// extrapolation (coefficients E1 when h is unchanged, else the polynomial in
+// h / hprev), the polynomial family's two-step start, and the cold start
+// (gamma_1 = M^-1 p) are all computed and the lane's own one chosen.
 static void emit_predict(Emitter *e) {
-  tmpl(e, "static void $P_batch_predict(const $P_batch *x, $R h, const $R *par, $R *gam)\n{\n"
-          "  $R mp[$P_M * $P_W];\n  int i, j, l, m, d;\n"
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  tmpl(e, "static void $P_batch_predict(const $P_batch *restrict x, $R h, const $R *restrict par, $R *restrict gam)\n{\n"
+          "  $R mp[$P_M * $P_W], r[$P_W], ec[$P_S * $P_S * $P_W];\n  $M cold[$P_W], two[$P_W], same[$P_W];\n"
+          "  int i, j, l, m, d, all2 = $P_W > 0;\n"
           "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
-          "    for (i = 0; i < $P_S * $P_M; i++) gam[i * $P_W + l] = 0;\n"
-          "    if (x->hprev[l] == 0) {\n"
-          "      for (i = 0; i < $P_M; i++) gam[i * $P_W + l] = mp[i * $P_W + l];\n      continue;\n    }\n");
-  if (e->st->kern[K_FACTOR].nout) /* the polynomial family's two-step start, as $P_predict's */
-    tmpl(e, "    if (h == x->hprev[l] && h == x->hprev2[l]) {\n"
-            "      for (j = 0; j < $P_S; j++)\n        for (i = 0; i < $P_S; i++)\n"
-            "          for (m = 0; m < $P_M; m++)\n"
-            "            gam[(j * $P_M + m) * $P_W + l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
-            "                                             $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n"
-            "      continue;\n    }\n");
-  tmpl(e, "    for (j = 0; j < $P_S; j++)\n      for (i = 0; i < $P_S; i++) {\n"
-          "        $R r = h / x->hprev[l], e = 0;\n"
-          "        if (h == x->hprev[l])\n          e = $P_E1[j * $P_S + i];\n        else\n"
-          "          for (d = $P_S - 1; d >= 0; d--) e = e * r + $P_E[(j * $P_S + i) * $P_S + d];\n"
-          "        if (e != 0)\n"
-          "          for (m = 0; m < $P_M; m++) gam[(j * $P_M + m) * $P_W + l] += e * x->gam[(i * $P_M + m) * $P_W + l];\n"
-          "      }\n  }\n}\n\n");
-}
-
-// The iteration's tests for lane l after a sweep, as in $P_step: sets rc[l]
-// and returns 1 when the lane stops.
-static void emit_lane_test(Emitter *e, int poly) {
-  tmpl(e, "/* After a sweep: lane l's increment and tests, those of $P_step; 1 when it stops\n"
-          " * (rc[l] then says why). */\n"
-          "static int $P_batch_test(const $P_batch *x, $R h, const $R *sw, $R *gam, $R *lam, int l,\n"
-          "    $R *inc, $R *incp, $R *inc_min, int *stall, int *rc)\n{\n"
-          "  $R inc_old = inc[l], scale = 0;\n  int i;\n  (void)lam;\n"
-          "  incp[l] = inc_old;\n"
-          "  inc[l] = 0;\n"
-          "  for (i = 0; i < $P_M; i++) {\n"
-          "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
-          "    if (v > scale) scale = v;\n  }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) {\n"
-          "    $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
-          "    if (v > inc[l]) inc[l] = v;\n"
-          "    gam[i * $P_W + l] = sw[($[sweep.gam]i) * $P_W + l];\n  }\n"
-          "  if (scale > 0) inc[l] /= scale;\n");
+          "    $R hp = x->hprev[l], hq = x->hprev2[l];\n"
+          "    cold[l] = hp == 0;\n    same[l] = h == hp;\n    r[l] = h / (hp != 0 ? hp : 1);\n    (void)hq;\n");
+  /* the polynomial family's two-step start, as $P_predict's */
+  tmpl(e, poly ? "    two[l] = (hp != 0) & (h == hp) & (h == hq);\n  }\n" : "    two[l] = 0;\n  }\n");
+  tmpl(e, ""
+          "  for (l = 0; l < $P_W; l++) all2 &= (int)two[l];\n"
+          "  if (!all2) /* the one-step coefficients, when a lane needs them */\n"
+          "    for (j = 0; j < $P_S * $P_S; j++) {\n"
+          "      $R c[$P_W];\n      for (l = 0; l < $P_W; l++) c[l] = 0;\n"
+          "      for (d = $P_S - 1; d >= 0; d--)\n        for (l = 0; l < $P_W; l++) c[l] = c[l] * r[l] + $P_E[j * $P_S + d];\n"
+          "      for (l = 0; l < $P_W; l++) ec[j * $P_W + l] = same[l] ? $P_E1[j] : c[l];\n    }\n"
+          "  for (j = 0; j < $P_S; j++)\n    for (m = 0; m < $P_M; m++) {\n"
+          "      $R a[$P_W], b[$P_W];\n"
+          "      for (l = 0; l < $P_W; l++) a[l] = b[l] = 0;\n"
+          "      for (i = 0; !all2 && i < $P_S; i++)\n        for (l = 0; l < $P_W; l++) {\n"
+          "          $R ei = ec[(j * $P_S + i) * $P_W + l], t = a[l] + ei * x->gam[(i * $P_M + m) * $P_W + l];\n"
+          "          a[l] = ei != 0 ? t : a[l];\n        }\n");
   if (poly)
-    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++) lam[i * $P_W + l] = sw[($[sweep.lam]i) * $P_W + l];\n"
-            "  for (i = 0; i < $<sweep.theta>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
-  else if (e->mod->nu)
-    tmpl(e, "  for (i = 0; i < $P_NU; i++) {\n"
-            "    $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
-            "    if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
-            "  }\n"
-            "  if (rc[l] == $P_ESINGULAR) return 1;\n");
-  if (!poly) tmpl(e, "  for (i = 0; i < $<sweep.pivot>; i++)\n    if (!isfinite(sw[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n");
-  tmpl(e, "  if (rc[l] == $P_ENONFINITE || !isfinite(inc[l])) {\n    rc[l] = $P_ENONFINITE;\n    return 1;\n  }\n");
-  tmpl(e, poly ? "  if (inc[l] <= $P_TOL) {\n"
-               : "  if (inc[l] <= $P_TOL / 256 || (inc[l] <= $P_TOL && 4 * inc[l] > inc_old)) {\n");
-  tmpl(e, "    rc[l] = $P_OK;\n    return 1;\n  }\n"
-          "  if (inc[l] < inc_min[l]) {\n    inc_min[l] = inc[l];\n    stall[l] = 0;\n"
-          "  } else if (++stall[l] >= $P_STALL) {\n"
-          "    rc[l] = inc_min[l] <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n    return 1;\n  }\n"
-          "  return 0;\n}\n\n");
-}
-
-// The end of the step for the lanes whose iteration converged (go[l]):
-// the constant family's update, or the polynomial family's projection,
-// rescale and multiplier (emit_end_poly in emit_step.c), lane by lane.
-static void emit_commit(Emitter *e, int poly) {
-  if (!poly) {
-    tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    if (!go[l]) continue;\n"
-            "    for (i = 0; i < $P_M; i++)\n"
-            "      if (!isfinite(x->q[i * $P_W + l] + h * fin[($[sweep.gam]i) * $P_W + l]) ||\n"
-            "          !isfinite(x->p[i * $P_W + l] + fin[($[sweep.dp]i) * $P_W + l]) ||\n"
-            "          !isfinite(x->qc[i * $P_W + l]) || !isfinite(x->pc[i * $P_W + l]))\n"
-            "        rc[l] = $P_ENONFINITE;\n"
-            "    if (rc[l] != $P_OK) continue;\n"
-            "    for (i = 0; i < $P_M; i++) {\n"
-            "      $P_add(&x->q[i * $P_W + l], &x->qc[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
-            "      $P_add(&x->p[i * $P_W + l], &x->pc[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n    }\n"
-            "    for (i = 0; i < $P_NU; i++) x->lambda[i * $P_W + l] = fin[($[sweep.lambda]i) * $P_W + l];\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) {\n      x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n      x->gam[i * $P_W + l] = gam[i * $P_W + l];\n    }\n"
-            "    for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
-            "    for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
-            "      x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
-            "    $P_add(&x->t[l], &x->tc[l], h);\n    x->hprev2[l] = x->hprev[l];\n    x->hprev[l] = h;\n  }\n");
-    return;
-  }
-  tmpl(e, "  {\n"
-          "    $R q1[$P_M * $P_W], p1[$P_M * $P_W], qc1[$P_M * $P_W], pc1[$P_M * $P_W];\n"
-          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam0[$P_NU * $P_W], pco[$P_M * $P_W];\n"
-          "    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n"
-          "    for (i = 0; i < $P_M * $P_W; i++) {\n"
-          "      q1[i] = x->q[i];\n      qc1[i] = x->qc[i];\n      p1[i] = x->p[i];\n      pc1[i] = x->pc[i];\n    }\n"
-          "    for (l = 0; l < $P_W; l++)\n      for (i = 0; go[l] && i < $P_M; i++) {\n"
-          "        $P_add(&q1[i * $P_W + l], &qc1[i * $P_W + l], h * fin[($[sweep.gam]i) * $P_W + l]);\n"
-          "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], fin[($[sweep.dp]i) * $P_W + l]);\n      }\n"
-          "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
-          "    for (l = 0; l < $P_W; l++) {\n"
-          "      $R K, U1, H0, beta = 1;\n      if (!go[l]) continue;\n"
-          "      for (i = 0; i < $P_NU; i++) {\n"
-          "        $R piv = pr[($[project_p1.pivot]i) * $P_W + l], dia = pr[($[project_p1.adiag]i) * $P_W + l];\n"
-          "        if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
-          "      }\n"
-          "      for (i = 0; rc[l] == $P_OK && i < $<project_p1>; i++)\n"
-          "        if (!isfinite(pr[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n"
-          "      if (rc[l] != $P_OK) continue;\n"
-          "      K = pr[($[project_p1.kin]0) * $P_W + l];\n      U1 = pr[($[project_p1.U]0) * $P_W + l];\n"
-          "      H0 = x->hprev[l] != 0 && fabs$f(Hn[l] - x->H0[l]) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0[l] : Hn[l];\n"
-          "      if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
-          "      for (i = 0; i < $P_M; i++) {\n"
-          "        $R d = pr[($[project_p1.dp]i) * $P_W + l], ph = p1[i * $P_W + l];\n"
-          "        $P_add(&p1[i * $P_W + l], &pc1[i * $P_W + l], d + (beta - 1) * (p1[i * $P_W + l] + d));\n"
-          "        pco[i * $P_W + l] = p1[i * $P_W + l] - ph;\n"
-          "        if (!isfinite(q1[i * $P_W + l]) || !isfinite(p1[i * $P_W + l])) rc[l] = $P_ENONFINITE;\n"
-          "      }\n"
-          "      if (rc[l] != $P_OK) continue;\n"
-          "      for (i = 0; i < $P_M; i++) {\n"
-          "        x->q[i * $P_W + l] = q1[i * $P_W + l];\n        x->p[i * $P_W + l] = p1[i * $P_W + l];\n"
-          "        x->qc[i * $P_W + l] = qc1[i * $P_W + l];\n        x->pc[i * $P_W + l] = pc1[i * $P_W + l];\n"
-          "        x->pcorr[i * $P_W + l] = pco[i * $P_W + l];\n      }\n"
-          "      for (i = 0; i < $P_S * $P_M; i++) {\n        x->gam2[i * $P_W + l] = x->gam[i * $P_W + l];\n        x->gam[i * $P_W + l] = gam[i * $P_W + l];\n      }\n"
-          "      for (i = 0; i < $P_M; i++) x->pinc[i * $P_W + l] = fin[($[sweep.dp]i) * $P_W + l];\n"
-          "      for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
-          "        x->pinc[($P_M + i) * $P_W + l] = fin[($[sweep.theta]i) * $P_W + l];\n"
-          "      x->H0[l] = H0;\n    }\n"
-          "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
-          "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"
-          "    for (l = 0; l < $P_W; l++) {\n      if (!go[l] || rc[l] != $P_OK) continue;\n"
-          "      for (i = 0; i < $P_NU; i++)\n"
-          "        x->lambda[i * $P_W + l] = isfinite(lam0[i * $P_W + l]) ? lam0[i * $P_W + l] : 0;\n"
-          "      $P_add(&x->t[l], &x->tc[l], h);\n      x->hprev2[l] = x->hprev[l];\n      x->hprev[l] = h;\n    }\n  }\n");
-}
-
-// NAME_batch_step.
-static void emit_batch_step(Emitter *e) {
-  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
-  emit_lane_test(e, poly);
-  tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  const $R h = ($R)h_;\n"
-          "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
-          "  $R sw[($<sweep> + 1) * $P_W], fin[($<sweep> + 1) * $P_W];\n"
-          "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n"
-          "  int rc[$P_W], go[$P_W], stall[$P_W], iters[$P_W];\n"
-          "  int it, i, l, nrun = 0, nfail = 0;\n"
-          "  $P_batch_params(prm, par);\n"
-          "  for (l = 0; l < $P_W; l++) {\n"
-          "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n"
-          "    rc[l] = x->idle[l] ? $P_OK : !(h != 0 && isfinite(h)) ? $P_EBADSTEP : $P_ENOCONV;\n"
-          "    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n  }\n"
-          "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) fin[i] = 0;\n"
-          "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n"
-          "  $P_batch_predict(x, h, par, gam);\n");
-  if (nu)
-    tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
-            "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
-  if (poly)
-    tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
-            "  $(factor q0=x->q gam=gam h=h prm=par out=fa);\n"
-            "  for (l = 0; l < $P_W; l++)\n    for (i = 0; go[l] && i < $P_S * $P_NU; i++) {\n"
-            "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
-            "      if (!isfinite(piv) || !isfinite(dia)) rc[l] = $P_ENONFINITE;\n"
-            "      else if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n"
-            "      go[l] = rc[l] == $P_ENOCONV;\n    }\n");
-  char call[160];
-  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=gam h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
-           poly ? " lam=lam lu=fa" : "");
-  tmpl(e, "  for (l = 0; l < $P_W; l++) nrun += go[l];\n"
-          "  /* the sweep over all lanes while any iterates; a lane that stops keeps its last sweep */\n"
-          "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
-  if (poly) /* $P_step's refresh of the frozen factor, for the lanes that slow down */
-    tmpl(e, "    if (it > 2) {\n"
-            "      $R fb[($<factor> + 1) * $P_W];\n      int any = 0, fresh[$P_W];\n"
-            "      for (l = 0; l < $P_W; l++) any |= fresh[l] = go[l] && !iters[l] && inc[l] > incp[l] / 8;\n"
-            "      if (any) {\n"
-            "        $(factor q0=x->q gam=gam h=h prm=par out=fb);\n"
-            "        for (l = 0; l < $P_W; l++) {\n          if (!fresh[l]) continue;\n"
-            "          for (i = 0; i < $<factor>; i++) fa[i * $P_W + l] = fb[i * $P_W + l];\n"
-            "          for (i = 0; i < $P_S * $P_NU; i++) {\n"
-            "            $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
-            "            if (!isfinite(piv) || !isfinite(dia)) rc[l] = $P_ENONFINITE;\n"
-            "            else if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc[l] = $P_ESINGULAR;\n          }\n"
-            "          if (rc[l] != $P_ENOCONV) {  /* the lane stops here, failed */\n"
-            "            iters[l] = it;\n            nrun--;\n          }\n"
-            "        }\n      }\n    }\n");
-  tmpl(e, call);
-  tmpl(e, "    for (l = 0; l < $P_W; l++) {\n"
-          "      if (!go[l] || iters[l] || !$P_batch_test(x, h, sw, gam, lam, l, inc, incp, inc_min, stall, rc)) continue;\n"
-          "      iters[l] = it;\n      nrun--;\n"
-          "      for (i = 0; i < $<sweep>; i++) fin[i * $P_W + l] = sw[i * $P_W + l];\n    }\n  }\n"
-          "  for (l = 0; l < $P_W; l++) {\n"
-          "    if (go[l] && !iters[l]) iters[l] = $P_MAXITER;  /* did not converge: rc[l] is $P_ENOCONV */\n"
-          "    go[l] = go[l] && rc[l] == $P_OK;  /* now: the lane is committed */\n"
-          "    if (go[l] && (!isfinite(x->t[l] + h) || !isfinite(x->tc[l]))) {\n"
-          "      rc[l] = $P_ENONFINITE;\n      go[l] = 0;\n    }\n  }\n");
-  emit_commit(e, poly);
-  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
-          "    nfail += rc[l] != $P_OK;\n"
-          "    if (!st) continue;\n"
-          "    st->code[l] = rc[l];\n    st->iters[l] = iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n"
-          "  }\n  return nfail;\n}\n");
+    tmpl(e, "      for (i = 0; i < $P_S; i++)\n        for (l = 0; l < $P_W; l++)\n"
+            "          b[l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
+            "                  $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n");
+  tmpl(e, "      for (l = 0; l < $P_W; l++) {\n");
+  tmpl(e, poly ? "        $R c = two[l] ? b[l] : a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n"
+               : "        $R c = a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n");
+  tmpl(e, "        gam[(j * $P_M + m) * $P_W + l] = cold[l] ? g : c;\n      }\n    }\n}\n\n");
 }
 
 // The batch half of NAME.c: the kernels over lanes, then the functions.

@@ -144,7 +144,8 @@ static void kernel_call(Emitter *e, const char *text, const char *end) {
           (int)vlen[IN_COUNT + 1], val[IN_COUNT + 1] ? val[IN_COUNT + 1] : "");
 }
 
-// Print text, replacing $P by the prefix, $R by the real type name, $f by
+// Print text, replacing $P by the prefix, $R by the real type name, $M by
+// the integer type as wide as it (a lane mask of --batch), $f by
 // the suffix of its math functions, $W by the type the step iterates in (the
 // real type, or the next wider one with --wide-step) and $g by the suffix of
 // that type's math functions. Kernels are named through the Step, never by
@@ -161,6 +162,7 @@ void tmpl(Emitter *e, const char *text) {
     switch (p[1]) {
     case 'P': fputs(e->P, e->f); break;
     case 'R': fputs(real_type(e, 0), e->f); break;
+    case 'M': fputs(strcmp(real_type(e, 0), "float") ? "long long" : "int", e->f); break; /* a lane mask as wide as $R */
     case 'f': fputs(math_suffix(e, 0), e->f); break;
     case 'W': fputs(real_type(e, e->wide_step), e->f); break;
     case 'g': fputs(math_suffix(e, e->wide_step), e->f); break;

@@ -1,0 +1,231 @@
+/* emit_batch_step.c - --batch W: NAME_batch_step, the control around the
+ * lane kernels (emit_batch.c prints those and the rest of the batch API).
+ *
+ * NAME_batch_step runs the scalar step's algorithm (emit_step.c) in every
+ * lane: the same prediction, the same sweeps until the lane's own increment
+ * is at round-off, the same tests and the same compensated update, so each
+ * lane is bitwise the scalar NAME_step from the same state. The sweep runs
+ * over all lanes while any of them iterates; a lane that has stopped keeps
+ * its gamma, so the later sweeps repeat its last one bitwise and the step
+ * ends with every lane's last sweep in sw[]. All control between the kernels
+ * is loops over the lanes with selects and masks as wide as the real type
+ * ($M), no per-lane branch, which the compiler vectorises; only "does any
+ * lane still iterate" is a branch. A lane that fails is not written. */
+#include "emit.h"
+
+// The factor's pivot tests of $P_step for the lanes in sel whose rc is still
+// ENOCONV: the first pivot that is not finite or is small sets rc.
+static void emit_pivots(Emitter *e) {
+  tmpl(e, "/* The multiplier factor's pivot tests of $P_step, in the lanes of sel still iterating. */\n"
+          "static void $P_batch_pivots(const $R *restrict fa, const $M *restrict sel, int *restrict rc)\n{\n"
+          "  int i, l;\n"
+          "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
+          "      $M nf = !isfinite(piv) | !isfinite(dia), sg = (fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0;\n"
+          "      int code = nf ? $P_ENONFINITE : sg ? $P_ESINGULAR : $P_ENOCONV;\n"
+          "      rc[l] = (sel[l] & (rc[l] == $P_ENOCONV)) ? code : rc[l];\n    }\n}\n\n");
+}
+
+// The iteration's tests after a sweep, as in $P_step, for every lane at
+// once. act[l]: lane l iterates; a lane that stops gets rc[l] and iters[l] =
+// it and keeps its gamma (and multiplier), so the sweeps that the other
+// lanes still need recompute its last sweep bitwise. The floating-point
+// tests are in a loop of their own and the integer logic in a second, with
+// & and | for && and ||: a comparison the compiler could sink under a
+// condition would stay a branch (it may trap), and the loop scalar.
+static void emit_lane_test(Emitter *e, int poly) {
+  tmpl(e, "/* After a sweep: the increment and tests of $P_step in every lane that iterates (act);\n"
+          " * a lane that stops gets rc, iters = it and keeps its gamma, so the next sweeps repeat\n"
+          " * its last one. Returns the number of lanes that iterate on. */\n"
+          "static int $P_batch_test(const $P_batch *restrict x, $R h, int it, const $R *restrict sw, $R *restrict gam,\n"
+          "    $R *restrict lam, const $M *restrict act, $R *restrict inc, $R *restrict incp, $R *restrict inc_min,\n"
+          "    int *restrict stall, int *restrict rc, int *restrict iters)\n{\n"
+          "  $R scale[$P_W], incn[$P_W];\n"
+          "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
+          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
+          "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+          "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
+          "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n");
+  if (!poly && e->mod->nu)
+    tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+            "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
+            "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
+  tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
+  tmpl(e, "    for (l = 0; l < $P_W; l++) bad[l] |= !isfinite(sw[i * $P_W + l]);\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
+          "    bad[l] |= !isfinite(in);\n");
+  tmpl(e, poly ? "    ok[l] = in <= $P_TOL;\n" : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
+  tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n"
+          "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
+          "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    int stl = better[l] ? 0 : stall[l] + 1;\n    $M a = act[l], okl = (bad[l] == 0) & ok[l];\n"
+          "    $M stop = sing[l] | bad[l] | okl | (stl >= $P_STALL);\n"
+          "    int code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : (okl | noise[l]) ? $P_OK : $P_ENOCONV;\n"
+          "    stall[l] = a ? stl : stall[l];\n    rc[l] = (a & stop) ? code : rc[l];\n"
+          "    iters[l] = (a & stop) ? it : iters[l];\n    run[l] = a & (stop == 0);\n    nrun += (int)run[l];\n  }\n"
+          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R s = sw[($[sweep.gam]i) * $P_W + l], g = gam[i * $P_W + l];\n      gam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
+  if (poly)
+    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+            "      $R s = sw[($[sweep.lam]i) * $P_W + l], g = lam[i * $P_W + l];\n      lam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
+  tmpl(e, "  return nrun;\n}\n\n");
+}
+
+// The writes both families make in a lane that commits (cm[l]): the history
+// of gamma, p's polynomial for NAME_dense, t and the previous steps.
+static void emit_commit_common(Emitter *e) {
+  tmpl(e, "    for (i = 0; i < $P_S * $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        $R g = x->gam[i * $P_W + l], n = sw[($[sweep.gam]i) * $P_W + l];\n"
+          "        x->gam2[i * $P_W + l] = cm[l] ? g : x->gam2[i * $P_W + l];\n        x->gam[i * $P_W + l] = cm[l] ? n : g;\n      }\n"
+          "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++)\n"
+          "        x->pinc[i * $P_W + l] = cm[l] ? sw[($[sweep.dp]i) * $P_W + l] : x->pinc[i * $P_W + l];\n"
+          "    for (i = 0; i < ($P_S - 1) * $P_M; i++)\n      for (l = 0; l < $P_W; l++)\n"
+          "        x->pinc[($P_M + i) * $P_W + l] = cm[l] ? sw[($[sweep.theta]i) * $P_W + l] : x->pinc[($P_M + i) * $P_W + l];\n"
+          "    for (l = 0; l < $P_W; l++) {\n"
+          "      $R t = x->t[l], tc = x->tc[l], hp = x->hprev[l];\n      $P_add(&t, &tc, h);\n"
+          "      x->t[l] = cm[l] ? t : x->t[l];\n      x->tc[l] = cm[l] ? tc : x->tc[l];\n"
+          "      x->hprev2[l] = cm[l] ? hp : x->hprev2[l];\n      x->hprev[l] = cm[l] ? h : hp;\n    }\n  }\n");
+}
+
+// The end of the step for the lanes whose iteration converged (go[l]):
+// the constant family's update, or the polynomial family's projection,
+// rescale and multiplier (emit_end_poly in emit_step.c), as masked loops
+// over the lanes; every lane computes, only the lanes in cm[] are written.
+static void emit_commit(Emitter *e, int poly) {
+  if (!poly) {
+    tmpl(e, "  {\n    $M nf[$P_W], cm[$P_W];\n"
+            "    for (l = 0; l < $P_W; l++) nf[l] = 0;\n"
+            "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++)\n"
+            "        nf[l] |= !isfinite(x->q[i * $P_W + l] + h * sw[($[sweep.gam]i) * $P_W + l]) |\n"
+            "                 !isfinite(x->p[i * $P_W + l] + sw[($[sweep.dp]i) * $P_W + l]) |\n"
+            "                 !isfinite(x->qc[i * $P_W + l]) | !isfinite(x->pc[i * $P_W + l]);\n"
+            "    for (l = 0; l < $P_W; l++) {\n"
+            "      rc[l] = (go[l] & nf[l]) ? $P_ENONFINITE : rc[l];\n      cm[l] = go[l] & (nf[l] == 0);\n    }\n"
+            "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+            "        $R q = x->q[i * $P_W + l], qc = x->qc[i * $P_W + l], p = x->p[i * $P_W + l], pc = x->pc[i * $P_W + l];\n"
+            "        $P_add(&q, &qc, h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+            "        $P_add(&p, &pc, sw[($[sweep.dp]i) * $P_W + l]);\n"
+            "        x->q[i * $P_W + l] = cm[l] ? q : x->q[i * $P_W + l];\n        x->qc[i * $P_W + l] = cm[l] ? qc : x->qc[i * $P_W + l];\n"
+            "        x->p[i * $P_W + l] = cm[l] ? p : x->p[i * $P_W + l];\n        x->pc[i * $P_W + l] = cm[l] ? pc : x->pc[i * $P_W + l];\n      }\n"
+            "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++)\n"
+            "        x->lambda[i * $P_W + l] = cm[l] ? sw[($[sweep.lambda]i) * $P_W + l] : x->lambda[i * $P_W + l];\n");
+    emit_commit_common(e);
+    return;
+  }
+  tmpl(e, "  {\n"
+          "    $R q1[$P_M * $P_W], p1[$P_M * $P_W], qc1[$P_M * $P_W], pc1[$P_M * $P_W], H0[$P_W], beta[$P_W];\n"
+          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam0[$P_NU * $P_W], pco[$P_M * $P_W];\n"
+          "    $M sg[$P_W], nf[$P_W], cm[$P_W];\n"
+          "    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n"
+          "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        $R q = x->q[i * $P_W + l], qc = x->qc[i * $P_W + l], p = x->p[i * $P_W + l], pc = x->pc[i * $P_W + l];\n"
+          "        $P_add(&q, &qc, h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+          "        $P_add(&p, &pc, sw[($[sweep.dp]i) * $P_W + l]);\n"
+          "        q1[i * $P_W + l] = q;\n        qc1[i * $P_W + l] = qc;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n      }\n"
+          "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
+          "    for (l = 0; l < $P_W; l++) sg[l] = nf[l] = 0;\n"
+          "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        $R piv = pr[($[project_p1.pivot]i) * $P_W + l], dia = pr[($[project_p1.adiag]i) * $P_W + l];\n"
+          "        sg[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n      }\n"
+          "    for (i = 0; i < $<project_p1>; i++)\n"
+          "      for (l = 0; l < $P_W; l++) nf[l] |= !isfinite(pr[i * $P_W + l]);\n"
+          "    for (l = 0; l < $P_W; l++) {\n"
+          "      $R K = pr[($[project_p1.kin]0) * $P_W + l], U1 = pr[($[project_p1.U]0) * $P_W + l], ho = x->H0[l];\n"
+          "      $M keep = (x->hprev[l] != 0) & (fabs$f(Hn[l] - ho) <= 64 * $P_TOL * (K + fabs$f(U1)));\n"
+          "      $R H = keep ? ho : Hn[l], a = (H - U1) / (K > 0 ? K : 1);\n"
+          "      $M up = (K > 0) & (H - U1 > 0);\n"
+          "      $R b = sqrt$f(up ? a : 1);\n"
+          "      H0[l] = H;\n      beta[l] = up ? b : 1;\n    }\n"
+          "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        $R d = pr[($[project_p1.dp]i) * $P_W + l], ph = p1[i * $P_W + l], p = ph, pc = pc1[i * $P_W + l];\n"
+          "        $P_add(&p, &pc, d + (beta[l] - 1) * (ph + d));\n"
+          "        pco[i * $P_W + l] = p - ph;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n"
+          "        nf[l] |= !isfinite(q1[i * $P_W + l]) | !isfinite(p);\n      }\n"
+          "    for (l = 0; l < $P_W; l++) {\n"
+          "      int code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n"
+          "      rc[l] = go[l] ? code : rc[l];\n      cm[l] = go[l] & (code == $P_OK);\n"
+          "      x->H0[l] = cm[l] ? H0[l] : x->H0[l];\n    }\n"
+          "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        x->q[i * $P_W + l] = cm[l] ? q1[i * $P_W + l] : x->q[i * $P_W + l];\n"
+          "        x->p[i * $P_W + l] = cm[l] ? p1[i * $P_W + l] : x->p[i * $P_W + l];\n"
+          "        x->qc[i * $P_W + l] = cm[l] ? qc1[i * $P_W + l] : x->qc[i * $P_W + l];\n"
+          "        x->pc[i * $P_W + l] = cm[l] ? pc1[i * $P_W + l] : x->pc[i * $P_W + l];\n"
+          "        x->pcorr[i * $P_W + l] = cm[l] ? pco[i * $P_W + l] : x->pcorr[i * $P_W + l];\n      }\n"
+          "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
+          "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"
+          "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        $R v = lam0[i * $P_W + l];\n"
+          "        v = isfinite(v) ? v : 0;\n        x->lambda[i * $P_W + l] = cm[l] ? v : x->lambda[i * $P_W + l];\n      }\n");
+  emit_commit_common(e);
+}
+
+// NAME_batch_step: the set-up, the factor, the sweeps while a lane
+// iterates, then the commit, all as loops over the lanes.
+void emit_batch_step(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
+  if (poly) emit_pivots(e);
+  emit_lane_test(e, poly);
+  tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
+          "  const $R h = ($R)h_;\n"
+          "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
+          "  $R sw[($<sweep> + 1) * $P_W];\n"
+          "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n"
+          "  int rc[$P_W], stall[$P_W], iters[$P_W];\n  $M go[$P_W], act[$P_W];\n"
+          "  int it, i, l, nrun = 0, nfail = 0, bad_h = !(h != 0 && isfinite(h));\n"
+          "  $P_batch_params(prm, par);\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n"
+          "    rc[l] = x->idle[l] ? $P_OK : bad_h ? $P_EBADSTEP : $P_ENOCONV;\n  }\n"
+          "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
+          "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n"
+          "  $P_batch_predict(x, h, par, gam);\n");
+  if (nu)
+    tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
+            "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+  if (poly)
+    tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
+            "  $(factor q0=x->q gam=gam h=h prm=par out=fa);\n"
+            "  for (l = 0; l < $P_W; l++) go[l] = 1;\n"
+            "  $P_batch_pivots(fa, go, rc);\n");
+  char call[160];
+  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=gam h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
+           poly ? " lam=lam lu=fa" : "");
+  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n"
+          "    nrun += (int)go[l];\n  }\n"
+          "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
+          "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
+  if (poly) /* $P_step's refresh of the frozen factor, for the lanes that slow down */
+    tmpl(e, "    if (it > 2) {\n"
+            "      $R fb[($<factor> + 1) * $P_W];\n      $M fresh[$P_W];\n      int any = 0;\n"
+            "      for (l = 0; l < $P_W; l++) {\n"
+            "        fresh[l] = go[l] & (iters[l] == 0) & (inc[l] > incp[l] / 8);\n        any |= (int)fresh[l];\n      }\n"
+            "      if (any) {\n"
+            "        $(factor q0=x->q gam=gam h=h prm=par out=fb);\n"
+            "        for (i = 0; i < $<factor>; i++)\n"
+            "          for (l = 0; l < $P_W; l++) fa[i * $P_W + l] = fresh[l] ? fb[i * $P_W + l] : fa[i * $P_W + l];\n"
+            "        $P_batch_pivots(fa, fresh, rc);\n"
+            "        for (l = 0; l < $P_W; l++) {  /* a lane whose factor fails stops here */\n"
+            "          $M stop = fresh[l] & (rc[l] != $P_ENOCONV);\n"
+            "          iters[l] = stop ? it : iters[l];\n          nrun -= (int)stop;\n        }\n"
+            "      }\n    }\n");
+  tmpl(e, call);
+  tmpl(e, "    for (l = 0; l < $P_W; l++) act[l] = go[l] & (iters[l] == 0);\n"
+          "    nrun = $P_batch_test(x, h, it, sw, gam, lam, act, inc, incp, inc_min, stall, rc, iters);\n  }\n"
+          "  for (l = 0; l < $P_W; l++) {  /* a lane still iterating did not converge: rc is $P_ENOCONV */\n"
+          "    $R t = x->t[l] + h, tc = x->tc[l];\n"
+          "    $M ok = go[l] & (rc[l] == $P_OK), tbad = !isfinite(t) | !isfinite(tc);\n"
+          "    iters[l] = (go[l] & (iters[l] == 0)) ? $P_MAXITER : iters[l];\n"
+          "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
+          "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
+  emit_commit(e, poly);
+  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
+          "    nfail += rc[l] != $P_OK;\n"
+          "    if (!st) continue;\n"
+          "    st->code[l] = rc[l];\n    st->iters[l] = iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n"
+          "  }\n  return nfail;\n}\n");
+}
