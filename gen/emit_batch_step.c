@@ -219,6 +219,8 @@ void emit_batch_step(Emitter *e) {
           "  for (l = 0; l < $P_W; l++) {  /* a lane still iterating did not converge: rc is $P_ENOCONV */\n"
           "    $R t = x->t[l] + h, tc = x->tc[l];\n"
           "    $M ok = go[l] & (rc[l] == $P_OK), tbad = !isfinite(t) | !isfinite(tc);\n"
+          "    for (i = 0; i < ($P_S - 1) * $P_M; i++)  /* the rest of p's polynomial, as $P_step */\n"
+          "      tbad |= !isfinite(sw[($[sweep.theta]i) * $P_W + l]);\n"
           "    iters[l] = (go[l] & (iters[l] == 0)) ? $P_MAXITER : iters[l];\n"
           "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
           "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
