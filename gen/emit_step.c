@@ -389,11 +389,12 @@ static void emit_first_sweep(Emitter *e) {
             "        for (d1 = 0, i = 0; i < $P_S * $P_M; i++) {\n"
             "          $R v = fabs$g(h * (gam[i] - ref[i]));\n"
             "          if (v > d1) d1 = v;\n        }\n");
-  tmpl(e, "      est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
-          "      if (tol > 0 && !(est <= tol * (1 + scale))) {\n"
-          "        if (st) {\n          st->iters = 1;\n          st->increment = inc;\n"
-          "          st->err_est = est;\n          st->h = h;\n          st->rejected = 0;\n        }\n"
-          "        return $P_EREJECT;\n      }\n    }\n");
+  tmpl(e, "      if (tol > 0) {  /* $P_step_adaptive's: no estimate here for a fixed step */\n"
+          "        est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
+          "        if (!(est <= tol * (1 + scale))) {\n"
+          "          if (st) {\n            st->iters = 1;\n            st->increment = inc;\n"
+          "            st->err_est = est;\n            st->h = h;\n            st->rejected = 0;\n          }\n"
+          "          return $P_EREJECT;\n        }\n      }\n    }\n");
 }
 
 // The fused step's locals: gamma as gm0, gm1, ... (from the predicted

@@ -431,16 +431,18 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;
-      est = conical_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* conical_k1s1_step_adaptive's: no estimate here for a fixed step */
+        est = conical_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return conical_k1s1_EREJECT;
         }
-        return conical_k1s1_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

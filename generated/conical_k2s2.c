@@ -499,16 +499,18 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
       gam[3] = gm3;
       gam[4] = gm4;
       gam[5] = gm5;
-      est = conical_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* conical_k2s2_step_adaptive's: no estimate here for a fixed step */
+        est = conical_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return conical_k2s2_EREJECT;
         }
-        return conical_k2s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

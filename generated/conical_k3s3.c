@@ -538,16 +538,18 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       gam[6] = gm6;
       gam[7] = gm7;
       gam[8] = gm8;
-      est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* conical_k3s3_step_adaptive's: no estimate here for a fixed step */
+        est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return conical_k3s3_EREJECT;
         }
-        return conical_k3s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

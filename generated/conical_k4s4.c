@@ -591,16 +591,18 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
       gam[9] = gm9;
       gam[10] = gm10;
       gam[11] = gm11;
-      est = conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* conical_k4s4_step_adaptive's: no estimate here for a fixed step */
+        est = conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return conical_k4s4_EREJECT;
         }
-        return conical_k4s4_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -838,16 +838,18 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      est = conical_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* conical_poly_k2s2_step_adaptive's: no estimate here for a fixed step */
+        est = conical_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return conical_poly_k2s2_EREJECT;
         }
-        return conical_poly_k2s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

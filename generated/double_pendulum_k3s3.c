@@ -2275,16 +2275,18 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      est = double_pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* double_pendulum_k3s3_step_adaptive's: no estimate here for a fixed step */
+        est = double_pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return double_pendulum_k3s3_EREJECT;
         }
-        return double_pendulum_k3s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -360,16 +360,18 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       gam[1] = gm1;
       gam[2] = gm2;
       gam[3] = gm3;
-      est = henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* henon_heiles_k3s2_step_adaptive's: no estimate here for a fixed step */
+        est = henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return henon_heiles_k3s2_EREJECT;
         }
-        return henon_heiles_k3s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -406,16 +406,18 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
       gam[3] = gm3;
       gam[4] = gm4;
       gam[5] = gm5;
-      est = kepler_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* kepler_k3s3_step_adaptive's: no estimate here for a fixed step */
+        est = kepler_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return kepler_k3s3_EREJECT;
         }
-        return kepler_k3s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -504,16 +504,18 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       gam[5] = gm5;
       gam[6] = gm6;
       gam[7] = gm7;
-      est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* kepler_k4s4_step_adaptive's: no estimate here for a fixed step */
+        est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return kepler_k4s4_EREJECT;
         }
-        return kepler_k4s4_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -492,16 +492,18 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;
-      est = modified_k3s1_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* modified_k3s1_step_adaptive's: no estimate here for a fixed step */
+        est = modified_k3s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return modified_k3s1_EREJECT;
         }
-        return modified_k3s1_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

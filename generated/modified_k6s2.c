@@ -684,16 +684,18 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
       gam[3] = gm3;
       gam[4] = gm4;
       gam[5] = gm5;
-      est = modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* modified_k6s2_step_adaptive's: no estimate here for a fixed step */
+        est = modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return modified_k6s2_EREJECT;
         }
-        return modified_k6s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

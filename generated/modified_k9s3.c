@@ -903,16 +903,18 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
       gam[6] = gm6;
       gam[7] = gm7;
       gam[8] = gm8;
-      est = modified_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* modified_k9s3_step_adaptive's: no estimate here for a fixed step */
+        est = modified_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return modified_k9s3_EREJECT;
         }
-        return modified_k9s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -1332,16 +1332,18 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      est = modified_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* modified_poly_k6s2_step_adaptive's: no estimate here for a fixed step */
+        est = modified_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return modified_poly_k6s2_EREJECT;
         }
-        return modified_poly_k6s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

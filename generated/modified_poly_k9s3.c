@@ -2313,16 +2313,18 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      est = modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* modified_poly_k9s3_step_adaptive's: no estimate here for a fixed step */
+        est = modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return modified_poly_k9s3_EREJECT;
         }
-        return modified_poly_k9s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

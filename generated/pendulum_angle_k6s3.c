@@ -350,16 +350,18 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;
-      est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* pendulum_angle_k6s3_step_adaptive's: no estimate here for a fixed step */
+        est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return pendulum_angle_k6s3_EREJECT;
         }
-        return pendulum_angle_k6s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -380,16 +380,18 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       d1 = inc;  /* the predictor's error, for pendulum_k1s1_err_est */
       gam[0] = gm0;
       gam[1] = gm1;
-      est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* pendulum_k1s1_step_adaptive's: no estimate here for a fixed step */
+        est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return pendulum_k1s1_EREJECT;
         }
-        return pendulum_k1s1_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

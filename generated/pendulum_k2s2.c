@@ -432,16 +432,18 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       gam[1] = gm1;
       gam[2] = gm2;
       gam[3] = gm3;
-      est = pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* pendulum_k2s2_step_adaptive's: no estimate here for a fixed step */
+        est = pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return pendulum_k2s2_EREJECT;
         }
-        return pendulum_k2s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -693,16 +693,18 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      est = pendulum_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* pendulum_poly_k2s2_step_adaptive's: no estimate here for a fixed step */
+        est = pendulum_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return pendulum_poly_k2s2_EREJECT;
         }
-        return pendulum_poly_k2s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -1836,16 +1836,18 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       gam[6] = gm6;
       gam[7] = gm7;
       gam[8] = gm8;
-      est = satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* satellites_k6s1_step_adaptive's: no estimate here for a fixed step */
+        est = satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return satellites_k6s1_EREJECT;
         }
-        return satellites_k6s1_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

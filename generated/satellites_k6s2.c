@@ -2289,16 +2289,18 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     }
     if (it == 1) {
       d1 = inc;  /* the predictor's error, for satellites_k6s2_err_est */
-      est = satellites_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* satellites_k6s2_step_adaptive's: no estimate here for a fixed step */
+        est = satellites_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return satellites_k6s2_EREJECT;
         }
-        return satellites_k6s2_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;

@@ -8775,16 +8775,18 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      est = satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
-      if (tol > 0 && !(est <= tol * (1 + scale))) {
-        if (st) {
-          st->iters = 1;
-          st->increment = inc;
-          st->err_est = est;
-          st->h = h;
-          st->rejected = 0;
+      if (tol > 0) {  /* satellites_poly_k6s3_step_adaptive's: no estimate here for a fixed step */
+        est = satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        if (!(est <= tol * (1 + scale))) {
+          if (st) {
+            st->iters = 1;
+            st->increment = inc;
+            st->err_est = est;
+            st->h = h;
+            st->rejected = 0;
+          }
+          return satellites_poly_k6s3_EREJECT;
         }
-        return satellites_poly_k6s3_EREJECT;
       }
     }
     if (scale > 0) inc /= scale;
