@@ -87,6 +87,18 @@ static double locate(hbvmrt_events *ev, const void *x, double h, int i, double f
   return fa == fb ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
 }
 
+int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0, const void *x, double theta,
+                        double hsub, void *z)
+{
+  hbvmrt_stats st;
+
+  memcpy(z, x0, md->state_size);
+  if (theta > 0 && hsub != 0 && md->step(z, hsub, prm, &st) == 0)
+    return 0;
+  md->dense(x, theta < 0 ? 0 : theta, z);
+  return 1;
+}
+
 /* Stage 2: the state at event i into ev->z, by steps of theta h from x0
  * (Newton on theta, the slope from the dense output of x); the dense
  * output at theta when a step fails. */
@@ -96,14 +108,14 @@ static void polish(hbvmrt_events *ev, const void *x0, const void *x, double h, i
   double d = 1e-6, lo = theta - d < 0 ? 0 : theta - d, hi = theta + d > 1 ? 1 : theta + d;
   double slope = (dense_value(ev, x, hi, i) - dense_value(ev, x, lo, i)) / (hi - lo);
   double tol = HBVMRT_EVENT_TOL * (1 + fabs(time_of(md, x))) / fabs(h);
-  hbvmrt_stats st;
   int k;
 
   for (k = 0; k < POLISH_ITERS; k++) {
     double f, dtheta;
-    memcpy(ev->z, x0, md->state_size);
-    if (theta * h == 0 || !(slope != 0 && isfinite(slope)) || md->step(ev->z, theta * h, ev->prm, &st) != 0)
+    if (!(slope != 0 && isfinite(slope)))
       break;
+    if (hbvmrt_state_within(md, ev->prm, x0, x, theta, theta * h, ev->z) != 0)
+      return; /* the dense output at theta: no step of the method reaches it */
     md->events(ev->z, ev->prm, ev->vt);
     f = ev->vt[i];
     dtheta = -f / slope;

@@ -103,6 +103,13 @@ int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_o
 int hbvmrt_events_step(hbvmrt_events *ev, const void *x0, void *x, double h);
 /* Close the events CSV: 0, or -1 after reporting a write error. */
 int hbvmrt_events_close(hbvmrt_events *ev);
+/* The state at theta inside the step from x0 to x into z: a step of the
+ * method of size hsub (theta times the step) from a copy of x0, as accurate
+ * as the run's steps, or, where theta <= 0, hsub = 0 or that step fails, the
+ * dense output of x at theta (at least 0). Returns 0 for the step, 1 for
+ * the dense output. */
+int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0, const void *x, double theta,
+                        double hsub, void *z);
 
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 

@@ -355,14 +355,10 @@ static void grid_rows(Run *r)
     if ((tk - t1) * dir > 1e-12 * (fabs(t1) + dt) || t1 == t0)
       return;
     theta = (tk - t0) / (t1 - t0);
-    if (theta >= 1) {
+    if (theta >= 1)
       memcpy(r->y, r->x, md->state_size);
-    } else {
-      hbvmrt_stats st;
-      memcpy(r->y, r->x0, md->state_size);
-      if (!(theta > 0) || md->step(r->y, tk - t0, r->prm, &st) != 0)
-        md->dense(r->x, theta < 0 ? 0 : theta, r->y);
-    }
+    else
+      hbvmrt_state_within(md, r->prm, r->x0, r->x, theta, tk - t0, r->y);
     memcpy((char *)r->y + md->off_t, &tk, sizeof tk);
     H = md->energy(r->y, r->prm);
     for (i = 0; i < md->nu; i++)
