@@ -32,6 +32,8 @@ typedef struct {
   const char *text;    /* text of the last name or number read (for messages) */
   int after_name;      /* the token before the current one was that name ... */
   Loc name_loc;        /* ... which is here */
+  const char *prev_text; /* the name or number read before text, and where */
+  Loc prev_loc;
   int is_name;         /* the current token is a name */
   long tokens;         /* tokens read, bounded by MAX_TOKENS */
   int depth;           /* open brackets, counted by the lexer ... */
@@ -308,6 +310,15 @@ static int yyreport_syntax_error(const yypcontext_t *ctx, yyscan_t scanner, Pars
   if (tok == YYTRANSLATE('(') && ps->after_name) {
     error_at(ps->name_loc, "'%.40s' is not a function (the functions are sin cos tan asin acos atan atan2 sinh "
              "cosh tanh exp log sqrt pow abs sign min max)", ps->text);
+    return 0;
+  }
+  /* a name after an event's expression, on its line (the unexpected token, or the one before): a
+   * mistyped direction */
+  int word = tok == YYSYMBOL_NAME || is_reserved(tok); /* the lexer's name_loc, text are this token's */
+  Loc stray = word ? ps->prev_loc : ps->name_loc;
+  if (ps->after_name && ps->last && ps->last->kind == S_EVENT && stray.line == ps->last->loc.line) {
+    error_at(stray, "'%.40s' after the expression of event '%s': an event's direction is 'rising' or "
+             "'falling' (or nothing: both)", word ? ps->prev_text : ps->text, ps->last->name);
     return 0;
   }
   msg_add(msg, "syntax error, unexpected %s", yysymbol_name(tok));
