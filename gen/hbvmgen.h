@@ -380,6 +380,7 @@ typedef struct {
 } Method;
 
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why);
+int method_quadrature_exact(int k, int s, int degU, int degg);
 Method *method_new(int k, int s, MultFamily family);
 
 /* ---- step.c, step_const.c, step_poly.c, lu.c: the step as a DAG ---- */

@@ -54,6 +54,12 @@ static double binomial(int n, int k) {
 // s = 2), k = 2 gives errors 5x smaller than k = 3..16 with H at 1e-16,
 // and with g = sqrt(x^2 + y^2) - 1, k = s keeps |g| at 1e-16 where k = 3
 // leaves 5e-12.
+// Whether k Gauss nodes integrate H and g exactly along a step's degree-s
+// polynomial: both polynomial, of degree at most 2k/s.
+int method_quadrature_exact(int k, int s, int degU, int degg) {
+  return degU != DEG_NONPOLY && degg != DEG_NONPOLY && s * degU <= 2 * k && s * degg <= 2 * k;
+}
+
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why) {
   int k = s;
   *why = "H and g are at most quadratic: k = s (Gauss collocation) conserves both";
