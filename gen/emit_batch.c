@@ -128,6 +128,8 @@ static void emit_predict(Emitter *e) {
     tmpl(e, "      for (i = 0; i < $P_S; i++)\n        for (l = 0; l < $P_W; l++)\n"
             "          b[l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
             "                  $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n");
+  if (poly) /* every lane from its last two steps (steps of one h): no selects */
+    tmpl(e, "      if (all2)\n        for (l = 0; l < $P_W; l++) gam[(j * $P_M + m) * $P_W + l] = b[l];\n      else\n");
   tmpl(e, "      for (l = 0; l < $P_W; l++) {\n");
   tmpl(e, poly ? "        $R c = two[l] ? b[l] : a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n"
                : "        $R c = a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n");

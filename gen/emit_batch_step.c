@@ -18,7 +18,12 @@
 static void emit_pivots(Emitter *e) {
   tmpl(e, "/* The multiplier factor's pivot tests of $P_step, in the lanes of sel still iterating. */\n"
           "static void $P_batch_pivots(const $R *restrict fa, const $M *restrict sel, int *restrict rc)\n{\n"
-          "  int i, l;\n"
+          "  $M any = 0;\n  int i, l;\n"
+          "  /* first whether any pivot of any lane fails: mostly none, and then no more */\n"
+          "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+          "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
+          "      any |= !isfinite(piv) | !isfinite(dia) | ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n"
+          "  if (!any) return;\n"
           "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
           "      $M nf = !isfinite(piv) | !isfinite(dia), sg = (fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0;\n"
@@ -40,9 +45,9 @@ static void emit_lane_test(Emitter *e, int poly) {
           "static int $P_batch_test(const $P_batch *restrict x, $R h, int it, const $R *restrict sw, $R *restrict gam,\n"
           "    $R *restrict lam, const $M *restrict act, $R *restrict inc, $R *restrict incp, $R *restrict inc_min,\n"
           "    int *restrict stall, int *restrict rc, int *restrict iters)\n{\n"
-          "  $R scale[$P_W], incn[$P_W];\n"
+          "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
-          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
+          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = nan[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
           "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
           "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
@@ -54,10 +59,12 @@ static void emit_lane_test(Emitter *e, int poly) {
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
             "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
   tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
-  tmpl(e, "    for (l = 0; l < $P_W; l++) bad[l] |= !isfinite(sw[i * $P_W + l]);\n"
+  /* a result is not finite where r - r is not 0 (inf - inf and NaN are NaN): their sum
+   * over the results is one test a lane, in a loop the compiler vectorises */
+  tmpl(e, "    for (l = 0; l < $P_W; l++) nan[l] += sw[i * $P_W + l] - sw[i * $P_W + l];\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
-          "    bad[l] |= !isfinite(in);\n");
+          "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   tmpl(e, poly ? "    ok[l] = in <= $P_TOL;\n" : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n"
           "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
