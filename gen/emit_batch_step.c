@@ -17,7 +17,7 @@
 // ENOCONV: the first pivot that is not finite or is small sets rc.
 static void emit_pivots(Emitter *e) {
   tmpl(e, "/* The multiplier factor's pivot tests of $P_step, in the lanes of sel still iterating. */\n"
-          "static void $P_batch_pivots(const $R *restrict fa, const $M *restrict sel, int *restrict rc)\n{\n"
+          "static void $P_batch_pivots(const $R *restrict fa, const $M *restrict sel, $M *restrict rc)\n{\n"
           "  $M any = 0;\n  int i, l;\n"
           "  /* first whether any pivot of any lane fails: mostly none, and then no more */\n"
           "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
@@ -27,7 +27,7 @@ static void emit_pivots(Emitter *e) {
           "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
           "      $M nf = !isfinite(piv) | !isfinite(dia), sg = (fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0;\n"
-          "      int code = nf ? $P_ENONFINITE : sg ? $P_ESINGULAR : $P_ENOCONV;\n"
+          "      $M code = nf ? $P_ENONFINITE : sg ? $P_ESINGULAR : $P_ENOCONV;\n"
           "      rc[l] = (sel[l] & (rc[l] == $P_ENOCONV)) ? code : rc[l];\n    }\n}\n\n");
 }
 
@@ -44,7 +44,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           " * its last one. Returns the number of lanes that iterate on. */\n"
           "static int $P_batch_test(const $P_batch *restrict x, $R h, int it, const $R *restrict sw, $R *restrict gam,\n"
           "    $R *restrict lam, const $M *restrict act, $R *restrict inc, $R *restrict incp, $R *restrict inc_min,\n"
-          "    int *restrict stall, int *restrict rc, int *restrict iters)\n{\n"
+          "    $M *restrict stall, $M *restrict rc, $M *restrict iters)\n{\n"
           "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = nan[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
@@ -70,9 +70,9 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
           "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n"
-          "    int stl = better[l] ? 0 : stall[l] + 1;\n    $M a = act[l], okl = (bad[l] == 0) & ok[l];\n"
+          "    $M stl = better[l] ? 0 : stall[l] + 1;\n    $M a = act[l], okl = (bad[l] == 0) & ok[l];\n"
           "    $M stop = sing[l] | bad[l] | okl | (stl >= $P_STALL);\n"
-          "    int code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : (okl | noise[l]) ? $P_OK : $P_ENOCONV;\n"
+          "    $M code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : (okl | noise[l]) ? $P_OK : $P_ENOCONV;\n"
           "    stall[l] = a ? stl : stall[l];\n    rc[l] = (a & stop) ? code : rc[l];\n"
           "    iters[l] = (a & stop) ? it : iters[l];\n    run[l] = a & (stop == 0);\n    nrun += (int)run[l];\n  }\n"
           "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
@@ -86,13 +86,21 @@ static void emit_lane_test(Emitter *e, int poly) {
 // The writes both families make in a lane that commits (cm[l]): the history
 // of gamma, p's polynomial for NAME_dense, t and the previous steps.
 static void emit_commit_common(Emitter *e) {
-  tmpl(e, "    for (i = 0; i < $P_S * $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
+  tmpl(e, "    $M all = 1;  /* mostly every lane commits: then plain copies, which vectorise */\n"
+          "    for (l = 0; l < $P_W; l++) all &= cm[l];\n"
+          "    if (all) {\n      for (i = 0; i < $P_S * $P_M * $P_W; i++) {\n"
+          "        x->gam2[i] = x->gam[i];\n        x->gam[i] = sw[($[sweep.gam]0) * $P_W + i];\n      }\n"
+          "      for (i = 0; i < $P_M * $P_W; i++) x->pinc[i] = sw[($[sweep.dp]0) * $P_W + i];\n"
+          "      for (i = 0; i < ($P_S - 1) * $P_M * $P_W; i++) x->pinc[$P_M * $P_W + i] = sw[($[sweep.theta]0) * $P_W + i];\n"
+          "    } else {\n"
+          "    for (i = 0; i < $P_S * $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
           "        $R g = x->gam[i * $P_W + l], n = sw[($[sweep.gam]i) * $P_W + l];\n"
           "        x->gam2[i * $P_W + l] = cm[l] ? g : x->gam2[i * $P_W + l];\n        x->gam[i * $P_W + l] = cm[l] ? n : g;\n      }\n"
           "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++)\n"
           "        x->pinc[i * $P_W + l] = cm[l] ? sw[($[sweep.dp]i) * $P_W + l] : x->pinc[i * $P_W + l];\n"
           "    for (i = 0; i < ($P_S - 1) * $P_M; i++)\n      for (l = 0; l < $P_W; l++)\n"
           "        x->pinc[($P_M + i) * $P_W + l] = cm[l] ? sw[($[sweep.theta]i) * $P_W + l] : x->pinc[($P_M + i) * $P_W + l];\n"
+          "    }\n"
           "    for (l = 0; l < $P_W; l++) {\n"
           "      $R t = x->t[l], tc = x->tc[l], hp = x->hprev[l];\n      $P_add(&t, &tc, h);\n"
           "      x->t[l] = cm[l] ? t : x->t[l];\n      x->tc[l] = cm[l] ? tc : x->tc[l];\n"
@@ -154,7 +162,7 @@ static void emit_commit(Emitter *e, int poly) {
           "        pco[i * $P_W + l] = p - ph;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n"
           "        nf[l] |= !isfinite(q1[i * $P_W + l]) | !isfinite(p);\n      }\n"
           "    for (l = 0; l < $P_W; l++) {\n"
-          "      int code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n"
+          "      $M code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n"
           "      rc[l] = go[l] ? code : rc[l];\n      cm[l] = go[l] & (code == $P_OK);\n"
           "      x->H0[l] = cm[l] ? H0[l] : x->H0[l];\n    }\n"
           "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
@@ -182,7 +190,7 @@ void emit_batch_step(Emitter *e) {
           "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
           "  $R sw[($<sweep> + 1) * $P_W];\n"
           "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n"
-          "  int rc[$P_W], stall[$P_W], iters[$P_W];\n  $M go[$P_W], act[$P_W];\n"
+          "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
           "  int it, i, l, nrun = 0, nfail = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
@@ -226,8 +234,9 @@ void emit_batch_step(Emitter *e) {
           "  for (l = 0; l < $P_W; l++) {  /* a lane still iterating did not converge: rc is $P_ENOCONV */\n"
           "    $R t = x->t[l] + h, tc = x->tc[l];\n"
           "    $M ok = go[l] & (rc[l] == $P_OK), tbad = !isfinite(t) | !isfinite(tc);\n"
-          "    for (i = 0; i < ($P_S - 1) * $P_M; i++)  /* the rest of p's polynomial, as $P_step */\n"
-          "      tbad |= !isfinite(sw[($[sweep.theta]i) * $P_W + l]);\n"
+          "    $R nan = 0;  /* the rest of p's polynomial finite, as in $P_step (see $P_batch_test) */\n"
+          "    for (i = 0; i < ($P_S - 1) * $P_M; i++) nan += sw[($[sweep.theta]i) * $P_W + l] - sw[($[sweep.theta]i) * $P_W + l];\n"
+          "    tbad |= nan != 0;\n"
           "    iters[l] = (go[l] & (iters[l] == 0)) ? $P_MAXITER : iters[l];\n"
           "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
           "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
@@ -235,6 +244,6 @@ void emit_batch_step(Emitter *e) {
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    nfail += rc[l] != $P_OK;\n"
           "    if (!st) continue;\n"
-          "    st->code[l] = rc[l];\n    st->iters[l] = iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n"
+          "    st->code[l] = (int)rc[l];\n    st->iters[l] = (int)iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n"
           "  }\n  return nfail;\n}\n");
 }
