@@ -73,8 +73,10 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $M stl = better[l] ? 0 : stall[l] + 1;\n    $M a = act[l], okl = (bad[l] == 0) & ok[l];\n"
           "    $M stop = sing[l] | bad[l] | okl | (stl >= $P_STALL);\n"
           "    $M code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : (okl | noise[l]) ? $P_OK : $P_ENOCONV;\n"
-          "    stall[l] = a ? stl : stall[l];\n    rc[l] = (a & stop) ? code : rc[l];\n"
-          "    iters[l] = (a & stop) ? it : iters[l];\n    run[l] = a & (stop == 0);\n    nrun += (int)run[l];\n  }\n"
+          "    $M as = -(a & stop);  /* all ones or zero: the writes as blends, which vectorise */\n"
+          "    stall[l] ^= (stall[l] ^ stl) & -a;\n    rc[l] ^= (rc[l] ^ code) & as;\n"
+          "    iters[l] ^= (iters[l] ^ it) & as;\n    run[l] = a & (stop == 0);\n  }\n"
+          "  for (l = 0; l < $P_W; l++) nrun += (int)run[l];\n"
           "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R s = sw[($[sweep.gam]i) * $P_W + l], g = gam[i * $P_W + l];\n      gam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
   if (poly)
