@@ -665,6 +665,37 @@ static void emit_predict(Emitter *e) {
             "static void $P_add($R *a, $R *c, $R b)\n{\n  (void)c;\n  *a += b;\n}\n\n");
 }
 
+// Whether the step's error estimate must take the quadrature's part from
+// the energy defect: k nodes do not integrate H exactly for this model (U or
+// g not polynomial, or k below -k auto), and no rescale restores H (the
+// constant family, or no constraints).
+static int energy_defect_wanted(const Emitter *e) {
+  return !e->st->kern[K_FACTOR].nout &&
+         !method_quadrature_exact(e->me->k, e->me->s, e->mod->degU, e->mod->degg);
+}
+
+// NAME_defect: the quadrature's part of a step's local error, which
+// NAME_err_est does not see. The step's energy defect |H(q1, p1) - H(q0, p0)|
+// beyond round-off (64 ulps of |K| + |U|), as the displacement across the
+// energy surface it takes, over the force |p1 - p0| / h; (q1, p1) from the
+// converged sweep, before the commit (no copy of the state: a step over the
+// tolerance with it is rejected as NAME_step_within rejects any, unwritten).
+static void emit_defect(Emitter *e) {
+  tmpl(e, "/* The quadrature's part of the local error (the $P_K nodes do not integrate H exactly\n"
+          " * for this model), which $P_err_est does not see: the energy defect of the step from\n"
+          " * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */\n"
+          "static $R $P_defect(const $P_state *x, const $W *sw, $R h, const $P_params *prm)\n{\n"
+          "  $R q1[$P_M], p1[$P_M], z[$P_M], H0, U0, H1, dH, dp = 0;\n  int i;\n"
+          "  for (i = 0; i < $P_M; i++) {\n"
+          "    q1[i] = x->q[i] + h * ($R)sw[$[sweep.gam]i];\n    p1[i] = x->p[i] + ($R)sw[$[sweep.dp]i];\n"
+          "    z[i] = 0;\n    if (fabs$f(p1[i] - x->p[i]) > dp) dp = fabs$f(p1[i] - x->p[i]);\n  }\n"
+          "  $(energy_kernel q0=x->q p0=x->p out=&H0);\n"
+          "  $(energy_kernel q0=x->q p0=z out=&U0);\n"
+          "  $(energy_kernel q0=q1 p0=p1 out=&H1);\n"
+          "  dH = fabs$f(H1 - H0) - $P_NOISETOL * (fabs$f(H0 - U0) + fabs$f(U0));\n"
+          "  return dH > 0 && dp > 0 ? dH * fabs$f(h) / dp : 0;\n}\n\n");
+}
+
 // The warm start, iteration and compensated update around the sweep kernel.
 // With --wide-step the iteration (gamma, the sweep's results) is in the wider
 // type, starts from the compensated state q - qc, p - pc, and the new q, p
@@ -673,6 +704,8 @@ static void emit_step(Emitter *e) {
   int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
   emit_predict(e);
   emit_err_est(e);
+  int defect = energy_defect_wanted(e);
+  if (defect) emit_defect(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
           "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
@@ -726,8 +759,9 @@ static void emit_step(Emitter *e) {
     for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "  gam[%d] = gm%d;\n", i, i);
     for (int i = 0; i < kernel_size(&e->st->kern[K_SWEEP]); i++) out(e, "  sw[%d] = sw%d;\n", i, i);
   }
-  tmpl(e, "  est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
-          "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
+  tmpl(e, "  est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n");
+  if (defect) tmpl(e, "  if (tol > 0 && rc == $P_OK) est += $P_defect(x, sw, h, prm);  /* under $P_step_adaptive */\n");
+  tmpl(e, "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
           "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
           "  if (rc != $P_OK) return rc;\n"
           "  /* $P_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */\n"
@@ -823,31 +857,6 @@ static void emit_project(Emitter *e) {
   tmpl(e, "  if (dq) *dq = dqmax;\n  if (dp) *dp = dpmax;\n  return $P_OK;\n}\n");
 }
 
-// Whether the step's error estimate must take the quadrature's part from
-// the energy defect: k nodes do not integrate H exactly for this model (U or
-// g not polynomial, or k below -k auto), and no rescale restores H (the
-// constant family, or no constraints).
-static int energy_defect_wanted(const Emitter *e) {
-  return !e->st->kern[K_FACTOR].nout &&
-         !method_quadrature_exact(e->me->k, e->me->s, e->mod->degU, e->mod->degg);
-}
-
-// NAME_defect: the quadrature's part of a step's local error, which
-// NAME_err_est does not see. The step's energy defect |H(x1) - H(x0)| beyond
-// round-off (64 ulps of |K| + |U|), as the displacement across the energy
-// surface it takes, over the force |p1 - p0| / h.
-static void emit_defect(Emitter *e) {
-  tmpl(e, "\n/* The quadrature's part of the local error (the $P_K nodes do not integrate H exactly\n"
-          " * for this model), which $P_err_est does not see: the energy defect of the step\n"
-          " * from x0 to x1 beyond round-off, over the force |p1 - p0| / h. */\n"
-          "static $R $P_defect(const $P_state *x0, const $P_state *x1, $R h, const $P_params *prm)\n{\n"
-          "  $P_state z = *x0;\n  $R H0 = $P_energy(x0, prm), U0, dH, dp = 0;\n  int i;\n"
-          "  for (i = 0; i < $P_M; i++) z.p[i] = 0;\n  U0 = $P_energy(&z, prm);\n"
-          "  dH = fabs$f($P_energy(x1, prm) - H0) - $P_NOISETOL * (fabs$f(H0 - U0) + fabs$f(U0));\n"
-          "  for (i = 0; i < $P_M; i++)\n    if (fabs$f(x1->p[i] - x0->p[i]) > dp) dp = fabs$f(x1->p[i] - x0->p[i]);\n"
-          "  return dH > 0 && dp > 0 ? dH * fabs$f(h) / dp : 0;\n}\n\n");
-}
-
 // NAME_step_adaptive: NAME_step with its error estimate tested before the
 // commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
 // and relative at once, so that the errors of the steps up to T add up to
@@ -865,28 +874,17 @@ static void emit_step_adaptive(Emitter *e) {
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
   out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
       e->P, e->P, e->single ? "0.01f" : "0.01");
-  int defect = energy_defect_wanted(e);
-  if (defect) emit_defect(e);
   out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
-          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0, misses = 0;\n");
-  if (defect) tmpl(e, "  $P_state x0;  /* the state before a try, for $P_defect */\n");
-  tmpl(e, "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
+          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0, misses = 0;\n"
+          "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
           "  tol *= $P_TOLC;\n"
-          "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n");
-  if (defect) tmpl(e, "    x0 = *x;\n");
-  tmpl(e, "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
+          "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
+          "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
           "     * previous step's error, which no smaller h removes from the estimate */\n"
-          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, &s);\n");
-  if (defect)
-    tmpl(e, "    if (rc == $P_OK) {  /* with the quadrature's part, over tol |h| (1 + max|q|): undone */\n"
-            "      $R sc = 0;\n      int i;\n"
-            "      s.err_est += $P_defect(&x0, x, hh, prm);\n"
-            "      for (i = 0; i < $P_M; i++)\n        if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
-            "      if (!(s.err_est <= tol * fabs$f(hh) * (1 + sc))) {\n        *x = x0;\n        rc = $P_EREJECT;\n"
-            "      }\n    }\n");
-  tmpl(e, "    if (rc == $P_EREJECT) misses++;\n"
+          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, &s);\n"
+          "    if (rc == $P_EREJECT) misses++;\n"
           "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
           "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
           "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");

@@ -226,7 +226,7 @@ END_TEST
 // Kepler at k = s = 3: U is not polynomial, the 3 nodes do not integrate H
 // exactly, and the quadrature's error, which err_est does not see, dominates
 // over many periods. NAME_step_adaptive adds it from the step's energy
-// defect: over ten periods (e = 0.6) error / tol is 25-38 at tol 1e-6 ..
+// defect: over ten periods (e = 0.6) error / tol is 37-49 at tol 1e-6 ..
 // 1e-10 (measured), 300-1400 without it.
 START_TEST(adaptive_quadrature_defect)
 {
@@ -235,7 +235,7 @@ START_TEST(adaptive_quadrature_defect)
   for (double tol = 1e-6; tol > 1e-10 / 2; tol /= 100) {
     Adaptive a = adaptive_kepler_k3s3(T, tol, qT, pT);
     for (int i = 0; i < 2; i++) a.err = fmax(a.err, fmax(fabs(qT[i] - q[2 + i]), fabs(pT[i] - p[2 + i])));
-    ck_assert_msg(a.err <= 60 * tol, "kepler (3,3) over ten periods, tol %g: error %g", tol, a.err);
+    ck_assert_msg(a.err <= 100 * tol, "kepler (3,3) over ten periods, tol %g: error %g", tol, a.err);
   }
 }
 END_TEST
