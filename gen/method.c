@@ -35,6 +35,16 @@ static double binomial(int n, int k) {
   return r;
 }
 
+// The smallest k for which k Gauss nodes integrate a function of degree deg
+// along a step's degree-s polynomial exactly: s deg <= 2k.
+static int exact_k(int s, int deg) { return (s * deg + 1) / 2; }
+
+// Whether k Gauss nodes integrate H and g exactly along a step's degree-s
+// polynomial: both polynomial, each within exact_k.
+int method_quadrature_exact(int k, int s, int degU, int degg) {
+  return degU != DEG_NONPOLY && degg != DEG_NONPOLY && exact_k(s, degU) <= k && exact_k(s, degg) <= k;
+}
+
 // The smallest k >= s for which the Gauss quadrature conserves H and g
 // exactly: H and g polynomial of degree <= 2k/s (the kinetic energy has
 // degree 2).
@@ -54,19 +64,13 @@ static double binomial(int n, int k) {
 // s = 2), k = 2 gives errors 5x smaller than k = 3..16 with H at 1e-16,
 // and with g = sqrt(x^2 + y^2) - 1, k = s keeps |g| at 1e-16 where k = 3
 // leaves 5e-12.
-// Whether k Gauss nodes integrate H and g exactly along a step's degree-s
-// polynomial: both polynomial, of degree at most 2k/s.
-int method_quadrature_exact(int k, int s, int degU, int degg) {
-  return degU != DEG_NONPOLY && degg != DEG_NONPOLY && s * degU <= 2 * k && s * degg <= 2 * k;
-}
-
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why) {
   int k = s;
   *why = "H and g are at most quadratic: k = s (Gauss collocation) conserves both";
   int degs[2] = {degU, degg};
   for (int i = 0; i < 2; i++) {
     if (degs[i] == DEG_NONPOLY) continue;
-    int need = (s * degs[i] + 1) / 2;
+    int need = exact_k(s, degs[i]);
     if (need > k) {
       k = need;
       *why = "smallest k with deg <= 2k/s: the quadrature is exact for H and g";
