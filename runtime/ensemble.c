@@ -2,8 +2,10 @@
  * --sweep NAME=A:B:N (docs/api.md, "Ensembles").
  *
  * Each trajectory is a row: initial values and params by column name over
- * the run's defaults (--q0, --p0, --param), N steps of h as in run.c, and one
- * summary row (final state, max |H - H0|, |g|, |hc|, iterations, status).
+ * the run's defaults (--q0, --p0, --param), the steps of a single run of the
+ * driver (span.c: N steps of h, the last shortened to end on -T, or --tol's
+ * adaptive steps to T), and one summary row (final state, max |H - H0|, |g|,
+ * |hc|, iterations, status).
  * Trajectories are cut into chunks of consecutive rows: W of them when the
  * solver has a batch step (stepped together, one lane each), else
  * HBVMRT_SCALAR_CHUNK stepped one after another.  Chunks are handed out
@@ -387,36 +389,55 @@ static void finish(const Ens *e, double *r, const void *x, const void *prm)
 
 /* ---- running chunks ---- */
 
+/* g and hc of the state x into w, when the model has constraints. */
+static void constraints_of(const hbvmrt_model *md, Work *w, const void *x, const void *prm)
+{
+  if (md->nu > 0) {
+    md->constraints(x, prm, w->g);
+    md->hidden(x, prm, w->hc);
+  }
+}
+
+/* Trajectory i's steps from its initial state in w->x: the N steps of h of
+ * the run, the last shortened to end on T with -T, or with --tol adaptive
+ * steps (NAME_step_adaptive, -h the first) to T exactly, as a single run of
+ * the driver takes them; stops at the first failed step, its code the
+ * trajectory's status. */
+static void steps_scalar(const Ens *e, Work *w, double *r, double H0)
+{
+  const hbvmrt_model *md = e->md;
+  double h = e->o.h, t_end = hbvmrt_span_end(&e->o);
+  long k;
+  int at_end = e->o.tol > 0 && hbvmrt_state_time(md, w->x) == t_end;
+
+  for (k = 1; e->o.tol > 0 ? !at_end : k <= e->o.nsteps; k++) {
+    hbvmrt_stats st = {0};
+    int code = e->o.tol > 0 ? hbvmrt_adaptive_step(md, w->x, &h, t_end, e->o.tol, w->prm, &st, &at_end)
+                            : md->step(w->x, hbvmrt_fixed_step(md, &e->o, k, w->x), w->prm, &st);
+    if (code != 0) {
+      r[0] = code;
+      return;
+    }
+    count(md, r, k, st.iters);
+    constraints_of(md, w, w->x, w->prm);
+    observe(e, r, md->energy(w->x, w->prm), H0, w->g, w->hc, 1);
+  }
+}
+
 /* Trajectories [first, first + n) one after another. */
 static void run_scalar(const Ens *e, Work *w, long first, long n)
 {
   const hbvmrt_model *md = e->md;
-  long i, k;
+  long i;
 
   for (i = first; i < first + n; i++) {
     double *r = result(e, i), H0;
     r[0] = start(e, i, w->x, w->prm, w->g, w->hc);
     H0 = md->energy(w->x, w->prm);
     if (r[0] == 0) {
-      if (md->nu > 0) {
-        md->constraints(w->x, w->prm, w->g);
-        md->hidden(w->x, w->prm, w->hc);
-      }
+      constraints_of(md, w, w->x, w->prm);
       observe(e, r, H0, H0, w->g, w->hc, 1);
-    }
-    for (k = 1; r[0] == 0 && k <= e->o.nsteps; k++) {
-      hbvmrt_stats st = {0};
-      int code = md->step(w->x, e->o.h, w->prm, &st);
-      if (code != 0) {
-        r[0] = code;
-        break;
-      }
-      count(md, r, k, st.iters);
-      if (md->nu > 0) {
-        md->constraints(w->x, w->prm, w->g);
-        md->hidden(w->x, w->prm, w->hc);
-      }
-      observe(e, r, md->energy(w->x, w->prm), H0, w->g, w->hc, 1);
+      steps_scalar(e, w, r, H0);
     }
     finish(e, r, w->x, w->prm);
   }
@@ -446,7 +467,14 @@ static void run_batch(const Ens *e, Work *w, long first, long n)
     if (result(e, first + l)[0] == 0)
       observe(e, result(e, first + l), w->Hb[l], w->H0[l], w->g + l, w->hc + l, W);
   for (k = 1; live > 0 && k <= e->o.nsteps; k++) {
-    e->bt->step(w->b, e->o.h, w->prms, w->code, w->iters);
+    double h = e->o.h;
+    if (k == e->o.nsteps && e->o.to_T) {  /* the last step ends on T: every live lane has the same t */
+      for (l = 0; result(e, first + l)[0] != 0; l++)
+        ;
+      e->bt->get(w->b, l, w->x);
+      h = hbvmrt_fixed_step(md, &e->o, k, w->x);
+    }
+    e->bt->step(w->b, h, w->prms, w->code, w->iters);
     e->bt->observe(w->b, w->prms, w->Hb, w->g, w->hc);
     for (l = 0; l < n; l++) {
       double *r = result(e, first + l);
@@ -524,7 +552,7 @@ static int worker(Ens *e)
     c = rc == 0 ? next_chunk(e) : -1;
     if (c < 0)
       break;
-    if (e->bt)
+    if (e->bt && !(e->o.tol > 0))  /* adaptive steps are each trajectory's own */
       run_batch(e, &w, c * e->chunk, e->nrow - c * e->chunk < e->chunk ? e->nrow - c * e->chunk : e->chunk);
     else
       run_scalar(e, &w, c * e->chunk, e->nrow - c * e->chunk < e->chunk ? e->nrow - c * e->chunk : e->chunk);
@@ -628,6 +656,11 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
     goto out;
   }
   status = 1;
+  if (e.o.dt > 0 || e.o.events || e.o.stop_event >= 0 || e.o.every != 1) {
+    hbvmrt_error(md, "--%s writes rows along one run: not with --ensemble or --sweep, which write a summary row "
+                 "per trajectory", e.o.dt > 0 ? "dt" : e.o.events ? "events" : e.o.stop_event >= 0 ? "stop-at" : "every");
+    goto out;
+  }
   if (!md->init_params || !md->names || md->m > 1024) {
     hbvmrt_error(md, "this driver cannot run ensembles (generated by an earlier hbvmgen, or m > 1024)");
     goto out;
@@ -668,10 +701,15 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
       status = 1;
     }
   }
-  if (e.rank == 0)
-    fprintf(stderr, "trajectories=%ld ok=%ld failed=%d steps=%ld W=%d threads=%d ranks=%d seconds=%.3g\n", e.nrow,
-            e.nrow - failed, failed, e.o.nsteps, bt ? bt->w : 1, threads_used(&e), e.nranks,
-            now() - t0);
+  if (e.rank == 0) {
+    fprintf(stderr, "trajectories=%ld ok=%ld failed=%d ", e.nrow, e.nrow - failed, failed);
+    if (e.o.tol > 0)
+      fprintf(stderr, "tol=%g ", e.o.tol);
+    else
+      fprintf(stderr, "steps=%ld ", e.o.nsteps);
+    fprintf(stderr, "W=%d threads=%d ranks=%d seconds=%.3g\n", bt && !(e.o.tol > 0) ? bt->w : 1, threads_used(&e),
+            e.nranks, now() - t0);
+  }
 out:
   hbvmrt_opts_free(&e.o);
   free(rest), free(e.kind), free(e.index), free(e.val), free(e.res);

@@ -47,20 +47,11 @@ static double dense_value(hbvmrt_events *ev, const void *x, double theta, int i)
   return ev->vt[i];
 }
 
-/* The time of a state. */
-static double time_of(const hbvmrt_model *md, const void *x)
-{
-  double t;
-
-  memcpy(&t, (const char *)x + md->off_t, sizeof t);
-  return t;
-}
-
 /* Stage 1: theta of the root of event i on the dense output of the step h
  * (x its end), bracketed by fa = value at 0 and fb = value at 1. */
 static double locate(hbvmrt_events *ev, const void *x, double h, int i, double fa, double fb)
 {
-  double a = 0, b = 1, tol = HBVMRT_EVENT_TOL * (1 + fabs(time_of(ev->md, x))) / fabs(h);
+  double a = 0, b = 1, tol = HBVMRT_EVENT_TOL * (1 + fabs(hbvmrt_state_time(ev->md, x))) / fabs(h);
   int side = 0, it;
 
   for (it = 0; it < 200 && b - a > tol; it++) {
@@ -107,7 +98,7 @@ static void polish(hbvmrt_events *ev, const void *x0, const void *x, double h, i
   const hbvmrt_model *md = ev->md;
   double d = 1e-6, lo = theta - d < 0 ? 0 : theta - d, hi = theta + d > 1 ? 1 : theta + d;
   double slope = (dense_value(ev, x, hi, i) - dense_value(ev, x, lo, i)) / (hi - lo);
-  double tol = HBVMRT_EVENT_TOL * (1 + fabs(time_of(md, x))) / fabs(h);
+  double tol = HBVMRT_EVENT_TOL * (1 + fabs(hbvmrt_state_time(md, x))) / fabs(h);
   int k;
 
   for (k = 0; k < POLISH_ITERS; k++) {

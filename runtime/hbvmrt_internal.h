@@ -111,6 +111,19 @@ int hbvmrt_events_close(hbvmrt_events *ev);
 int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0, const void *x, double theta,
                         double hsub, void *z);
 
+/* span.c: stepping to the end of the span, hit exactly (run.c, ensemble.c) */
+
+/* The time of the state x (its rounded value). */
+double hbvmrt_state_time(const hbvmrt_model *md, const void *x);
+/* The end of the span: T in the direction of h. */
+double hbvmrt_span_end(const hbvmrt_opts *o);
+/* Step n of N of a fixed-step run from x: h, the last shortened to end on T. */
+double hbvmrt_fixed_step(const hbvmrt_model *md, const hbvmrt_opts *o, long n, const void *x);
+/* One adaptive step toward t_end from x, of at most *h (the last shortened
+ * to end on t_end); the step's code, the next h in *h, *at_end when on it. */
+int hbvmrt_adaptive_step(const hbvmrt_model *md, void *x, double *h, double t_end, double tol, const void *prm,
+                         hbvmrt_stats *st, int *at_end);
+
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 
 int hbvmrt_ensemble_wanted(int argc, char **argv);

@@ -75,6 +75,12 @@ static double now(void)
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* The time of the run's state (its rounded value). */
+static double state_t(const Run *r)
+{
+  return hbvmrt_state_time(r->md, r->x);
+}
+
 /* max = max(max, |v|), except that a NaN, once seen, stays */
 static void keep_max(double *max, double v)
 {
@@ -300,11 +306,8 @@ static void progress_tick(Progress *pg, const Run *r, long n)
   if (t - pg->start < 1.0 || t - pg->last_draw < 0.1)
     return;
   pg->last_draw = t;
-  if (r->o->tol > 0 && r->o->T > 0) {   /* adaptive: the share of the span */
-    double t;
-    memcpy(&t, (const char *)r->x + r->md->off_t, sizeof t);
-    done = fabs(t) / r->o->T;
-  }
+  if (r->o->tol > 0 && r->o->T > 0)   /* adaptive: the share of the span */
+    done = fabs(state_t(r)) / r->o->T;
   len = snprintf(line, sizeof line, "%s: %5.1f%%  %.0f steps/s  |H-H0|=%.2e",
                  r->md->name, 100.0 * done,
                  (double)n / (t - pg->start), fabs(r->H - r->H0));
@@ -322,15 +325,6 @@ static void progress_clear(Progress *pg)
   pg->width = 0;
 }
 
-/* The time of the state (its rounded value). */
-static double state_t(const Run *r)
-{
-  double t;
-
-  memcpy(&t, (const char *)r->x + r->md->off_t, sizeof t);
-  return t;
-}
-
 /* A row per step, unless --dt writes the rows on its grid. */
 static int step_row(Run *r)
 {
@@ -346,10 +340,9 @@ static int step_row(Run *r)
 static void grid_rows(Run *r)
 {
   const hbvmrt_model *md = r->md;
-  double t0, t1 = state_t(r), dt = r->o->dt;
+  double t0 = hbvmrt_state_time(md, r->x0), t1 = state_t(r), dt = r->o->dt;
   int i;
 
-  memcpy(&t0, (const char *)r->x0 + md->off_t, sizeof t0);
   for (;;) {
     double dir = t1 < t0 ? -1 : 1, tk = dir * (double)r->grid_k * dt, theta, H;
     if ((tk - t1) * dir > 1e-12 * (fabs(t1) + dt) || t1 == t0)
@@ -431,29 +424,23 @@ static int advance(Run *r, double h, int depth)
   return advance(r, target - state_t(r), depth + 1);
 }
 
-/* --tol: adaptive steps from h until -T, hit exactly: a step that would
- * pass it is shortened to end on it (and one within 1e-12 of it too, so
- * that no sliver of a step is left).  Rows at t=0, every K steps taken and
- * at T; stops at the first failed step (its code in r->fail_code). */
+/* --tol: adaptive steps from h until -T, hit exactly (hbvmrt_adaptive_step).
+ * Rows at t=0, every K steps taken and at T; stops at the first failed step
+ * (its code in r->fail_code). */
 static void loop_adaptive(Run *r, Progress *pg)
 {
-  const hbvmrt_model *md = r->md;
   long n = 0, K = r->o->every;
-  double h = r->o->h, t_end = h < 0 ? -r->o->T : r->o->T;
+  double h = r->o->h, t_end = hbvmrt_span_end(r->o);
 
   observe(r);
   if (write_row(r) != 0)
     return;
   while (state_t(r) != t_end) {
-    double rest = t_end - state_t(r), hn = h;
     hbvmrt_stats st;
-    int last = fabs(hn) >= fabs(rest) * (1 - 1e-12), code;
+    int at_end, code;
 
-    memset(&st, 0, sizeof st);
-    if (last)
-      hn = rest;
     before_step(r);
-    code = md->step_adaptive(r->x, &hn, r->o->tol, r->prm, &st);
+    code = hbvmrt_adaptive_step(r->md, r->x, &h, t_end, r->o->tol, r->prm, &st, &at_end);
     r->rejected += st.rejected;
     if (code != 0) {
       r->fail_code = code;
@@ -463,11 +450,10 @@ static void loop_adaptive(Run *r, Progress *pg)
     }
     n++;
     taken(r, &st, st.h);
-    if (r->stopped || (last && st.h == rest)) {   /* at the event, or on T */
+    if (r->stopped || at_end) {   /* at the event, or on T */
       step_row(r);
       return;
     }
-    h = hn;
     if (n % K == 0 && step_row(r) != 0)
       return;
     if (pg->on && n >= pg->next)
@@ -482,14 +468,12 @@ static void loop_adaptive(Run *r, Progress *pg)
 static void loop(Run *r, Progress *pg)
 {
   long n, N = r->o->nsteps, K = r->o->every;
-  double h = r->o->h, t_end = h < 0 ? -r->o->T : r->o->T;
 
   observe(r);
   if (write_row(r) != 0)
     return;
   for (n = 1; n <= N; n++) {
-    double hn = n == N && r->o->to_T ? t_end - state_t(r) : h;
-    int code = advance(r, hn, 0);
+    int code = advance(r, hbvmrt_fixed_step(r->md, r->o, n, r->x), 0);
     if (code != 0) {
       r->fail_code = code;
       if ((n - 1) % K != 0)
@@ -513,10 +497,8 @@ static void report_failure(const Run *r)
 {
   const hbvmrt_model *md = r->md;
   const char *why = md->strerror ? md->strerror(r->fail_code) : NULL;
-  double t;
 
-  memcpy(&t, (const char *)r->x + md->off_t, sizeof t);
-  fprintf(stderr, "%s: error: step failed at t=%.15g: ", md->name, t);
+  fprintf(stderr, "%s: error: step failed at t=%.15g: ", md->name, state_t(r));
   if (why)
     fprintf(stderr, "%s\n", why);
   else

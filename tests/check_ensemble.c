@@ -1,7 +1,8 @@
 /* check_ensemble.c - the ensemble runner (runtime/ensemble.c): the summary
  * file of --ensemble and --sweep is byte for byte the same for the scalar
  * step and --batch W (W = 1, 3, 4), on 1 and 2 OpenMP threads, and on 1 and
- * 2 MPI ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI). */
+ * 2 MPI ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI);
+ * a trajectory ends where a single run ends (-T hit exactly, --tol). */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
 #include <stdio.h>
@@ -118,12 +119,60 @@ START_TEST(test_sweep_and_mpi)
 }
 END_TEST
 
+/* The first n fields of the last line of text, with their commas, into buf. */
+static void last_fields(const char *text, int n, char *buf, size_t size)
+{
+  size_t len = strlen(text), i = 0;
+  while (len > 0 && text[len - 1] == '\n') len--;
+  const char *line = text + len;
+  while (line > text && line[-1] != '\n') line--;
+  for (int commas = 0; line + i < text + len && i + 1 < size && commas < n; i++) {
+    buf[i] = line[i];
+    commas += line[i] == ',';
+  }
+  buf[i] = 0;
+}
+
+/* A trajectory of an ensemble ends where a single run of the driver ends:
+ * on T exactly with -T (the last step shortened: -h 0.3 -T 10 is 33 steps
+ * of 0.3 and one of 0.1) and with --tol (adaptive steps, each trajectory its
+ * own even with --batch), bitwise, for the scalar step and --batch 4. */
+START_TEST(test_span_and_tol)
+{
+  static const char *const how[] = {"-h 0.3 -T 10", "--tol 1e-8 -T 10"};
+  build("ps", "../models/pendulum.ham", "-s 2", 0);
+  build("pb", "../models/pendulum.ham", "-s 2 --batch 4", 0);
+  for (int i = 0; i < 2; i++) {
+    char args[256], single[256], want[300];
+    snprintf(args, sizeof args, "--sweep p_x=0.5:1:5 %s --threads 2", how[i]);
+    char *ens = run("", "ps", args, "e1.csv", 0), *bat = run("", "pb", args, "e2.csv", 0);
+    ck_assert_msg(!strcmp(ens, bat), "%s: --batch 4 differs from the scalar step", args);
+    snprintf(args, sizeof args, "--p0 0.5,0 %s", how[i]);
+    char *one = run("", "ps", args, "one.csv", 0);
+    last_fields(one, 7, single, sizeof single); /* t,x,y,p_x,p_y,lambda_1,H, */
+    ck_assert_msg(!strncmp(single, "10,", 3), "%s: the single run ends at %s", args, single);
+    snprintf(want, sizeof want, "\n1,0,%s,%s", i ? "" : "34", single);
+    if (i) { /* the adaptive run's number of steps is its own: find the row by its state */
+      char *row = strstr(ens, "\n1,0,");
+      ck_assert_ptr_nonnull(row);
+      row = strchr(row + 5, ',');
+      ck_assert_msg(row && !strncmp(row + 1, single, strlen(single)), "%s: trajectory 1 is not the single run's %s",
+                    how[i], single);
+    } else {
+      ck_assert_msg(strstr(ens, want) != NULL, "%s: trajectory 1 is not the single run's %s", how[i], single);
+    }
+    free(ens), free(bat), free(one);
+  }
+}
+END_TEST
+
 START_TEST(test_errors)
 {
   char cmd[512];
   build("pe", "../models/pendulum.ham", "-s 2 --batch 2", 0);
   static const char *const bad[] = {"--sweep z=0:1:3", "--sweep x=0:1", "--ensemble /nonexistent.csv",
-                                    "--sweep x=0:1:3 --ensemble a.csv", "--sweep x=0:1:3 --threads 0"};
+                                    "--sweep x=0:1:3 --ensemble a.csv", "--sweep x=0:1:3 --threads 0",
+                                    "--sweep x=0:1:3 --dt 0.1", "--sweep x=0:1:3 --every 2"};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     snprintf(cmd, sizeof cmd, "%s/pe %s -N 1 2>/dev/null", dir, bad[i]);
     ck_assert_msg(sh(cmd) == 1, "%s: expected exit status 1", bad[i]);
@@ -153,6 +202,7 @@ Suite *ensemble_suite(void)
   tcase_set_timeout(tc, 300);
   tcase_add_test(tc, test_independent_of_w_and_threads);
   tcase_add_test(tc, test_sweep_and_mpi);
+  tcase_add_test(tc, test_span_and_tol);
   tcase_add_test(tc, test_errors);
   suite_add_tcase(s, tc);
   return s;
