@@ -47,6 +47,10 @@ void emit_tables(Emitter *e);
 int kernel_inlinable(const Emitter *e, KernelId k);
 int emit_kernel_inline(Emitter *e, KernelId k);
 
+/* emit_step.c, for the batch's adaptive step too */
+int energy_defect_wanted(const Emitter *e);
+void emit_step_factor(Emitter *e);
+
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);
 void emit_batch_source(Emitter *e, int lanes);

@@ -31,6 +31,9 @@ void emit_batch_header(Emitter *e, int lanes) {
           "  int code[$P_W];            /* the lane's return code, as $P_step's ($P_OK for idle lanes) */\n"
           "  int iters[$P_W];           /* fixed-point iterations (0: failed or idle before the first) */\n"
           "  $P_real increment[$P_W];  /* last scaled increment */\n"
+          "  $P_real err_est[$P_W];    /* $P_batch_step_adaptive: the lane's local error estimate */\n"
+          "  $P_real h;                 /* the step taken (0: none) */\n"
+          "  int rejected;              /* $P_batch_step_adaptive: tries rejected before it */\n"
           "} $P_batch_stats;\n\n"
           "/* Lane `lane` of x from / into a state; set also makes the lane active (idle 0). */\n"
           "void $P_batch_set($P_batch *x, int lane, const $P_state *s);\n"
@@ -39,6 +42,12 @@ void emit_batch_header(Emitter *e, int lanes) {
           " * per lane; st may be NULL. Each lane is bitwise what $P_step would make of it; a lane\n"
           " * that fails is left unchanged. Returns the number of lanes that failed. */\n"
           "int $P_batch_step($P_batch *x, $P_real h, const $P_params *prm, $P_batch_stats *st);\n"
+          "/* One step of at most *h shared by every active lane, within tol as $P_step_adaptive's\n"
+          " * in each lane: a try with a lane over its tolerance, or failing, is retried smaller\n"
+          " * with no lane written; *h is the next step proposed. Each lane of an accepted step is\n"
+          " * bitwise $P_step with that h. Returns the number of lanes that failed: below the\n"
+          " * smallest step every active lane, none written. */\n"
+          "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st);\n"
           "/* H (W values), g and the hidden constraints ($P_NU * $P_W values) of every lane. */\n"
           "void $P_batch_energy(const $P_batch *x, const $P_params *prm, $P_real *H);\n"
           "void $P_batch_constraints(const $P_batch *x, const $P_params *prm, $P_real *g);\n"
@@ -99,21 +108,26 @@ static void emit_params_observers(Emitter *e) {
 // $P_predict over the lanes with selects: every lane's one-step
 // extrapolation (coefficients E1 when h is unchanged, else the polynomial in
 // h / hprev), the polynomial family's two-step start, and the cold start
-// (gamma_1 = M^-1 p) are all computed and the lane's own one chosen.
+// (gamma_1 = M^-1 p; every lane's with cold_all) are all computed and the
+// lane's own one chosen. For the adaptive step, ref (when not NULL) gets the
+// one-step start and twos (when not NULL) the lanes that took the two-step.
 static void emit_predict(Emitter *e) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
-  tmpl(e, "static void $P_batch_predict(const $P_batch *restrict x, $R h, const $R *restrict par, $R *restrict gam)\n{\n"
+  tmpl(e, "$P_LANE_INLINE void $P_batch_predict(const $P_batch *restrict x, $R h, int cold_all, const $R *restrict par,\n"
+          "    $R *restrict gam, $R *restrict ref, $M *restrict twos)\n{\n"
           "  $R mp[$P_M * $P_W], r[$P_W], ec[$P_S * $P_S * $P_W];\n  $M cold[$P_W], two[$P_W], same[$P_W];\n"
-          "  int i, j, l, m, d, all2 = $P_W > 0;\n"
+          "  int i, j, l, m, d, all2 = $P_W > 0, one;\n"
           "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    $R hp = x->hprev[l], hq = x->hprev2[l];\n"
-          "    cold[l] = hp == 0;\n    same[l] = h == hp;\n    r[l] = h / (hp != 0 ? hp : 1);\n    (void)hq;\n");
+          "    cold[l] = (hp == 0) | cold_all;\n    same[l] = h == hp;\n    r[l] = h / (hp != 0 ? hp : 1);\n    (void)hq;\n");
   /* the polynomial family's two-step start, as $P_predict's */
-  tmpl(e, poly ? "    two[l] = (hp != 0) & (h == hp) & (h == hq);\n  }\n" : "    two[l] = 0;\n  }\n");
+  tmpl(e, poly ? "    two[l] = (hp != 0) & (h == hp) & (h == hq) & (cold_all == 0);\n  }\n" : "    two[l] = 0;\n  }\n");
   tmpl(e, ""
           "  for (l = 0; l < $P_W; l++) all2 &= (int)two[l];\n"
-          "  if (!all2) /* the one-step coefficients, when a lane needs them */\n"
+          "  if (twos)\n    for (l = 0; l < $P_W; l++) twos[l] = two[l];\n"
+          "  one = !all2 || ref;  /* ref: the one-step start too, where the two-step one is taken */\n"
+          "  if (one) /* the one-step coefficients, when a lane needs them */\n"
           "    for (j = 0; j < $P_S * $P_S; j++) {\n"
           "      $R c[$P_W];\n      for (l = 0; l < $P_W; l++) c[l] = 0;\n"
           "      for (d = $P_S - 1; d >= 0; d--)\n        for (l = 0; l < $P_W; l++) c[l] = c[l] * r[l] + $P_E[j * $P_S + d];\n"
@@ -121,9 +135,10 @@ static void emit_predict(Emitter *e) {
           "  for (j = 0; j < $P_S; j++)\n    for (m = 0; m < $P_M; m++) {\n"
           "      $R a[$P_W], b[$P_W];\n"
           "      for (l = 0; l < $P_W; l++) a[l] = b[l] = 0;\n"
-          "      for (i = 0; !all2 && i < $P_S; i++)\n        for (l = 0; l < $P_W; l++) {\n"
+          "      for (i = 0; one && i < $P_S; i++)\n        for (l = 0; l < $P_W; l++) {\n"
           "          $R ei = ec[(j * $P_S + i) * $P_W + l], t = a[l] + ei * x->gam[(i * $P_M + m) * $P_W + l];\n"
-          "          a[l] = ei != 0 ? t : a[l];\n        }\n");
+          "          a[l] = ei != 0 ? t : a[l];\n        }\n"
+          "      if (ref)\n        for (l = 0; l < $P_W; l++) ref[(j * $P_M + m) * $P_W + l] = a[l];\n");
   if (poly)
     tmpl(e, "      for (i = 0; i < $P_S; i++)\n        for (l = 0; l < $P_W; l++)\n"
             "          b[l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
@@ -142,7 +157,12 @@ void emit_batch_source(Emitter *e, int lanes) {
   int poly = e->st->kern[K_FACTOR].nout > 0; /* lambda0: only the polynomial family's step needs it */
   e->lanes = lanes;
   tmpl(e, "\n/* ---- --batch: the kernels above as loops over $P_W lanes; value i of lane l is\n"
-          " * at [i * $P_W + l]. Each lane does the scalar kernel's operations in its order. ---- */\n");
+          " * at [i * $P_W + l]. Each lane does the scalar kernel's operations in its order. ---- */\n\n"
+          "/* The sweep, the prediction and the tests, which $P_batch_step and the tries of\n"
+          " * $P_batch_step_adaptive each call once, inlined into both (gcc, clang) as a function\n"
+          " * called once would be: the fixed step keeps its code. */\n"
+          "#if defined(__GNUC__)\n#define $P_LANE_INLINE static inline __attribute__((always_inline))\n"
+          "#else\n#define $P_LANE_INLINE static\n#endif\n");
   for (size_t i = 0; i < sizeof used / sizeof used[0]; i++)
     if (e->st->kern[used[i]].nout && (poly || used[i] != K_LAMBDA0)) emit_kernel(e, used[i]);
   out(e, "\n");

@@ -42,7 +42,7 @@ static void emit_lane_test(Emitter *e, int poly) {
   tmpl(e, "/* After a sweep: the increment and tests of $P_step in every lane that iterates (act);\n"
           " * a lane that stops gets rc, iters = it and keeps its gamma, so the next sweeps repeat\n"
           " * its last one. Returns the number of lanes that iterate on. */\n"
-          "static int $P_batch_test(const $P_batch *restrict x, $R h, int it, const $R *restrict sw, $R *restrict gam,\n"
+          "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, const $R *restrict sw, $R *restrict gam,\n"
           "    $R *restrict lam, const $M *restrict act, $R *restrict inc, $R *restrict incp, $R *restrict inc_min,\n"
           "    $M *restrict stall, $M *restrict rc, $M *restrict iters)\n{\n"
           "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
@@ -181,26 +181,134 @@ static void emit_commit(Emitter *e, int poly) {
   emit_commit_common(e);
 }
 
-// NAME_batch_step: the set-up, the factor, the sweeps while a lane
-// iterates, then the commit, all as loops over the lanes.
-void emit_batch_step(Emitter *e) {
+// The error estimate of one lane for NAME_batch_step_adaptive, by the
+// scalar step's own functions on the lane's values (once or twice a step,
+// not worth lanes): NAME_err_est on the gamma of sw with the lane's scale
+// max |q0| + |h gamma_0|, and, where the scalar step adds it, NAME_defect
+// on the lane's state.
+static void emit_lane_estimate(Emitter *e, int defect) {
+  tmpl(e, "/* Lane l's error estimate, $P_err_est on the gamma of sw, and its scale max|q0| + |h gamma_0|\n"
+          " * (as $P_step_within's from the same sweep). */\n"
+          "static $R $P_batch_est(const $P_batch *x, const $R *sw, int l, $R h, $R d1, int cold, $R *scale)\n{\n"
+          "  $R g[$P_S * $P_M], sc = 0;\n  int i;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) g[i] = sw[($[sweep.gam]i) * $P_W + l];\n"
+          "  for (i = 0; i < $P_M; i++) {\n"
+          "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * g[i]);\n    if (v > sc) sc = v;\n  }\n"
+          "  *scale = sc;\n  return $P_err_est(g, h, d1, cold);\n}\n\n");
+  if (defect)
+    tmpl(e, "/* Lane l's $P_defect, on its state and its sweep's results. */\n"
+            "static $R $P_batch_defect(const $P_batch *x, const $R *sw, int l, $R h, const $P_params *prm)\n{\n"
+            "  $P_state s;\n  $P_params dflt;\n  $R v[$<sweep> + 1];\n  int i;\n"
+            "  if (!prm) $P_params_default(&dflt);\n"
+            "  $P_batch_get(x, l, &s);\n"
+            "  for (i = 0; i < $<sweep>; i++) v[i] = sw[i * $P_W + l];\n"
+            "  return $P_defect(&s, v, h, prm ? &prm[l] : &dflt);\n}\n\n");
+}
+
+// NAME_batch_step_adaptive's tests inside NAME_batch_within, as
+// NAME_step_within's: after the first sweep, each lane's predictor error d1
+// (against the one-step start where the two-step one was taken) and the
+// early estimate; after the iteration, that every active lane converged and
+// its estimate (with the energy defect where the scalar step has it). A
+// lane over tol (1 + its scale) makes the whole try a rejection.
+static void emit_lane_tolerance(Emitter *e, int poly, int defect) {
+  tmpl(e, "/* After the first sweep (tol > 0): each iterating lane's predictor error d1 and its\n"
+          " * estimate; 1 when one is already over tol (1 + its scale), its code then $P_EREJECT. */\n"
+          "static int $P_batch_first(const $P_batch *x, $R h, $R tol, const $R *sw, const $R *gam, const $R *ref,\n"
+          "    const $M *two, const $M *go, const $M *cl, $R *d1, $R *est, $M *rc)\n{\n"
+          "  int i, l, over = 0;\n  (void)ref;\n  (void)two;\n"
+          "  for (l = 0; l < $P_W; l++) {\n    $R d = 0, sc;\n"
+          "    d1[l] = est[l] = 0;\n    if (!go[l]) continue;\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) {\n");
+  tmpl(e, poly ? "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - (two[l] ? ref : gam)[i * $P_W + l]));\n"
+               : "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n");
+  tmpl(e, "      if (v > d) d = v;\n    }\n"
+          "    d1[l] = d;\n    est[l] = $P_batch_est(x, sw, l, h, d, (int)cl[l], &sc);\n"
+          "    if (!(est[l] <= tol * (1 + sc))) {\n      rc[l] = $P_EREJECT;\n      over = 1;\n    }\n  }\n"
+          "  return over;\n}\n\n"
+          "/* After the iteration (tol > 0): -2 when an active lane did not converge, -1 when one's\n"
+          " * estimate is over tol (1 + its scale), its code then $P_EREJECT, else 0. */\n"
+          "static int $P_batch_last(const $P_batch *x, $R h, $R tol, const $R *sw, const $M *go, const $M *cl,\n"
+          "    const $R *d1, const $P_params *prm, $R *est, $M *rc)\n{\n"
+          "  int l, over = 0;\n  (void)prm;\n"
+          "  for (l = 0; l < $P_W; l++) {\n    $R sc;\n"
+          "    est[l] = 0;\n    if (x->idle[l]) continue;\n    if (!go[l]) return -2;\n"
+          "    est[l] = $P_batch_est(x, sw, l, h, d1[l], (int)cl[l], &sc);\n");
+  if (defect) tmpl(e, "    est[l] += $P_batch_defect(x, sw, l, h, prm);\n");
+  tmpl(e, "    if (!(est[l] <= tol * (1 + sc))) {\n      rc[l] = $P_EREJECT;\n      over = 1;\n    }\n  }\n"
+          "  return over ? -1 : 0;\n}\n\n");
+}
+
+// NAME_batch_step_adaptive: NAME_step_adaptive's controller on the lanes'
+// largest error over its tolerance, every try one NAME_batch_within of the
+// shared step hh: accepted when every active lane converged within its
+// tolerance, else retried from the unchanged lanes, smaller (halved after a
+// failure), cold after three tries over the tolerance. Below the smallest
+// step every active lane fails: ENOCONV, or its own failure.
+static void emit_batch_adaptive(Emitter *e) {
+  tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
+          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, i, l;\n"
+          "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
+          "  if (!(hh != 0 && isfinite(hh))) return $P_batch_within(x, hh, 0, 0, prm, st);\n"
+          "  tol *= $P_TOLC;\n"
+          "  for (l = 0; l < $P_W; l++)\n    if (!x->idle[l]) {\n      nact++;\n"
+          "      if (fabs$f(x->t[l]) > tmax) tmax = fabs$f(x->t[l]);\n    }\n"
+          "  for (;;) {\n"
+          "    rc = $P_batch_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, s);\n"
+          "    if (rc == -1) misses++;\n"
+          "    if (rc != -2) {\n"
+          "      /* the lanes' largest error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
+          "      err = 0;\n"
+          "      for (l = 0; l < $P_W; l++) {\n        $R sc = 0, el;\n"
+          "        if (x->idle[l] || (rc >= 0 && s->code[l] != $P_OK)) continue;\n"
+          "        for (i = 0; rc >= 0 && i < $P_M; i++)\n"
+          "          if (fabs$f(x->q[i * $P_W + l]) > sc) sc = fabs$f(x->q[i * $P_W + l]);\n"
+          "        el = s->err_est[l] / (tol * fabs$f(hh) * (1 + sc));\n        if (el > err) err = el;\n      }\n");
+  emit_step_factor(e);
+  tmpl(e, "      if (rc >= 0) {\n        *h = hh * fac;\n        s->rejected = rejected;\n"
+          "        return rc;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
+          "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + tmax)) {\n"
+          "      s->h = 0;\n      s->rejected = rejected;\n"
+          "      for (l = 0; l < $P_W; l++)\n"
+          "        if (!x->idle[l] && (s->code[l] == $P_OK || s->code[l] == $P_EREJECT)) s->code[l] = $P_ENOCONV;\n"
+          "      return nact;\n    }\n  }\n}\n");
+}
+
+// The body of NAME_batch_step (adaptive 0) and of NAME_batch_within
+// (adaptive 1, for NAME_batch_step_adaptive), printed from one template: the
+// set-up, the factor, the sweeps while a lane iterates, then the commit, all
+// as loops over the lanes. The adaptive one adds the tests of
+// emit_lane_tolerance, which leave before the commit with no lane written:
+// -1 when a lane is over its tolerance, -2 when one failed. The fixed step
+// is printed without them, so that nothing of them costs it a cycle.
+static void emit_step_body(Emitter *e, int adaptive) {
   int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
-  if (poly) emit_pivots(e);
-  emit_lane_test(e, poly);
-  tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  const $R h = ($R)h_;\n"
-          "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
+  if (adaptive)
+    tmpl(e, "/* One try of $P_batch_step_adaptive: $P_batch_step with the tests of $P_step_within at tol\n"
+            " * > 0; -1 (a lane over tol) or -2 (a lane failed) with no lane written. cold: every lane\n"
+            " * without its warm start. */\n"
+            "static int $P_batch_within($P_batch *x, $R h, $R tol, int cold, const $P_params *prm, $P_batch_stats *st)\n{\n");
+  else
+    tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
+            "  const $R h = ($R)h_;\n");
+  tmpl(e, "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
           "  $R sw[($<sweep> + 1) * $P_W];\n"
-          "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n"
-          "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
-          "  int it, i, l, nrun = 0, nfail = 0, bad_h = !(h != 0 && isfinite(h));\n"
-          "  $P_batch_params(prm, par);\n"
+          "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n");
+  if (adaptive) tmpl(e, "  $R ref[$P_S * $P_M * $P_W], d1[$P_W], est[$P_W];\n  $M two[$P_W], cl[$P_W];\n");
+  tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
+          "  int it, i, l, nrun = 0, nfail = 0, bad_h = !(h != 0 && isfinite(h));\n");
+  if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
+  tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
-          "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n"
-          "    rc[l] = x->idle[l] ? $P_OK : bad_h ? $P_EBADSTEP : $P_ENOCONV;\n  }\n"
+          "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
+  if (adaptive) tmpl(e, "    est[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
+  tmpl(e, "    rc[l] = x->idle[l] ? $P_OK : bad_h ? $P_EBADSTEP : $P_ENOCONV;\n  }\n"
           "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
-          "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n"
-          "  $P_batch_predict(x, h, par, gam);\n");
+          "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n");
+  tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, gam, 0, 0);\n"
+          : poly    ? "  $P_batch_predict(x, h, cold, par, gam, ref, two);\n"
+                    : "  $P_batch_predict(x, h, cold, par, gam, 0, two);\n");
   if (nu)
     tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
             "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
@@ -213,8 +321,11 @@ void emit_batch_step(Emitter *e) {
   snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=gam h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
            poly ? " lam=lam lu=fa" : "");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n"
-          "    nrun += (int)go[l];\n  }\n"
-          "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
+          "    nrun += (int)go[l];\n");
+  tmpl(e, adaptive ? "    early |= (rc[l] != $P_OK) & !go[l];\n  }\n"
+                     "  if (early) {  /* a lane failed before the first sweep */\n    tried = -2;\n    goto out;\n  }\n"
+                   : "  }\n");
+  tmpl(e, "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
           "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
   if (poly) /* $P_step's refresh of the frozen factor, for the lanes that slow down */
     tmpl(e, "    if (it > 2) {\n"
@@ -231,6 +342,9 @@ void emit_batch_step(Emitter *e) {
             "          iters[l] = stop ? it : iters[l];\n          nrun -= (int)stop;\n        }\n"
             "      }\n    }\n");
   tmpl(e, call);
+  if (adaptive)
+    tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, gam, ref, two, go, cl, d1, est, rc)) {\n"
+            "      tried = -1;\n      goto out;\n    }\n");
   tmpl(e, "    for (l = 0; l < $P_W; l++) act[l] = go[l] & (iters[l] == 0);\n"
           "    nrun = $P_batch_test(x, h, it, sw, gam, lam, act, inc, incp, inc_min, stall, rc, iters);\n  }\n"
           "  for (l = 0; l < $P_W; l++) {  /* a lane still iterating did not converge: rc is $P_ENOCONV */\n"
@@ -242,10 +356,29 @@ void emit_batch_step(Emitter *e) {
           "    iters[l] = (go[l] & (iters[l] == 0)) ? $P_MAXITER : iters[l];\n"
           "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
           "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
+  if (adaptive) tmpl(e, "  if ((tried = $P_batch_last(x, h, tol, sw, go, cl, d1, prm, est, rc)) != 0) goto out;\n");
   emit_commit(e, poly);
+  if (adaptive) tmpl(e, "out:\n");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    nfail += rc[l] != $P_OK;\n"
           "    if (!st) continue;\n"
-          "    st->code[l] = (int)rc[l];\n    st->iters[l] = (int)iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n"
-          "  }\n  return nfail;\n}\n");
+          "    st->code[l] = (int)rc[l];\n    st->iters[l] = (int)iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n");
+  tmpl(e, adaptive ? "    st->err_est[l] = est[l];\n  }\n"
+                     "  if (st) {\n    st->h = tried ? 0 : h;\n    st->rejected = 0;\n  }\n"
+                     "  return tried ? tried : nfail;\n}\n\n"
+                   : "    st->err_est[l] = 0;\n  }\n"
+                     "  if (st) {\n    st->h = h;\n    st->rejected = 0;\n  }\n"
+                     "  return nfail;\n}\n\n");
+}
+
+// NAME_batch_step and NAME_batch_step_adaptive with what they call.
+void emit_batch_step(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0, defect = energy_defect_wanted(e);
+  if (poly) emit_pivots(e);
+  emit_lane_test(e, poly);
+  emit_step_body(e, 0);
+  emit_lane_estimate(e, defect);
+  emit_lane_tolerance(e, poly, defect);
+  emit_step_body(e, 1);
+  emit_batch_adaptive(e);
 }

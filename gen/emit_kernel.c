@@ -446,7 +446,8 @@ static void kernel_signature(Emitter *e, const Kernel *k, int part) {
   const Step *st = e->st;
   const char *t = real_type(e, e->wide); /* the sweep of --wide-step: state, gamma, results wider */
   const char *rs = e->lanes ? "*restrict " : "*"; /* lanes: the compiler may assume no overlap */
-  tmpl(e, e->lanes ? "static void $P_batch_" : "static void $P_");
+  /* the batch sweep, called once by each of the two batch steps, is inlined into both */
+  tmpl(e, !e->lanes ? "static void $P_" : part < 0 && k == &st->kern[K_SWEEP] ? "$P_LANE_INLINE void $P_batch_" : "static void $P_batch_");
   out(e, part >= 0 ? "%s_part%d(" : "%s(", k->name, part);
   for (int i = 0; i < IN_COUNT; i++) {
     const Slots *in = &st->in[i];

@@ -669,7 +669,7 @@ static void emit_predict(Emitter *e) {
 // the energy defect: k nodes do not integrate H exactly for this model (U or
 // g not polynomial, or k below -k auto), and no rescale restores H (the
 // constant family, or no constraints).
-static int energy_defect_wanted(const Emitter *e) {
+int energy_defect_wanted(const Emitter *e) {
   return !e->st->kern[K_FACTOR].nout &&
          !method_quadrature_exact(e->me->k, e->me->s, e->mod->degU, e->mod->degg);
 }
@@ -857,6 +857,15 @@ static void emit_project(Emitter *e) {
   tmpl(e, "  if (dq) *dq = dqmax;\n  if (dp) *dp = dpmax;\n  return $P_OK;\n}\n");
 }
 
+// The controller's factor for the next step, fac, from err, the error over
+// its tolerance (NAME_step_adaptive, NAME_batch_step_adaptive): the
+// standard (0.9 / err)^(1/p) for the step's order p, within [0.2, grow].
+void emit_step_factor(Emitter *e) {
+  out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
+      real_type(e, 0), step_order(e));
+  tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n");
+}
+
 // NAME_step_adaptive: NAME_step with its error estimate tested before the
 // commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
 // and relative at once, so that the errors of the steps up to T add up to
@@ -891,10 +900,8 @@ static void emit_step_adaptive(Emitter *e) {
   tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n        int i;\n"
           "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
           "        err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n      }\n");
-  out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
-      real_type(e, 0), step_order(e));
-  tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n"
-          "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
+  emit_step_factor(e);
+  tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
           "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"

@@ -1,7 +1,9 @@
 /* check_batch.c - hbvmgen --batch W: every lane of NAME_batch_step is bitwise
  * NAME_step from the same state, for both multiplier families, float and
  * double, with params per lane, lanes that fail (left byte-identical while
- * the others advance) and idle lanes (tests/models/LIST, the b* solvers). */
+ * the others advance) and idle lanes (tests/models/LIST, the b* solvers);
+ * every lane of an accepted NAME_batch_step_adaptive is NAME_step_adaptive's
+ * step of that size, and a failed one writes no lane. */
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
@@ -99,6 +101,83 @@ BATCH_TEST(bloop_k16s2, 0.03, 12)
 BATCH_TEST(bswing_k6s2, 0.02, 12)
 BATCH_TEST(bplain_k3s3, 0.1, 12)
 
+/* NAME_batch_step_adaptive, lanes sharing h: from the model's initial values
+ * with lane l's momenta scaled by 1 + l / 16 (lane 1 idle), NSTEP steps at
+ * TOL from the first step H0, large enough to be rejected. Every accepted
+ * step is, lane by lane, what NAME_step_adaptive makes of the lane's state
+ * given that step: accepted at once, bitwise the same state and estimate
+ * (when the batch's try was not a cold one, after three rejections); the
+ * idle lane is untouched; H stays at round-off where the family restores it.
+ * Then a lane that cannot step (q NaN): every active lane fails, none is
+ * written. */
+#define ADAPTIVE_TEST(P, H0, TOL, NSTEP)                                                                   \
+  START_TEST(test_adaptive_##P) {                                                                      \
+    P##_batch b, c;                                                                                    \
+    P##_state s[P##_W], y, z;                                                                          \
+    P##_params prm[P##_W];                                                                             \
+    P##_batch_stats bs;                                                                                \
+    P##_stats ss;                                                                                      \
+    P##_real h = (P##_real)(H0), hs, hmin = 1e30f, hmax = 0, H[P##_W], q[P##_M], p[P##_M];               \
+    int l, n, i, rejected = 0, compared = 0;                                                          \
+    memset(&b, 0, sizeof b);                                                                           \
+    for (l = 0; l < P##_W; l++) {                                                                      \
+      P##_params_default(&prm[l]);                                                                     \
+      P##_init_params(&s[l], NULL, NULL, &prm[l]);                                                     \
+      for (i = 0; i < P##_M; i++) {                                                                    \
+        q[i] = s[l].q[i];                                                                              \
+        p[i] = s[l].p[i] * (P##_real)(1 + l / 16.0);                                                   \
+      }                                                                                                \
+      P##_init_params(&s[l], q, p, &prm[l]);                                                           \
+      H[l] = P##_energy(&s[l], &prm[l]);                                                               \
+      P##_batch_set(&b, l, &s[l]);                                                                     \
+    }                                                                                                  \
+    if (P##_W > 2) b.idle[1] = 1;                                                                      \
+    for (n = 0; n < (NSTEP); n++) {                                                                    \
+      for (l = 0; l < P##_W; l++) P##_batch_get(&b, l, &s[l]);                                         \
+      ck_assert_int_eq(P##_batch_step_adaptive(&b, &h, (P##_real)(TOL), prm, &bs), 0);                  \
+      ck_assert(bs.h != 0 && h != 0);                                                                  \
+      rejected += bs.rejected;                                                                         \
+      hmin = fabs(bs.h) < hmin ? (P##_real)fabs(bs.h) : hmin;                                          \
+      hmax = fabs(bs.h) > hmax ? (P##_real)fabs(bs.h) : hmax;                                          \
+      for (l = 0; l < P##_W; l++) {                                                                    \
+        P##_batch_get(&b, l, &y);                                                                      \
+        if (P##_W > 2 && l == 1) {                                                                     \
+          ck_assert_msg(!memcmp(&y, &s[l], sizeof y), #P " step %d: the idle lane moved", n);         \
+          continue;                                                                                    \
+        }                                                                                              \
+        ck_assert_int_eq(bs.code[l], 0);                                                               \
+        if (bs.rejected >= 3) continue; /* the accepted try may have been cold */                      \
+        z = s[l];                                                                                      \
+        hs = bs.h;                                                                                     \
+        ck_assert_int_eq(P##_step_adaptive(&z, &hs, (P##_real)(TOL), &prm[l], &ss), 0);                 \
+        ck_assert_msg(ss.rejected == 0 && ss.h == bs.h, #P " step %d lane %d: the scalar step rejects it", n, l); \
+        ck_assert_msg(!memcmp(&z, &y, sizeof y), #P " step %d lane %d: the state differs", n, l);       \
+        ck_assert_msg(!memcmp(&ss.err_est, &bs.err_est[l], sizeof ss.err_est), #P " step %d lane %d: estimate", n, l); \
+        compared++;                                                                                    \
+      }                                                                                                \
+    }                                                                                                  \
+    ck_assert_msg(rejected > 0 && hmin < hmax && compared > (NSTEP), #P ": rejected %d, h %g..%g, compared %d", \
+                  rejected, (double)hmin, (double)hmax, compared);                                      \
+    if (P##_NU && sizeof(P##_real) == sizeof(double))                                                  \
+      for (l = 0; l < P##_W; l++) {                                                                    \
+        P##_batch_get(&b, l, &y);                                                                      \
+        ck_assert_msg(fabs(P##_energy(&y, &prm[l]) - H[l]) <= 1e-13, #P " lane %d: H moved", l);       \
+      }                                                                                                \
+    b.q[P##_W - 1] = (P##_real)NAN; /* coordinate 0 of the last lane */                                \
+    memcpy(&c, &b, sizeof b);                                                                          \
+    ck_assert_int_eq(P##_batch_step_adaptive(&b, &h, (P##_real)(TOL), prm, &bs), P##_W > 2 ? P##_W - 1 : P##_W); \
+    ck_assert_msg(!memcmp(&b, &c, sizeof b), #P ": a lane was written by a failed step");             \
+    ck_assert(bs.h == 0 && bs.code[0] != 0 && bs.code[P##_W - 1] != 0);                                \
+  }                                                                                                    \
+  END_TEST
+
+ADAPTIVE_TEST(bpoly_k3s3, 0.5, 1e-8, 30)
+ADAPTIVE_TEST(bconst_k2s2, 0.5, 1e-6, 30)
+ADAPTIVE_TEST(bkepler_k16s2, 0.5, 1e-8, 30)
+ADAPTIVE_TEST(bchain_k2s2, 0.05, 1e-6, 20)
+ADAPTIVE_TEST(bsat_k6s2, 0.5, 1e-6, 20)
+ADAPTIVE_TEST(bfloatpoly_k2s2, 0.5, 1e-4, 20)
+
 /* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
 START_TEST(test_defaults_and_idle) {
   bconst_k2s2_batch b, c;
@@ -141,6 +220,12 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_bswing_k6s2);
   tcase_add_test(tc, test_bplain_k3s3);
   tcase_add_test(tc, test_defaults_and_idle);
+  tcase_add_test(tc, test_adaptive_bpoly_k3s3);
+  tcase_add_test(tc, test_adaptive_bconst_k2s2);
+  tcase_add_test(tc, test_adaptive_bkepler_k16s2);
+  tcase_add_test(tc, test_adaptive_bchain_k2s2);
+  tcase_add_test(tc, test_adaptive_bsat_k6s2);
+  tcase_add_test(tc, test_adaptive_bfloatpoly_k2s2);
   suite_add_tcase(s, tc);
   return s;
 }
