@@ -35,6 +35,7 @@ typedef struct {
   const char *prev_text; /* the name or number read before text, and where */
   Loc prev_loc;
   int is_name;         /* the current token is a name */
+  int event_line;      /* the line of the last 'event' read (0: none) */
   long tokens;         /* tokens read, bounded by MAX_TOKENS */
   int depth;           /* open brackets, counted by the lexer ... */
   int pop;             /* ... which closes one when it reads the next token */
@@ -321,12 +322,23 @@ static int yyreport_syntax_error(const yypcontext_t *ctx, yyscan_t scanner, Pars
              "'falling' (or nothing: both)", word ? ps->prev_text : ps->text, ps->last->name);
     return 0;
   }
+  yysymbol_kind_t expected[YYNTOKENS];
+  int nexp = expected_tokens(ctx, expected);
+  /* a comma in an event, as in a list: after its name (one event a statement) or
+   * between its expression and its direction */
+  const YYLTYPE *at_tok = yypcontext_location(ctx);
+  if (is_char(tok, ",") && ps->depth == 0 && at_tok->first_line == ps->event_line) {
+    int want_eq = 0;
+    for (int i = 0; i < nexp; i++) want_eq |= expected[i] == YYTRANSLATE('=');
+    error_at(loc_of(*at_tok), want_eq ? "',' after the name of an event: one event a statement ('event NAME = EXPR')"
+                                      : "',' after the expression of an event: its direction follows with no comma "
+                                        "('event NAME = EXPR falling')");
+    return 0;
+  }
   msg_add(msg, "syntax error, unexpected %s", yysymbol_name(tok));
   if (tok == YYSYMBOL_NAME || tok == YYSYMBOL_FUNC || tok == YYSYMBOL_NUMBER)
     msg_add(msg, " '%.40s%s'", ps->text, strlen(ps->text) > 40 ? "..." : "");
   if (is_char(tok, ")]") && ps->depth == 0) msg_add(msg, " (no bracket is open)");
-  yysymbol_kind_t expected[YYNTOKENS];
-  int nexp = expected_tokens(ctx, expected);
   yysymbol_kind_t closer = YYSYMBOL_YYEMPTY;
   if (ps->depth > 0) closer = YYTRANSLATE(ps->open_char[ps->depth - 1] == '(' ? ')' : ']');
   int closes = 0;
