@@ -302,7 +302,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
-  if (adaptive) tmpl(e, "    est[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
+  if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
   tmpl(e, "    rc[l] = x->idle[l] ? $P_OK : bad_h ? $P_EBADSTEP : $P_ENOCONV;\n  }\n"
           "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
           "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n");
