@@ -859,10 +859,27 @@ static void emit_project(Emitter *e) {
 
 // The controller's factor for the next step, fac, from err, the error over
 // its tolerance (NAME_step_adaptive, NAME_batch_step_adaptive): the
-// standard (0.9 / err)^(1/p) for the step's order p, within [0.2, grow].
+// standard 0.9 err^(-1/p) for the step's order p, within [0.2, grow]. The
+// p-th root is a chain of square and cube roots when p = 2^a 3^b (every
+// order of s = 1, 2, 3, 4, 6, 8, 9, 12, ...): cheaper than pow, and on a
+// microcontroller by far (sqrtf is one instruction of a Cortex-M4F, powf a
+// library call of a thousand cycles).
 void emit_step_factor(Emitter *e) {
-  out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), math_suffix(e, 0),
-      real_type(e, 0), step_order(e));
+  int p = step_order(e), a = 0, b = 0;
+  const char *f = math_suffix(e, 0);
+  while (p % 2 == 0) p /= 2, a++;
+  while (p % 3 == 0) p /= 3, b++;
+  if (p != 1) {
+    out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), f, real_type(e, 0),
+        step_order(e));
+  } else {
+    out(e, "      fac = err > 0 ? (%s)0.9 / ", real_type(e, 0));
+    for (int i = 0; i < b; i++) out(e, "cbrt%s(", f);
+    for (int i = 0; i < a; i++) out(e, "sqrt%s(", f);
+    out(e, "err");
+    for (int i = 0; i < a + b; i++) out(e, ")");
+    out(e, " : grow;  /* 0.9 err^(-1/%d) */\n", step_order(e));
+  }
   tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n");
 }
 

@@ -1004,7 +1004,7 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 4) : grow;
+      fac = err > 0 ? (double)0.9 / sqrt(sqrt(err)) : grow;  /* 0.9 err^(-1/4) */
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == conical_poly_k2s2_OK) {

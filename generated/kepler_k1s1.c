@@ -398,7 +398,7 @@ int kepler_k1s1_step_adaptive(kepler_k1s1_state *x, kepler_k1s1_real *h, kepler_
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
+      fac = err > 0 ? (double)0.9 / sqrt(err) : grow;  /* 0.9 err^(-1/2) */
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == kepler_k1s1_OK) {

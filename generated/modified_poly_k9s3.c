@@ -2491,7 +2491,7 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 6) : grow;
+      fac = err > 0 ? (double)0.9 / cbrt(sqrt(err)) : grow;  /* 0.9 err^(-1/6) */
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == modified_poly_k9s3_OK) {

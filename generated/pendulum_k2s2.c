@@ -561,7 +561,7 @@ int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, p
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 2) : grow;
+      fac = err > 0 ? (double)0.9 / sqrt(err) : grow;  /* 0.9 err^(-1/2) */
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == pendulum_k2s2_OK) {

@@ -8920,7 +8920,7 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 * pow(err, (double)-1 / 6) : grow;
+      fac = err > 0 ? (double)0.9 / cbrt(sqrt(err)) : grow;  /* 0.9 err^(-1/6) */
       if (fac > grow) fac = grow;
       if (fac < (double)0.2) fac = (double)0.2;
       if (rc == satellites_poly_k6s3_OK) {

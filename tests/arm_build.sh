@@ -20,7 +20,7 @@ if ! command -v "$CC" >/dev/null 2>&1 || ! command -v "$NM" >/dev/null 2>&1; the
   exit 77
 fi
 FLAGS="-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -ffreestanding -std=c99 -Wall -Wextra -pedantic -Werror -O2"
-MATH="sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt pow fabs fmax fmin floor ceil fmod hypot copysign"
+MATH="sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt cbrt pow fabs fmax fmin floor ceil fmod hypot copysign"
 tmp=$(mktemp -d) || exit 1
 trap 'rm -rf "$tmp"' EXIT INT TERM
 fail=0
