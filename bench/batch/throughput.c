@@ -9,41 +9,17 @@
  * per trajectory-step and their ratio. Exits 1 if a lane ever differs from
  * the scalar run at the end. */
 #define _POSIX_C_SOURCE 200809L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
 
-#include HDR
-
-#define CAT2(a, b) a##b
-#define CAT(a, b) CAT2(a, b)
-#define F(name) CAT(P, name)
-#define NT 8
-#define REPS 9
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
+#include "lanes.h"
 
 int main(int argc, char **argv) {
   double h = argc > 1 ? atof(argv[1]) : 0.01, ts[REPS], tb[REPS];
   long nstep = argc > 2 ? atol(argv[2]) : 1000;
   static F(_state) s0[NT], s[NT], y;
   static F(_batch) b[NT / F(_W)];
-  int j, r, l, bad = 0;
+  int j, r, bad = 0;
   long n;
-  for (j = 0; j < NT; j++) {
-    F(_init)(&s0[j], NULL, NULL);
-    for (l = 0; l < F(_M); l++) s0[j].p[l] *= 1 + j / 1000.0;
-  }
+  initial_states(s0);
   for (r = 0; r < REPS; r++) {
     double t = now();
     memcpy(s, s0, sizeof s);
