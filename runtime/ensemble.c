@@ -398,30 +398,60 @@ static void constraints_of(const hbvmrt_model *md, Work *w, const void *x, const
   }
 }
 
-/* Trajectory i's steps from its initial state in w->x: the N steps of h of
- * the run, the last shortened to end on T with -T, or with --tol adaptive
- * steps (NAME_step_adaptive, -h the first) to T exactly, as a single run of
- * the driver takes them; stops at the first failed step, its code the
- * trajectory's status. */
-static void steps_scalar(const Ens *e, Work *w, double *r, double H0)
-{
-  const hbvmrt_model *md = e->md;
-  double h = e->o.h, t_end = hbvmrt_span_end(&e->o);
-  long k;
-  int at_end = e->o.tol > 0 && hbvmrt_state_time(md, w->x) == t_end;
+/* One trajectory on the scalar path, for hbvmrt_advance's callback. */
+typedef struct {
+  const Ens *e;
+  Work *w;                     /* its state in w->x */
+  double *r, H0;               /* its result, its initial energy */
+  const void *prm;
+} Traj;
 
-  for (k = 1; e->o.tol > 0 ? !at_end : k <= e->o.nsteps; k++) {
-    hbvmrt_stats st = {0};
-    int code = e->o.tol > 0 ? hbvmrt_adaptive_step(md, w->x, &h, t_end, e->o.tol, w->prm, &st, &at_end)
-                            : md->step(w->x, hbvmrt_fixed_step(md, &e->o, k, w->x), w->prm, &st);
-    if (code != 0) {
-      r[0] = code;
-      return;
+/* A step taken (a halved one counts as a step, as in a single run): into
+ * the trajectory's counters and maxima. */
+static int traj_taken(void *ctx, const hbvmrt_stats *st, double h)
+{
+  Traj *tr = ctx;
+  const hbvmrt_model *md = tr->e->md;
+
+  (void)h;
+  count(md, tr->r, (long)tr->r[1] + 1, st->iters);
+  constraints_of(md, tr->w, tr->w->x, tr->prm);
+  observe(tr->e, tr->r, md->energy(tr->w->x, tr->prm), tr->H0, tr->w->g, tr->w->hc, 1);
+  return 0;
+}
+
+/* A trajectory's steps from its state in w->x, as a single run of the
+ * driver takes them: with --tol adaptive steps (NAME_step_adaptive, -h the
+ * first) to T exactly; else steps `from`..N of h, the last shortened to end
+ * on T with -T, a failed one retried as halves (hbvmrt_advance), after the
+ * halves of the step fail_h that failed in a batch lane with fail_code
+ * (when that is not 0). A step that fails even halved ends the trajectory,
+ * its code the status. */
+static void steps_scalar(Traj *tr, long from, double fail_h, int fail_code)
+{
+  const Ens *e = tr->e;
+  const hbvmrt_model *md = e->md;
+  void *x = tr->w->x;
+  hbvmrt_steps cb = {NULL, traj_taken, NULL, NULL};
+  double h = e->o.h, t_end = hbvmrt_span_end(&e->o);
+  int code = 0, stopped, at_end = hbvmrt_state_time(md, x) == t_end;
+  long k;
+
+  cb.ctx = tr;
+  if (e->o.tol > 0)
+    while (code == 0 && !at_end) {
+      hbvmrt_stats st;
+      if ((code = hbvmrt_adaptive_step(md, x, &h, t_end, e->o.tol, tr->prm, &st, &at_end)) == 0)
+        traj_taken(tr, &st, st.h);
     }
-    count(md, r, k, st.iters);
-    constraints_of(md, w, w->x, w->prm);
-    observe(e, r, md->energy(w->x, w->prm), H0, w->g, w->hc, 1);
+  else {
+    if (fail_code != 0)
+      code = hbvmrt_halve(md, x, tr->prm, fail_h, fail_code, 0, &cb, &stopped);
+    for (k = from; code == 0 && k <= e->o.nsteps; k++)
+      code = hbvmrt_advance(md, x, tr->prm, hbvmrt_fixed_step(md, &e->o, k, x), 0, &cb, &stopped);
   }
+  if (code != 0)
+    tr->r[0] = code;
 }
 
 /* Trajectories [first, first + n) one after another. */
@@ -435,20 +465,24 @@ static void run_scalar(const Ens *e, Work *w, long first, long n)
     r[0] = start(e, i, w->x, w->prm, w->g, w->hc);
     H0 = md->energy(w->x, w->prm);
     if (r[0] == 0) {
+      Traj tr = {e, w, r, H0, w->prm};
       constraints_of(md, w, w->x, w->prm);
       observe(e, r, H0, H0, w->g, w->hc, 1);
-      steps_scalar(e, w, r, H0);
+      steps_scalar(&tr, 1, 0, 0);
     }
     finish(e, r, w->x, w->prm);
   }
 }
 
 /* Trajectories [first, first + n), n <= W, in the lanes of one batch; the
- * lanes not used, not started or failed are idle. */
+ * lanes not used, not started or failed are idle. A lane whose step fails
+ * leaves the batch and finishes on the scalar path (steps_scalar), from the
+ * halves of that step on, as its single run would: the lane was left as it
+ * was, and every lane is bitwise NAME_step. */
 static void run_batch(const Ens *e, Work *w, long first, long n)
 {
   const hbvmrt_model *md = e->md;
-  int W = e->bt->w, l, live = 0;
+  int W = e->bt->w, l, live = 0, on[HBVMRT_MAX_LANES], failed[HBVMRT_MAX_LANES], done[HBVMRT_MAX_LANES];
   long k;
 
   for (l = 0; l < W; l++) {
@@ -459,17 +493,19 @@ static void run_batch(const Ens *e, Work *w, long first, long n)
     w->H0[l] = md->energy(w->x, prm);
     if (l < n)
       result(e, i)[0] = status;
-    e->bt->idle(w->b, l, l >= n || status != 0);
-    live += l < n && status == 0;
+    on[l] = l < n && status == 0;
+    done[l] = 0;
+    e->bt->idle(w->b, l, !on[l]);
+    live += on[l];
   }
   e->bt->observe(w->b, w->prms, w->Hb, w->g, w->hc);
   for (l = 0; l < n; l++)
-    if (result(e, first + l)[0] == 0)
+    if (on[l])
       observe(e, result(e, first + l), w->Hb[l], w->H0[l], w->g + l, w->hc + l, W);
   for (k = 1; live > 0 && k <= e->o.nsteps; k++) {
     double h = e->o.h;
     if (k == e->o.nsteps && e->o.to_T) {  /* the last step ends on T: every live lane has the same t */
-      for (l = 0; result(e, first + l)[0] != 0; l++)
+      for (l = 0; !on[l]; l++)
         ;
       e->bt->get(w->b, l, w->x);
       h = hbvmrt_fixed_step(md, &e->o, k, w->x);
@@ -477,26 +513,32 @@ static void run_batch(const Ens *e, Work *w, long first, long n)
     e->bt->step(w->b, h, w->prms, w->code, w->iters);
     e->bt->observe(w->b, w->prms, w->Hb, w->g, w->hc);
     for (l = 0; l < n; l++) {
-      double *r = result(e, first + l);
-      if (r[0] != 0)
+      failed[l] = on[l] && w->code[l] != 0;
+      if (!on[l] || failed[l])
         continue;
-      if (w->code[l] != 0) {
-        r[0] = w->code[l];
-        e->bt->idle(w->b, l, 1);
-        live--;
-        continue;
-      }
-      count(md, r, k, w->iters[l]);
-      observe(e, r, w->Hb[l], w->H0[l], w->g + l, w->hc + l, W);
+      count(md, result(e, first + l), k, w->iters[l]);
+      observe(e, result(e, first + l), w->Hb[l], w->H0[l], w->g + l, w->hc + l, W);
     }
+    for (l = 0; l < n; l++)   /* after the lanes' g and hc above: the scalar path reuses them */
+      if (failed[l]) {
+        Traj tr = {e, w, result(e, first + l), w->H0[l], (char *)w->prms + (size_t)l * md->params_size};
+        e->bt->idle(w->b, l, 1);
+        on[l] = 0;
+        live--;
+        e->bt->get(w->b, l, w->x);
+        steps_scalar(&tr, k + 1, h, w->code[l]);
+        finish(e, tr.r, w->x, tr.prm);
+        done[l] = 1;
+      }
   }
   for (l = 0; l < n; l++) {
     char *prm = (char *)w->prms + (size_t)l * md->params_size;
+    if (done[l])
+      continue;  /* finished on the scalar path */
     e->bt->get(w->b, l, w->x);
     finish(e, result(e, first + l), w->x, prm);
   }
 }
-
 /* The next chunk to run, or -1: from the counter of this process, or of
  * rank 0 under MPI.  Called by one thread at a time. */
 static long next_chunk(Ens *e)
@@ -668,6 +710,10 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
   if ((e.file ? read_ensemble(&e) : read_sweep(&e)) != 0)
     goto out;
   e.width = at_H(md) + R_COUNT;
+  if (bt && (bt->w < 1 || bt->w > HBVMRT_MAX_LANES)) {
+    hbvmrt_error(md, "a batch of %d lanes: the ensemble runner takes 1 to %d", bt->w, HBVMRT_MAX_LANES);
+    goto out;
+  }
   e.chunk = bt ? bt->w : HBVMRT_SCALAR_CHUNK;
   e.nchunk = (e.nrow + e.chunk - 1) / e.chunk;
   if (!(e.res = calloc((size_t)e.nrow * (size_t)e.width + 1, sizeof *e.res))) {

@@ -26,6 +26,8 @@
 /* A failed step of the fixed h is retried as two halves, each of which may
  * be halved again, this many times deep (h / 256) before the run stops. */
 #define HBVMRT_HALVINGS 8
+/* The most lanes of a batch (hbvmgen --batch W: W <= 64). */
+#define HBVMRT_MAX_LANES 64
 
 /* The driver options once parsed and checked. */
 typedef struct {
@@ -111,7 +113,8 @@ int hbvmrt_events_close(hbvmrt_events *ev);
 int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0, const void *x, double theta,
                         double hsub, void *z);
 
-/* span.c: stepping to the end of the span, hit exactly (run.c, ensemble.c) */
+/* span.c: stepping to the end of the span, hit exactly, and halving a failed
+ * fixed step (run.c, ensemble.c) */
 
 /* The time of the state x (its rounded value). */
 double hbvmrt_state_time(const hbvmrt_model *md, const void *x);
@@ -123,6 +126,23 @@ double hbvmrt_fixed_step(const hbvmrt_model *md, const hbvmrt_opts *o, long n, c
  * to end on t_end); the step's code, the next h in *h, *at_end when on it. */
 int hbvmrt_adaptive_step(const hbvmrt_model *md, void *x, double *h, double t_end, double tol, const void *prm,
                          hbvmrt_stats *st, int *at_end);
+
+/* What the caller of hbvmrt_advance hears: before each try (may be NULL),
+ * after each step taken (its stats and size; nonzero: stop there), after
+ * each failed try (may be NULL). */
+typedef struct {
+  void (*before)(void *ctx);
+  int (*taken)(void *ctx, const hbvmrt_stats *st, double h);
+  void (*failed)(void *ctx, double h, int code, int depth);
+  void *ctx;
+} hbvmrt_steps;
+/* Advance x by the fixed step h, a failed step retried as halves
+ * (HBVMRT_HALVINGS deep); 0 or the last failed step's code. */
+int hbvmrt_advance(const hbvmrt_model *md, void *x, const void *prm, double h, int depth, const hbvmrt_steps *cb,
+                   int *stopped);
+/* The halves of a step h that failed with code at depth, as hbvmrt_advance. */
+int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int code, int depth,
+                 const hbvmrt_steps *cb, int *stopped);
 
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 

@@ -392,36 +392,42 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
     grid_rows(r);
 }
 
-/* Advance the state by h: one step, or, when it fails, two halves, each of
- * which may be halved again, HBVMRT_HALVINGS deep, so that the run keeps
- * its grid of fixed steps.  A failed step leaves the state as it was, so
- * the retry starts from the same point.  The first retry of a fixed step
- * is said on stderr.  Returns 0, or the code of the last failed step. */
-static int advance(Run *r, double h, int depth)
+/* hbvmrt_advance's callbacks for the run: the state before each try, each
+ * step taken into the run's figures (stop at the --stop-at event), each
+ * failed try counted, the first retry of a fixed step said on stderr. */
+static void on_before(void *ctx)
 {
-  const hbvmrt_model *md = r->md;
-  hbvmrt_stats st;
-  double target = state_t(r) + h;
-  int code;
+  before_step(ctx);
+}
 
-  memset(&st, 0, sizeof st);
-  before_step(r);
-  code = md->step(r->x, h, r->prm, &st);
+static int on_taken(void *ctx, const hbvmrt_stats *st, double h)
+{
+  Run *r = ctx;
 
-  if (code == 0) {
-    taken(r, &st, h);
-    return 0;
-  }
+  taken(r, st, h);
+  return r->stopped;
+}
+
+static void on_failed(void *ctx, double h, int code, int depth)
+{
+  Run *r = ctx;
+
   r->rejected++;
-  if (depth >= HBVMRT_HALVINGS)
-    return code;
   if (depth == 0)
     fprintf(stderr, "%s: step h=%.6g failed at t=%.15g (%s): retrying with "
-            "halved steps\n", md->name, h, state_t(r),
-            md->strerror ? md->strerror(code) : "failed");
-  if ((code = advance(r, h / 2, depth + 1)) != 0 || r->stopped)
-    return code;
-  return advance(r, target - state_t(r), depth + 1);
+            "halved steps\n", r->md->name, h, state_t(r),
+            r->md->strerror ? r->md->strerror(code) : "failed");
+}
+
+/* Advance the state by h (hbvmrt_advance: one step, or, when it fails, its
+ * halves).  Returns 0, or the code of the last failed step. */
+static int advance(Run *r, double h)
+{
+  hbvmrt_steps cb = {on_before, on_taken, on_failed, NULL};
+  int stopped;
+
+  cb.ctx = r;
+  return hbvmrt_advance(r->md, r->x, r->prm, h, 0, &cb, &stopped);
 }
 
 /* --tol: adaptive steps from h until -T, hit exactly (hbvmrt_adaptive_step).
@@ -473,7 +479,7 @@ static void loop(Run *r, Progress *pg)
   if (write_row(r) != 0)
     return;
   for (n = 1; n <= N; n++) {
-    int code = advance(r, hbvmrt_fixed_step(r->md, r->o, n, r->x), 0);
+    int code = advance(r, hbvmrt_fixed_step(r->md, r->o, n, r->x));
     if (code != 0) {
       r->fail_code = code;
       if ((n - 1) % K != 0)

@@ -1,6 +1,7 @@
-/* span.c - stepping through the span of a run to its end, hit exactly: what
- * the driver (run.c) and the ensemble runner (ensemble.c) both do, so that a
- * trajectory of an ensemble ends where a single run of it ends. */
+/* span.c - stepping through the span of a run to its end, hit exactly, and
+ * retrying a failed fixed step with halved steps: what the driver (run.c)
+ * and the ensemble runner (ensemble.c) both do, so that a trajectory of an
+ * ensemble ends where a single run of it ends. */
 #include <math.h>
 #include <string.h>
 
@@ -47,4 +48,46 @@ int hbvmrt_adaptive_step(const hbvmrt_model *md, void *x, double *h, double t_en
   if (code == 0 && !*at_end)
     *h = hn;
   return code;
+}
+
+/* The halves of the fixed step h from x that failed with code at depth:
+ * h / 2, then the rest to where h would have ended, each a step or, when it
+ * fails too, halved again, HBVMRT_HALVINGS deep (h / 256). A failed step
+ * leaves the state as it was, so each retry starts from the same point.
+ * Returns 0, or the code of the last failed step; *stopped is set when
+ * cb->taken asked to stop (the --stop-at event). */
+int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int code, int depth,
+                 const hbvmrt_steps *cb, int *stopped)
+{
+  double target = hbvmrt_state_time(md, x) + h;
+
+  if (cb->failed)
+    cb->failed(cb->ctx, h, code, depth);
+  if (depth >= HBVMRT_HALVINGS)
+    return code;
+  if ((code = hbvmrt_advance(md, x, prm, h / 2, depth + 1, cb, stopped)) != 0 || *stopped)
+    return code;
+  return hbvmrt_advance(md, x, prm, target - hbvmrt_state_time(md, x), depth + 1, cb, stopped);
+}
+
+/* Advance x by the fixed step h: one step, or, when it fails, its halves
+ * (hbvmrt_halve), so that the run keeps its grid of fixed steps. cb->before
+ * runs before each try, cb->taken after each step taken. Returns 0, or the
+ * code of the last failed step. */
+int hbvmrt_advance(const hbvmrt_model *md, void *x, const void *prm, double h, int depth, const hbvmrt_steps *cb,
+                   int *stopped)
+{
+  hbvmrt_stats st;
+  int code;
+
+  memset(&st, 0, sizeof st);
+  *stopped = 0;
+  if (cb->before)
+    cb->before(cb->ctx);
+  code = md->step(x, h, prm, &st);
+  if (code == 0) {
+    *stopped = cb->taken(cb->ctx, &st, h);
+    return 0;
+  }
+  return hbvmrt_halve(md, x, prm, h, code, depth, cb, stopped);
 }
