@@ -65,7 +65,8 @@ static void emit_lane_test(Emitter *e, int poly) {
           "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
-  tmpl(e, poly ? "    ok[l] = in <= $P_TOL;\n" : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
+  tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
+               : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n"
           "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
           "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
