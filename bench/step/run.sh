@@ -17,8 +17,9 @@
 #   the sweep is too large to be inline (satellites) the sum over its parts
 #   of the cycles of one run of each. Cycles become ns at the clock measured
 #   by bench/step/clock.c. -> bench/results/step.csv
-# flags: the current step built by gcc and clang at -O2/-O3 and with
-#   -march=native -fno-math-errno (and -ffp-contract=fast), each against gcc
+# flags: the current step built by gcc and clang at -O2/-O3, gcc -O2 without
+#   its SLP vectoriser, and with -march=native -fno-math-errno (and
+#   -ffp-contract=fast), each against gcc
 #   -O2 in one process: the time ratio, and whether the states after the run
 #   are bitwise gcc -O2's. -> bench/results/flags.csv
 set -eu
@@ -92,7 +93,8 @@ if echo "$parts" | grep -q flags; then
     IFS=: read -r model k s h n <<EOT
 $p
 EOT
-    for v in "gcc:-O3" "gcc:-O2 -march=native -fno-math-errno" "gcc:-O3 -march=native -fno-math-errno" \
+    for v in "gcc:-O3" "gcc:-O2 -fno-tree-slp-vectorize" "gcc:-O2 -march=native -fno-math-errno" \
+      "gcc:-O3 -march=native -fno-math-errno" \
       "gcc:-O2 -march=native -fno-math-errno -ffp-contract=fast" "clang:-O2" "clang:-O3" \
       "clang:-O3 -march=native -fno-math-errno" "clang:-O3 -march=native -fno-math-errno -ffp-contract=off"; do
       cc=${v%%:*} fl=${v#*:}
