@@ -539,6 +539,7 @@ static void run_batch(const Ens *e, Work *w, long first, long n)
     finish(e, result(e, first + l), w->x, prm);
   }
 }
+
 /* The next chunk to run, or -1: from the counter of this process, or of
  * rank 0 under MPI.  Called by one thread at a time. */
 static long next_chunk(Ens *e)
