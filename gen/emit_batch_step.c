@@ -217,8 +217,9 @@ static void emit_lane_tolerance(Emitter *e, int poly, int defect) {
           " * estimate; 1 when one is already over tol (1 + its scale), its code then $P_EREJECT. */\n"
           "static int $P_batch_first(const $P_batch *x, $R h, $R tol, const $R *sw, const $R *gam, const $R *ref,\n"
           "    const $M *two, const $M *go, const $M *cl, $R *d1, $R *est, $M *rc)\n{\n"
-          "  int i, l, over = 0;\n  (void)ref;\n  (void)two;\n"
-          "  for (l = 0; l < $P_W; l++) {\n    $R d = 0, sc;\n"
+          "  int i, l, over = 0;\n");
+  if (!poly) tmpl(e, "  (void)ref;\n  (void)two;  /* no two-step start in this family */\n");
+  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    $R d = 0, sc;\n"
           "    d1[l] = est[l] = 0;\n    if (!go[l]) continue;\n"
           "    for (i = 0; i < $P_S * $P_M; i++) {\n");
   tmpl(e, poly ? "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - (two[l] ? ref : gam)[i * $P_W + l]));\n"
@@ -231,8 +232,9 @@ static void emit_lane_tolerance(Emitter *e, int poly, int defect) {
           " * estimate is over tol (1 + its scale), its code then $P_EREJECT, else 0. */\n"
           "static int $P_batch_last(const $P_batch *x, $R h, $R tol, const $R *sw, const $M *go, const $M *cl,\n"
           "    const $R *d1, const $P_params *prm, $R *est, $M *rc)\n{\n"
-          "  int l, over = 0;\n  (void)prm;\n"
-          "  for (l = 0; l < $P_W; l++) {\n    $R sc;\n"
+          "  int l, over = 0;\n");
+  if (!defect) tmpl(e, "  (void)prm;  /* for the energy defect, which this model does not need */\n");
+  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    $R sc;\n"
           "    est[l] = 0;\n    if (x->idle[l]) continue;\n    if (!go[l]) return -2;\n"
           "    est[l] = $P_batch_est(x, sw, l, h, d1[l], (int)cl[l], &sc);\n");
   if (defect) tmpl(e, "    est[l] += $P_batch_defect(x, sw, l, h, prm);\n");
