@@ -127,7 +127,21 @@ static void emit_predict(Emitter *e) {
   tmpl(e, ""
           "  for (l = 0; l < $P_W; l++) all2 &= (int)two[l];\n"
           "  if (twos)\n    for (l = 0; l < $P_W; l++) twos[l] = two[l];\n"
-          "  one = !all2 || ref;  /* ref: the one-step start too, where the two-step one is taken */\n"
+          "  one = !all2 || ref;  /* ref: the one-step start too, where the two-step one is taken */\n");
+  if (poly) { /* every lane from its last two steps (steps of one h), as in a run of fixed steps:
+               * one loop over the whole rows of M W values, no selects, each value summed in
+               * $P_predict's order, the sum over the S steps written out */
+    tmpl(e, "  if (!one) {\n"
+            "    for (j = 0; j < $P_S; j++)\n"
+            "      for (l = 0; l < $P_M * $P_W; l++) {\n"
+            "        $R b = 0;\n");
+    for (int i = 0; i < e->me->s; i++)
+      out(e, "        b += %s_E2[2 * %s_S * j + %d] * x->gam[%d * %s_M * %s_W + l] +\n"
+             "             %s_E2[2 * %s_S * j + %s_S + %d] * x->gam2[%d * %s_M * %s_W + l];\n",
+          e->P, e->P, i, i, e->P, e->P, e->P, e->P, e->P, i, i, e->P, e->P);
+    tmpl(e, "        gam[j * $P_M * $P_W + l] = b;\n      }\n    return;\n  }\n");
+  }
+  tmpl(e, ""
           "  if (one) /* the one-step coefficients, when a lane needs them */\n"
           "    for (j = 0; j < $P_S * $P_S; j++) {\n"
           "      $R c[$P_W];\n      for (l = 0; l < $P_W; l++) c[l] = 0;\n"

@@ -18,11 +18,14 @@
 static void emit_pivots(Emitter *e) {
   tmpl(e, "/* The multiplier factor's pivot tests of $P_step, in the lanes of sel still iterating. */\n"
           "static void $P_batch_pivots(const $R *restrict fa, const $M *restrict sel, $M *restrict rc)\n{\n"
-          "  $M any = 0;\n  int i, l;\n"
-          "  /* first whether any pivot of any lane fails: mostly none, and then no more */\n"
+          "  $M bad[$P_W], any = 0;\n  int i, l;\n"
+          "  /* first whether any pivot of any lane fails: mostly none, and then no more (a mask\n"
+          "   * a lane, and one test of them at the end: no reduction across the lanes a pivot) */\n"
+          "  for (l = 0; l < $P_W; l++) bad[l] = 0;\n"
           "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
-          "      any |= !isfinite(piv) | !isfinite(dia) | ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n"
+          "      bad[l] |= !isfinite(piv) | !isfinite(dia) | ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n"
+          "  for (l = 0; l < $P_W; l++) any |= bad[l];\n"
           "  if (!any) return;\n"
           "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
           "      $R piv = fa[($[factor.pivot]i) * $P_W + l], dia = fa[($[factor.adiag]i) * $P_W + l];\n"
@@ -307,14 +310,14 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
   if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
   tmpl(e, "    rc[l] = x->idle[l] ? $P_OK : bad_h ? $P_EBADSTEP : $P_ENOCONV;\n  }\n"
-          "  for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
           "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n");
   tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, gam, 0, 0);\n"
           : poly    ? "  $P_batch_predict(x, h, cold, par, gam, ref, two);\n"
                     : "  $P_batch_predict(x, h, cold, par, gam, 0, two);\n");
   if (nu)
     tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
-            "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+            "  for (i = 0; i < $P_NU * $P_W; i++) {  /* the division first, then the select: vectorises */\n"
+            "    $R d = g0[i] / h;\n    g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : d;\n  }\n");
   if (poly)
     tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
             "  $(factor q0=x->q gam=gam h=h prm=par out=fa);\n"
@@ -328,7 +331,9 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, adaptive ? "    early |= (rc[l] != $P_OK) & !go[l];\n  }\n"
                      "  if (early) {  /* a lane failed before the first sweep */\n    tried = -2;\n    goto out;\n  }\n"
                    : "  }\n");
-  tmpl(e, "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
+  tmpl(e, "  if (nrun == 0)  /* no sweep: what the commit reads of sw is defined all the same */\n"
+          "    for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
+          "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
           "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
   if (poly) /* $P_step's refresh of the frozen factor, for the lanes that slow down */
     tmpl(e, "    if (it > 2) {\n"
@@ -350,12 +355,14 @@ static void emit_step_body(Emitter *e, int adaptive) {
             "      tried = -1;\n      goto out;\n    }\n");
   tmpl(e, "    for (l = 0; l < $P_W; l++) act[l] = go[l] & (iters[l] == 0);\n"
           "    nrun = $P_batch_test(x, h, it, sw, gam, lam, act, inc, incp, inc_min, stall, rc, iters);\n  }\n"
+          "  $R nan[$P_W];  /* the rest of p's polynomial finite, as in $P_step (see $P_batch_test) */\n"
+          "  for (l = 0; l < $P_W; l++) nan[l] = 0;\n"
+          "  for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"
+          "    for (l = 0; l < $P_W; l++) nan[l] += sw[($[sweep.theta]i) * $P_W + l] - sw[($[sweep.theta]i) * $P_W + l];\n"
           "  for (l = 0; l < $P_W; l++) {  /* a lane still iterating did not converge: rc is $P_ENOCONV */\n"
           "    $R t = x->t[l] + h, tc = x->tc[l];\n"
           "    $M ok = go[l] & (rc[l] == $P_OK), tbad = !isfinite(t) | !isfinite(tc);\n"
-          "    $R nan = 0;  /* the rest of p's polynomial finite, as in $P_step (see $P_batch_test) */\n"
-          "    for (i = 0; i < ($P_S - 1) * $P_M; i++) nan += sw[($[sweep.theta]i) * $P_W + l] - sw[($[sweep.theta]i) * $P_W + l];\n"
-          "    tbad |= nan != 0;\n"
+          "    tbad |= nan[l] != 0;\n"
           "    iters[l] = (go[l] & (iters[l] == 0)) ? $P_MAXITER : iters[l];\n"
           "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
           "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
