@@ -7,7 +7,9 @@
 #      -std=c99 keeps -ffp-contract=off, so lanes stay bitwise NAME_step);
 #      bench/batch/throughput.c times NAME_step and NAME_batch_step side by
 #      side: ns per trajectory-step, medians of 9, and the ratio; W = 4 also
-#      with -O2 -mavx2 -mfma -fno-math-errno (AVX2 alone)
+#      with AVX2 alone ($AVX2: -fno-trapping-math lets gcc if-convert the lane
+#      selects around a division or sqrt, which AVX-512's masks do without it;
+#      bitwise the same states, bench/README.md)
 #   2. NAME_batch_step_adaptive against NAME_step_adaptive per trajectory,
 #      W = 4, over T = 10 at tol 1e-8 (bench/batch/adaptive.c)
 #   3. a pendulum's driver (tests/models/mass_param.ham) with --batch 4 on a
@@ -18,6 +20,7 @@
 # show: bench/README.md.
 set -eu
 cd "$(dirname "$0")/../.."
+AVX2="-O2 -mavx2 -mfma -fno-math-errno -fno-trapping-math"
 B=build/bench/batch
 R=bench/results
 CC=${CC:-gcc}
@@ -45,17 +48,16 @@ EOT
       echo "$model,$k,$s,$W,$cc,$FLAGS,$line" | tee -a "$R/batch.csv"
     done
     if [ "$W" = 4 ]; then # issue 14's target is for AVX2: without AVX-512's 32 registers and masks
-      avx2="-O2 -mavx2 -mfma -fno-math-errno"
       # shellcheck disable=SC2086
-      $CC -std=c99 $avx2 -I"$B" -DP="$name" -DHDR="\"$name.h\"" "$B/$name.c" bench/batch/throughput.c -lm -o "$B/$name.avx2"
-      echo "$model,$k,$s,$W,$CC,$avx2,$("$B/$name.avx2" "$h" "$n")" | tee -a "$R/batch.csv"
+      $CC -std=c99 $AVX2 -I"$B" -DP="$name" -DHDR="\"$name.h\"" "$B/$name.c" bench/batch/throughput.c -lm -o "$B/$name.avx2"
+      echo "$model,$k,$s,$W,$CC,$AVX2,$("$B/$name.avx2" "$h" "$n")" | tee -a "$R/batch.csv"
     fi
   done
 done
 
 # NAME_batch_step_adaptive (lanes sharing h) against NAME_step_adaptive per
 # trajectory: W = 4, 8 close trajectories over T = 10 at tol 1e-8, with FLAGS
-# and with -mavx2 -mfma (bench/batch/adaptive.c)
+# and with AVX2 alone (bench/batch/adaptive.c)
 if [ -n "$problems" ]; then
   echo "model,k,s,W,flags,scalar_ns_per_unit_t,batch_ns_per_unit_t,ratio,steps_scalar,steps_batch" >"$R/batch_adaptive.csv"
   for p in $problems; do
@@ -63,7 +65,7 @@ if [ -n "$problems" ]; then
 $p
 EOT
     name=${model}_b4
-    for fl in "$FLAGS" "-O2 -mavx2 -mfma -fno-math-errno"; do
+    for fl in "$FLAGS" "$AVX2"; do
       # shellcheck disable=SC2086
       $CC -std=c99 $fl -I"$B" -DP="$name" -DHDR="\"$name.h\"" "$B/$name.c" bench/batch/adaptive.c -lm -o "$B/$name.adaptive"
       echo "$model,$k,$s,4,$fl,$("$B/$name.adaptive" 10 1e-8)" | tee -a "$R/batch_adaptive.csv"
