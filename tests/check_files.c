@@ -12,7 +12,8 @@
  *              message names one.
  *   cost       diagnostics cost the size of the input, not its size times
  *              the number of messages (counted in bytes read, not seconds),
- *              and 10^5 unused definitions print 20 warnings and a count.
+ *              10^5 unused definitions print 20 warnings and a count, and
+ *              a NAME.c of 4 MB or more gets a note with its size.
  *   driver     -T shorter than |h| still takes one step, as --help says.
  *
  * The suite is files_suite(); the project's runner (check_main.c) adds it.
@@ -386,6 +387,32 @@ START_TEST(test_many_warnings_capped)
 }
 END_TEST
 
+/* A NAME.c of 4 MB or more gets a note with its size (gcc needs minutes and
+ * gigabytes for it); a small one none. 400 coordinates in a chain of 399
+ * constraints give 7.9 MB of C in about 0.2 s. */
+START_TEST(test_large_output_note)
+{
+  make_root();
+  char model[PATH_SIZE], out[PATH_SIZE], *err;
+  FILE *f = fopen(in_root(model, "chain.ham"), "w");
+  ck_assert(f != NULL);
+  fputs("variables x[400]\nU = sum(i in 1..400, x[i]^4)\ng = [x[i]^2 + x[i+1]^2 - 1 for i in 1..399]\n", f);
+  ck_assert(fclose(f) == 0);
+  const char *args[] = {"-o", in_root(out, "out"), model, NULL};
+  ck_assert_int_eq(generate(args, 0, &err), 0);
+  const char *note = strstr(err, "hbvmgen: note: '");
+  ck_assert_msg(note && strstr(note, "/out/chain.c' is ") && strstr(note, " MB of C: compilers take minutes"),
+                "no note on the size of chain.c: %s", err);
+  double mb = atof(strstr(note, "' is ") + 5);
+  ck_assert_msg(mb > 4 && mb < 20, "chain.c said to be %g MB", mb);
+  free(err);
+  const char *small[] = {"-o", out, PENDULUM, NULL};
+  ck_assert_int_eq(generate(small, 0, &err), 0);
+  ck_assert_msg(!strstr(err, "MB of C"), "a note on a small file: %s", err);
+  free(err);
+}
+END_TEST
+
 /* ---- driver ---- */
 
 static const hbvmrt_model fake = {.name = "fake", .m = 1, .k = 1, .s = 1};
@@ -433,6 +460,7 @@ Suite *files_suite(void)
   TCase *cost = tcase_in(s, "cost");
   tcase_add_test(cost, test_diagnostics_linear);
   tcase_add_test(cost, test_many_warnings_capped);
+  tcase_add_test(cost, test_large_output_note);
   tcase_add_test(tcase_in(s, "driver"), test_driver_short_span);
   return s;
 }
