@@ -69,9 +69,10 @@ typedef struct {
 } Work;
 
 /* The result row of trajectory i: status, steps, t, q, p, lambda, then from
- * R_H on H, max_dH, max_g, max_hc, iters_mean, iters_max and the running sum
- * of the iterations. */
-enum { R_H, R_DH, R_G, R_HC, R_MEAN, R_MAX, R_SUM, R_COUNT };
+ * R_H on H, max_dH, max_g, max_hc, iters_mean, iters_max, and, not written,
+ * the running sum of the iterations and the number of failed steps retried
+ * as halves. */
+enum { R_H, R_DH, R_G, R_HC, R_MEAN, R_MAX, R_SUM, R_HALVED, R_COUNT };
 
 static double *result(const Ens *e, long i)
 {
@@ -420,6 +421,18 @@ static int traj_taken(void *ctx, const hbvmrt_stats *st, double h)
   return 0;
 }
 
+/* A step of h that failed and is retried as halves (depth 0: the step of
+ * the run's grid; deeper, its halves): counted in the trajectory's row for
+ * the summary line, where a single run says it on stderr. */
+static void traj_failed(void *ctx, double h, int code, int depth)
+{
+  Traj *tr = ctx;
+
+  (void)h, (void)code;
+  if (depth == 0)
+    tr->r[at_H(tr->e->md) + R_HALVED] += 1;
+}
+
 /* A trajectory's steps from its state in w->x, as a single run of the
  * driver takes them: with --tol adaptive steps (NAME_step_adaptive, -h the
  * first) to T exactly; else steps `from`..N of h, the last shortened to end
@@ -432,7 +445,7 @@ static void steps_scalar(Traj *tr, long from, double fail_h, int fail_code)
   const Ens *e = tr->e;
   const hbvmrt_model *md = e->md;
   void *x = tr->w->x;
-  hbvmrt_steps cb = {NULL, traj_taken, NULL, NULL};
+  hbvmrt_steps cb = {NULL, traj_taken, traj_failed, NULL};
   double h = e->o.h, t_end = hbvmrt_span_end(&e->o);
   int code = 0, stopped, at_end = hbvmrt_state_time(md, x) == t_end;
   long k;
@@ -677,7 +690,7 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
   char **rest = calloc((size_t)argc + 1, sizeof *rest);
   int nrest, status = 1, failed = 0;
   double t0;
-  long i;
+  long i, halved = 0;
 
   memset(&e, 0, sizeof e);
   e.md = md;
@@ -738,8 +751,10 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
   MPI_Win_unlock_all(e.win);
   MPI_Win_free(&e.win);
 #endif
-  for (i = 0; i < e.nrow; i++)
+  for (i = 0; i < e.nrow; i++) {
     failed += result(&e, i)[0] != 0;
+    halved += result(&e, i)[at_H(md) + R_HALVED] > 0;
+  }
   status = failed ? 2 : 0;
   if (e.rank == 0 && e.o.csv) {
     FILE *f = strcmp(e.o.csv, "-") ? fopen(e.o.csv, "w") : stdout;
@@ -749,7 +764,7 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
     }
   }
   if (e.rank == 0) {
-    fprintf(stderr, "trajectories=%ld ok=%ld failed=%d ", e.nrow, e.nrow - failed, failed);
+    fprintf(stderr, "trajectories=%ld ok=%ld failed=%d halved=%ld ", e.nrow, e.nrow - failed, failed, halved);
     if (e.o.tol > 0)
       fprintf(stderr, "tol=%g ", e.o.tol);
     else
