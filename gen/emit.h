@@ -45,6 +45,7 @@ void tmpl(Emitter *e, const char *text);
 void emit_kernel(Emitter *e, KernelId k);
 void emit_tables(Emitter *e);
 int kernel_inlinable(const Emitter *e, KernelId k);
+int sweep_reduces(const Emitter *e);
 int emit_kernel_inline(Emitter *e, KernelId k);
 
 /* emit_step.c, for the batch's adaptive step too */

@@ -50,22 +50,29 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $M *restrict stall, $M *restrict rc, $M *restrict iters)\n{\n"
           "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
-          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = nan[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n"
-          "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
-          "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
-          "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
-          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
-          "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
-          "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n");
+          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = nan[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n");
+  if (sweep_reduces(e)) /* the sweep took them while its results were at hand */
+    tmpl(e, "  (void)x;\n  (void)h;\n"
+            "  for (l = 0; l < $P_W; l++) {\n    scale[l] = sw[($<sweep>) * $P_W + l];\n"
+            "    incn[l] = sw[($<sweep> + 1) * $P_W + l];\n    nan[l] = sw[($<sweep> + 2) * $P_W + l];\n  }\n");
+  else
+    tmpl(e, "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+            "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+            "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
+            "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+            "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
+            "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n");
   if (!poly && e->mod->nu)
     tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
             "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
-  tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
   /* a result is not finite where r - r is not 0 (inf - inf and NaN are NaN): their sum
    * over the results is one test a lane, in a loop the compiler vectorises */
-  tmpl(e, "    for (l = 0; l < $P_W; l++) nan[l] += sw[i * $P_W + l] - sw[i * $P_W + l];\n"
-          "  for (l = 0; l < $P_W; l++) {\n"
+  if (!sweep_reduces(e)) {
+    tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
+    tmpl(e, "    for (l = 0; l < $P_W; l++) nan[l] += sw[i * $P_W + l] - sw[i * $P_W + l];\n");
+  }
+  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
@@ -299,7 +306,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
     tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
             "  const $R h = ($R)h_;\n");
   tmpl(e, "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
-          "  $R sw[($<sweep> + 1) * $P_W];\n"
+          "  $R sw[($<sweep> + 3) * $P_W];  /* + the sweep's reductions for the lane test */\n"
           "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n");
   if (adaptive) tmpl(e, "  $R ref[$P_S * $P_M * $P_W], d1[$P_W], est[$P_W];\n  $M two[$P_W], cl[$P_W];\n");
   tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
@@ -332,7 +339,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
                      "  if (early) {  /* a lane failed before the first sweep */\n    tried = -2;\n    goto out;\n  }\n"
                    : "  }\n");
   tmpl(e, "  if (nrun == 0)  /* no sweep: what the commit reads of sw is defined all the same */\n"
-          "    for (i = 0; i < ($<sweep> + 1) * $P_W; i++) sw[i] = 0;\n"
+          "    for (i = 0; i < ($<sweep> + 3) * $P_W; i++) sw[i] = 0;\n"
           "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
           "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
   if (poly) /* $P_step's refresh of the frozen factor, for the lanes that slow down */

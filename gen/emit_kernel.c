@@ -613,6 +613,52 @@ static int kernel_ops(const Emitter *e, KernelId id, int **ops) {
   return nops;
 }
 
+// The offset in out[] of kernel k's result block named name, or -1.
+static int block_first(const Kernel *k, const char *name) {
+  for (int b = 0; b < k->nout; b++)
+    if (!strcmp(k->out[b].name, name)) return k->out[b].first;
+  return -1;
+}
+
+// Whether the batch sweep prints the lane test's reductions of its results
+// (emit_lane_reductions): when it is one function, so that its results are
+// still at hand in its loop over the lanes.
+int sweep_reduces(const Emitter *e) {
+  return e->lanes && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES && block_first(&e->st->kern[K_SWEEP], "gam") >= 0;
+}
+
+// In the batch sweep's loop over the lanes, after its results: the three
+// reductions of them that the lane test after a sweep needs
+// (emit_batch_step.c), each in the order the test took them, so that the
+// test reads three values a lane instead of passing over the results again.
+// Below the N results of out[]: out[N] = max_i |q0_i| + |h gamma_0,i| (the
+// scale), out[N + 1] = max_i |h (gamma_i - gam_i)| (the increment), out[N + 2]
+// = the sum of r - r over the results before theta (poly) or pivot (const),
+// not 0 where one of them is not finite.
+static void emit_lane_reductions(Emitter *e, const Kernel *k, const int *outs, int nouts) {
+  int g = block_first(k, "gam"), end = block_first(k, "theta");
+  const char *R = real_type(e, e->wide), *f = math_suffix(e, e->wide);
+  char r[NAME_SIZE];
+  if (end < 0) end = block_first(k, "pivot");
+  if (end < 0) end = nouts;
+  out(e, "    { /* the lane test's scale, increment and finiteness of these results */\n"
+         "      %s sc = 0, inc = 0, nan = 0, v;\n", R);
+  for (int i = 0; i < e->mod->m; i++) {
+    ref(e, outs[g + i], r, sizeof r);
+    out(e, "      v = fabs%s(q0[%d + l]) + fabs%s(h * %s);\n      sc = v > sc ? v : sc;\n", f, i * e->lanes, f, r);
+  }
+  for (int i = 0; i < e->me->s * e->mod->m; i++) {
+    ref(e, outs[g + i], r, sizeof r);
+    out(e, "      v = fabs%s(h * (%s - gam[%d + l]));\n      inc = v > inc ? v : inc;\n", f, r, i * e->lanes);
+  }
+  for (int i = 0; i < end; i++) {
+    ref(e, outs[i], r, sizeof r);
+    out(e, "      nan += %s - %s;\n", r, r);
+  }
+  out(e, "      out[%d + l] = sc;\n      out[%d + l] = inc;\n      out[%d + l] = nan;\n    }\n", nouts * e->lanes,
+      (nouts + 1) * e->lanes, (nouts + 2) * e->lanes);
+}
+
 // Print kernel k, computing its result blocks into out[]: straight-line
 // code from the DAG, in several parts when it is large. Kernels marked wide
 // compute one precision wider under --wide-step.
@@ -635,6 +681,7 @@ void emit_kernel(Emitter *e, KernelId id) {
     lane_loop(e, 1);
     emit_ops(e, ops, 0, nops);
     emit_outputs(e, k, outs, nouts);
+    if (id == K_SWEEP && sweep_reduces(e)) emit_lane_reductions(e, k, outs, nouts);
     lane_loop(e, 0);
     out(e, "}\n");
   }
