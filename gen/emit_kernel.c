@@ -631,7 +631,7 @@ int sweep_reduces(const Emitter *e) {
 // reductions of them that the lane test after a sweep needs
 // (emit_batch_step.c), each in the order the test took them, so that the
 // test reads three values a lane instead of passing over the results again.
-// Below the N results of out[]: out[N] = max_i |q0_i| + |h gamma_0,i| (the
+// After the N results in out[]: out[N] = max_i |q0_i| + |h gamma_0,i| (the
 // scale), out[N + 1] = max_i |h (gamma_i - gam_i)| (the increment), out[N + 2]
 // = the sum of r - r over the results before theta (poly) or pivot (const),
 // not 0 where one of them is not finite.
