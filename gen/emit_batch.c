@@ -106,6 +106,44 @@ static void emit_params_observers(Emitter *e) {
             "  (void)x; (void)prm; (void)gp;\n}\n\n");
 }
 
+// The prediction when every lane comes from the same last steps (hprev and
+// hprev2 equal in all lanes, none cold: lanes that share h, or a run of fixed
+// steps): the coefficients once, and loops over whole rows of M W values
+// with no selects, each value summed in $P_predict's order (the two-step sum
+// written out over the S steps). Bitwise the general path's values.
+static void emit_predict_uniform(Emitter *e, int poly) {
+  tmpl(e, "  for (l = 0; l < $P_W; l++)\n"
+          "    uni &= (x->hprev[l] == x->hprev[0]) & (x->hprev2[l] == x->hprev2[0]) & (x->hprev[l] != 0);\n"
+          "  if (uni) {  /* every lane from the same last steps: one set of coefficients */\n"
+          "    $R hp = x->hprev[0], r0 = h / hp;\n");
+  tmpl(e, poly ? "    int two0 = (h == hp) & (h == x->hprev2[0]);\n" : "    int two0 = 0;  /* no two-step start in this family */\n");
+  tmpl(e, "    if (twos)\n      for (l = 0; l < $P_W; l++) twos[l] = two0;\n"
+          "    if (!two0 || ref)  /* the one-step start */\n"
+          "      for (j = 0; j < $P_S; j++) {\n"
+          "        $R *restrict a = (two0 ? ref : gam) + j * $P_M * $P_W;\n"
+          "        for (l = 0; l < $P_M * $P_W; l++) a[l] = 0;\n"
+          "        for (i = 0; i < $P_S; i++) {\n"
+          "          $R c = 0;\n"
+          "          if (h == hp)\n            c = $P_E1[j * $P_S + i];\n"
+          "          else\n            for (d = $P_S - 1; d >= 0; d--) c = c * r0 + $P_E[(j * $P_S + i) * $P_S + d];\n"
+          "          if (c != 0)\n            for (l = 0; l < $P_M * $P_W; l++) a[l] += c * x->gam[i * $P_M * $P_W + l];\n"
+          "        }\n      }\n");
+  if (poly) {
+    tmpl(e, "    if (two0)  /* the two-step start */\n"
+            "      for (j = 0; j < $P_S; j++)\n"
+            "        for (l = 0; l < $P_M * $P_W; l++) {\n"
+            "          $R b = 0;\n");
+    for (int i = 0; i < e->me->s; i++)
+      out(e, "          b += %s_E2[2 * %s_S * j + %d] * x->gam[%d * %s_M * %s_W + l] +\n"
+             "               %s_E2[2 * %s_S * j + %s_S + %d] * x->gam2[%d * %s_M * %s_W + l];\n",
+          e->P, e->P, i, i, e->P, e->P, e->P, e->P, e->P, i, i, e->P, e->P);
+    tmpl(e, "          gam[j * $P_M * $P_W + l] = b;\n        }\n    else if (ref)\n");
+  } else
+    tmpl(e, "    if (ref)\n");
+  tmpl(e, "      for (l = 0; l < $P_S * $P_M * $P_W; l++) ref[l] = gam[l];\n"
+          "    return;\n  }\n");
+}
+
 // $P_predict over the lanes with selects: every lane's one-step
 // extrapolation (coefficients E1 when h is unchanged, else the polynomial in
 // h / hprev), the polynomial family's two-step start, and the cold start
@@ -117,8 +155,9 @@ static void emit_predict(Emitter *e) {
   tmpl(e, "$P_LANE_INLINE void $P_batch_predict(const $P_batch *restrict x, $R h, int cold_all, const $R *restrict par,\n"
           "    $R *restrict gam, $R *restrict ref, $M *restrict twos)\n{\n"
           "  $R mp[$P_M * $P_W], r[$P_W], ec[$P_S * $P_S * $P_W];\n  $M cold[$P_W], two[$P_W], same[$P_W];\n"
-          "  int i, j, l, m, d, all2 = $P_W > 0, one;\n"
-          "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
+          "  int i, j, l, m, d, all2 = $P_W > 0, one, uni = !cold_all;\n");
+  emit_predict_uniform(e, poly);
+  tmpl(e, "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    $R hp = x->hprev[l], hq = x->hprev2[l];\n"
           "    cold[l] = (hp == 0) | cold_all;\n    same[l] = h == hp;\n    r[l] = h / (hp != 0 ? hp : 1);\n    (void)hq;\n");
@@ -128,19 +167,6 @@ static void emit_predict(Emitter *e) {
           "  for (l = 0; l < $P_W; l++) all2 &= (int)two[l];\n"
           "  if (twos)\n    for (l = 0; l < $P_W; l++) twos[l] = two[l];\n"
           "  one = !all2 || ref;  /* ref: the one-step start too, where the two-step one is taken */\n");
-  if (poly) { /* every lane from its last two steps (steps of one h), as in a run of fixed steps:
-               * one loop over the whole rows of M W values, no selects, each value summed in
-               * $P_predict's order, the sum over the S steps written out */
-    tmpl(e, "  if (!one) {\n"
-            "    for (j = 0; j < $P_S; j++)\n"
-            "      for (l = 0; l < $P_M * $P_W; l++) {\n"
-            "        $R b = 0;\n");
-    for (int i = 0; i < e->me->s; i++)
-      out(e, "        b += %s_E2[2 * %s_S * j + %d] * x->gam[%d * %s_M * %s_W + l] +\n"
-             "             %s_E2[2 * %s_S * j + %s_S + %d] * x->gam2[%d * %s_M * %s_W + l];\n",
-          e->P, e->P, i, i, e->P, e->P, e->P, e->P, e->P, i, i, e->P, e->P);
-    tmpl(e, "        gam[j * $P_M * $P_W + l] = b;\n      }\n    return;\n  }\n");
-  }
   tmpl(e, ""
           "  if (one) /* the one-step coefficients, when a lane needs them */\n"
           "    for (j = 0; j < $P_S * $P_S; j++) {\n"
