@@ -47,7 +47,8 @@ static const char usage[] =
     "                degree s-1, then p projected onto the hidden constraint and rescaled\n"
     "                to the energy: order 2s. Default: poly for s >= 2 with constraints\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
-    "  --check       parse and analyse only; print m, nu, degrees and the chosen k\n"
+    "  --check       parse and analyse only; print m, nu, degrees and the chosen k, and the\n"
+    "                size of the code it would write (nothing is written)\n"
     "  --real T      float or double (default): the type of the state, constants and\n"
     "                arithmetic of the generated code (float: for FPUs without double)\n"
     "  --plain-sum   update q, p, t by plain addition instead of compensated (Kahan)\n"
@@ -451,14 +452,41 @@ static void note_large_output(const char *path) {
           path, (double)sb.st_size / 1e6);
 }
 
+// What the emitter takes of the options.
+static EmitOptions emit_options(const Options *o) {
+  EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
+                    !o->plain_sum, o->wide_step, o->batch};
+  return eo;
+}
+
+// --check's last line: the code the options would write, emitted into
+// temporary files and thrown away: the size of NAME.c (and of NAME.h), and
+// whether the k stages are straight-line code or one loop (--stage-loop).
+// Returns 1 when the step cannot be emitted (the reason reported), else 0.
+static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam) {
+  const Method *me = method_new(k, o->s, fam);
+  Step *st = step_build(mod, me);
+  EmitOptions eo = emit_options(o);
+  if (!st || emit_check(mod, st, &eo)) return 1;
+  FILE *h = tmpfile(), *c = tmpfile();
+  int rc = !h || !c || emit_solver(h, c, mod, me, st, &eo) != 0;
+  if (rc)
+    fprintf(stderr, "hbvmgen: error: cannot emit the code into a temporary file: %s\n", strerror(errno));
+  else
+    printf("code: %s.c %.2f MB, %s.h %ld bytes; the %d stages %s\n", o->name, (double)ftell(c) / 1e6, o->name,
+           ftell(h), k, mod->dag->nloops ? "as one loop (--stage-loop)" : "in straight-line code");
+  if (h) fclose(h);
+  if (c) fclose(c);
+  return rc;
+}
+
 // Emit the solver files; all or nothing.
 static int write_outputs(const Options *o, const Model *mod, const Method *me, const Step *st) {
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
   char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
   int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
-  EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
-                    !o->plain_sum, o->wide_step, o->batch};
+  EmitOptions eo = emit_options(o);
   if (!rc && emit_check(mod, st, &eo)) return 1; /* nothing is written yet */
   atexit(remove_temporaries);
   mode_t mask = umask(0);
@@ -542,6 +570,7 @@ int main(int argc, char **argv) {
     rc = 1;
   } else if (o.check_only) {
     print_check(mod, &o, k, why, fam);
+    rc = print_check_code(&o, mod, k, fam);
   } else {
     const Method *me = method_new(k, o.s, fam);
     Step *st = step_build(mod, me);

@@ -598,6 +598,22 @@ START_TEST(test_check_options)
 }
 END_TEST
 
+/* --check's last line: the size of the code the options would write, and
+ * whether the stages are one loop; nothing is written. */
+START_TEST(test_check_code)
+{
+  char out[4096];
+  ck_assert_int_eq(run_cli("--check -k 4 -n pend -o /nonexistent/dir ../models/pendulum.ham", 0, out, sizeof out), 0);
+  const char *code = strstr(out, "\ncode: pend.c ");
+  ck_assert_msg(code != NULL, "no code line: %s", out);
+  double mb = atof(code + strlen("\ncode: pend.c "));
+  ck_assert_msg(mb > 0.01 && mb < 1, "pend.c said to be %g MB", mb);
+  ck_assert_msg(strstr(code, " bytes; the 4 stages in straight-line code\n"), "%s", code);
+  ck_assert_int_eq(run_cli("--check -k 16 --stage-loop 1 ../models/kepler.ham", 0, out, sizeof out), 0);
+  ck_assert_msg(strstr(out, "; the 16 stages as one loop (--stage-loop)\n"), "%s", out);
+}
+END_TEST
+
 START_TEST(test_help)
 {
   static const char *const options[] = {"-s S", "-k K", "auto", "-o DIR", "-n NAME", "--main", "--check", "-h",
@@ -692,6 +708,7 @@ Suite *parser_suite(void)
   tcase_set_timeout(cli, 60);
   tcase_add_loop_test(cli, test_check_models, 0, NCASES(check_cases));
   tcase_add_test(cli, test_check_options);
+  tcase_add_test(cli, test_check_code);
   tcase_add_test(cli, test_help);
   tcase_add_loop_test(cli, test_bad_options, 0, NCASES(bad_options));
   suite_add_tcase(s, cli);
