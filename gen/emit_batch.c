@@ -148,14 +148,15 @@ static void emit_predict_uniform(Emitter *e, int poly) {
 // extrapolation (coefficients E1 when h is unchanged, else the polynomial in
 // h / hprev), the polynomial family's two-step start, and the cold start
 // (gamma_1 = M^-1 p; every lane's with cold_all) are all computed and the
-// lane's own one chosen. For the adaptive step, ref (when not NULL) gets the
+// lane's own one chosen. Lanes that all take the two-step start come from the
+// same last steps, so they take the uniform path above, never this one. For the adaptive step, ref (when not NULL) gets the
 // one-step start and twos (when not NULL) the lanes that took the two-step.
 static void emit_predict(Emitter *e) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "$P_LANE_INLINE void $P_batch_predict(const $P_batch *restrict x, $R h, int cold_all, const $R *restrict par,\n"
           "    $R *restrict gam, $R *restrict ref, $M *restrict twos)\n{\n"
           "  $R mp[$P_M * $P_W], r[$P_W], ec[$P_S * $P_S * $P_W];\n  $M cold[$P_W], two[$P_W], same[$P_W];\n"
-          "  int i, j, l, m, d, all2 = $P_W > 0, one, uni = !cold_all;\n");
+          "  int i, j, l, m, d, uni = !cold_all;\n");
   emit_predict_uniform(e, poly);
   tmpl(e, "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
@@ -163,20 +164,15 @@ static void emit_predict(Emitter *e) {
           "    cold[l] = (hp == 0) | cold_all;\n    same[l] = h == hp;\n    r[l] = h / (hp != 0 ? hp : 1);\n    (void)hq;\n");
   /* the polynomial family's two-step start, as $P_predict's */
   tmpl(e, poly ? "    two[l] = (hp != 0) & (h == hp) & (h == hq) & (cold_all == 0);\n  }\n" : "    two[l] = 0;\n  }\n");
-  tmpl(e, ""
-          "  for (l = 0; l < $P_W; l++) all2 &= (int)two[l];\n"
-          "  if (twos)\n    for (l = 0; l < $P_W; l++) twos[l] = two[l];\n"
-          "  one = !all2 || ref;  /* ref: the one-step start too, where the two-step one is taken */\n");
-  tmpl(e, ""
-          "  if (one) /* the one-step coefficients, when a lane needs them */\n"
-          "    for (j = 0; j < $P_S * $P_S; j++) {\n"
-          "      $R c[$P_W];\n      for (l = 0; l < $P_W; l++) c[l] = 0;\n"
-          "      for (d = $P_S - 1; d >= 0; d--)\n        for (l = 0; l < $P_W; l++) c[l] = c[l] * r[l] + $P_E[j * $P_S + d];\n"
-          "      for (l = 0; l < $P_W; l++) ec[j * $P_W + l] = same[l] ? $P_E1[j] : c[l];\n    }\n"
+  tmpl(e, "  if (twos)\n    for (l = 0; l < $P_W; l++) twos[l] = two[l];\n"
+          "  for (j = 0; j < $P_S * $P_S; j++) {  /* the one-step coefficients */\n"
+          "    $R c[$P_W];\n    for (l = 0; l < $P_W; l++) c[l] = 0;\n"
+          "    for (d = $P_S - 1; d >= 0; d--)\n      for (l = 0; l < $P_W; l++) c[l] = c[l] * r[l] + $P_E[j * $P_S + d];\n"
+          "    for (l = 0; l < $P_W; l++) ec[j * $P_W + l] = same[l] ? $P_E1[j] : c[l];\n  }\n"
           "  for (j = 0; j < $P_S; j++)\n    for (m = 0; m < $P_M; m++) {\n"
           "      $R a[$P_W], b[$P_W];\n"
           "      for (l = 0; l < $P_W; l++) a[l] = b[l] = 0;\n"
-          "      for (i = 0; one && i < $P_S; i++)\n        for (l = 0; l < $P_W; l++) {\n"
+          "      for (i = 0; i < $P_S; i++)\n        for (l = 0; l < $P_W; l++) {\n"
           "          $R ei = ec[(j * $P_S + i) * $P_W + l], t = a[l] + ei * x->gam[(i * $P_M + m) * $P_W + l];\n"
           "          a[l] = ei != 0 ? t : a[l];\n        }\n"
           "      if (ref)\n        for (l = 0; l < $P_W; l++) ref[(j * $P_M + m) * $P_W + l] = a[l];\n");
@@ -184,8 +180,6 @@ static void emit_predict(Emitter *e) {
     tmpl(e, "      for (i = 0; i < $P_S; i++)\n        for (l = 0; l < $P_W; l++)\n"
             "          b[l] += $P_E2[2 * $P_S * j + i] * x->gam[(i * $P_M + m) * $P_W + l] +\n"
             "                  $P_E2[2 * $P_S * j + $P_S + i] * x->gam2[(i * $P_M + m) * $P_W + l];\n");
-  if (poly) /* every lane from its last two steps (steps of one h): no selects */
-    tmpl(e, "      if (all2)\n        for (l = 0; l < $P_W; l++) gam[(j * $P_M + m) * $P_W + l] = b[l];\n      else\n");
   tmpl(e, "      for (l = 0; l < $P_W; l++) {\n");
   tmpl(e, poly ? "        $R c = two[l] ? b[l] : a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n"
                : "        $R c = a[l], g = j == 0 ? mp[m * $P_W + l] : 0;\n");

@@ -50,28 +50,28 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $M *restrict stall, $M *restrict rc, $M *restrict iters)\n{\n"
           "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
-          "  for (l = 0; l < $P_W; l++) {\n    scale[l] = incn[l] = nan[l] = 0;\n    bad[l] = sing[l] = 0;\n  }\n");
-  if (sweep_reduces(e)) /* the sweep took them while its results were at hand */
+          "  for (l = 0; l < $P_W; l++) bad[l] = sing[l] = 0;\n");
+  /* a result is not finite where r - r is not 0 (inf - inf and NaN are NaN): their sum
+   * over the results is one test a lane, in a loop the compiler vectorises */
+  if (sweep_reduces(e)) /* the sweep took the three while its results were at hand */
     tmpl(e, "  (void)x;\n  (void)h;\n"
             "  for (l = 0; l < $P_W; l++) {\n    scale[l] = sw[($<sweep>) * $P_W + l];\n"
             "    incn[l] = sw[($<sweep> + 1) * $P_W + l];\n    nan[l] = sw[($<sweep> + 2) * $P_W + l];\n  }\n");
-  else
-    tmpl(e, "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
+  else {
+    tmpl(e, "  for (l = 0; l < $P_W; l++) scale[l] = incn[l] = nan[l] = 0;\n"
+            "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
             "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
             "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
             "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n");
+    tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
+    tmpl(e, "    for (l = 0; l < $P_W; l++) nan[l] += sw[i * $P_W + l] - sw[i * $P_W + l];\n");
+  }
   if (!poly && e->mod->nu)
     tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
             "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
-  /* a result is not finite where r - r is not 0 (inf - inf and NaN are NaN): their sum
-   * over the results is one test a lane, in a loop the compiler vectorises */
-  if (!sweep_reduces(e)) {
-    tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
-    tmpl(e, "    for (l = 0; l < $P_W; l++) nan[l] += sw[i * $P_W + l] - sw[i * $P_W + l];\n");
-  }
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
@@ -323,8 +323,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
                     : "  $P_batch_predict(x, h, cold, par, gam, 0, two);\n");
   if (nu)
     tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
-            "  for (i = 0; i < $P_NU * $P_W; i++) {  /* the division first, then the select: vectorises */\n"
-            "    $R d = g0[i] / h;\n    g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : d;\n  }\n");
+            "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
   if (poly)
     tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
             "  $(factor q0=x->q gam=gam h=h prm=par out=fa);\n"

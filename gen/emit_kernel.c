@@ -624,7 +624,7 @@ static int block_first(const Kernel *k, const char *name) {
 // (emit_lane_reductions): when it is one function, so that its results are
 // still at hand in its loop over the lanes.
 int sweep_reduces(const Emitter *e) {
-  return e->lanes && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES && block_first(&e->st->kern[K_SWEEP], "gam") >= 0;
+  return e->lanes && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES;
 }
 
 // In the batch sweep's loop over the lanes, after its results: the three
