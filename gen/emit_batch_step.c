@@ -192,12 +192,25 @@ static void emit_commit(Emitter *e, int poly) {
   emit_commit_common(e);
 }
 
+// A lane's call of a scalar step function f(state, sw, h, prm) (NAME_defect,
+// NAME_mult_err) on the lane's state and its sweep's results.
+static void emit_lane_call(Emitter *e, const char *f) {
+  out(e, "/* Lane l's %s_%s, on its state and its sweep's results. */\n", e->P, f);
+  out(e, "static %s %s_batch_%s(const %s_batch *x, const %s *sw, int l, %s h, const %s_params *prm)\n{\n",
+      real_type(e, 0), e->P, f, e->P, real_type(e, 0), real_type(e, 0), e->P);
+  tmpl(e, "  $P_state s;\n  $P_params dflt;\n  $R v[$<sweep> + 1];\n  int i;\n"
+          "  if (!prm) $P_params_default(&dflt);\n"
+          "  $P_batch_get(x, l, &s);\n"
+          "  for (i = 0; i < $<sweep>; i++) v[i] = sw[i * $P_W + l];\n");
+  out(e, "  return %s_%s(&s, v, h, prm ? &prm[l] : &dflt);\n}\n\n", e->P, f);
+}
+
 // The error estimate of one lane for NAME_batch_step_adaptive, by the
 // scalar step's own functions on the lane's values (once or twice a step,
 // not worth lanes): NAME_err_est on the gamma of sw with the lane's scale
-// max |q0| + |h gamma_0|, and, where the scalar step adds it, NAME_defect
-// on the lane's state.
-static void emit_lane_estimate(Emitter *e, int defect) {
+// max |q0| + |h gamma_0|, and, where the scalar step adds them,
+// NAME_mult_err and NAME_defect on the lane's state.
+static void emit_lane_estimate(Emitter *e, int mult, int defect) {
   tmpl(e, "/* Lane l's error estimate, $P_err_est on the gamma of sw, and its scale max|q0| + |h gamma_0|\n"
           " * (as $P_step_within's from the same sweep). */\n"
           "static $R $P_batch_est(const $P_batch *x, const $R *sw, int l, $R h, $R d1, int cold, $R *scale)\n{\n"
@@ -206,14 +219,8 @@ static void emit_lane_estimate(Emitter *e, int defect) {
           "  for (i = 0; i < $P_M; i++) {\n"
           "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * g[i]);\n    if (v > sc) sc = v;\n  }\n"
           "  *scale = sc;\n  return $P_err_est(g, h, d1, cold);\n}\n\n");
-  if (defect)
-    tmpl(e, "/* Lane l's $P_defect, on its state and its sweep's results. */\n"
-            "static $R $P_batch_defect(const $P_batch *x, const $R *sw, int l, $R h, const $P_params *prm)\n{\n"
-            "  $P_state s;\n  $P_params dflt;\n  $R v[$<sweep> + 1];\n  int i;\n"
-            "  if (!prm) $P_params_default(&dflt);\n"
-            "  $P_batch_get(x, l, &s);\n"
-            "  for (i = 0; i < $<sweep>; i++) v[i] = sw[i * $P_W + l];\n"
-            "  return $P_defect(&s, v, h, prm ? &prm[l] : &dflt);\n}\n\n");
+  if (mult) emit_lane_call(e, "mult_err");
+  if (defect) emit_lane_call(e, "defect");
 }
 
 // NAME_batch_step_adaptive's tests inside NAME_batch_within, as
@@ -222,7 +229,7 @@ static void emit_lane_estimate(Emitter *e, int defect) {
 // early estimate; after the iteration, that every active lane converged and
 // its estimate (with the energy defect where the scalar step has it). A
 // lane over tol (1 + its scale) makes the whole try a rejection.
-static void emit_lane_tolerance(Emitter *e, int poly, int defect) {
+static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
   tmpl(e, "/* After the first sweep (tol > 0): each iterating lane's predictor error d1 and its\n"
           " * estimate; 1 when one is already over tol (1 + its scale), its code then $P_EREJECT. */\n"
           "static int $P_batch_first(const $P_batch *x, $R h, $R tol, const $R *sw, const $R *gam, const $R *ref,\n"
@@ -243,10 +250,12 @@ static void emit_lane_tolerance(Emitter *e, int poly, int defect) {
           "static int $P_batch_last(const $P_batch *x, $R h, $R tol, const $R *sw, const $M *go, const $M *cl,\n"
           "    const $R *d1, const $P_params *prm, $R *est, $M *rc)\n{\n"
           "  int l, over = 0;\n");
-  if (!defect) tmpl(e, "  (void)prm;  /* for the energy defect, which this model does not need */\n");
+  if (!defect && !mult) tmpl(e, "  (void)prm;  /* for the energy defect, which this model does not need */\n");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    $R sc;\n"
           "    est[l] = 0;\n    if (x->idle[l]) continue;\n    if (!go[l]) return -2;\n"
           "    est[l] = $P_batch_est(x, sw, l, h, d1[l], (int)cl[l], &sc);\n");
+  if (mult)
+    tmpl(e, "    {\n      $R em = $P_batch_mult_err(x, sw, l, h, prm);\n      if (em > est[l]) est[l] = em;\n    }\n");
   if (defect) tmpl(e, "    est[l] += $P_batch_defect(x, sw, l, h, prm);\n");
   tmpl(e, "    if (!(est[l] <= tol * (1 + sc))) {\n      rc[l] = $P_EREJECT;\n      over = 1;\n    }\n  }\n"
           "  return over ? -1 : 0;\n}\n\n");
@@ -389,12 +398,12 @@ static void emit_step_body(Emitter *e, int adaptive) {
 
 // NAME_batch_step and NAME_batch_step_adaptive with what they call.
 void emit_batch_step(Emitter *e) {
-  int poly = e->st->kern[K_FACTOR].nout > 0, defect = energy_defect_wanted(e);
+  int poly = e->st->kern[K_FACTOR].nout > 0, defect = energy_defect_wanted(e), mult = mult_err_wanted(e);
   if (poly) emit_pivots(e);
   emit_lane_test(e, poly);
   emit_step_body(e, 0);
-  emit_lane_estimate(e, defect);
-  emit_lane_tolerance(e, poly, defect);
+  emit_lane_estimate(e, mult, defect);
+  emit_lane_tolerance(e, poly, mult, defect);
   emit_step_body(e, 1);
   emit_batch_adaptive(e);
 }

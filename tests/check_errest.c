@@ -109,6 +109,9 @@ static const StepCase cases[] = {
     {"modified", "modified_k6s2", 0.1, 100},             {"conical", "conical_poly_k2s2", 0.1, 100},
     {"kepler", "kepler_k1s1", 0.01, 628},                {"kepler", "kepler_k2s2", 0.05, 126},
     {"kepler", "kepler_k3s3", 0.1, 63},                  {"kepler", "kepler_k4s4", 0.2, 32},
+    /* the constant multiplier's part (NAME_mult_err) at a second h, and where it is 0 */
+    {"satellites", "satellites_k6s2", 0.05, 200},        {"modified", "modified_k9s3", 0.1, 100},
+    {"conical", "conical_k2s2", 0.1, 100},
 };
 
 START_TEST(tracks_true_error)
@@ -119,11 +122,6 @@ START_TEST(tracks_true_error)
            cases[_i].solver, cases[_i].h, r.n, r.mean, r.lo, r.hi);
   fflush(stdout);
   ck_assert_msg(r.n > 0, "%s: no step above round-off", cases[_i].solver);
-  /* the constant multiplier at s >= 2 has an error driven by the multiplier's
-   * change, which the velocity's coefficients do not see: not tracked */
-  static const char *const untracked[] = {"pendulum_k3s3", "satellites_k6s2", "satellites_k6s3"};
-  for (size_t u = 0; u < sizeof untracked / sizeof untracked[0]; u++)
-    if (!strcmp(cases[_i].solver, untracked[u])) return;
   ck_assert_msg(r.mean >= 0.1 && r.mean <= 10, "%s, h=%g: true/est %g on average", cases[_i].solver, cases[_i].h,
                 r.mean);
   /* and no step's estimate far below its true error (measured: at most 60x,
@@ -144,7 +142,9 @@ Suite *errest_suite(void) {
 
 /* ---- NAME_step_adaptive ---- */
 
+#include "double_pendulum_const_k2s2.h"
 #include "kepler_k3s3.h"
+#include "pendulum_k3s3.h"
 #include "pendulum_poly_k3s3.h"
 #include "satellites_poly_k6s3.h"
 
@@ -185,6 +185,8 @@ typedef struct {
 RUN_ADAPTIVE(kepler_k3s3)
 RUN_ADAPTIVE(pendulum_poly_k3s3)
 RUN_ADAPTIVE(satellites_poly_k6s3)
+RUN_ADAPTIVE(pendulum_k3s3)
+RUN_ADAPTIVE(double_pendulum_const_k2s2)
 
 static const struct {
   const char *problem;
@@ -219,6 +221,37 @@ START_TEST(adaptive_proportional)
     ck_assert_double_le(a.dg, 1e-13);
     ck_assert_double_le(a.dhc, 1e-13);
     if (strcmp(problem, "kepler")) ck_assert_double_le(a.dH, 1e-13);
+  }
+}
+END_TEST
+
+// The constant multiplier (s >= 2, order 4 in q, 2 in p across the hidden
+// constraint): its estimate adds NAME_mult_err. The global error at T
+// against tol = 1e-6 .. 1e-10 (measured 0.064-12; before NAME_mult_err the
+// double pendulum failed at the h floor at tol 1e-8 and the pendulum ended
+// at 43-209 tol), few rejections, g at round-off and H too (U and g
+// polynomial, k = s integrates H exactly). Not asserted at 1e-12: the
+// velocity across the hidden constraint that a large step leaves does not
+// decay under the constant multiplier (docs/api.md), 124-541 tol there.
+START_TEST(adaptive_const_proportional)
+{
+  const char *problem = _i ? "double_pendulum" : "pendulum";
+  double T = 10, q[2 * 4], p[2 * 4], qT[4], pT[4];
+  int m, nu;
+  ck_assert_int_eq(ref_dims(problem, &m, &nu), 0);
+  ck_assert_int_eq(errest_reference(problem, T, 1, m, q, p), 0);
+  for (double tol = 1e-6; tol > 1e-10 / 2; tol /= 100) {
+    Adaptive a = _i ? adaptive_double_pendulum_const_k2s2(T, tol, qT, pT) : adaptive_pendulum_k3s3(T, tol, qT, pT);
+    for (int i = 0; i < m; i++) a.err = fmax(a.err, fmax(fabs(qT[i] - q[m + i]), fabs(pT[i] - p[m + i])));
+    if (getenv("HBVM_ERREST_TABLE"))
+      printf("%-16s const tol=%-6g error at T=%.3e (%.3g tol) steps=%ld rejected=%ld max|dH|=%.1e max|g|=%.1e\n",
+             problem, tol, a.err, a.err / tol, a.steps, a.rejected, a.dH, a.dg);
+    fflush(stdout);
+    ck_assert_msg(a.err <= 30 * tol && a.err >= tol / 30, "%s const, tol %g: error %g", problem, tol, a.err);
+    ck_assert_msg(a.rejected * 10 <= a.steps, "%s const, tol %g: %ld of %ld steps rejected", problem, tol, a.rejected,
+                  a.steps);
+    ck_assert_double_le(a.dg, 1e-13);
+    ck_assert_double_le(a.dH, 1e-13);
   }
 }
 END_TEST
@@ -265,6 +298,7 @@ Suite *adaptive_suite(void) {
   Suite *s = suite_create("adaptive");
   TCase *tc = tcase_create("adaptive");
   tcase_add_loop_test(tc, adaptive_proportional, 0, (int)(sizeof adaptive_cases / sizeof adaptive_cases[0]));
+  tcase_add_loop_test(tc, adaptive_const_proportional, 0, 2);
   tcase_add_test(tc, adaptive_rejected_unchanged);
   tcase_add_test(tc, adaptive_quadrature_defect);
   tcase_set_timeout(tc, 60);
