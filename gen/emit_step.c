@@ -802,7 +802,7 @@ static void emit_step(Emitter *e) {
     for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "  gam[%d] = gm%d;\n", i, i);
     for (int i = 0; i < kernel_size(&e->st->kern[K_SWEEP]); i++) out(e, "  sw[%d] = sw%d;\n", i, i);
   }
-  tmpl(e, "  est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n");
+  tmpl(e, "  est = st || tol > 0 ? $P_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */\n");
   if (mult)
     tmpl(e, "  if ((tol > 0 || st) && rc == $P_OK) {  /* the multiplier's part: for $P_step_adaptive and the stats */\n"
             "    $R em = $P_mult_err(x, sw, h, prm);\n    if (em > est) est = em;\n  }\n");

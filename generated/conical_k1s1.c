@@ -483,7 +483,7 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
   sw[6] = sw6;
   sw[7] = sw7;
   sw[8] = sw8;
-  est = conical_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? conical_k1s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > conical_k1s1_MAXITER ? conical_k1s1_MAXITER : it;
     st->increment = inc;

@@ -590,7 +590,7 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
   sw[12] = sw12;
   sw[13] = sw13;
   sw[14] = sw14;
-  est = conical_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? conical_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == conical_k2s2_OK) {  /* the multiplier's part: for conical_k2s2_step_adaptive and the stats */
     double em = conical_k2s2_mult_err(x, sw, h, prm);
     if (em > est) est = em;

@@ -653,7 +653,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
   sw[18] = sw18;
   sw[19] = sw19;
   sw[20] = sw20;
-  est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == conical_k3s3_OK) {  /* the multiplier's part: for conical_k3s3_step_adaptive and the stats */
     double em = conical_k3s3_mult_err(x, sw, h, prm);
     if (em > est) est = em;

@@ -715,7 +715,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
   sw[24] = sw24;
   sw[25] = sw25;
   sw[26] = sw26;
-  est = conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == conical_k4s4_OK) {  /* the multiplier's part: for conical_k4s4_step_adaptive and the stats */
     double em = conical_k4s4_mult_err(x, sw, h, prm);
     if (em > est) est = em;

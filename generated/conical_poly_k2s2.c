@@ -898,7 +898,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   sw[11] = sw11;
   sw[12] = sw12;
   sw[13] = sw13;
-  est = conical_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? conical_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > conical_poly_k2s2_MAXITER ? conical_poly_k2s2_MAXITER : it;
     st->increment = inc;

@@ -807,7 +807,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
   sw[19] = sw19;
   sw[20] = sw20;
   sw[21] = sw21;
-  est = double_pendulum_const_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? double_pendulum_const_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == double_pendulum_const_k2s2_OK) {  /* the multiplier's part: for double_pendulum_const_k2s2_step_adaptive and the stats */
     double em = double_pendulum_const_k2s2_mult_err(x, sw, h, prm);
     if (em > est) est = em;

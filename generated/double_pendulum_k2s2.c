@@ -1376,7 +1376,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   sw[17] = sw17;
   sw[18] = sw18;
   sw[19] = sw19;
-  est = double_pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? double_pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > double_pendulum_k2s2_MAXITER ? double_pendulum_k2s2_MAXITER : it;
     st->increment = inc;

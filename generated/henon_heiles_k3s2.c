@@ -406,7 +406,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
   sw[5] = sw5;
   sw[6] = sw6;
   sw[7] = sw7;
-  est = henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? henon_heiles_k3s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > henon_heiles_k3s2_MAXITER ? henon_heiles_k3s2_MAXITER : it;
     st->increment = inc;

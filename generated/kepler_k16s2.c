@@ -843,7 +843,7 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
   sw[5] = sw5;
   sw[6] = sw6;
   sw[7] = sw7;
-  est = kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (tol > 0 && rc == kepler_k16s2_OK) est += kepler_k16s2_defect(x, sw, h, prm);  /* under kepler_k16s2_step_adaptive */
   if (st) {
     st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it;

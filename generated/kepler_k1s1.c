@@ -323,7 +323,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
   sw[1] = sw1;
   sw[2] = sw2;
   sw[3] = sw3;
-  est = kepler_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? kepler_k1s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (tol > 0 && rc == kepler_k1s1_OK) est += kepler_k1s1_defect(x, sw, h, prm);  /* under kepler_k1s1_step_adaptive */
   if (st) {
     st->iters = it > kepler_k1s1_MAXITER ? kepler_k1s1_MAXITER : it;

@@ -583,7 +583,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
   sw[13] = sw13;
   sw[14] = sw14;
   sw[15] = sw15;
-  est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (tol > 0 && rc == kepler_k4s4_OK) est += kepler_k4s4_defect(x, sw, h, prm);  /* under kepler_k4s4_step_adaptive */
   if (st) {
     st->iters = it > kepler_k4s4_MAXITER ? kepler_k4s4_MAXITER : it;

@@ -605,7 +605,7 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
   sw[9] = sw9;
   sw[10] = sw10;
   sw[11] = sw11;
-  est = kepler_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? kepler_k6s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (tol > 0 && rc == kepler_k6s3_OK) est += kepler_k6s3_defect(x, sw, h, prm);  /* under kepler_k6s3_step_adaptive */
   if (st) {
     st->iters = it > kepler_k6s3_MAXITER ? kepler_k6s3_MAXITER : it;

@@ -775,7 +775,7 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
   sw[12] = sw12;
   sw[13] = sw13;
   sw[14] = sw14;
-  est = modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == modified_k6s2_OK) {  /* the multiplier's part: for modified_k6s2_step_adaptive and the stats */
     double em = modified_k6s2_mult_err(x, sw, h, prm);
     if (em > est) est = em;

@@ -1018,7 +1018,7 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
   sw[18] = sw18;
   sw[19] = sw19;
   sw[20] = sw20;
-  est = modified_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? modified_k9s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == modified_k9s3_OK) {  /* the multiplier's part: for modified_k9s3_step_adaptive and the stats */
     double em = modified_k9s3_mult_err(x, sw, h, prm);
     if (em > est) est = em;

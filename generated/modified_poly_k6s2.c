@@ -1392,7 +1392,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   sw[11] = sw11;
   sw[12] = sw12;
   sw[13] = sw13;
-  est = modified_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? modified_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > modified_poly_k6s2_MAXITER ? modified_poly_k6s2_MAXITER : it;
     st->increment = inc;

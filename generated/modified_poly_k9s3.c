@@ -2385,7 +2385,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   sw[18] = sw18;
   sw[19] = sw19;
   sw[20] = sw20;
-  est = modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > modified_poly_k9s3_MAXITER ? modified_poly_k9s3_MAXITER : it;
     st->increment = inc;

@@ -413,7 +413,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   sw[3] = sw3;
   sw[4] = sw4;
   sw[5] = sw5;
-  est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (tol > 0 && rc == pendulum_angle_k6s3_OK) est += pendulum_angle_k6s3_defect(x, sw, h, prm);  /* under pendulum_angle_k6s3_step_adaptive */
   if (st) {
     st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it;

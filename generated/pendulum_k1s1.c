@@ -428,7 +428,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
   sw[4] = sw4;
   sw[5] = sw5;
   sw[6] = sw6;
-  est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > pendulum_k1s1_MAXITER ? pendulum_k1s1_MAXITER : it;
     st->increment = inc;

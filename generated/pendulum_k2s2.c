@@ -517,7 +517,7 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
   sw[8] = sw8;
   sw[9] = sw9;
   sw[10] = sw10;
-  est = pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == pendulum_k2s2_OK) {  /* the multiplier's part: for pendulum_k2s2_step_adaptive and the stats */
     double em = pendulum_k2s2_mult_err(x, sw, h, prm);
     if (em > est) est = em;

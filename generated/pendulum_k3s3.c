@@ -558,7 +558,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
   sw[12] = sw12;
   sw[13] = sw13;
   sw[14] = sw14;
-  est = pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == pendulum_k3s3_OK) {  /* the multiplier's part: for pendulum_k3s3_step_adaptive and the stats */
     double em = pendulum_k3s3_mult_err(x, sw, h, prm);
     if (em > est) est = em;

@@ -543,7 +543,7 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
   sw[2] = sw2;
   sw[3] = sw3;
   sw[4] = sw4;
-  est = pendulum_poly_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_poly_k1s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > pendulum_poly_k1s1_MAXITER ? pendulum_poly_k1s1_MAXITER : it;
     st->increment = inc;

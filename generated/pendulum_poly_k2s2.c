@@ -747,7 +747,7 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
   sw[7] = sw7;
   sw[8] = sw8;
   sw[9] = sw9;
-  est = pendulum_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > pendulum_poly_k2s2_MAXITER ? pendulum_poly_k2s2_MAXITER : it;
     st->increment = inc;

@@ -1620,7 +1620,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   sw[17] = sw17;
   sw[18] = sw18;
   sw[19] = sw19;
-  est = pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > pendulum_poly_k4s4_MAXITER ? pendulum_poly_k4s4_MAXITER : it;
     st->increment = inc;

@@ -1942,7 +1942,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
   sw[24] = sw24;
   sw[25] = sw25;
   sw[26] = sw26;
-  est = satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (tol > 0 && rc == satellites_k6s1_OK) est += satellites_k6s1_defect(x, sw, h, prm);  /* under satellites_k6s1_step_adaptive */
   if (st) {
     st->iters = it > satellites_k6s1_MAXITER ? satellites_k6s1_MAXITER : it;

@@ -2880,7 +2880,7 @@ static int satellites_k6s3_step_within(satellites_k6s3_state *x, satellites_k6s3
       break;
     }
   }
-  est = satellites_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? satellites_k6s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == satellites_k6s3_OK) {  /* the multiplier's part: for satellites_k6s3_step_adaptive and the stats */
     double em = satellites_k6s3_mult_err(x, sw, h, prm);
     if (em > est) est = em;

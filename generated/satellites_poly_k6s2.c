@@ -5137,7 +5137,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
       break;
     }
   }
-  est = satellites_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? satellites_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > satellites_poly_k6s2_MAXITER ? satellites_poly_k6s2_MAXITER : it;
     st->increment = inc;

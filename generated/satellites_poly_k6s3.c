@@ -8814,7 +8814,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
       break;
     }
   }
-  est = satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+  est = st || tol > 0 ? satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if (st) {
     st->iters = it > satellites_poly_k6s3_MAXITER ? satellites_poly_k6s3_MAXITER : it;
     st->increment = inc;
