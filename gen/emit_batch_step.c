@@ -192,9 +192,10 @@ static void emit_commit(Emitter *e, int poly) {
   emit_commit_common(e);
 }
 
-// A lane's call of a scalar step function f(state, sw, h, prm) (NAME_defect,
-// NAME_mult_err) on the lane's state and its sweep's results.
-static void emit_lane_call(Emitter *e, const char *f) {
+// A lane's call of a scalar step function f(state, sw, h, prm more)
+// (NAME_defect; NAME_mult_err with more ", 1": as under the adaptive step) on
+// the lane's state and its sweep's results.
+static void emit_lane_call(Emitter *e, const char *f, const char *more) {
   out(e, "/* Lane l's %s_%s, on its state and its sweep's results. */\n", e->P, f);
   out(e, "static %s %s_batch_%s(const %s_batch *x, const %s *sw, int l, %s h, const %s_params *prm)\n{\n",
       real_type(e, 0), e->P, f, e->P, real_type(e, 0), real_type(e, 0), e->P);
@@ -202,7 +203,7 @@ static void emit_lane_call(Emitter *e, const char *f) {
           "  if (!prm) $P_params_default(&dflt);\n"
           "  $P_batch_get(x, l, &s);\n"
           "  for (i = 0; i < $<sweep>; i++) v[i] = sw[i * $P_W + l];\n");
-  out(e, "  return %s_%s(&s, v, h, prm ? &prm[l] : &dflt);\n}\n\n", e->P, f);
+  out(e, "  return %s_%s(&s, v, h, prm ? &prm[l] : &dflt%s);\n}\n\n", e->P, f, more);
 }
 
 // The error estimate of one lane for NAME_batch_step_adaptive, by the
@@ -219,8 +220,8 @@ static void emit_lane_estimate(Emitter *e, int mult, int defect) {
           "  for (i = 0; i < $P_M; i++) {\n"
           "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * g[i]);\n    if (v > sc) sc = v;\n  }\n"
           "  *scale = sc;\n  return $P_err_est(g, h, d1, cold);\n}\n\n");
-  if (mult) emit_lane_call(e, "mult_err");
-  if (defect) emit_lane_call(e, "defect");
+  if (mult) emit_lane_call(e, "mult_err", ", 1");
+  if (defect) emit_lane_call(e, "defect", "");
 }
 
 // NAME_batch_step_adaptive's tests inside NAME_batch_within, as

@@ -625,6 +625,12 @@ static void emit_err_est(Emitter *e) {
 
 #define MULT_ERRC 0.12 /* NAME_MULTC: the geometric mean of true / estimate (docs/api.md) */
 
+// NAME_TOLC, the share of tol allowed per unit step (NAME_step_adaptive).
+static void emit_tolc(Emitter *e) {
+  out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
+      e->P, e->P, e->single ? "0.01f" : "0.01");
+}
+
 // NAME_mult_err: the constant multiplier's part of a step's local error
 // (order 2 in q, beside the velocity's order 2s that NAME_err_est sees). The
 // multiplier is held constant over the step while the true one varies, and
@@ -645,8 +651,11 @@ static void emit_mult_err(Emitter *e) {
   out(e, "#define %s_MULTC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
   tmpl(e, "/* The constant multiplier's part of the local error in q, which $P_err_est does not\n"
           " * see: h |M^-1 (dp1 + dp0)| |p1 - p0| / (|p0| + |p1 - p0|), dp0 and dp1 the projections\n"
-          " * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]). */\n"
-          "static $R $P_mult_err(const $P_state *x, const $W *sw, $R h, const $P_params *prm)\n{\n"
+          " * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]).\n"
+          " * For $P_step_adaptive (adaptive 1) at least $P_TOLC |h| |M^-1 (dp1 + dp0)|: p's error, the\n"
+          " * velocity across the hidden constraint that the step adds, within tol (1 + max|q|); it\n"
+          " * alternates in sign from step to step and does not add up. */\n"
+          "static $R $P_mult_err(const $P_state *x, const $W *sw, $R h, const $P_params *prm, int adaptive)\n{\n"
           "  $R q1[$P_M], p1[$P_M], pr[$<consistent>], dp0[$P_M], dp1[$P_M], v[$P_M], vd = 0, dp = 0, p0 = 0, est;\n"
           "  int i;\n"
           "  for (i = 0; i < $P_M; i++) {\n"
@@ -660,6 +669,7 @@ static void emit_mult_err(Emitter *e) {
           "  $(minv_p q0=q1 p0=dp0 out=v);\n"
           "  for (i = 0; i < $P_M; i++)\n    if (fabs$f(v[i]) > vd) vd = fabs$f(v[i]);\n"
           "  est = dp > 0 ? $P_MULTC * fabs$f(h) * vd * (dp / (p0 + dp)) : 0;\n"
+          "  if (adaptive && $P_TOLC * fabs$f(h) * vd > est) est = $P_TOLC * fabs$f(h) * vd;\n"
           "  return isfinite(est) ? est : 0;\n}\n\n");
 }
 
@@ -748,7 +758,10 @@ static void emit_step(Emitter *e) {
   emit_err_est(e);
   int defect = energy_defect_wanted(e), mult = mult_err_wanted(e);
   if (defect) emit_defect(e);
-  if (mult) emit_mult_err(e);
+  if (mult) {
+    emit_tolc(e); /* NAME_mult_err reads it */
+    emit_mult_err(e);
+  }
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
           "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
@@ -805,7 +818,7 @@ static void emit_step(Emitter *e) {
   tmpl(e, "  est = st || tol > 0 ? $P_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */\n");
   if (mult)
     tmpl(e, "  if ((tol > 0 || st) && rc == $P_OK) {  /* the multiplier's part: for $P_step_adaptive and the stats */\n"
-            "    $R em = $P_mult_err(x, sw, h, prm);\n    if (em > est) est = em;\n  }\n");
+            "    $R em = $P_mult_err(x, sw, h, prm, tol > 0);\n    if (em > est) est = em;\n  }\n");
   if (defect) tmpl(e, "  if (tol > 0 && rc == $P_OK) est += $P_defect(x, sw, h, prm);  /* under $P_step_adaptive */\n");
   tmpl(e, "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
           "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
@@ -944,8 +957,7 @@ static void emit_step_adaptive(Emitter *e) {
           "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");
   out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
-  out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
-      e->P, e->P, e->single ? "0.01f" : "0.01");
+  if (!mult_err_wanted(e)) emit_tolc(e); /* else before NAME_mult_err, which reads it */
   if (controller_order(e) == step_order(e))
     out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
   else

@@ -328,13 +328,20 @@ static double conical_k4s4_err_est(const double *gam, double h, double d1, int c
   return v;
 }
 
+#ifndef conical_k4s4_TOLC
+#define conical_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 #ifndef conical_k4s4_MULTC
 #define conical_k4s4_MULTC 0.12  /* measured: docs/api.md */
 #endif
 /* The constant multiplier's part of the local error in q, which conical_k4s4_err_est does not
  * see: h |M^-1 (dp1 + dp0)| |p1 - p0| / (|p0| + |p1 - p0|), dp0 and dp1 the projections
- * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]). */
-static double conical_k4s4_mult_err(const conical_k4s4_state *x, const double *sw, double h, const conical_k4s4_params *prm)
+ * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]).
+ * For conical_k4s4_step_adaptive (adaptive 1) at least conical_k4s4_TOLC |h| |M^-1 (dp1 + dp0)|: p's error, the
+ * velocity across the hidden constraint that the step adds, within tol (1 + max|q|); it
+ * alternates in sign from step to step and does not add up. */
+static double conical_k4s4_mult_err(const conical_k4s4_state *x, const double *sw, double h, const conical_k4s4_params *prm, int adaptive)
 {
   double q1[conical_k4s4_M], p1[conical_k4s4_M], pr[2 * conical_k4s4_M + 2 * conical_k4s4_NU], dp0[conical_k4s4_M], dp1[conical_k4s4_M], v[conical_k4s4_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
@@ -355,6 +362,7 @@ static double conical_k4s4_mult_err(const conical_k4s4_state *x, const double *s
   for (i = 0; i < conical_k4s4_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);
   est = dp > 0 ? conical_k4s4_MULTC * fabs(h) * vd * (dp / (p0 + dp)) : 0;
+  if (adaptive && conical_k4s4_TOLC * fabs(h) * vd > est) est = conical_k4s4_TOLC * fabs(h) * vd;
   return isfinite(est) ? est : 0;
 }
 
@@ -717,7 +725,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
   sw[26] = sw26;
   est = st || tol > 0 ? conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == conical_k4s4_OK) {  /* the multiplier's part: for conical_k4s4_step_adaptive and the stats */
-    double em = conical_k4s4_mult_err(x, sw, h, prm);
+    double em = conical_k4s4_mult_err(x, sw, h, prm, tol > 0);
     if (em > est) est = em;
   }
   if (st) {
@@ -761,10 +769,6 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
 
 #ifndef conical_k4s4_HMIN
 #define conical_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef conical_k4s4_TOLC
-#define conical_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step

@@ -346,13 +346,20 @@ static double modified_k6s2_err_est(const double *gam, double h, double d1, int 
   return v;
 }
 
+#ifndef modified_k6s2_TOLC
+#define modified_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 #ifndef modified_k6s2_MULTC
 #define modified_k6s2_MULTC 0.12  /* measured: docs/api.md */
 #endif
 /* The constant multiplier's part of the local error in q, which modified_k6s2_err_est does not
  * see: h |M^-1 (dp1 + dp0)| |p1 - p0| / (|p0| + |p1 - p0|), dp0 and dp1 the projections
- * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]). */
-static double modified_k6s2_mult_err(const modified_k6s2_state *x, const double *sw, double h, const modified_k6s2_params *prm)
+ * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]).
+ * For modified_k6s2_step_adaptive (adaptive 1) at least modified_k6s2_TOLC |h| |M^-1 (dp1 + dp0)|: p's error, the
+ * velocity across the hidden constraint that the step adds, within tol (1 + max|q|); it
+ * alternates in sign from step to step and does not add up. */
+static double modified_k6s2_mult_err(const modified_k6s2_state *x, const double *sw, double h, const modified_k6s2_params *prm, int adaptive)
 {
   double q1[modified_k6s2_M], p1[modified_k6s2_M], pr[2 * modified_k6s2_M + 2 * modified_k6s2_NU], dp0[modified_k6s2_M], dp1[modified_k6s2_M], v[modified_k6s2_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
@@ -373,6 +380,7 @@ static double modified_k6s2_mult_err(const modified_k6s2_state *x, const double 
   for (i = 0; i < modified_k6s2_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);
   est = dp > 0 ? modified_k6s2_MULTC * fabs(h) * vd * (dp / (p0 + dp)) : 0;
+  if (adaptive && modified_k6s2_TOLC * fabs(h) * vd > est) est = modified_k6s2_TOLC * fabs(h) * vd;
   return isfinite(est) ? est : 0;
 }
 
@@ -777,7 +785,7 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
   sw[14] = sw14;
   est = st || tol > 0 ? modified_k6s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == modified_k6s2_OK) {  /* the multiplier's part: for modified_k6s2_step_adaptive and the stats */
-    double em = modified_k6s2_mult_err(x, sw, h, prm);
+    double em = modified_k6s2_mult_err(x, sw, h, prm, tol > 0);
     if (em > est) est = em;
   }
   if (st) {
@@ -821,10 +829,6 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h, const modif
 
 #ifndef modified_k6s2_HMIN
 #define modified_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef modified_k6s2_TOLC
-#define modified_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step

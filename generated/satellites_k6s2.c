@@ -2275,13 +2275,20 @@ static double satellites_k6s2_defect(const satellites_k6s2_state *x, const doubl
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
 
+#ifndef satellites_k6s2_TOLC
+#define satellites_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 #ifndef satellites_k6s2_MULTC
 #define satellites_k6s2_MULTC 0.12  /* measured: docs/api.md */
 #endif
 /* The constant multiplier's part of the local error in q, which satellites_k6s2_err_est does not
  * see: h |M^-1 (dp1 + dp0)| |p1 - p0| / (|p0| + |p1 - p0|), dp0 and dp1 the projections
- * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]). */
-static double satellites_k6s2_mult_err(const satellites_k6s2_state *x, const double *sw, double h, const satellites_k6s2_params *prm)
+ * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]).
+ * For satellites_k6s2_step_adaptive (adaptive 1) at least satellites_k6s2_TOLC |h| |M^-1 (dp1 + dp0)|: p's error, the
+ * velocity across the hidden constraint that the step adds, within tol (1 + max|q|); it
+ * alternates in sign from step to step and does not add up. */
+static double satellites_k6s2_mult_err(const satellites_k6s2_state *x, const double *sw, double h, const satellites_k6s2_params *prm, int adaptive)
 {
   double q1[satellites_k6s2_M], p1[satellites_k6s2_M], pr[2 * satellites_k6s2_M + 2 * satellites_k6s2_NU], dp0[satellites_k6s2_M], dp1[satellites_k6s2_M], v[satellites_k6s2_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
@@ -2302,6 +2309,7 @@ static double satellites_k6s2_mult_err(const satellites_k6s2_state *x, const dou
   for (i = 0; i < satellites_k6s2_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);
   est = dp > 0 ? satellites_k6s2_MULTC * fabs(h) * vd * (dp / (p0 + dp)) : 0;
+  if (adaptive && satellites_k6s2_TOLC * fabs(h) * vd > est) est = satellites_k6s2_TOLC * fabs(h) * vd;
   return isfinite(est) ? est : 0;
 }
 
@@ -2381,7 +2389,7 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
   }
   est = st || tol > 0 ? satellites_k6s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
   if ((tol > 0 || st) && rc == satellites_k6s2_OK) {  /* the multiplier's part: for satellites_k6s2_step_adaptive and the stats */
-    double em = satellites_k6s2_mult_err(x, sw, h, prm);
+    double em = satellites_k6s2_mult_err(x, sw, h, prm, tol > 0);
     if (em > est) est = em;
   }
   if (tol > 0 && rc == satellites_k6s2_OK) est += satellites_k6s2_defect(x, sw, h, prm);  /* under satellites_k6s2_step_adaptive */
@@ -2426,10 +2434,6 @@ int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h, const
 
 #ifndef satellites_k6s2_HMIN
 #define satellites_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef satellites_k6s2_TOLC
-#define satellites_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
