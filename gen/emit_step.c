@@ -381,7 +381,8 @@ static void emit_all_finite(Emitter *e, int n) {
 // first sweep already puts over its tolerance rather than after the
 // iteration has converged. gamma (gm0, ... in the fused step) is the sweep's.
 static void emit_first_sweep(Emitter *e) {
-  tmpl(e, "    if (it == 1) {\n      d1 = inc;  /* the predictor's error, for $P_err_est */\n");
+  tmpl(e, "    if (it == 1 && (st || tol > 0)) {  /* for $P_err_est: only when someone reads it */\n"
+          "      d1 = inc;  /* the predictor's error */\n");
   if (e->fused)
     for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
   if (e->st->kern[K_FACTOR].nout)

@@ -426,8 +426,8 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
       if (v > inc) inc = v;
       gm2 = sw2;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for conical_k1s1_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for conical_k1s1_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -529,8 +529,8 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
       if (v > inc) inc = v;
       gm5 = sw5;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for conical_k2s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for conical_k2s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

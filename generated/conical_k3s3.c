@@ -579,8 +579,8 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       if (v > inc) inc = v;
       gm8 = sw8;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for conical_k3s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for conical_k3s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -730,8 +730,8 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       if (v > inc) inc = v;
       gm7 = sw7;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for double_pendulum_const_k2s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for double_pendulum_const_k2s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

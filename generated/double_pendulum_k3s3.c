@@ -2256,8 +2256,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
       if (v > inc) inc = v;
       gm11 = sw11;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for double_pendulum_k3s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for double_pendulum_k3s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -354,8 +354,8 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       if (v > inc) inc = v;
       gm3 = sw3;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for henon_heiles_k3s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for henon_heiles_k3s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

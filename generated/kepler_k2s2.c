@@ -351,8 +351,8 @@ static int kepler_k2s2_step_within(kepler_k2s2_state *x, kepler_k2s2_real h_, do
       if (v > inc) inc = v;
       gm3 = sw3;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for kepler_k2s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for kepler_k2s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -418,8 +418,8 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
       if (v > inc) inc = v;
       gm5 = sw5;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for kepler_k3s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for kepler_k3s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -514,8 +514,8 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       if (v > inc) inc = v;
       gm7 = sw7;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for kepler_k4s4_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for kepler_k4s4_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -401,8 +401,8 @@ static int kepler_k6s1_step_within(kepler_k6s1_state *x, kepler_k6s1_real h_, do
       if (v > inc) inc = v;
       gm1 = sw1;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for kepler_k6s1_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for kepler_k6s1_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       if (tol > 0) {  /* kepler_k6s1_step_adaptive's: no estimate here for a fixed step */

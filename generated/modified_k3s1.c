@@ -487,8 +487,8 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       if (v > inc) inc = v;
       gm2 = sw2;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for modified_k3s1_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for modified_k3s1_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

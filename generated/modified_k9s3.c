@@ -944,8 +944,8 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
       if (v > inc) inc = v;
       gm8 = sw8;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for modified_k9s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for modified_k9s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

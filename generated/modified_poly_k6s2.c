@@ -1319,8 +1319,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
       if (v > inc) inc = v;
       gm5 = sw5;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for modified_poly_k6s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for modified_poly_k6s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

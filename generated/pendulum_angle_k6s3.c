@@ -365,8 +365,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       if (v > inc) inc = v;
       gm2 = sw2;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for pendulum_angle_k6s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for pendulum_angle_k6s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -464,8 +464,8 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       if (v > inc) inc = v;
       gm3 = sw3;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for pendulum_k2s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for pendulum_k2s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

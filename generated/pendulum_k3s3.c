@@ -497,8 +497,8 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       if (v > inc) inc = v;
       gm5 = sw5;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for pendulum_k3s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for pendulum_k3s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -489,8 +489,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
       if (v > inc) inc = v;
       gm1 = sw1;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for pendulum_poly_k1s1_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for pendulum_poly_k1s1_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       if (two)  /* the two-step start: the one-step start's miss */

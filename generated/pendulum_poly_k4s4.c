@@ -1534,8 +1534,8 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
       if (v > inc) inc = v;
       gm7 = sw7;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for pendulum_poly_k4s4_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for pendulum_poly_k4s4_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

@@ -1845,8 +1845,8 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       if (v > inc) inc = v;
       gm8 = sw8;
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for satellites_k6s1_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for satellites_k6s1_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;

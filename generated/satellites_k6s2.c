@@ -2345,8 +2345,8 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for satellites_k6s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for satellites_k6s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       if (tol > 0) {  /* satellites_k6s2_step_adaptive's: no estimate here for a fixed step */
         est = satellites_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {

@@ -5091,8 +5091,8 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for satellites_poly_k6s2_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for satellites_poly_k6s2_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       if (two)  /* the two-step start: the one-step start's miss */
         for (d1 = 0, i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
           double v = fabs(h * (gam[i] - ref[i]));

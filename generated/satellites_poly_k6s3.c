@@ -8768,8 +8768,8 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
       if (v > inc) inc = v;
       gam[i] = sw[i];
     }
-    if (it == 1) {
-      d1 = inc;  /* the predictor's error, for satellites_poly_k6s3_err_est */
+    if (it == 1 && (st || tol > 0)) {  /* for satellites_poly_k6s3_err_est: only when someone reads it */
+      d1 = inc;  /* the predictor's error */
       if (two)  /* the two-step start: the one-step start's miss */
         for (d1 = 0, i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
           double v = fabs(h * (gam[i] - ref[i]));
