@@ -111,7 +111,7 @@ static const StepCase cases[] = {
     {"kepler", "kepler_k3s3", 0.1, 63},                  {"kepler", "kepler_k4s4", 0.2, 32},
     /* the constant multiplier's part (NAME_mult_err) at a second h, and where it is 0 */
     {"satellites", "satellites_k6s2", 0.05, 200},        {"modified", "modified_k9s3", 0.1, 100},
-    {"conical", "conical_k2s2", 0.1, 100},
+    {"conical", "conical_k2s2", 0.1, 100},               {"double_pendulum", "double_pendulum_const_k4s4", 0.2, 50},
 };
 
 START_TEST(tracks_true_error)

@@ -36,6 +36,7 @@
 #include "double_pendulum_k3s3.h"
 #include "double_pendulum_k4s4.h"
 #include "double_pendulum_const_k2s2.h"
+#include "double_pendulum_const_k4s4.h"
 #include "conical_poly_k2s2.h"
 #include "modified_poly_k6s2.h"
 #include "modified_poly_k9s3.h"
@@ -48,7 +49,7 @@
   X(satellites_k6s3) X(kepler_k1s1) X(kepler_k2s2) X(kepler_k3s3) X(kepler_k6s1) X(kepler_k6s2) X(kepler_k6s3)   \
   X(kepler_k16s2) X(kepler_k4s4) X(henon_heiles_k2s2) X(henon_heiles_k3s2) X(pendulum_poly_k1s1) X(pendulum_poly_k2s2)               \
   X(pendulum_poly_k3s3) X(pendulum_poly_k4s4) X(double_pendulum_k2s2) X(double_pendulum_k3s3) X(double_pendulum_k4s4)    \
-  X(double_pendulum_const_k2s2) X(conical_poly_k2s2) X(modified_poly_k6s2) X(modified_poly_k9s3)                        \
+  X(double_pendulum_const_k2s2) X(double_pendulum_const_k4s4) X(conical_poly_k2s2) X(modified_poly_k6s2) X(modified_poly_k9s3)                        \
   X(satellites_poly_k6s2) X(satellites_poly_k6s3)
 
 SOLVERS(SOLVER_ADAPT)
