@@ -192,9 +192,9 @@ static void emit_commit(Emitter *e, int poly) {
   emit_commit_common(e);
 }
 
-// A lane's call of a scalar step function f(state, sw, h, prm more)
-// (NAME_defect; NAME_mult_err with more ", 1": as under the adaptive step) on
-// the lane's state and its sweep's results.
+// A lane's call of a scalar step function f(state, sw, h, prm) on the lane's
+// state and its sweep's results, with the arguments `more` after prm
+// (NAME_defect: none; NAME_mult_err: ", 1", as under the adaptive step).
 static void emit_lane_call(Emitter *e, const char *f, const char *more) {
   out(e, "/* Lane l's %s_%s, on its state and its sweep's results. */\n", e->P, f);
   out(e, "static %s %s_batch_%s(const %s_batch *x, const %s *sw, int l, %s h, const %s_params *prm)\n{\n",
