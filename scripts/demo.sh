@@ -55,7 +55,7 @@ table() {
 table pendulum "polynomial multiplier (default)"
 echo "   Order 4 = 2s in q, p (and lambda); H, g and the hidden constraint at round-off."
 table pendulum_const "constant multiplier (the paper's method)"
-echo "   Order 2 in q, p and the hidden constraint; H and g at round-off (paper, table tab0)."
+echo "   Order 2, in p: its error lies across the hidden constraint (q alone has order 4); H and g at round-off (paper, table tab0)."
 echo "== the same, adaptive steps: --tol TOL (-h 0.1 the first step), rows at t = 0, 0.1, .. (--dt 0.1)"
 header tol
 for tol in 1e-6 1e-8 1e-10; do
