@@ -46,26 +46,33 @@ base_gen() {
   echo "$B/base/build/hbvmgen"
 }
 
-# mca FILE.c PREFIX: "cycles rthroughput" of one sweep of solver PREFIX
+# mca FILE.c PREFIX: "cycles rthroughput" of one iteration of solver PREFIX's
+# step: the loop of PREFIX_step_within from its head to its convergence test,
+# between llvm-mca markers, simulated 100 times (the loop-carried chain or the
+# resources, whichever is longer), plus, where the sweep is not inline, its
+# functions (its parts), one run each (the loop only calls them)
 cpu=$(llc --version 2>/dev/null | sed -n 's/.*Host CPU: *//p')
 mca() {
   c=$1 P=$2
-  if grep -q "the kernel sweep, inline" "$c"; then
-    awk -v P="$P" '
-      $0 ~ "^int " P "_step\\(" { step = 1 }
-      step && $0 ~ "^  for \\(it = 1; it <= " P "_MAXITER; it\\+\\+\\) \\{$" { print; print "    __asm__ volatile(\"# LLVM-MCA-BEGIN sweep\");"; next }
-      step && /^    \/\* otherwise progress is a new smallest increment/ { print "    __asm__ volatile(\"# LLVM-MCA-END\");"; step = 0 }
-      { print }' "$c" >"$B/mca.c"
-    gcc -std=gnu99 -O2 -S -I"$(dirname "$c")" -o "$B/mca.s" "$B/mca.c"
-    llvm-mca -mcpu="$cpu" -iterations=100 "$B/mca.s" 2>/dev/null |
+  awk -v P="$P" '
+    $0 ~ "^static int " P "_step_within\\(" { step = 1 }
+    step && $0 ~ "^  for \\(it = 1; it <= " P "_MAXITER; it\\+\\+\\) \\{$" { print; print "    __asm__ volatile(\"# LLVM-MCA-BEGIN sweep\");"; next }
+    step && /^    \/\* otherwise progress is a new smallest increment/ { print "    __asm__ volatile(\"# LLVM-MCA-END sweep\");"; step = 0 }
+    { print }' "$c" >"$B/mca.c"
+  # gcc may duplicate the block of the end marker: llvm-mca takes the first
+  gcc -std=gnu99 -O2 -S -I"$(dirname "$c")" -o "$B/mca.s" "$B/mca.c"
+  awk '/LLVM-MCA-END/ { if (ends++) next } { print }' "$B/mca.s" >"$B/mca1.s"
+  {
+    llvm-mca -mcpu="$cpu" -iterations=100 "$B/mca1.s" 2>/dev/null |
       awk '/^Iterations:/ { it = $2 } /^Total Cycles:/ { c = $3 } /^Block RThroughput:/ { printf "%.1f %.1f\n", c / it, $3; exit }'
-  else # the sweep's functions (its parts), one run each
-    gcc -std=c99 -O2 -fno-inline -S -o "$B/mca.s" "$c"
-    for f in $(sed -En "s/^(${P}_sweep(_part[0-9]+)?(\.[a-z]+\.[0-9]+)?):$/\1/p" "$B/mca.s"); do
-      awk -v f="$f:" '$0 == f { on = 1; next } on && /\.cfi_endproc/ { exit } on && !/^\s*\./ { print }' "$B/mca.s" >"$B/fn.s"
-      llvm-mca -mcpu="$cpu" -iterations=1 "$B/fn.s" 2>/dev/null | awk '/^Total Cycles:/ { c = $3 } /^Block RThroughput:/ { print c, $3 }'
-    done | awk '{ c += $1; r += $2 } END { printf "%.1f %.1f\n", c, r }'
-  fi
+    if ! grep -q "the kernel sweep, inline" "$c"; then
+      gcc -std=c99 -O2 -fno-inline -S -o "$B/sweep.s" "$c"
+      for f in $(sed -En "s/^(${P}_sweep(_part[0-9]+)?(\.[a-z]+\.[0-9]+)?):$/\1/p" "$B/sweep.s"); do
+        awk -v f="$f:" '$0 == f { on = 1; next } on && /\.cfi_endproc/ { exit } on && !/^\s*\./ { print }' "$B/sweep.s" >"$B/fn.s"
+        llvm-mca -mcpu="$cpu" -iterations=1 "$B/fn.s" 2>/dev/null | awk '/^Total Cycles:/ { c = $3 } /^Block RThroughput:/ { print c, $3 }'
+      done
+    fi
+  } | awk '{ c += $1; r += $2 } END { printf "%.1f %.1f\n", c, r }'
 }
 
 if echo "$parts" | grep -q table; then
