@@ -267,9 +267,11 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   else if (fam == MULT_POLY)
     printf("multiplier: poly (degree %d, projection and energy rescale): order %d in q, p and lambda\n", o->s - 1,
            o->s >= 2 ? 2 * o->s : 2);
+  else if (o->s >= 2) /* measured: docs/api.md, "The local error estimate" */
+    printf("multiplier: const (the paper's method): order 2 in p (across the hidden constraint), 4 in q, 1 in lambda "
+           "(%d where the true multiplier is constant)\n", 2 * o->s);
   else
-    printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda (%d where the true multiplier is "
-           "constant)\n", 2 * o->s);
+    printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
   if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
   else
     printf("M: with params: %s, computed from them in every kernel call\n",
