@@ -633,6 +633,15 @@ static void emit_tolc(Emitter *e) {
       e->P, e->P, e->single ? "0.01f" : "0.01");
 }
 
+// The head of a loop over the coordinates, in NAME_defect and NAME_mult_err:
+// the step's end (q1, p1) = x + (h sw[gam], sw[dp]) from the converged sweep,
+// before the commit, and dp = max |p1 - p0|; the caller closes the loop.
+static void emit_step_end_loop(Emitter *e) {
+  tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
+          "    q1[i] = x->q[i] + h * ($R)sw[$[sweep.gam]i];\n    p1[i] = x->p[i] + ($R)sw[$[sweep.dp]i];\n"
+          "    if (fabs$f(p1[i] - x->p[i]) > dp) dp = fabs$f(p1[i] - x->p[i]);\n");
+}
+
 // NAME_mult_err: the constant multiplier's part of a step's local error,
 // beside the velocity's order 2s that NAME_err_est sees. Measured (docs/api.md,
 // "The local error estimate"): under the constant multiplier q has order 4,
@@ -661,16 +670,14 @@ static void emit_mult_err(Emitter *e) {
           " * velocity across the hidden constraint that the step adds, within tol (1 + max|q|); it\n"
           " * alternates in sign from step to step and does not add up. */\n"
           "static $R $P_mult_err(const $P_state *x, const $W *sw, $R h, const $P_params *prm, int adaptive)\n{\n"
-          "  $R q1[$P_M], p1[$P_M], pr[$<consistent>], dp0[$P_M], dp1[$P_M], v[$P_M], vd = 0, dp = 0, p0 = 0, est;\n"
-          "  int i;\n"
-          "  for (i = 0; i < $P_M; i++) {\n"
-          "    q1[i] = x->q[i] + h * ($R)sw[$[sweep.gam]i];\n    p1[i] = x->p[i] + ($R)sw[$[sweep.dp]i];\n"
-          "    if (fabs$f(p1[i] - x->p[i]) > dp) dp = fabs$f(p1[i] - x->p[i]);\n"
-          "    if (fabs$f(x->p[i]) > p0) p0 = fabs$f(x->p[i]);\n  }\n"
+          "  $R q1[$P_M], p1[$P_M], pr[$<consistent>], dp0[$P_M], v[$P_M], vd = 0, dp = 0, p0 = 0, est;\n"
+          "  int i;\n");
+  emit_step_end_loop(e);
+  tmpl(e, "    if (fabs$f(x->p[i]) > p0) p0 = fabs$f(x->p[i]);\n  }\n"
           "  $(consistent q0=x->q p0=x->p out=pr);\n"
           "  for (i = 0; i < $P_M; i++) dp0[i] = pr[$[consistent.dp]i];\n"
           "  $(consistent q0=q1 p0=p1 out=pr);\n"
-          "  for (i = 0; i < $P_M; i++) {\n    dp1[i] = pr[$[consistent.dp]i];\n    dp0[i] = dp1[i] + dp0[i];\n  }\n"
+          "  for (i = 0; i < $P_M; i++) dp0[i] += pr[$[consistent.dp]i];  /* dp1 + dp0 */\n"
           "  $(minv_p q0=q1 p0=dp0 out=v);\n"
           "  for (i = 0; i < $P_M; i++)\n    if (fabs$f(v[i]) > vd) vd = fabs$f(v[i]);\n"
           "  est = dp > 0 ? $P_MULTC * fabs$f(h) * vd * (dp / (p0 + dp)) : 0;\n"
@@ -742,10 +749,9 @@ static void emit_defect(Emitter *e) {
           " * for this model), which $P_err_est does not see: the energy defect of the step from\n"
           " * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */\n"
           "static $R $P_defect(const $P_state *x, const $W *sw, $R h, const $P_params *prm)\n{\n"
-          "  $R q1[$P_M], p1[$P_M], z[$P_M], H0, U0, H1, dH, dp = 0;\n  int i;\n"
-          "  for (i = 0; i < $P_M; i++) {\n"
-          "    q1[i] = x->q[i] + h * ($R)sw[$[sweep.gam]i];\n    p1[i] = x->p[i] + ($R)sw[$[sweep.dp]i];\n"
-          "    z[i] = 0;\n    if (fabs$f(p1[i] - x->p[i]) > dp) dp = fabs$f(p1[i] - x->p[i]);\n  }\n"
+          "  $R q1[$P_M], p1[$P_M], z[$P_M], H0, U0, H1, dH, dp = 0;\n  int i;\n");
+  emit_step_end_loop(e);
+  tmpl(e, "    z[i] = 0;\n  }\n"
           "  $(energy_kernel q0=x->q p0=x->p out=&H0);\n"
           "  $(energy_kernel q0=x->q p0=z out=&U0);\n"
           "  $(energy_kernel q0=q1 p0=p1 out=&H1);\n"
@@ -763,10 +769,8 @@ static void emit_step(Emitter *e) {
   emit_err_est(e);
   int defect = energy_defect_wanted(e), mult = mult_err_wanted(e);
   if (defect) emit_defect(e);
-  if (mult) {
-    emit_tolc(e); /* NAME_mult_err reads it */
-    emit_mult_err(e);
-  }
+  emit_tolc(e);
+  if (mult) emit_mult_err(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
           "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
@@ -962,7 +966,6 @@ static void emit_step_adaptive(Emitter *e) {
           "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");
   out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
-  if (!mult_err_wanted(e)) emit_tolc(e); /* else before NAME_mult_err, which reads it */
   if (controller_order(e) == step_order(e))
     out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
   else

@@ -312,6 +312,10 @@ static double conical_k1s1_err_est(const double *gam, double h, double d1, int c
   return v;
 }
 
+#ifndef conical_k1s1_TOLC
+#define conical_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_, double tol, int cold, const conical_k1s1_params *prm, conical_k1s1_stats *st)
@@ -525,10 +529,6 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_
 
 #ifndef conical_k1s1_HMIN
 #define conical_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef conical_k1s1_TOLC
-#define conical_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */

@@ -343,7 +343,7 @@ static double conical_k4s4_err_est(const double *gam, double h, double d1, int c
  * alternates in sign from step to step and does not add up. */
 static double conical_k4s4_mult_err(const conical_k4s4_state *x, const double *sw, double h, const conical_k4s4_params *prm, int adaptive)
 {
-  double q1[conical_k4s4_M], p1[conical_k4s4_M], pr[2 * conical_k4s4_M + 2 * conical_k4s4_NU], dp0[conical_k4s4_M], dp1[conical_k4s4_M], v[conical_k4s4_M], vd = 0, dp = 0, p0 = 0, est;
+  double q1[conical_k4s4_M], p1[conical_k4s4_M], pr[2 * conical_k4s4_M + 2 * conical_k4s4_NU], dp0[conical_k4s4_M], v[conical_k4s4_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
   for (i = 0; i < conical_k4s4_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -354,10 +354,7 @@ static double conical_k4s4_mult_err(const conical_k4s4_state *x, const double *s
   conical_k4s4_consistent(x->q, x->p, 0, 0, 0, prm, pr);
   for (i = 0; i < conical_k4s4_M; i++) dp0[i] = pr[conical_k4s4_M + i];
   conical_k4s4_consistent(q1, p1, 0, 0, 0, prm, pr);
-  for (i = 0; i < conical_k4s4_M; i++) {
-    dp1[i] = pr[conical_k4s4_M + i];
-    dp0[i] = dp1[i] + dp0[i];
-  }
+  for (i = 0; i < conical_k4s4_M; i++) dp0[i] += pr[conical_k4s4_M + i];  /* dp1 + dp0 */
   conical_k4s4_minv_p(q1, dp0, 0, 0, 0, prm, v);
   for (i = 0; i < conical_k4s4_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);

@@ -539,6 +539,10 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1, 
   return v;
 }
 
+#ifndef conical_poly_k2s2_TOLC
+#define conical_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, int cold, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
@@ -977,10 +981,6 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h,
 
 #ifndef conical_poly_k2s2_HMIN
 #define conical_poly_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef conical_poly_k2s2_TOLC
-#define conical_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

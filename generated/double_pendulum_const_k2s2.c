@@ -429,7 +429,7 @@ static double double_pendulum_const_k2s2_err_est(const double *gam, double h, do
  * alternates in sign from step to step and does not add up. */
 static double double_pendulum_const_k2s2_mult_err(const double_pendulum_const_k2s2_state *x, const double *sw, double h, const double_pendulum_const_k2s2_params *prm, int adaptive)
 {
-  double q1[double_pendulum_const_k2s2_M], p1[double_pendulum_const_k2s2_M], pr[2 * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU], dp0[double_pendulum_const_k2s2_M], dp1[double_pendulum_const_k2s2_M], v[double_pendulum_const_k2s2_M], vd = 0, dp = 0, p0 = 0, est;
+  double q1[double_pendulum_const_k2s2_M], p1[double_pendulum_const_k2s2_M], pr[2 * double_pendulum_const_k2s2_M + 2 * double_pendulum_const_k2s2_NU], dp0[double_pendulum_const_k2s2_M], v[double_pendulum_const_k2s2_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
   for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -440,10 +440,7 @@ static double double_pendulum_const_k2s2_mult_err(const double_pendulum_const_k2
   double_pendulum_const_k2s2_consistent(x->q, x->p, 0, 0, 0, prm, pr);
   for (i = 0; i < double_pendulum_const_k2s2_M; i++) dp0[i] = pr[double_pendulum_const_k2s2_M + i];
   double_pendulum_const_k2s2_consistent(q1, p1, 0, 0, 0, prm, pr);
-  for (i = 0; i < double_pendulum_const_k2s2_M; i++) {
-    dp1[i] = pr[double_pendulum_const_k2s2_M + i];
-    dp0[i] = dp1[i] + dp0[i];
-  }
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++) dp0[i] += pr[double_pendulum_const_k2s2_M + i];  /* dp1 + dp0 */
   double_pendulum_const_k2s2_minv_p(q1, dp0, 0, 0, 0, prm, v);
   for (i = 0; i < double_pendulum_const_k2s2_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);

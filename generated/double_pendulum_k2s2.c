@@ -874,6 +874,10 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
   return v;
 }
 
+#ifndef double_pendulum_k2s2_TOLC
+#define double_pendulum_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, int cold, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
@@ -1455,10 +1459,6 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
 
 #ifndef double_pendulum_k2s2_HMIN
 #define double_pendulum_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef double_pendulum_k2s2_TOLC
-#define double_pendulum_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

@@ -1561,6 +1561,10 @@ static double double_pendulum_k3s3_err_est(const double *gam, double h, double d
   return v;
 }
 
+#ifndef double_pendulum_k3s3_TOLC
+#define double_pendulum_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, int cold, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
@@ -2442,10 +2446,6 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s
 
 #ifndef double_pendulum_k3s3_HMIN
 #define double_pendulum_k3s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef double_pendulum_k3s3_TOLC
-#define double_pendulum_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */

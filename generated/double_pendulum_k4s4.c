@@ -3024,6 +3024,10 @@ static double double_pendulum_k4s4_err_est(const double *gam, double h, double d
   return v;
 }
 
+#ifndef double_pendulum_k4s4_TOLC
+#define double_pendulum_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, int cold, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
@@ -4399,10 +4403,6 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
 
 #ifndef double_pendulum_k4s4_HMIN
 #define double_pendulum_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef double_pendulum_k4s4_TOLC
-#define double_pendulum_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 8 (error per unit step). */

@@ -217,8 +217,8 @@ static double henon_heiles_k2s2_defect(const henon_heiles_k2s2_state *x, const d
   for (i = 0; i < henon_heiles_k2s2_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
     p1[i] = x->p[i] + (double)sw[henon_heiles_k2s2_S * henon_heiles_k2s2_M + i];
-    z[i] = 0;
     if (fabs(p1[i] - x->p[i]) > dp) dp = fabs(p1[i] - x->p[i]);
+    z[i] = 0;
   }
   henon_heiles_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   henon_heiles_k2s2_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
@@ -226,6 +226,10 @@ static double henon_heiles_k2s2_defect(const henon_heiles_k2s2_state *x, const d
   dH = fabs(H1 - H0) - henon_heiles_k2s2_NOISETOL * (fabs(H0 - U0) + fabs(U0));
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
+
+#ifndef henon_heiles_k2s2_TOLC
+#define henon_heiles_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
@@ -444,10 +448,6 @@ int henon_heiles_k2s2_step(henon_heiles_k2s2_state *x, henon_heiles_k2s2_real h,
 
 #ifndef henon_heiles_k2s2_HMIN
 #define henon_heiles_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef henon_heiles_k2s2_TOLC
-#define henon_heiles_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

@@ -208,6 +208,10 @@ static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, 
   return v;
 }
 
+#ifndef henon_heiles_k3s2_TOLC
+#define henon_heiles_k3s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(3,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h_, double tol, int cold, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
@@ -448,10 +452,6 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h,
 
 #ifndef henon_heiles_k3s2_HMIN
 #define henon_heiles_k3s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef henon_heiles_k3s2_TOLC
-#define henon_heiles_k3s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

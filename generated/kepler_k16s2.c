@@ -227,8 +227,8 @@ static double kepler_k16s2_defect(const kepler_k16s2_state *x, const double *sw,
   for (i = 0; i < kepler_k16s2_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
     p1[i] = x->p[i] + (double)sw[kepler_k16s2_S * kepler_k16s2_M + i];
-    z[i] = 0;
     if (fabs(p1[i] - x->p[i]) > dp) dp = fabs(p1[i] - x->p[i]);
+    z[i] = 0;
   }
   kepler_k16s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   kepler_k16s2_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
@@ -236,6 +236,10 @@ static double kepler_k16s2_defect(const kepler_k16s2_state *x, const double *sw,
   dH = fabs(H1 - H0) - kepler_k16s2_NOISETOL * (fabs(H0 - U0) + fabs(U0));
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
+
+#ifndef kepler_k16s2_TOLC
+#define kepler_k16s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
 
 /* One step of HBVM(16,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
@@ -886,10 +890,6 @@ int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h, const kepler_k
 
 #ifndef kepler_k16s2_HMIN
 #define kepler_k16s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef kepler_k16s2_TOLC
-#define kepler_k16s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

@@ -215,8 +215,8 @@ static double kepler_k4s4_defect(const kepler_k4s4_state *x, const double *sw, d
   for (i = 0; i < kepler_k4s4_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
     p1[i] = x->p[i] + (double)sw[kepler_k4s4_S * kepler_k4s4_M + i];
-    z[i] = 0;
     if (fabs(p1[i] - x->p[i]) > dp) dp = fabs(p1[i] - x->p[i]);
+    z[i] = 0;
   }
   kepler_k4s4_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   kepler_k4s4_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
@@ -224,6 +224,10 @@ static double kepler_k4s4_defect(const kepler_k4s4_state *x, const double *sw, d
   dH = fabs(H1 - H0) - kepler_k4s4_NOISETOL * (fabs(H0 - U0) + fabs(U0));
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
+
+#ifndef kepler_k4s4_TOLC
+#define kepler_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
@@ -626,10 +630,6 @@ int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h, const kepler_k4s4
 
 #ifndef kepler_k4s4_HMIN
 #define kepler_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef kepler_k4s4_TOLC
-#define kepler_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 8 (error per unit step). */

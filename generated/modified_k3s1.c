@@ -330,6 +330,10 @@ static double modified_k3s1_err_est(const double *gam, double h, double d1, int 
   return v;
 }
 
+#ifndef modified_k3s1_TOLC
+#define modified_k3s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(3,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real h_, double tol, int cold, const modified_k3s1_params *prm, modified_k3s1_stats *st)
@@ -586,10 +590,6 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modif
 
 #ifndef modified_k3s1_HMIN
 #define modified_k3s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef modified_k3s1_TOLC
-#define modified_k3s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */

@@ -361,7 +361,7 @@ static double modified_k6s2_err_est(const double *gam, double h, double d1, int 
  * alternates in sign from step to step and does not add up. */
 static double modified_k6s2_mult_err(const modified_k6s2_state *x, const double *sw, double h, const modified_k6s2_params *prm, int adaptive)
 {
-  double q1[modified_k6s2_M], p1[modified_k6s2_M], pr[2 * modified_k6s2_M + 2 * modified_k6s2_NU], dp0[modified_k6s2_M], dp1[modified_k6s2_M], v[modified_k6s2_M], vd = 0, dp = 0, p0 = 0, est;
+  double q1[modified_k6s2_M], p1[modified_k6s2_M], pr[2 * modified_k6s2_M + 2 * modified_k6s2_NU], dp0[modified_k6s2_M], v[modified_k6s2_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
   for (i = 0; i < modified_k6s2_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -372,10 +372,7 @@ static double modified_k6s2_mult_err(const modified_k6s2_state *x, const double 
   modified_k6s2_consistent(x->q, x->p, 0, 0, 0, prm, pr);
   for (i = 0; i < modified_k6s2_M; i++) dp0[i] = pr[modified_k6s2_M + i];
   modified_k6s2_consistent(q1, p1, 0, 0, 0, prm, pr);
-  for (i = 0; i < modified_k6s2_M; i++) {
-    dp1[i] = pr[modified_k6s2_M + i];
-    dp0[i] = dp1[i] + dp0[i];
-  }
+  for (i = 0; i < modified_k6s2_M; i++) dp0[i] += pr[modified_k6s2_M + i];  /* dp1 + dp0 */
   modified_k6s2_minv_p(q1, dp0, 0, 0, 0, prm, v);
   for (i = 0; i < modified_k6s2_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);

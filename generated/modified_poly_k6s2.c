@@ -720,6 +720,10 @@ static double modified_poly_k6s2_err_est(const double *gam, double h, double d1,
   return v;
 }
 
+#ifndef modified_poly_k6s2_TOLC
+#define modified_poly_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, double tol, int cold, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
@@ -1471,10 +1475,6 @@ int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real
 
 #ifndef modified_poly_k6s2_HMIN
 #define modified_poly_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef modified_poly_k6s2_TOLC
-#define modified_poly_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

@@ -1183,6 +1183,10 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1,
   return v;
 }
 
+#ifndef modified_poly_k9s3_TOLC
+#define modified_poly_k9s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, int cold, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
@@ -2464,10 +2468,6 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
 
 #ifndef modified_poly_k9s3_HMIN
 #define modified_poly_k9s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef modified_poly_k9s3_TOLC
-#define modified_poly_k9s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */

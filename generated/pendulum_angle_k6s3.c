@@ -210,8 +210,8 @@ static double pendulum_angle_k6s3_defect(const pendulum_angle_k6s3_state *x, con
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
     p1[i] = x->p[i] + (double)sw[pendulum_angle_k6s3_S * pendulum_angle_k6s3_M + i];
-    z[i] = 0;
     if (fabs(p1[i] - x->p[i]) > dp) dp = fabs(p1[i] - x->p[i]);
+    z[i] = 0;
   }
   pendulum_angle_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   pendulum_angle_k6s3_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
@@ -219,6 +219,10 @@ static double pendulum_angle_k6s3_defect(const pendulum_angle_k6s3_state *x, con
   dH = fabs(H1 - H0) - pendulum_angle_k6s3_NOISETOL * (fabs(H0 - U0) + fabs(U0));
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
+
+#ifndef pendulum_angle_k6s3_TOLC
+#define pendulum_angle_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
@@ -456,10 +460,6 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
 
 #ifndef pendulum_angle_k6s3_HMIN
 #define pendulum_angle_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef pendulum_angle_k6s3_TOLC
-#define pendulum_angle_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */

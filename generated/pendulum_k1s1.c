@@ -285,6 +285,10 @@ static double pendulum_k1s1_err_est(const double *gam, double h, double d1, int 
   return v;
 }
 
+#ifndef pendulum_k1s1_TOLC
+#define pendulum_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real h_, double tol, int cold, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
@@ -470,10 +474,6 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendu
 
 #ifndef pendulum_k1s1_HMIN
 #define pendulum_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef pendulum_k1s1_TOLC
-#define pendulum_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */

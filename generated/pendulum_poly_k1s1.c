@@ -374,6 +374,10 @@ static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1,
   return v;
 }
 
+#ifndef pendulum_poly_k1s1_TOLC
+#define pendulum_poly_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h_, double tol, int cold, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
@@ -622,10 +626,6 @@ int pendulum_poly_k1s1_step(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real
 
 #ifndef pendulum_poly_k1s1_HMIN
 #define pendulum_poly_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef pendulum_poly_k1s1_TOLC
-#define pendulum_poly_k1s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */

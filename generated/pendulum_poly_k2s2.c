@@ -462,6 +462,10 @@ static double pendulum_poly_k2s2_err_est(const double *gam, double h, double d1,
   return v;
 }
 
+#ifndef pendulum_poly_k2s2_TOLC
+#define pendulum_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real h_, double tol, int cold, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
@@ -826,10 +830,6 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
 
 #ifndef pendulum_poly_k2s2_HMIN
 #define pendulum_poly_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef pendulum_poly_k2s2_TOLC
-#define pendulum_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */

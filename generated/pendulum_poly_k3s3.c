@@ -630,6 +630,10 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1,
   return v;
 }
 
+#ifndef pendulum_poly_k3s3_TOLC
+#define pendulum_poly_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, int cold, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
@@ -1128,10 +1132,6 @@ int pendulum_poly_k3s3_step(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real
 
 #ifndef pendulum_poly_k3s3_HMIN
 #define pendulum_poly_k3s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef pendulum_poly_k3s3_TOLC
-#define pendulum_poly_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */

@@ -973,6 +973,10 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1,
   return v;
 }
 
+#ifndef pendulum_poly_k4s4_TOLC
+#define pendulum_poly_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, int cold, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
@@ -1699,10 +1703,6 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
 
 #ifndef pendulum_poly_k4s4_HMIN
 #define pendulum_poly_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef pendulum_poly_k4s4_TOLC
-#define pendulum_poly_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 8 (error per unit step). */

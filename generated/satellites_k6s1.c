@@ -830,8 +830,8 @@ static double satellites_k6s1_defect(const satellites_k6s1_state *x, const doubl
   for (i = 0; i < satellites_k6s1_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
     p1[i] = x->p[i] + (double)sw[satellites_k6s1_S * satellites_k6s1_M + i];
-    z[i] = 0;
     if (fabs(p1[i] - x->p[i]) > dp) dp = fabs(p1[i] - x->p[i]);
+    z[i] = 0;
   }
   satellites_k6s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   satellites_k6s1_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
@@ -839,6 +839,10 @@ static double satellites_k6s1_defect(const satellites_k6s1_state *x, const doubl
   dH = fabs(H1 - H0) - satellites_k6s1_NOISETOL * (fabs(H0 - U0) + fabs(U0));
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
+
+#ifndef satellites_k6s1_TOLC
+#define satellites_k6s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
 
 /* One step of HBVM(6,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
@@ -1985,10 +1989,6 @@ int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h, const
 
 #ifndef satellites_k6s1_HMIN
 #define satellites_k6s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef satellites_k6s1_TOLC
-#define satellites_k6s1_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */

@@ -2766,8 +2766,8 @@ static double satellites_k6s3_defect(const satellites_k6s3_state *x, const doubl
   for (i = 0; i < satellites_k6s3_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
     p1[i] = x->p[i] + (double)sw[satellites_k6s3_S * satellites_k6s3_M + i];
-    z[i] = 0;
     if (fabs(p1[i] - x->p[i]) > dp) dp = fabs(p1[i] - x->p[i]);
+    z[i] = 0;
   }
   satellites_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   satellites_k6s3_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
@@ -2791,7 +2791,7 @@ static double satellites_k6s3_defect(const satellites_k6s3_state *x, const doubl
  * alternates in sign from step to step and does not add up. */
 static double satellites_k6s3_mult_err(const satellites_k6s3_state *x, const double *sw, double h, const satellites_k6s3_params *prm, int adaptive)
 {
-  double q1[satellites_k6s3_M], p1[satellites_k6s3_M], pr[2 * satellites_k6s3_M + 2 * satellites_k6s3_NU], dp0[satellites_k6s3_M], dp1[satellites_k6s3_M], v[satellites_k6s3_M], vd = 0, dp = 0, p0 = 0, est;
+  double q1[satellites_k6s3_M], p1[satellites_k6s3_M], pr[2 * satellites_k6s3_M + 2 * satellites_k6s3_NU], dp0[satellites_k6s3_M], v[satellites_k6s3_M], vd = 0, dp = 0, p0 = 0, est;
   int i;
   for (i = 0; i < satellites_k6s3_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -2802,10 +2802,7 @@ static double satellites_k6s3_mult_err(const satellites_k6s3_state *x, const dou
   satellites_k6s3_consistent(x->q, x->p, 0, 0, 0, prm, pr);
   for (i = 0; i < satellites_k6s3_M; i++) dp0[i] = pr[satellites_k6s3_M + i];
   satellites_k6s3_consistent(q1, p1, 0, 0, 0, prm, pr);
-  for (i = 0; i < satellites_k6s3_M; i++) {
-    dp1[i] = pr[satellites_k6s3_M + i];
-    dp0[i] = dp1[i] + dp0[i];
-  }
+  for (i = 0; i < satellites_k6s3_M; i++) dp0[i] += pr[satellites_k6s3_M + i];  /* dp1 + dp0 */
   satellites_k6s3_minv_p(q1, dp0, 0, 0, 0, prm, v);
   for (i = 0; i < satellites_k6s3_M; i++)
     if (fabs(v[i]) > vd) vd = fabs(v[i]);

@@ -5034,6 +5034,10 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
   return v;
 }
 
+#ifndef satellites_poly_k6s2_TOLC
+#define satellites_poly_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
+#endif
+
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, int cold, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
@@ -5216,10 +5220,6 @@ int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s
 
 #ifndef satellites_poly_k6s2_HMIN
 #define satellites_poly_k6s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
-#endif
-
-#ifndef satellites_poly_k6s2_TOLC
-#define satellites_poly_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */
