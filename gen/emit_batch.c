@@ -193,9 +193,9 @@ void emit_batch_source(Emitter *e, int lanes) {
   e->lanes = lanes;
   tmpl(e, "\n/* ---- --batch: the kernels above as loops over $P_W lanes; value i of lane l is\n"
           " * at [i * $P_W + l]. Each lane does the scalar kernel's operations in its order. ---- */\n\n"
-          "/* The sweep, the prediction and the tests, which $P_batch_step and the tries of\n"
-          " * $P_batch_step_adaptive each call once, inlined into both (gcc, clang) as a function\n"
-          " * called once would be: the fixed step keeps its code. */\n"
+          "/* The sweep, the prediction, the tests and the kernels other than the factor, which\n"
+          " * $P_batch_step and the tries of $P_batch_step_adaptive each call once, inlined into both\n"
+          " * (gcc, clang) as a function called once would be: the fixed step keeps its code. */\n"
           "#if defined(__GNUC__)\n#define $P_LANE_INLINE static inline __attribute__((always_inline))\n"
           "#else\n#define $P_LANE_INLINE static\n#endif\n");
   for (size_t i = 0; i < sizeof used / sizeof used[0]; i++)

@@ -35,20 +35,28 @@ static void emit_pivots(Emitter *e) {
 }
 
 // The iteration's tests after a sweep, as in $P_step, for every lane at
-// once. act[l]: lane l iterates; a lane that stops gets rc[l] and iters[l] =
-// it and keeps its gamma (and multiplier), so the sweeps that the other
-// lanes still need recompute its last sweep bitwise. The floating-point
+// once. The sweep read gam (and lam) and wrote sw, whose gamma (and
+// multiplier) the next sweep reads: no copy while every lane iterates on.
+// act[l]: lane l iterates (on return: in the next sweep); a lane that stops
+// gets rc[l] and iters[l] = it, and while other lanes iterate on (a next
+// sweep follows), sw gets its gamma (and multiplier) back from gam (lam), so
+// the sweeps that the other lanes still need recompute its last sweep
+// bitwise and the last sweep leaves every lane's own results in sw. The floating-point
 // tests are in a loop of their own and the integer logic in a second, with
 // & and | for && and ||: a comparison the compiler could sink under a
-// condition would stay a branch (it may trap), and the loop scalar.
+// condition would stay a branch (it may trap), and the loop scalar. The
+// polynomial family's fresh[l] (the count of them returned in *nfresh): lane
+// l iterates on with increments that fell by less than 8x, so its factor is
+// refreshed before the next sweep, as in $P_step.
 static void emit_lane_test(Emitter *e, int poly) {
   tmpl(e, "/* After a sweep: the increment and tests of $P_step in every lane that iterates (act);\n"
           " * a lane that stops gets rc, iters = it and keeps its gamma, so the next sweeps repeat\n"
           " * its last one. Returns the number of lanes that iterate on. */\n"
-          "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, const $R *restrict sw, $R *restrict gam,\n"
-          "    $R *restrict lam, const $M *restrict act, $R *restrict inc, $R *restrict incp, $R *restrict inc_min,\n"
-          "    $M *restrict stall, $M *restrict rc, $M *restrict iters)\n{\n"
-          "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
+          "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, $R *restrict sw, const $R *restrict gam,\n"
+          "    const $R *restrict lam, const $M *restrict go, $M *restrict act, $R *restrict inc, $R *restrict incp,\n"
+          "    $R *restrict inc_min, $M *restrict stall, $M *restrict rc, $M *restrict iters");
+  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh)\n{\n" : ")\n{\n");
+  tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) bad[l] = sing[l] = 0;\n");
   /* a result is not finite where r - r is not 0 (inf - inf and NaN are NaN): their sum
@@ -62,9 +70,10 @@ static void emit_lane_test(Emitter *e, int poly) {
             "  for (i = 0; i < $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
             "      scale[l] = v > scale[l] ? v : scale[l];\n    }\n"
-            "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
-            "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
-            "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n");
+            "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {  /* |h| max |d|: max |h d| (emit_lane_reductions) */\n"
+            "      $R v = fabs$f(sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]);\n"
+            "      incn[l] = v > incn[l] ? v : incn[l];\n    }\n"
+            "  for (l = 0; l < $P_W; l++) incn[l] = fabs$f(h) * incn[l];\n");
     tmpl(e, poly ? "  for (i = 0; i < $<sweep.theta>; i++)\n" : "  for (i = 0; i < $<sweep.pivot>; i++)\n");
     tmpl(e, "    for (l = 0; l < $P_W; l++) nan[l] += sw[i * $P_W + l] - sw[i * $P_W + l];\n");
   }
@@ -87,13 +96,23 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $M as = -(a & stop);  /* all ones or zero: the writes as blends, which vectorise */\n"
           "    stall[l] ^= (stall[l] ^ stl) & -a;\n    rc[l] ^= (rc[l] ^ code) & as;\n"
           "    iters[l] ^= (iters[l] ^ it) & as;\n    run[l] = a & (stop == 0);\n  }\n"
-          "  for (l = 0; l < $P_W; l++) nrun += (int)run[l];\n"
-          "  for (i = 0; i < $P_S * $P_M; i++)\n    for (l = 0; l < $P_W; l++) {\n"
-          "      $R s = sw[($[sweep.gam]i) * $P_W + l], g = gam[i * $P_W + l];\n      gam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
+          "  for (l = 0; l < $P_W; l++) {\n    nrun += (int)run[l];\n    act[l] = run[l];\n  }\n");
   if (poly)
-    tmpl(e, "  for (i = 0; i < $P_S * $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
-            "      $R s = sw[($[sweep.lam]i) * $P_W + l], g = lam[i * $P_W + l];\n      lam[i * $P_W + l] = run[l] ? s : g;\n    }\n");
-  tmpl(e, "  return nrun;\n}\n\n");
+    tmpl(e, "  {\n    $M any = 0;\n"
+            "    for (l = 0; l < $P_W; l++) any |= fresh[l] = run[l] & (inc[l] > incp[l] / 8);\n"
+            "    *nfresh = (int)any;\n  }\n");
+  tmpl(e, "  if (nrun > 0 && it < $P_MAXITER) {  /* the lanes that stopped keep their gamma for the next sweeps */\n"
+          "    $M keep[$P_W], any = 0;\n"
+          "    for (l = 0; l < $P_W; l++) any |= keep[l] = go[l] & (run[l] == 0);\n"
+          "    if (any) {\n"
+          "      for (i = 0; i < $P_S * $P_M; i++)\n        for (l = 0; l < $P_W; l++) {\n"
+          "          $R s = sw[($[sweep.gam]i) * $P_W + l], g = gam[i * $P_W + l];\n"
+          "          sw[($[sweep.gam]i) * $P_W + l] = keep[l] ? g : s;\n        }\n");
+  if (poly)
+    tmpl(e, "      for (i = 0; i < $P_S * $P_NU; i++)\n        for (l = 0; l < $P_W; l++) {\n"
+            "          $R s = sw[($[sweep.lam]i) * $P_W + l], g = lam[i * $P_W + l];\n"
+            "          sw[($[sweep.lam]i) * $P_W + l] = keep[l] ? g : s;\n        }\n");
+  tmpl(e, "    }\n  }\n  return nrun;\n}\n\n");
 }
 
 // The writes both families make in a lane that commits (cm[l]): the history
@@ -315,62 +334,67 @@ static void emit_step_body(Emitter *e, int adaptive) {
   else
     tmpl(e, "int $P_batch_step($P_batch *x, $P_real h_, const $P_params *prm, $P_batch_stats *st)\n{\n"
             "  const $R h = ($R)h_;\n");
-  tmpl(e, "  $R par[($P_NPARAMS + 1) * $P_W], gam[$P_S * $P_M * $P_W];\n"
-          "  $R sw[($<sweep> + 3) * $P_W];  /* + the sweep's reductions for the lane test */\n"
-          "  $R inc[$P_W], incp[$P_W], inc_min[$P_W], lam[($P_S * $P_NU + 1) * $P_W];\n");
+  /* two buffers of the sweep's results (+ its reductions for the lane test), in turn
+   * the sweep's input (gamma from the prediction, then from the last sweep) and output */
+  tmpl(e, "  $R par[($P_NPARAMS + 1) * $P_W], swb[2][($<sweep> + 3) * $P_W];\n"
+          "  $R *in = swb[0], *sw = swb[1];  /* the sweep reads gamma (and lam) in in, writes sw */\n"
+          "  $R inc[$P_W], incp[$P_W], inc_min[$P_W];\n");
   if (adaptive) tmpl(e, "  $R ref[$P_S * $P_M * $P_W], d1[$P_W], est[$P_W];\n  $M two[$P_W], cl[$P_W];\n");
   tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
-          "  int it, i, l, nrun = 0, nfail = 0, bad_h = !(h != 0 && isfinite(h));\n");
+          "  int it, i, l, nrun = 0, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
+          "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
+  if (poly) tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n  $M fresh[$P_W];\n  int nfresh = 0;\n");
   if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
   tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
   if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
-  tmpl(e, "    rc[l] = x->idle[l] ? $P_OK : bad_h ? $P_EBADSTEP : $P_ENOCONV;\n  }\n"
-          "  for (i = 0; i < ($P_S * $P_NU + 1) * $P_W; i++) lam[i] = 0;\n");
-  tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, gam, 0, 0);\n"
-          : poly    ? "  $P_batch_predict(x, h, cold, par, gam, ref, two);\n"
-                    : "  $P_batch_predict(x, h, cold, par, gam, 0, two);\n");
+  tmpl(e, "    rc[l] = rc0;\n    idle |= x->idle[l];\n  }\n"
+          "  if (idle)  /* mostly none */\n    for (l = 0; l < $P_W; l++) rc[l] = x->idle[l] ? $P_OK : rc0;\n");
+  if (poly) tmpl(e, "  for (i = 0; i < $P_S * $P_NU * $P_W; i++) lin[i] = 0;\n");
+  tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, in, 0, 0);\n"
+          : poly    ? "  $P_batch_predict(x, h, cold, par, in, ref, two);\n"
+                    : "  $P_batch_predict(x, h, cold, par, in, 0, two);\n");
   if (nu)
     tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
             "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
   if (poly)
     tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
-            "  $(factor q0=x->q gam=gam h=h prm=par out=fa);\n"
+            "  $(factor q0=x->q gam=in h=h prm=par out=fa);\n"
             "  for (l = 0; l < $P_W; l++) go[l] = 1;\n"
             "  $P_batch_pivots(fa, go, rc);\n");
   char call[160];
-  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=gam h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
-           poly ? " lam=lam lu=fa" : "");
+  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=in h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
+           poly ? " lam=lin lu=fa" : "");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n"
-          "    nrun += (int)go[l];\n");
+          "    act[l] = go[l];\n    nrun += (int)go[l];\n");
   tmpl(e, adaptive ? "    early |= (rc[l] != $P_OK) & !go[l];\n  }\n"
                      "  if (early) {  /* a lane failed before the first sweep */\n    tried = -2;\n    goto out;\n  }\n"
                    : "  }\n");
   tmpl(e, "  if (nrun == 0)  /* no sweep: what the commit reads of sw is defined all the same */\n"
-          "    for (i = 0; i < ($<sweep> + 3) * $P_W; i++) sw[i] = 0;\n"
+          "    for (i = 0; i < ($<sweep> + 3) * $P_W; i++) in[i] = 0;\n"
           "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
           "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
   if (poly) /* $P_step's refresh of the frozen factor, for the lanes that slow down */
-    tmpl(e, "    if (it > 2) {\n"
-            "      $R fb[($<factor> + 1) * $P_W];\n      $M fresh[$P_W];\n      int any = 0;\n"
-            "      for (l = 0; l < $P_W; l++) {\n"
-            "        fresh[l] = go[l] & (iters[l] == 0) & (inc[l] > incp[l] / 8);\n        any |= (int)fresh[l];\n      }\n"
-            "      if (any) {\n"
-            "        $(factor q0=x->q gam=gam h=h prm=par out=fb);\n"
-            "        for (i = 0; i < $<factor>; i++)\n"
-            "          for (l = 0; l < $P_W; l++) fa[i * $P_W + l] = fresh[l] ? fb[i * $P_W + l] : fa[i * $P_W + l];\n"
-            "        $P_batch_pivots(fa, fresh, rc);\n"
-            "        for (l = 0; l < $P_W; l++) {  /* a lane whose factor fails stops here */\n"
-            "          $M stop = fresh[l] & (rc[l] != $P_ENOCONV);\n"
-            "          iters[l] = stop ? it : iters[l];\n          nrun -= (int)stop;\n        }\n"
+    tmpl(e, "    if (it > 2 && nfresh) {\n"
+            "      $R fb[($<factor> + 1) * $P_W];\n"
+            "      $(factor q0=x->q gam=in h=h prm=par out=fb);\n"
+            "      for (i = 0; i < $<factor>; i++)\n"
+            "        for (l = 0; l < $P_W; l++) fa[i * $P_W + l] = fresh[l] ? fb[i * $P_W + l] : fa[i * $P_W + l];\n"
+            "      $P_batch_pivots(fa, fresh, rc);\n"
+            "      for (l = 0; l < $P_W; l++) {  /* a lane whose factor fails stops here */\n"
+            "        $M stop = fresh[l] & (rc[l] != $P_ENOCONV);\n"
+            "        iters[l] = stop ? it : iters[l];\n        act[l] = stop ? 0 : act[l];\n        nrun -= (int)stop;\n"
             "      }\n    }\n");
   tmpl(e, call);
   if (adaptive)
-    tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, gam, ref, two, go, cl, d1, est, rc)) {\n"
+    tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, in, ref, two, go, cl, d1, est, rc)) {\n"
             "      tried = -1;\n      goto out;\n    }\n");
-  tmpl(e, "    for (l = 0; l < $P_W; l++) act[l] = go[l] & (iters[l] == 0);\n"
-          "    nrun = $P_batch_test(x, h, it, sw, gam, lam, act, inc, incp, inc_min, stall, rc, iters);\n  }\n"
+  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh);\n"
+               : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters);\n");
+  tmpl(e, "    {  /* this sweep's results are the next one's input */\n      $R *t = in;\n      in = sw;\n      sw = t;\n    }\n");
+  if (poly) tmpl(e, "    lin = in + ($[sweep.lam]0) * $P_W;\n");
+  tmpl(e, "  }\n  sw = in;  /* the last sweep's results */\n"
           "  $R nan[$P_W];  /* the rest of p's polynomial finite, as in $P_step (see $P_batch_test) */\n"
           "  for (l = 0; l < $P_W; l++) nan[l] = 0;\n"
           "  for (i = 0; i < ($P_S - 1) * $P_M; i++)\n"

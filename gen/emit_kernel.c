@@ -440,14 +440,24 @@ static void emit_node(Emitter *e, int id) {
   out(e, "%s%s  const %s %s = %s;\n", body_indent(e), e->body ? "    " : "", real_type(e, e->wide), lhs, rhs);
 }
 
+// Whether the batch kernel k is inlined where it is called: those that each
+// batch step calls once (not the factor, called again when a lane's
+// iteration slows down), so that their results need not pass through memory
+// and a call between the step's dependent parts (bench/README.md, "Batch").
+static int lane_inlined(const Emitter *e, const Kernel *k) {
+  static const KernelId once[] = {K_SWEEP, K_MINV_P, K_ENERGY, K_G, K_PROJECT, K_LAMBDA0};
+  for (size_t i = 0; i < sizeof once / sizeof once[0]; i++)
+    if (k == &e->st->kern[once[i]]) return 1;
+  return 0;
+}
+
 // The signature of kernel k (of its part-th part when part >= 0): one
 // argument per input block of the Step, then the parameters and out[].
 static void kernel_signature(Emitter *e, const Kernel *k, int part) {
   const Step *st = e->st;
   const char *t = real_type(e, e->wide); /* the sweep of --wide-step: state, gamma, results wider */
   const char *rs = e->lanes ? "*restrict " : "*"; /* lanes: the compiler may assume no overlap */
-  /* the batch sweep, called once by each of the two batch steps, is inlined into both */
-  tmpl(e, !e->lanes ? "static void $P_" : part < 0 && k == &st->kern[K_SWEEP] ? "$P_LANE_INLINE void $P_batch_" : "static void $P_batch_");
+  tmpl(e, !e->lanes ? "static void $P_" : part < 0 && lane_inlined(e, k) ? "$P_LANE_INLINE void $P_batch_" : "static void $P_batch_");
   out(e, part >= 0 ? "%s_part%d(" : "%s(", k->name, part);
   for (int i = 0; i < IN_COUNT; i++) {
     const Slots *in = &st->in[i];
@@ -634,7 +644,10 @@ int sweep_reduces(const Emitter *e) {
 // After the N results in out[]: out[N] = max_i |q0_i| + |h gamma_0,i| (the
 // scale), out[N + 1] = max_i |h (gamma_i - gam_i)| (the increment), out[N + 2]
 // = the sum of r - r over the results before theta (poly) or pivot (const),
-// not 0 where one of them is not finite.
+// not 0 where one of them is not finite. The increment is taken as |h| max_i
+// |gamma_i - gam_i|, one product instead of one a result: the same value
+// bit for bit, as rounding is monotone and symmetric, so the largest of the
+// rounded |h| |d_i| is the rounded |h| times the largest |d_i|.
 static void emit_lane_reductions(Emitter *e, const Kernel *k, const int *outs, int nouts) {
   int g = block_first(k, "gam"), end = block_first(k, "theta");
   const char *R = real_type(e, e->wide), *f = math_suffix(e, e->wide);
@@ -649,8 +662,9 @@ static void emit_lane_reductions(Emitter *e, const Kernel *k, const int *outs, i
   }
   for (int i = 0; i < e->me->s * e->mod->m; i++) {
     ref(e, outs[g + i], r, sizeof r);
-    out(e, "      v = fabs%s(h * (%s - gam[%d + l]));\n      inc = v > inc ? v : inc;\n", f, r, i * e->lanes);
+    out(e, "      v = fabs%s(%s - gam[%d + l]);\n      inc = v > inc ? v : inc;\n", f, r, i * e->lanes);
   }
+  out(e, "      inc = fabs%s(h) * inc;\n", f);
   for (int i = 0; i < end; i++) {
     ref(e, outs[i], r, sizeof r);
     out(e, "      nan += %s - %s;\n", r, r);
