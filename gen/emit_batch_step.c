@@ -41,7 +41,9 @@ static void emit_pivots(Emitter *e) {
 // gets rc[l] and iters[l] = it, and while other lanes iterate on (a next
 // sweep follows), sw gets its gamma (and multiplier) back from gam (lam), so
 // the sweeps that the other lanes still need recompute its last sweep
-// bitwise and the last sweep leaves every lane's own results in sw. The floating-point
+// bitwise and the last sweep leaves every lane's own results in sw (ngo:
+// the number of lanes that iterate in this step, so that the common case,
+// every one of them still iterating, is one comparison). The floating-point
 // tests are in a loop of their own and the integer logic in a second, with
 // & and | for && and ||: a comparison the compiler could sink under a
 // condition would stay a branch (it may trap), and the loop scalar. The
@@ -55,7 +57,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, $R *restrict sw, const $R *restrict gam,\n"
           "    const $R *restrict lam, const $M *restrict go, $M *restrict act, $R *restrict inc, $R *restrict incp,\n"
           "    $R *restrict inc_min, $M *restrict stall, $M *restrict rc, $M *restrict iters");
-  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh)\n{\n" : ")\n{\n");
+  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh, int ngo)\n{\n" : ", int ngo)\n{\n");
   tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) bad[l] = sing[l] = 0;\n");
@@ -97,11 +99,11 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    stall[l] ^= (stall[l] ^ stl) & -a;\n    rc[l] ^= (rc[l] ^ code) & as;\n"
           "    iters[l] ^= (iters[l] ^ it) & as;\n    run[l] = a & (stop == 0);\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n    nrun += (int)run[l];\n    act[l] = run[l];\n  }\n");
-  if (poly)
-    tmpl(e, "  {\n    $M any = 0;\n"
+  if (poly) /* read from the third sweep on */
+    tmpl(e, "  *nfresh = 0;\n  if (nrun > 0 && it >= 2) {\n    $M any = 0;\n"
             "    for (l = 0; l < $P_W; l++) any |= fresh[l] = run[l] & (inc[l] > incp[l] / 8);\n"
             "    *nfresh = (int)any;\n  }\n");
-  tmpl(e, "  if (nrun > 0 && it < $P_MAXITER) {  /* the lanes that stopped keep their gamma for the next sweeps */\n"
+  tmpl(e, "  if (nrun > 0 && nrun < ngo && it < $P_MAXITER) {  /* the lanes that stopped keep their gamma for the next sweeps */\n"
           "    $M keep[$P_W], any = 0;\n"
           "    for (l = 0; l < $P_W; l++) any |= keep[l] = go[l] & (run[l] == 0);\n"
           "    if (any) {\n"
@@ -341,7 +343,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "  $R inc[$P_W], incp[$P_W], inc_min[$P_W];\n");
   if (adaptive) tmpl(e, "  $R ref[$P_S * $P_M * $P_W], d1[$P_W], est[$P_W];\n  $M two[$P_W], cl[$P_W];\n");
   tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
-          "  int it, i, l, nrun = 0, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
+          "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
   if (poly) tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n  $M fresh[$P_W];\n  int nfresh = 0;\n");
   if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
@@ -371,7 +373,8 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, adaptive ? "    early |= (rc[l] != $P_OK) & !go[l];\n  }\n"
                      "  if (early) {  /* a lane failed before the first sweep */\n    tried = -2;\n    goto out;\n  }\n"
                    : "  }\n");
-  tmpl(e, "  if (nrun == 0)  /* no sweep: what the commit reads of sw is defined all the same */\n"
+  tmpl(e, "  ngo = nrun;\n"
+          "  if (nrun == 0)  /* no sweep: what the commit reads of sw is defined all the same */\n"
           "    for (i = 0; i < ($<sweep> + 3) * $P_W; i++) in[i] = 0;\n"
           "  /* the sweep over all lanes while any iterates; a lane that stops keeps its gamma */\n"
           "  for (it = 1; it <= $P_MAXITER && nrun > 0; it++) {\n");
@@ -390,8 +393,8 @@ static void emit_step_body(Emitter *e, int adaptive) {
   if (adaptive)
     tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, in, ref, two, go, cl, d1, est, rc)) {\n"
             "      tried = -1;\n      goto out;\n    }\n");
-  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh);\n"
-               : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters);\n");
+  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh, ngo);\n"
+               : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo);\n");
   tmpl(e, "    {  /* this sweep's results are the next one's input */\n      $R *t = in;\n      in = sw;\n      sw = t;\n    }\n");
   if (poly) tmpl(e, "    lin = in + ($[sweep.lam]0) * $P_W;\n");
   tmpl(e, "  }\n  sw = in;  /* the last sweep's results */\n"
