@@ -47,7 +47,7 @@ static void emit_pivots(Emitter *e) {
 // tests are in a loop of their own and the integer logic in a second, with
 // & and | for && and ||: a comparison the compiler could sink under a
 // condition would stay a branch (it may trap), and the loop scalar. The
-// polynomial family's fresh[l] (the count of them returned in *nfresh): lane
+// polynomial family's fresh[l] (whether any, in *nfresh): lane
 // l iterates on with increments that fell by less than 8x, so its factor is
 // refreshed before the next sweep, as in $P_step.
 static void emit_lane_test(Emitter *e, int poly) {

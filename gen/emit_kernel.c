@@ -443,7 +443,7 @@ static void emit_node(Emitter *e, int id) {
 // Whether the batch kernel k is inlined where it is called: those that each
 // batch step calls once (not the factor, called again when a lane's
 // iteration slows down), so that their results need not pass through memory
-// and a call between the step's dependent parts (bench/README.md, "Batch").
+// and a call between the step's dependent parts (bench/README.md, "Batches").
 static int lane_inlined(const Emitter *e, const Kernel *k) {
   static const KernelId once[] = {K_SWEEP, K_MINV_P, K_ENERGY, K_G, K_PROJECT, K_LAMBDA0};
   for (size_t i = 0; i < sizeof once / sizeof once[0]; i++)
