@@ -57,7 +57,8 @@ static void emit_lane_test(Emitter *e, int poly) {
           "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, $R *restrict sw, const $R *restrict gam,\n"
           "    const $R *restrict lam, const $M *restrict go, $M *restrict act, $R *restrict inc, $R *restrict incp,\n"
           "    $R *restrict inc_min, $M *restrict stall, $M *restrict rc, $M *restrict iters");
-  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh, int ngo)\n{\n" : ", int ngo)\n{\n");
+  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh, int ngo)\n{\n"
+               : ", int ngo)\n{\n  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
   tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) bad[l] = sing[l] = 0;\n");
@@ -88,8 +89,9 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
                : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
-  tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n"
-          "    incp[l] = act[l] ? old : incp[l];\n    inc[l] = act[l] ? in : old;\n"
+  tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n");
+  if (poly) tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* for the factor's refresh (fresh) */\n");
+  tmpl(e, "    inc[l] = act[l] ? in : old;\n"
           "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    $M stl = better[l] ? 0 : stall[l] + 1;\n    $M a = act[l], okl = (bad[l] == 0) & ok[l];\n"
