@@ -51,6 +51,7 @@ int emit_kernel_inline(Emitter *e, KernelId k);
 /* emit_step.c, for the batch's adaptive step too */
 int energy_defect_wanted(const Emitter *e);
 int mult_err_wanted(const Emitter *e);
+int itol_wanted(const Emitter *e);
 void emit_step_factor(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */

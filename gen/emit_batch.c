@@ -186,10 +186,19 @@ static void emit_predict(Emitter *e) {
   tmpl(e, "        gam[(j * $P_M + m) * $P_W + l] = cold[l] ? g : c;\n      }\n    }\n}\n\n");
 }
 
+// Whether the batch step calls kernel id: those of the step and its
+// diagnostics; lambda0 only the polynomial family's (the constant one's
+// sweep gives the multiplier), consistent only for the Newton step after an
+// adaptive iteration stopped at its tolerance (itol_wanted).
+static int batch_kernel_wanted(const Emitter *e, KernelId id) {
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  if (!e->st->kern[id].nout) return 0;
+  return id == K_LAMBDA0 ? poly : id == K_CONSISTENT ? itol_wanted(e) : 1;
+}
+
 // The batch half of NAME.c: the kernels over lanes, then the functions.
 void emit_batch_source(Emitter *e, int lanes) {
-  static const KernelId used[] = {K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_PROJECT, K_LAMBDA0};
-  int poly = e->st->kern[K_FACTOR].nout > 0; /* lambda0: only the polynomial family's step needs it */
+  static const KernelId used[] = {K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_PROJECT, K_LAMBDA0, K_CONSISTENT};
   e->lanes = lanes;
   tmpl(e, "\n/* ---- --batch: the kernels above as loops over $P_W lanes; value i of lane l is\n"
           " * at [i * $P_W + l]. Each lane does the scalar kernel's operations in its order. ---- */\n\n"
@@ -199,7 +208,7 @@ void emit_batch_source(Emitter *e, int lanes) {
           "#if defined(__GNUC__)\n#define $P_LANE_INLINE static inline __attribute__((always_inline))\n"
           "#else\n#define $P_LANE_INLINE static\n#endif\n");
   for (size_t i = 0; i < sizeof used / sizeof used[0]; i++)
-    if (e->st->kern[used[i]].nout && (poly || used[i] != K_LAMBDA0)) emit_kernel(e, used[i]);
+    if (batch_kernel_wanted(e, used[i])) emit_kernel(e, used[i]);
   out(e, "\n");
   emit_set_get(e);
   emit_params_observers(e);

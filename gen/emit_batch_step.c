@@ -57,8 +57,9 @@ static void emit_lane_test(Emitter *e, int poly) {
           "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, $R *restrict sw, const $R *restrict gam,\n"
           "    const $R *restrict lam, const $M *restrict go, $M *restrict act, $R *restrict inc, $R *restrict incp,\n"
           "    $R *restrict inc_min, $M *restrict stall, $M *restrict rc, $M *restrict iters");
-  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh, int ngo)\n{\n"
-               : ", int ngo)\n{\n  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
+  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh, int ngo" : ", int ngo");
+  tmpl(e, itol_wanted(e) ? ", $R tol, $R *restrict itl)\n{\n" : ")\n{\n");
+  if (!poly) tmpl(e, "  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
   tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) bad[l] = sing[l] = 0;\n");
@@ -87,8 +88,13 @@ static void emit_lane_test(Emitter *e, int poly) {
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
-  tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
-               : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
+  if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
+    tmpl(e, "    $R ti = $P_itol(tol, scale[l]);\n"
+            "    ok[l] = (in <= ti) | ((it > 1) & (in < old) & (in * in <= ti * (old - in)));\n"
+            "    itl[l] = act[l] ? ti : itl[l];\n");
+  else
+    tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
+                 : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n");
   if (poly) tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* for the factor's refresh (fresh) */\n");
   tmpl(e, "    inc[l] = act[l] ? in : old;\n"
@@ -143,11 +149,44 @@ static void emit_commit_common(Emitter *e) {
           "      x->hprev2[l] = cm[l] ? hp : x->hprev2[l];\n      x->hprev[l] = cm[l] ? h : hp;\n    }\n  }\n");
 }
 
+// In NAME_batch_within, before the projection: the Newton step of
+// emit_end_poly (emit_step.c) onto g = 0 in the lanes whose iteration
+// stopped at the tolerance (itl above TOL) with g(q1) not at round-off;
+// its failure code nc[l] goes before the projection's, as the scalar step
+// returns it first.
+static void emit_lane_newton(Emitter *e) {
+  tmpl(e, "    $M nc[$P_W];  /* the Newton step's code, before the projection's */\n"
+          "    {  /* the lanes whose iteration stopped at the tolerance: q1 onto g = 0 ($P_step_within) */\n"
+          "      $R g1[$P_NU * $P_W];\n      $M ea[$P_W], off[$P_W], any = 0;\n"
+          "      for (l = 0; l < $P_W; l++) {\n        nc[l] = $P_OK;\n        off[l] = 0;\n"
+          "        ea[l] = go[l] & (itl[l] > $P_TOL);\n        any |= ea[l];\n      }\n"
+          "      if (any) {  /* those where g(q1) is not round-off */\n"
+          "        $(g q0=q1 prm=par out=g1);\n"
+          "        for (i = 0; i < $P_NU; i++)\n"
+          "          for (l = 0; l < $P_W; l++) off[l] |= !(fabs$f(g1[i * $P_W + l]) <= $P_GTOL);\n"
+          "        any = 0;\n        for (l = 0; l < $P_W; l++) any |= ea[l] &= off[l];\n      }\n"
+          "      if (any) {\n        $R cs[($<consistent>) * $P_W];\n        $M sgc[$P_W], nfc[$P_W];\n"
+          "        $(consistent q0=q1 p0=p1 prm=par out=cs);\n"
+          "        for (l = 0; l < $P_W; l++) sgc[l] = nfc[l] = 0;\n"
+          "        for (i = 0; i < $P_NU; i++)\n          for (l = 0; l < $P_W; l++) {\n"
+          "            $R piv = cs[($[consistent.pivot]i) * $P_W + l], dia = cs[($[consistent.adiag]i) * $P_W + l];\n"
+          "            sgc[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n          }\n"
+          "        for (i = 0; i < $P_M; i++)\n          for (l = 0; l < $P_W; l++) {\n"
+          "            $R d = cs[($[consistent.dq]i) * $P_W + l], q = q1[i * $P_W + l], qc = qc1[i * $P_W + l];\n"
+          "            $R g = sw[($[sweep.gam]i) * $P_W + l], gn = g + d / h;\n"
+          "            nfc[l] |= !isfinite(d);\n            $P_add(&q, &qc, d);\n"
+          "            q1[i * $P_W + l] = ea[l] ? q : q1[i * $P_W + l];\n"
+          "            qc1[i * $P_W + l] = ea[l] ? qc : qc1[i * $P_W + l];\n"
+          "            sw[($[sweep.gam]i) * $P_W + l] = ea[l] ? gn : g;  /* gamma_0 with it */\n          }\n"
+          "        for (l = 0; l < $P_W; l++) nc[l] = !ea[l] ? $P_OK : sgc[l] ? $P_ESINGULAR : nfc[l] ? $P_ENONFINITE : $P_OK;\n"
+          "      }\n    }\n");
+}
+
 // The end of the step for the lanes whose iteration converged (go[l]):
 // the constant family's update, or the polynomial family's projection,
 // rescale and multiplier (emit_end_poly in emit_step.c), as masked loops
 // over the lanes; every lane computes, only the lanes in cm[] are written.
-static void emit_commit(Emitter *e, int poly) {
+static void emit_commit(Emitter *e, int poly, int adaptive) {
   if (!poly) {
     tmpl(e, "  {\n    $M nf[$P_W], cm[$P_W];\n"
             "    for (l = 0; l < $P_W; l++) nf[l] = 0;\n"
@@ -178,8 +217,9 @@ static void emit_commit(Emitter *e, int poly) {
           "        $P_add(&q, &qc, h * sw[($[sweep.gam]i) * $P_W + l]);\n"
           "        $P_add(&p, &pc, sw[($[sweep.dp]i) * $P_W + l]);\n"
           "        q1[i * $P_W + l] = q;\n        qc1[i * $P_W + l] = qc;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n      }\n"
-          "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
-          "    for (l = 0; l < $P_W; l++) sg[l] = nf[l] = 0;\n"
+          "    for (l = 0; l < $P_W; l++) sg[l] = nf[l] = 0;\n");
+  if (adaptive && itol_wanted(e)) emit_lane_newton(e);
+  tmpl(e, "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
           "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++) {\n"
           "        $R piv = pr[($[project_p1.pivot]i) * $P_W + l], dia = pr[($[project_p1.adiag]i) * $P_W + l];\n"
           "        sg[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n      }\n"
@@ -198,7 +238,9 @@ static void emit_commit(Emitter *e, int poly) {
           "        pco[i * $P_W + l] = p - ph;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n"
           "        nf[l] |= !isfinite(q1[i * $P_W + l]) | !isfinite(p);\n      }\n"
           "    for (l = 0; l < $P_W; l++) {\n"
-          "      $M code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n"
+          "      $M code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n");
+  if (adaptive && itol_wanted(e)) tmpl(e, "      code = nc[l] != $P_OK ? nc[l] : code;  /* the Newton step's first, as in $P_step_within */\n");
+  tmpl(e, ""
           "      rc[l] = go[l] ? code : rc[l];\n      cm[l] = go[l] & (code == $P_OK);\n"
           "      x->H0[l] = cm[l] ? H0[l] : x->H0[l];\n    }\n"
           "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
@@ -348,11 +390,13 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
   if (poly) tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n  $M fresh[$P_W];\n  int nfresh = 0;\n");
+  if (itol_wanted(e)) tmpl(e, "  $R itl[$P_W];  /* where each lane's iteration stopped ($P_itol) */\n");
   if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
   tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
   if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
+  if (itol_wanted(e)) tmpl(e, "    itl[l] = $P_TOL;\n");
   tmpl(e, "    rc[l] = rc0;\n    idle |= x->idle[l];\n  }\n"
           "  if (idle)  /* mostly none */\n    for (l = 0; l < $P_W; l++) rc[l] = x->idle[l] ? $P_OK : rc0;\n");
   if (poly) tmpl(e, "  for (i = 0; i < $P_S * $P_NU * $P_W; i++) lin[i] = 0;\n");
@@ -395,8 +439,9 @@ static void emit_step_body(Emitter *e, int adaptive) {
   if (adaptive)
     tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, in, ref, two, go, cl, d1, est, rc)) {\n"
             "      tried = -1;\n      goto out;\n    }\n");
-  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh, ngo);\n"
-               : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo);\n");
+  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh, ngo"
+               : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo");
+  tmpl(e, !itol_wanted(e) ? ");\n" : adaptive ? ", tol, itl);\n" : ", 0, itl);\n");
   tmpl(e, "    {  /* this sweep's results are the next one's input */\n      $R *t = in;\n      in = sw;\n      sw = t;\n    }\n");
   if (poly) tmpl(e, "    lin = in + ($[sweep.lam]0) * $P_W;\n");
   tmpl(e, "  }\n  sw = in;  /* the last sweep's results */\n"
@@ -412,7 +457,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "    rc[l] = (ok & tbad) ? $P_ENONFINITE : rc[l];\n"
           "    go[l] = ok & (tbad == 0);  /* now: the lane is committed */\n  }\n");
   if (adaptive) tmpl(e, "  if ((tried = $P_batch_last(x, h, tol, sw, go, cl, d1, prm, est, rc)) != 0) goto out;\n");
-  emit_commit(e, poly);
+  emit_commit(e, poly, adaptive);
   if (adaptive) tmpl(e, "out:\n");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    nfail += rc[l] != $P_OK;\n"

@@ -316,6 +316,24 @@ static void emit_end_poly(Emitter *e) {
             "    q1[i] = x->q[i];\n    qc1[i] = x->qc[i];\n    p1[i] = x->p[i];\n    pc1[i] = x->pc[i];\n"
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
+  if (itol_wanted(e))
+    tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol): where g(q1) is\n"
+            "   * not round-off ($P_GTOL), q1 onto g = 0 by one Newton step, which leaves it so\n"
+            "   * ($P_ITOLMAX), and gamma_0 with it, so that $P_dense still starts the step at q0 */\n"
+            "  if (tit > $P_TOL) {\n    $R g1[$P_NU];\n    int off = 0;\n"
+            "    $(g q0=q1 out=g1);\n"
+            "    for (i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_GTOL);\n"
+            "    if (off) {\n      $R cs[$<consistent>];\n"
+            "      $(consistent q0=q1 p0=p1 out=cs);\n"
+            "      for (i = 0; i < $P_NU; i++) {\n"
+            "        $R piv = cs[$[consistent.pivot]i], dia = cs[$[consistent.adiag]i];\n"
+            "        if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ESINGULAR;\n"
+            "      }\n"
+            "      for (i = 0; i < $P_M; i++) {\n"
+            "        $R d = cs[$[consistent.dq]i];\n"
+            "        if (!isfinite(d)) return $P_ENONFINITE;\n"
+            "        $P_add(&q1[i], &qc1[i], d);\n"
+            "        gam[i] += d / h;\n      }\n    }\n  }\n");
   tmpl(e, "  $W phat[$P_M];  /* p1 before the projection, the end of p's polynomial */\n"
           "  for (i = 0; i < $P_M; i++) phat[i] = p1[i];\n");
   tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
@@ -500,7 +518,17 @@ static void emit_fused_checks(Emitter *e) {
 static void emit_convergence(Emitter *e) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
-  if (poly) /* the end of the step restores H and the hidden constraint */
+  if (poly && itol_wanted(e))
+    tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
+            "     * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the\n"
+            "     * standard test, Hairer & Wanner IV.8), which saves the sweep that would only\n"
+            "     * confirm it. Iterating further would not help H, which the rescale keeps. Under\n"
+            "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
+            "     * the end of the step restores H, g and the hidden constraint. */\n"
+            "    if (tol > 0) tit = $P_itol(tol, scale);\n"
+            "    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {\n"
+            "      rc = $P_OK;\n      break;\n    }\n");
+  else if (poly) /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
             "     * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the\n"
             "     * standard test, Hairer & Wanner IV.8), which saves the sweep that would only\n"
@@ -631,6 +659,34 @@ static void emit_err_est(Emitter *e) {
 static void emit_tolc(Emitter *e) {
   out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
       e->P, e->P, e->single ? "0.01f" : "0.01");
+}
+
+// Whether NAME_step_adaptive's iteration stops at its tolerance rather than
+// at round-off (NAME_itol): the polynomial family, whose end of step restores
+// H (the rescale) and the hidden constraint (the projection) whatever the
+// iteration left, and g with one Newton step (emit_end_poly); not under
+// --wide-step, whose iteration is in the wider type.
+int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e->wide_step; }
+
+// NAME_itol: where the adaptive step's iteration stops (docs/api.md, "The
+// iteration under a tolerance"). The step's tolerance tol (1 + scale) bounds
+// its local error in q; the iteration error the converged test leaves in q,
+// rho inc / (1 - rho) scale (inc relative to scale), is allowed NAME_ITERC of
+// it. Capped at NAME_ITOLMAX, so that the one Newton step onto g = 0 at the
+// end of the step leaves g at round-off (its error is the square of the
+// correction's), and at least NAME_TOL, the fixed step's round-off test.
+static void emit_itol(Emitter *e) {
+  out(e, "#ifndef %s_ITERC\n#define %s_ITERC %s  /* the iteration error allowed, over the step's tolerance */\n#endif\n",
+      e->P, e->P, e->single ? "0.1f" : "0.1");
+  out(e, "#ifndef %s_ITOLMAX\n#define %s_ITOLMAX %s  /* at most: one Newton step then puts g at round-off */\n#endif\n",
+      e->P, e->P, e->single ? "1e-4f" : "1e-8");
+  tmpl(e, "/* The scaled increment at which the iteration of $P_step_adaptive stops: the error\n"
+          " * rho inc / (1 - rho) it leaves within $P_ITERC times the step's tolerance tol (1 + scale),\n"
+          " * between $P_TOL and $P_ITOLMAX; $P_TOL (round-off) for a fixed step (tol 0). */\n"
+          "static $R $P_itol($R tol, $R scale)\n{\n"
+          "  $R t = $P_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);\n"
+          "  t = t < $P_ITOLMAX ? t : $P_ITOLMAX;\n"
+          "  return (tol > 0) & (scale > 0) & (t > $P_TOL) ? t : $P_TOL;\n}\n\n");
 }
 
 // The head of a loop over the coordinates, in NAME_defect and NAME_mult_err:
@@ -770,6 +826,7 @@ static void emit_step(Emitter *e) {
   int defect = energy_defect_wanted(e), mult = mult_err_wanted(e);
   if (defect) emit_defect(e);
   emit_tolc(e);
+  if (itol_wanted(e)) emit_itol(e);
   if (mult) emit_mult_err(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
@@ -780,6 +837,7 @@ static void emit_step(Emitter *e) {
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
   if (poly) tmpl(e, "  $R ref[$P_S * $P_M];\n  int two;\n");
+  if (itol_wanted(e)) tmpl(e, "  $R tit = $P_TOL;  /* where the iteration stops ($P_itol) */\n");
   if (wide) {
     tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
             "  {\n    $R guess[$P_S * $P_M];\n");

@@ -543,6 +543,22 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1, 
 #define conical_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef conical_poly_k2s2_ITERC
+#define conical_poly_k2s2_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef conical_poly_k2s2_ITOLMAX
+#define conical_poly_k2s2_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of conical_poly_k2s2_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within conical_poly_k2s2_ITERC times the step's tolerance tol (1 + scale),
+ * between conical_poly_k2s2_TOL and conical_poly_k2s2_ITOLMAX; conical_poly_k2s2_TOL (round-off) for a fixed step (tol 0). */
+static double conical_poly_k2s2_itol(double tol, double scale)
+{
+  double t = conical_poly_k2s2_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < conical_poly_k2s2_ITOLMAX ? t : conical_poly_k2s2_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > conical_poly_k2s2_TOL) ? t : conical_poly_k2s2_TOL;
+}
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, int cold, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
@@ -555,6 +571,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   if (!(h != 0 && isfinite(h))) return conical_poly_k2s2_EBADSTEP;
   double ref[conical_poly_k2s2_S * conical_poly_k2s2_M];
   int two;
+  double tit = conical_poly_k2s2_TOL;  /* where the iteration stops (conical_poly_k2s2_itol) */
   two = conical_poly_k2s2_predict(x, h, cold, prm, gam, ref);
   double g0[conical_poly_k2s2_NU];
   conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -865,8 +882,11 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     /* converged: the increment is within 2 ulps of the state (conical_poly_k2s2_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= conical_poly_k2s2_TOL || (it > 1 && inc < inc_old && inc * inc <= conical_poly_k2s2_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * conical_poly_k2s2_step_adaptive the error allowed is the step's tolerance's share (conical_poly_k2s2_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = conical_poly_k2s2_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = conical_poly_k2s2_OK;
       break;
     }
@@ -926,6 +946,29 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     pc1[i] = x->pc[i];
     conical_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
+  }
+  /* the iteration stopped at conical_poly_k2s2_step_adaptive's tolerance (conical_poly_k2s2_itol): where g(q1) is
+   * not round-off (conical_poly_k2s2_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (conical_poly_k2s2_ITOLMAX), and gamma_0 with it, so that conical_poly_k2s2_dense still starts the step at q0 */
+  if (tit > conical_poly_k2s2_TOL) {
+    double g1[conical_poly_k2s2_NU];
+    int off = 0;
+    conical_poly_k2s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < conical_poly_k2s2_NU; i++) off |= !(fabs(g1[i]) <= conical_poly_k2s2_GTOL);
+    if (off) {
+      double cs[2 * conical_poly_k2s2_M + 2 * conical_poly_k2s2_NU];
+      conical_poly_k2s2_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < conical_poly_k2s2_NU; i++) {
+        double piv = cs[2 * conical_poly_k2s2_M + i], dia = cs[2 * conical_poly_k2s2_M + conical_poly_k2s2_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > conical_poly_k2s2_SINGTOL * fabs(dia))) return conical_poly_k2s2_ESINGULAR;
+      }
+      for (i = 0; i < conical_poly_k2s2_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return conical_poly_k2s2_ENONFINITE;
+        conical_poly_k2s2_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[conical_poly_k2s2_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < conical_poly_k2s2_M; i++) phat[i] = p1[i];

@@ -878,6 +878,22 @@ static double double_pendulum_k2s2_err_est(const double *gam, double h, double d
 #define double_pendulum_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef double_pendulum_k2s2_ITERC
+#define double_pendulum_k2s2_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef double_pendulum_k2s2_ITOLMAX
+#define double_pendulum_k2s2_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of double_pendulum_k2s2_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within double_pendulum_k2s2_ITERC times the step's tolerance tol (1 + scale),
+ * between double_pendulum_k2s2_TOL and double_pendulum_k2s2_ITOLMAX; double_pendulum_k2s2_TOL (round-off) for a fixed step (tol 0). */
+static double double_pendulum_k2s2_itol(double tol, double scale)
+{
+  double t = double_pendulum_k2s2_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < double_pendulum_k2s2_ITOLMAX ? t : double_pendulum_k2s2_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > double_pendulum_k2s2_TOL) ? t : double_pendulum_k2s2_TOL;
+}
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, int cold, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
@@ -890,6 +906,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   if (!(h != 0 && isfinite(h))) return double_pendulum_k2s2_EBADSTEP;
   double ref[double_pendulum_k2s2_S * double_pendulum_k2s2_M];
   int two;
+  double tit = double_pendulum_k2s2_TOL;  /* where the iteration stops (double_pendulum_k2s2_itol) */
   two = double_pendulum_k2s2_predict(x, h, cold, prm, gam, ref);
   double g0[double_pendulum_k2s2_NU];
   double_pendulum_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -1335,8 +1352,11 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k2s2_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= double_pendulum_k2s2_TOL || (it > 1 && inc < inc_old && inc * inc <= double_pendulum_k2s2_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * double_pendulum_k2s2_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k2s2_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = double_pendulum_k2s2_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = double_pendulum_k2s2_OK;
       break;
     }
@@ -1404,6 +1424,29 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     pc1[i] = x->pc[i];
     double_pendulum_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k2s2_add(&p1[i], &pc1[i], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i]);
+  }
+  /* the iteration stopped at double_pendulum_k2s2_step_adaptive's tolerance (double_pendulum_k2s2_itol): where g(q1) is
+   * not round-off (double_pendulum_k2s2_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (double_pendulum_k2s2_ITOLMAX), and gamma_0 with it, so that double_pendulum_k2s2_dense still starts the step at q0 */
+  if (tit > double_pendulum_k2s2_TOL) {
+    double g1[double_pendulum_k2s2_NU];
+    int off = 0;
+    double_pendulum_k2s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < double_pendulum_k2s2_NU; i++) off |= !(fabs(g1[i]) <= double_pendulum_k2s2_GTOL);
+    if (off) {
+      double cs[2 * double_pendulum_k2s2_M + 2 * double_pendulum_k2s2_NU];
+      double_pendulum_k2s2_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < double_pendulum_k2s2_NU; i++) {
+        double piv = cs[2 * double_pendulum_k2s2_M + i], dia = cs[2 * double_pendulum_k2s2_M + double_pendulum_k2s2_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k2s2_SINGTOL * fabs(dia))) return double_pendulum_k2s2_ESINGULAR;
+      }
+      for (i = 0; i < double_pendulum_k2s2_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return double_pendulum_k2s2_ENONFINITE;
+        double_pendulum_k2s2_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[double_pendulum_k2s2_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < double_pendulum_k2s2_M; i++) phat[i] = p1[i];

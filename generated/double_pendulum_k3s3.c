@@ -1565,6 +1565,22 @@ static double double_pendulum_k3s3_err_est(const double *gam, double h, double d
 #define double_pendulum_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef double_pendulum_k3s3_ITERC
+#define double_pendulum_k3s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef double_pendulum_k3s3_ITOLMAX
+#define double_pendulum_k3s3_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of double_pendulum_k3s3_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within double_pendulum_k3s3_ITERC times the step's tolerance tol (1 + scale),
+ * between double_pendulum_k3s3_TOL and double_pendulum_k3s3_ITOLMAX; double_pendulum_k3s3_TOL (round-off) for a fixed step (tol 0). */
+static double double_pendulum_k3s3_itol(double tol, double scale)
+{
+  double t = double_pendulum_k3s3_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < double_pendulum_k3s3_ITOLMAX ? t : double_pendulum_k3s3_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > double_pendulum_k3s3_TOL) ? t : double_pendulum_k3s3_TOL;
+}
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, int cold, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
@@ -1577,6 +1593,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
   if (!(h != 0 && isfinite(h))) return double_pendulum_k3s3_EBADSTEP;
   double ref[double_pendulum_k3s3_S * double_pendulum_k3s3_M];
   int two;
+  double tit = double_pendulum_k3s3_TOL;  /* where the iteration stops (double_pendulum_k3s3_itol) */
   two = double_pendulum_k3s3_predict(x, h, cold, prm, gam, ref);
   double g0[double_pendulum_k3s3_NU];
   double_pendulum_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -2308,8 +2325,11 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     /* converged: the increment is within 2 ulps of the state (double_pendulum_k3s3_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= double_pendulum_k3s3_TOL || (it > 1 && inc < inc_old && inc * inc <= double_pendulum_k3s3_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * double_pendulum_k3s3_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k3s3_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = double_pendulum_k3s3_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = double_pendulum_k3s3_OK;
       break;
     }
@@ -2391,6 +2411,29 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     pc1[i] = x->pc[i];
     double_pendulum_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k3s3_add(&p1[i], &pc1[i], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i]);
+  }
+  /* the iteration stopped at double_pendulum_k3s3_step_adaptive's tolerance (double_pendulum_k3s3_itol): where g(q1) is
+   * not round-off (double_pendulum_k3s3_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (double_pendulum_k3s3_ITOLMAX), and gamma_0 with it, so that double_pendulum_k3s3_dense still starts the step at q0 */
+  if (tit > double_pendulum_k3s3_TOL) {
+    double g1[double_pendulum_k3s3_NU];
+    int off = 0;
+    double_pendulum_k3s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < double_pendulum_k3s3_NU; i++) off |= !(fabs(g1[i]) <= double_pendulum_k3s3_GTOL);
+    if (off) {
+      double cs[2 * double_pendulum_k3s3_M + 2 * double_pendulum_k3s3_NU];
+      double_pendulum_k3s3_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < double_pendulum_k3s3_NU; i++) {
+        double piv = cs[2 * double_pendulum_k3s3_M + i], dia = cs[2 * double_pendulum_k3s3_M + double_pendulum_k3s3_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > double_pendulum_k3s3_SINGTOL * fabs(dia))) return double_pendulum_k3s3_ESINGULAR;
+      }
+      for (i = 0; i < double_pendulum_k3s3_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return double_pendulum_k3s3_ENONFINITE;
+        double_pendulum_k3s3_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[double_pendulum_k3s3_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < double_pendulum_k3s3_M; i++) phat[i] = p1[i];

@@ -1187,6 +1187,22 @@ static double modified_poly_k9s3_err_est(const double *gam, double h, double d1,
 #define modified_poly_k9s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef modified_poly_k9s3_ITERC
+#define modified_poly_k9s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef modified_poly_k9s3_ITOLMAX
+#define modified_poly_k9s3_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of modified_poly_k9s3_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within modified_poly_k9s3_ITERC times the step's tolerance tol (1 + scale),
+ * between modified_poly_k9s3_TOL and modified_poly_k9s3_ITOLMAX; modified_poly_k9s3_TOL (round-off) for a fixed step (tol 0). */
+static double modified_poly_k9s3_itol(double tol, double scale)
+{
+  double t = modified_poly_k9s3_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < modified_poly_k9s3_ITOLMAX ? t : modified_poly_k9s3_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > modified_poly_k9s3_TOL) ? t : modified_poly_k9s3_TOL;
+}
+
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, int cold, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
@@ -1199,6 +1215,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   if (!(h != 0 && isfinite(h))) return modified_poly_k9s3_EBADSTEP;
   double ref[modified_poly_k9s3_S * modified_poly_k9s3_M];
   int two;
+  double tit = modified_poly_k9s3_TOL;  /* where the iteration stops (modified_poly_k9s3_itol) */
   two = modified_poly_k9s3_predict(x, h, cold, prm, gam, ref);
   double g0[modified_poly_k9s3_NU];
   modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -2342,8 +2359,11 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     /* converged: the increment is within 2 ulps of the state (modified_poly_k9s3_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= modified_poly_k9s3_TOL || (it > 1 && inc < inc_old && inc * inc <= modified_poly_k9s3_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * modified_poly_k9s3_step_adaptive the error allowed is the step's tolerance's share (modified_poly_k9s3_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = modified_poly_k9s3_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = modified_poly_k9s3_OK;
       break;
     }
@@ -2413,6 +2433,29 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     pc1[i] = x->pc[i];
     modified_poly_k9s3_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k9s3_add(&p1[i], &pc1[i], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i]);
+  }
+  /* the iteration stopped at modified_poly_k9s3_step_adaptive's tolerance (modified_poly_k9s3_itol): where g(q1) is
+   * not round-off (modified_poly_k9s3_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (modified_poly_k9s3_ITOLMAX), and gamma_0 with it, so that modified_poly_k9s3_dense still starts the step at q0 */
+  if (tit > modified_poly_k9s3_TOL) {
+    double g1[modified_poly_k9s3_NU];
+    int off = 0;
+    modified_poly_k9s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < modified_poly_k9s3_NU; i++) off |= !(fabs(g1[i]) <= modified_poly_k9s3_GTOL);
+    if (off) {
+      double cs[2 * modified_poly_k9s3_M + 2 * modified_poly_k9s3_NU];
+      modified_poly_k9s3_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < modified_poly_k9s3_NU; i++) {
+        double piv = cs[2 * modified_poly_k9s3_M + i], dia = cs[2 * modified_poly_k9s3_M + modified_poly_k9s3_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > modified_poly_k9s3_SINGTOL * fabs(dia))) return modified_poly_k9s3_ESINGULAR;
+      }
+      for (i = 0; i < modified_poly_k9s3_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return modified_poly_k9s3_ENONFINITE;
+        modified_poly_k9s3_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[modified_poly_k9s3_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < modified_poly_k9s3_M; i++) phat[i] = p1[i];

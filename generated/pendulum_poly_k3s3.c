@@ -634,6 +634,22 @@ static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1,
 #define pendulum_poly_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef pendulum_poly_k3s3_ITERC
+#define pendulum_poly_k3s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef pendulum_poly_k3s3_ITOLMAX
+#define pendulum_poly_k3s3_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of pendulum_poly_k3s3_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within pendulum_poly_k3s3_ITERC times the step's tolerance tol (1 + scale),
+ * between pendulum_poly_k3s3_TOL and pendulum_poly_k3s3_ITOLMAX; pendulum_poly_k3s3_TOL (round-off) for a fixed step (tol 0). */
+static double pendulum_poly_k3s3_itol(double tol, double scale)
+{
+  double t = pendulum_poly_k3s3_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < pendulum_poly_k3s3_ITOLMAX ? t : pendulum_poly_k3s3_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > pendulum_poly_k3s3_TOL) ? t : pendulum_poly_k3s3_TOL;
+}
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, int cold, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
@@ -646,6 +662,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k3s3_EBADSTEP;
   double ref[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M];
   int two;
+  double tit = pendulum_poly_k3s3_TOL;  /* where the iteration stops (pendulum_poly_k3s3_itol) */
   two = pendulum_poly_k3s3_predict(x, h, cold, prm, gam, ref);
   double g0[pendulum_poly_k3s3_NU];
   pendulum_poly_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -1015,8 +1032,11 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k3s3_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= pendulum_poly_k3s3_TOL || (it > 1 && inc < inc_old && inc * inc <= pendulum_poly_k3s3_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * pendulum_poly_k3s3_step_adaptive the error allowed is the step's tolerance's share (pendulum_poly_k3s3_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = pendulum_poly_k3s3_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = pendulum_poly_k3s3_OK;
       break;
     }
@@ -1077,6 +1097,29 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     pc1[i] = x->pc[i];
     pendulum_poly_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k3s3_add(&p1[i], &pc1[i], sw[pendulum_poly_k3s3_S * pendulum_poly_k3s3_M + i]);
+  }
+  /* the iteration stopped at pendulum_poly_k3s3_step_adaptive's tolerance (pendulum_poly_k3s3_itol): where g(q1) is
+   * not round-off (pendulum_poly_k3s3_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (pendulum_poly_k3s3_ITOLMAX), and gamma_0 with it, so that pendulum_poly_k3s3_dense still starts the step at q0 */
+  if (tit > pendulum_poly_k3s3_TOL) {
+    double g1[pendulum_poly_k3s3_NU];
+    int off = 0;
+    pendulum_poly_k3s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < pendulum_poly_k3s3_NU; i++) off |= !(fabs(g1[i]) <= pendulum_poly_k3s3_GTOL);
+    if (off) {
+      double cs[2 * pendulum_poly_k3s3_M + 2 * pendulum_poly_k3s3_NU];
+      pendulum_poly_k3s3_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < pendulum_poly_k3s3_NU; i++) {
+        double piv = cs[2 * pendulum_poly_k3s3_M + i], dia = cs[2 * pendulum_poly_k3s3_M + pendulum_poly_k3s3_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k3s3_SINGTOL * fabs(dia))) return pendulum_poly_k3s3_ESINGULAR;
+      }
+      for (i = 0; i < pendulum_poly_k3s3_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return pendulum_poly_k3s3_ENONFINITE;
+        pendulum_poly_k3s3_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[pendulum_poly_k3s3_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < pendulum_poly_k3s3_M; i++) phat[i] = p1[i];

@@ -977,6 +977,22 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1,
 #define pendulum_poly_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef pendulum_poly_k4s4_ITERC
+#define pendulum_poly_k4s4_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef pendulum_poly_k4s4_ITOLMAX
+#define pendulum_poly_k4s4_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of pendulum_poly_k4s4_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within pendulum_poly_k4s4_ITERC times the step's tolerance tol (1 + scale),
+ * between pendulum_poly_k4s4_TOL and pendulum_poly_k4s4_ITOLMAX; pendulum_poly_k4s4_TOL (round-off) for a fixed step (tol 0). */
+static double pendulum_poly_k4s4_itol(double tol, double scale)
+{
+  double t = pendulum_poly_k4s4_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < pendulum_poly_k4s4_ITOLMAX ? t : pendulum_poly_k4s4_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > pendulum_poly_k4s4_TOL) ? t : pendulum_poly_k4s4_TOL;
+}
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, int cold, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
@@ -989,6 +1005,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k4s4_EBADSTEP;
   double ref[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M];
   int two;
+  double tit = pendulum_poly_k4s4_TOL;  /* where the iteration stops (pendulum_poly_k4s4_itol) */
   two = pendulum_poly_k4s4_predict(x, h, cold, prm, gam, ref);
   double g0[pendulum_poly_k4s4_NU];
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -1579,8 +1596,11 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     /* converged: the increment is within 2 ulps of the state (pendulum_poly_k4s4_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= pendulum_poly_k4s4_TOL || (it > 1 && inc < inc_old && inc * inc <= pendulum_poly_k4s4_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * pendulum_poly_k4s4_step_adaptive the error allowed is the step's tolerance's share (pendulum_poly_k4s4_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = pendulum_poly_k4s4_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = pendulum_poly_k4s4_OK;
       break;
     }
@@ -1648,6 +1668,29 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     pc1[i] = x->pc[i];
     pendulum_poly_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k4s4_add(&p1[i], &pc1[i], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i]);
+  }
+  /* the iteration stopped at pendulum_poly_k4s4_step_adaptive's tolerance (pendulum_poly_k4s4_itol): where g(q1) is
+   * not round-off (pendulum_poly_k4s4_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (pendulum_poly_k4s4_ITOLMAX), and gamma_0 with it, so that pendulum_poly_k4s4_dense still starts the step at q0 */
+  if (tit > pendulum_poly_k4s4_TOL) {
+    double g1[pendulum_poly_k4s4_NU];
+    int off = 0;
+    pendulum_poly_k4s4_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < pendulum_poly_k4s4_NU; i++) off |= !(fabs(g1[i]) <= pendulum_poly_k4s4_GTOL);
+    if (off) {
+      double cs[2 * pendulum_poly_k4s4_M + 2 * pendulum_poly_k4s4_NU];
+      pendulum_poly_k4s4_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < pendulum_poly_k4s4_NU; i++) {
+        double piv = cs[2 * pendulum_poly_k4s4_M + i], dia = cs[2 * pendulum_poly_k4s4_M + pendulum_poly_k4s4_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > pendulum_poly_k4s4_SINGTOL * fabs(dia))) return pendulum_poly_k4s4_ESINGULAR;
+      }
+      for (i = 0; i < pendulum_poly_k4s4_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return pendulum_poly_k4s4_ENONFINITE;
+        pendulum_poly_k4s4_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[pendulum_poly_k4s4_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < pendulum_poly_k4s4_M; i++) phat[i] = p1[i];

@@ -5038,6 +5038,22 @@ static double satellites_poly_k6s2_err_est(const double *gam, double h, double d
 #define satellites_poly_k6s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef satellites_poly_k6s2_ITERC
+#define satellites_poly_k6s2_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef satellites_poly_k6s2_ITOLMAX
+#define satellites_poly_k6s2_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of satellites_poly_k6s2_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within satellites_poly_k6s2_ITERC times the step's tolerance tol (1 + scale),
+ * between satellites_poly_k6s2_TOL and satellites_poly_k6s2_ITOLMAX; satellites_poly_k6s2_TOL (round-off) for a fixed step (tol 0). */
+static double satellites_poly_k6s2_itol(double tol, double scale)
+{
+  double t = satellites_poly_k6s2_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < satellites_poly_k6s2_ITOLMAX ? t : satellites_poly_k6s2_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > satellites_poly_k6s2_TOL) ? t : satellites_poly_k6s2_TOL;
+}
+
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real h_, double tol, int cold, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
@@ -5050,6 +5066,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s2_EBADSTEP;
   double ref[satellites_poly_k6s2_S * satellites_poly_k6s2_M];
   int two;
+  double tit = satellites_poly_k6s2_TOL;  /* where the iteration stops (satellites_poly_k6s2_itol) */
   two = satellites_poly_k6s2_predict(x, h, cold, prm, gam, ref);
   double g0[satellites_poly_k6s2_NU];
   satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -5124,8 +5141,11 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     /* converged: the increment is within 2 ulps of the state (satellites_poly_k6s2_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= satellites_poly_k6s2_TOL || (it > 1 && inc < inc_old && inc * inc <= satellites_poly_k6s2_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * satellites_poly_k6s2_step_adaptive the error allowed is the step's tolerance's share (satellites_poly_k6s2_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = satellites_poly_k6s2_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = satellites_poly_k6s2_OK;
       break;
     }
@@ -5165,6 +5185,29 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     pc1[i] = x->pc[i];
     satellites_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     satellites_poly_k6s2_add(&p1[i], &pc1[i], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i]);
+  }
+  /* the iteration stopped at satellites_poly_k6s2_step_adaptive's tolerance (satellites_poly_k6s2_itol): where g(q1) is
+   * not round-off (satellites_poly_k6s2_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (satellites_poly_k6s2_ITOLMAX), and gamma_0 with it, so that satellites_poly_k6s2_dense still starts the step at q0 */
+  if (tit > satellites_poly_k6s2_TOL) {
+    double g1[satellites_poly_k6s2_NU];
+    int off = 0;
+    satellites_poly_k6s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < satellites_poly_k6s2_NU; i++) off |= !(fabs(g1[i]) <= satellites_poly_k6s2_GTOL);
+    if (off) {
+      double cs[2 * satellites_poly_k6s2_M + 2 * satellites_poly_k6s2_NU];
+      satellites_poly_k6s2_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < satellites_poly_k6s2_NU; i++) {
+        double piv = cs[2 * satellites_poly_k6s2_M + i], dia = cs[2 * satellites_poly_k6s2_M + satellites_poly_k6s2_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_poly_k6s2_SINGTOL * fabs(dia))) return satellites_poly_k6s2_ESINGULAR;
+      }
+      for (i = 0; i < satellites_poly_k6s2_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return satellites_poly_k6s2_ENONFINITE;
+        satellites_poly_k6s2_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[satellites_poly_k6s2_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < satellites_poly_k6s2_M; i++) phat[i] = p1[i];

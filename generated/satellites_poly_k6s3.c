@@ -8715,6 +8715,22 @@ static double satellites_poly_k6s3_err_est(const double *gam, double h, double d
 #define satellites_poly_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+#ifndef satellites_poly_k6s3_ITERC
+#define satellites_poly_k6s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
+#endif
+#ifndef satellites_poly_k6s3_ITOLMAX
+#define satellites_poly_k6s3_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#endif
+/* The scaled increment at which the iteration of satellites_poly_k6s3_step_adaptive stops: the error
+ * rho inc / (1 - rho) it leaves within satellites_poly_k6s3_ITERC times the step's tolerance tol (1 + scale),
+ * between satellites_poly_k6s3_TOL and satellites_poly_k6s3_ITOLMAX; satellites_poly_k6s3_TOL (round-off) for a fixed step (tol 0). */
+static double satellites_poly_k6s3_itol(double tol, double scale)
+{
+  double t = satellites_poly_k6s3_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
+  t = t < satellites_poly_k6s3_ITOLMAX ? t : satellites_poly_k6s3_ITOLMAX;
+  return (tol > 0) & (scale > 0) & (t > satellites_poly_k6s3_TOL) ? t : satellites_poly_k6s3_TOL;
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, double tol, int cold, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
@@ -8727,6 +8743,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s3_EBADSTEP;
   double ref[satellites_poly_k6s3_S * satellites_poly_k6s3_M];
   int two;
+  double tit = satellites_poly_k6s3_TOL;  /* where the iteration stops (satellites_poly_k6s3_itol) */
   two = satellites_poly_k6s3_predict(x, h, cold, prm, gam, ref);
   double g0[satellites_poly_k6s3_NU];
   satellites_poly_k6s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -8801,8 +8818,11 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     /* converged: the increment is within 2 ulps of the state (satellites_poly_k6s3_TOL), or the error it
      * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the
      * standard test, Hairer & Wanner IV.8), which saves the sweep that would only
-     * confirm it. Iterating further would not help H, which the rescale keeps. */
-    if (inc <= satellites_poly_k6s3_TOL || (it > 1 && inc < inc_old && inc * inc <= satellites_poly_k6s3_TOL * (inc_old - inc))) {
+     * confirm it. Iterating further would not help H, which the rescale keeps. Under
+     * satellites_poly_k6s3_step_adaptive the error allowed is the step's tolerance's share (satellites_poly_k6s3_itol):
+     * the end of the step restores H, g and the hidden constraint. */
+    if (tol > 0) tit = satellites_poly_k6s3_itol(tol, scale);
+    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
       rc = satellites_poly_k6s3_OK;
       break;
     }
@@ -8842,6 +8862,29 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     pc1[i] = x->pc[i];
     satellites_poly_k6s3_add(&q1[i], &qc1[i], h * sw[i]);
     satellites_poly_k6s3_add(&p1[i], &pc1[i], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i]);
+  }
+  /* the iteration stopped at satellites_poly_k6s3_step_adaptive's tolerance (satellites_poly_k6s3_itol): where g(q1) is
+   * not round-off (satellites_poly_k6s3_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
+   * (satellites_poly_k6s3_ITOLMAX), and gamma_0 with it, so that satellites_poly_k6s3_dense still starts the step at q0 */
+  if (tit > satellites_poly_k6s3_TOL) {
+    double g1[satellites_poly_k6s3_NU];
+    int off = 0;
+    satellites_poly_k6s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+    for (i = 0; i < satellites_poly_k6s3_NU; i++) off |= !(fabs(g1[i]) <= satellites_poly_k6s3_GTOL);
+    if (off) {
+      double cs[2 * satellites_poly_k6s3_M + 2 * satellites_poly_k6s3_NU];
+      satellites_poly_k6s3_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
+      for (i = 0; i < satellites_poly_k6s3_NU; i++) {
+        double piv = cs[2 * satellites_poly_k6s3_M + i], dia = cs[2 * satellites_poly_k6s3_M + satellites_poly_k6s3_NU + i];
+        if (isfinite(piv) && isfinite(dia) && !(fabs(piv) > satellites_poly_k6s3_SINGTOL * fabs(dia))) return satellites_poly_k6s3_ESINGULAR;
+      }
+      for (i = 0; i < satellites_poly_k6s3_M; i++) {
+        double d = cs[i];
+        if (!isfinite(d)) return satellites_poly_k6s3_ENONFINITE;
+        satellites_poly_k6s3_add(&q1[i], &qc1[i], d);
+        gam[i] += d / h;
+      }
+    }
   }
   double phat[satellites_poly_k6s3_M];  /* p1 before the projection, the end of p's polynomial */
   for (i = 0; i < satellites_poly_k6s3_M; i++) phat[i] = p1[i];
