@@ -149,36 +149,39 @@ static void emit_commit_common(Emitter *e) {
           "      x->hprev2[l] = cm[l] ? hp : x->hprev2[l];\n      x->hprev[l] = cm[l] ? h : hp;\n    }\n  }\n");
 }
 
-// In NAME_batch_within, before the projection: the Newton step of
+// In NAME_batch_within, before the projection: the Newton steps of
 // emit_end_poly (emit_step.c) onto g = 0 in the lanes whose iteration
-// stopped at the tolerance (itl above TOL) with g(q1) not at round-off;
-// its failure code nc[l] goes before the projection's, as the scalar step
-// returns it first.
+// stopped at the tolerance (itl above TOL), each while its g(q1) is not at
+// round-off, at most NAME_NEWTON; a failure's code nc[l] goes before the
+// projection's, as the scalar step returns it first.
 static void emit_lane_newton(Emitter *e) {
-  tmpl(e, "    $M nc[$P_W];  /* the Newton step's code, before the projection's */\n"
+  tmpl(e, "    $M nc[$P_W];  /* the Newton steps' code, before the projection's */\n"
           "    {  /* the lanes whose iteration stopped at the tolerance: q1 onto g = 0 ($P_step_within) */\n"
-          "      $R g1[$P_NU * $P_W];\n      $M ea[$P_W], off[$P_W], any = 0;\n"
-          "      for (l = 0; l < $P_W; l++) {\n        nc[l] = $P_OK;\n        off[l] = 0;\n"
+          "      $R g1[$P_NU * $P_W], cs[($<consistent>) * $P_W];\n      $M ea[$P_W], off[$P_W], any = 0;\n      int n;\n"
+          "      for (l = 0; l < $P_W; l++) {\n        nc[l] = $P_OK;\n"
           "        ea[l] = go[l] & (itl[l] > $P_TOL);\n        any |= ea[l];\n      }\n"
-          "      if (any) {  /* those where g(q1) is not round-off */\n"
+          "      for (n = 0; n < $P_NEWTON && any; n++) {\n"
           "        $(g q0=q1 prm=par out=g1);\n"
+          "        for (l = 0; l < $P_W; l++) off[l] = 0;\n"
           "        for (i = 0; i < $P_NU; i++)\n"
           "          for (l = 0; l < $P_W; l++) off[l] |= !(fabs$f(g1[i * $P_W + l]) <= $P_GTOL);\n"
-          "        any = 0;\n        for (l = 0; l < $P_W; l++) any |= ea[l] &= off[l];\n      }\n"
-          "      if (any) {\n        $R cs[($<consistent>) * $P_W];\n        $M sgc[$P_W], nfc[$P_W];\n"
+          "        any = 0;\n        for (l = 0; l < $P_W; l++) any |= ea[l] &= off[l];\n"
+          "        if (!any) break;\n"
           "        $(consistent q0=q1 p0=p1 prm=par out=cs);\n"
-          "        for (l = 0; l < $P_W; l++) sgc[l] = nfc[l] = 0;\n"
           "        for (i = 0; i < $P_NU; i++)\n          for (l = 0; l < $P_W; l++) {\n"
           "            $R piv = cs[($[consistent.pivot]i) * $P_W + l], dia = cs[($[consistent.adiag]i) * $P_W + l];\n"
-          "            sgc[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n          }\n"
+          "            $M sg1 = isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n"
+          "            nc[l] = (ea[l] & sg1 & (nc[l] == $P_OK)) ? $P_ESINGULAR : nc[l];\n          }\n"
           "        for (i = 0; i < $P_M; i++)\n          for (l = 0; l < $P_W; l++) {\n"
           "            $R d = cs[($[consistent.dq]i) * $P_W + l], q = q1[i * $P_W + l], qc = qc1[i * $P_W + l];\n"
           "            $R g = sw[($[sweep.gam]i) * $P_W + l], gn = g + d / h;\n"
-          "            nfc[l] |= !isfinite(d);\n            $P_add(&q, &qc, d);\n"
+          "            nc[l] = (ea[l] & !isfinite(d) & (nc[l] == $P_OK)) ? $P_ENONFINITE : nc[l];\n"
+          "            $P_add(&q, &qc, d);\n"
           "            q1[i * $P_W + l] = ea[l] ? q : q1[i * $P_W + l];\n"
           "            qc1[i * $P_W + l] = ea[l] ? qc : qc1[i * $P_W + l];\n"
           "            sw[($[sweep.gam]i) * $P_W + l] = ea[l] ? gn : g;  /* gamma_0 with it */\n          }\n"
-          "        for (l = 0; l < $P_W; l++) nc[l] = !ea[l] ? $P_OK : sgc[l] ? $P_ESINGULAR : nfc[l] ? $P_ENONFINITE : $P_OK;\n"
+          "        any = 0;  /* a lane that failed stops, as the scalar step returns */\n"
+          "        for (l = 0; l < $P_W; l++) any |= ea[l] &= nc[l] == $P_OK;\n"
           "      }\n    }\n");
 }
 

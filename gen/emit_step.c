@@ -317,13 +317,14 @@ static void emit_end_poly(Emitter *e) {
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
   if (itol_wanted(e))
-    tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol): where g(q1) is\n"
-            "   * not round-off ($P_GTOL), q1 onto g = 0 by one Newton step, which leaves it so\n"
-            "   * ($P_ITOLMAX), and gamma_0 with it, so that $P_dense still starts the step at q0 */\n"
-            "  if (tit > $P_TOL) {\n    $R g1[$P_NU];\n    int off = 0;\n"
-            "    $(g q0=q1 out=g1);\n"
-            "    for (i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_GTOL);\n"
-            "    if (off) {\n      $R cs[$<consistent>];\n"
+    tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol): while g(q1) is not\n"
+            "   * round-off ($P_GTOL), q1 onto g = 0 by Newton steps ($P_NEWTON at most: one, or two\n"
+            "   * from $P_ITOLMAX), and gamma_0 with it, so that $P_dense still starts the step at q0 */\n"
+            "  if (tit > $P_TOL) {\n    $R g1[$P_NU], cs[$<consistent>];\n    int n, off;\n"
+            "    for (n = 0; n < $P_NEWTON; n++) {\n"
+            "      $(g q0=q1 out=g1);\n"
+            "      for (off = 0, i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_GTOL);\n"
+            "      if (!off) break;\n"
             "      $(consistent q0=q1 p0=p1 out=cs);\n"
             "      for (i = 0; i < $P_NU; i++) {\n"
             "        $R piv = cs[$[consistent.pivot]i], dia = cs[$[consistent.adiag]i];\n"
@@ -672,14 +673,16 @@ int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e-
 // iteration under a tolerance"). The step's tolerance tol (1 + scale) bounds
 // its local error in q; the iteration error the converged test leaves in q,
 // rho inc / (1 - rho) scale (inc relative to scale), is allowed NAME_ITERC of
-// it. Capped at NAME_ITOLMAX, so that the one Newton step onto g = 0 at the
-// end of the step leaves g at round-off (its error is the square of the
-// correction's), and at least NAME_TOL, the fixed step's round-off test.
+// it. Capped at NAME_ITOLMAX, so that the Newton steps onto g = 0 at the end
+// of the step (each squares the error of the last) bring g back to round-off
+// in one or two (NAME_NEWTON at most), and at least NAME_TOL, the fixed
+// step's round-off test.
 static void emit_itol(Emitter *e) {
   out(e, "#ifndef %s_ITERC\n#define %s_ITERC %s  /* the iteration error allowed, over the step's tolerance */\n#endif\n",
       e->P, e->P, e->single ? "0.1f" : "0.1");
-  out(e, "#ifndef %s_ITOLMAX\n#define %s_ITOLMAX %s  /* at most: one Newton step then puts g at round-off */\n#endif\n",
+  out(e, "#ifndef %s_ITOLMAX\n#define %s_ITOLMAX %s  /* at most: one or two Newton steps put g back at round-off */\n#endif\n",
       e->P, e->P, e->single ? "1e-4f" : "1e-8");
+  out(e, "#ifndef %s_NEWTON\n#define %s_NEWTON 3  /* Newton steps onto g = 0 after it, at most */\n#endif\n", e->P, e->P);
   tmpl(e, "/* The scaled increment at which the iteration of $P_step_adaptive stops: the error\n"
           " * rho inc / (1 - rho) it leaves within $P_ITERC times the step's tolerance tol (1 + scale),\n"
           " * between $P_TOL and $P_ITOLMAX; $P_TOL (round-off) for a fixed step (tol 0). */\n"

@@ -547,7 +547,10 @@ static double conical_poly_k2s2_err_est(const double *gam, double h, double d1, 
 #define conical_poly_k2s2_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
 #ifndef conical_poly_k2s2_ITOLMAX
-#define conical_poly_k2s2_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#define conical_poly_k2s2_ITOLMAX 1e-8  /* at most: one or two Newton steps put g back at round-off */
+#endif
+#ifndef conical_poly_k2s2_NEWTON
+#define conical_poly_k2s2_NEWTON 3  /* Newton steps onto g = 0 after it, at most */
 #endif
 /* The scaled increment at which the iteration of conical_poly_k2s2_step_adaptive stops: the error
  * rho inc / (1 - rho) it leaves within conical_poly_k2s2_ITERC times the step's tolerance tol (1 + scale),
@@ -947,16 +950,16 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     conical_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
   }
-  /* the iteration stopped at conical_poly_k2s2_step_adaptive's tolerance (conical_poly_k2s2_itol): where g(q1) is
-   * not round-off (conical_poly_k2s2_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
-   * (conical_poly_k2s2_ITOLMAX), and gamma_0 with it, so that conical_poly_k2s2_dense still starts the step at q0 */
+  /* the iteration stopped at conical_poly_k2s2_step_adaptive's tolerance (conical_poly_k2s2_itol): while g(q1) is not
+   * round-off (conical_poly_k2s2_GTOL), q1 onto g = 0 by Newton steps (conical_poly_k2s2_NEWTON at most: one, or two
+   * from conical_poly_k2s2_ITOLMAX), and gamma_0 with it, so that conical_poly_k2s2_dense still starts the step at q0 */
   if (tit > conical_poly_k2s2_TOL) {
-    double g1[conical_poly_k2s2_NU];
-    int off = 0;
-    conical_poly_k2s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
-    for (i = 0; i < conical_poly_k2s2_NU; i++) off |= !(fabs(g1[i]) <= conical_poly_k2s2_GTOL);
-    if (off) {
-      double cs[2 * conical_poly_k2s2_M + 2 * conical_poly_k2s2_NU];
+    double g1[conical_poly_k2s2_NU], cs[2 * conical_poly_k2s2_M + 2 * conical_poly_k2s2_NU];
+    int n, off;
+    for (n = 0; n < conical_poly_k2s2_NEWTON; n++) {
+      conical_poly_k2s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+      for (off = 0, i = 0; i < conical_poly_k2s2_NU; i++) off |= !(fabs(g1[i]) <= conical_poly_k2s2_GTOL);
+      if (!off) break;
       conical_poly_k2s2_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
       for (i = 0; i < conical_poly_k2s2_NU; i++) {
         double piv = cs[2 * conical_poly_k2s2_M + i], dia = cs[2 * conical_poly_k2s2_M + conical_poly_k2s2_NU + i];

@@ -1569,7 +1569,10 @@ static double double_pendulum_k3s3_err_est(const double *gam, double h, double d
 #define double_pendulum_k3s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
 #ifndef double_pendulum_k3s3_ITOLMAX
-#define double_pendulum_k3s3_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#define double_pendulum_k3s3_ITOLMAX 1e-8  /* at most: one or two Newton steps put g back at round-off */
+#endif
+#ifndef double_pendulum_k3s3_NEWTON
+#define double_pendulum_k3s3_NEWTON 3  /* Newton steps onto g = 0 after it, at most */
 #endif
 /* The scaled increment at which the iteration of double_pendulum_k3s3_step_adaptive stops: the error
  * rho inc / (1 - rho) it leaves within double_pendulum_k3s3_ITERC times the step's tolerance tol (1 + scale),
@@ -2412,16 +2415,16 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     double_pendulum_k3s3_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k3s3_add(&p1[i], &pc1[i], sw[double_pendulum_k3s3_S * double_pendulum_k3s3_M + i]);
   }
-  /* the iteration stopped at double_pendulum_k3s3_step_adaptive's tolerance (double_pendulum_k3s3_itol): where g(q1) is
-   * not round-off (double_pendulum_k3s3_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
-   * (double_pendulum_k3s3_ITOLMAX), and gamma_0 with it, so that double_pendulum_k3s3_dense still starts the step at q0 */
+  /* the iteration stopped at double_pendulum_k3s3_step_adaptive's tolerance (double_pendulum_k3s3_itol): while g(q1) is not
+   * round-off (double_pendulum_k3s3_GTOL), q1 onto g = 0 by Newton steps (double_pendulum_k3s3_NEWTON at most: one, or two
+   * from double_pendulum_k3s3_ITOLMAX), and gamma_0 with it, so that double_pendulum_k3s3_dense still starts the step at q0 */
   if (tit > double_pendulum_k3s3_TOL) {
-    double g1[double_pendulum_k3s3_NU];
-    int off = 0;
-    double_pendulum_k3s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
-    for (i = 0; i < double_pendulum_k3s3_NU; i++) off |= !(fabs(g1[i]) <= double_pendulum_k3s3_GTOL);
-    if (off) {
-      double cs[2 * double_pendulum_k3s3_M + 2 * double_pendulum_k3s3_NU];
+    double g1[double_pendulum_k3s3_NU], cs[2 * double_pendulum_k3s3_M + 2 * double_pendulum_k3s3_NU];
+    int n, off;
+    for (n = 0; n < double_pendulum_k3s3_NEWTON; n++) {
+      double_pendulum_k3s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+      for (off = 0, i = 0; i < double_pendulum_k3s3_NU; i++) off |= !(fabs(g1[i]) <= double_pendulum_k3s3_GTOL);
+      if (!off) break;
       double_pendulum_k3s3_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
       for (i = 0; i < double_pendulum_k3s3_NU; i++) {
         double piv = cs[2 * double_pendulum_k3s3_M + i], dia = cs[2 * double_pendulum_k3s3_M + double_pendulum_k3s3_NU + i];

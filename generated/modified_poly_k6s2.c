@@ -728,7 +728,10 @@ static double modified_poly_k6s2_err_est(const double *gam, double h, double d1,
 #define modified_poly_k6s2_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
 #ifndef modified_poly_k6s2_ITOLMAX
-#define modified_poly_k6s2_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#define modified_poly_k6s2_ITOLMAX 1e-8  /* at most: one or two Newton steps put g back at round-off */
+#endif
+#ifndef modified_poly_k6s2_NEWTON
+#define modified_poly_k6s2_NEWTON 3  /* Newton steps onto g = 0 after it, at most */
 #endif
 /* The scaled increment at which the iteration of modified_poly_k6s2_step_adaptive stops: the error
  * rho inc / (1 - rho) it leaves within modified_poly_k6s2_ITERC times the step's tolerance tol (1 + scale),
@@ -1441,16 +1444,16 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     modified_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k6s2_add(&p1[i], &pc1[i], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i]);
   }
-  /* the iteration stopped at modified_poly_k6s2_step_adaptive's tolerance (modified_poly_k6s2_itol): where g(q1) is
-   * not round-off (modified_poly_k6s2_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
-   * (modified_poly_k6s2_ITOLMAX), and gamma_0 with it, so that modified_poly_k6s2_dense still starts the step at q0 */
+  /* the iteration stopped at modified_poly_k6s2_step_adaptive's tolerance (modified_poly_k6s2_itol): while g(q1) is not
+   * round-off (modified_poly_k6s2_GTOL), q1 onto g = 0 by Newton steps (modified_poly_k6s2_NEWTON at most: one, or two
+   * from modified_poly_k6s2_ITOLMAX), and gamma_0 with it, so that modified_poly_k6s2_dense still starts the step at q0 */
   if (tit > modified_poly_k6s2_TOL) {
-    double g1[modified_poly_k6s2_NU];
-    int off = 0;
-    modified_poly_k6s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
-    for (i = 0; i < modified_poly_k6s2_NU; i++) off |= !(fabs(g1[i]) <= modified_poly_k6s2_GTOL);
-    if (off) {
-      double cs[2 * modified_poly_k6s2_M + 2 * modified_poly_k6s2_NU];
+    double g1[modified_poly_k6s2_NU], cs[2 * modified_poly_k6s2_M + 2 * modified_poly_k6s2_NU];
+    int n, off;
+    for (n = 0; n < modified_poly_k6s2_NEWTON; n++) {
+      modified_poly_k6s2_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+      for (off = 0, i = 0; i < modified_poly_k6s2_NU; i++) off |= !(fabs(g1[i]) <= modified_poly_k6s2_GTOL);
+      if (!off) break;
       modified_poly_k6s2_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
       for (i = 0; i < modified_poly_k6s2_NU; i++) {
         double piv = cs[2 * modified_poly_k6s2_M + i], dia = cs[2 * modified_poly_k6s2_M + modified_poly_k6s2_NU + i];

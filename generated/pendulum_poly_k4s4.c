@@ -981,7 +981,10 @@ static double pendulum_poly_k4s4_err_est(const double *gam, double h, double d1,
 #define pendulum_poly_k4s4_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
 #ifndef pendulum_poly_k4s4_ITOLMAX
-#define pendulum_poly_k4s4_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#define pendulum_poly_k4s4_ITOLMAX 1e-8  /* at most: one or two Newton steps put g back at round-off */
+#endif
+#ifndef pendulum_poly_k4s4_NEWTON
+#define pendulum_poly_k4s4_NEWTON 3  /* Newton steps onto g = 0 after it, at most */
 #endif
 /* The scaled increment at which the iteration of pendulum_poly_k4s4_step_adaptive stops: the error
  * rho inc / (1 - rho) it leaves within pendulum_poly_k4s4_ITERC times the step's tolerance tol (1 + scale),
@@ -1669,16 +1672,16 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     pendulum_poly_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k4s4_add(&p1[i], &pc1[i], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i]);
   }
-  /* the iteration stopped at pendulum_poly_k4s4_step_adaptive's tolerance (pendulum_poly_k4s4_itol): where g(q1) is
-   * not round-off (pendulum_poly_k4s4_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
-   * (pendulum_poly_k4s4_ITOLMAX), and gamma_0 with it, so that pendulum_poly_k4s4_dense still starts the step at q0 */
+  /* the iteration stopped at pendulum_poly_k4s4_step_adaptive's tolerance (pendulum_poly_k4s4_itol): while g(q1) is not
+   * round-off (pendulum_poly_k4s4_GTOL), q1 onto g = 0 by Newton steps (pendulum_poly_k4s4_NEWTON at most: one, or two
+   * from pendulum_poly_k4s4_ITOLMAX), and gamma_0 with it, so that pendulum_poly_k4s4_dense still starts the step at q0 */
   if (tit > pendulum_poly_k4s4_TOL) {
-    double g1[pendulum_poly_k4s4_NU];
-    int off = 0;
-    pendulum_poly_k4s4_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
-    for (i = 0; i < pendulum_poly_k4s4_NU; i++) off |= !(fabs(g1[i]) <= pendulum_poly_k4s4_GTOL);
-    if (off) {
-      double cs[2 * pendulum_poly_k4s4_M + 2 * pendulum_poly_k4s4_NU];
+    double g1[pendulum_poly_k4s4_NU], cs[2 * pendulum_poly_k4s4_M + 2 * pendulum_poly_k4s4_NU];
+    int n, off;
+    for (n = 0; n < pendulum_poly_k4s4_NEWTON; n++) {
+      pendulum_poly_k4s4_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+      for (off = 0, i = 0; i < pendulum_poly_k4s4_NU; i++) off |= !(fabs(g1[i]) <= pendulum_poly_k4s4_GTOL);
+      if (!off) break;
       pendulum_poly_k4s4_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
       for (i = 0; i < pendulum_poly_k4s4_NU; i++) {
         double piv = cs[2 * pendulum_poly_k4s4_M + i], dia = cs[2 * pendulum_poly_k4s4_M + pendulum_poly_k4s4_NU + i];

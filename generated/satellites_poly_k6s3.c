@@ -8719,7 +8719,10 @@ static double satellites_poly_k6s3_err_est(const double *gam, double h, double d
 #define satellites_poly_k6s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
 #ifndef satellites_poly_k6s3_ITOLMAX
-#define satellites_poly_k6s3_ITOLMAX 1e-8  /* at most: one Newton step then puts g at round-off */
+#define satellites_poly_k6s3_ITOLMAX 1e-8  /* at most: one or two Newton steps put g back at round-off */
+#endif
+#ifndef satellites_poly_k6s3_NEWTON
+#define satellites_poly_k6s3_NEWTON 3  /* Newton steps onto g = 0 after it, at most */
 #endif
 /* The scaled increment at which the iteration of satellites_poly_k6s3_step_adaptive stops: the error
  * rho inc / (1 - rho) it leaves within satellites_poly_k6s3_ITERC times the step's tolerance tol (1 + scale),
@@ -8863,16 +8866,16 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     satellites_poly_k6s3_add(&q1[i], &qc1[i], h * sw[i]);
     satellites_poly_k6s3_add(&p1[i], &pc1[i], sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + i]);
   }
-  /* the iteration stopped at satellites_poly_k6s3_step_adaptive's tolerance (satellites_poly_k6s3_itol): where g(q1) is
-   * not round-off (satellites_poly_k6s3_GTOL), q1 onto g = 0 by one Newton step, which leaves it so
-   * (satellites_poly_k6s3_ITOLMAX), and gamma_0 with it, so that satellites_poly_k6s3_dense still starts the step at q0 */
+  /* the iteration stopped at satellites_poly_k6s3_step_adaptive's tolerance (satellites_poly_k6s3_itol): while g(q1) is not
+   * round-off (satellites_poly_k6s3_GTOL), q1 onto g = 0 by Newton steps (satellites_poly_k6s3_NEWTON at most: one, or two
+   * from satellites_poly_k6s3_ITOLMAX), and gamma_0 with it, so that satellites_poly_k6s3_dense still starts the step at q0 */
   if (tit > satellites_poly_k6s3_TOL) {
-    double g1[satellites_poly_k6s3_NU];
-    int off = 0;
-    satellites_poly_k6s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
-    for (i = 0; i < satellites_poly_k6s3_NU; i++) off |= !(fabs(g1[i]) <= satellites_poly_k6s3_GTOL);
-    if (off) {
-      double cs[2 * satellites_poly_k6s3_M + 2 * satellites_poly_k6s3_NU];
+    double g1[satellites_poly_k6s3_NU], cs[2 * satellites_poly_k6s3_M + 2 * satellites_poly_k6s3_NU];
+    int n, off;
+    for (n = 0; n < satellites_poly_k6s3_NEWTON; n++) {
+      satellites_poly_k6s3_g(q1, 0, 0, 0, 0, 0, 0, prm, g1);
+      for (off = 0, i = 0; i < satellites_poly_k6s3_NU; i++) off |= !(fabs(g1[i]) <= satellites_poly_k6s3_GTOL);
+      if (!off) break;
       satellites_poly_k6s3_consistent(q1, p1, 0, 0, 0, 0, 0, prm, cs);
       for (i = 0; i < satellites_poly_k6s3_NU; i++) {
         double piv = cs[2 * satellites_poly_k6s3_M + i], dia = cs[2 * satellites_poly_k6s3_M + satellites_poly_k6s3_NU + i];
