@@ -338,12 +338,14 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // step every active lane fails: ENOCONV, or its own failure.
 static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, i, l;\n"
+          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_batch_within(x, hh, 0, 0, prm, st);\n"
           "  tol *= $P_TOLC;\n"
           "  for (l = 0; l < $P_W; l++)\n    if (!x->idle[l]) {\n      nact++;\n"
-          "      if (fabs$f(x->t[l]) > tmax) tmax = fabs$f(x->t[l]);\n    }\n"
+          "      if (fabs$f(x->t[l]) > tmax) tmax = fabs$f(x->t[l]);\n"
+          "      if (x->hprev[l] != 0) first = 0;\n    }\n"
+          "  if (first) grow = 100;  /* every active lane's first step: from a guess, as $P_step_adaptive */\n"
           "  for (;;) {\n"
           "    rc = $P_batch_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, s);\n"
           "    if (rc == -1) misses++;\n"

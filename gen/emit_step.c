@@ -1019,7 +1019,9 @@ void emit_step_factor(Emitter *e) {
 // with a smaller step. The next step from the standard controller of
 // Hairer, Norsett and Wanner (I.II.4) for an error of order h^p per unit
 // step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
-// rejection. A failed step is retried with half the step. After three tries
+// rejection; after the first step (hprev 0: from the caller's guess) within
+// [h/5, 100h], as CVODE lets its first step grow 1e4x: the ramp from a small
+// guess took three steps of the satellites' 9 to 33 (2026-11-26, bench/README.md). A failed step is retried with half the step. After three tries
 // over the tolerance the tries start cold (no warm start): the warm start
 // carries the previous step's error into the estimate at every h.
 static void emit_step_adaptive(Emitter *e) {
@@ -1034,7 +1036,8 @@ static void emit_step_adaptive(Emitter *e) {
            " * (%s_mult_err: q is of order 4, p of order %d across the hidden constraint). */\n",
         controller_order(e), e->P, step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
-          "  $P_stats s;\n  $R hh = *h, err, fac, grow = 5;\n  int rc, rejected = 0, misses = 0;\n"
+          "  $P_stats s;\n  $R hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */\n"
+          "  int rc, rejected = 0, misses = 0;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
           "  tol *= $P_TOLC;\n"

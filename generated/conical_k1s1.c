@@ -535,7 +535,7 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_
 int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, conical_k1s1_real tol, const conical_k1s1_params *prm, conical_k1s1_stats *st)
 {
   conical_k1s1_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k1s1_EBADSTEP;

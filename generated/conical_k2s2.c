@@ -648,7 +648,7 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h, const conical_
 int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, conical_k2s2_real tol, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   conical_k2s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k2s2_EBADSTEP;

@@ -711,7 +711,7 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h, const conical_
 int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, conical_k3s3_real tol, const conical_k3s3_params *prm, conical_k3s3_stats *st)
 {
   conical_k3s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k3s3_EBADSTEP;

@@ -773,7 +773,7 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
 int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, conical_k4s4_real tol, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   conical_k4s4_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return conical_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k4s4_EBADSTEP;

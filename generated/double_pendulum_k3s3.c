@@ -2498,7 +2498,7 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s
 int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, double_pendulum_k3s3_real tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   double_pendulum_k3s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k3s3_EBADSTEP;

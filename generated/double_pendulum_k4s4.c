@@ -4455,7 +4455,7 @@ int double_pendulum_k4s4_step(double_pendulum_k4s4_state *x, double_pendulum_k4s
 int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real *h, double_pendulum_k4s4_real tol, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {
   double_pendulum_k4s4_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k4s4_EBADSTEP;

@@ -458,7 +458,7 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h,
 int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, henon_heiles_k3s2_real tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   henon_heiles_k3s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return henon_heiles_k3s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return henon_heiles_k3s2_EBADSTEP;

@@ -896,7 +896,7 @@ int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h, const kepler_k
 int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepler_k16s2_real tol, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
 {
   kepler_k16s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k16s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k16s2_EBADSTEP;

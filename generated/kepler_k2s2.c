@@ -456,7 +456,7 @@ int kepler_k2s2_step(kepler_k2s2_state *x, kepler_k2s2_real h, const kepler_k2s2
 int kepler_k2s2_step_adaptive(kepler_k2s2_state *x, kepler_k2s2_real *h, kepler_k2s2_real tol, const kepler_k2s2_params *prm, kepler_k2s2_stats *st)
 {
   kepler_k2s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k2s2_EBADSTEP;

@@ -532,7 +532,7 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h, const kepler_k3s3
 int kepler_k3s3_step_adaptive(kepler_k3s3_state *x, kepler_k3s3_real *h, kepler_k3s3_real tol, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
 {
   kepler_k3s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k3s3_EBADSTEP;

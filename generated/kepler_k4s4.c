@@ -636,7 +636,7 @@ int kepler_k4s4_step(kepler_k4s4_state *x, kepler_k4s4_real h, const kepler_k4s4
 int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_k4s4_real tol, const kepler_k4s4_params *prm, kepler_k4s4_stats *st)
 {
   kepler_k4s4_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k4s4_EBADSTEP;

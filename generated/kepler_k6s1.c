@@ -498,7 +498,7 @@ int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h, const kepler_k6s1
 int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_k6s1_real tol, const kepler_k6s1_params *prm, kepler_k6s1_stats *st)
 {
   kepler_k6s1_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s1_EBADSTEP;

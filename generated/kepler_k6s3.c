@@ -658,7 +658,7 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h, const kepler_k6s3
 int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_k6s3_real tol, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   kepler_k6s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s3_EBADSTEP;

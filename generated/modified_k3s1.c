@@ -596,7 +596,7 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modif
 int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   modified_k3s1_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return modified_k3s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k3s1_EBADSTEP;

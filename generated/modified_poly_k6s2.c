@@ -1527,7 +1527,7 @@ int modified_poly_k6s2_step(modified_poly_k6s2_state *x, modified_poly_k6s2_real
 int modified_poly_k6s2_step_adaptive(modified_poly_k6s2_state *x, modified_poly_k6s2_real *h, modified_poly_k6s2_real tol, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {
   modified_poly_k6s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return modified_poly_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_poly_k6s2_EBADSTEP;

@@ -466,7 +466,7 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
 int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   pendulum_angle_k6s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_angle_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_angle_k6s3_EBADSTEP;

@@ -480,7 +480,7 @@ int pendulum_k1s1_step(pendulum_k1s1_state *x, pendulum_k1s1_real h, const pendu
 int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, pendulum_k1s1_real tol, const pendulum_k1s1_params *prm, pendulum_k1s1_stats *st)
 {
   pendulum_k1s1_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k1s1_EBADSTEP;

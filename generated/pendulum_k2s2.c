@@ -575,7 +575,7 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h, const pendu
 int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, pendulum_k2s2_real tol, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
 {
   pendulum_k2s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k2s2_EBADSTEP;

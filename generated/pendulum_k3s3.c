@@ -616,7 +616,7 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h, const pendu
 int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, pendulum_k3s3_real tol, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
   pendulum_k3s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k3s3_EBADSTEP;

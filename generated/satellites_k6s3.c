@@ -2939,7 +2939,7 @@ int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h, const
 int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real *h, satellites_k6s3_real tol, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   satellites_k6s3_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s3_EBADSTEP;

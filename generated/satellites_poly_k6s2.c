@@ -5272,7 +5272,7 @@ int satellites_poly_k6s2_step(satellites_poly_k6s2_state *x, satellites_poly_k6s
 int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites_poly_k6s2_real *h, satellites_poly_k6s2_real tol, const satellites_poly_k6s2_params *prm, satellites_poly_k6s2_stats *st)
 {
   satellites_poly_k6s2_stats s;
-  double hh = *h, err, fac, grow = 5;
+  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0;
   if (!(hh != 0 && isfinite(hh))) return satellites_poly_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_poly_k6s2_EBADSTEP;
