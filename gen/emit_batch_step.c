@@ -242,9 +242,8 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
           "        nf[l] |= !isfinite(q1[i * $P_W + l]) | !isfinite(p);\n      }\n"
           "    for (l = 0; l < $P_W; l++) {\n"
           "      $M code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n");
-  if (adaptive && itol_wanted(e)) tmpl(e, "      code = nc[l] != $P_OK ? nc[l] : code;  /* the Newton step's first, as in $P_step_within */\n");
-  tmpl(e, ""
-          "      rc[l] = go[l] ? code : rc[l];\n      cm[l] = go[l] & (code == $P_OK);\n"
+  if (adaptive && itol_wanted(e)) tmpl(e, "      code = nc[l] != $P_OK ? nc[l] : code;  /* the Newton steps' first, as in $P_step_within */\n");
+  tmpl(e, "      rc[l] = go[l] ? code : rc[l];\n      cm[l] = go[l] & (code == $P_OK);\n"
           "      x->H0[l] = cm[l] ? H0[l] : x->H0[l];\n    }\n"
           "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
           "        x->q[i * $P_W + l] = cm[l] ? q1[i * $P_W + l] : x->q[i * $P_W + l];\n"

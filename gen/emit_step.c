@@ -519,29 +519,27 @@ static void emit_fused_checks(Emitter *e) {
 static void emit_convergence(Emitter *e) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
-  if (poly && itol_wanted(e))
+  if (poly) { /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
             "     * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the\n"
             "     * standard test, Hairer & Wanner IV.8), which saves the sweep that would only\n"
-            "     * confirm it. Iterating further would not help H, which the rescale keeps. Under\n"
-            "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
-            "     * the end of the step restores H, g and the hidden constraint. */\n"
-            "    if (tol > 0) tit = $P_itol(tol, scale);\n"
-            "    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {\n"
-            "      rc = $P_OK;\n      break;\n    }\n");
-  else if (poly) /* the end of the step restores H and the hidden constraint */
-    tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
-            "     * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the\n"
-            "     * standard test, Hairer & Wanner IV.8), which saves the sweep that would only\n"
-            "     * confirm it. Iterating further would not help H, which the rescale keeps. */\n"
-            "    if (inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc))) {\n"
-            "      rc = $P_OK;\n      break;\n    }\n");
-  else
+            "     * confirm it. Iterating further would not help H, which the rescale keeps.");
+    if (itol_wanted(e))
+      tmpl(e, " Under\n"
+              "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
+              "     * the end of the step restores H, g and the hidden constraint. */\n"
+              "    if (tol > 0) tit = $P_itol(tol, scale);\n"
+              "    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {\n");
+    else
+      tmpl(e, " */\n    if (inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc))) {\n");
+    tmpl(e, "      rc = $P_OK;\n      break;\n    }\n");
+  } else {
     tmpl(e, "    /* converged: the increment is far below an ulp of the state ($P_TOL / 256), or\n"
             "     * within 2 ulps ($P_TOL) and falling by less than 4x (round-off noise). Iterating\n"
             "     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a\n"
             "     * random walk over millions of steps (bench/results/longrun.txt). */\n"
             "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) { rc = $P_OK; break; }\n");
+  }
   tmpl(e, "    /* otherwise progress is a new smallest increment: those of a converging sweep\n"
           "     * need not fall every time (X_s has complex eigenvalues), so a rise alone is\n"
           "     * no failure. $P_STALL sweeps without one are a stall: converged if it is at\n"
@@ -665,7 +663,7 @@ static void emit_tolc(Emitter *e) {
 // Whether NAME_step_adaptive's iteration stops at its tolerance rather than
 // at round-off (NAME_itol): the polynomial family, whose end of step restores
 // H (the rescale) and the hidden constraint (the projection) whatever the
-// iteration left, and g with one Newton step (emit_end_poly); not under
+// iteration left, and g with Newton steps (emit_end_poly); not under
 // --wide-step, whose iteration is in the wider type.
 int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e->wide_step; }
 
