@@ -85,13 +85,14 @@ static void emit_lane_test(Emitter *e, int poly) {
     tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
             "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
+  if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
+    tmpl(e, "  if (it == 1)  /* once a step, at the first sweep's scale (a loop of its own: a division) */\n"
+            "    for (l = 0; l < $P_W; l++) itl[l] = $P_itol(tol, scale[l]);\n");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
-  if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
-    tmpl(e, "    $R ti = $P_itol(tol, scale[l]);\n"
-            "    ok[l] = (in <= ti) | ((it > 1) & (in < old) & (in * in <= ti * (old - in)));\n"
-            "    itl[l] = act[l] ? ti : itl[l];\n");
+  if (itol_wanted(e))
+    tmpl(e, "    ok[l] = (in <= itl[l]) | ((it > 1) & (in < old) & (in * in <= itl[l] * (old - in)));\n");
   else
     tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
                  : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
@@ -151,15 +152,19 @@ static void emit_commit_common(Emitter *e) {
 
 // In NAME_batch_within, before the projection: the Newton steps of
 // emit_end_poly (emit_step.c) onto g = 0 in the lanes whose iteration
-// stopped at the tolerance (itl above TOL), each while its g(q1) is not at
-// round-off, at most NAME_NEWTON; a failure's code nc[l] goes before the
-// projection's, as the scalar step returns it first.
+// stopped at the tolerance above round-off (the test of NAME_step_within on
+// its last increments: it met the tolerance's, not round-off's), each while
+// its g(q1) is not at round-off, at most NAME_NEWTON; a failure's code nc[l]
+// goes before the projection's, as the scalar step returns it first.
 static void emit_lane_newton(Emitter *e) {
   tmpl(e, "    $M nc[$P_W];  /* the Newton steps' code, before the projection's */\n"
           "    {  /* the lanes whose iteration stopped at the tolerance: q1 onto g = 0 ($P_step_within) */\n"
           "      $R g1[$P_NU * $P_W], cs[($<consistent>) * $P_W];\n      $M ea[$P_W], off[$P_W], any = 0;\n      int n;\n"
-          "      for (l = 0; l < $P_W; l++) {\n        nc[l] = $P_OK;\n"
-          "        ea[l] = go[l] & (itl[l] > $P_TOL);\n        any |= ea[l];\n      }\n"
+          "      for (l = 0; l < $P_W; l++) {  /* the stopping test on the last increment (inc) and the one before (incp) */\n"
+          "        $R in = inc[l], old = incp[l];\n"
+          "        $M at = (in <= itl[l]) | ((iters[l] > 1) & (in < old) & (in * in <= itl[l] * (old - in)));\n"
+          "        $M round = (in <= $P_TOL) | ((iters[l] > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
+          "        nc[l] = $P_OK;\n        ea[l] = go[l] & at & (round == 0);\n        any |= ea[l];\n      }\n"
           "      for (n = 0; n < $P_NEWTON && any; n++) {\n"
           "        $(g q0=q1 prm=par out=g1);\n"
           "        for (l = 0; l < $P_W; l++) off[l] = 0;\n"
@@ -394,7 +399,8 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
   if (poly) tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n  $M fresh[$P_W];\n  int nfresh = 0;\n");
-  if (itol_wanted(e)) tmpl(e, "  $R itl[$P_W];  /* where each lane's iteration stopped ($P_itol) */\n");
+  if (itol_wanted(e))
+    tmpl(e, "  $R itl[$P_W];  /* where each lane's iteration stops ($P_itol) */\n");
   if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
   tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"

@@ -317,10 +317,11 @@ static void emit_end_poly(Emitter *e) {
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
   if (itol_wanted(e))
-    tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol): while g(q1) is not\n"
-            "   * round-off ($P_GTOL), q1 onto g = 0 by Newton steps ($P_NEWTON at most: one, or two\n"
-            "   * from $P_ITOLMAX), and gamma_0 with it, so that $P_dense still starts the step at q0 */\n"
-            "  if (tit > $P_TOL) {\n    $R g1[$P_NU], cs[$<consistent>];\n    int n, off;\n"
+    tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol), above round-off:\n"
+            "   * while g(q1) is not round-off ($P_GTOL), q1 onto g = 0 by Newton steps ($P_NEWTON at\n"
+            "   * most: one, or two from $P_ITOLMAX), and gamma_0 with it, so that $P_dense still\n"
+            "   * starts the step at q0 */\n"
+            "  if (attol) {\n    $R g1[$P_NU], cs[$<consistent>];\n    int n, off;\n"
             "    for (n = 0; n < $P_NEWTON; n++) {\n"
             "      $(g q0=q1 out=g1);\n"
             "      for (off = 0, i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_GTOL);\n"
@@ -528,8 +529,9 @@ static void emit_convergence(Emitter *e) {
       tmpl(e, " Under\n"
               "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
               "     * the end of the step restores H, g and the hidden constraint. */\n"
-              "    if (tol > 0) tit = $P_itol(tol, scale);\n"
-              "    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {\n");
+              "    if (tol > 0 && it == 1) tit = $P_itol(tol, scale);  /* once a step, at the first sweep's scale */\n"
+              "    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {\n"
+              "      attol = !(inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc)));\n");
     else
       tmpl(e, " */\n    if (inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc))) {\n");
     tmpl(e, "      rc = $P_OK;\n      break;\n    }\n");
@@ -838,7 +840,9 @@ static void emit_step(Emitter *e) {
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
   if (poly) tmpl(e, "  $R ref[$P_S * $P_M];\n  int two;\n");
-  if (itol_wanted(e)) tmpl(e, "  $R tit = $P_TOL;  /* where the iteration stops ($P_itol) */\n");
+  if (itol_wanted(e))
+    tmpl(e, "  $R tit = $P_TOL;  /* where the iteration stops ($P_itol) */\n"
+            "  int attol = 0;  /* it stopped there, above round-off */\n");
   if (wide) {
     tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
             "  {\n    $R guess[$P_S * $P_M];\n");

@@ -575,6 +575,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   double ref[conical_poly_k2s2_S * conical_poly_k2s2_M];
   int two;
   double tit = conical_poly_k2s2_TOL;  /* where the iteration stops (conical_poly_k2s2_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = conical_poly_k2s2_predict(x, h, cold, prm, gam, ref);
   double g0[conical_poly_k2s2_NU];
   conical_poly_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -888,8 +889,9 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * conical_poly_k2s2_step_adaptive the error allowed is the step's tolerance's share (conical_poly_k2s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = conical_poly_k2s2_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = conical_poly_k2s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= conical_poly_k2s2_TOL || (it > 1 && inc < inc_old && inc * inc <= conical_poly_k2s2_TOL * (inc_old - inc)));
       rc = conical_poly_k2s2_OK;
       break;
     }
@@ -950,10 +952,11 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     conical_poly_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     conical_poly_k2s2_add(&p1[i], &pc1[i], sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i]);
   }
-  /* the iteration stopped at conical_poly_k2s2_step_adaptive's tolerance (conical_poly_k2s2_itol): while g(q1) is not
-   * round-off (conical_poly_k2s2_GTOL), q1 onto g = 0 by Newton steps (conical_poly_k2s2_NEWTON at most: one, or two
-   * from conical_poly_k2s2_ITOLMAX), and gamma_0 with it, so that conical_poly_k2s2_dense still starts the step at q0 */
-  if (tit > conical_poly_k2s2_TOL) {
+  /* the iteration stopped at conical_poly_k2s2_step_adaptive's tolerance (conical_poly_k2s2_itol), above round-off:
+   * while g(q1) is not round-off (conical_poly_k2s2_GTOL), q1 onto g = 0 by Newton steps (conical_poly_k2s2_NEWTON at
+   * most: one, or two from conical_poly_k2s2_ITOLMAX), and gamma_0 with it, so that conical_poly_k2s2_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[conical_poly_k2s2_NU], cs[2 * conical_poly_k2s2_M + 2 * conical_poly_k2s2_NU];
     int n, off;
     for (n = 0; n < conical_poly_k2s2_NEWTON; n++) {

@@ -910,6 +910,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   double ref[double_pendulum_k2s2_S * double_pendulum_k2s2_M];
   int two;
   double tit = double_pendulum_k2s2_TOL;  /* where the iteration stops (double_pendulum_k2s2_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = double_pendulum_k2s2_predict(x, h, cold, prm, gam, ref);
   double g0[double_pendulum_k2s2_NU];
   double_pendulum_k2s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -1358,8 +1359,9 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * double_pendulum_k2s2_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k2s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = double_pendulum_k2s2_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = double_pendulum_k2s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= double_pendulum_k2s2_TOL || (it > 1 && inc < inc_old && inc * inc <= double_pendulum_k2s2_TOL * (inc_old - inc)));
       rc = double_pendulum_k2s2_OK;
       break;
     }
@@ -1428,10 +1430,11 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     double_pendulum_k2s2_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k2s2_add(&p1[i], &pc1[i], sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i]);
   }
-  /* the iteration stopped at double_pendulum_k2s2_step_adaptive's tolerance (double_pendulum_k2s2_itol): while g(q1) is not
-   * round-off (double_pendulum_k2s2_GTOL), q1 onto g = 0 by Newton steps (double_pendulum_k2s2_NEWTON at most: one, or two
-   * from double_pendulum_k2s2_ITOLMAX), and gamma_0 with it, so that double_pendulum_k2s2_dense still starts the step at q0 */
-  if (tit > double_pendulum_k2s2_TOL) {
+  /* the iteration stopped at double_pendulum_k2s2_step_adaptive's tolerance (double_pendulum_k2s2_itol), above round-off:
+   * while g(q1) is not round-off (double_pendulum_k2s2_GTOL), q1 onto g = 0 by Newton steps (double_pendulum_k2s2_NEWTON at
+   * most: one, or two from double_pendulum_k2s2_ITOLMAX), and gamma_0 with it, so that double_pendulum_k2s2_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[double_pendulum_k2s2_NU], cs[2 * double_pendulum_k2s2_M + 2 * double_pendulum_k2s2_NU];
     int n, off;
     for (n = 0; n < double_pendulum_k2s2_NEWTON; n++) {

@@ -3060,6 +3060,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   double ref[double_pendulum_k4s4_S * double_pendulum_k4s4_M];
   int two;
   double tit = double_pendulum_k4s4_TOL;  /* where the iteration stops (double_pendulum_k4s4_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = double_pendulum_k4s4_predict(x, h, cold, prm, gam, ref);
   double g0[double_pendulum_k4s4_NU];
   double_pendulum_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -4274,8 +4275,9 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * double_pendulum_k4s4_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k4s4_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = double_pendulum_k4s4_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = double_pendulum_k4s4_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= double_pendulum_k4s4_TOL || (it > 1 && inc < inc_old && inc * inc <= double_pendulum_k4s4_TOL * (inc_old - inc)));
       rc = double_pendulum_k4s4_OK;
       break;
     }
@@ -4372,10 +4374,11 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     double_pendulum_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     double_pendulum_k4s4_add(&p1[i], &pc1[i], sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + i]);
   }
-  /* the iteration stopped at double_pendulum_k4s4_step_adaptive's tolerance (double_pendulum_k4s4_itol): while g(q1) is not
-   * round-off (double_pendulum_k4s4_GTOL), q1 onto g = 0 by Newton steps (double_pendulum_k4s4_NEWTON at most: one, or two
-   * from double_pendulum_k4s4_ITOLMAX), and gamma_0 with it, so that double_pendulum_k4s4_dense still starts the step at q0 */
-  if (tit > double_pendulum_k4s4_TOL) {
+  /* the iteration stopped at double_pendulum_k4s4_step_adaptive's tolerance (double_pendulum_k4s4_itol), above round-off:
+   * while g(q1) is not round-off (double_pendulum_k4s4_GTOL), q1 onto g = 0 by Newton steps (double_pendulum_k4s4_NEWTON at
+   * most: one, or two from double_pendulum_k4s4_ITOLMAX), and gamma_0 with it, so that double_pendulum_k4s4_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[double_pendulum_k4s4_NU], cs[2 * double_pendulum_k4s4_M + 2 * double_pendulum_k4s4_NU];
     int n, off;
     for (n = 0; n < double_pendulum_k4s4_NEWTON; n++) {

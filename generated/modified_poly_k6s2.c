@@ -756,6 +756,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   double ref[modified_poly_k6s2_S * modified_poly_k6s2_M];
   int two;
   double tit = modified_poly_k6s2_TOL;  /* where the iteration stops (modified_poly_k6s2_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = modified_poly_k6s2_predict(x, h, cold, prm, gam, ref);
   double g0[modified_poly_k6s2_NU];
   modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -1382,8 +1383,9 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * modified_poly_k6s2_step_adaptive the error allowed is the step's tolerance's share (modified_poly_k6s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = modified_poly_k6s2_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = modified_poly_k6s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= modified_poly_k6s2_TOL || (it > 1 && inc < inc_old && inc * inc <= modified_poly_k6s2_TOL * (inc_old - inc)));
       rc = modified_poly_k6s2_OK;
       break;
     }
@@ -1444,10 +1446,11 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     modified_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k6s2_add(&p1[i], &pc1[i], sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i]);
   }
-  /* the iteration stopped at modified_poly_k6s2_step_adaptive's tolerance (modified_poly_k6s2_itol): while g(q1) is not
-   * round-off (modified_poly_k6s2_GTOL), q1 onto g = 0 by Newton steps (modified_poly_k6s2_NEWTON at most: one, or two
-   * from modified_poly_k6s2_ITOLMAX), and gamma_0 with it, so that modified_poly_k6s2_dense still starts the step at q0 */
-  if (tit > modified_poly_k6s2_TOL) {
+  /* the iteration stopped at modified_poly_k6s2_step_adaptive's tolerance (modified_poly_k6s2_itol), above round-off:
+   * while g(q1) is not round-off (modified_poly_k6s2_GTOL), q1 onto g = 0 by Newton steps (modified_poly_k6s2_NEWTON at
+   * most: one, or two from modified_poly_k6s2_ITOLMAX), and gamma_0 with it, so that modified_poly_k6s2_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[modified_poly_k6s2_NU], cs[2 * modified_poly_k6s2_M + 2 * modified_poly_k6s2_NU];
     int n, off;
     for (n = 0; n < modified_poly_k6s2_NEWTON; n++) {

@@ -1219,6 +1219,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   double ref[modified_poly_k9s3_S * modified_poly_k9s3_M];
   int two;
   double tit = modified_poly_k9s3_TOL;  /* where the iteration stops (modified_poly_k9s3_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = modified_poly_k9s3_predict(x, h, cold, prm, gam, ref);
   double g0[modified_poly_k9s3_NU];
   modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -2365,8 +2366,9 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * modified_poly_k9s3_step_adaptive the error allowed is the step's tolerance's share (modified_poly_k9s3_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = modified_poly_k9s3_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = modified_poly_k9s3_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= modified_poly_k9s3_TOL || (it > 1 && inc < inc_old && inc * inc <= modified_poly_k9s3_TOL * (inc_old - inc)));
       rc = modified_poly_k9s3_OK;
       break;
     }
@@ -2437,10 +2439,11 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     modified_poly_k9s3_add(&q1[i], &qc1[i], h * sw[i]);
     modified_poly_k9s3_add(&p1[i], &pc1[i], sw[modified_poly_k9s3_S * modified_poly_k9s3_M + i]);
   }
-  /* the iteration stopped at modified_poly_k9s3_step_adaptive's tolerance (modified_poly_k9s3_itol): while g(q1) is not
-   * round-off (modified_poly_k9s3_GTOL), q1 onto g = 0 by Newton steps (modified_poly_k9s3_NEWTON at most: one, or two
-   * from modified_poly_k9s3_ITOLMAX), and gamma_0 with it, so that modified_poly_k9s3_dense still starts the step at q0 */
-  if (tit > modified_poly_k9s3_TOL) {
+  /* the iteration stopped at modified_poly_k9s3_step_adaptive's tolerance (modified_poly_k9s3_itol), above round-off:
+   * while g(q1) is not round-off (modified_poly_k9s3_GTOL), q1 onto g = 0 by Newton steps (modified_poly_k9s3_NEWTON at
+   * most: one, or two from modified_poly_k9s3_ITOLMAX), and gamma_0 with it, so that modified_poly_k9s3_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[modified_poly_k9s3_NU], cs[2 * modified_poly_k9s3_M + 2 * modified_poly_k9s3_NU];
     int n, off;
     for (n = 0; n < modified_poly_k9s3_NEWTON; n++) {

@@ -1009,6 +1009,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   double ref[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M];
   int two;
   double tit = pendulum_poly_k4s4_TOL;  /* where the iteration stops (pendulum_poly_k4s4_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = pendulum_poly_k4s4_predict(x, h, cold, prm, gam, ref);
   double g0[pendulum_poly_k4s4_NU];
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -1602,8 +1603,9 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * pendulum_poly_k4s4_step_adaptive the error allowed is the step's tolerance's share (pendulum_poly_k4s4_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = pendulum_poly_k4s4_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = pendulum_poly_k4s4_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= pendulum_poly_k4s4_TOL || (it > 1 && inc < inc_old && inc * inc <= pendulum_poly_k4s4_TOL * (inc_old - inc)));
       rc = pendulum_poly_k4s4_OK;
       break;
     }
@@ -1672,10 +1674,11 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     pendulum_poly_k4s4_add(&q1[i], &qc1[i], h * sw[i]);
     pendulum_poly_k4s4_add(&p1[i], &pc1[i], sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i]);
   }
-  /* the iteration stopped at pendulum_poly_k4s4_step_adaptive's tolerance (pendulum_poly_k4s4_itol): while g(q1) is not
-   * round-off (pendulum_poly_k4s4_GTOL), q1 onto g = 0 by Newton steps (pendulum_poly_k4s4_NEWTON at most: one, or two
-   * from pendulum_poly_k4s4_ITOLMAX), and gamma_0 with it, so that pendulum_poly_k4s4_dense still starts the step at q0 */
-  if (tit > pendulum_poly_k4s4_TOL) {
+  /* the iteration stopped at pendulum_poly_k4s4_step_adaptive's tolerance (pendulum_poly_k4s4_itol), above round-off:
+   * while g(q1) is not round-off (pendulum_poly_k4s4_GTOL), q1 onto g = 0 by Newton steps (pendulum_poly_k4s4_NEWTON at
+   * most: one, or two from pendulum_poly_k4s4_ITOLMAX), and gamma_0 with it, so that pendulum_poly_k4s4_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[pendulum_poly_k4s4_NU], cs[2 * pendulum_poly_k4s4_M + 2 * pendulum_poly_k4s4_NU];
     int n, off;
     for (n = 0; n < pendulum_poly_k4s4_NEWTON; n++) {

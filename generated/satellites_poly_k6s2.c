@@ -5070,6 +5070,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
   double ref[satellites_poly_k6s2_S * satellites_poly_k6s2_M];
   int two;
   double tit = satellites_poly_k6s2_TOL;  /* where the iteration stops (satellites_poly_k6s2_itol) */
+  int attol = 0;  /* it stopped there, above round-off */
   two = satellites_poly_k6s2_predict(x, h, cold, prm, gam, ref);
   double g0[satellites_poly_k6s2_NU];
   satellites_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
@@ -5147,8 +5148,9 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
      * confirm it. Iterating further would not help H, which the rescale keeps. Under
      * satellites_poly_k6s2_step_adaptive the error allowed is the step's tolerance's share (satellites_poly_k6s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
-    if (tol > 0) tit = satellites_poly_k6s2_itol(tol, scale);
+    if (tol > 0 && it == 1) tit = satellites_poly_k6s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
     if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
+      attol = !(inc <= satellites_poly_k6s2_TOL || (it > 1 && inc < inc_old && inc * inc <= satellites_poly_k6s2_TOL * (inc_old - inc)));
       rc = satellites_poly_k6s2_OK;
       break;
     }
@@ -5189,10 +5191,11 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     satellites_poly_k6s2_add(&q1[i], &qc1[i], h * sw[i]);
     satellites_poly_k6s2_add(&p1[i], &pc1[i], sw[satellites_poly_k6s2_S * satellites_poly_k6s2_M + i]);
   }
-  /* the iteration stopped at satellites_poly_k6s2_step_adaptive's tolerance (satellites_poly_k6s2_itol): while g(q1) is not
-   * round-off (satellites_poly_k6s2_GTOL), q1 onto g = 0 by Newton steps (satellites_poly_k6s2_NEWTON at most: one, or two
-   * from satellites_poly_k6s2_ITOLMAX), and gamma_0 with it, so that satellites_poly_k6s2_dense still starts the step at q0 */
-  if (tit > satellites_poly_k6s2_TOL) {
+  /* the iteration stopped at satellites_poly_k6s2_step_adaptive's tolerance (satellites_poly_k6s2_itol), above round-off:
+   * while g(q1) is not round-off (satellites_poly_k6s2_GTOL), q1 onto g = 0 by Newton steps (satellites_poly_k6s2_NEWTON at
+   * most: one, or two from satellites_poly_k6s2_ITOLMAX), and gamma_0 with it, so that satellites_poly_k6s2_dense still
+   * starts the step at q0 */
+  if (attol) {
     double g1[satellites_poly_k6s2_NU], cs[2 * satellites_poly_k6s2_M + 2 * satellites_poly_k6s2_NU];
     int n, off;
     for (n = 0; n < satellites_poly_k6s2_NEWTON; n++) {
