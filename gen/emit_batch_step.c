@@ -86,13 +86,14 @@ static void emit_lane_test(Emitter *e, int poly) {
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
             "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
   if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
-    tmpl(e, "  if (it == 1)  /* once a step, at the first sweep's scale (a loop of its own: a division) */\n"
+    tmpl(e, "  if (itl && it == 1)  /* once a step, at the first sweep's scale (a loop of its own: a division) */\n"
             "    for (l = 0; l < $P_W; l++) itl[l] = $P_itol(tol, scale[l]);\n");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   if (itol_wanted(e))
-    tmpl(e, "    ok[l] = (in <= itl[l]) | ((it > 1) & (in < old) & (in * in <= itl[l] * (old - in)));\n");
+    tmpl(e, "    $R ti = itl ? itl[l] : $P_TOL;  /* the fixed step passes none: its test is $P_TOL's */\n"
+            "    ok[l] = (in <= ti) | ((it > 1) & (in < old) & (in * in <= ti * (old - in)));\n");
   else
     tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
                  : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
@@ -399,14 +400,13 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
   if (poly) tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n  $M fresh[$P_W];\n  int nfresh = 0;\n");
-  if (itol_wanted(e))
-    tmpl(e, "  $R itl[$P_W];  /* where each lane's iteration stops ($P_itol) */\n");
+  if (itol_wanted(e) && adaptive) tmpl(e, "  $R itl[$P_W];  /* where each lane's iteration stops ($P_itol) */\n");
   if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
   tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
   if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
-  if (itol_wanted(e)) tmpl(e, "    itl[l] = $P_TOL;\n");
+  if (itol_wanted(e) && adaptive) tmpl(e, "    itl[l] = $P_TOL;\n");
   tmpl(e, "    rc[l] = rc0;\n    idle |= x->idle[l];\n  }\n"
           "  if (idle)  /* mostly none */\n    for (l = 0; l < $P_W; l++) rc[l] = x->idle[l] ? $P_OK : rc0;\n");
   if (poly) tmpl(e, "  for (i = 0; i < $P_S * $P_NU * $P_W; i++) lin[i] = 0;\n");
@@ -451,7 +451,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
             "      tried = -1;\n      goto out;\n    }\n");
   tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh, ngo"
                : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo");
-  tmpl(e, !itol_wanted(e) ? ");\n" : adaptive ? ", tol, itl);\n" : ", 0, itl);\n");
+  tmpl(e, !itol_wanted(e) ? ");\n" : adaptive ? ", tol, itl);\n" : ", 0, 0);\n");
   tmpl(e, "    {  /* this sweep's results are the next one's input */\n      $R *t = in;\n      in = sw;\n      sw = t;\n    }\n");
   if (poly) tmpl(e, "    lin = in + ($[sweep.lam]0) * $P_W;\n");
   tmpl(e, "  }\n  sw = in;  /* the last sweep's results */\n"
