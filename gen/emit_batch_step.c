@@ -93,7 +93,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   if (itol_wanted(e))
     tmpl(e, "    $R ti = itl ? itl[l] : $P_TOL;  /* the fixed step passes none: its test is $P_TOL's */\n"
-            "    ok[l] = (in <= ti) | ((it > 1) & (in < old) & (in * in <= ti * (old - in)));\n");
+            "    ok[l] = (in <= ti) | ((it > 1) & (in < old) & (in * in <= ti * (old - in)));  /* $P_converged, as masks */\n");
   else
     tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
                  : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
@@ -161,8 +161,8 @@ static void emit_lane_newton(Emitter *e) {
   tmpl(e, "    $M nc[$P_W];  /* the Newton steps' code, before the projection's */\n"
           "    {  /* the lanes whose iteration stopped at the tolerance: q1 onto g = 0 ($P_step_within) */\n"
           "      $R g1[$P_NU * $P_W], cs[($<consistent>) * $P_W];\n      $M ea[$P_W], off[$P_W], any = 0;\n      int n;\n"
-          "      for (l = 0; l < $P_W; l++) {  /* the stopping test on the last increment (inc) and the one before (incp) */\n"
-          "        $R in = inc[l], old = incp[l];\n"
+          "      for (l = 0; l < $P_W; l++) {  /* the test on the last increment (inc) and the one before (incp) */\n"
+          "        $R in = inc[l], old = incp[l];  /* $P_converged at itl and at $P_TOL, as masks */\n"
           "        $M at = (in <= itl[l]) | ((iters[l] > 1) & (in < old) & (in * in <= itl[l] * (old - in)));\n"
           "        $M round = (in <= $P_TOL) | ((iters[l] > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
           "        nc[l] = $P_OK;\n        ea[l] = go[l] & at & (round == 0);\n        any |= ea[l];\n      }\n"

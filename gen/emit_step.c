@@ -530,8 +530,8 @@ static void emit_convergence(Emitter *e) {
               "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
               "     * the end of the step restores H, g and the hidden constraint. */\n"
               "    if (tol > 0 && it == 1) tit = $P_itol(tol, scale);  /* once a step, at the first sweep's scale */\n"
-              "    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {\n"
-              "      attol = !(inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc)));\n");
+              "    if ($P_converged(inc, inc_old, it, tit)) {\n"
+              "      attol = !$P_converged(inc, inc_old, it, $P_TOL);\n");
     else
       tmpl(e, " */\n    if (inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc))) {\n");
     tmpl(e, "      rc = $P_OK;\n      break;\n    }\n");
@@ -689,7 +689,11 @@ static void emit_itol(Emitter *e) {
           "static $R $P_itol($R tol, $R scale)\n{\n"
           "  $R t = $P_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);\n"
           "  t = t < $P_ITOLMAX ? t : $P_ITOLMAX;\n"
-          "  return (tol > 0) & (scale > 0) & (t > $P_TOL) ? t : $P_TOL;\n}\n\n");
+          "  return (tol > 0) & (scale > 0) & (t > $P_TOL) ? t : $P_TOL;\n}\n\n"
+          "/* The iteration's stopping test at the threshold t: the increment inc within t, or the\n"
+          " * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */\n"
+          "static int $P_converged($R inc, $R inc_old, int it, $R t)\n{\n"
+          "  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));\n}\n\n");
 }
 
 // The head of a loop over the coordinates, in NAME_defect and NAME_mult_err:
@@ -1023,9 +1027,10 @@ void emit_step_factor(Emitter *e) {
 // step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
 // rejection; after the first step (hprev 0: from the caller's guess) within
 // [h/5, 100h], as CVODE lets its first step grow 1e4x: the ramp from a small
-// guess took three steps of the satellites' 9 to 33 (2026-11-26, bench/README.md). A failed step is retried with half the step. After three tries
-// over the tolerance the tries start cold (no warm start): the warm start
-// carries the previous step's error into the estimate at every h.
+// guess took three steps of the satellites' 9 to 33 (2026-11-26,
+// bench/README.md). A failed step is retried with half the step. After three
+// tries over the tolerance the tries start cold (no warm start): the warm
+// start carries the previous step's error into the estimate at every h.
 static void emit_step_adaptive(Emitter *e) {
   tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
           "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");

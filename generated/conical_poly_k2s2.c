@@ -562,6 +562,13 @@ static double conical_poly_k2s2_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > conical_poly_k2s2_TOL) ? t : conical_poly_k2s2_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int conical_poly_k2s2_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, int cold, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
@@ -890,8 +897,8 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
      * conical_poly_k2s2_step_adaptive the error allowed is the step's tolerance's share (conical_poly_k2s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = conical_poly_k2s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= conical_poly_k2s2_TOL || (it > 1 && inc < inc_old && inc * inc <= conical_poly_k2s2_TOL * (inc_old - inc)));
+    if (conical_poly_k2s2_converged(inc, inc_old, it, tit)) {
+      attol = !conical_poly_k2s2_converged(inc, inc_old, it, conical_poly_k2s2_TOL);
       rc = conical_poly_k2s2_OK;
       break;
     }

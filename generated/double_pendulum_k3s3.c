@@ -1584,6 +1584,13 @@ static double double_pendulum_k3s3_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > double_pendulum_k3s3_TOL) ? t : double_pendulum_k3s3_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int double_pendulum_k3s3_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, int cold, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
@@ -2333,8 +2340,8 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
      * double_pendulum_k3s3_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k3s3_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = double_pendulum_k3s3_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= double_pendulum_k3s3_TOL || (it > 1 && inc < inc_old && inc * inc <= double_pendulum_k3s3_TOL * (inc_old - inc)));
+    if (double_pendulum_k3s3_converged(inc, inc_old, it, tit)) {
+      attol = !double_pendulum_k3s3_converged(inc, inc_old, it, double_pendulum_k3s3_TOL);
       rc = double_pendulum_k3s3_OK;
       break;
     }

@@ -3047,6 +3047,13 @@ static double double_pendulum_k4s4_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > double_pendulum_k4s4_TOL) ? t : double_pendulum_k4s4_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int double_pendulum_k4s4_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, int cold, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
@@ -4276,8 +4283,8 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
      * double_pendulum_k4s4_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k4s4_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = double_pendulum_k4s4_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= double_pendulum_k4s4_TOL || (it > 1 && inc < inc_old && inc * inc <= double_pendulum_k4s4_TOL * (inc_old - inc)));
+    if (double_pendulum_k4s4_converged(inc, inc_old, it, tit)) {
+      attol = !double_pendulum_k4s4_converged(inc, inc_old, it, double_pendulum_k4s4_TOL);
       rc = double_pendulum_k4s4_OK;
       break;
     }

@@ -743,6 +743,13 @@ static double modified_poly_k6s2_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > modified_poly_k6s2_TOL) ? t : modified_poly_k6s2_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int modified_poly_k6s2_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, double tol, int cold, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
@@ -1384,8 +1391,8 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
      * modified_poly_k6s2_step_adaptive the error allowed is the step's tolerance's share (modified_poly_k6s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = modified_poly_k6s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= modified_poly_k6s2_TOL || (it > 1 && inc < inc_old && inc * inc <= modified_poly_k6s2_TOL * (inc_old - inc)));
+    if (modified_poly_k6s2_converged(inc, inc_old, it, tit)) {
+      attol = !modified_poly_k6s2_converged(inc, inc_old, it, modified_poly_k6s2_TOL);
       rc = modified_poly_k6s2_OK;
       break;
     }

@@ -397,6 +397,13 @@ static double pendulum_poly_k1s1_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > pendulum_poly_k1s1_TOL) ? t : pendulum_poly_k1s1_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int pendulum_poly_k1s1_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h_, double tol, int cold, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
@@ -548,8 +555,8 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
      * pendulum_poly_k1s1_step_adaptive the error allowed is the step's tolerance's share (pendulum_poly_k1s1_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = pendulum_poly_k1s1_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= pendulum_poly_k1s1_TOL || (it > 1 && inc < inc_old && inc * inc <= pendulum_poly_k1s1_TOL * (inc_old - inc)));
+    if (pendulum_poly_k1s1_converged(inc, inc_old, it, tit)) {
+      attol = !pendulum_poly_k1s1_converged(inc, inc_old, it, pendulum_poly_k1s1_TOL);
       rc = pendulum_poly_k1s1_OK;
       break;
     }

@@ -653,6 +653,13 @@ static double pendulum_poly_k3s3_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > pendulum_poly_k3s3_TOL) ? t : pendulum_poly_k3s3_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int pendulum_poly_k3s3_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, int cold, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
@@ -1040,8 +1047,8 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
      * pendulum_poly_k3s3_step_adaptive the error allowed is the step's tolerance's share (pendulum_poly_k3s3_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = pendulum_poly_k3s3_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= pendulum_poly_k3s3_TOL || (it > 1 && inc < inc_old && inc * inc <= pendulum_poly_k3s3_TOL * (inc_old - inc)));
+    if (pendulum_poly_k3s3_converged(inc, inc_old, it, tit)) {
+      attol = !pendulum_poly_k3s3_converged(inc, inc_old, it, pendulum_poly_k3s3_TOL);
       rc = pendulum_poly_k3s3_OK;
       break;
     }

@@ -8734,6 +8734,13 @@ static double satellites_poly_k6s3_itol(double tol, double scale)
   return (tol > 0) & (scale > 0) & (t > satellites_poly_k6s3_TOL) ? t : satellites_poly_k6s3_TOL;
 }
 
+/* The iteration's stopping test at the threshold t: the increment inc within t, or the
+ * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
+static int satellites_poly_k6s3_converged(double inc, double inc_old, int it, double t)
+{
+  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, double tol, int cold, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
@@ -8826,8 +8833,8 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
      * satellites_poly_k6s3_step_adaptive the error allowed is the step's tolerance's share (satellites_poly_k6s3_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = satellites_poly_k6s3_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (inc <= tit || (it > 1 && inc < inc_old && inc * inc <= tit * (inc_old - inc))) {
-      attol = !(inc <= satellites_poly_k6s3_TOL || (it > 1 && inc < inc_old && inc * inc <= satellites_poly_k6s3_TOL * (inc_old - inc)));
+    if (satellites_poly_k6s3_converged(inc, inc_old, it, tit)) {
+      attol = !satellites_poly_k6s3_converged(inc, inc_old, it, satellites_poly_k6s3_TOL);
       rc = satellites_poly_k6s3_OK;
       break;
     }
