@@ -836,8 +836,10 @@ static void emit_step(Emitter *e) {
   if (itol_wanted(e)) emit_itol(e);
   if (mult) emit_mult_err(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
-  tmpl(e, " * or stops decreasing; commits to *x only on success. */\n"
-          "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
+  tmpl(e, itol_wanted(e) ? " * (under $P_step_adaptive, tol > 0: the threshold of $P_itol)\n"
+                           " * or stops decreasing; commits to *x only on success. */\n"
+                         : " * or stops decreasing; commits to *x only on success. */\n");
+  tmpl(e, "static int $P_step_within($P_state *x, $P_real h_, $R tol, int cold, const $P_params *prm, $P_stats *st)\n{\n"
           "  const $R h = ($R)h_;\n"
           "  $W gam[$P_S * $P_M], sw[$<sweep> + 1];\n"
           "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;\n"

@@ -570,6 +570,7 @@ static int conical_poly_k2s2_converged(double inc, double inc_old, int it, doubl
 }
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
+ * (under conical_poly_k2s2_step_adaptive, tol > 0: the threshold of conical_poly_k2s2_itol)
  * or stops decreasing; commits to *x only on success. */
 static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_poly_k2s2_real h_, double tol, int cold, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {

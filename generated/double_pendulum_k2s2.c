@@ -905,6 +905,7 @@ static int double_pendulum_k2s2_converged(double inc, double inc_old, int it, do
 }
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
+ * (under double_pendulum_k2s2_step_adaptive, tol > 0: the threshold of double_pendulum_k2s2_itol)
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real h_, double tol, int cold, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {

@@ -1592,6 +1592,7 @@ static int double_pendulum_k3s3_converged(double inc, double inc_old, int it, do
 }
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
+ * (under double_pendulum_k3s3_step_adaptive, tol > 0: the threshold of double_pendulum_k3s3_itol)
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real h_, double tol, int cold, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {

@@ -3055,6 +3055,7 @@ static int double_pendulum_k4s4_converged(double inc, double inc_old, int it, do
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
+ * (under double_pendulum_k4s4_step_adaptive, tol > 0: the threshold of double_pendulum_k4s4_itol)
  * or stops decreasing; commits to *x only on success. */
 static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, double_pendulum_k4s4_real h_, double tol, int cold, const double_pendulum_k4s4_params *prm, double_pendulum_k4s4_stats *st)
 {

@@ -751,6 +751,7 @@ static int modified_poly_k6s2_converged(double inc, double inc_old, int it, doub
 }
 
 /* One step of HBVM(6,2). Iterates the sweep until the increment reaches round-off
+ * (under modified_poly_k6s2_step_adaptive, tol > 0: the threshold of modified_poly_k6s2_itol)
  * or stops decreasing; commits to *x only on success. */
 static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_poly_k6s2_real h_, double tol, int cold, const modified_poly_k6s2_params *prm, modified_poly_k6s2_stats *st)
 {

@@ -1214,6 +1214,7 @@ static int modified_poly_k9s3_converged(double inc, double inc_old, int it, doub
 }
 
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
+ * (under modified_poly_k9s3_step_adaptive, tol > 0: the threshold of modified_poly_k9s3_itol)
  * or stops decreasing; commits to *x only on success. */
 static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_poly_k9s3_real h_, double tol, int cold, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {

@@ -405,6 +405,7 @@ static int pendulum_poly_k1s1_converged(double inc, double inc_old, int it, doub
 }
 
 /* One step of HBVM(1,1). Iterates the sweep until the increment reaches round-off
+ * (under pendulum_poly_k1s1_step_adaptive, tol > 0: the threshold of pendulum_poly_k1s1_itol)
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_poly_k1s1_real h_, double tol, int cold, const pendulum_poly_k1s1_params *prm, pendulum_poly_k1s1_stats *st)
 {

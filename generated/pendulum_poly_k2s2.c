@@ -493,6 +493,7 @@ static int pendulum_poly_k2s2_converged(double inc, double inc_old, int it, doub
 }
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
+ * (under pendulum_poly_k2s2_step_adaptive, tol > 0: the threshold of pendulum_poly_k2s2_itol)
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real h_, double tol, int cold, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
 {

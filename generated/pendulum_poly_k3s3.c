@@ -661,6 +661,7 @@ static int pendulum_poly_k3s3_converged(double inc, double inc_old, int it, doub
 }
 
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
+ * (under pendulum_poly_k3s3_step_adaptive, tol > 0: the threshold of pendulum_poly_k3s3_itol)
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_poly_k3s3_real h_, double tol, int cold, const pendulum_poly_k3s3_params *prm, pendulum_poly_k3s3_stats *st)
 {

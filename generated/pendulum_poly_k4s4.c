@@ -1004,6 +1004,7 @@ static int pendulum_poly_k4s4_converged(double inc, double inc_old, int it, doub
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
+ * (under pendulum_poly_k4s4_step_adaptive, tol > 0: the threshold of pendulum_poly_k4s4_itol)
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real h_, double tol, int cold, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {

@@ -8742,6 +8742,7 @@ static int satellites_poly_k6s3_converged(double inc, double inc_old, int it, do
 }
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
+ * (under satellites_poly_k6s3_step_adaptive, tol > 0: the threshold of satellites_poly_k6s3_itol)
  * or stops decreasing; commits to *x only on success. */
 static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real h_, double tol, int cold, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
