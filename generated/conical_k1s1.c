@@ -35,8 +35,6 @@
  * their products with P_j and int_0^c P_j, folded into the code):
  *   c_1 = 0.5   b_1 = 1
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double conical_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double conical_k1s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
@@ -257,22 +255,22 @@ void conical_k1s1_hidden(const conical_k1s1_state *x, const conical_k1s1_params 
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void conical_k1s1_predict(const conical_k1s1_state *x, double h, int cold, const conical_k1s1_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < conical_k1s1_S * conical_k1s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     conical_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < conical_k1s1_S; j++)
-    for (i = 0; i < conical_k1s1_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = conical_k1s1_E1[j * conical_k1s1_S + i];
-      else
-        for (d = conical_k1s1_S - 1; d >= 0; d--) e = e * r + conical_k1s1_E[(j * conical_k1s1_S + i) * conical_k1s1_S + d];
-      if (e != 0)
-        for (l = 0; l < conical_k1s1_M; l++) gam[j * conical_k1s1_M + l] += e * x->gam[i * conical_k1s1_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < conical_k1s1_S; j++)
+      for (i = 0; i < conical_k1s1_S; i++)
+        if (conical_k1s1_E1[j * conical_k1s1_S + i] != 0)
+          for (l = 0; l < conical_k1s1_M; l++) gam[j * conical_k1s1_M + l] += conical_k1s1_E1[j * conical_k1s1_S + i] * x->gam[i * conical_k1s1_M + l];
+  } else {
+    double e;
+    e = 1.0;
+    for (l = 0; l < conical_k1s1_M; l++) gam[0 * conical_k1s1_M + l] += e * x->gam[0 * conical_k1s1_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

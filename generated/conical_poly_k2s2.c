@@ -36,8 +36,6 @@
  *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double conical_poly_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double conical_poly_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
 /* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
@@ -458,22 +456,29 @@ void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_po
  * conical_poly_k2s2_err_est needs), else 0. */
 static int conical_poly_k2s2_predict(const conical_poly_k2s2_state *x, double h, int cold, const conical_poly_k2s2_params *prm, double *gam, double *ref)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     conical_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  for (j = 0; j < conical_poly_k2s2_S; j++)
-    for (i = 0; i < conical_poly_k2s2_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = conical_poly_k2s2_E1[j * conical_poly_k2s2_S + i];
-      else
-        for (d = conical_poly_k2s2_S - 1; d >= 0; d--) e = e * r + conical_poly_k2s2_E[(j * conical_poly_k2s2_S + i) * conical_poly_k2s2_S + d];
-      if (e != 0)
-        for (l = 0; l < conical_poly_k2s2_M; l++) gam[j * conical_poly_k2s2_M + l] += e * x->gam[i * conical_poly_k2s2_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < conical_poly_k2s2_S; j++)
+      for (i = 0; i < conical_poly_k2s2_S; i++)
+        if (conical_poly_k2s2_E1[j * conical_poly_k2s2_S + i] != 0)
+          for (l = 0; l < conical_poly_k2s2_M; l++) gam[j * conical_poly_k2s2_M + l] += conical_poly_k2s2_E1[j * conical_poly_k2s2_S + i] * x->gam[i * conical_poly_k2s2_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < conical_poly_k2s2_M; l++) gam[0 * conical_poly_k2s2_M + l] += e * x->gam[0 * conical_poly_k2s2_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < conical_poly_k2s2_M; l++) gam[0 * conical_poly_k2s2_M + l] += e * x->gam[1 * conical_poly_k2s2_M + l];
+    e = 0.99999999999999967;
+    e = e * r;
+    for (l = 0; l < conical_poly_k2s2_M; l++) gam[1 * conical_poly_k2s2_M + l] += e * x->gam[1 * conical_poly_k2s2_M + l];
+  }
   if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
     for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) {
       ref[i] = gam[i];

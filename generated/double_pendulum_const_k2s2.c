@@ -36,8 +36,6 @@
  *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double double_pendulum_const_k2s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 0.99999999999999967};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double double_pendulum_const_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
 /* Model defaults for q0 and p0. */
@@ -346,22 +344,29 @@ void double_pendulum_const_k2s2_hidden(const double_pendulum_const_k2s2_state *x
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void double_pendulum_const_k2s2_predict(const double_pendulum_const_k2s2_state *x, double h, int cold, const double_pendulum_const_k2s2_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < double_pendulum_const_k2s2_S * double_pendulum_const_k2s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     double_pendulum_const_k2s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < double_pendulum_const_k2s2_S; j++)
-    for (i = 0; i < double_pendulum_const_k2s2_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = double_pendulum_const_k2s2_E1[j * double_pendulum_const_k2s2_S + i];
-      else
-        for (d = double_pendulum_const_k2s2_S - 1; d >= 0; d--) e = e * r + double_pendulum_const_k2s2_E[(j * double_pendulum_const_k2s2_S + i) * double_pendulum_const_k2s2_S + d];
-      if (e != 0)
-        for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[j * double_pendulum_const_k2s2_M + l] += e * x->gam[i * double_pendulum_const_k2s2_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < double_pendulum_const_k2s2_S; j++)
+      for (i = 0; i < double_pendulum_const_k2s2_S; i++)
+        if (double_pendulum_const_k2s2_E1[j * double_pendulum_const_k2s2_S + i] != 0)
+          for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[j * double_pendulum_const_k2s2_M + l] += double_pendulum_const_k2s2_E1[j * double_pendulum_const_k2s2_S + i] * x->gam[i * double_pendulum_const_k2s2_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[0 * double_pendulum_const_k2s2_M + l] += e * x->gam[0 * double_pendulum_const_k2s2_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[0 * double_pendulum_const_k2s2_M + l] += e * x->gam[1 * double_pendulum_const_k2s2_M + l];
+    e = 0.99999999999999967;
+    e = e * r;
+    for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[1 * double_pendulum_const_k2s2_M + l] += e * x->gam[1 * double_pendulum_const_k2s2_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

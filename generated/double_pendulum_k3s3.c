@@ -37,8 +37,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double double_pendulum_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double double_pendulum_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
 /* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
@@ -1480,22 +1478,46 @@ void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const doub
  * double_pendulum_k3s3_err_est needs), else 0. */
 static int double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, int cold, const double_pendulum_k3s3_params *prm, double *gam, double *ref)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     double_pendulum_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  for (j = 0; j < double_pendulum_k3s3_S; j++)
-    for (i = 0; i < double_pendulum_k3s3_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = double_pendulum_k3s3_E1[j * double_pendulum_k3s3_S + i];
-      else
-        for (d = double_pendulum_k3s3_S - 1; d >= 0; d--) e = e * r + double_pendulum_k3s3_E[(j * double_pendulum_k3s3_S + i) * double_pendulum_k3s3_S + d];
-      if (e != 0)
-        for (l = 0; l < double_pendulum_k3s3_M; l++) gam[j * double_pendulum_k3s3_M + l] += e * x->gam[i * double_pendulum_k3s3_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < double_pendulum_k3s3_S; j++)
+      for (i = 0; i < double_pendulum_k3s3_S; i++)
+        if (double_pendulum_k3s3_E1[j * double_pendulum_k3s3_S + i] != 0)
+          for (l = 0; l < double_pendulum_k3s3_M; l++) gam[j * double_pendulum_k3s3_M + l] += double_pendulum_k3s3_E1[j * double_pendulum_k3s3_S + i] * x->gam[i * double_pendulum_k3s3_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += e * x->gam[0 * double_pendulum_k3s3_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += e * x->gam[1 * double_pendulum_k3s3_M + l];
+    e = 4.4721359549995805;
+    e = e * r + 6.7082039324993694;
+    e = e * r + 2.2360679774997898;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += e * x->gam[2 * double_pendulum_k3s3_M + l];
+    e = 1.0;
+    e = e * r;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[1 * double_pendulum_k3s3_M + l] += e * x->gam[1 * double_pendulum_k3s3_M + l];
+    e = 3.8729833462074175;
+    e = e * r + 3.8729833462074175;
+    e = e * r;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[1 * double_pendulum_k3s3_M + l] += e * x->gam[2 * double_pendulum_k3s3_M + l];
+    e = 1.1102230246251565e-16;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += e * x->gam[0 * double_pendulum_k3s3_M + l];
+    e = 1.9229626863835638e-16;
+    e = e * r + 1.9229626863835638e-16;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += e * x->gam[1 * double_pendulum_k3s3_M + l];
+    e = 1.0000000000000007;
+    e = e * r + 7.4476024597418194e-16;
+    e = e * r + 2.4825341532472731e-16;
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += e * x->gam[2 * double_pendulum_k3s3_M + l];
+  }
   if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
     for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) {
       ref[i] = gam[i];

@@ -38,8 +38,6 @@
  *   c_3 = 0.66999052179242813   b_3 = 0.32607257743127305
  *   c_4 = 0.93056815579702623   b_4 = 0.17392742256872692
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double double_pendulum_k4s4_E[64] = {1.0, 0.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995796, 0.0, 2.6457513110645934, 15.874507866387544, 26.457513110645905, 13.228756555322951, 0.0, 0.0, 0.0, 0.0, 0.0, 0.99999999999999989, 0.0, 0.0, 0.0, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 9.1651513899116814, 22.912878474779198, 13.747727084867515, (-8.3266726846886741e-17), 0.0, 0.0, 0.0, (-1.442222014787673e-16), (-3.8459253727671276e-16), 0.0, 0.0, (-1.8619006149354548e-16), (-1.4895204919483639e-15), 0.99999999999999911, 0.0, (-2.2030305172320797e-16), (-3.5248488275713244e-15), 5.9160797830996108, 5.9160797830996108, (-1.6653345369377348e-16), 0.0, 0.0, 0.0, (-2.884444029575346e-16), (-5.7688880591506919e-16), 0.0, 0.0, (-3.7238012298709097e-16), (-2.2342807379225458e-15), (-2.4204707994160914e-15), 0.0, (-4.4060610344641594e-16), (-5.2872732413569865e-15), (-1.4319698362008503e-14), 0.99999999999999023};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double double_pendulum_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.416407864998739, 58.206528843420998, 0.0, 0.99999999999999989, 7.745966692414834, 45.825756949558397, (-8.3266726846886741e-17), (-5.2881473875548006e-16), 0.99999999999999745, 11.832159566199218, (-1.6653345369377348e-16), (-8.6533320887260379e-16), (-5.0271316603257284e-15), 0.99999999999997014};
 /* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
@@ -2943,22 +2941,75 @@ void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const doub
  * double_pendulum_k4s4_err_est needs), else 0. */
 static int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, double h, int cold, const double_pendulum_k4s4_params *prm, double *gam, double *ref)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     double_pendulum_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  for (j = 0; j < double_pendulum_k4s4_S; j++)
-    for (i = 0; i < double_pendulum_k4s4_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = double_pendulum_k4s4_E1[j * double_pendulum_k4s4_S + i];
-      else
-        for (d = double_pendulum_k4s4_S - 1; d >= 0; d--) e = e * r + double_pendulum_k4s4_E[(j * double_pendulum_k4s4_S + i) * double_pendulum_k4s4_S + d];
-      if (e != 0)
-        for (l = 0; l < double_pendulum_k4s4_M; l++) gam[j * double_pendulum_k4s4_M + l] += e * x->gam[i * double_pendulum_k4s4_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < double_pendulum_k4s4_S; j++)
+      for (i = 0; i < double_pendulum_k4s4_S; i++)
+        if (double_pendulum_k4s4_E1[j * double_pendulum_k4s4_S + i] != 0)
+          for (l = 0; l < double_pendulum_k4s4_M; l++) gam[j * double_pendulum_k4s4_M + l] += double_pendulum_k4s4_E1[j * double_pendulum_k4s4_S + i] * x->gam[i * double_pendulum_k4s4_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += e * x->gam[0 * double_pendulum_k4s4_M + l];
+    e = 1.732050807568877;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
+    e = 4.4721359549995796;
+    e = e * r + 6.7082039324993685;
+    e = e * r + 2.2360679774997898;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += e * x->gam[2 * double_pendulum_k4s4_M + l];
+    e = 13.228756555322951;
+    e = e * r + 26.457513110645905;
+    e = e * r + 15.874507866387544;
+    e = e * r + 2.6457513110645934;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
+    e = 0.99999999999999989;
+    e = e * r;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
+    e = 3.872983346207417;
+    e = e * r + 3.872983346207417;
+    e = e * r;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += e * x->gam[2 * double_pendulum_k4s4_M + l];
+    e = 13.747727084867515;
+    e = e * r + 22.912878474779198;
+    e = e * r + 9.1651513899116814;
+    e = e * r;
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
+    e = (-8.3266726846886741e-17);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[0 * double_pendulum_k4s4_M + l];
+    e = (-3.8459253727671276e-16);
+    e = e * r + (-1.442222014787673e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
+    e = 0.99999999999999911;
+    e = e * r + (-1.4895204919483639e-15);
+    e = e * r + (-1.8619006149354548e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[2 * double_pendulum_k4s4_M + l];
+    e = 5.9160797830996108;
+    e = e * r + 5.9160797830996108;
+    e = e * r + (-3.5248488275713244e-15);
+    e = e * r + (-2.2030305172320797e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
+    e = (-1.6653345369377348e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[0 * double_pendulum_k4s4_M + l];
+    e = (-5.7688880591506919e-16);
+    e = e * r + (-2.884444029575346e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
+    e = (-2.4204707994160914e-15);
+    e = e * r + (-2.2342807379225458e-15);
+    e = e * r + (-3.7238012298709097e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[2 * double_pendulum_k4s4_M + l];
+    e = 0.99999999999999023;
+    e = e * r + (-1.4319698362008503e-14);
+    e = e * r + (-5.2872732413569865e-15);
+    e = e * r + (-4.4060610344641594e-16);
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
+  }
   if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
     for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
       ref[i] = gam[i];

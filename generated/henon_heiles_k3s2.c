@@ -37,8 +37,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double henon_heiles_k3s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 0.0, 0.0, 1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double henon_heiles_k3s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 1.0};
 /* Model defaults for q0 and p0. */
@@ -140,22 +138,29 @@ void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heil
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, int cold, const henon_heiles_k3s2_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     henon_heiles_k3s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < henon_heiles_k3s2_S; j++)
-    for (i = 0; i < henon_heiles_k3s2_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = henon_heiles_k3s2_E1[j * henon_heiles_k3s2_S + i];
-      else
-        for (d = henon_heiles_k3s2_S - 1; d >= 0; d--) e = e * r + henon_heiles_k3s2_E[(j * henon_heiles_k3s2_S + i) * henon_heiles_k3s2_S + d];
-      if (e != 0)
-        for (l = 0; l < henon_heiles_k3s2_M; l++) gam[j * henon_heiles_k3s2_M + l] += e * x->gam[i * henon_heiles_k3s2_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < henon_heiles_k3s2_S; j++)
+      for (i = 0; i < henon_heiles_k3s2_S; i++)
+        if (henon_heiles_k3s2_E1[j * henon_heiles_k3s2_S + i] != 0)
+          for (l = 0; l < henon_heiles_k3s2_M; l++) gam[j * henon_heiles_k3s2_M + l] += henon_heiles_k3s2_E1[j * henon_heiles_k3s2_S + i] * x->gam[i * henon_heiles_k3s2_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += e * x->gam[0 * henon_heiles_k3s2_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += e * x->gam[1 * henon_heiles_k3s2_M + l];
+    e = 1.0;
+    e = e * r;
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[1 * henon_heiles_k3s2_M + l] += e * x->gam[1 * henon_heiles_k3s2_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

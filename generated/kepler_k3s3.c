@@ -37,8 +37,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double kepler_k3s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995805, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 3.8729833462074175, 3.8729833462074175, 1.1102230246251565e-16, 0.0, 0.0, 1.9229626863835638e-16, 1.9229626863835638e-16, 0.0, 2.4825341532472731e-16, 7.4476024597418194e-16, 1.0000000000000007};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double kepler_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
 /* Model defaults for q0 and p0. */
@@ -136,22 +134,46 @@ void kepler_k3s3_hidden(const kepler_k3s3_state *x, const kepler_k3s3_params *pr
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void kepler_k3s3_predict(const kepler_k3s3_state *x, double h, int cold, const kepler_k3s3_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < kepler_k3s3_S * kepler_k3s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     kepler_k3s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < kepler_k3s3_S; j++)
-    for (i = 0; i < kepler_k3s3_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = kepler_k3s3_E1[j * kepler_k3s3_S + i];
-      else
-        for (d = kepler_k3s3_S - 1; d >= 0; d--) e = e * r + kepler_k3s3_E[(j * kepler_k3s3_S + i) * kepler_k3s3_S + d];
-      if (e != 0)
-        for (l = 0; l < kepler_k3s3_M; l++) gam[j * kepler_k3s3_M + l] += e * x->gam[i * kepler_k3s3_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < kepler_k3s3_S; j++)
+      for (i = 0; i < kepler_k3s3_S; i++)
+        if (kepler_k3s3_E1[j * kepler_k3s3_S + i] != 0)
+          for (l = 0; l < kepler_k3s3_M; l++) gam[j * kepler_k3s3_M + l] += kepler_k3s3_E1[j * kepler_k3s3_S + i] * x->gam[i * kepler_k3s3_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[0 * kepler_k3s3_M + l] += e * x->gam[0 * kepler_k3s3_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[0 * kepler_k3s3_M + l] += e * x->gam[1 * kepler_k3s3_M + l];
+    e = 4.4721359549995805;
+    e = e * r + 6.7082039324993694;
+    e = e * r + 2.2360679774997898;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[0 * kepler_k3s3_M + l] += e * x->gam[2 * kepler_k3s3_M + l];
+    e = 1.0;
+    e = e * r;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[1 * kepler_k3s3_M + l] += e * x->gam[1 * kepler_k3s3_M + l];
+    e = 3.8729833462074175;
+    e = e * r + 3.8729833462074175;
+    e = e * r;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[1 * kepler_k3s3_M + l] += e * x->gam[2 * kepler_k3s3_M + l];
+    e = 1.1102230246251565e-16;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += e * x->gam[0 * kepler_k3s3_M + l];
+    e = 1.9229626863835638e-16;
+    e = e * r + 1.9229626863835638e-16;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += e * x->gam[1 * kepler_k3s3_M + l];
+    e = 1.0000000000000007;
+    e = e * r + 7.4476024597418194e-16;
+    e = e * r + 2.4825341532472731e-16;
+    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += e * x->gam[2 * kepler_k3s3_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

@@ -40,8 +40,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double kepler_k6s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double kepler_k6s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
@@ -139,22 +137,22 @@ void kepler_k6s1_hidden(const kepler_k6s1_state *x, const kepler_k6s1_params *pr
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void kepler_k6s1_predict(const kepler_k6s1_state *x, double h, int cold, const kepler_k6s1_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < kepler_k6s1_S * kepler_k6s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     kepler_k6s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < kepler_k6s1_S; j++)
-    for (i = 0; i < kepler_k6s1_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = kepler_k6s1_E1[j * kepler_k6s1_S + i];
-      else
-        for (d = kepler_k6s1_S - 1; d >= 0; d--) e = e * r + kepler_k6s1_E[(j * kepler_k6s1_S + i) * kepler_k6s1_S + d];
-      if (e != 0)
-        for (l = 0; l < kepler_k6s1_M; l++) gam[j * kepler_k6s1_M + l] += e * x->gam[i * kepler_k6s1_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < kepler_k6s1_S; j++)
+      for (i = 0; i < kepler_k6s1_S; i++)
+        if (kepler_k6s1_E1[j * kepler_k6s1_S + i] != 0)
+          for (l = 0; l < kepler_k6s1_M; l++) gam[j * kepler_k6s1_M + l] += kepler_k6s1_E1[j * kepler_k6s1_S + i] * x->gam[i * kepler_k6s1_M + l];
+  } else {
+    double e;
+    e = 1.0;
+    for (l = 0; l < kepler_k6s1_M; l++) gam[0 * kepler_k6s1_M + l] += e * x->gam[0 * kepler_k6s1_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

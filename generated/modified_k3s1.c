@@ -37,8 +37,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double modified_k3s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double modified_k3s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
@@ -275,22 +273,22 @@ void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_para
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void modified_k3s1_predict(const modified_k3s1_state *x, double h, int cold, const modified_k3s1_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     modified_k3s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < modified_k3s1_S; j++)
-    for (i = 0; i < modified_k3s1_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = modified_k3s1_E1[j * modified_k3s1_S + i];
-      else
-        for (d = modified_k3s1_S - 1; d >= 0; d--) e = e * r + modified_k3s1_E[(j * modified_k3s1_S + i) * modified_k3s1_S + d];
-      if (e != 0)
-        for (l = 0; l < modified_k3s1_M; l++) gam[j * modified_k3s1_M + l] += e * x->gam[i * modified_k3s1_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < modified_k3s1_S; j++)
+      for (i = 0; i < modified_k3s1_S; i++)
+        if (modified_k3s1_E1[j * modified_k3s1_S + i] != 0)
+          for (l = 0; l < modified_k3s1_M; l++) gam[j * modified_k3s1_M + l] += modified_k3s1_E1[j * modified_k3s1_S + i] * x->gam[i * modified_k3s1_M + l];
+  } else {
+    double e;
+    e = 1.0;
+    for (l = 0; l < modified_k3s1_M; l++) gam[0 * modified_k3s1_M + l] += e * x->gam[0 * modified_k3s1_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

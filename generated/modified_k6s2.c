@@ -40,8 +40,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double modified_k6s2_E[8] = {1.0, 0.0, 1.7320508075688772, 1.7320508075688772, 5.5511151231257827e-17, 0.0, 9.6148134319178191e-17, 0.99999999999999989};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double modified_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231257827e-17, 1.0};
 /* Model defaults for q0 and p0. */
@@ -278,22 +276,31 @@ void modified_k6s2_hidden(const modified_k6s2_state *x, const modified_k6s2_para
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void modified_k6s2_predict(const modified_k6s2_state *x, double h, int cold, const modified_k6s2_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < modified_k6s2_S * modified_k6s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     modified_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < modified_k6s2_S; j++)
-    for (i = 0; i < modified_k6s2_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = modified_k6s2_E1[j * modified_k6s2_S + i];
-      else
-        for (d = modified_k6s2_S - 1; d >= 0; d--) e = e * r + modified_k6s2_E[(j * modified_k6s2_S + i) * modified_k6s2_S + d];
-      if (e != 0)
-        for (l = 0; l < modified_k6s2_M; l++) gam[j * modified_k6s2_M + l] += e * x->gam[i * modified_k6s2_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < modified_k6s2_S; j++)
+      for (i = 0; i < modified_k6s2_S; i++)
+        if (modified_k6s2_E1[j * modified_k6s2_S + i] != 0)
+          for (l = 0; l < modified_k6s2_M; l++) gam[j * modified_k6s2_M + l] += modified_k6s2_E1[j * modified_k6s2_S + i] * x->gam[i * modified_k6s2_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < modified_k6s2_M; l++) gam[0 * modified_k6s2_M + l] += e * x->gam[0 * modified_k6s2_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < modified_k6s2_M; l++) gam[0 * modified_k6s2_M + l] += e * x->gam[1 * modified_k6s2_M + l];
+    e = 5.5511151231257827e-17;
+    for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += e * x->gam[0 * modified_k6s2_M + l];
+    e = 0.99999999999999989;
+    e = e * r + 9.6148134319178191e-17;
+    for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += e * x->gam[1 * modified_k6s2_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

@@ -43,8 +43,6 @@
  *   c_8 = 0.91801555366331788   b_8 = 0.090324080347428698
  *   c_9 = 0.98408011975381304   b_9 = 0.040637194180787206
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double modified_k9s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.732050807568877, 0.0, 2.2360679774997898, 6.7082039324993685, 4.4721359549995796, (-2.7755575615628914e-17), 0.0, 0.0, (-4.8074067159589095e-17), 0.99999999999999989, 0.0, (-6.2063353831181828e-17), 3.872983346207417, 3.872983346207417, (-1.1102230246251565e-16), 0.0, 0.0, (-1.9229626863835638e-16), (-9.6148134319178191e-17), 0.0, (-2.4825341532472731e-16), (-3.7238012298709097e-16), 0.99999999999999956};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double modified_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, (-2.7755575615628914e-17), 0.99999999999999989, 7.745966692414834, (-1.1102230246251565e-16), (-2.884444029575346e-16), 0.999999999999999};
 /* Model defaults for q0 and p0. */
@@ -281,22 +279,48 @@ void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_para
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 static void modified_k9s3_predict(const modified_k9s3_state *x, double h, int cold, const modified_k9s3_params *prm, double *gam)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     modified_k9s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  for (j = 0; j < modified_k9s3_S; j++)
-    for (i = 0; i < modified_k9s3_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = modified_k9s3_E1[j * modified_k9s3_S + i];
-      else
-        for (d = modified_k9s3_S - 1; d >= 0; d--) e = e * r + modified_k9s3_E[(j * modified_k9s3_S + i) * modified_k9s3_S + d];
-      if (e != 0)
-        for (l = 0; l < modified_k9s3_M; l++) gam[j * modified_k9s3_M + l] += e * x->gam[i * modified_k9s3_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < modified_k9s3_S; j++)
+      for (i = 0; i < modified_k9s3_S; i++)
+        if (modified_k9s3_E1[j * modified_k9s3_S + i] != 0)
+          for (l = 0; l < modified_k9s3_M; l++) gam[j * modified_k9s3_M + l] += modified_k9s3_E1[j * modified_k9s3_S + i] * x->gam[i * modified_k9s3_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[0 * modified_k9s3_M + l];
+    e = 1.732050807568877;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
+    e = 4.4721359549995796;
+    e = e * r + 6.7082039324993685;
+    e = e * r + 2.2360679774997898;
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
+    e = (-2.7755575615628914e-17);
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[0 * modified_k9s3_M + l];
+    e = 0.99999999999999989;
+    e = e * r + (-4.8074067159589095e-17);
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
+    e = 3.872983346207417;
+    e = e * r + 3.872983346207417;
+    e = e * r + (-6.2063353831181828e-17);
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
+    e = (-1.1102230246251565e-16);
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[0 * modified_k9s3_M + l];
+    e = (-9.6148134319178191e-17);
+    e = e * r + (-1.9229626863835638e-16);
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
+    e = 0.99999999999999956;
+    e = e * r + (-3.7238012298709097e-16);
+    e = e * r + (-2.4825341532472731e-16);
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
+  }
 }
 
 /* a += b with the rounding error carried in *c (Kahan). */

@@ -35,8 +35,6 @@
  * their products with P_j and int_0^c P_j, folded into the code):
  *   c_1 = 0.5   b_1 = 1
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double pendulum_poly_k1s1_E[1] = {1.0};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double pendulum_poly_k1s1_E1[1] = {1.0};
 /* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
@@ -306,22 +304,22 @@ void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum
  * pendulum_poly_k1s1_err_est needs), else 0. */
 static int pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, int cold, const pendulum_poly_k1s1_params *prm, double *gam, double *ref)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     pendulum_poly_k1s1_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  for (j = 0; j < pendulum_poly_k1s1_S; j++)
-    for (i = 0; i < pendulum_poly_k1s1_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = pendulum_poly_k1s1_E1[j * pendulum_poly_k1s1_S + i];
-      else
-        for (d = pendulum_poly_k1s1_S - 1; d >= 0; d--) e = e * r + pendulum_poly_k1s1_E[(j * pendulum_poly_k1s1_S + i) * pendulum_poly_k1s1_S + d];
-      if (e != 0)
-        for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[j * pendulum_poly_k1s1_M + l] += e * x->gam[i * pendulum_poly_k1s1_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < pendulum_poly_k1s1_S; j++)
+      for (i = 0; i < pendulum_poly_k1s1_S; i++)
+        if (pendulum_poly_k1s1_E1[j * pendulum_poly_k1s1_S + i] != 0)
+          for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[j * pendulum_poly_k1s1_M + l] += pendulum_poly_k1s1_E1[j * pendulum_poly_k1s1_S + i] * x->gam[i * pendulum_poly_k1s1_M + l];
+  } else {
+    double e;
+    e = 1.0;
+    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += e * x->gam[0 * pendulum_poly_k1s1_M + l];
+  }
   if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
     for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
       ref[i] = gam[i];

@@ -40,8 +40,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */
-static const double satellites_poly_k6s3_E[27] = {1.0, 0.0, 0.0, 1.7320508075688772, 1.7320508075688772, 0.0, 2.2360679774997898, 6.7082039324993694, 4.4721359549995796, 5.5511151231257827e-17, 0.0, 0.0, 9.6148134319178191e-17, 0.99999999999999989, 0.0, 1.2412670766236366e-16, 3.872983346207417, 3.872983346207417, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0000000000000002};
 /* E[j][i](1): the warm start of a step as long as the last one. */
 static const double satellites_poly_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 5.5511151231257827e-17, 1.0, 7.745966692414834, 0.0, 0.0, 1.0000000000000002};
 /* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
@@ -8630,22 +8628,43 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
  * satellites_poly_k6s3_err_est needs), else 0. */
 static int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, int cold, const satellites_poly_k6s3_params *prm, double *gam, double *ref)
 {
-  int i, j, l, d;
+  int i, j, l;
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  for (j = 0; j < satellites_poly_k6s3_S; j++)
-    for (i = 0; i < satellites_poly_k6s3_S; i++) {
-      double r = h / x->hprev, e = 0;
-      if (h == x->hprev)
-        e = satellites_poly_k6s3_E1[j * satellites_poly_k6s3_S + i];
-      else
-        for (d = satellites_poly_k6s3_S - 1; d >= 0; d--) e = e * r + satellites_poly_k6s3_E[(j * satellites_poly_k6s3_S + i) * satellites_poly_k6s3_S + d];
-      if (e != 0)
-        for (l = 0; l < satellites_poly_k6s3_M; l++) gam[j * satellites_poly_k6s3_M + l] += e * x->gam[i * satellites_poly_k6s3_M + l];
-    }
+  if (h == x->hprev) {
+    for (j = 0; j < satellites_poly_k6s3_S; j++)
+      for (i = 0; i < satellites_poly_k6s3_S; i++)
+        if (satellites_poly_k6s3_E1[j * satellites_poly_k6s3_S + i] != 0)
+          for (l = 0; l < satellites_poly_k6s3_M; l++) gam[j * satellites_poly_k6s3_M + l] += satellites_poly_k6s3_E1[j * satellites_poly_k6s3_S + i] * x->gam[i * satellites_poly_k6s3_M + l];
+  } else {
+    const double r = h / x->hprev;
+    double e;
+    e = 1.0;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += e * x->gam[0 * satellites_poly_k6s3_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += e * x->gam[1 * satellites_poly_k6s3_M + l];
+    e = 4.4721359549995796;
+    e = e * r + 6.7082039324993694;
+    e = e * r + 2.2360679774997898;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += e * x->gam[2 * satellites_poly_k6s3_M + l];
+    e = 5.5511151231257827e-17;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += e * x->gam[0 * satellites_poly_k6s3_M + l];
+    e = 0.99999999999999989;
+    e = e * r + 9.6148134319178191e-17;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += e * x->gam[1 * satellites_poly_k6s3_M + l];
+    e = 3.872983346207417;
+    e = e * r + 3.872983346207417;
+    e = e * r + 1.2412670766236366e-16;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += e * x->gam[2 * satellites_poly_k6s3_M + l];
+    e = 1.0000000000000002;
+    e = e * r;
+    e = e * r;
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[2 * satellites_poly_k6s3_M + l] += e * x->gam[2 * satellites_poly_k6s3_M + l];
+  }
   if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
       ref[i] = gam[i];
