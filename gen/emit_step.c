@@ -594,6 +594,16 @@ static double err_constant(const Emitter *e) {
   return order2s[s < 4 ? s - 1 : 3];
 }
 
+// The constant of NAME_err_est's cold estimate (the first step, no warm
+// start): the largest true / (|h gamma_{s-1}| rho^(s+1)) over the cold steps
+// of tests/check_errest.c's problems and Kepler, h from 0.01 to 3 (true
+// errors above 1e-12), rounded up: an estimate that is never below the
+// truth there, as the first step's size is a guess (docs/api.md).
+static double cold_constant(const Emitter *e) {
+  int s = e->me->s;
+  return s <= 2 ? 12 : s == 3 ? 20 : s <= 6 ? 40 : 150;
+}
+
 // Whether the step's error has a part NAME_err_est does not see: the
 // constant multiplier with constraints at s >= 2 (order 2, not 2s), whose
 // error comes from the multiplier's change over the step (NAME_mult_err).
@@ -618,12 +628,13 @@ static int controller_order(const Emitter *e) { return mult_err_wanted(e) ? 3 : 
 // never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
 // The first step after NAME_init has no warm start (its predictor is
 // gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
-// is the whole velocity): there, at s >= 2, rho is the decay of the two
-// highest coefficients, and the estimate h |gamma_{s-1}| rho^(s+1), or,
-// when larger and d1 < |h v| / 4, |h v| (d1 / |h v|)^2s (d1 as the miss of the
-// degree-1 coefficient; the decay alone is far too low at Kepler's perihelion,
-// where the coefficients of the odd component fall faster than rho^j; from
-// rest d1 ~ |h v| and this term would reject every step down to h ~ tol).
+// is the whole velocity): there, at s >= 2, the estimate is the same model
+// read off the converged coefficients, NAME_COLDC |h gamma_{s-1}| rho^(s+1),
+// with rho the slowest decay among |gamma_{s-1}| / |gamma_{s-2}|,
+// |gamma_{s-2}| / |gamma_{s-3}| (s >= 4) and (|gamma_{s-1}| / |gamma_{s-3}|)^(1/2)
+// (s >= 3): the square root for motions whose odd and even coefficients fall
+// at different rates (Kepler's perihelion); not gamma_1 / gamma_0 beyond s = 2,
+// which does not fall with h from rest (gamma_0 ~ h a / 2).
 // The constant multiplier's own error (order 2) is NAME_mult_err's.
 static void emit_err_est(Emitter *e) {
   int s = e->me->s, p = 2 * s;
@@ -639,17 +650,25 @@ static void emit_err_est(Emitter *e) {
   char c[40];
   format_real(e, c, sizeof c, err_constant(e));
   out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
+  if (s >= 2) {
+    format_real(e, c, sizeof c, cold_constant(e));
+    out(e, "#ifndef %s_COLDC\n#define %s_COLDC %s  /* the first step's: measured, docs/api.md */\n#endif\n", e->P,
+        e->P, c);
+  }
   tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v, r;\n  int i;\n");
   tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
   if (s >= 2) {
-    out(e, "  if (cold) {  /* no warm start: the decay of the two highest coefficients, */\n"
-           "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d), w = 0;\n", real_type(e, 0), e->P, s - 1, e->P, s - 2);
-    tmpl(e, "    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;\n"
-            "                      * not from rest, where d1 ~ |h v| */\n"
-            "      r = d1 / v;\n      w = $P_ERRC * v;\n");
-    out(e, "      for (i = 0; i < %d; i++) w *= r;\n    }\n", p);
-    tmpl(e, "    if (!(b > c)) return c > 0 ? d1 : w;\n    r = c / b;\n    v = $P_ERRC * fabs$f(h) * c;\n");
-    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v > w ? v : w;\n  }\n", p - s + 1);
+    out(e, "  if (cold) {  /* no warm start: %s_COLDC |h gamma_%d| rho^%d, rho the slowest decay */\n", e->P, s - 1,
+        s + 1);
+    out(e, "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d)", real_type(e, 0), e->P, s - 1, e->P, s - 2);
+    if (s >= 3) out(e, ", a = %s_coef(gam, %d), t", e->P, s - 3);
+    out(e, ";\n    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < %d */\n"
+           "    r = c / b;\n", s);
+    if (s >= 4) out(e, "    t = b / a;\n    if (t > r) r = t;\n");
+    if (s >= 3) out(e, "    t = sqrt%s(c / a);\n    if (t > r) r = t;\n", math_suffix(e, 0));
+    tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
+            "    v = $P_COLDC * fabs$f(h) * c;\n");
+    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v;\n  }\n", s + 1);
   } else
     tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");
   tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");

@@ -305,24 +305,22 @@ static double conical_k2s2_coef(const double *gam, int j)
 #ifndef conical_k2s2_ERRC
 #define conical_k2s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
+#ifndef conical_k2s2_COLDC
+#define conical_k2s2_COLDC 12.0  /* the first step's: measured, docs/api.md */
+#endif
 static double conical_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * conical_k2s2_coef(gam, 0);
-  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
-    double c = conical_k2s2_coef(gam, 1), b = conical_k2s2_coef(gam, 0), w = 0;
-    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
-                      * not from rest, where d1 ~ |h v| */
-      r = d1 / v;
-      w = conical_k2s2_ERRC * v;
-      for (i = 0; i < 4; i++) w *= r;
-    }
-    if (!(b > c)) return c > 0 ? d1 : w;
+  if (cold) {  /* no warm start: conical_k2s2_COLDC |h gamma_1| rho^3, rho the slowest decay */
+    double c = conical_k2s2_coef(gam, 1), b = conical_k2s2_coef(gam, 0);
+    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;
-    v = conical_k2s2_ERRC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = conical_k2s2_COLDC * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
-    return v > w ? v : w;
+    return v;
   }
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;

@@ -3049,24 +3049,26 @@ static double double_pendulum_k4s4_coef(const double *gam, int j)
 #ifndef double_pendulum_k4s4_ERRC
 #define double_pendulum_k4s4_ERRC 2.8e-05  /* measured: docs/api.md */
 #endif
+#ifndef double_pendulum_k4s4_COLDC
+#define double_pendulum_k4s4_COLDC 40.0  /* the first step's: measured, docs/api.md */
+#endif
 static double double_pendulum_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * double_pendulum_k4s4_coef(gam, 0);
-  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
-    double c = double_pendulum_k4s4_coef(gam, 3), b = double_pendulum_k4s4_coef(gam, 2), w = 0;
-    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
-                      * not from rest, where d1 ~ |h v| */
-      r = d1 / v;
-      w = double_pendulum_k4s4_ERRC * v;
-      for (i = 0; i < 8; i++) w *= r;
-    }
-    if (!(b > c)) return c > 0 ? d1 : w;
+  if (cold) {  /* no warm start: double_pendulum_k4s4_COLDC |h gamma_3| rho^5, rho the slowest decay */
+    double c = double_pendulum_k4s4_coef(gam, 3), b = double_pendulum_k4s4_coef(gam, 2), a = double_pendulum_k4s4_coef(gam, 1), t;
+    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 4 */
     r = c / b;
-    v = double_pendulum_k4s4_ERRC * fabs(h) * c;
+    t = b / a;
+    if (t > r) r = t;
+    t = sqrt(c / a);
+    if (t > r) r = t;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = double_pendulum_k4s4_COLDC * fabs(h) * c;
     for (i = 0; i < 5; i++) v *= r;
-    return v > w ? v : w;
+    return v;
   }
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;

@@ -186,24 +186,22 @@ static double henon_heiles_k2s2_coef(const double *gam, int j)
 #ifndef henon_heiles_k2s2_ERRC
 #define henon_heiles_k2s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
+#ifndef henon_heiles_k2s2_COLDC
+#define henon_heiles_k2s2_COLDC 12.0  /* the first step's: measured, docs/api.md */
+#endif
 static double henon_heiles_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * henon_heiles_k2s2_coef(gam, 0);
-  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
-    double c = henon_heiles_k2s2_coef(gam, 1), b = henon_heiles_k2s2_coef(gam, 0), w = 0;
-    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
-                      * not from rest, where d1 ~ |h v| */
-      r = d1 / v;
-      w = henon_heiles_k2s2_ERRC * v;
-      for (i = 0; i < 4; i++) w *= r;
-    }
-    if (!(b > c)) return c > 0 ? d1 : w;
+  if (cold) {  /* no warm start: henon_heiles_k2s2_COLDC |h gamma_1| rho^3, rho the slowest decay */
+    double c = henon_heiles_k2s2_coef(gam, 1), b = henon_heiles_k2s2_coef(gam, 0);
+    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;
-    v = henon_heiles_k2s2_ERRC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = henon_heiles_k2s2_COLDC * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
-    return v > w ? v : w;
+    return v;
   }
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;

@@ -8704,24 +8704,24 @@ static double satellites_poly_k6s3_coef(const double *gam, int j)
 #ifndef satellites_poly_k6s3_ERRC
 #define satellites_poly_k6s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
+#ifndef satellites_poly_k6s3_COLDC
+#define satellites_poly_k6s3_COLDC 20.0  /* the first step's: measured, docs/api.md */
+#endif
 static double satellites_poly_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * satellites_poly_k6s3_coef(gam, 0);
-  if (cold) {  /* no warm start: the decay of the two highest coefficients, */
-    double c = satellites_poly_k6s3_coef(gam, 2), b = satellites_poly_k6s3_coef(gam, 1), w = 0;
-    if (4 * d1 < v) {  /* or, when larger, d1 as a miss of degree 1: (d1 / |h v|)^p;
-                      * not from rest, where d1 ~ |h v| */
-      r = d1 / v;
-      w = satellites_poly_k6s3_ERRC * v;
-      for (i = 0; i < 6; i++) w *= r;
-    }
-    if (!(b > c)) return c > 0 ? d1 : w;
+  if (cold) {  /* no warm start: satellites_poly_k6s3_COLDC |h gamma_2| rho^4, rho the slowest decay */
+    double c = satellites_poly_k6s3_coef(gam, 2), b = satellites_poly_k6s3_coef(gam, 1), a = satellites_poly_k6s3_coef(gam, 0), t;
+    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = c / b;
-    v = satellites_poly_k6s3_ERRC * fabs(h) * c;
+    t = sqrt(c / a);
+    if (t > r) r = t;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = satellites_poly_k6s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
-    return v > w ? v : w;
+    return v;
   }
   if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */
   r = d1 / v;
