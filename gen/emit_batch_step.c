@@ -300,9 +300,10 @@ static void emit_lane_estimate(Emitter *e, int mult, int defect) {
 // NAME_batch_step_adaptive's tests inside NAME_batch_within, as
 // NAME_step_within's: after the first sweep, each lane's predictor error d1
 // (against the one-step start where the two-step one was taken) and the
-// early estimate; after the iteration, that every active lane converged and
-// its estimate (with the energy defect where the scalar step has it). A
-// lane over tol (1 + its scale) makes the whole try a rejection.
+// early estimate, which rejects warm lanes only; after the iteration, that
+// every active lane converged and its estimate (with the energy defect where
+// the scalar step has it). A lane over tol (1 + its scale) makes the whole
+// try a rejection.
 static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
   tmpl(e, "/* After the first sweep (tol > 0): each iterating lane's predictor error d1 and its\n"
           " * estimate; 1 when one is already over tol (1 + its scale), its code then $P_EREJECT. */\n"
@@ -317,7 +318,8 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
                : "      $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n");
   tmpl(e, "      if (v > d) d = v;\n    }\n"
           "    d1[l] = d;\n    est[l] = $P_batch_est(x, sw, l, h, d, (int)cl[l], &sc);\n"
-          "    if (!(est[l] <= tol * (1 + sc))) {\n      rc[l] = $P_EREJECT;\n      over = 1;\n    }\n  }\n"
+          "    if (!cl[l] && !(est[l] <= tol * (1 + sc))) {  /* warm lanes only, as $P_step_within */\n"
+          "      rc[l] = $P_EREJECT;\n      over = 1;\n    }\n  }\n"
           "  return over;\n}\n\n"
           "/* After the iteration (tol > 0): -2 when an active lane did not converge, -1 when one's\n"
           " * estimate is over tol (1 + its scale), its code then $P_EREJECT, else 0. */\n"

@@ -403,6 +403,10 @@ static void emit_all_finite(Emitter *e, int n) {
 // and the error estimate, with which NAME_step_adaptive rejects a step the
 // first sweep already puts over its tolerance rather than after the
 // iteration has converged. gamma (gm0, ... in the fused step) is the sweep's.
+// Not on a cold try (no warm start): one sweep from the cold predictor leaves
+// the highest coefficients far from their converged values, and the early
+// test rejected chain8's first step from rest (s = 3, tol 1e-12) down to the
+// floor; there the converged estimate decides.
 static void emit_first_sweep(Emitter *e) {
   tmpl(e, "    if (it == 1 && (st || tol > 0)) {  /* for $P_err_est: only when someone reads it */\n"
           "      d1 = inc;  /* the predictor's error */\n");
@@ -413,7 +417,7 @@ static void emit_first_sweep(Emitter *e) {
             "        for (d1 = 0, i = 0; i < $P_S * $P_M; i++) {\n"
             "          $R v = fabs$g(h * (gam[i] - ref[i]));\n"
             "          if (v > d1) d1 = v;\n        }\n");
-  tmpl(e, "      if (tol > 0) {  /* $P_step_adaptive's: no estimate here for a fixed step */\n"
+  tmpl(e, "      if (tol > 0 && !(cold || x->hprev == 0)) {  /* $P_step_adaptive's, warm tries only */\n"
           "        est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
           "        if (!(est <= tol * (1 + scale))) {\n"
           "          if (st) {\n            st->iters = 1;\n            st->increment = inc;\n"
@@ -601,7 +605,7 @@ static double err_constant(const Emitter *e) {
 // truth there, as the first step's size is a guess (docs/api.md).
 static double cold_constant(const Emitter *e) {
   int s = e->me->s;
-  return s <= 2 ? 12 : s == 3 ? 20 : s <= 6 ? 40 : 150;
+  return s <= 2 ? 70 : s <= 4 ? 40 : 250;
 }
 
 // Whether the step's error has a part NAME_err_est does not see: the
@@ -630,11 +634,11 @@ static int controller_order(const Emitter *e) { return mult_err_wanted(e) ? 3 : 
 // gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
 // is the whole velocity): there, at s >= 2, the estimate is the same model
 // read off the converged coefficients, NAME_COLDC |h gamma_{s-1}| rho^(s+1),
-// with rho the slowest decay among |gamma_{s-1}| / |gamma_{s-2}|,
-// |gamma_{s-2}| / |gamma_{s-3}| (s >= 4) and (|gamma_{s-1}| / |gamma_{s-3}|)^(1/2)
-// (s >= 3): the square root for motions whose odd and even coefficients fall
-// at different rates (Kepler's perihelion); not gamma_1 / gamma_0 beyond s = 2,
-// which does not fall with h from rest (gamma_0 ~ h a / 2).
+// with rho the slower of the two-step decays (|gamma_{s-1}| / |gamma_{s-3}|)^(1/2)
+// and (|gamma_{s-2}| / |gamma_{s-4}|)^(1/2): odd and even coefficients can fall
+// at different rates (Kepler's perihelion; from rest, v = a t + O(t^3) makes
+// gamma_2 and gamma_3 both O(h^3)). At s = 2, gamma_1 / gamma_0, which is
+// 1/sqrt(3) from rest whatever h: there (rho >= 0.35) NAME_COLDC_REST.
 // The constant multiplier's own error (order 2) is NAME_mult_err's.
 static void emit_err_est(Emitter *e) {
   int s = e->me->s, p = 2 * s;
@@ -655,19 +659,29 @@ static void emit_err_est(Emitter *e) {
     out(e, "#ifndef %s_COLDC\n#define %s_COLDC %s  /* the first step's: measured, docs/api.md */\n#endif\n", e->P,
         e->P, c);
   }
+  if (s == 2) {
+    format_real(e, c, sizeof c, 0.05);
+    out(e, "#ifndef %s_COLDC_REST\n#define %s_COLDC_REST %s  /* the same from rest: measured, docs/api.md */\n"
+           "#endif\n", e->P, e->P, c);
+  }
   tmpl(e, "static $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v, r;\n  int i;\n");
   tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
   if (s >= 2) {
-    out(e, "  if (cold) {  /* no warm start: %s_COLDC |h gamma_%d| rho^%d, rho the slowest decay */\n", e->P, s - 1,
-        s + 1);
-    out(e, "    %s c = %s_coef(gam, %d), b = %s_coef(gam, %d)", real_type(e, 0), e->P, s - 1, e->P, s - 2);
-    if (s >= 3) out(e, ", a = %s_coef(gam, %d), t", e->P, s - 3);
-    out(e, ";\n    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < %d */\n"
-           "    r = c / b;\n", s);
-    if (s >= 4) out(e, "    t = b / a;\n    if (t > r) r = t;\n");
-    if (s >= 3) out(e, "    t = sqrt%s(c / a);\n    if (t > r) r = t;\n", math_suffix(e, 0));
-    tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
-            "    v = $P_COLDC * fabs$f(h) * c;\n");
+    out(e, "  if (cold) {  /* no warm start: %s_COLDC |h gamma_%d| rho^%d */\n", e->P, s - 1, s + 1);
+    out(e, "    %s c = %s_coef(gam, %d)", real_type(e, 0), e->P, s - 1);
+    if (s != 3) out(e, ", b = %s_coef(gam, %d)", e->P, s - 2);
+    if (s >= 3) out(e, ", a = %s_coef(gam, %d)", e->P, s - 3);
+    if (s >= 4) out(e, ", z = %s_coef(gam, %d), t", e->P, s - 4);
+    out(e, ";\n    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < %d */\n", s);
+    if (s == 2)
+      tmpl(e, "    r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */\n"
+              "    v = (r < ($R)0.35 ? $P_COLDC : $P_COLDC_REST) * fabs$f(h) * c;\n");
+    else {
+      out(e, "    r = sqrt%s(c / a);  /* the slower of the two-step decays */\n", math_suffix(e, 0));
+      if (s >= 4) out(e, "    t = sqrt%s(b / z);\n    if (t > r) r = t;\n", math_suffix(e, 0));
+      tmpl(e, "    v = $P_COLDC * fabs$f(h) * c;\n");
+    }
+    tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n");
     out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v;\n  }\n", s + 1);
   } else
     tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");

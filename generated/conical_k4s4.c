@@ -361,16 +361,14 @@ static double conical_k4s4_err_est(const double *gam, double h, double d1, int c
   double v, r;
   int i;
   v = fabs(h) * conical_k4s4_coef(gam, 0);
-  if (cold) {  /* no warm start: conical_k4s4_COLDC |h gamma_3| rho^5, rho the slowest decay */
-    double c = conical_k4s4_coef(gam, 3), b = conical_k4s4_coef(gam, 2), a = conical_k4s4_coef(gam, 1), t;
+  if (cold) {  /* no warm start: conical_k4s4_COLDC |h gamma_3| rho^5 */
+    double c = conical_k4s4_coef(gam, 3), b = conical_k4s4_coef(gam, 2), a = conical_k4s4_coef(gam, 1), z = conical_k4s4_coef(gam, 0), t;
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 4 */
-    r = c / b;
-    t = b / a;
+    r = sqrt(c / a);  /* the slower of the two-step decays */
+    t = sqrt(b / z);
     if (t > r) r = t;
-    t = sqrt(c / a);
-    if (t > r) r = t;
-    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     v = conical_k4s4_COLDC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -693,7 +691,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
       gam[9] = gm9;
       gam[10] = gm10;
       gam[11] = gm11;
-      if (tol > 0) {  /* conical_k4s4_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* conical_k4s4_step_adaptive's, warm tries only */
         est = conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

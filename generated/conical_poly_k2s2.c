@@ -519,19 +519,22 @@ static double conical_poly_k2s2_coef(const double *gam, int j)
 #define conical_poly_k2s2_ERRC 0.0086999999999999994  /* measured: docs/api.md */
 #endif
 #ifndef conical_poly_k2s2_COLDC
-#define conical_poly_k2s2_COLDC 12.0  /* the first step's: measured, docs/api.md */
+#define conical_poly_k2s2_COLDC 70.0  /* the first step's: measured, docs/api.md */
+#endif
+#ifndef conical_poly_k2s2_COLDC_REST
+#define conical_poly_k2s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
 #endif
 static double conical_poly_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * conical_poly_k2s2_coef(gam, 0);
-  if (cold) {  /* no warm start: conical_poly_k2s2_COLDC |h gamma_1| rho^3, rho the slowest decay */
+  if (cold) {  /* no warm start: conical_poly_k2s2_COLDC |h gamma_1| rho^3 */
     double c = conical_poly_k2s2_coef(gam, 1), b = conical_poly_k2s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
-    r = c / b;
+    r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
+    v = (r < (double)0.35 ? conical_poly_k2s2_COLDC : conical_poly_k2s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
-    v = conical_poly_k2s2_COLDC * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -874,7 +877,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      if (tol > 0) {  /* conical_poly_k2s2_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* conical_poly_k2s2_step_adaptive's, warm tries only */
         est = conical_poly_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

@@ -3057,16 +3057,14 @@ static double double_pendulum_k4s4_err_est(const double *gam, double h, double d
   double v, r;
   int i;
   v = fabs(h) * double_pendulum_k4s4_coef(gam, 0);
-  if (cold) {  /* no warm start: double_pendulum_k4s4_COLDC |h gamma_3| rho^5, rho the slowest decay */
-    double c = double_pendulum_k4s4_coef(gam, 3), b = double_pendulum_k4s4_coef(gam, 2), a = double_pendulum_k4s4_coef(gam, 1), t;
+  if (cold) {  /* no warm start: double_pendulum_k4s4_COLDC |h gamma_3| rho^5 */
+    double c = double_pendulum_k4s4_coef(gam, 3), b = double_pendulum_k4s4_coef(gam, 2), a = double_pendulum_k4s4_coef(gam, 1), z = double_pendulum_k4s4_coef(gam, 0), t;
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 4 */
-    r = c / b;
-    t = b / a;
+    r = sqrt(c / a);  /* the slower of the two-step decays */
+    t = sqrt(b / z);
     if (t > r) r = t;
-    t = sqrt(c / a);
-    if (t > r) r = t;
-    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     v = double_pendulum_k4s4_COLDC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -4301,7 +4299,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      if (tol > 0) {  /* double_pendulum_k4s4_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* double_pendulum_k4s4_step_adaptive's, warm tries only */
         est = double_pendulum_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

@@ -285,7 +285,7 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
       d1 = inc;  /* the predictor's error */
       gam[0] = gm0;
       gam[1] = gm1;
-      if (tol > 0) {  /* kepler_k1s1_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* kepler_k1s1_step_adaptive's, warm tries only */
         est = kepler_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

@@ -238,16 +238,14 @@ static double kepler_k4s4_err_est(const double *gam, double h, double d1, int co
   double v, r;
   int i;
   v = fabs(h) * kepler_k4s4_coef(gam, 0);
-  if (cold) {  /* no warm start: kepler_k4s4_COLDC |h gamma_3| rho^5, rho the slowest decay */
-    double c = kepler_k4s4_coef(gam, 3), b = kepler_k4s4_coef(gam, 2), a = kepler_k4s4_coef(gam, 1), t;
+  if (cold) {  /* no warm start: kepler_k4s4_COLDC |h gamma_3| rho^5 */
+    double c = kepler_k4s4_coef(gam, 3), b = kepler_k4s4_coef(gam, 2), a = kepler_k4s4_coef(gam, 1), z = kepler_k4s4_coef(gam, 0), t;
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 4 */
-    r = c / b;
-    t = b / a;
+    r = sqrt(c / a);  /* the slower of the two-step decays */
+    t = sqrt(b / z);
     if (t > r) r = t;
-    t = sqrt(c / a);
-    if (t > r) r = t;
-    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     v = kepler_k4s4_COLDC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -581,7 +579,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       gam[5] = gm5;
       gam[6] = gm6;
       gam[7] = gm7;
-      if (tol > 0) {  /* kepler_k4s4_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* kepler_k4s4_step_adaptive's, warm tries only */
         est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

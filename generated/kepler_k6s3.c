@@ -201,21 +201,19 @@ static double kepler_k6s3_coef(const double *gam, int j)
 #define kepler_k6s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
 #ifndef kepler_k6s3_COLDC
-#define kepler_k6s3_COLDC 20.0  /* the first step's: measured, docs/api.md */
+#define kepler_k6s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
 static double kepler_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * kepler_k6s3_coef(gam, 0);
-  if (cold) {  /* no warm start: kepler_k6s3_COLDC |h gamma_2| rho^4, rho the slowest decay */
-    double c = kepler_k6s3_coef(gam, 2), b = kepler_k6s3_coef(gam, 1), a = kepler_k6s3_coef(gam, 0), t;
+  if (cold) {  /* no warm start: kepler_k6s3_COLDC |h gamma_2| rho^4 */
+    double c = kepler_k6s3_coef(gam, 2), a = kepler_k6s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
-    r = c / b;
-    t = sqrt(c / a);
-    if (t > r) r = t;
-    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    r = sqrt(c / a);  /* the slower of the two-step decays */
     v = kepler_k6s3_COLDC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -575,7 +573,7 @@ static int kepler_k6s3_step_within(kepler_k6s3_state *x, kepler_k6s3_real h_, do
       gam[3] = gm3;
       gam[4] = gm4;
       gam[5] = gm5;
-      if (tol > 0) {  /* kepler_k6s3_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* kepler_k6s3_step_adaptive's, warm tries only */
         est = kepler_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

@@ -494,7 +494,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       gam[0] = gm0;
       gam[1] = gm1;
       gam[2] = gm2;
-      if (tol > 0) {  /* modified_k3s1_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* modified_k3s1_step_adaptive's, warm tries only */
         est = modified_k3s1_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

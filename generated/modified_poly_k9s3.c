@@ -1182,21 +1182,19 @@ static double modified_poly_k9s3_coef(const double *gam, int j)
 #define modified_poly_k9s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
 #ifndef modified_poly_k9s3_COLDC
-#define modified_poly_k9s3_COLDC 20.0  /* the first step's: measured, docs/api.md */
+#define modified_poly_k9s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
 static double modified_poly_k9s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * modified_poly_k9s3_coef(gam, 0);
-  if (cold) {  /* no warm start: modified_poly_k9s3_COLDC |h gamma_2| rho^4, rho the slowest decay */
-    double c = modified_poly_k9s3_coef(gam, 2), b = modified_poly_k9s3_coef(gam, 1), a = modified_poly_k9s3_coef(gam, 0), t;
+  if (cold) {  /* no warm start: modified_poly_k9s3_COLDC |h gamma_2| rho^4 */
+    double c = modified_poly_k9s3_coef(gam, 2), a = modified_poly_k9s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
-    r = c / b;
-    t = sqrt(c / a);
-    if (t > r) r = t;
-    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    r = sqrt(c / a);  /* the slower of the two-step decays */
     v = modified_poly_k9s3_COLDC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -2370,7 +2368,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      if (tol > 0) {  /* modified_poly_k9s3_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* modified_poly_k9s3_step_adaptive's, warm tries only */
         est = modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {

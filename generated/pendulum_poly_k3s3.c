@@ -627,21 +627,19 @@ static double pendulum_poly_k3s3_coef(const double *gam, int j)
 #define pendulum_poly_k3s3_ERRC 0.00051000000000000004  /* measured: docs/api.md */
 #endif
 #ifndef pendulum_poly_k3s3_COLDC
-#define pendulum_poly_k3s3_COLDC 20.0  /* the first step's: measured, docs/api.md */
+#define pendulum_poly_k3s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
 static double pendulum_poly_k3s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
   v = fabs(h) * pendulum_poly_k3s3_coef(gam, 0);
-  if (cold) {  /* no warm start: pendulum_poly_k3s3_COLDC |h gamma_2| rho^4, rho the slowest decay */
-    double c = pendulum_poly_k3s3_coef(gam, 2), b = pendulum_poly_k3s3_coef(gam, 1), a = pendulum_poly_k3s3_coef(gam, 0), t;
+  if (cold) {  /* no warm start: pendulum_poly_k3s3_COLDC |h gamma_2| rho^4 */
+    double c = pendulum_poly_k3s3_coef(gam, 2), a = pendulum_poly_k3s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
-    r = c / b;
-    t = sqrt(c / a);
-    if (t > r) r = t;
-    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    r = sqrt(c / a);  /* the slower of the two-step decays */
     v = pendulum_poly_k3s3_COLDC * fabs(h) * c;
+    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -1042,7 +1040,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
           double v = fabs(h * (gam[i] - ref[i]));
           if (v > d1) d1 = v;
         }
-      if (tol > 0) {  /* pendulum_poly_k3s3_step_adaptive's: no estimate here for a fixed step */
+      if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_poly_k3s3_step_adaptive's, warm tries only */
         est = pendulum_poly_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
