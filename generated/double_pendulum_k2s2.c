@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define double_pendulum_k2s2_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define double_pendulum_k2s2_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define double_pendulum_k2s2_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef double_pendulum_k2s2_MAXITER
 #define double_pendulum_k2s2_MAXITER 100  /* fixed-point iterations before giving up */
@@ -36,11 +44,6 @@
  *   c_1 = 0.21132486540518713   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double double_pendulum_k2s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 0.99999999999999967};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double double_pendulum_k2s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double double_pendulum_k2s2_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_k2s2_p0[4] = {0.0, 0.0, 0.0, 0.0};
@@ -789,24 +792,22 @@ void double_pendulum_k2s2_hidden(const double_pendulum_k2s2_state *x, const doub
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * double_pendulum_k2s2_err_est needs), else 0. */
-static int double_pendulum_k2s2_predict(const double_pendulum_k2s2_state *x, double h, int cold, const double_pendulum_k2s2_params *prm, double *gam, double *ref)
+double_pendulum_k2s2_OUT_OF_LINE int double_pendulum_k2s2_predict(const double_pendulum_k2s2_state *x, double h, int cold, const double_pendulum_k2s2_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     double_pendulum_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < double_pendulum_k2s2_S; j++)
-      for (i = 0; i < double_pendulum_k2s2_S; i++)
-        if (double_pendulum_k2s2_E1[j * double_pendulum_k2s2_S + i] != 0)
-          for (l = 0; l < double_pendulum_k2s2_M; l++) gam[j * double_pendulum_k2s2_M + l] += double_pendulum_k2s2_E1[j * double_pendulum_k2s2_S + i] * x->gam[i * double_pendulum_k2s2_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += x->gam[0 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[1 * double_pendulum_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * double_pendulum_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += e * x->gam[0 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += x->gam[0 * double_pendulum_k2s2_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += e * x->gam[1 * double_pendulum_k2s2_M + l];
@@ -814,16 +815,20 @@ static int double_pendulum_k2s2_predict(const double_pendulum_k2s2_state *x, dou
     e = e * r;
     for (l = 0; l < double_pendulum_k2s2_M; l++) gam[1 * double_pendulum_k2s2_M + l] += e * x->gam[1 * double_pendulum_k2s2_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < double_pendulum_k2s2_S; j++)
-      for (i = 0; i < double_pendulum_k2s2_S; i++)
-        for (l = 0; l < double_pendulum_k2s2_M; l++)
-          gam[j * double_pendulum_k2s2_M + l] += double_pendulum_k2s2_E2[2 * double_pendulum_k2s2_S * j + i] * x->gam[i * double_pendulum_k2s2_M + l] +
-                               double_pendulum_k2s2_E2[2 * double_pendulum_k2s2_S * j + double_pendulum_k2s2_S + i] * x->gam2[i * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++)
+      gam[0 * double_pendulum_k2s2_M + l] += (-5.5000000000000036) * x->gam[0 * double_pendulum_k2s2_M + l] + 6.5000000000000036 * x->gam2[0 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++)
+      gam[0 * double_pendulum_k2s2_M + l] += 16.454482671904344 * x->gam[1 * double_pendulum_k2s2_M + l] + 9.5262794416288337 * x->gam2[1 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++)
+      gam[1 * double_pendulum_k2s2_M + l] += (-4.3301270189221963) * x->gam[0 * double_pendulum_k2s2_M + l] + 4.3301270189221963 * x->gam2[0 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++)
+      gam[1 * double_pendulum_k2s2_M + l] += 9.5000000000000071 * x->gam[1 * double_pendulum_k2s2_M + l] + 6.5000000000000071 * x->gam2[1 * double_pendulum_k2s2_M + l];
     return 1;
   }
   return 0;
@@ -859,7 +864,7 @@ static double double_pendulum_k2s2_coef(const double *gam, int j)
 #ifndef double_pendulum_k2s2_COLDC_REST
 #define double_pendulum_k2s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
 #endif
-static double double_pendulum_k2s2_err_est(const double *gam, double h, double d1, int cold)
+double_pendulum_k2s2_OUT_OF_LINE double double_pendulum_k2s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

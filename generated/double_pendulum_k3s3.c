@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define double_pendulum_k3s3_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define double_pendulum_k3s3_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define double_pendulum_k3s3_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef double_pendulum_k3s3_MAXITER
 #define double_pendulum_k3s3_MAXITER 100  /* fixed-point iterations before giving up */
@@ -37,11 +45,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double double_pendulum_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double double_pendulum_k3s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double double_pendulum_k3s3_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_k3s3_p0[4] = {0.0, 0.0, 0.0, 0.0};
@@ -1476,24 +1479,27 @@ void double_pendulum_k3s3_hidden(const double_pendulum_k3s3_state *x, const doub
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * double_pendulum_k3s3_err_est needs), else 0. */
-static int double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, int cold, const double_pendulum_k3s3_params *prm, double *gam, double *ref)
+double_pendulum_k3s3_OUT_OF_LINE int double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, double h, int cold, const double_pendulum_k3s3_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     double_pendulum_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < double_pendulum_k3s3_S; j++)
-      for (i = 0; i < double_pendulum_k3s3_S; i++)
-        if (double_pendulum_k3s3_E1[j * double_pendulum_k3s3_S + i] != 0)
-          for (l = 0; l < double_pendulum_k3s3_M; l++) gam[j * double_pendulum_k3s3_M + l] += double_pendulum_k3s3_E1[j * double_pendulum_k3s3_S + i] * x->gam[i * double_pendulum_k3s3_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += x->gam[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += 3.4641016151377544 * x->gam[1 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += 13.416407864998739 * x->gam[2 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[1 * double_pendulum_k3s3_M + l] += x->gam[1 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[1 * double_pendulum_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += 3.8459253727671276e-16 * x->gam[1 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += 1.0000000000000016 * x->gam[2 * double_pendulum_k3s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += e * x->gam[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += x->gam[0 * double_pendulum_k3s3_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < double_pendulum_k3s3_M; l++) gam[0 * double_pendulum_k3s3_M + l] += e * x->gam[1 * double_pendulum_k3s3_M + l];
@@ -1508,8 +1514,7 @@ static int double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, dou
     e = e * r + 3.8729833462074175;
     e = e * r;
     for (l = 0; l < double_pendulum_k3s3_M; l++) gam[1 * double_pendulum_k3s3_M + l] += e * x->gam[2 * double_pendulum_k3s3_M + l];
-    e = 1.1102230246251565e-16;
-    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += e * x->gam[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * double_pendulum_k3s3_M + l];
     e = 1.9229626863835638e-16;
     e = e * r + 1.9229626863835638e-16;
     for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += e * x->gam[1 * double_pendulum_k3s3_M + l];
@@ -1518,16 +1523,30 @@ static int double_pendulum_k3s3_predict(const double_pendulum_k3s3_state *x, dou
     e = e * r + 2.4825341532472731e-16;
     for (l = 0; l < double_pendulum_k3s3_M; l++) gam[2 * double_pendulum_k3s3_M + l] += e * x->gam[2 * double_pendulum_k3s3_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < double_pendulum_k3s3_S * double_pendulum_k3s3_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < double_pendulum_k3s3_S; j++)
-      for (i = 0; i < double_pendulum_k3s3_S; i++)
-        for (l = 0; l < double_pendulum_k3s3_M; l++)
-          gam[j * double_pendulum_k3s3_M + l] += double_pendulum_k3s3_E2[2 * double_pendulum_k3s3_S * j + i] * x->gam[i * double_pendulum_k3s3_M + l] +
-                               double_pendulum_k3s3_E2[2 * double_pendulum_k3s3_S * j + double_pendulum_k3s3_S + i] * x->gam2[i * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[0 * double_pendulum_k3s3_M + l] += 69.500000000000085 * x->gam[0 * double_pendulum_k3s3_M + l] + (-68.500000000000085) * x->gam2[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[0 * double_pendulum_k3s3_M + l] += (-121.78482240718688) * x->gam[1 * double_pendulum_k3s3_M + l] + (-112.04203661461193) * x->gam2[1 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[0 * double_pendulum_k3s3_M + l] += 166.44731007514071 * x->gam[2 * double_pendulum_k3s3_M + l] + (-101.88084722483431) * x->gam2[2 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[1 * double_pendulum_k3s3_M + l] += 63.219854476264132 * x->gam[0 * double_pendulum_k3s3_M + l] + (-63.219854476264118) * x->gam2[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[1 * double_pendulum_k3s3_M + l] += (-114.06250000000021) * x->gam[1 * double_pendulum_k3s3_M + l] + (-103.93750000000018) * x->gam2[1 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[1 * double_pendulum_k3s3_M + l] += 146.25353361115765 * x->gam[2 * double_pendulum_k3s3_M + l] + (-95.420627192185393) * x->gam2[2 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[2 * double_pendulum_k3s3_M + l] += 23.478713763747862 * x->gam[0 * double_pendulum_k3s3_M + l] + (-23.478713763747855) * x->gam2[0 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[2 * double_pendulum_k3s3_M + l] += (-42.360755349143751) * x->gam[1 * double_pendulum_k3s3_M + l] + (-38.971894921212247) * x->gam2[1 * double_pendulum_k3s3_M + l];
+    for (l = 0; l < double_pendulum_k3s3_M; l++)
+      gam[2 * double_pendulum_k3s3_M + l] += 50.562500000000107 * x->gam[2 * double_pendulum_k3s3_M + l] + (-36.437500000000099) * x->gam2[2 * double_pendulum_k3s3_M + l];
     return 1;
   }
   return 0;
@@ -1560,7 +1579,7 @@ static double double_pendulum_k3s3_coef(const double *gam, int j)
 #ifndef double_pendulum_k3s3_COLDC
 #define double_pendulum_k3s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double double_pendulum_k3s3_err_est(const double *gam, double h, double d1, int cold)
+double_pendulum_k3s3_OUT_OF_LINE double double_pendulum_k3s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define double_pendulum_k4s4_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define double_pendulum_k4s4_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define double_pendulum_k4s4_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef double_pendulum_k4s4_MAXITER
 #define double_pendulum_k4s4_MAXITER 100  /* fixed-point iterations before giving up */
@@ -38,11 +46,6 @@
  *   c_3 = 0.66999052179242813   b_3 = 0.32607257743127305
  *   c_4 = 0.93056815579702623   b_4 = 0.17392742256872692
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double double_pendulum_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.416407864998739, 58.206528843420998, 0.0, 0.99999999999999989, 7.745966692414834, 45.825756949558397, (-8.3266726846886741e-17), (-5.2881473875548006e-16), 0.99999999999999745, 11.832159566199218, (-1.6653345369377348e-16), (-8.6533320887260379e-16), (-5.0271316603257284e-15), 0.99999999999997014};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double double_pendulum_k4s4_E2[32] = {(-910.18749999962267), 1626.0709487800843, (-2046.4214621572421), 1911.2482261090747, 911.18749999962233, 1533.8392432770761, 1716.0424184817782, 1199.1631589599583, (-990.62480875351343), 1762.4374999992667, (-2219.9456417533411), 2030.3674438455259, 990.62480875351298, 1670.1874999993049, 1874.2818781044716, 1315.4856354327121, (-506.88865964927345), 898.77419777888406, (-1127.6874999995282), 999.13079551143642, 506.88865964927322, 857.13962680717373, 967.43749999960107, 684.7334127525794, (-150.64246527367814), 266.07580128826294, (-330.93071286699558), 283.43749999987261, 150.64246527367808, 255.76500597461808, 290.99717433109475, 208.43749999991726};
 /* Model defaults for q0 and p0. */
 static const double double_pendulum_k4s4_q0[4] = {0.47942553860420301, (-0.87758256189037276), 0.18390533194286346, (-1.8329190510159787)};
 static const double double_pendulum_k4s4_p0[4] = {0.0, 0.0, 0.0, 0.0};
@@ -2939,24 +2942,34 @@ void double_pendulum_k4s4_hidden(const double_pendulum_k4s4_state *x, const doub
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * double_pendulum_k4s4_err_est needs), else 0. */
-static int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, double h, int cold, const double_pendulum_k4s4_params *prm, double *gam, double *ref)
+double_pendulum_k4s4_OUT_OF_LINE int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, double h, int cold, const double_pendulum_k4s4_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     double_pendulum_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < double_pendulum_k4s4_S; j++)
-      for (i = 0; i < double_pendulum_k4s4_S; i++)
-        if (double_pendulum_k4s4_E1[j * double_pendulum_k4s4_S + i] != 0)
-          for (l = 0; l < double_pendulum_k4s4_M; l++) gam[j * double_pendulum_k4s4_M + l] += double_pendulum_k4s4_E1[j * double_pendulum_k4s4_S + i] * x->gam[i * double_pendulum_k4s4_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += x->gam[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += 3.4641016151377544 * x->gam[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += 13.416407864998739 * x->gam[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += 58.206528843420998 * x->gam[3 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += 0.99999999999999989 * x->gam[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += 7.745966692414834 * x->gam[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += 45.825756949558397 * x->gam[3 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += (-8.3266726846886741e-17) * x->gam[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += (-5.2881473875548006e-16) * x->gam[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += 0.99999999999999745 * x->gam[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += 11.832159566199218 * x->gam[3 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += (-1.6653345369377348e-16) * x->gam[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += (-8.6533320887260379e-16) * x->gam[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += (-5.0271316603257284e-15) * x->gam[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += 0.99999999999997014 * x->gam[3 * double_pendulum_k4s4_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += e * x->gam[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += x->gam[0 * double_pendulum_k4s4_M + l];
     e = 1.732050807568877;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < double_pendulum_k4s4_M; l++) gam[0 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
@@ -2981,8 +2994,7 @@ static int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, dou
     e = e * r + 9.1651513899116814;
     e = e * r;
     for (l = 0; l < double_pendulum_k4s4_M; l++) gam[1 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
-    e = (-8.3266726846886741e-17);
-    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += (-8.3266726846886741e-17) * x->gam[0 * double_pendulum_k4s4_M + l];
     e = (-3.8459253727671276e-16);
     e = e * r + (-1.442222014787673e-16);
     for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
@@ -2995,8 +3007,7 @@ static int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, dou
     e = e * r + (-3.5248488275713244e-15);
     e = e * r + (-2.2030305172320797e-16);
     for (l = 0; l < double_pendulum_k4s4_M; l++) gam[2 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
-    e = (-1.6653345369377348e-16);
-    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += (-1.6653345369377348e-16) * x->gam[0 * double_pendulum_k4s4_M + l];
     e = (-5.7688880591506919e-16);
     e = e * r + (-2.884444029575346e-16);
     for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[1 * double_pendulum_k4s4_M + l];
@@ -3010,16 +3021,44 @@ static int double_pendulum_k4s4_predict(const double_pendulum_k4s4_state *x, dou
     e = e * r + (-4.4060610344641594e-16);
     for (l = 0; l < double_pendulum_k4s4_M; l++) gam[3 * double_pendulum_k4s4_M + l] += e * x->gam[3 * double_pendulum_k4s4_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < double_pendulum_k4s4_S * double_pendulum_k4s4_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < double_pendulum_k4s4_S; j++)
-      for (i = 0; i < double_pendulum_k4s4_S; i++)
-        for (l = 0; l < double_pendulum_k4s4_M; l++)
-          gam[j * double_pendulum_k4s4_M + l] += double_pendulum_k4s4_E2[2 * double_pendulum_k4s4_S * j + i] * x->gam[i * double_pendulum_k4s4_M + l] +
-                               double_pendulum_k4s4_E2[2 * double_pendulum_k4s4_S * j + double_pendulum_k4s4_S + i] * x->gam2[i * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[0 * double_pendulum_k4s4_M + l] += (-910.18749999962267) * x->gam[0 * double_pendulum_k4s4_M + l] + 911.18749999962233 * x->gam2[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[0 * double_pendulum_k4s4_M + l] += 1626.0709487800843 * x->gam[1 * double_pendulum_k4s4_M + l] + 1533.8392432770761 * x->gam2[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[0 * double_pendulum_k4s4_M + l] += (-2046.4214621572421) * x->gam[2 * double_pendulum_k4s4_M + l] + 1716.0424184817782 * x->gam2[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[0 * double_pendulum_k4s4_M + l] += 1911.2482261090747 * x->gam[3 * double_pendulum_k4s4_M + l] + 1199.1631589599583 * x->gam2[3 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[1 * double_pendulum_k4s4_M + l] += (-990.62480875351343) * x->gam[0 * double_pendulum_k4s4_M + l] + 990.62480875351298 * x->gam2[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[1 * double_pendulum_k4s4_M + l] += 1762.4374999992667 * x->gam[1 * double_pendulum_k4s4_M + l] + 1670.1874999993049 * x->gam2[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[1 * double_pendulum_k4s4_M + l] += (-2219.9456417533411) * x->gam[2 * double_pendulum_k4s4_M + l] + 1874.2818781044716 * x->gam2[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[1 * double_pendulum_k4s4_M + l] += 2030.3674438455259 * x->gam[3 * double_pendulum_k4s4_M + l] + 1315.4856354327121 * x->gam2[3 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[2 * double_pendulum_k4s4_M + l] += (-506.88865964927345) * x->gam[0 * double_pendulum_k4s4_M + l] + 506.88865964927322 * x->gam2[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[2 * double_pendulum_k4s4_M + l] += 898.77419777888406 * x->gam[1 * double_pendulum_k4s4_M + l] + 857.13962680717373 * x->gam2[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[2 * double_pendulum_k4s4_M + l] += (-1127.6874999995282) * x->gam[2 * double_pendulum_k4s4_M + l] + 967.43749999960107 * x->gam2[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[2 * double_pendulum_k4s4_M + l] += 999.13079551143642 * x->gam[3 * double_pendulum_k4s4_M + l] + 684.7334127525794 * x->gam2[3 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[3 * double_pendulum_k4s4_M + l] += (-150.64246527367814) * x->gam[0 * double_pendulum_k4s4_M + l] + 150.64246527367808 * x->gam2[0 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[3 * double_pendulum_k4s4_M + l] += 266.07580128826294 * x->gam[1 * double_pendulum_k4s4_M + l] + 255.76500597461808 * x->gam2[1 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[3 * double_pendulum_k4s4_M + l] += (-330.93071286699558) * x->gam[2 * double_pendulum_k4s4_M + l] + 290.99717433109475 * x->gam2[2 * double_pendulum_k4s4_M + l];
+    for (l = 0; l < double_pendulum_k4s4_M; l++)
+      gam[3 * double_pendulum_k4s4_M + l] += 283.43749999987261 * x->gam[3 * double_pendulum_k4s4_M + l] + 208.43749999991726 * x->gam2[3 * double_pendulum_k4s4_M + l];
     return 1;
   }
   return 0;
@@ -3052,7 +3091,7 @@ static double double_pendulum_k4s4_coef(const double *gam, int j)
 #ifndef double_pendulum_k4s4_COLDC
 #define double_pendulum_k4s4_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double double_pendulum_k4s4_err_est(const double *gam, double h, double d1, int cold)
+double_pendulum_k4s4_OUT_OF_LINE double double_pendulum_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

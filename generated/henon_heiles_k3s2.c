@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define henon_heiles_k3s2_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define henon_heiles_k3s2_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define henon_heiles_k3s2_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef henon_heiles_k3s2_MAXITER
 #define henon_heiles_k3s2_MAXITER 100  /* fixed-point iterations before giving up */
@@ -37,8 +45,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double henon_heiles_k3s2_E1[4] = {1.0, 3.4641016151377544, 0.0, 1.0};
 /* Model defaults for q0 and p0. */
 static const double henon_heiles_k3s2_q0[2] = {0.0, 0.10000000000000001};
 static const double henon_heiles_k3s2_p0[2] = {0.29999999999999999, 0.20000000000000001};
@@ -136,24 +142,22 @@ void henon_heiles_k3s2_hidden(const henon_heiles_k3s2_state *x, const henon_heil
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, int cold, const henon_heiles_k3s2_params *prm, double *gam)
+henon_heiles_k3s2_OUT_OF_LINE void henon_heiles_k3s2_predict(const henon_heiles_k3s2_state *x, double h, int cold, const henon_heiles_k3s2_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < henon_heiles_k3s2_S * henon_heiles_k3s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     henon_heiles_k3s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < henon_heiles_k3s2_S; j++)
-      for (i = 0; i < henon_heiles_k3s2_S; i++)
-        if (henon_heiles_k3s2_E1[j * henon_heiles_k3s2_S + i] != 0)
-          for (l = 0; l < henon_heiles_k3s2_M; l++) gam[j * henon_heiles_k3s2_M + l] += henon_heiles_k3s2_E1[j * henon_heiles_k3s2_S + i] * x->gam[i * henon_heiles_k3s2_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += x->gam[0 * henon_heiles_k3s2_M + l];
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += 3.4641016151377544 * x->gam[1 * henon_heiles_k3s2_M + l];
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[1 * henon_heiles_k3s2_M + l] += x->gam[1 * henon_heiles_k3s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += e * x->gam[0 * henon_heiles_k3s2_M + l];
+    for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += x->gam[0 * henon_heiles_k3s2_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < henon_heiles_k3s2_M; l++) gam[0 * henon_heiles_k3s2_M + l] += e * x->gam[1 * henon_heiles_k3s2_M + l];
@@ -193,7 +197,7 @@ static double henon_heiles_k3s2_coef(const double *gam, int j)
 #ifndef henon_heiles_k3s2_COLDC_REST
 #define henon_heiles_k3s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
 #endif
-static double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, int cold)
+henon_heiles_k3s2_OUT_OF_LINE double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define kepler_k1s1_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define kepler_k1s1_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define kepler_k1s1_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef kepler_k1s1_MAXITER
 #define kepler_k1s1_MAXITER 100  /* fixed-point iterations before giving up */
@@ -35,8 +43,6 @@
  * their products with P_j and int_0^c P_j, folded into the code):
  *   c_1 = 0.5   b_1 = 1
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double kepler_k1s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double kepler_k1s1_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k1s1_p0[2] = {0.0, 2.0};
@@ -130,23 +136,18 @@ void kepler_k1s1_hidden(const kepler_k1s1_state *x, const kepler_k1s1_params *pr
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, int cold, const kepler_k1s1_params *prm, double *gam)
+kepler_k1s1_OUT_OF_LINE void kepler_k1s1_predict(const kepler_k1s1_state *x, double h, int cold, const kepler_k1s1_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < kepler_k1s1_S * kepler_k1s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     kepler_k1s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < kepler_k1s1_S; j++)
-      for (i = 0; i < kepler_k1s1_S; i++)
-        if (kepler_k1s1_E1[j * kepler_k1s1_S + i] != 0)
-          for (l = 0; l < kepler_k1s1_M; l++) gam[j * kepler_k1s1_M + l] += kepler_k1s1_E1[j * kepler_k1s1_S + i] * x->gam[i * kepler_k1s1_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < kepler_k1s1_M; l++) gam[0 * kepler_k1s1_M + l] += x->gam[0 * kepler_k1s1_M + l];
   } else {
-    double e;
-    e = 1.0;
-    for (l = 0; l < kepler_k1s1_M; l++) gam[0 * kepler_k1s1_M + l] += e * x->gam[0 * kepler_k1s1_M + l];
+    for (l = 0; l < kepler_k1s1_M; l++) gam[0 * kepler_k1s1_M + l] += x->gam[0 * kepler_k1s1_M + l];
   }
 }
 
@@ -174,7 +175,7 @@ static double kepler_k1s1_coef(const double *gam, int j)
 #ifndef kepler_k1s1_ERRC
 #define kepler_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double kepler_k1s1_err_est(const double *gam, double h, double d1, int cold)
+kepler_k1s1_OUT_OF_LINE double kepler_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define kepler_k4s4_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define kepler_k4s4_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define kepler_k4s4_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef kepler_k4s4_MAXITER
 #define kepler_k4s4_MAXITER 100  /* fixed-point iterations before giving up */
@@ -38,8 +46,6 @@
  *   c_3 = 0.66999052179242813   b_3 = 0.32607257743127305
  *   c_4 = 0.93056815579702623   b_4 = 0.17392742256872692
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double kepler_k4s4_E1[16] = {1.0, 3.4641016151377544, 13.416407864998739, 58.206528843420998, 0.0, 0.99999999999999989, 7.745966692414834, 45.825756949558397, (-8.3266726846886741e-17), (-5.2881473875548006e-16), 0.99999999999999745, 11.832159566199218, (-1.6653345369377348e-16), (-8.6533320887260379e-16), (-5.0271316603257284e-15), 0.99999999999997014};
 /* Model defaults for q0 and p0. */
 static const double kepler_k4s4_q0[2] = {0.40000000000000002, 0.0};
 static const double kepler_k4s4_p0[2] = {0.0, 2.0};
@@ -133,24 +139,34 @@ void kepler_k4s4_hidden(const kepler_k4s4_state *x, const kepler_k4s4_params *pr
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void kepler_k4s4_predict(const kepler_k4s4_state *x, double h, int cold, const kepler_k4s4_params *prm, double *gam)
+kepler_k4s4_OUT_OF_LINE void kepler_k4s4_predict(const kepler_k4s4_state *x, double h, int cold, const kepler_k4s4_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < kepler_k4s4_S * kepler_k4s4_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     kepler_k4s4_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < kepler_k4s4_S; j++)
-      for (i = 0; i < kepler_k4s4_S; i++)
-        if (kepler_k4s4_E1[j * kepler_k4s4_S + i] != 0)
-          for (l = 0; l < kepler_k4s4_M; l++) gam[j * kepler_k4s4_M + l] += kepler_k4s4_E1[j * kepler_k4s4_S + i] * x->gam[i * kepler_k4s4_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += x->gam[0 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += 3.4641016151377544 * x->gam[1 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += 13.416407864998739 * x->gam[2 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += 58.206528843420998 * x->gam[3 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[1 * kepler_k4s4_M + l] += 0.99999999999999989 * x->gam[1 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[1 * kepler_k4s4_M + l] += 7.745966692414834 * x->gam[2 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[1 * kepler_k4s4_M + l] += 45.825756949558397 * x->gam[3 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += (-8.3266726846886741e-17) * x->gam[0 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += (-5.2881473875548006e-16) * x->gam[1 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += 0.99999999999999745 * x->gam[2 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += 11.832159566199218 * x->gam[3 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += (-1.6653345369377348e-16) * x->gam[0 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += (-8.6533320887260379e-16) * x->gam[1 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += (-5.0271316603257284e-15) * x->gam[2 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += 0.99999999999997014 * x->gam[3 * kepler_k4s4_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += e * x->gam[0 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += x->gam[0 * kepler_k4s4_M + l];
     e = 1.732050807568877;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < kepler_k4s4_M; l++) gam[0 * kepler_k4s4_M + l] += e * x->gam[1 * kepler_k4s4_M + l];
@@ -175,8 +191,7 @@ static void kepler_k4s4_predict(const kepler_k4s4_state *x, double h, int cold, 
     e = e * r + 9.1651513899116814;
     e = e * r;
     for (l = 0; l < kepler_k4s4_M; l++) gam[1 * kepler_k4s4_M + l] += e * x->gam[3 * kepler_k4s4_M + l];
-    e = (-8.3266726846886741e-17);
-    for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += e * x->gam[0 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += (-8.3266726846886741e-17) * x->gam[0 * kepler_k4s4_M + l];
     e = (-3.8459253727671276e-16);
     e = e * r + (-1.442222014787673e-16);
     for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += e * x->gam[1 * kepler_k4s4_M + l];
@@ -189,8 +204,7 @@ static void kepler_k4s4_predict(const kepler_k4s4_state *x, double h, int cold, 
     e = e * r + (-3.5248488275713244e-15);
     e = e * r + (-2.2030305172320797e-16);
     for (l = 0; l < kepler_k4s4_M; l++) gam[2 * kepler_k4s4_M + l] += e * x->gam[3 * kepler_k4s4_M + l];
-    e = (-1.6653345369377348e-16);
-    for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += e * x->gam[0 * kepler_k4s4_M + l];
+    for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += (-1.6653345369377348e-16) * x->gam[0 * kepler_k4s4_M + l];
     e = (-5.7688880591506919e-16);
     e = e * r + (-2.884444029575346e-16);
     for (l = 0; l < kepler_k4s4_M; l++) gam[3 * kepler_k4s4_M + l] += e * x->gam[1 * kepler_k4s4_M + l];
@@ -233,7 +247,7 @@ static double kepler_k4s4_coef(const double *gam, int j)
 #ifndef kepler_k4s4_COLDC
 #define kepler_k4s4_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double kepler_k4s4_err_est(const double *gam, double h, double d1, int cold)
+kepler_k4s4_OUT_OF_LINE double kepler_k4s4_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define modified_k3s1_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define modified_k3s1_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define modified_k3s1_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef modified_k3s1_MAXITER
 #define modified_k3s1_MAXITER 100  /* fixed-point iterations before giving up */
@@ -37,8 +45,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double modified_k3s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double modified_k3s1_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k3s1_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -271,23 +277,18 @@ void modified_k3s1_hidden(const modified_k3s1_state *x, const modified_k3s1_para
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void modified_k3s1_predict(const modified_k3s1_state *x, double h, int cold, const modified_k3s1_params *prm, double *gam)
+modified_k3s1_OUT_OF_LINE void modified_k3s1_predict(const modified_k3s1_state *x, double h, int cold, const modified_k3s1_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < modified_k3s1_S * modified_k3s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     modified_k3s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < modified_k3s1_S; j++)
-      for (i = 0; i < modified_k3s1_S; i++)
-        if (modified_k3s1_E1[j * modified_k3s1_S + i] != 0)
-          for (l = 0; l < modified_k3s1_M; l++) gam[j * modified_k3s1_M + l] += modified_k3s1_E1[j * modified_k3s1_S + i] * x->gam[i * modified_k3s1_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < modified_k3s1_M; l++) gam[0 * modified_k3s1_M + l] += x->gam[0 * modified_k3s1_M + l];
   } else {
-    double e;
-    e = 1.0;
-    for (l = 0; l < modified_k3s1_M; l++) gam[0 * modified_k3s1_M + l] += e * x->gam[0 * modified_k3s1_M + l];
+    for (l = 0; l < modified_k3s1_M; l++) gam[0 * modified_k3s1_M + l] += x->gam[0 * modified_k3s1_M + l];
   }
 }
 
@@ -315,7 +316,7 @@ static double modified_k3s1_coef(const double *gam, int j)
 #ifndef modified_k3s1_ERRC
 #define modified_k3s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double modified_k3s1_err_est(const double *gam, double h, double d1, int cold)
+modified_k3s1_OUT_OF_LINE double modified_k3s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

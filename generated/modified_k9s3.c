@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define modified_k9s3_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define modified_k9s3_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define modified_k9s3_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef modified_k9s3_MAXITER
 #define modified_k9s3_MAXITER 100  /* fixed-point iterations before giving up */
@@ -43,8 +51,6 @@
  *   c_8 = 0.91801555366331788   b_8 = 0.090324080347428698
  *   c_9 = 0.98408011975381304   b_9 = 0.040637194180787206
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double modified_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, (-2.7755575615628914e-17), 0.99999999999999989, 7.745966692414834, (-1.1102230246251565e-16), (-2.884444029575346e-16), 0.999999999999999};
 /* Model defaults for q0 and p0. */
 static const double modified_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -277,24 +283,28 @@ void modified_k9s3_hidden(const modified_k9s3_state *x, const modified_k9s3_para
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void modified_k9s3_predict(const modified_k9s3_state *x, double h, int cold, const modified_k9s3_params *prm, double *gam)
+modified_k9s3_OUT_OF_LINE void modified_k9s3_predict(const modified_k9s3_state *x, double h, int cold, const modified_k9s3_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < modified_k9s3_S * modified_k9s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     modified_k9s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < modified_k9s3_S; j++)
-      for (i = 0; i < modified_k9s3_S; i++)
-        if (modified_k9s3_E1[j * modified_k9s3_S + i] != 0)
-          for (l = 0; l < modified_k9s3_M; l++) gam[j * modified_k9s3_M + l] += modified_k9s3_E1[j * modified_k9s3_S + i] * x->gam[i * modified_k9s3_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += x->gam[0 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += 3.4641016151377544 * x->gam[1 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += 13.416407864998739 * x->gam[2 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += 0.99999999999999989 * x->gam[1 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += 7.745966692414834 * x->gam[2 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += (-1.1102230246251565e-16) * x->gam[0 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += (-2.884444029575346e-16) * x->gam[1 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += 0.999999999999999 * x->gam[2 * modified_k9s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[0 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += x->gam[0 * modified_k9s3_M + l];
     e = 1.732050807568877;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
@@ -302,8 +312,7 @@ static void modified_k9s3_predict(const modified_k9s3_state *x, double h, int co
     e = e * r + 6.7082039324993685;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
-    e = (-2.7755575615628914e-17);
-    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[0 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_k9s3_M + l];
     e = 0.99999999999999989;
     e = e * r + (-4.8074067159589095e-17);
     for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
@@ -311,8 +320,7 @@ static void modified_k9s3_predict(const modified_k9s3_state *x, double h, int co
     e = e * r + 3.872983346207417;
     e = e * r + (-6.2063353831181828e-17);
     for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
-    e = (-1.1102230246251565e-16);
-    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[0 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += (-1.1102230246251565e-16) * x->gam[0 * modified_k9s3_M + l];
     e = (-9.6148134319178191e-17);
     e = e * r + (-1.9229626863835638e-16);
     for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
@@ -350,7 +358,7 @@ static double modified_k9s3_coef(const double *gam, int j)
 #ifndef modified_k9s3_COLDC
 #define modified_k9s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double modified_k9s3_err_est(const double *gam, double h, double d1, int cold)
+modified_k9s3_OUT_OF_LINE double modified_k9s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define modified_poly_k9s3_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define modified_poly_k9s3_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define modified_poly_k9s3_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef modified_poly_k9s3_MAXITER
 #define modified_poly_k9s3_MAXITER 100  /* fixed-point iterations before giving up */
@@ -43,11 +51,6 @@
  *   c_8 = 0.91801555366331788   b_8 = 0.090324080347428698
  *   c_9 = 0.98408011975381304   b_9 = 0.040637194180787206
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double modified_poly_k9s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, (-2.7755575615628914e-17), 0.99999999999999989, 7.745966692414834, (-1.1102230246251565e-16), (-2.884444029575346e-16), 0.999999999999999};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double modified_poly_k9s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double modified_poly_k9s3_q0[3] = {0.70710678118654757, 0.0, (-0.70710678118654757)};
 static const double modified_poly_k9s3_p0[3] = {0.0, 0.8408964152537145, 0.0};
@@ -1098,24 +1101,28 @@ void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * modified_poly_k9s3_err_est needs), else 0. */
-static int modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double h, int cold, const modified_poly_k9s3_params *prm, double *gam, double *ref)
+modified_poly_k9s3_OUT_OF_LINE int modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double h, int cold, const modified_poly_k9s3_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     modified_poly_k9s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < modified_poly_k9s3_S; j++)
-      for (i = 0; i < modified_poly_k9s3_S; i++)
-        if (modified_poly_k9s3_E1[j * modified_poly_k9s3_S + i] != 0)
-          for (l = 0; l < modified_poly_k9s3_M; l++) gam[j * modified_poly_k9s3_M + l] += modified_poly_k9s3_E1[j * modified_poly_k9s3_S + i] * x->gam[i * modified_poly_k9s3_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += x->gam[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += 3.4641016151377544 * x->gam[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += 13.416407864998739 * x->gam[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += 0.99999999999999989 * x->gam[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += 7.745966692414834 * x->gam[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += (-1.1102230246251565e-16) * x->gam[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += (-2.884444029575346e-16) * x->gam[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += 0.999999999999999 * x->gam[2 * modified_poly_k9s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += e * x->gam[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += x->gam[0 * modified_poly_k9s3_M + l];
     e = 1.732050807568877;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += e * x->gam[1 * modified_poly_k9s3_M + l];
@@ -1123,8 +1130,7 @@ static int modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double 
     e = e * r + 6.7082039324993685;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += e * x->gam[2 * modified_poly_k9s3_M + l];
-    e = (-2.7755575615628914e-17);
-    for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += e * x->gam[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_poly_k9s3_M + l];
     e = 0.99999999999999989;
     e = e * r + (-4.8074067159589095e-17);
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += e * x->gam[1 * modified_poly_k9s3_M + l];
@@ -1132,8 +1138,7 @@ static int modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double 
     e = e * r + 3.872983346207417;
     e = e * r + (-6.2063353831181828e-17);
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[1 * modified_poly_k9s3_M + l] += e * x->gam[2 * modified_poly_k9s3_M + l];
-    e = (-1.1102230246251565e-16);
-    for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += e * x->gam[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += (-1.1102230246251565e-16) * x->gam[0 * modified_poly_k9s3_M + l];
     e = (-9.6148134319178191e-17);
     e = e * r + (-1.9229626863835638e-16);
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += e * x->gam[1 * modified_poly_k9s3_M + l];
@@ -1142,16 +1147,30 @@ static int modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double 
     e = e * r + (-2.4825341532472731e-16);
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += e * x->gam[2 * modified_poly_k9s3_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < modified_poly_k9s3_S; j++)
-      for (i = 0; i < modified_poly_k9s3_S; i++)
-        for (l = 0; l < modified_poly_k9s3_M; l++)
-          gam[j * modified_poly_k9s3_M + l] += modified_poly_k9s3_E2[2 * modified_poly_k9s3_S * j + i] * x->gam[i * modified_poly_k9s3_M + l] +
-                               modified_poly_k9s3_E2[2 * modified_poly_k9s3_S * j + modified_poly_k9s3_S + i] * x->gam2[i * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[0 * modified_poly_k9s3_M + l] += 69.500000000000085 * x->gam[0 * modified_poly_k9s3_M + l] + (-68.500000000000085) * x->gam2[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[0 * modified_poly_k9s3_M + l] += (-121.78482240718688) * x->gam[1 * modified_poly_k9s3_M + l] + (-112.04203661461193) * x->gam2[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[0 * modified_poly_k9s3_M + l] += 166.44731007514071 * x->gam[2 * modified_poly_k9s3_M + l] + (-101.88084722483431) * x->gam2[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[1 * modified_poly_k9s3_M + l] += 63.219854476264132 * x->gam[0 * modified_poly_k9s3_M + l] + (-63.219854476264118) * x->gam2[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[1 * modified_poly_k9s3_M + l] += (-114.06250000000021) * x->gam[1 * modified_poly_k9s3_M + l] + (-103.93750000000018) * x->gam2[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[1 * modified_poly_k9s3_M + l] += 146.25353361115765 * x->gam[2 * modified_poly_k9s3_M + l] + (-95.420627192185393) * x->gam2[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[2 * modified_poly_k9s3_M + l] += 23.478713763747862 * x->gam[0 * modified_poly_k9s3_M + l] + (-23.478713763747855) * x->gam2[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[2 * modified_poly_k9s3_M + l] += (-42.360755349143751) * x->gam[1 * modified_poly_k9s3_M + l] + (-38.971894921212247) * x->gam2[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[2 * modified_poly_k9s3_M + l] += 50.562500000000107 * x->gam[2 * modified_poly_k9s3_M + l] + (-36.437500000000099) * x->gam2[2 * modified_poly_k9s3_M + l];
     return 1;
   }
   return 0;
@@ -1184,7 +1203,7 @@ static double modified_poly_k9s3_coef(const double *gam, int j)
 #ifndef modified_poly_k9s3_COLDC
 #define modified_poly_k9s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double modified_poly_k9s3_err_est(const double *gam, double h, double d1, int cold)
+modified_poly_k9s3_OUT_OF_LINE double modified_poly_k9s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define pendulum_k3s3_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define pendulum_k3s3_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define pendulum_k3s3_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef pendulum_k3s3_MAXITER
 #define pendulum_k3s3_MAXITER 100  /* fixed-point iterations before giving up */
@@ -37,8 +45,6 @@
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double pendulum_k3s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 0.0, 1.0, 7.7459666924148349, 1.1102230246251565e-16, 3.8459253727671276e-16, 1.0000000000000016};
 /* Model defaults for q0 and p0. */
 static const double pendulum_k3s3_q0[2] = {0.0, (-1.0)};
 static const double pendulum_k3s3_p0[2] = {1.0, 0.0};
@@ -228,24 +234,27 @@ void pendulum_k3s3_hidden(const pendulum_k3s3_state *x, const pendulum_k3s3_para
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void pendulum_k3s3_predict(const pendulum_k3s3_state *x, double h, int cold, const pendulum_k3s3_params *prm, double *gam)
+pendulum_k3s3_OUT_OF_LINE void pendulum_k3s3_predict(const pendulum_k3s3_state *x, double h, int cold, const pendulum_k3s3_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < pendulum_k3s3_S * pendulum_k3s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     pendulum_k3s3_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < pendulum_k3s3_S; j++)
-      for (i = 0; i < pendulum_k3s3_S; i++)
-        if (pendulum_k3s3_E1[j * pendulum_k3s3_S + i] != 0)
-          for (l = 0; l < pendulum_k3s3_M; l++) gam[j * pendulum_k3s3_M + l] += pendulum_k3s3_E1[j * pendulum_k3s3_S + i] * x->gam[i * pendulum_k3s3_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += x->gam[0 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += 13.416407864998739 * x->gam[2 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += x->gam[1 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 3.8459253727671276e-16 * x->gam[1 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 1.0000000000000016 * x->gam[2 * pendulum_k3s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += e * x->gam[0 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += x->gam[0 * pendulum_k3s3_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += e * x->gam[1 * pendulum_k3s3_M + l];
@@ -260,8 +269,7 @@ static void pendulum_k3s3_predict(const pendulum_k3s3_state *x, double h, int co
     e = e * r + 3.8729833462074175;
     e = e * r;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += e * x->gam[2 * pendulum_k3s3_M + l];
-    e = 1.1102230246251565e-16;
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += e * x->gam[0 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * pendulum_k3s3_M + l];
     e = 1.9229626863835638e-16;
     e = e * r + 1.9229626863835638e-16;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += e * x->gam[1 * pendulum_k3s3_M + l];
@@ -299,7 +307,7 @@ static double pendulum_k3s3_coef(const double *gam, int j)
 #ifndef pendulum_k3s3_COLDC
 #define pendulum_k3s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double pendulum_k3s3_err_est(const double *gam, double h, double d1, int cold)
+pendulum_k3s3_OUT_OF_LINE double pendulum_k3s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

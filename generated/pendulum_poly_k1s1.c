@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define pendulum_poly_k1s1_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define pendulum_poly_k1s1_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define pendulum_poly_k1s1_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef pendulum_poly_k1s1_MAXITER
 #define pendulum_poly_k1s1_MAXITER 100  /* fixed-point iterations before giving up */
@@ -35,11 +43,6 @@
  * their products with P_j and int_0^c P_j, folded into the code):
  *   c_1 = 0.5   b_1 = 1
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double pendulum_poly_k1s1_E1[1] = {1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double pendulum_poly_k1s1_E2[2] = {2.0, (-1.0)};
 /* Model defaults for q0 and p0. */
 static const double pendulum_poly_k1s1_q0[2] = {0.0, (-1.0)};
 static const double pendulum_poly_k1s1_p0[2] = {1.0, 0.0};
@@ -302,34 +305,27 @@ void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * pendulum_poly_k1s1_err_est needs), else 0. */
-static int pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, int cold, const pendulum_poly_k1s1_params *prm, double *gam, double *ref)
+pendulum_poly_k1s1_OUT_OF_LINE int pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, int cold, const pendulum_poly_k1s1_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     pendulum_poly_k1s1_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < pendulum_poly_k1s1_S; j++)
-      for (i = 0; i < pendulum_poly_k1s1_S; i++)
-        if (pendulum_poly_k1s1_E1[j * pendulum_poly_k1s1_S + i] != 0)
-          for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[j * pendulum_poly_k1s1_M + l] += pendulum_poly_k1s1_E1[j * pendulum_poly_k1s1_S + i] * x->gam[i * pendulum_poly_k1s1_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
   } else {
-    double e;
-    e = 1.0;
-    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += e * x->gam[0 * pendulum_poly_k1s1_M + l];
+    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < pendulum_poly_k1s1_S; j++)
-      for (i = 0; i < pendulum_poly_k1s1_S; i++)
-        for (l = 0; l < pendulum_poly_k1s1_M; l++)
-          gam[j * pendulum_poly_k1s1_M + l] += pendulum_poly_k1s1_E2[2 * pendulum_poly_k1s1_S * j + i] * x->gam[i * pendulum_poly_k1s1_M + l] +
-                               pendulum_poly_k1s1_E2[2 * pendulum_poly_k1s1_S * j + pendulum_poly_k1s1_S + i] * x->gam2[i * pendulum_poly_k1s1_M + l];
+    for (l = 0; l < pendulum_poly_k1s1_M; l++)
+      gam[0 * pendulum_poly_k1s1_M + l] += 2.0 * x->gam[0 * pendulum_poly_k1s1_M + l] + (-1.0) * x->gam2[0 * pendulum_poly_k1s1_M + l];
     return 1;
   }
   return 0;
@@ -359,7 +355,7 @@ static double pendulum_poly_k1s1_coef(const double *gam, int j)
 #ifndef pendulum_poly_k1s1_ERRC
 #define pendulum_poly_k1s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1, int cold)
+pendulum_poly_k1s1_OUT_OF_LINE double pendulum_poly_k1s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

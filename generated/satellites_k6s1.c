@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define satellites_k6s1_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define satellites_k6s1_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define satellites_k6s1_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef satellites_k6s1_MAXITER
 #define satellites_k6s1_MAXITER 100  /* fixed-point iterations before giving up */
@@ -40,8 +48,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double satellites_k6s1_E1[1] = {1.0};
 /* Model defaults for q0 and p0. */
 static const double satellites_k6s1_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s1_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -761,23 +767,18 @@ void satellites_k6s1_hidden(const satellites_k6s1_state *x, const satellites_k6s
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, int cold, const satellites_k6s1_params *prm, double *gam)
+satellites_k6s1_OUT_OF_LINE void satellites_k6s1_predict(const satellites_k6s1_state *x, double h, int cold, const satellites_k6s1_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < satellites_k6s1_S * satellites_k6s1_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     satellites_k6s1_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < satellites_k6s1_S; j++)
-      for (i = 0; i < satellites_k6s1_S; i++)
-        if (satellites_k6s1_E1[j * satellites_k6s1_S + i] != 0)
-          for (l = 0; l < satellites_k6s1_M; l++) gam[j * satellites_k6s1_M + l] += satellites_k6s1_E1[j * satellites_k6s1_S + i] * x->gam[i * satellites_k6s1_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < satellites_k6s1_M; l++) gam[0 * satellites_k6s1_M + l] += x->gam[0 * satellites_k6s1_M + l];
   } else {
-    double e;
-    e = 1.0;
-    for (l = 0; l < satellites_k6s1_M; l++) gam[0 * satellites_k6s1_M + l] += e * x->gam[0 * satellites_k6s1_M + l];
+    for (l = 0; l < satellites_k6s1_M; l++) gam[0 * satellites_k6s1_M + l] += x->gam[0 * satellites_k6s1_M + l];
   }
 }
 
@@ -805,7 +806,7 @@ static double satellites_k6s1_coef(const double *gam, int j)
 #ifndef satellites_k6s1_ERRC
 #define satellites_k6s1_ERRC 0.068000000000000005  /* measured: docs/api.md */
 #endif
-static double satellites_k6s1_err_est(const double *gam, double h, double d1, int cold)
+satellites_k6s1_OUT_OF_LINE double satellites_k6s1_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

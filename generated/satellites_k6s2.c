@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define satellites_k6s2_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define satellites_k6s2_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define satellites_k6s2_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef satellites_k6s2_MAXITER
 #define satellites_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
@@ -40,8 +48,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double satellites_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231257827e-17, 1.0};
 /* Model defaults for q0 and p0. */
 static const double satellites_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -2183,29 +2189,27 @@ void satellites_k6s2_hidden(const satellites_k6s2_state *x, const satellites_k6s
 /* gamma for a step of size h: extrapolated from the last two steps' polynomials
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
-static void satellites_k6s2_predict(const satellites_k6s2_state *x, double h, int cold, const satellites_k6s2_params *prm, double *gam)
+satellites_k6s2_OUT_OF_LINE void satellites_k6s2_predict(const satellites_k6s2_state *x, double h, int cold, const satellites_k6s2_params *prm, double *gam)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < satellites_k6s2_S * satellites_k6s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     satellites_k6s2_minv_p(x->q, x->p, 0, 0, 0, prm, gam);
     return;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < satellites_k6s2_S; j++)
-      for (i = 0; i < satellites_k6s2_S; i++)
-        if (satellites_k6s2_E1[j * satellites_k6s2_S + i] != 0)
-          for (l = 0; l < satellites_k6s2_M; l++) gam[j * satellites_k6s2_M + l] += satellites_k6s2_E1[j * satellites_k6s2_S + i] * x->gam[i * satellites_k6s2_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < satellites_k6s2_M; l++) gam[0 * satellites_k6s2_M + l] += x->gam[0 * satellites_k6s2_M + l];
+    for (l = 0; l < satellites_k6s2_M; l++) gam[0 * satellites_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * satellites_k6s2_M + l];
+    for (l = 0; l < satellites_k6s2_M; l++) gam[1 * satellites_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * satellites_k6s2_M + l];
+    for (l = 0; l < satellites_k6s2_M; l++) gam[1 * satellites_k6s2_M + l] += x->gam[1 * satellites_k6s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < satellites_k6s2_M; l++) gam[0 * satellites_k6s2_M + l] += e * x->gam[0 * satellites_k6s2_M + l];
+    for (l = 0; l < satellites_k6s2_M; l++) gam[0 * satellites_k6s2_M + l] += x->gam[0 * satellites_k6s2_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < satellites_k6s2_M; l++) gam[0 * satellites_k6s2_M + l] += e * x->gam[1 * satellites_k6s2_M + l];
-    e = 5.5511151231257827e-17;
-    for (l = 0; l < satellites_k6s2_M; l++) gam[1 * satellites_k6s2_M + l] += e * x->gam[0 * satellites_k6s2_M + l];
+    for (l = 0; l < satellites_k6s2_M; l++) gam[1 * satellites_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * satellites_k6s2_M + l];
     e = 0.99999999999999989;
     e = e * r + 9.6148134319178191e-17;
     for (l = 0; l < satellites_k6s2_M; l++) gam[1 * satellites_k6s2_M + l] += e * x->gam[1 * satellites_k6s2_M + l];
@@ -2242,7 +2246,7 @@ static double satellites_k6s2_coef(const double *gam, int j)
 #ifndef satellites_k6s2_COLDC_REST
 #define satellites_k6s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
 #endif
-static double satellites_k6s2_err_est(const double *gam, double h, double d1, int cold)
+satellites_k6s2_OUT_OF_LINE double satellites_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

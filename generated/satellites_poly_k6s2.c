@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define satellites_poly_k6s2_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define satellites_poly_k6s2_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define satellites_poly_k6s2_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef satellites_poly_k6s2_MAXITER
 #define satellites_poly_k6s2_MAXITER 100  /* fixed-point iterations before giving up */
@@ -40,11 +48,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double satellites_poly_k6s2_E1[4] = {1.0, 3.4641016151377544, 5.5511151231257827e-17, 1.0};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double satellites_poly_k6s2_E2[8] = {(-5.5000000000000036), 16.454482671904344, 6.5000000000000036, 9.5262794416288337, (-4.3301270189221963), 9.5000000000000071, 4.3301270189221963, 6.5000000000000071};
 /* Model defaults for q0 and p0. */
 static const double satellites_poly_k6s2_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_poly_k6s2_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -4949,43 +4952,45 @@ void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const sate
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * satellites_poly_k6s2_err_est needs), else 0. */
-static int satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, int cold, const satellites_poly_k6s2_params *prm, double *gam, double *ref)
+satellites_poly_k6s2_OUT_OF_LINE int satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, int cold, const satellites_poly_k6s2_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     satellites_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < satellites_poly_k6s2_S; j++)
-      for (i = 0; i < satellites_poly_k6s2_S; i++)
-        if (satellites_poly_k6s2_E1[j * satellites_poly_k6s2_S + i] != 0)
-          for (l = 0; l < satellites_poly_k6s2_M; l++) gam[j * satellites_poly_k6s2_M + l] += satellites_poly_k6s2_E1[j * satellites_poly_k6s2_S + i] * x->gam[i * satellites_poly_k6s2_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += x->gam[0 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += x->gam[1 * satellites_poly_k6s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += e * x->gam[0 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += x->gam[0 * satellites_poly_k6s2_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += e * x->gam[1 * satellites_poly_k6s2_M + l];
-    e = 5.5511151231257827e-17;
-    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += e * x->gam[0 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * satellites_poly_k6s2_M + l];
     e = 0.99999999999999989;
     e = e * r + 9.6148134319178191e-17;
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += e * x->gam[1 * satellites_poly_k6s2_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < satellites_poly_k6s2_S; j++)
-      for (i = 0; i < satellites_poly_k6s2_S; i++)
-        for (l = 0; l < satellites_poly_k6s2_M; l++)
-          gam[j * satellites_poly_k6s2_M + l] += satellites_poly_k6s2_E2[2 * satellites_poly_k6s2_S * j + i] * x->gam[i * satellites_poly_k6s2_M + l] +
-                               satellites_poly_k6s2_E2[2 * satellites_poly_k6s2_S * j + satellites_poly_k6s2_S + i] * x->gam2[i * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++)
+      gam[0 * satellites_poly_k6s2_M + l] += (-5.5000000000000036) * x->gam[0 * satellites_poly_k6s2_M + l] + 6.5000000000000036 * x->gam2[0 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++)
+      gam[0 * satellites_poly_k6s2_M + l] += 16.454482671904344 * x->gam[1 * satellites_poly_k6s2_M + l] + 9.5262794416288337 * x->gam2[1 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++)
+      gam[1 * satellites_poly_k6s2_M + l] += (-4.3301270189221963) * x->gam[0 * satellites_poly_k6s2_M + l] + 4.3301270189221963 * x->gam2[0 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++)
+      gam[1 * satellites_poly_k6s2_M + l] += 9.5000000000000071 * x->gam[1 * satellites_poly_k6s2_M + l] + 6.5000000000000071 * x->gam2[1 * satellites_poly_k6s2_M + l];
     return 1;
   }
   return 0;
@@ -5021,7 +5026,7 @@ static double satellites_poly_k6s2_coef(const double *gam, int j)
 #ifndef satellites_poly_k6s2_COLDC_REST
 #define satellites_poly_k6s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
 #endif
-static double satellites_poly_k6s2_err_est(const double *gam, double h, double d1, int cold)
+satellites_poly_k6s2_OUT_OF_LINE double satellites_poly_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;

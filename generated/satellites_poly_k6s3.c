@@ -10,6 +10,14 @@
 #error "compile without -ffast-math (docs/api.md), or define satellites_poly_k6s3_ALLOW_FAST_MATH"
 #endif
 
+/* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed
+ * gcc's register allocation of the fused sweep there (Kepler (11,6), h = 0.02) */
+#if defined(__GNUC__)
+#define satellites_poly_k6s3_OUT_OF_LINE static __attribute__((noinline))
+#else
+#define satellites_poly_k6s3_OUT_OF_LINE static
+#endif
+
 /* Limits of the iteration; each can be set with -D (docs/api.md). */
 #ifndef satellites_poly_k6s3_MAXITER
 #define satellites_poly_k6s3_MAXITER 100  /* fixed-point iterations before giving up */
@@ -40,11 +48,6 @@
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
  *   c_6 = 0.96623475710157603   b_6 = 0.085662246189585178
  */
-/* E[j][i](1): the warm start of a step as long as the last one. */
-static const double satellites_poly_k6s3_E1[9] = {1.0, 3.4641016151377544, 13.416407864998739, 5.5511151231257827e-17, 1.0, 7.745966692414834, 0.0, 0.0, 1.0000000000000002};
-/* The warm start of a step as long as the last two: gamma_j = sum_i E2[j][i] gamma_i
- * + E2[j][S + i] gamma_prev_i, from the polynomial of degree 2S-1 fitting both. */
-static const double satellites_poly_k6s3_E2[18] = {69.500000000000085, (-121.78482240718688), 166.44731007514071, (-68.500000000000085), (-112.04203661461193), (-101.88084722483431), 63.219854476264132, (-114.06250000000021), 146.25353361115765, (-63.219854476264118), (-103.93750000000018), (-95.420627192185393), 23.478713763747862, (-42.360755349143751), 50.562500000000107, (-23.478713763747855), (-38.971894921212247), (-36.437500000000099)};
 /* Model defaults for q0 and p0. */
 static const double satellites_poly_k6s3_q0[9] = {0.0, 0.5, 20.0, 0.0, (-0.5), 20.0, 0.0, 0.0, 19.133974596215563};
 static const double satellites_poly_k6s3_p0[9] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.55178224216018856, 0.0, 0.0};
@@ -8626,24 +8629,26 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
  * satellites_poly_k6s3_err_est needs), else 0. */
-static int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, int cold, const satellites_poly_k6s3_params *prm, double *gam, double *ref)
+satellites_poly_k6s3_OUT_OF_LINE int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, int cold, const satellites_poly_k6s3_params *prm, double *gam, double *ref)
 {
-  int i, j, l;
+  int i, l;
   for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
   if (cold || x->hprev == 0) {
     satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {
-    for (j = 0; j < satellites_poly_k6s3_S; j++)
-      for (i = 0; i < satellites_poly_k6s3_S; i++)
-        if (satellites_poly_k6s3_E1[j * satellites_poly_k6s3_S + i] != 0)
-          for (l = 0; l < satellites_poly_k6s3_M; l++) gam[j * satellites_poly_k6s3_M + l] += satellites_poly_k6s3_E1[j * satellites_poly_k6s3_S + i] * x->gam[i * satellites_poly_k6s3_M + l];
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += x->gam[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += 3.4641016151377544 * x->gam[1 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += 13.416407864998739 * x->gam[2 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += 5.5511151231257827e-17 * x->gam[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += x->gam[1 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += 7.745966692414834 * x->gam[2 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[2 * satellites_poly_k6s3_M + l] += 1.0000000000000002 * x->gam[2 * satellites_poly_k6s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    e = 1.0;
-    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += e * x->gam[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += x->gam[0 * satellites_poly_k6s3_M + l];
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += e * x->gam[1 * satellites_poly_k6s3_M + l];
@@ -8651,8 +8656,7 @@ static int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, dou
     e = e * r + 6.7082039324993694;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += e * x->gam[2 * satellites_poly_k6s3_M + l];
-    e = 5.5511151231257827e-17;
-    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += e * x->gam[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += 5.5511151231257827e-17 * x->gam[0 * satellites_poly_k6s3_M + l];
     e = 0.99999999999999989;
     e = e * r + 9.6148134319178191e-17;
     for (l = 0; l < satellites_poly_k6s3_M; l++) gam[1 * satellites_poly_k6s3_M + l] += e * x->gam[1 * satellites_poly_k6s3_M + l];
@@ -8665,16 +8669,30 @@ static int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, dou
     e = e * r;
     for (l = 0; l < satellites_poly_k6s3_M; l++) gam[2 * satellites_poly_k6s3_M + l] += e * x->gam[2 * satellites_poly_k6s3_M + l];
   }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps */
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
     for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) {
       ref[i] = gam[i];
       gam[i] = 0;
     }
-    for (j = 0; j < satellites_poly_k6s3_S; j++)
-      for (i = 0; i < satellites_poly_k6s3_S; i++)
-        for (l = 0; l < satellites_poly_k6s3_M; l++)
-          gam[j * satellites_poly_k6s3_M + l] += satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + i] * x->gam[i * satellites_poly_k6s3_M + l] +
-                               satellites_poly_k6s3_E2[2 * satellites_poly_k6s3_S * j + satellites_poly_k6s3_S + i] * x->gam2[i * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[0 * satellites_poly_k6s3_M + l] += 69.500000000000085 * x->gam[0 * satellites_poly_k6s3_M + l] + (-68.500000000000085) * x->gam2[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[0 * satellites_poly_k6s3_M + l] += (-121.78482240718688) * x->gam[1 * satellites_poly_k6s3_M + l] + (-112.04203661461193) * x->gam2[1 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[0 * satellites_poly_k6s3_M + l] += 166.44731007514071 * x->gam[2 * satellites_poly_k6s3_M + l] + (-101.88084722483431) * x->gam2[2 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[1 * satellites_poly_k6s3_M + l] += 63.219854476264132 * x->gam[0 * satellites_poly_k6s3_M + l] + (-63.219854476264118) * x->gam2[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[1 * satellites_poly_k6s3_M + l] += (-114.06250000000021) * x->gam[1 * satellites_poly_k6s3_M + l] + (-103.93750000000018) * x->gam2[1 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[1 * satellites_poly_k6s3_M + l] += 146.25353361115765 * x->gam[2 * satellites_poly_k6s3_M + l] + (-95.420627192185393) * x->gam2[2 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[2 * satellites_poly_k6s3_M + l] += 23.478713763747862 * x->gam[0 * satellites_poly_k6s3_M + l] + (-23.478713763747855) * x->gam2[0 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[2 * satellites_poly_k6s3_M + l] += (-42.360755349143751) * x->gam[1 * satellites_poly_k6s3_M + l] + (-38.971894921212247) * x->gam2[1 * satellites_poly_k6s3_M + l];
+    for (l = 0; l < satellites_poly_k6s3_M; l++)
+      gam[2 * satellites_poly_k6s3_M + l] += 50.562500000000107 * x->gam[2 * satellites_poly_k6s3_M + l] + (-36.437500000000099) * x->gam2[2 * satellites_poly_k6s3_M + l];
     return 1;
   }
   return 0;
@@ -8707,7 +8725,7 @@ static double satellites_poly_k6s3_coef(const double *gam, int j)
 #ifndef satellites_poly_k6s3_COLDC
 #define satellites_poly_k6s3_COLDC 40.0  /* the first step's: measured, docs/api.md */
 #endif
-static double satellites_poly_k6s3_err_est(const double *gam, double h, double d1, int cold)
+satellites_poly_k6s3_OUT_OF_LINE double satellites_poly_k6s3_err_est(const double *gam, double h, double d1, int cold)
 {
   double v, r;
   int i;
