@@ -131,7 +131,7 @@ $(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(TSOLV_OBJ) $(LIBRT)
 # (make SANITIZE=1 check runs only the latter); the plain binaries are put
 # back in place at the end.
 check: deps
-	@scripts/deps.sh embedded mpi
+	@scripts/deps.sh embedded clang mpi
 	@$(MAKE) --no-print-directory $(B)/tests/runner all
 	cd tests && HBVM_SANITIZED=$(if $(SANITIZE),1,) ../$(B)/tests/runner
 ifndef SANITIZE

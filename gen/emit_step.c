@@ -735,7 +735,7 @@ static void emit_itol(Emitter *e) {
           "static $R $P_itol($R tol, $R scale)\n{\n"
           "  $R t = $P_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);\n"
           "  t = t < $P_ITOLMAX ? t : $P_ITOLMAX;\n"
-          "  return (tol > 0) & (scale > 0) & (t > $P_TOL) ? t : $P_TOL;\n}\n\n"
+          "  return ((tol > 0) & (scale > 0) & (t > $P_TOL)) ? t : $P_TOL;\n}\n\n"
           "/* The iteration's stopping test at the threshold t: the increment inc within t, or the\n"
           " * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */\n"
           "static int $P_converged($R inc, $R inc_old, int it, $R t)\n{\n"

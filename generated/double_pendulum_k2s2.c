@@ -905,7 +905,7 @@ static double double_pendulum_k2s2_itol(double tol, double scale)
 {
   double t = double_pendulum_k2s2_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
   t = t < double_pendulum_k2s2_ITOLMAX ? t : double_pendulum_k2s2_ITOLMAX;
-  return (tol > 0) & (scale > 0) & (t > double_pendulum_k2s2_TOL) ? t : double_pendulum_k2s2_TOL;
+  return ((tol > 0) & (scale > 0) & (t > double_pendulum_k2s2_TOL)) ? t : double_pendulum_k2s2_TOL;
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the

@@ -3134,7 +3134,7 @@ static double double_pendulum_k4s4_itol(double tol, double scale)
 {
   double t = double_pendulum_k4s4_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
   t = t < double_pendulum_k4s4_ITOLMAX ? t : double_pendulum_k4s4_ITOLMAX;
-  return (tol > 0) & (scale > 0) & (t > double_pendulum_k4s4_TOL) ? t : double_pendulum_k4s4_TOL;
+  return ((tol > 0) & (scale > 0) & (t > double_pendulum_k4s4_TOL)) ? t : double_pendulum_k4s4_TOL;
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the

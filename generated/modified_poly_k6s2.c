@@ -753,7 +753,7 @@ static double modified_poly_k6s2_itol(double tol, double scale)
 {
   double t = modified_poly_k6s2_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
   t = t < modified_poly_k6s2_ITOLMAX ? t : modified_poly_k6s2_ITOLMAX;
-  return (tol > 0) & (scale > 0) & (t > modified_poly_k6s2_TOL) ? t : modified_poly_k6s2_TOL;
+  return ((tol > 0) & (scale > 0) & (t > modified_poly_k6s2_TOL)) ? t : modified_poly_k6s2_TOL;
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the

@@ -388,7 +388,7 @@ static double pendulum_poly_k1s1_itol(double tol, double scale)
 {
   double t = pendulum_poly_k1s1_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
   t = t < pendulum_poly_k1s1_ITOLMAX ? t : pendulum_poly_k1s1_ITOLMAX;
-  return (tol > 0) & (scale > 0) & (t > pendulum_poly_k1s1_TOL) ? t : pendulum_poly_k1s1_TOL;
+  return ((tol > 0) & (scale > 0) & (t > pendulum_poly_k1s1_TOL)) ? t : pendulum_poly_k1s1_TOL;
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the

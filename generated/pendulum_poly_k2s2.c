@@ -493,7 +493,7 @@ static double pendulum_poly_k2s2_itol(double tol, double scale)
 {
   double t = pendulum_poly_k2s2_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
   t = t < pendulum_poly_k2s2_ITOLMAX ? t : pendulum_poly_k2s2_ITOLMAX;
-  return (tol > 0) & (scale > 0) & (t > pendulum_poly_k2s2_TOL) ? t : pendulum_poly_k2s2_TOL;
+  return ((tol > 0) & (scale > 0) & (t > pendulum_poly_k2s2_TOL)) ? t : pendulum_poly_k2s2_TOL;
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the

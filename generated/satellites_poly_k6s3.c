@@ -8766,7 +8766,7 @@ static double satellites_poly_k6s3_itol(double tol, double scale)
 {
   double t = satellites_poly_k6s3_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);
   t = t < satellites_poly_k6s3_ITOLMAX ? t : satellites_poly_k6s3_ITOLMAX;
-  return (tol > 0) & (scale > 0) & (t > satellites_poly_k6s3_TOL) ? t : satellites_poly_k6s3_TOL;
+  return ((tol > 0) & (scale > 0) & (t > satellites_poly_k6s3_TOL)) ? t : satellites_poly_k6s3_TOL;
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the

@@ -3,6 +3,7 @@
 #   scripts/deps.sh            build and test: bison flex libgsl-dev check libsubunit-dev pkg-config valgrind
 #   scripts/deps.sh bench      also the benchmark peers, plotting, clang and llvm-mca
 #   scripts/deps.sh embedded   also the ARM cross compiler for the embedded build check
+#   scripts/deps.sh clang      also clang, the second compiler the generated C is checked with
 #   scripts/deps.sh fuzz       also clang with libFuzzer
 #   scripts/deps.sh mpi        also Open MPI (make MPI=1: ensembles across ranks)
 # As root it runs apt-get install -y; otherwise it prints the exact line to run.
@@ -13,9 +14,10 @@ for set in "$@"; do
   case "$set" in
     bench)    pkgs="$pkgs libsundials-dev gnuplot-nox clang llvm" ;;
     embedded) pkgs="$pkgs gcc-arm-none-eabi libnewlib-arm-none-eabi" ;;
+    clang)    pkgs="$pkgs clang" ;;
     fuzz)     pkgs="$pkgs clang libclang-rt-14-dev" ;;
     mpi)      pkgs="$pkgs libopenmpi-dev openmpi-bin" ;;
-    *) echo "deps.sh: unknown package set '$set' (bench, embedded, fuzz, mpi)" >&2; exit 1 ;;
+    *) echo "deps.sh: unknown package set '$set' (bench, embedded, clang, fuzz, mpi)" >&2; exit 1 ;;
   esac
 done
 

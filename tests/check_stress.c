@@ -27,7 +27,9 @@
  *   embedded   tests/arm_build.sh: every committed solver compiles for a
  *              Cortex-M4 with -ffreestanding -Werror and needs nothing but
  *              <math.h> and compiler helpers; --real float needs no double
- *              function.
+ *              function. tests/clang_build.sh: the committed solvers and
+ *              drivers and the generator's other forms are warning-free
+ *              under clang -Wall -Wextra -pedantic -Werror too.
  *
  * The suite is stress_suite(); the project's runner (check_main.c) adds it.
  * It runs from tests/, in about 8 s. */
@@ -488,20 +490,31 @@ START_TEST(singularity_fails_cleanly) {
 }
 END_TEST
 
-/* ---- (d) the embedded build ---- */
+/* ---- (d) the embedded build, and the second compiler ---- */
 
-#define ARM_SKIP 77 /* tests/arm_build.sh: the cross compiler is not installed */
+#define BUILD_SKIP 77 /* the script's compiler is not installed */
 
-START_TEST(embedded_build) {
-  int status = system("sh arm_build.sh");
-  ck_assert_msg(status != -1 && WIFEXITED(status), "cannot run tests/arm_build.sh");
-  if (WEXITSTATUS(status) == ARM_SKIP) {
-    printf("stress: embedded build skipped: arm-none-eabi-gcc not found (scripts/deps.sh embedded)\n");
+// Run a build check script of tests/ (arm_build.sh, clang_build.sh): it
+// passes, or says it was skipped because its compiler is missing (exit 77,
+// the line names the package set of scripts/deps.sh to install).
+static void run_build_check(const char *script, const char *what, const char *deps) {
+  char cmd[64];
+  snprintf(cmd, sizeof cmd, "sh %s", script);
+  int status = system(cmd);
+  ck_assert_msg(status != -1 && WIFEXITED(status), "cannot run tests/%s", script);
+  if (WEXITSTATUS(status) == BUILD_SKIP) {
+    printf("stress: %s skipped: its compiler is not installed (scripts/deps.sh %s)\n", what, deps);
     fflush(stdout);
     return;
   }
-  ck_assert_msg(WEXITSTATUS(status) == 0, "tests/arm_build.sh failed (see its output above)");
+  ck_assert_msg(WEXITSTATUS(status) == 0, "tests/%s failed (see its output above)", script);
 }
+
+START_TEST(embedded_build) { run_build_check("arm_build.sh", "embedded build", "embedded"); }
+END_TEST
+
+// The generated C is warning-free under clang too (tests/clang_build.sh).
+START_TEST(clang_build) { run_build_check("clang_build.sh", "clang build", "clang"); }
 END_TEST
 
 Suite *stress_suite(void) {
@@ -521,6 +534,7 @@ Suite *stress_suite(void) {
   TCase *arm = tcase_create("embedded");
   tcase_set_timeout(arm, 120);
   tcase_add_test(arm, embedded_build);
+  tcase_add_test(arm, clang_build);
   suite_add_tcase(s, arm);
   return s;
 }
