@@ -10,13 +10,13 @@
 #   and the two-step warm start) against the current gen/hbvmgen, built with
 #   gcc -O2 and timed side by side (bench/step/ab.c: medians of 41
 #   alternations, in CPU time). The bound of a step is sweeps x max(dependency
-#   chain, resource bound) of one sweep, both from llvm-mca: the current
-#   step's iteration between markers (gcc -O2 -S), simulated 100 times, its
+#   chain, resource bound) of one sweep, both from llvm-mca over the current
+#   step's iteration as it runs: the instructions callgrind counts once (or k
+#   times) a sweep in the timed build (hot_bound below), simulated 100 times:
 #   cycles per iteration (the loop-carried chain through gamma, in registers,
-#   or the resources, whichever is longer) and its Block RThroughput; where
-#   the sweep is too large to be inline (satellites) the sum over its parts
-#   of the cycles of one run of each. Cycles become ns at the clock measured
-#   by bench/step/clock.c. -> bench/results/step.csv
+#   or the resources, whichever is longer) and Block RThroughput. Cycles
+#   become ns at the clock measured by bench/step/clock.c.
+#   -> bench/results/step.csv
 # flags: the current step built by gcc and clang at -O2/-O3, gcc -O2 without
 #   its SLP vectoriser, and with -march=native -fno-math-errno (and
 #   -ffp-contract=fast), each against gcc
@@ -46,33 +46,46 @@ base_gen() {
   echo "$B/base/build/hbvmgen"
 }
 
-# mca FILE.c PREFIX: "cycles rthroughput" of one iteration of solver PREFIX's
-# step: the loop of PREFIX_step_within from its head to its convergence test,
-# between llvm-mca markers, simulated 100 times (the loop-carried chain or the
-# resources, whichever is longer), plus, where the sweep is not inline, its
-# functions (its parts), one run each (the loop only calls them)
+# hot_bound FILE.c PREFIX H NSTEP MODEL: "cycles rthroughput" of one iteration of
+# solver PREFIX's step, from llvm-mca over the iteration's hot path: FILE.c
+# built as timed (gcc -O2) and stepped NSTEP times by h without statistics
+# (bench/step/hot.c) under callgrind, which counts each instruction; the
+# iteration is the instructions of PREFIX_step_within and of the sweep's
+# functions (PREFIX_sweep*, where the sweep is not inline) run at least 0.6x
+# as often as the sweeps and at most as often, and those run an exact multiple
+# k of the sweeps (an inner loop of the iteration: its block repeated k times),
+# leaving out counts that are multiples of the steps (per-step loops); without
+# its jumps, in address order, simulated 100 times (the loop-carried chain or
+# the resources, whichever is longer). gcc lays blocks the fixed step never runs (the adaptive step's
+# tests, the factor's refresh) between the iteration's own, which a region
+# between markers would have counted (2026-11-26: 518 instead of 255
+# instructions an iteration on the pendulum)
 cpu=$(llc --version 2>/dev/null | sed -n 's/.*Host CPU: *//p')
-mca() {
-  c=$1 P=$2
-  awk -v P="$P" '
-    $0 ~ "^static int " P "_step_within\\(" { step = 1 }
-    step && $0 ~ "^  for \\(it = 1; it <= " P "_MAXITER; it\\+\\+\\) \\{$" { print; print "    __asm__ volatile(\"# LLVM-MCA-BEGIN sweep\");"; next }
-    step && /^    \/\* otherwise progress is a new smallest increment/ { print "    __asm__ volatile(\"# LLVM-MCA-END sweep\");"; step = 0 }
-    { print }' "$c" >"$B/mca.c"
-  # gcc may duplicate the block of the end marker: llvm-mca takes the first
-  gcc -std=gnu99 -O2 -S -I"$(dirname "$c")" -o "$B/mca.s" "$B/mca.c"
-  awk '/LLVM-MCA-END/ { if (ends++) next } { print }' "$B/mca.s" >"$B/mca1.s"
-  {
-    llvm-mca -mcpu="$cpu" -iterations=100 "$B/mca1.s" 2>/dev/null |
-      awk '/^Iterations:/ { it = $2 } /^Total Cycles:/ { c = $3 } /^Block RThroughput:/ { printf "%.1f %.1f\n", c / it, $3; exit }'
-    if ! grep -q "the kernel sweep, inline" "$c"; then
-      gcc -std=c99 -O2 -fno-inline -S -o "$B/sweep.s" "$c"
-      for f in $(sed -En "s/^(${P}_sweep(_part[0-9]+)?(\.[a-z]+\.[0-9]+)?):$/\1/p" "$B/sweep.s"); do
-        awk -v f="$f:" '$0 == f { on = 1; next } on && /\.cfi_endproc/ { exit } on && !/^\s*\./ { print }' "$B/sweep.s" >"$B/fn.s"
-        llvm-mca -mcpu="$cpu" -iterations=1 "$B/fn.s" 2>/dev/null | awk '/^Total Cycles:/ { c = $3 } /^Block RThroughput:/ { print c, $3 }'
-      done
-    fi
-  } | awk '{ c += $1; r += $2 } END { printf "%.1f %.1f\n", c, r }'
+hot_bound() {
+  c=$1 P=$2 h=$3 n=$4 d=$B/hot_$5
+  mkdir -p "$d"
+  cp "$c" "$d/B.c"
+  cp "$(dirname "$c")/$P.h" "$d/B.h"
+  gcc -std=c99 -O2 -c "$d/B.c" -o "$d/B.o"
+  gcc -std=c99 -O2 -I"$d" bench/step/hot.c "$d/B.o" -lm -o "$d/hot"
+  sweeps=$("$d/hot" "$h" "$n" count)
+  valgrind --tool=callgrind --callgrind-out-file="$d/cg" --dump-instr=yes --dump-line=no "$d/hot" "$h" "$n" 2>/dev/null
+  awk -v P="$P" -f bench/step/counts.awk "$d/cg" |
+    awk -v S="$sweeps" -v N="$n" -v P="$P" '($1 == P "_step_within" || index($1, P "_sweep") == 1) && $3 >= 0.6 * S {
+      k = int($3 / S + 0.5)  # times an iteration: 1, or an inner loop of the iteration
+      if ($3 <= S || ($3 == k * S && $3 % N != 0)) print $2, (k > 1 ? k : 1) }' >"$d/hot.list"
+  objdump -d --no-show-raw-insn "$d/hot" |
+    awk 'NR == FNR { times[$1] = $2; next }
+      function flush(   j) { for (j = 0; j < k; j++) printf "%s", block; block = "" }
+      /^ *[0-9a-f]+:\t/ { a = $1; sub(/:$/, "", a); sub(/^0+/, "", a)
+        if (!(a in times)) next
+        i = $0; sub(/^ *[0-9a-f]+:\t/, "", i); sub(/ *#.*$/, "", i)
+        if (i ~ /^(j[a-z]*|call|ret|nop)/) next
+        if (times[a] != k) { flush(); k = times[a] }
+        block = block "\t" i "\n" }
+      BEGIN { print "# LLVM-MCA-BEGIN hot" } END { flush(); print "# LLVM-MCA-END hot" }' "$d/hot.list" - >"$d/hot.s"
+  llvm-mca -mcpu="$cpu" -iterations=100 "$d/hot.s" 2>/dev/null |
+    awk '/^Iterations:/ { it = $2 } /^Total Cycles:/ { c = $3 } /^Block RThroughput:/ { printf "%.1f %.1f\n", c / it, $3; exit }'
 }
 
 if echo "$parts" | grep -q table; then
@@ -85,7 +98,7 @@ if echo "$parts" | grep -q table; then
 $p
 EOT
     row=$(ABDIR="$B/ab_$model" bench/step/ab.sh "$gen_a" gen/hbvmgen gcc -O2 "$model" "$k" "$s" "$h" "$n")
-    set -- $(mca "$B/ab_$model/B.c" B)
+    set -- $(hot_bound "$B/ab_$model/B.c" B "$h" "$n" "$model")
     echo "$model,$k,$s,$h,$row,$1,$2,$ghz" | awk -F, -v OFS=, '{
       per = ($13 > $14 ? $13 : $14) / $15   # ns of one sweep at the bound
       bb = $8 * per; bn = $9 * per          # times the sweeps of each
