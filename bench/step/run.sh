@@ -98,6 +98,7 @@ if echo "$parts" | grep -q table; then
 $p
 EOT
     row=$(ABDIR="$B/ab_$model" bench/step/ab.sh "$gen_a" gen/hbvmgen gcc -O2 "$model" "$k" "$s" "$h" "$n")
+    # shellcheck disable=SC2046 # two numbers, split on purpose
     set -- $(hot_bound "$B/ab_$model/B.c" B "$h" "$n" "$model")
     echo "$model,$k,$s,$h,$row,$1,$2,$ghz" | awk -F, -v OFS=, '{
       per = ($13 > $14 ? $13 : $14) / $15   # ns of one sweep at the bound
