@@ -164,11 +164,9 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   out(e, " * their products with P_j and int_0^c P_j, folded into the code):\n");
   for (int l = 0; l < me->k; l++) out(e, " *   c_%d = %.17g   b_%d = %.17g\n", l + 1, me->c[l], l + 1, me->b[l]);
   out(e, " */\n");
-  if (o->batch) {
+  if (o->batch) { /* the batch's loops read the tables NAME_predict has unrolled */
     out(e, "/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */\n");
     emit_array(e, "E", me->E, me->s * me->s * me->s);
-  }
-  if (o->batch) { /* the batch's loops read the tables NAME_predict has unrolled */
     double *e1 = xmalloc((size_t)me->s * me->s * sizeof(double));
     for (int t = 0; t < me->s * me->s; t++) e1[t] = same_size_coefficient(e, t);
     out(e, "/* E[j][i](1): the warm start of a step as long as the last one. */\n");
@@ -428,7 +426,7 @@ static void emit_first_sweep(Emitter *e) {
             "          $R v = fabs$g(h * (gam[i] - ref[i]));\n"
             "          if (v > d1) d1 = v;\n        }\n");
   tmpl(e, "      if (tol > 0 && !(cold || x->hprev == 0)) {  /* $P_step_adaptive's, warm tries only */\n"
-          "        est = $P_err_est(gam, h, d1, cold || x->hprev == 0);\n"
+          "        est = $P_err_est(gam, h, d1, 0);\n"
           "        if (!(est <= tol * (1 + scale))) {\n"
           "          if (st) {\n            st->iters = 1;\n            st->increment = inc;\n"
           "            st->err_est = est;\n            st->h = h;\n            st->rejected = 0;\n          }\n"
@@ -685,13 +683,14 @@ static void emit_err_est(Emitter *e) {
     out(e, ";\n    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < %d */\n", s);
     if (s == 2)
       tmpl(e, "    r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */\n"
+              "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
               "    v = (r < ($R)0.35 ? $P_COLDC : $P_COLDC_REST) * fabs$f(h) * c;\n");
     else {
       out(e, "    r = sqrt%s(c / a);  /* the slower of the two-step decays */\n", math_suffix(e, 0));
       if (s >= 4) out(e, "    t = sqrt%s(b / z);\n    if (t > r) r = t;\n", math_suffix(e, 0));
-      tmpl(e, "    v = $P_COLDC * fabs$f(h) * c;\n");
+      tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
+              "    v = $P_COLDC * fabs$f(h) * c;\n");
     }
-    tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n");
     out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v;\n  }\n", s + 1);
   } else
     tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");
@@ -834,9 +833,12 @@ static void emit_predict_resized(Emitter *e) {
       format_real(e, lit, sizeof lit, c[d]);
       out(e, "    e = %s;\n", lit);
       for (d--; d >= 0; d--) {
+        if (c[d] == 0) {
+          out(e, "    e = e * r;\n");
+          continue;
+        }
         format_real(e, lit, sizeof lit, c[d]);
-        if (c[d] == 0) out(e, "    e = e * r;\n");
-        else out(e, "    e = e * r + %s;\n", lit);
+        out(e, "    e = e * r + %s;\n", lit);
       }
       out(e, "    for (l = 0; l < %s_M; l++) gam[%d * %s_M + l] += e * x->gam[%d * %s_M + l];\n", e->P, j, e->P, i,
           e->P);
@@ -865,8 +867,10 @@ static void emit_predict(Emitter *e) {
    * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
    * (pendulum, h = 0.1); the polynomial family restores H every step. */
   tmpl(e, "  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */\n");
-  for (int t = 0; t < e->me->s * e->me->s; t++)
-    if (same_size_coefficient(e, t) != 0) emit_warm_term(e, t / e->me->s, t % e->me->s, same_size_coefficient(e, t));
+  for (int t = 0; t < e->me->s * e->me->s; t++) {
+    double c = same_size_coefficient(e, t);
+    if (c != 0) emit_warm_term(e, t / e->me->s, t % e->me->s, c);
+  }
   tmpl(e, "  } else {\n");
   emit_predict_resized(e);
   tmpl(e, "  }\n");

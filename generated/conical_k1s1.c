@@ -435,7 +435,7 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
       gam[1] = gm1;
       gam[2] = gm2;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* conical_k1s1_step_adaptive's, warm tries only */
-        est = conical_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = conical_k1s1_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -343,8 +343,8 @@ conical_k3s3_OUT_OF_LINE double conical_k3s3_err_est(const double *gam, double h
     double c = conical_k3s3_coef(gam, 2), a = conical_k3s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = conical_k3s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = conical_k3s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -616,7 +616,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       gam[7] = gm7;
       gam[8] = gm8;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* conical_k3s3_step_adaptive's, warm tries only */
-        est = conical_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = conical_k3s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

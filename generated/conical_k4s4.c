@@ -381,8 +381,8 @@ conical_k4s4_OUT_OF_LINE double conical_k4s4_err_est(const double *gam, double h
     r = sqrt(c / a);  /* the slower of the two-step decays */
     t = sqrt(b / z);
     if (t > r) r = t;
-    v = conical_k4s4_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = conical_k4s4_COLDC * fabs(h) * c;
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -706,7 +706,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
       gam[10] = gm10;
       gam[11] = gm11;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* conical_k4s4_step_adaptive's, warm tries only */
-        est = conical_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = conical_k4s4_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

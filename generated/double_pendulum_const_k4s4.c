@@ -469,8 +469,8 @@ double_pendulum_const_k4s4_OUT_OF_LINE double double_pendulum_const_k4s4_err_est
     r = sqrt(c / a);  /* the slower of the two-step decays */
     t = sqrt(b / z);
     if (t > r) r = t;
-    v = double_pendulum_const_k4s4_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = double_pendulum_const_k4s4_COLDC * fabs(h) * c;
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -991,7 +991,7 @@ static int double_pendulum_const_k4s4_step_within(double_pendulum_const_k4s4_sta
       gam[14] = gm14;
       gam[15] = gm15;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* double_pendulum_const_k4s4_step_adaptive's, warm tries only */
-        est = double_pendulum_const_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = double_pendulum_const_k4s4_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -873,8 +873,8 @@ double_pendulum_k2s2_OUT_OF_LINE double double_pendulum_k2s2_err_est(const doubl
     double c = double_pendulum_k2s2_coef(gam, 1), b = double_pendulum_k2s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
-    v = (r < (double)0.35 ? double_pendulum_k2s2_COLDC : double_pendulum_k2s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = (r < (double)0.35 ? double_pendulum_k2s2_COLDC : double_pendulum_k2s2_COLDC_REST) * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -1350,7 +1350,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* double_pendulum_k2s2_step_adaptive's, warm tries only */
-        est = double_pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = double_pendulum_k2s2_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -1588,8 +1588,8 @@ double_pendulum_k3s3_OUT_OF_LINE double double_pendulum_k3s3_err_est(const doubl
     double c = double_pendulum_k3s3_coef(gam, 2), a = double_pendulum_k3s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = double_pendulum_k3s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = double_pendulum_k3s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -2348,7 +2348,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* double_pendulum_k3s3_step_adaptive's, warm tries only */
-        est = double_pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = double_pendulum_k3s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

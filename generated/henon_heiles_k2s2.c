@@ -205,8 +205,8 @@ henon_heiles_k2s2_OUT_OF_LINE double henon_heiles_k2s2_err_est(const double *gam
     double c = henon_heiles_k2s2_coef(gam, 1), b = henon_heiles_k2s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
-    v = (r < (double)0.35 ? henon_heiles_k2s2_COLDC : henon_heiles_k2s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = (r < (double)0.35 ? henon_heiles_k2s2_COLDC : henon_heiles_k2s2_COLDC_REST) * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -370,7 +370,7 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
       gam[2] = gm2;
       gam[3] = gm3;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* henon_heiles_k2s2_step_adaptive's, warm tries only */
-        est = henon_heiles_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = henon_heiles_k2s2_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

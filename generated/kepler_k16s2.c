@@ -217,8 +217,8 @@ kepler_k16s2_OUT_OF_LINE double kepler_k16s2_err_est(const double *gam, double h
     double c = kepler_k16s2_coef(gam, 1), b = kepler_k16s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
-    v = (r < (double)0.35 ? kepler_k16s2_COLDC : kepler_k16s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = (r < (double)0.35 ? kepler_k16s2_COLDC : kepler_k16s2_COLDC_REST) * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -814,7 +814,7 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       gam[2] = gm2;
       gam[3] = gm3;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* kepler_k16s2_step_adaptive's, warm tries only */
-        est = kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = kepler_k16s2_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

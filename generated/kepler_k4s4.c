@@ -258,8 +258,8 @@ kepler_k4s4_OUT_OF_LINE double kepler_k4s4_err_est(const double *gam, double h, 
     r = sqrt(c / a);  /* the slower of the two-step decays */
     t = sqrt(b / z);
     if (t > r) r = t;
-    v = kepler_k4s4_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = kepler_k4s4_COLDC * fabs(h) * c;
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -594,7 +594,7 @@ static int kepler_k4s4_step_within(kepler_k4s4_state *x, kepler_k4s4_real h_, do
       gam[6] = gm6;
       gam[7] = gm7;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* kepler_k4s4_step_adaptive's, warm tries only */
-        est = kepler_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = kepler_k4s4_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

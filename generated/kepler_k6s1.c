@@ -409,7 +409,7 @@ static int kepler_k6s1_step_within(kepler_k6s1_state *x, kepler_k6s1_real h_, do
       gam[0] = gm0;
       gam[1] = gm1;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* kepler_k6s1_step_adaptive's, warm tries only */
-        est = kepler_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = kepler_k6s1_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -496,7 +496,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       gam[1] = gm1;
       gam[2] = gm2;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* modified_k3s1_step_adaptive's, warm tries only */
-        est = modified_k3s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = modified_k3s1_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

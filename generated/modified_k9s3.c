@@ -367,8 +367,8 @@ modified_k9s3_OUT_OF_LINE double modified_k9s3_err_est(const double *gam, double
     double c = modified_k9s3_coef(gam, 2), a = modified_k9s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = modified_k9s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = modified_k9s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -983,7 +983,7 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
       gam[7] = gm7;
       gam[8] = gm8;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* modified_k9s3_step_adaptive's, warm tries only */
-        est = modified_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = modified_k9s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

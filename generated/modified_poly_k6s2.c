@@ -721,8 +721,8 @@ modified_poly_k6s2_OUT_OF_LINE double modified_poly_k6s2_err_est(const double *g
     double c = modified_poly_k6s2_coef(gam, 1), b = modified_poly_k6s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
-    v = (r < (double)0.35 ? modified_poly_k6s2_COLDC : modified_poly_k6s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = (r < (double)0.35 ? modified_poly_k6s2_COLDC : modified_poly_k6s2_COLDC_REST) * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -1379,7 +1379,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* modified_poly_k6s2_step_adaptive's, warm tries only */
-        est = modified_poly_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = modified_poly_k6s2_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -1212,8 +1212,8 @@ modified_poly_k9s3_OUT_OF_LINE double modified_poly_k9s3_err_est(const double *g
     double c = modified_poly_k9s3_coef(gam, 2), a = modified_poly_k9s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = modified_poly_k9s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = modified_poly_k9s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -2388,7 +2388,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* modified_poly_k9s3_step_adaptive's, warm tries only */
-        est = modified_poly_k9s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = modified_poly_k9s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

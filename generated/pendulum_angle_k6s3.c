@@ -212,8 +212,8 @@ pendulum_angle_k6s3_OUT_OF_LINE double pendulum_angle_k6s3_err_est(const double 
     double c = pendulum_angle_k6s3_coef(gam, 2), a = pendulum_angle_k6s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = pendulum_angle_k6s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = pendulum_angle_k6s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -399,7 +399,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       gam[1] = gm1;
       gam[2] = gm2;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_angle_k6s3_step_adaptive's, warm tries only */
-        est = pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = pendulum_angle_k6s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -384,7 +384,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       gam[0] = gm0;
       gam[1] = gm1;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_k1s1_step_adaptive's, warm tries only */
-        est = pendulum_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = pendulum_k1s1_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

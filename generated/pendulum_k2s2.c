@@ -297,8 +297,8 @@ pendulum_k2s2_OUT_OF_LINE double pendulum_k2s2_err_est(const double *gam, double
     double c = pendulum_k2s2_coef(gam, 1), b = pendulum_k2s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
-    v = (r < (double)0.35 ? pendulum_k2s2_COLDC : pendulum_k2s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = (r < (double)0.35 ? pendulum_k2s2_COLDC : pendulum_k2s2_COLDC_REST) * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -478,7 +478,7 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       gam[2] = gm2;
       gam[3] = gm3;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_k2s2_step_adaptive's, warm tries only */
-        est = pendulum_k2s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = pendulum_k2s2_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

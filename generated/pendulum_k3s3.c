@@ -316,8 +316,8 @@ pendulum_k3s3_OUT_OF_LINE double pendulum_k3s3_err_est(const double *gam, double
     double c = pendulum_k3s3_coef(gam, 2), a = pendulum_k3s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = pendulum_k3s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = pendulum_k3s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -531,7 +531,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       gam[4] = gm4;
       gam[5] = gm5;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_k3s3_step_adaptive's, warm tries only */
-        est = pendulum_k3s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = pendulum_k3s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -526,7 +526,7 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_poly_k1s1_step_adaptive's, warm tries only */
-        est = pendulum_poly_k1s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = pendulum_poly_k1s1_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

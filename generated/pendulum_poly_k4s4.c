@@ -1051,8 +1051,8 @@ pendulum_poly_k4s4_OUT_OF_LINE double pendulum_poly_k4s4_err_est(const double *g
     r = sqrt(c / a);  /* the slower of the two-step decays */
     t = sqrt(b / z);
     if (t > r) r = t;
-    v = pendulum_poly_k4s4_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = pendulum_poly_k4s4_COLDC * fabs(h) * c;
     for (i = 0; i < 5; i++) v *= r;
     return v;
   }
@@ -1673,7 +1673,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* pendulum_poly_k4s4_step_adaptive's, warm tries only */
-        est = pendulum_poly_k4s4_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = pendulum_poly_k4s4_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -1860,7 +1860,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       gam[7] = gm7;
       gam[8] = gm8;
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* satellites_k6s1_step_adaptive's, warm tries only */
-        est = satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = satellites_k6s1_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

@@ -2255,8 +2255,8 @@ satellites_k6s2_OUT_OF_LINE double satellites_k6s2_err_est(const double *gam, do
     double c = satellites_k6s2_coef(gam, 1), b = satellites_k6s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
-    v = (r < (double)0.35 ? satellites_k6s2_COLDC : satellites_k6s2_COLDC_REST) * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = (r < (double)0.35 ? satellites_k6s2_COLDC : satellites_k6s2_COLDC_REST) * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
@@ -2357,7 +2357,7 @@ static int satellites_k6s2_step_within(satellites_k6s2_state *x, satellites_k6s2
     if (it == 1 && (st || tol > 0)) {  /* for satellites_k6s2_err_est: only when someone reads it */
       d1 = inc;  /* the predictor's error */
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* satellites_k6s2_step_adaptive's, warm tries only */
-        est = satellites_k6s2_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = satellites_k6s2_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;

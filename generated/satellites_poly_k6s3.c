@@ -8734,8 +8734,8 @@ satellites_poly_k6s3_OUT_OF_LINE double satellites_poly_k6s3_err_est(const doubl
     double c = satellites_poly_k6s3_coef(gam, 2), a = satellites_poly_k6s3_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 3 */
     r = sqrt(c / a);  /* the slower of the two-step decays */
-    v = satellites_poly_k6s3_COLDC * fabs(h) * c;
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
+    v = satellites_poly_k6s3_COLDC * fabs(h) * c;
     for (i = 0; i < 4; i++) v *= r;
     return v;
   }
@@ -8844,7 +8844,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
           if (v > d1) d1 = v;
         }
       if (tol > 0 && !(cold || x->hprev == 0)) {  /* satellites_poly_k6s3_step_adaptive's, warm tries only */
-        est = satellites_poly_k6s3_err_est(gam, h, d1, cold || x->hprev == 0);
+        est = satellites_poly_k6s3_err_est(gam, h, d1, 0);
         if (!(est <= tol * (1 + scale))) {
           if (st) {
             st->iters = 1;
