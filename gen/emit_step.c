@@ -793,17 +793,26 @@ static void emit_mult_err(Emitter *e) {
           "  return isfinite(est) ? est : 0;\n}\n\n");
 }
 
-// One term of the warm start, gamma_j += c gamma_i (the previous step's),
-// with c a literal: without the product where c is 1 (the same sum).
-static void emit_warm_term(Emitter *e, int j, int i, double c) {
-  char lit[40];
-  if (c == 1) {
-    out(e, "    for (l = 0; l < %s_M; l++) gam[%d * %s_M + l] += x->gam[%d * %s_M + l];\n", e->P, j, e->P, i, e->P);
-    return;
+// One term of the warm start, to[j] += c gamma_i (the previous step's),
+// with c a literal: without the product where c is 1 (the same sum); ind:
+// the line's indent.
+static void emit_warm_term(Emitter *e, const char *ind, const char *to, int j, int i, double c) {
+  char lit[40] = "";
+  if (c != 1) {
+    format_real(e, lit, sizeof lit, c);
+    strcat(lit, " * ");
   }
-  format_real(e, lit, sizeof lit, c);
-  out(e, "    for (l = 0; l < %s_M; l++) gam[%d * %s_M + l] += %s * x->gam[%d * %s_M + l];\n", e->P, j, e->P, lit, i,
-      e->P);
+  out(e, "%sfor (l = 0; l < %s_M; l++) %s[%d * %s_M + l] += %sx->gam[%d * %s_M + l];\n", ind, e->P, to, j, e->P, lit,
+      i, e->P);
+}
+
+// The warm start of a step as long as the last one, into to:
+// gamma_j += E[j][i](1) gamma_i, the zero terms left out.
+static void emit_predict_same_size(Emitter *e, const char *ind, const char *to) {
+  for (int t = 0; t < e->me->s * e->me->s; t++) {
+    double c = same_size_coefficient(e, t);
+    if (c != 0) emit_warm_term(e, ind, to, t / e->me->s, t % e->me->s, c);
+  }
 }
 
 // The warm start of a step whose size differs from the last one's (every
@@ -827,7 +836,7 @@ static void emit_predict_resized(Emitter *e) {
       while (d >= 0 && c[d] == 0) d--;
       if (d < 0) continue;
       if (d == 0) { /* a constant: 0 r + c = c */
-        emit_warm_term(e, j, i, c[0]);
+        emit_warm_term(e, "    ", "gam", j, i, c[0]);
         continue;
       }
       format_real(e, lit, sizeof lit, c[d]);
@@ -853,7 +862,8 @@ static void emit_predict(Emitter *e) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
   if (poly)
     tmpl(e, "/* Returns 1 when gam is the two-step start, ref then the one-step one (whose error\n"
-            " * $P_err_est needs), else 0. */\n"
+            " * $P_err_est needs; not computed when ref is 0, as in a fixed step without\n"
+            " * statistics), else 0. */\n"
             "$P_OUT_OF_LINE int $P_predict(const $P_state *x, $R h, int cold, const $P_params *prm, $R *gam, $R *ref)\n"
             "{\n");
   else
@@ -866,19 +876,14 @@ static void emit_predict(Emitter *e) {
    * polynomial family only: it changes where the iteration stops, and the
    * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
    * (pendulum, h = 0.1); the polynomial family restores H every step. */
-  tmpl(e, "  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */\n");
-  for (int t = 0; t < e->me->s * e->me->s; t++) {
-    double c = same_size_coefficient(e, t);
-    if (c != 0) emit_warm_term(e, t / e->me->s, t % e->me->s, c);
-  }
-  tmpl(e, "  } else {\n");
-  emit_predict_resized(e);
-  tmpl(e, "  }\n");
   if (poly) {
     int s = e->me->s;
     tmpl(e, "  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i\n"
             "                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */\n"
-            "    for (i = 0; i < $P_S * $P_M; i++) {\n      ref[i] = gam[i];\n      gam[i] = 0;\n    }\n");
+            "    if (ref) {  /* the one-step start, for the estimate */\n"
+            "      for (i = 0; i < $P_S * $P_M; i++) ref[i] = 0;\n");
+    emit_predict_same_size(e, "      ", "ref");
+    tmpl(e, "    }\n");
     for (int j = 0; j < s; j++)
       for (int i = 0; i < s; i++) {
         char a[40], b[40];
@@ -887,8 +892,14 @@ static void emit_predict(Emitter *e) {
         out(e, "    for (l = 0; l < %s_M; l++)\n      gam[%d * %s_M + l] += %s * x->gam[%d * %s_M + l] + %s * x->gam2[%d * %s_M + l];\n",
             e->P, j, e->P, a, i, e->P, b, i, e->P);
       }
-    tmpl(e, "    return 1;\n  }\n  return 0;\n");
+    tmpl(e, "    return 1;\n  }\n");
   }
+  tmpl(e, "  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */\n");
+  emit_predict_same_size(e, "    ", "gam");
+  tmpl(e, "  } else {\n");
+  emit_predict_resized(e);
+  tmpl(e, "  }\n");
+  if (poly) tmpl(e, "  return 0;\n");
   tmpl(e, "}\n\n");
   if (e->compensated)
     tmpl(e, "/* a += b with the rounding error carried in *c (Kahan). */\n"
@@ -959,14 +970,16 @@ static void emit_step(Emitter *e) {
   if (wide) {
     tmpl(e, "  $W q0w[$P_M], p0w[$P_M];\n"
             "  {\n    $R guess[$P_S * $P_M];\n");
-    tmpl(e, poly ? "    two = $P_predict(x, h, cold, prm, guess, ref);\n" : "    $P_predict(x, h, cold, prm, guess);\n");
+    tmpl(e, poly ? "    two = $P_predict(x, h, cold, prm, guess, st || tol > 0 ? ref : 0);\n"
+                 : "    $P_predict(x, h, cold, prm, guess);\n");
     tmpl(e, "    for (i = 0; i < $P_S * $P_M; i++) gam[i] = guess[i];\n  }\n"
             "  /* the sweep starts from the compensated state q - qc, p - pc, in $W */\n"
             "  for (i = 0; i < $P_M; i++) {\n"
             "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
             "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
   } else
-    tmpl(e, poly ? "  two = $P_predict(x, h, cold, prm, gam, ref);\n" : "  $P_predict(x, h, cold, prm, gam);\n");
+    tmpl(e, poly ? "  two = $P_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */\n"
+                 : "  $P_predict(x, h, cold, prm, gam);\n");
   if (e->mod->nu)
     tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
             "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"

@@ -637,7 +637,8 @@ void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
- * modified_poly_k6s2_err_est needs), else 0. */
+ * modified_poly_k6s2_err_est needs; not computed when ref is 0, as in a fixed step without
+ * statistics), else 0. */
 modified_poly_k6s2_OUT_OF_LINE int modified_poly_k6s2_predict(const modified_poly_k6s2_state *x, double h, int cold, const modified_poly_k6s2_params *prm, double *gam, double *ref)
 {
   int i, l;
@@ -645,6 +646,25 @@ modified_poly_k6s2_OUT_OF_LINE int modified_poly_k6s2_predict(const modified_pol
   if (cold || x->hprev == 0) {
     modified_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+    if (ref) {  /* the one-step start, for the estimate */
+      for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) ref[i] = 0;
+      for (l = 0; l < modified_poly_k6s2_M; l++) ref[0 * modified_poly_k6s2_M + l] += x->gam[0 * modified_poly_k6s2_M + l];
+      for (l = 0; l < modified_poly_k6s2_M; l++) ref[0 * modified_poly_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * modified_poly_k6s2_M + l];
+      for (l = 0; l < modified_poly_k6s2_M; l++) ref[1 * modified_poly_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * modified_poly_k6s2_M + l];
+      for (l = 0; l < modified_poly_k6s2_M; l++) ref[1 * modified_poly_k6s2_M + l] += x->gam[1 * modified_poly_k6s2_M + l];
+    }
+    for (l = 0; l < modified_poly_k6s2_M; l++)
+      gam[0 * modified_poly_k6s2_M + l] += (-5.5000000000000036) * x->gam[0 * modified_poly_k6s2_M + l] + 6.5000000000000036 * x->gam2[0 * modified_poly_k6s2_M + l];
+    for (l = 0; l < modified_poly_k6s2_M; l++)
+      gam[0 * modified_poly_k6s2_M + l] += 16.454482671904344 * x->gam[1 * modified_poly_k6s2_M + l] + 9.5262794416288337 * x->gam2[1 * modified_poly_k6s2_M + l];
+    for (l = 0; l < modified_poly_k6s2_M; l++)
+      gam[1 * modified_poly_k6s2_M + l] += (-4.3301270189221963) * x->gam[0 * modified_poly_k6s2_M + l] + 4.3301270189221963 * x->gam2[0 * modified_poly_k6s2_M + l];
+    for (l = 0; l < modified_poly_k6s2_M; l++)
+      gam[1 * modified_poly_k6s2_M + l] += 9.5000000000000071 * x->gam[1 * modified_poly_k6s2_M + l] + 6.5000000000000071 * x->gam2[1 * modified_poly_k6s2_M + l];
+    return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < modified_poly_k6s2_M; l++) gam[0 * modified_poly_k6s2_M + l] += x->gam[0 * modified_poly_k6s2_M + l];
@@ -662,22 +682,6 @@ modified_poly_k6s2_OUT_OF_LINE int modified_poly_k6s2_predict(const modified_pol
     e = 0.99999999999999989;
     e = e * r + 9.6148134319178191e-17;
     for (l = 0; l < modified_poly_k6s2_M; l++) gam[1 * modified_poly_k6s2_M + l] += e * x->gam[1 * modified_poly_k6s2_M + l];
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
-    for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) {
-      ref[i] = gam[i];
-      gam[i] = 0;
-    }
-    for (l = 0; l < modified_poly_k6s2_M; l++)
-      gam[0 * modified_poly_k6s2_M + l] += (-5.5000000000000036) * x->gam[0 * modified_poly_k6s2_M + l] + 6.5000000000000036 * x->gam2[0 * modified_poly_k6s2_M + l];
-    for (l = 0; l < modified_poly_k6s2_M; l++)
-      gam[0 * modified_poly_k6s2_M + l] += 16.454482671904344 * x->gam[1 * modified_poly_k6s2_M + l] + 9.5262794416288337 * x->gam2[1 * modified_poly_k6s2_M + l];
-    for (l = 0; l < modified_poly_k6s2_M; l++)
-      gam[1 * modified_poly_k6s2_M + l] += (-4.3301270189221963) * x->gam[0 * modified_poly_k6s2_M + l] + 4.3301270189221963 * x->gam2[0 * modified_poly_k6s2_M + l];
-    for (l = 0; l < modified_poly_k6s2_M; l++)
-      gam[1 * modified_poly_k6s2_M + l] += 9.5000000000000071 * x->gam[1 * modified_poly_k6s2_M + l] + 6.5000000000000071 * x->gam2[1 * modified_poly_k6s2_M + l];
-    return 1;
   }
   return 0;
 }
@@ -778,7 +782,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   int two;
   double tit = modified_poly_k6s2_TOL;  /* where the iteration stops (modified_poly_k6s2_itol) */
   int attol = 0;  /* it stopped there, above round-off */
-  two = modified_poly_k6s2_predict(x, h, cold, prm, gam, ref);
+  two = modified_poly_k6s2_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */
   double g0[modified_poly_k6s2_NU];
   modified_poly_k6s2_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g

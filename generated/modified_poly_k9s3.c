@@ -1100,7 +1100,8 @@ void modified_poly_k9s3_hidden(const modified_poly_k9s3_state *x, const modified
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
- * modified_poly_k9s3_err_est needs), else 0. */
+ * modified_poly_k9s3_err_est needs; not computed when ref is 0, as in a fixed step without
+ * statistics), else 0. */
 modified_poly_k9s3_OUT_OF_LINE int modified_poly_k9s3_predict(const modified_poly_k9s3_state *x, double h, int cold, const modified_poly_k9s3_params *prm, double *gam, double *ref)
 {
   int i, l;
@@ -1108,6 +1109,40 @@ modified_poly_k9s3_OUT_OF_LINE int modified_poly_k9s3_predict(const modified_pol
   if (cold || x->hprev == 0) {
     modified_poly_k9s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+    if (ref) {  /* the one-step start, for the estimate */
+      for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) ref[i] = 0;
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[0 * modified_poly_k9s3_M + l] += x->gam[0 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[0 * modified_poly_k9s3_M + l] += 3.4641016151377544 * x->gam[1 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[0 * modified_poly_k9s3_M + l] += 13.416407864998739 * x->gam[2 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[1 * modified_poly_k9s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[1 * modified_poly_k9s3_M + l] += 0.99999999999999989 * x->gam[1 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[1 * modified_poly_k9s3_M + l] += 7.745966692414834 * x->gam[2 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[2 * modified_poly_k9s3_M + l] += (-1.1102230246251565e-16) * x->gam[0 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[2 * modified_poly_k9s3_M + l] += (-2.884444029575346e-16) * x->gam[1 * modified_poly_k9s3_M + l];
+      for (l = 0; l < modified_poly_k9s3_M; l++) ref[2 * modified_poly_k9s3_M + l] += 0.999999999999999 * x->gam[2 * modified_poly_k9s3_M + l];
+    }
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[0 * modified_poly_k9s3_M + l] += 69.500000000000085 * x->gam[0 * modified_poly_k9s3_M + l] + (-68.500000000000085) * x->gam2[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[0 * modified_poly_k9s3_M + l] += (-121.78482240718688) * x->gam[1 * modified_poly_k9s3_M + l] + (-112.04203661461193) * x->gam2[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[0 * modified_poly_k9s3_M + l] += 166.44731007514071 * x->gam[2 * modified_poly_k9s3_M + l] + (-101.88084722483431) * x->gam2[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[1 * modified_poly_k9s3_M + l] += 63.219854476264132 * x->gam[0 * modified_poly_k9s3_M + l] + (-63.219854476264118) * x->gam2[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[1 * modified_poly_k9s3_M + l] += (-114.06250000000021) * x->gam[1 * modified_poly_k9s3_M + l] + (-103.93750000000018) * x->gam2[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[1 * modified_poly_k9s3_M + l] += 146.25353361115765 * x->gam[2 * modified_poly_k9s3_M + l] + (-95.420627192185393) * x->gam2[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[2 * modified_poly_k9s3_M + l] += 23.478713763747862 * x->gam[0 * modified_poly_k9s3_M + l] + (-23.478713763747855) * x->gam2[0 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[2 * modified_poly_k9s3_M + l] += (-42.360755349143751) * x->gam[1 * modified_poly_k9s3_M + l] + (-38.971894921212247) * x->gam2[1 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++)
+      gam[2 * modified_poly_k9s3_M + l] += 50.562500000000107 * x->gam[2 * modified_poly_k9s3_M + l] + (-36.437500000000099) * x->gam2[2 * modified_poly_k9s3_M + l];
+    return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[0 * modified_poly_k9s3_M + l] += x->gam[0 * modified_poly_k9s3_M + l];
@@ -1146,32 +1181,6 @@ modified_poly_k9s3_OUT_OF_LINE int modified_poly_k9s3_predict(const modified_pol
     e = e * r + (-3.7238012298709097e-16);
     e = e * r + (-2.4825341532472731e-16);
     for (l = 0; l < modified_poly_k9s3_M; l++) gam[2 * modified_poly_k9s3_M + l] += e * x->gam[2 * modified_poly_k9s3_M + l];
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
-    for (i = 0; i < modified_poly_k9s3_S * modified_poly_k9s3_M; i++) {
-      ref[i] = gam[i];
-      gam[i] = 0;
-    }
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[0 * modified_poly_k9s3_M + l] += 69.500000000000085 * x->gam[0 * modified_poly_k9s3_M + l] + (-68.500000000000085) * x->gam2[0 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[0 * modified_poly_k9s3_M + l] += (-121.78482240718688) * x->gam[1 * modified_poly_k9s3_M + l] + (-112.04203661461193) * x->gam2[1 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[0 * modified_poly_k9s3_M + l] += 166.44731007514071 * x->gam[2 * modified_poly_k9s3_M + l] + (-101.88084722483431) * x->gam2[2 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[1 * modified_poly_k9s3_M + l] += 63.219854476264132 * x->gam[0 * modified_poly_k9s3_M + l] + (-63.219854476264118) * x->gam2[0 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[1 * modified_poly_k9s3_M + l] += (-114.06250000000021) * x->gam[1 * modified_poly_k9s3_M + l] + (-103.93750000000018) * x->gam2[1 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[1 * modified_poly_k9s3_M + l] += 146.25353361115765 * x->gam[2 * modified_poly_k9s3_M + l] + (-95.420627192185393) * x->gam2[2 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[2 * modified_poly_k9s3_M + l] += 23.478713763747862 * x->gam[0 * modified_poly_k9s3_M + l] + (-23.478713763747855) * x->gam2[0 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[2 * modified_poly_k9s3_M + l] += (-42.360755349143751) * x->gam[1 * modified_poly_k9s3_M + l] + (-38.971894921212247) * x->gam2[1 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[2 * modified_poly_k9s3_M + l] += 50.562500000000107 * x->gam[2 * modified_poly_k9s3_M + l] + (-36.437500000000099) * x->gam2[2 * modified_poly_k9s3_M + l];
-    return 1;
   }
   return 0;
 }
@@ -1269,7 +1278,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   int two;
   double tit = modified_poly_k9s3_TOL;  /* where the iteration stops (modified_poly_k9s3_itol) */
   int attol = 0;  /* it stopped there, above round-off */
-  two = modified_poly_k9s3_predict(x, h, cold, prm, gam, ref);
+  two = modified_poly_k9s3_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */
   double g0[modified_poly_k9s3_NU];
   modified_poly_k9s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g

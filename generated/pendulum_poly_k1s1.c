@@ -304,7 +304,8 @@ void pendulum_poly_k1s1_hidden(const pendulum_poly_k1s1_state *x, const pendulum
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
- * pendulum_poly_k1s1_err_est needs), else 0. */
+ * pendulum_poly_k1s1_err_est needs; not computed when ref is 0, as in a fixed step without
+ * statistics), else 0. */
 pendulum_poly_k1s1_OUT_OF_LINE int pendulum_poly_k1s1_predict(const pendulum_poly_k1s1_state *x, double h, int cold, const pendulum_poly_k1s1_params *prm, double *gam, double *ref)
 {
   int i, l;
@@ -313,20 +314,20 @@ pendulum_poly_k1s1_OUT_OF_LINE int pendulum_poly_k1s1_predict(const pendulum_pol
     pendulum_poly_k1s1_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
   }
-  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
-    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
-  } else {
-    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
-  }
   if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
                                             * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
-    for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) {
-      ref[i] = gam[i];
-      gam[i] = 0;
+    if (ref) {  /* the one-step start, for the estimate */
+      for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) ref[i] = 0;
+      for (l = 0; l < pendulum_poly_k1s1_M; l++) ref[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
     }
     for (l = 0; l < pendulum_poly_k1s1_M; l++)
       gam[0 * pendulum_poly_k1s1_M + l] += 2.0 * x->gam[0 * pendulum_poly_k1s1_M + l] + (-1.0) * x->gam2[0 * pendulum_poly_k1s1_M + l];
     return 1;
+  }
+  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
+    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
+  } else {
+    for (l = 0; l < pendulum_poly_k1s1_M; l++) gam[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
   }
   return 0;
 }
@@ -413,7 +414,7 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
   int two;
   double tit = pendulum_poly_k1s1_TOL;  /* where the iteration stops (pendulum_poly_k1s1_itol) */
   int attol = 0;  /* it stopped there, above round-off */
-  two = pendulum_poly_k1s1_predict(x, h, cold, prm, gam, ref);
+  two = pendulum_poly_k1s1_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */
   double g0[pendulum_poly_k1s1_NU];
   pendulum_poly_k1s1_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g

@@ -547,7 +547,8 @@ void pendulum_poly_k3s3_hidden(const pendulum_poly_k3s3_state *x, const pendulum
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
- * pendulum_poly_k3s3_err_est needs), else 0. */
+ * pendulum_poly_k3s3_err_est needs; not computed when ref is 0, as in a fixed step without
+ * statistics), else 0. */
 pendulum_poly_k3s3_OUT_OF_LINE int pendulum_poly_k3s3_predict(const pendulum_poly_k3s3_state *x, double h, int cold, const pendulum_poly_k3s3_params *prm, double *gam, double *ref)
 {
   int i, l;
@@ -555,6 +556,39 @@ pendulum_poly_k3s3_OUT_OF_LINE int pendulum_poly_k3s3_predict(const pendulum_pol
   if (cold || x->hprev == 0) {
     pendulum_poly_k3s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+    if (ref) {  /* the one-step start, for the estimate */
+      for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) ref[i] = 0;
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[0 * pendulum_poly_k3s3_M + l] += x->gam[0 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[0 * pendulum_poly_k3s3_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[0 * pendulum_poly_k3s3_M + l] += 13.416407864998739 * x->gam[2 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[1 * pendulum_poly_k3s3_M + l] += x->gam[1 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[1 * pendulum_poly_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[2 * pendulum_poly_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[2 * pendulum_poly_k3s3_M + l] += 3.8459253727671276e-16 * x->gam[1 * pendulum_poly_k3s3_M + l];
+      for (l = 0; l < pendulum_poly_k3s3_M; l++) ref[2 * pendulum_poly_k3s3_M + l] += 1.0000000000000016 * x->gam[2 * pendulum_poly_k3s3_M + l];
+    }
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[0 * pendulum_poly_k3s3_M + l] += 69.500000000000085 * x->gam[0 * pendulum_poly_k3s3_M + l] + (-68.500000000000085) * x->gam2[0 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[0 * pendulum_poly_k3s3_M + l] += (-121.78482240718688) * x->gam[1 * pendulum_poly_k3s3_M + l] + (-112.04203661461193) * x->gam2[1 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[0 * pendulum_poly_k3s3_M + l] += 166.44731007514071 * x->gam[2 * pendulum_poly_k3s3_M + l] + (-101.88084722483431) * x->gam2[2 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[1 * pendulum_poly_k3s3_M + l] += 63.219854476264132 * x->gam[0 * pendulum_poly_k3s3_M + l] + (-63.219854476264118) * x->gam2[0 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[1 * pendulum_poly_k3s3_M + l] += (-114.06250000000021) * x->gam[1 * pendulum_poly_k3s3_M + l] + (-103.93750000000018) * x->gam2[1 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[1 * pendulum_poly_k3s3_M + l] += 146.25353361115765 * x->gam[2 * pendulum_poly_k3s3_M + l] + (-95.420627192185393) * x->gam2[2 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[2 * pendulum_poly_k3s3_M + l] += 23.478713763747862 * x->gam[0 * pendulum_poly_k3s3_M + l] + (-23.478713763747855) * x->gam2[0 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[2 * pendulum_poly_k3s3_M + l] += (-42.360755349143751) * x->gam[1 * pendulum_poly_k3s3_M + l] + (-38.971894921212247) * x->gam2[1 * pendulum_poly_k3s3_M + l];
+    for (l = 0; l < pendulum_poly_k3s3_M; l++)
+      gam[2 * pendulum_poly_k3s3_M + l] += 50.562500000000107 * x->gam[2 * pendulum_poly_k3s3_M + l] + (-36.437500000000099) * x->gam2[2 * pendulum_poly_k3s3_M + l];
+    return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < pendulum_poly_k3s3_M; l++) gam[0 * pendulum_poly_k3s3_M + l] += x->gam[0 * pendulum_poly_k3s3_M + l];
@@ -591,32 +625,6 @@ pendulum_poly_k3s3_OUT_OF_LINE int pendulum_poly_k3s3_predict(const pendulum_pol
     e = e * r + 7.4476024597418194e-16;
     e = e * r + 2.4825341532472731e-16;
     for (l = 0; l < pendulum_poly_k3s3_M; l++) gam[2 * pendulum_poly_k3s3_M + l] += e * x->gam[2 * pendulum_poly_k3s3_M + l];
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
-    for (i = 0; i < pendulum_poly_k3s3_S * pendulum_poly_k3s3_M; i++) {
-      ref[i] = gam[i];
-      gam[i] = 0;
-    }
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[0 * pendulum_poly_k3s3_M + l] += 69.500000000000085 * x->gam[0 * pendulum_poly_k3s3_M + l] + (-68.500000000000085) * x->gam2[0 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[0 * pendulum_poly_k3s3_M + l] += (-121.78482240718688) * x->gam[1 * pendulum_poly_k3s3_M + l] + (-112.04203661461193) * x->gam2[1 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[0 * pendulum_poly_k3s3_M + l] += 166.44731007514071 * x->gam[2 * pendulum_poly_k3s3_M + l] + (-101.88084722483431) * x->gam2[2 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[1 * pendulum_poly_k3s3_M + l] += 63.219854476264132 * x->gam[0 * pendulum_poly_k3s3_M + l] + (-63.219854476264118) * x->gam2[0 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[1 * pendulum_poly_k3s3_M + l] += (-114.06250000000021) * x->gam[1 * pendulum_poly_k3s3_M + l] + (-103.93750000000018) * x->gam2[1 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[1 * pendulum_poly_k3s3_M + l] += 146.25353361115765 * x->gam[2 * pendulum_poly_k3s3_M + l] + (-95.420627192185393) * x->gam2[2 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[2 * pendulum_poly_k3s3_M + l] += 23.478713763747862 * x->gam[0 * pendulum_poly_k3s3_M + l] + (-23.478713763747855) * x->gam2[0 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[2 * pendulum_poly_k3s3_M + l] += (-42.360755349143751) * x->gam[1 * pendulum_poly_k3s3_M + l] + (-38.971894921212247) * x->gam2[1 * pendulum_poly_k3s3_M + l];
-    for (l = 0; l < pendulum_poly_k3s3_M; l++)
-      gam[2 * pendulum_poly_k3s3_M + l] += 50.562500000000107 * x->gam[2 * pendulum_poly_k3s3_M + l] + (-36.437500000000099) * x->gam2[2 * pendulum_poly_k3s3_M + l];
-    return 1;
   }
   return 0;
 }
@@ -714,7 +722,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
   int two;
   double tit = pendulum_poly_k3s3_TOL;  /* where the iteration stops (pendulum_poly_k3s3_itol) */
   int attol = 0;  /* it stopped there, above round-off */
-  two = pendulum_poly_k3s3_predict(x, h, cold, prm, gam, ref);
+  two = pendulum_poly_k3s3_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */
   double g0[pendulum_poly_k3s3_NU];
   pendulum_poly_k3s3_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g

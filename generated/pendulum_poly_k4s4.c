@@ -890,7 +890,8 @@ void pendulum_poly_k4s4_hidden(const pendulum_poly_k4s4_state *x, const pendulum
  * when they had size h (polynomial family), else from the previous step's, or gamma_0 = M^-1 p,
  * gamma_j = 0 (j > 0) on the first step or when cold. */
 /* Returns 1 when gam is the two-step start, ref then the one-step one (whose error
- * pendulum_poly_k4s4_err_est needs), else 0. */
+ * pendulum_poly_k4s4_err_est needs; not computed when ref is 0, as in a fixed step without
+ * statistics), else 0. */
 pendulum_poly_k4s4_OUT_OF_LINE int pendulum_poly_k4s4_predict(const pendulum_poly_k4s4_state *x, double h, int cold, const pendulum_poly_k4s4_params *prm, double *gam, double *ref)
 {
   int i, l;
@@ -898,6 +899,60 @@ pendulum_poly_k4s4_OUT_OF_LINE int pendulum_poly_k4s4_predict(const pendulum_pol
   if (cold || x->hprev == 0) {
     pendulum_poly_k4s4_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
     return 0;
+  }
+  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
+                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+    if (ref) {  /* the one-step start, for the estimate */
+      for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) ref[i] = 0;
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[0 * pendulum_poly_k4s4_M + l] += x->gam[0 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[0 * pendulum_poly_k4s4_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[0 * pendulum_poly_k4s4_M + l] += 13.416407864998739 * x->gam[2 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[0 * pendulum_poly_k4s4_M + l] += 58.206528843420998 * x->gam[3 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[1 * pendulum_poly_k4s4_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[1 * pendulum_poly_k4s4_M + l] += 7.745966692414834 * x->gam[2 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[1 * pendulum_poly_k4s4_M + l] += 45.825756949558397 * x->gam[3 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[2 * pendulum_poly_k4s4_M + l] += (-8.3266726846886741e-17) * x->gam[0 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[2 * pendulum_poly_k4s4_M + l] += (-5.2881473875548006e-16) * x->gam[1 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[2 * pendulum_poly_k4s4_M + l] += 0.99999999999999745 * x->gam[2 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[2 * pendulum_poly_k4s4_M + l] += 11.832159566199218 * x->gam[3 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[3 * pendulum_poly_k4s4_M + l] += (-1.6653345369377348e-16) * x->gam[0 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[3 * pendulum_poly_k4s4_M + l] += (-8.6533320887260379e-16) * x->gam[1 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[3 * pendulum_poly_k4s4_M + l] += (-5.0271316603257284e-15) * x->gam[2 * pendulum_poly_k4s4_M + l];
+      for (l = 0; l < pendulum_poly_k4s4_M; l++) ref[3 * pendulum_poly_k4s4_M + l] += 0.99999999999997014 * x->gam[3 * pendulum_poly_k4s4_M + l];
+    }
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[0 * pendulum_poly_k4s4_M + l] += (-910.18749999962267) * x->gam[0 * pendulum_poly_k4s4_M + l] + 911.18749999962233 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[0 * pendulum_poly_k4s4_M + l] += 1626.0709487800843 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1533.8392432770761 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[0 * pendulum_poly_k4s4_M + l] += (-2046.4214621572421) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1716.0424184817782 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[0 * pendulum_poly_k4s4_M + l] += 1911.2482261090747 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1199.1631589599583 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[1 * pendulum_poly_k4s4_M + l] += (-990.62480875351343) * x->gam[0 * pendulum_poly_k4s4_M + l] + 990.62480875351298 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[1 * pendulum_poly_k4s4_M + l] += 1762.4374999992667 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1670.1874999993049 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[1 * pendulum_poly_k4s4_M + l] += (-2219.9456417533411) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1874.2818781044716 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[1 * pendulum_poly_k4s4_M + l] += 2030.3674438455259 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1315.4856354327121 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[2 * pendulum_poly_k4s4_M + l] += (-506.88865964927345) * x->gam[0 * pendulum_poly_k4s4_M + l] + 506.88865964927322 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[2 * pendulum_poly_k4s4_M + l] += 898.77419777888406 * x->gam[1 * pendulum_poly_k4s4_M + l] + 857.13962680717373 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[2 * pendulum_poly_k4s4_M + l] += (-1127.6874999995282) * x->gam[2 * pendulum_poly_k4s4_M + l] + 967.43749999960107 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[2 * pendulum_poly_k4s4_M + l] += 999.13079551143642 * x->gam[3 * pendulum_poly_k4s4_M + l] + 684.7334127525794 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[3 * pendulum_poly_k4s4_M + l] += (-150.64246527367814) * x->gam[0 * pendulum_poly_k4s4_M + l] + 150.64246527367808 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[3 * pendulum_poly_k4s4_M + l] += 266.07580128826294 * x->gam[1 * pendulum_poly_k4s4_M + l] + 255.76500597461808 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[3 * pendulum_poly_k4s4_M + l] += (-330.93071286699558) * x->gam[2 * pendulum_poly_k4s4_M + l] + 290.99717433109475 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+    for (l = 0; l < pendulum_poly_k4s4_M; l++)
+      gam[3 * pendulum_poly_k4s4_M + l] += 283.43749999987261 * x->gam[3 * pendulum_poly_k4s4_M + l] + 208.43749999991726 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+    return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < pendulum_poly_k4s4_M; l++) gam[0 * pendulum_poly_k4s4_M + l] += x->gam[0 * pendulum_poly_k4s4_M + l];
@@ -969,46 +1024,6 @@ pendulum_poly_k4s4_OUT_OF_LINE int pendulum_poly_k4s4_predict(const pendulum_pol
     e = e * r + (-5.2872732413569865e-15);
     e = e * r + (-4.4060610344641594e-16);
     for (l = 0; l < pendulum_poly_k4s4_M; l++) gam[3 * pendulum_poly_k4s4_M + l] += e * x->gam[3 * pendulum_poly_k4s4_M + l];
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
-    for (i = 0; i < pendulum_poly_k4s4_S * pendulum_poly_k4s4_M; i++) {
-      ref[i] = gam[i];
-      gam[i] = 0;
-    }
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[0 * pendulum_poly_k4s4_M + l] += (-910.18749999962267) * x->gam[0 * pendulum_poly_k4s4_M + l] + 911.18749999962233 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[0 * pendulum_poly_k4s4_M + l] += 1626.0709487800843 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1533.8392432770761 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[0 * pendulum_poly_k4s4_M + l] += (-2046.4214621572421) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1716.0424184817782 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[0 * pendulum_poly_k4s4_M + l] += 1911.2482261090747 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1199.1631589599583 * x->gam2[3 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[1 * pendulum_poly_k4s4_M + l] += (-990.62480875351343) * x->gam[0 * pendulum_poly_k4s4_M + l] + 990.62480875351298 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[1 * pendulum_poly_k4s4_M + l] += 1762.4374999992667 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1670.1874999993049 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[1 * pendulum_poly_k4s4_M + l] += (-2219.9456417533411) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1874.2818781044716 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[1 * pendulum_poly_k4s4_M + l] += 2030.3674438455259 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1315.4856354327121 * x->gam2[3 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[2 * pendulum_poly_k4s4_M + l] += (-506.88865964927345) * x->gam[0 * pendulum_poly_k4s4_M + l] + 506.88865964927322 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[2 * pendulum_poly_k4s4_M + l] += 898.77419777888406 * x->gam[1 * pendulum_poly_k4s4_M + l] + 857.13962680717373 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[2 * pendulum_poly_k4s4_M + l] += (-1127.6874999995282) * x->gam[2 * pendulum_poly_k4s4_M + l] + 967.43749999960107 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[2 * pendulum_poly_k4s4_M + l] += 999.13079551143642 * x->gam[3 * pendulum_poly_k4s4_M + l] + 684.7334127525794 * x->gam2[3 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[3 * pendulum_poly_k4s4_M + l] += (-150.64246527367814) * x->gam[0 * pendulum_poly_k4s4_M + l] + 150.64246527367808 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[3 * pendulum_poly_k4s4_M + l] += 266.07580128826294 * x->gam[1 * pendulum_poly_k4s4_M + l] + 255.76500597461808 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[3 * pendulum_poly_k4s4_M + l] += (-330.93071286699558) * x->gam[2 * pendulum_poly_k4s4_M + l] + 290.99717433109475 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-    for (l = 0; l < pendulum_poly_k4s4_M; l++)
-      gam[3 * pendulum_poly_k4s4_M + l] += 283.43749999987261 * x->gam[3 * pendulum_poly_k4s4_M + l] + 208.43749999991726 * x->gam2[3 * pendulum_poly_k4s4_M + l];
-    return 1;
   }
   return 0;
 }
@@ -1108,7 +1123,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   int two;
   double tit = pendulum_poly_k4s4_TOL;  /* where the iteration stops (pendulum_poly_k4s4_itol) */
   int attol = 0;  /* it stopped there, above round-off */
-  two = pendulum_poly_k4s4_predict(x, h, cold, prm, gam, ref);
+  two = pendulum_poly_k4s4_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */
   double g0[pendulum_poly_k4s4_NU];
   pendulum_poly_k4s4_g(x->q, x->p, 0, 0, 0, 0, 0, prm, g0);
   /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g
