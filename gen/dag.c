@@ -222,6 +222,44 @@ static int merge_factors(Dag *d, int c, int prod) {
   return dag_op(d, OP_MUL, dag_const(d, p), k == pn->a ? pn->b : pn->a);
 }
 
+// When node id is 2^e * x (a product with a constant power of two), sets
+// *scale to 2^e and *x and returns 1; else returns 0.
+static int pow2_scaled(const Dag *d, int id, double *scale, int *x) {
+  const Node *n = &d->nodes[id];
+  if (n->op != OP_MUL) return 0;
+  int k = d->nodes[n->a].op == OP_CONST ? n->a : d->nodes[n->b].op == OP_CONST ? n->b : -1;
+  int e;
+  if (k < 0 || fabs(frexp(d->nodes[k].val, &e)) != 0.5) return 0;
+  *scale = d->nodes[k].val;
+  *x = k == n->a ? n->b : n->a;
+  return 1;
+}
+
+// (2^e x) * y -> 2^e (x * y), for either factor or both: multiplying by a
+// power of two commutes with rounding (exact while no intermediate over- or
+// underflows), so such a factor floats up the products until it cancels
+// (the 2 of d(x^2)/dx against a 1/2) or merges into a constant (a weight,
+// merge_factors), and its own multiplication is gone. -1 when neither factor
+// is scaled.
+static int float_pow2(Dag *d, int a, int b) {
+  double sa = 1, sb = 1;
+  int xa = a, xb = b, fa = pow2_scaled(d, a, &sa, &xa), fb = pow2_scaled(d, b, &sb, &xb);
+  if (!fa && !fb) return -1;
+  return dag_op(d, OP_MUL, dag_const(d, sa * sb), dag_op(d, OP_MUL, xa, xb));
+}
+
+// (2^e x) +- (2^e y) -> 2^e (x +- y): the common power of two floats on
+// (exact, as in float_pow2). -1 unless both terms carry the same one.
+static int float_pow2_sum(Dag *d, Op op, int a, int b) {
+  double sa, sb;
+  int xa, xb;
+  if (!pow2_scaled(d, a, &sa, &xa) || !pow2_scaled(d, b, &sb, &xb) || fabs(sa) != fabs(sb)) return -1;
+  if (sa != sb) { // opposite signs: 2^e x + (-2^e) y = 2^e (x - y)
+    op = op == OP_ADD ? OP_SUB : OP_ADD;
+  }
+  return dag_op(d, OP_MUL, dag_const(d, sa), dag_op(d, op, xa, xb));
+}
+
 // Algebraic identities; returns the simplified node or -1 when none applies.
 static int simplify(Dag *d, Op op, int a, int b) {
   switch (op) {
@@ -230,13 +268,13 @@ static int simplify(Dag *d, Op op, int a, int b) {
     if (dag_is_zero(d, b)) return a;
     if (is_neg(d, b)) return dag_op(d, OP_SUB, a, d->nodes[b].a);
     if (is_neg(d, a)) return dag_op(d, OP_SUB, b, d->nodes[a].a);
-    return -1;
+    return float_pow2_sum(d, op, a, b);
   case OP_SUB:
     if (dag_is_zero(d, b)) return a;
     if (dag_is_zero(d, a)) return dag_op(d, OP_NEG, b, -1);
     if (a == b) return dag_const(d, 0);
     if (is_neg(d, b)) return dag_op(d, OP_ADD, a, d->nodes[b].a);
-    return -1;
+    return float_pow2_sum(d, op, a, b);
   case OP_MUL:
     if (dag_is_zero(d, a) || dag_is_zero(d, b)) return dag_const(d, 0);
     if (dag_is_const(d, a, 1)) return b;
@@ -248,7 +286,7 @@ static int simplify(Dag *d, Op op, int a, int b) {
     if (is_neg(d, b)) return dag_op(d, OP_NEG, dag_op(d, OP_MUL, a, d->nodes[b].a), -1);
     if (d->nodes[a].op == OP_CONST) return merge_factors(d, a, b);
     if (d->nodes[b].op == OP_CONST) return merge_factors(d, b, a);
-    return -1;
+    return float_pow2(d, a, b);
   case OP_DIV:
     if (dag_is_const(d, b, 1)) return a;
     if (dag_is_const(d, a, -1)) return dag_op(d, OP_NEG, dag_op(d, OP_DIV, dag_const(d, 1), b), -1); /* exact */

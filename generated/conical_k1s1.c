@@ -96,17 +96,15 @@ static void conical_k1s1_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t3 = t2 * p0[0] /* p_x */;
-  const double t4 = t1 * p0[1] /* p_y */;
-  const double t5 = t3 + t4;
-  const double t6 = t0 * p0[2] /* p_z */;
-  const double t7 = t5 + t6;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = q0[2] /* z */ * p0[2] /* p_z */;
+  const double t4 = t2 + t3;
+  const double t5 = 2.0 * t4;
   /* hidden */
-  out[0] = t7;
+  out[0] = t5;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -115,27 +113,23 @@ static void conical_k1s1_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = p0[2] /* p_z */ * p0[2] /* p_z */;
+  const double t4 = t2 + t3;
   /* consistent initial multiplier */
-  const double t3 = t2 * t2;
-  const double t4 = t1 * t1;
-  const double t5 = t3 + t4;
-  const double t6 = t0 * t0;
+  const double t5 = q0[0] /* x */ * q0[0] /* x */;
+  const double t6 = q0[1] /* y */ * q0[1] /* y */;
   const double t7 = t5 + t6;
-  const double t8 = 2.0 * p0[0] /* p_x */;
-  const double t9 = 2.0 * p0[1] /* p_y */;
-  const double t10 = 2.0 * p0[2] /* p_z */;
-  const double t11 = p0[0] /* p_x */ * t8;
-  const double t12 = p0[1] /* p_y */ * t9;
-  const double t13 = t11 + t12;
-  const double t14 = p0[2] /* p_z */ * t10;
-  const double t15 = t13 + t14;
-  const double t16 = t15 - t0;
-  const double t17 = t16 / t7;
+  const double t8 = q0[2] /* z */ * q0[2] /* z */;
+  const double t9 = t7 + t8;
+  const double t10 = 4.0 * t9;
+  const double t11 = t4 - q0[2] /* z */;
+  const double t12 = 2.0 * t11;
+  const double t13 = t12 / t10;
   /* lambda */
-  out[0] = t17;
+  out[0] = t13;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -145,52 +139,57 @@ static void conical_k1s1_consistent(const double *q0, const double *p0, const do
     const double *g0, const conical_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
-  const double t3 = q0[0] /* x */ * q0[0] /* x */;
-  const double t4 = q0[1] /* y */ * q0[1] /* y */;
-  const double t5 = t3 + t4;
-  const double t6 = q0[2] /* z */ * q0[2] /* z */;
-  const double t7 = t5 + t6;
-  const double t8 = t7 - 1.0;
-  const double t9 = t2 * p0[0] /* p_x */;
-  const double t10 = t1 * p0[1] /* p_y */;
-  const double t11 = t9 + t10;
-  const double t12 = t0 * p0[2] /* p_z */;
-  const double t13 = t11 + t12;
-  const double t14 = t2 * t2;
-  const double t15 = t1 * t1;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = q0[2] /* z */ * q0[2] /* z */;
+  const double t4 = t2 + t3;
+  const double t5 = t4 - 1.0;
+  const double t6 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t7 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t8 = t6 + t7;
+  const double t9 = q0[2] /* z */ * p0[2] /* p_z */;
+  const double t10 = t8 + t9;
+  const double t11 = 2.0 * t10;
+  const double t12 = q0[0] /* x */ * q0[0] /* x */;
+  const double t13 = q0[1] /* y */ * q0[1] /* y */;
+  const double t14 = t12 + t13;
+  const double t15 = q0[2] /* z */ * q0[2] /* z */;
   const double t16 = t14 + t15;
-  const double t17 = t0 * t0;
-  const double t18 = t16 + t17;
+  const double t17 = 4.0 * t16;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t19 = t8 / t18;
-  const double t20 = t2 * t19;
-  const double t21 = t1 * t19;
-  const double t22 = t0 * t19;
-  const double t23 = -t20;
-  const double t24 = -t21;
-  const double t25 = -t22;
-  const double t26 = t13 / t18;
-  const double t27 = t2 * t26;
-  const double t28 = -t27;
-  const double t29 = t1 * t26;
-  const double t30 = -t29;
-  const double t31 = t0 * t26;
-  const double t32 = -t31;
+  const double t18 = t5 / t17;
+  const double t19 = q0[0] /* x */ * t18;
+  const double t20 = 2.0 * t19;
+  const double t21 = q0[1] /* y */ * t18;
+  const double t22 = 2.0 * t21;
+  const double t23 = q0[2] /* z */ * t18;
+  const double t24 = 2.0 * t23;
+  const double t25 = -t20;
+  const double t26 = -t22;
+  const double t27 = -t24;
+  const double t28 = t11 / t17;
+  const double t29 = q0[0] /* x */ * t28;
+  const double t30 = 2.0 * t29;
+  const double t31 = -t30;
+  const double t32 = q0[1] /* y */ * t28;
+  const double t33 = 2.0 * t32;
+  const double t34 = -t33;
+  const double t35 = q0[2] /* z */ * t28;
+  const double t36 = 2.0 * t35;
+  const double t37 = -t36;
   /* dq */
-  out[0] = t23;
-  out[1] = t24;
-  out[2] = t25;
+  out[0] = t25;
+  out[1] = t26;
+  out[2] = t27;
   /* dp */
-  out[3] = t28;
-  out[4] = t30;
-  out[5] = t32;
+  out[3] = t31;
+  out[4] = t34;
+  out[5] = t37;
   /* pivot */
-  out[6] = t18;
+  out[6] = t17;
   /* adiag */
-  out[7] = t18;
+  out[7] = t17;
 }
 
 void conical_k1s1_params_default(conical_k1s1_params *prm)
@@ -342,70 +341,61 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
       const double t0 = 2.0 * x->q[2] /* z */;
       const double t1 = 2.0 * x->q[1] /* y */;
       const double t2 = 2.0 * x->q[0] /* x */;
-      const double t3 = gm0 * 0.5;
-      const double t4 = h * t3;
-      const double t5 = 2.0 * t4;
-      const double t6 = t2 + t5;
-      const double t7 = 0.5 * gm1;
-      const double t8 = h * t7;
-      const double t9 = 2.0 * t8;
-      const double t10 = t1 + t9;
-      const double t11 = 0.5 * gm2;
-      const double t12 = h * t11;
-      const double t13 = 2.0 * t12;
-      const double t14 = t0 + t13;
+      const double t3 = h * gm0;
+      const double t4 = t2 + t3;
+      const double t5 = h * gm1;
+      const double t6 = t1 + t5;
+      const double t7 = h * gm2;
+      const double t8 = t0 + t7;
       /* multiplier system A lambda = r */
-      const double t15 = t6 * t6;
-      const double t16 = t10 * t10;
-      const double t17 = t15 + t16;
-      const double t18 = t14 * t14;
-      const double t19 = t17 + t18;
-      const double t20 = 0.5 * t19;
-      const double t21 = h * t20;
-      const double t22 = 0.5 * t14;
-      const double t23 = h * t22;
-      const double t24 = t6 * x->p[0] /* p_x */;
-      const double t25 = t10 * x->p[1] /* p_y */;
-      const double t26 = t24 + t25;
-      const double t27 = t14 * x->p[2] /* p_z */;
-      const double t28 = t26 + t27;
-      const double t29 = t28 - t23;
-      const double t30 = t29 + g0[0];
-      const double t31 = t30 / t21;
+      const double t9 = t4 * t4;
+      const double t10 = t6 * t6;
+      const double t11 = t9 + t10;
+      const double t12 = t8 * t8;
+      const double t13 = t11 + t12;
+      const double t14 = h * t13;
+      const double t15 = 0.5 * t14;
+      const double t16 = h * t8;
+      const double t17 = 0.5 * t16;
+      const double t18 = t4 * x->p[0] /* p_x */;
+      const double t19 = t6 * x->p[1] /* p_y */;
+      const double t20 = t18 + t19;
+      const double t21 = t8 * x->p[2] /* p_z */;
+      const double t22 = t20 + t21;
+      const double t23 = t22 - t17;
+      const double t24 = t23 + g0[0];
+      const double t25 = t24 / t15;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t32 = t6 * t31;
-      const double t33 = t10 * t31;
-      const double t34 = t14 * t31;
-      const double t35 = 1.0 + t34;
-      const double t36 = 0.5 * t32;
-      const double t37 = h * t36;
-      const double t38 = x->p[0] /* p_x */ - t37;
-      const double t39 = 0.5 * t33;
-      const double t40 = h * t39;
-      const double t41 = x->p[1] /* p_y */ - t40;
-      const double t42 = 0.5 * t35;
-      const double t43 = h * t42;
-      const double t44 = x->p[2] /* p_z */ - t43;
-      const double t45 = h * t32;
-      const double t46 = -t45;
-      const double t47 = h * t33;
-      const double t48 = -t47;
-      const double t49 = h * t35;
-      const double t50 = -t49;
+      const double t26 = t4 * t25;
+      const double t27 = t6 * t25;
+      const double t28 = t8 * t25;
+      const double t29 = 1.0 + t28;
+      const double t30 = h * t26;
+      const double t31 = 0.5 * t30;
+      const double t32 = x->p[0] /* p_x */ - t31;
+      const double t33 = h * t27;
+      const double t34 = 0.5 * t33;
+      const double t35 = x->p[1] /* p_y */ - t34;
+      const double t36 = h * t29;
+      const double t37 = 0.5 * t36;
+      const double t38 = x->p[2] /* p_z */ - t37;
+      const double t39 = -t30;
+      const double t40 = -t33;
+      const double t41 = -t36;
       /* gam */
-      sw0 = t38;
-      sw1 = t41;
-      sw2 = t44;
+      sw0 = t32;
+      sw1 = t35;
+      sw2 = t38;
       /* dp */
-      sw3 = t46;
-      sw4 = t48;
-      sw5 = t50;
+      sw3 = t39;
+      sw4 = t40;
+      sw5 = t41;
       /* lambda */
-      sw6 = t31;
+      sw6 = t25;
       /* pivot */
-      sw7 = t21;
+      sw7 = t15;
       /* adiag */
-      sw8 = t21;
+      sw8 = t15;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

@@ -97,17 +97,15 @@ static void conical_k2s2_hidden_kernel(const double *q0, const double *p0, const
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t3 = t2 * p0[0] /* p_x */;
-  const double t4 = t1 * p0[1] /* p_y */;
-  const double t5 = t3 + t4;
-  const double t6 = t0 * p0[2] /* p_z */;
-  const double t7 = t5 + t6;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = q0[2] /* z */ * p0[2] /* p_z */;
+  const double t4 = t2 + t3;
+  const double t5 = 2.0 * t4;
   /* hidden */
-  out[0] = t7;
+  out[0] = t5;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -116,27 +114,23 @@ static void conical_k2s2_lambda0(const double *q0, const double *p0, const doubl
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = p0[2] /* p_z */ * p0[2] /* p_z */;
+  const double t4 = t2 + t3;
   /* consistent initial multiplier */
-  const double t3 = t2 * t2;
-  const double t4 = t1 * t1;
-  const double t5 = t3 + t4;
-  const double t6 = t0 * t0;
+  const double t5 = q0[0] /* x */ * q0[0] /* x */;
+  const double t6 = q0[1] /* y */ * q0[1] /* y */;
   const double t7 = t5 + t6;
-  const double t8 = 2.0 * p0[0] /* p_x */;
-  const double t9 = 2.0 * p0[1] /* p_y */;
-  const double t10 = 2.0 * p0[2] /* p_z */;
-  const double t11 = p0[0] /* p_x */ * t8;
-  const double t12 = p0[1] /* p_y */ * t9;
-  const double t13 = t11 + t12;
-  const double t14 = p0[2] /* p_z */ * t10;
-  const double t15 = t13 + t14;
-  const double t16 = t15 - t0;
-  const double t17 = t16 / t7;
+  const double t8 = q0[2] /* z */ * q0[2] /* z */;
+  const double t9 = t7 + t8;
+  const double t10 = 4.0 * t9;
+  const double t11 = t4 - q0[2] /* z */;
+  const double t12 = 2.0 * t11;
+  const double t13 = t12 / t10;
   /* lambda */
-  out[0] = t17;
+  out[0] = t13;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -146,52 +140,57 @@ static void conical_k2s2_consistent(const double *q0, const double *p0, const do
     const double *g0, const conical_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[2] /* z */;
-  const double t1 = 2.0 * q0[1] /* y */;
-  const double t2 = 2.0 * q0[0] /* x */;
-  const double t3 = q0[0] /* x */ * q0[0] /* x */;
-  const double t4 = q0[1] /* y */ * q0[1] /* y */;
-  const double t5 = t3 + t4;
-  const double t6 = q0[2] /* z */ * q0[2] /* z */;
-  const double t7 = t5 + t6;
-  const double t8 = t7 - 1.0;
-  const double t9 = t2 * p0[0] /* p_x */;
-  const double t10 = t1 * p0[1] /* p_y */;
-  const double t11 = t9 + t10;
-  const double t12 = t0 * p0[2] /* p_z */;
-  const double t13 = t11 + t12;
-  const double t14 = t2 * t2;
-  const double t15 = t1 * t1;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = q0[2] /* z */ * q0[2] /* z */;
+  const double t4 = t2 + t3;
+  const double t5 = t4 - 1.0;
+  const double t6 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t7 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t8 = t6 + t7;
+  const double t9 = q0[2] /* z */ * p0[2] /* p_z */;
+  const double t10 = t8 + t9;
+  const double t11 = 2.0 * t10;
+  const double t12 = q0[0] /* x */ * q0[0] /* x */;
+  const double t13 = q0[1] /* y */ * q0[1] /* y */;
+  const double t14 = t12 + t13;
+  const double t15 = q0[2] /* z */ * q0[2] /* z */;
   const double t16 = t14 + t15;
-  const double t17 = t0 * t0;
-  const double t18 = t16 + t17;
+  const double t17 = 4.0 * t16;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t19 = t8 / t18;
-  const double t20 = t2 * t19;
-  const double t21 = t1 * t19;
-  const double t22 = t0 * t19;
-  const double t23 = -t20;
-  const double t24 = -t21;
-  const double t25 = -t22;
-  const double t26 = t13 / t18;
-  const double t27 = t2 * t26;
-  const double t28 = -t27;
-  const double t29 = t1 * t26;
-  const double t30 = -t29;
-  const double t31 = t0 * t26;
-  const double t32 = -t31;
+  const double t18 = t5 / t17;
+  const double t19 = q0[0] /* x */ * t18;
+  const double t20 = 2.0 * t19;
+  const double t21 = q0[1] /* y */ * t18;
+  const double t22 = 2.0 * t21;
+  const double t23 = q0[2] /* z */ * t18;
+  const double t24 = 2.0 * t23;
+  const double t25 = -t20;
+  const double t26 = -t22;
+  const double t27 = -t24;
+  const double t28 = t11 / t17;
+  const double t29 = q0[0] /* x */ * t28;
+  const double t30 = 2.0 * t29;
+  const double t31 = -t30;
+  const double t32 = q0[1] /* y */ * t28;
+  const double t33 = 2.0 * t32;
+  const double t34 = -t33;
+  const double t35 = q0[2] /* z */ * t28;
+  const double t36 = 2.0 * t35;
+  const double t37 = -t36;
   /* dq */
-  out[0] = t23;
-  out[1] = t24;
-  out[2] = t25;
+  out[0] = t25;
+  out[1] = t26;
+  out[2] = t27;
   /* dp */
-  out[3] = t28;
-  out[4] = t30;
-  out[5] = t32;
+  out[3] = t31;
+  out[4] = t34;
+  out[5] = t37;
   /* pivot */
-  out[6] = t18;
+  out[6] = t17;
   /* adiag */
-  out[7] = t18;
+  out[7] = t17;
 }
 
 void conical_k2s2_params_default(conical_k2s2_params *prm)
@@ -395,115 +394,110 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
   for (it = 1; it <= conical_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
-      const double t0 = 2.0 * x->q[2] /* z */;
-      const double t1 = 2.0 * x->q[1] /* y */;
-      const double t2 = 2.0 * x->q[0] /* x */;
-      const double t3 = gm0 * 0.5;
-      const double t4 = gm3 * 0.28867513459481292;
-      const double t5 = t3 - t4;
+      const double t0 = gm0 * 0.5;
+      const double t1 = gm3 * 0.28867513459481292;
+      const double t2 = t0 - t1;
+      const double t3 = h * t2;
+      const double t4 = x->q[0] /* x */ + t3;
+      const double t5 = gm0 * 0.28867513459481292;
       const double t6 = h * t5;
-      const double t7 = 2.0 * t6;
-      const double t8 = t2 + t7;
-      const double t9 = gm0 * 0.28867513459481292;
+      const double t7 = 0.5 * gm1;
+      const double t8 = 0.28867513459481292 * gm4;
+      const double t9 = t7 - t8;
       const double t10 = h * t9;
-      const double t11 = 2.0 * t10;
-      const double t12 = 0.5 * gm1;
-      const double t13 = 0.28867513459481292 * gm4;
-      const double t14 = t12 - t13;
-      const double t15 = h * t14;
-      const double t16 = 2.0 * t15;
-      const double t17 = t1 + t16;
-      const double t18 = 0.28867513459481292 * gm1;
-      const double t19 = h * t18;
-      const double t20 = 2.0 * t19;
-      const double t21 = 0.5 * gm2;
-      const double t22 = 0.28867513459481292 * gm5;
-      const double t23 = t21 - t22;
-      const double t24 = h * t23;
-      const double t25 = 2.0 * t24;
-      const double t26 = t0 + t25;
-      const double t27 = 0.28867513459481292 * gm2;
-      const double t28 = h * t27;
-      const double t29 = 2.0 * t28;
+      const double t11 = x->q[1] /* y */ + t10;
+      const double t12 = 0.28867513459481292 * gm1;
+      const double t13 = h * t12;
+      const double t14 = 0.5 * gm2;
+      const double t15 = 0.28867513459481292 * gm5;
+      const double t16 = t14 - t15;
+      const double t17 = h * t16;
+      const double t18 = x->q[2] /* z */ + t17;
+      const double t19 = 0.28867513459481292 * gm2;
+      const double t20 = h * t19;
       /* multiplier system A lambda = r */
-      const double t30 = t8 * t8;
-      const double t31 = t17 * t17;
-      const double t32 = t30 + t31;
-      const double t33 = t26 * t26;
-      const double t34 = t32 + t33;
-      const double t35 = 0.5 * t34;
-      const double t36 = h * t35;
-      const double t37 = 0.5 * t26;
-      const double t38 = t28 * 0.57735026918962584;
-      const double t39 = t37 + t38;
-      const double t40 = h * t39;
-      const double t41 = t8 * x->p[0] /* p_x */;
-      const double t42 = t17 * x->p[1] /* p_y */;
-      const double t43 = t41 + t42;
-      const double t44 = t26 * x->p[2] /* p_z */;
-      const double t45 = t43 + t44;
-      const double t46 = t45 - t40;
-      const double t47 = t46 + g0[0];
-      const double t48 = t47 / t36;
+      const double t21 = t4 * t4;
+      const double t22 = t11 * t11;
+      const double t23 = t21 + t22;
+      const double t24 = t18 * t18;
+      const double t25 = t23 + t24;
+      const double t26 = h * t25;
+      const double t27 = 2.0 * t26;
+      const double t28 = t20 * 0.57735026918962584;
+      const double t29 = t18 + t28;
+      const double t30 = h * t29;
+      const double t31 = t4 * x->p[0] /* p_x */;
+      const double t32 = t11 * x->p[1] /* p_y */;
+      const double t33 = t31 + t32;
+      const double t34 = t18 * x->p[2] /* p_z */;
+      const double t35 = t33 + t34;
+      const double t36 = 2.0 * t35;
+      const double t37 = t36 - t30;
+      const double t38 = t37 + g0[0];
+      const double t39 = t38 / t27;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t49 = t8 * t48;
-      const double t50 = t17 * t48;
-      const double t51 = t26 * t48;
-      const double t52 = 1.0 + t51;
-      const double t53 = t11 * t48;
-      const double t54 = t20 * t48;
-      const double t55 = t29 * t48;
-      const double t56 = 0.5 * t49;
-      const double t57 = 0.28867513459481292 * t53;
-      const double t58 = t56 - t57;
-      const double t59 = h * t58;
-      const double t60 = x->p[0] /* p_x */ - t59;
-      const double t61 = 0.5 * t50;
-      const double t62 = 0.28867513459481292 * t54;
-      const double t63 = t61 - t62;
-      const double t64 = h * t63;
-      const double t65 = x->p[1] /* p_y */ - t64;
-      const double t66 = 0.5 * t52;
-      const double t67 = 0.28867513459481292 * t55;
-      const double t68 = t66 - t67;
-      const double t69 = h * t68;
-      const double t70 = x->p[2] /* p_z */ - t69;
-      const double t71 = 0.28867513459481292 * t49;
-      const double t72 = h * t71;
-      const double t73 = -t72;
-      const double t74 = 0.28867513459481292 * t50;
-      const double t75 = h * t74;
-      const double t76 = -t75;
-      const double t77 = 0.28867513459481292 * t52;
-      const double t78 = h * t77;
-      const double t79 = -t78;
-      const double t80 = h * t49;
-      const double t81 = -t80;
-      const double t82 = h * t50;
-      const double t83 = -t82;
-      const double t84 = h * t52;
-      const double t85 = -t84;
+      const double t40 = t4 * t39;
+      const double t41 = t11 * t39;
+      const double t42 = t18 * t39;
+      const double t43 = 2.0 * t42;
+      const double t44 = 1.0 + t43;
+      const double t45 = t6 * t39;
+      const double t46 = 2.0 * t45;
+      const double t47 = t13 * t39;
+      const double t48 = 2.0 * t47;
+      const double t49 = t20 * t39;
+      const double t50 = 2.0 * t49;
+      const double t51 = 0.57735026918962584 * t45;
+      const double t52 = t40 - t51;
+      const double t53 = h * t52;
+      const double t54 = x->p[0] /* p_x */ - t53;
+      const double t55 = 0.57735026918962584 * t47;
+      const double t56 = t41 - t55;
+      const double t57 = h * t56;
+      const double t58 = x->p[1] /* p_y */ - t57;
+      const double t59 = 0.5 * t44;
+      const double t60 = 0.57735026918962584 * t49;
+      const double t61 = t59 - t60;
+      const double t62 = h * t61;
+      const double t63 = x->p[2] /* p_z */ - t62;
+      const double t64 = 0.57735026918962584 * t40;
+      const double t65 = h * t64;
+      const double t66 = -t65;
+      const double t67 = 0.57735026918962584 * t41;
+      const double t68 = h * t67;
+      const double t69 = -t68;
+      const double t70 = 0.28867513459481292 * t44;
+      const double t71 = h * t70;
+      const double t72 = -t71;
+      const double t73 = h * t40;
+      const double t74 = 2.0 * t73;
+      const double t75 = -t74;
+      const double t76 = h * t41;
+      const double t77 = 2.0 * t76;
+      const double t78 = -t77;
+      const double t79 = h * t44;
+      const double t80 = -t79;
       /* gam */
-      sw0 = t60;
-      sw1 = t65;
-      sw2 = t70;
-      sw3 = t73;
-      sw4 = t76;
-      sw5 = t79;
+      sw0 = t54;
+      sw1 = t58;
+      sw2 = t63;
+      sw3 = t66;
+      sw4 = t69;
+      sw5 = t72;
       /* dp */
-      sw6 = t81;
-      sw7 = t83;
-      sw8 = t85;
+      sw6 = t75;
+      sw7 = t78;
+      sw8 = t80;
       /* lambda */
-      sw9 = t48;
+      sw9 = t39;
       /* pivot */
-      sw10 = t36;
+      sw10 = t27;
       /* adiag */
-      sw11 = t36;
+      sw11 = t27;
       /* theta */
-      sw12 = t53;
-      sw13 = t54;
-      sw14 = t55;
+      sw12 = t46;
+      sw13 = t48;
+      sw14 = t50;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

@@ -229,11 +229,11 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
   for (it = 1; it <= kepler_k1s1_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 1: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = 0.5 * gm0;
-      const double t1 = h * t0;
+      const double t0 = h * gm0;
+      const double t1 = 0.5 * t0;
       const double t2 = t1 + x->q[0] /* x */;
-      const double t3 = 0.5 * gm1;
-      const double t4 = h * t3;
+      const double t3 = h * gm1;
+      const double t4 = 0.5 * t3;
       const double t5 = t4 + x->q[1] /* y */;
       const double t6 = t2 * t2;
       const double t7 = t5 * t5;
@@ -241,29 +241,24 @@ static int kepler_k1s1_step_within(kepler_k1s1_state *x, kepler_k1s1_real h_, do
       const double t9 = sqrt(t8);
       const double t10 = 1.0 / t9;
       const double t11 = t10 * t10;
-      const double t12 = 0.5 * t11;
-      const double t13 = t10 * t12;
-      const double t14 = 2.0 * t5;
-      const double t15 = t13 * t14;
-      const double t16 = 2.0 * t2;
-      const double t17 = t13 * t16;
+      const double t12 = t10 * t11;
+      const double t13 = t5 * t12;
+      const double t14 = t2 * t12;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t18 = 0.5 * t17;
-      const double t19 = h * t18;
-      const double t20 = x->p[0] /* p_x */ - t19;
-      const double t21 = 0.5 * t15;
-      const double t22 = h * t21;
-      const double t23 = x->p[1] /* p_y */ - t22;
-      const double t24 = h * t17;
-      const double t25 = -t24;
-      const double t26 = h * t15;
-      const double t27 = -t26;
+      const double t15 = h * t14;
+      const double t16 = 0.5 * t15;
+      const double t17 = x->p[0] /* p_x */ - t16;
+      const double t18 = h * t13;
+      const double t19 = 0.5 * t18;
+      const double t20 = x->p[1] /* p_y */ - t19;
+      const double t21 = -t15;
+      const double t22 = -t18;
       /* gam */
-      sw0 = t20;
-      sw1 = t23;
+      sw0 = t17;
+      sw1 = t20;
       /* dp */
-      sw2 = t25;
-      sw3 = t27;
+      sw2 = t21;
+      sw3 = t22;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

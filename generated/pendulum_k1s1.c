@@ -91,14 +91,13 @@ static void pendulum_k1s1_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t2 = t1 * p0[0] /* p_x */;
-  const double t3 = t0 * p0[1] /* p_y */;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = 2.0 * t2;
   /* hidden */
-  out[0] = t4;
+  out[0] = t3;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -107,21 +106,19 @@ static void pendulum_k1s1_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
   /* consistent initial multiplier */
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = 2.0 * p0[0] /* p_x */;
-  const double t6 = 2.0 * p0[1] /* p_y */;
-  const double t7 = p0[0] /* p_x */ * t5;
-  const double t8 = p0[1] /* p_y */ * t6;
-  const double t9 = t7 + t8;
-  const double t10 = t9 - t0;
-  const double t11 = t10 / t4;
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
+  const double t5 = t3 + t4;
+  const double t6 = 4.0 * t5;
+  const double t7 = t2 - q0[1] /* y */;
+  const double t8 = 2.0 * t7;
+  const double t9 = t8 / t6;
   /* lambda */
-  out[0] = t11;
+  out[0] = t9;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -131,35 +128,39 @@ static void pendulum_k1s1_consistent(const double *q0, const double *p0, const d
     const double *g0, const pendulum_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = q0[0] /* x */ * q0[0] /* x */;
-  const double t3 = q0[1] /* y */ * q0[1] /* y */;
-  const double t4 = t2 + t3;
-  const double t5 = t4 - 1.0;
-  const double t6 = t1 * p0[0] /* p_x */;
-  const double t7 = t0 * p0[1] /* p_y */;
-  const double t8 = t6 + t7;
-  const double t9 = t1 * t1;
-  const double t10 = t0 * t0;
-  const double t11 = t9 + t10;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = t2 - 1.0;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = q0[0] /* x */ * q0[0] /* x */;
+  const double t9 = q0[1] /* y */ * q0[1] /* y */;
+  const double t10 = t8 + t9;
+  const double t11 = 4.0 * t10;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t12 = t5 / t11;
-  const double t13 = t1 * t12;
-  const double t14 = t0 * t12;
-  const double t15 = -t13;
-  const double t16 = -t14;
-  const double t17 = t8 / t11;
-  const double t18 = t1 * t17;
-  const double t19 = -t18;
-  const double t20 = t0 * t17;
-  const double t21 = -t20;
+  const double t12 = t3 / t11;
+  const double t13 = q0[0] /* x */ * t12;
+  const double t14 = 2.0 * t13;
+  const double t15 = q0[1] /* y */ * t12;
+  const double t16 = 2.0 * t15;
+  const double t17 = -t14;
+  const double t18 = -t16;
+  const double t19 = t7 / t11;
+  const double t20 = q0[0] /* x */ * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = -t21;
+  const double t23 = q0[1] /* y */ * t19;
+  const double t24 = 2.0 * t23;
+  const double t25 = -t24;
   /* dq */
-  out[0] = t15;
-  out[1] = t16;
+  out[0] = t17;
+  out[1] = t18;
   /* dp */
-  out[2] = t19;
-  out[3] = t21;
+  out[2] = t22;
+  out[3] = t25;
   /* pivot */
   out[4] = t11;
   /* adiag */
@@ -313,54 +314,48 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
       /* affine derivative entries, projected in closed form */
       const double t0 = 2.0 * x->q[1] /* y */;
       const double t1 = 2.0 * x->q[0] /* x */;
-      const double t2 = gm0 * 0.5;
-      const double t3 = h * t2;
-      const double t4 = 2.0 * t3;
-      const double t5 = t1 + t4;
-      const double t6 = 0.5 * gm1;
-      const double t7 = h * t6;
-      const double t8 = 2.0 * t7;
-      const double t9 = t0 + t8;
+      const double t2 = h * gm0;
+      const double t3 = t1 + t2;
+      const double t4 = h * gm1;
+      const double t5 = t0 + t4;
       /* multiplier system A lambda = r */
-      const double t10 = t5 * t5;
-      const double t11 = t9 * t9;
-      const double t12 = t10 + t11;
-      const double t13 = 0.5 * t12;
-      const double t14 = h * t13;
-      const double t15 = 0.5 * t9;
-      const double t16 = h * t15;
-      const double t17 = t5 * x->p[0] /* p_x */;
-      const double t18 = t9 * x->p[1] /* p_y */;
-      const double t19 = t17 + t18;
-      const double t20 = t19 - t16;
-      const double t21 = t20 + g0[0];
-      const double t22 = t21 / t14;
+      const double t6 = t3 * t3;
+      const double t7 = t5 * t5;
+      const double t8 = t6 + t7;
+      const double t9 = h * t8;
+      const double t10 = 0.5 * t9;
+      const double t11 = h * t5;
+      const double t12 = 0.5 * t11;
+      const double t13 = t3 * x->p[0] /* p_x */;
+      const double t14 = t5 * x->p[1] /* p_y */;
+      const double t15 = t13 + t14;
+      const double t16 = t15 - t12;
+      const double t17 = t16 + g0[0];
+      const double t18 = t17 / t10;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t23 = t5 * t22;
-      const double t24 = t9 * t22;
-      const double t25 = 1.0 + t24;
-      const double t26 = 0.5 * t23;
-      const double t27 = h * t26;
-      const double t28 = x->p[0] /* p_x */ - t27;
-      const double t29 = 0.5 * t25;
-      const double t30 = h * t29;
-      const double t31 = x->p[1] /* p_y */ - t30;
-      const double t32 = h * t23;
-      const double t33 = -t32;
-      const double t34 = h * t25;
-      const double t35 = -t34;
+      const double t19 = t3 * t18;
+      const double t20 = t5 * t18;
+      const double t21 = 1.0 + t20;
+      const double t22 = h * t19;
+      const double t23 = 0.5 * t22;
+      const double t24 = x->p[0] /* p_x */ - t23;
+      const double t25 = h * t21;
+      const double t26 = 0.5 * t25;
+      const double t27 = x->p[1] /* p_y */ - t26;
+      const double t28 = -t22;
+      const double t29 = -t25;
       /* gam */
-      sw0 = t28;
-      sw1 = t31;
+      sw0 = t24;
+      sw1 = t27;
       /* dp */
-      sw2 = t33;
-      sw3 = t35;
+      sw2 = t28;
+      sw3 = t29;
       /* lambda */
-      sw4 = t22;
+      sw4 = t18;
       /* pivot */
-      sw5 = t14;
+      sw5 = t10;
       /* adiag */
-      sw6 = t14;
+      sw6 = t10;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

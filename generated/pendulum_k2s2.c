@@ -92,14 +92,13 @@ static void pendulum_k2s2_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t2 = t1 * p0[0] /* p_x */;
-  const double t3 = t0 * p0[1] /* p_y */;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = 2.0 * t2;
   /* hidden */
-  out[0] = t4;
+  out[0] = t3;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -108,21 +107,19 @@ static void pendulum_k2s2_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
   /* consistent initial multiplier */
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = 2.0 * p0[0] /* p_x */;
-  const double t6 = 2.0 * p0[1] /* p_y */;
-  const double t7 = p0[0] /* p_x */ * t5;
-  const double t8 = p0[1] /* p_y */ * t6;
-  const double t9 = t7 + t8;
-  const double t10 = t9 - t0;
-  const double t11 = t10 / t4;
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
+  const double t5 = t3 + t4;
+  const double t6 = 4.0 * t5;
+  const double t7 = t2 - q0[1] /* y */;
+  const double t8 = 2.0 * t7;
+  const double t9 = t8 / t6;
   /* lambda */
-  out[0] = t11;
+  out[0] = t9;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -132,35 +129,39 @@ static void pendulum_k2s2_consistent(const double *q0, const double *p0, const d
     const double *g0, const pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = q0[0] /* x */ * q0[0] /* x */;
-  const double t3 = q0[1] /* y */ * q0[1] /* y */;
-  const double t4 = t2 + t3;
-  const double t5 = t4 - 1.0;
-  const double t6 = t1 * p0[0] /* p_x */;
-  const double t7 = t0 * p0[1] /* p_y */;
-  const double t8 = t6 + t7;
-  const double t9 = t1 * t1;
-  const double t10 = t0 * t0;
-  const double t11 = t9 + t10;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = t2 - 1.0;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = q0[0] /* x */ * q0[0] /* x */;
+  const double t9 = q0[1] /* y */ * q0[1] /* y */;
+  const double t10 = t8 + t9;
+  const double t11 = 4.0 * t10;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t12 = t5 / t11;
-  const double t13 = t1 * t12;
-  const double t14 = t0 * t12;
-  const double t15 = -t13;
-  const double t16 = -t14;
-  const double t17 = t8 / t11;
-  const double t18 = t1 * t17;
-  const double t19 = -t18;
-  const double t20 = t0 * t17;
-  const double t21 = -t20;
+  const double t12 = t3 / t11;
+  const double t13 = q0[0] /* x */ * t12;
+  const double t14 = 2.0 * t13;
+  const double t15 = q0[1] /* y */ * t12;
+  const double t16 = 2.0 * t15;
+  const double t17 = -t14;
+  const double t18 = -t16;
+  const double t19 = t7 / t11;
+  const double t20 = q0[0] /* x */ * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = -t21;
+  const double t23 = q0[1] /* y */ * t19;
+  const double t24 = 2.0 * t23;
+  const double t25 = -t24;
   /* dq */
-  out[0] = t15;
-  out[1] = t16;
+  out[0] = t17;
+  out[1] = t18;
   /* dp */
-  out[2] = t19;
-  out[3] = t21;
+  out[2] = t22;
+  out[3] = t25;
   /* pivot */
   out[4] = t11;
   /* adiag */
@@ -368,85 +369,82 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
   for (it = 1; it <= pendulum_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
-      const double t0 = 2.0 * x->q[1] /* y */;
-      const double t1 = 2.0 * x->q[0] /* x */;
-      const double t2 = gm0 * 0.5;
-      const double t3 = gm2 * 0.28867513459481292;
-      const double t4 = t2 - t3;
-      const double t5 = h * t4;
-      const double t6 = 2.0 * t5;
-      const double t7 = t1 + t6;
-      const double t8 = gm0 * 0.28867513459481292;
-      const double t9 = h * t8;
-      const double t10 = 2.0 * t9;
-      const double t11 = 0.5 * gm1;
-      const double t12 = 0.28867513459481292 * gm3;
-      const double t13 = t11 - t12;
-      const double t14 = h * t13;
-      const double t15 = 2.0 * t14;
-      const double t16 = t0 + t15;
-      const double t17 = 0.28867513459481292 * gm1;
-      const double t18 = h * t17;
-      const double t19 = 2.0 * t18;
+      const double t0 = gm0 * 0.5;
+      const double t1 = gm2 * 0.28867513459481292;
+      const double t2 = t0 - t1;
+      const double t3 = h * t2;
+      const double t4 = x->q[0] /* x */ + t3;
+      const double t5 = gm0 * 0.28867513459481292;
+      const double t6 = h * t5;
+      const double t7 = 0.5 * gm1;
+      const double t8 = 0.28867513459481292 * gm3;
+      const double t9 = t7 - t8;
+      const double t10 = h * t9;
+      const double t11 = x->q[1] /* y */ + t10;
+      const double t12 = 0.28867513459481292 * gm1;
+      const double t13 = h * t12;
       /* multiplier system A lambda = r */
-      const double t20 = t7 * t7;
-      const double t21 = t16 * t16;
-      const double t22 = t20 + t21;
-      const double t23 = 0.5 * t22;
-      const double t24 = h * t23;
-      const double t25 = 0.5 * t16;
-      const double t26 = t18 * 0.57735026918962584;
-      const double t27 = t25 + t26;
-      const double t28 = h * t27;
-      const double t29 = t7 * x->p[0] /* p_x */;
-      const double t30 = t16 * x->p[1] /* p_y */;
-      const double t31 = t29 + t30;
-      const double t32 = t31 - t28;
-      const double t33 = t32 + g0[0];
-      const double t34 = t33 / t24;
+      const double t14 = t4 * t4;
+      const double t15 = t11 * t11;
+      const double t16 = t14 + t15;
+      const double t17 = h * t16;
+      const double t18 = 2.0 * t17;
+      const double t19 = t13 * 0.57735026918962584;
+      const double t20 = t11 + t19;
+      const double t21 = h * t20;
+      const double t22 = t4 * x->p[0] /* p_x */;
+      const double t23 = t11 * x->p[1] /* p_y */;
+      const double t24 = t22 + t23;
+      const double t25 = 2.0 * t24;
+      const double t26 = t25 - t21;
+      const double t27 = t26 + g0[0];
+      const double t28 = t27 / t18;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t35 = t7 * t34;
-      const double t36 = t16 * t34;
-      const double t37 = 1.0 + t36;
-      const double t38 = t10 * t34;
-      const double t39 = t19 * t34;
-      const double t40 = 0.5 * t35;
-      const double t41 = 0.28867513459481292 * t38;
-      const double t42 = t40 - t41;
-      const double t43 = h * t42;
-      const double t44 = x->p[0] /* p_x */ - t43;
-      const double t45 = 0.5 * t37;
-      const double t46 = 0.28867513459481292 * t39;
-      const double t47 = t45 - t46;
-      const double t48 = h * t47;
-      const double t49 = x->p[1] /* p_y */ - t48;
-      const double t50 = 0.28867513459481292 * t35;
-      const double t51 = h * t50;
-      const double t52 = -t51;
-      const double t53 = 0.28867513459481292 * t37;
-      const double t54 = h * t53;
-      const double t55 = -t54;
-      const double t56 = h * t35;
-      const double t57 = -t56;
-      const double t58 = h * t37;
-      const double t59 = -t58;
+      const double t29 = t4 * t28;
+      const double t30 = t11 * t28;
+      const double t31 = 2.0 * t30;
+      const double t32 = 1.0 + t31;
+      const double t33 = t6 * t28;
+      const double t34 = 2.0 * t33;
+      const double t35 = t13 * t28;
+      const double t36 = 2.0 * t35;
+      const double t37 = 0.57735026918962584 * t33;
+      const double t38 = t29 - t37;
+      const double t39 = h * t38;
+      const double t40 = x->p[0] /* p_x */ - t39;
+      const double t41 = 0.5 * t32;
+      const double t42 = 0.57735026918962584 * t35;
+      const double t43 = t41 - t42;
+      const double t44 = h * t43;
+      const double t45 = x->p[1] /* p_y */ - t44;
+      const double t46 = 0.57735026918962584 * t29;
+      const double t47 = h * t46;
+      const double t48 = -t47;
+      const double t49 = 0.28867513459481292 * t32;
+      const double t50 = h * t49;
+      const double t51 = -t50;
+      const double t52 = h * t29;
+      const double t53 = 2.0 * t52;
+      const double t54 = -t53;
+      const double t55 = h * t32;
+      const double t56 = -t55;
       /* gam */
-      sw0 = t44;
-      sw1 = t49;
-      sw2 = t52;
-      sw3 = t55;
+      sw0 = t40;
+      sw1 = t45;
+      sw2 = t48;
+      sw3 = t51;
       /* dp */
-      sw4 = t57;
-      sw5 = t59;
+      sw4 = t54;
+      sw5 = t56;
       /* lambda */
-      sw6 = t34;
+      sw6 = t28;
       /* pivot */
-      sw7 = t24;
+      sw7 = t18;
       /* adiag */
-      sw8 = t24;
+      sw8 = t18;
       /* theta */
-      sw9 = t38;
-      sw10 = t39;
+      sw9 = t34;
+      sw10 = t36;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

@@ -93,14 +93,13 @@ static void pendulum_k3s3_hidden_kernel(const double *q0, const double *p0, cons
     const double *g0, const pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
   /* hidden constraints */
-  const double t2 = t1 * p0[0] /* p_x */;
-  const double t3 = t0 * p0[1] /* p_y */;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = 2.0 * t2;
   /* hidden */
-  out[0] = t4;
+  out[0] = t3;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -109,21 +108,19 @@ static void pendulum_k3s3_lambda0(const double *q0, const double *p0, const doub
     const double *g0, const pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
+  const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
   /* consistent initial multiplier */
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = 2.0 * p0[0] /* p_x */;
-  const double t6 = 2.0 * p0[1] /* p_y */;
-  const double t7 = p0[0] /* p_x */ * t5;
-  const double t8 = p0[1] /* p_y */ * t6;
-  const double t9 = t7 + t8;
-  const double t10 = t9 - t0;
-  const double t11 = t10 / t4;
+  const double t3 = q0[0] /* x */ * q0[0] /* x */;
+  const double t4 = q0[1] /* y */ * q0[1] /* y */;
+  const double t5 = t3 + t4;
+  const double t6 = 4.0 * t5;
+  const double t7 = t2 - q0[1] /* y */;
+  const double t8 = 2.0 * t7;
+  const double t9 = t8 / t6;
   /* lambda */
-  out[0] = t11;
+  out[0] = t9;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -133,35 +130,39 @@ static void pendulum_k3s3_consistent(const double *q0, const double *p0, const d
     const double *g0, const pendulum_k3s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = q0[0] /* x */ * q0[0] /* x */;
-  const double t3 = q0[1] /* y */ * q0[1] /* y */;
-  const double t4 = t2 + t3;
-  const double t5 = t4 - 1.0;
-  const double t6 = t1 * p0[0] /* p_x */;
-  const double t7 = t0 * p0[1] /* p_y */;
-  const double t8 = t6 + t7;
-  const double t9 = t1 * t1;
-  const double t10 = t0 * t0;
-  const double t11 = t9 + t10;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = t2 - 1.0;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = q0[0] /* x */ * q0[0] /* x */;
+  const double t9 = q0[1] /* y */ * q0[1] /* y */;
+  const double t10 = t8 + t9;
+  const double t11 = 4.0 * t10;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t12 = t5 / t11;
-  const double t13 = t1 * t12;
-  const double t14 = t0 * t12;
-  const double t15 = -t13;
-  const double t16 = -t14;
-  const double t17 = t8 / t11;
-  const double t18 = t1 * t17;
-  const double t19 = -t18;
-  const double t20 = t0 * t17;
-  const double t21 = -t20;
+  const double t12 = t3 / t11;
+  const double t13 = q0[0] /* x */ * t12;
+  const double t14 = 2.0 * t13;
+  const double t15 = q0[1] /* y */ * t12;
+  const double t16 = 2.0 * t15;
+  const double t17 = -t14;
+  const double t18 = -t16;
+  const double t19 = t7 / t11;
+  const double t20 = q0[0] /* x */ * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = -t21;
+  const double t23 = q0[1] /* y */ * t19;
+  const double t24 = 2.0 * t23;
+  const double t25 = -t24;
   /* dq */
-  out[0] = t15;
-  out[1] = t16;
+  out[0] = t17;
+  out[1] = t18;
   /* dp */
-  out[2] = t19;
-  out[3] = t21;
+  out[2] = t22;
+  out[3] = t25;
   /* pivot */
   out[4] = t11;
   /* adiag */
@@ -387,111 +388,108 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
   for (it = 1; it <= pendulum_k3s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
-      const double t0 = 2.0 * x->q[1] /* y */;
-      const double t1 = 2.0 * x->q[0] /* x */;
-      const double t2 = gm0 * 0.5;
-      const double t3 = gm2 * 0.28867513459481292;
-      const double t4 = t2 - t3;
-      const double t5 = h * t4;
-      const double t6 = 2.0 * t5;
-      const double t7 = t1 + t6;
-      const double t8 = gm0 * 0.28867513459481292;
-      const double t9 = gm4 * 0.12909944487358055;
-      const double t10 = t8 - t9;
-      const double t11 = h * t10;
-      const double t12 = 2.0 * t11;
-      const double t13 = gm2 * 0.12909944487358055;
+      const double t0 = gm0 * 0.5;
+      const double t1 = gm2 * 0.28867513459481292;
+      const double t2 = t0 - t1;
+      const double t3 = h * t2;
+      const double t4 = x->q[0] /* x */ + t3;
+      const double t5 = gm0 * 0.28867513459481292;
+      const double t6 = gm4 * 0.12909944487358055;
+      const double t7 = t5 - t6;
+      const double t8 = h * t7;
+      const double t9 = gm2 * 0.12909944487358055;
+      const double t10 = h * t9;
+      const double t11 = 0.5 * gm1;
+      const double t12 = 0.28867513459481292 * gm3;
+      const double t13 = t11 - t12;
       const double t14 = h * t13;
-      const double t15 = 2.0 * t14;
-      const double t16 = 0.5 * gm1;
-      const double t17 = 0.28867513459481292 * gm3;
+      const double t15 = x->q[1] /* y */ + t14;
+      const double t16 = 0.28867513459481292 * gm1;
+      const double t17 = 0.12909944487358055 * gm5;
       const double t18 = t16 - t17;
       const double t19 = h * t18;
-      const double t20 = 2.0 * t19;
-      const double t21 = t0 + t20;
-      const double t22 = 0.28867513459481292 * gm1;
-      const double t23 = 0.12909944487358055 * gm5;
-      const double t24 = t22 - t23;
+      const double t20 = 0.12909944487358055 * gm3;
+      const double t21 = h * t20;
+      /* multiplier system A lambda = r */
+      const double t22 = t4 * t4;
+      const double t23 = t15 * t15;
+      const double t24 = t22 + t23;
       const double t25 = h * t24;
       const double t26 = 2.0 * t25;
-      const double t27 = 0.12909944487358055 * gm3;
-      const double t28 = h * t27;
-      const double t29 = 2.0 * t28;
-      /* multiplier system A lambda = r */
-      const double t30 = t7 * t7;
-      const double t31 = t21 * t21;
+      const double t27 = t19 * 0.57735026918962584;
+      const double t28 = t15 + t27;
+      const double t29 = h * t28;
+      const double t30 = t4 * x->p[0] /* p_x */;
+      const double t31 = t15 * x->p[1] /* p_y */;
       const double t32 = t30 + t31;
-      const double t33 = 0.5 * t32;
-      const double t34 = h * t33;
-      const double t35 = 0.5 * t21;
-      const double t36 = t25 * 0.57735026918962584;
-      const double t37 = t35 + t36;
-      const double t38 = h * t37;
-      const double t39 = t7 * x->p[0] /* p_x */;
-      const double t40 = t21 * x->p[1] /* p_y */;
-      const double t41 = t39 + t40;
-      const double t42 = t41 - t38;
-      const double t43 = t42 + g0[0];
-      const double t44 = t43 / t34;
+      const double t33 = 2.0 * t32;
+      const double t34 = t33 - t29;
+      const double t35 = t34 + g0[0];
+      const double t36 = t35 / t26;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t45 = t7 * t44;
-      const double t46 = t21 * t44;
-      const double t47 = 1.0 + t46;
-      const double t48 = t12 * t44;
-      const double t49 = t26 * t44;
-      const double t50 = t15 * t44;
-      const double t51 = t29 * t44;
-      const double t52 = 0.5 * t45;
-      const double t53 = 0.28867513459481292 * t48;
-      const double t54 = t52 - t53;
-      const double t55 = h * t54;
-      const double t56 = x->p[0] /* p_x */ - t55;
-      const double t57 = 0.5 * t47;
-      const double t58 = 0.28867513459481292 * t49;
-      const double t59 = t57 - t58;
-      const double t60 = h * t59;
-      const double t61 = x->p[1] /* p_y */ - t60;
-      const double t62 = 0.28867513459481292 * t45;
-      const double t63 = 0.12909944487358055 * t50;
-      const double t64 = t62 - t63;
-      const double t65 = h * t64;
-      const double t66 = -t65;
-      const double t67 = 0.28867513459481292 * t47;
-      const double t68 = 0.12909944487358055 * t51;
-      const double t69 = t67 - t68;
-      const double t70 = h * t69;
-      const double t71 = -t70;
-      const double t72 = 0.12909944487358055 * t48;
-      const double t73 = h * t72;
-      const double t74 = -t73;
-      const double t75 = 0.12909944487358055 * t49;
-      const double t76 = h * t75;
-      const double t77 = -t76;
-      const double t78 = h * t45;
-      const double t79 = -t78;
-      const double t80 = h * t47;
-      const double t81 = -t80;
+      const double t37 = t4 * t36;
+      const double t38 = t15 * t36;
+      const double t39 = 2.0 * t38;
+      const double t40 = 1.0 + t39;
+      const double t41 = t8 * t36;
+      const double t42 = 2.0 * t41;
+      const double t43 = t19 * t36;
+      const double t44 = 2.0 * t43;
+      const double t45 = t10 * t36;
+      const double t46 = 2.0 * t45;
+      const double t47 = t21 * t36;
+      const double t48 = 2.0 * t47;
+      const double t49 = 0.57735026918962584 * t41;
+      const double t50 = t37 - t49;
+      const double t51 = h * t50;
+      const double t52 = x->p[0] /* p_x */ - t51;
+      const double t53 = 0.5 * t40;
+      const double t54 = 0.57735026918962584 * t43;
+      const double t55 = t53 - t54;
+      const double t56 = h * t55;
+      const double t57 = x->p[1] /* p_y */ - t56;
+      const double t58 = 0.57735026918962584 * t37;
+      const double t59 = t45 * 0.2581988897471611;
+      const double t60 = t58 - t59;
+      const double t61 = h * t60;
+      const double t62 = -t61;
+      const double t63 = 0.28867513459481292 * t40;
+      const double t64 = t47 * 0.2581988897471611;
+      const double t65 = t63 - t64;
+      const double t66 = h * t65;
+      const double t67 = -t66;
+      const double t68 = t41 * 0.2581988897471611;
+      const double t69 = h * t68;
+      const double t70 = -t69;
+      const double t71 = t43 * 0.2581988897471611;
+      const double t72 = h * t71;
+      const double t73 = -t72;
+      const double t74 = h * t37;
+      const double t75 = 2.0 * t74;
+      const double t76 = -t75;
+      const double t77 = h * t40;
+      const double t78 = -t77;
       /* gam */
-      sw0 = t56;
-      sw1 = t61;
-      sw2 = t66;
-      sw3 = t71;
-      sw4 = t74;
-      sw5 = t77;
+      sw0 = t52;
+      sw1 = t57;
+      sw2 = t62;
+      sw3 = t67;
+      sw4 = t70;
+      sw5 = t73;
       /* dp */
-      sw6 = t79;
-      sw7 = t81;
+      sw6 = t76;
+      sw7 = t78;
       /* lambda */
-      sw8 = t44;
+      sw8 = t36;
       /* pivot */
-      sw9 = t34;
+      sw9 = t26;
       /* adiag */
-      sw10 = t34;
+      sw10 = t26;
       /* theta */
-      sw11 = t48;
-      sw12 = t49;
-      sw13 = t50;
-      sw14 = t51;
+      sw11 = t42;
+      sw12 = t44;
+      sw13 = t46;
+      sw14 = t48;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

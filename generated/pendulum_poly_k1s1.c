@@ -54,27 +54,26 @@ static void pendulum_poly_k1s1_factor(const double *q0, const double *p0, const 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* affine derivative entries, projected in closed form */
-  const double t0 = gam[0] * 0.5;
-  const double t1 = h * t0;
-  const double t2 = 0.5 * gam[1];
-  const double t3 = h * t2;
+  const double t0 = h * gam[0];
+  const double t1 = 0.5 * t0;
+  const double t2 = h * gam[1];
+  const double t3 = 0.5 * t2;
   /* grad g at the stages */
   const double t4 = q0[0] /* x */ + t1;
   const double t5 = q0[1] /* y */ + t3;
-  const double t6 = 2.0 * t5;
-  const double t7 = 2.0 * t4;
   /* the multiplier matrix A, factored once per step */
-  const double t8 = t4 * t7;
-  const double t9 = t5 * t6;
-  const double t10 = t8 + t9;
-  const double t11 = h * t10;
-  const double t12 = 1.0 / t11;
+  const double t6 = t4 * t4;
+  const double t7 = t5 * t5;
+  const double t8 = t6 + t7;
+  const double t9 = h * t8;
+  const double t10 = 2.0 * t9;
+  const double t11 = 1.0 / t10;
   /* lu */
-  out[0] = t12;
+  out[0] = t11;
   /* pivot */
-  out[1] = t11;
+  out[1] = t10;
   /* adiag */
-  out[2] = t11;
+  out[2] = t10;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -121,13 +120,12 @@ static void pendulum_poly_k1s1_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = t1 * p0[0] /* p_x */;
-  const double t3 = t0 * p0[1] /* p_y */;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = 2.0 * t2;
   /* hidden */
-  out[0] = t4;
+  out[0] = t3;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -136,21 +134,19 @@ static void pendulum_poly_k1s1_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = 4.0 * t2;
+  const double t4 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t5 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
   /* consistent initial multiplier */
-  const double t5 = 2.0 * p0[0] /* p_x */;
-  const double t6 = 2.0 * p0[1] /* p_y */;
-  const double t7 = p0[0] /* p_x */ * t5;
-  const double t8 = p0[1] /* p_y */ * t6;
-  const double t9 = t7 + t8;
-  const double t10 = t9 - t0;
-  const double t11 = t10 / t4;
+  const double t7 = t6 - q0[1] /* y */;
+  const double t8 = 2.0 * t7;
+  const double t9 = t8 / t3;
   /* lambda */
-  out[0] = t11;
+  out[0] = t9;
 }
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
@@ -160,37 +156,39 @@ static void pendulum_poly_k1s1_project_p1(const double *q0, const double *p0, co
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = t1 * p0[0] /* p_x */;
-  const double t6 = t0 * p0[1] /* p_y */;
-  const double t7 = t5 + t6;
-  const double t8 = t7 / t4;
-  const double t9 = t1 * t8;
-  const double t10 = -t9;
-  const double t11 = t0 * t8;
-  const double t12 = -t11;
-  const double t13 = p0[0] /* p_x */ - t9;
-  const double t14 = p0[1] /* p_y */ - t11;
-  const double t15 = t13 * t13;
-  const double t16 = t14 * t14;
-  const double t17 = t15 + t16;
-  const double t18 = 0.5 * t17;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = 4.0 * t2;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t7 / t3;
+  const double t9 = q0[0] /* x */ * t8;
+  const double t10 = 2.0 * t9;
+  const double t11 = -t10;
+  const double t12 = q0[1] /* y */ * t8;
+  const double t13 = 2.0 * t12;
+  const double t14 = -t13;
+  const double t15 = p0[0] /* p_x */ - t10;
+  const double t16 = p0[1] /* p_y */ - t13;
+  const double t17 = t15 * t15;
+  const double t18 = t16 * t16;
+  const double t19 = t17 + t18;
+  const double t20 = 0.5 * t19;
   /* dp */
-  out[0] = t10;
-  out[1] = t12;
+  out[0] = t11;
+  out[1] = t14;
   /* kin */
-  out[2] = t18;
+  out[2] = t20;
   /* U */
   out[3] = q0[1] /* y */;
   /* pivot */
-  out[4] = t4;
+  out[4] = t3;
   /* adiag */
-  out[5] = t4;
+  out[5] = t3;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -200,39 +198,43 @@ static void pendulum_poly_k1s1_consistent(const double *q0, const double *p0, co
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k1s1_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = t1 * p0[0] /* p_x */;
-  const double t6 = t0 * p0[1] /* p_y */;
-  const double t7 = t5 + t6;
-  const double t8 = t7 / t4;
-  const double t9 = t1 * t8;
-  const double t10 = -t9;
-  const double t11 = t0 * t8;
-  const double t12 = -t11;
-  const double t13 = q0[0] /* x */ * q0[0] /* x */;
-  const double t14 = q0[1] /* y */ * q0[1] /* y */;
-  const double t15 = t13 + t14;
-  const double t16 = t15 - 1.0;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = 4.0 * t2;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t7 / t3;
+  const double t9 = q0[0] /* x */ * t8;
+  const double t10 = 2.0 * t9;
+  const double t11 = -t10;
+  const double t12 = q0[1] /* y */ * t8;
+  const double t13 = 2.0 * t12;
+  const double t14 = -t13;
+  const double t15 = q0[0] /* x */ * q0[0] /* x */;
+  const double t16 = q0[1] /* y */ * q0[1] /* y */;
+  const double t17 = t15 + t16;
+  const double t18 = t17 - 1.0;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t17 = t16 / t4;
-  const double t18 = t1 * t17;
-  const double t19 = t0 * t17;
-  const double t20 = -t18;
-  const double t21 = -t19;
+  const double t19 = t18 / t3;
+  const double t20 = q0[0] /* x */ * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = q0[1] /* y */ * t19;
+  const double t23 = 2.0 * t22;
+  const double t24 = -t21;
+  const double t25 = -t23;
   /* dq */
-  out[0] = t20;
-  out[1] = t21;
+  out[0] = t24;
+  out[1] = t25;
   /* dp */
-  out[2] = t10;
-  out[3] = t12;
+  out[2] = t11;
+  out[3] = t14;
   /* pivot */
-  out[4] = t4;
+  out[4] = t3;
   /* adiag */
-  out[5] = t4;
+  out[5] = t3;
 }
 
 void pendulum_poly_k1s1_params_default(pendulum_poly_k1s1_params *prm)
@@ -452,53 +454,51 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
     }
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
-      const double t0 = gm0 * 0.5;
-      const double t1 = h * t0;
-      const double t2 = 0.5 * gm1;
-      const double t3 = h * t2;
+      const double t0 = h * gm0;
+      const double t1 = 0.5 * t0;
+      const double t2 = h * gm1;
+      const double t3 = 0.5 * t2;
       /* grad g at the stages */
       const double t4 = x->q[0] /* x */ + t1;
       const double t5 = x->q[1] /* y */ + t3;
-      const double t6 = 2.0 * t5;
-      const double t7 = 2.0 * t4;
       /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-      const double t8 = t7 * lm0;
-      const double t9 = t6 * lm0;
-      const double t10 = 1.0 + t9;
-      const double t11 = 0.5 * t8;
-      const double t12 = h * t11;
-      const double t13 = x->p[0] /* p_x */ - t12;
-      const double t14 = 0.5 * t10;
-      const double t15 = h * t14;
-      const double t16 = x->p[1] /* p_y */ - t15;
-      const double t17 = t7 * t13;
-      const double t18 = t6 * t16;
-      const double t19 = t17 + t18;
-      const double t20 = t19 + g0[0];
-      const double t21 = fa[0] * t20;
-      const double t22 = lm0 + t21;
+      const double t6 = t4 * lm0;
+      const double t7 = t5 * lm0;
+      const double t8 = 2.0 * t7;
+      const double t9 = 1.0 + t8;
+      const double t10 = h * t6;
+      const double t11 = x->p[0] /* p_x */ - t10;
+      const double t12 = h * t9;
+      const double t13 = 0.5 * t12;
+      const double t14 = x->p[1] /* p_y */ - t13;
+      const double t15 = t4 * t11;
+      const double t16 = t5 * t14;
+      const double t17 = t15 + t16;
+      const double t18 = 2.0 * t17;
+      const double t19 = t18 + g0[0];
+      const double t20 = fa[0] * t19;
+      const double t21 = lm0 + t20;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-      const double t23 = t7 * t22;
-      const double t24 = t6 * t22;
+      const double t22 = t4 * t21;
+      const double t23 = t5 * t21;
+      const double t24 = 2.0 * t23;
       const double t25 = 1.0 + t24;
-      const double t26 = 0.5 * t23;
-      const double t27 = h * t26;
-      const double t28 = x->p[0] /* p_x */ - t27;
-      const double t29 = 0.5 * t25;
-      const double t30 = h * t29;
-      const double t31 = x->p[1] /* p_y */ - t30;
-      const double t32 = h * t23;
-      const double t33 = -t32;
-      const double t34 = h * t25;
-      const double t35 = -t34;
+      const double t26 = h * t22;
+      const double t27 = x->p[0] /* p_x */ - t26;
+      const double t28 = h * t25;
+      const double t29 = 0.5 * t28;
+      const double t30 = x->p[1] /* p_y */ - t29;
+      const double t31 = 2.0 * t26;
+      const double t32 = -t31;
+      const double t33 = -t28;
       /* gam */
-      sw0 = t28;
-      sw1 = t31;
+      sw0 = t27;
+      sw1 = t30;
       /* dp */
-      sw2 = t33;
-      sw3 = t35;
+      sw2 = t32;
+      sw3 = t33;
       /* lam */
-      sw4 = t22;
+      sw4 = t21;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

@@ -196,13 +196,12 @@ static void pendulum_poly_k2s2_hidden_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = t1 * p0[0] /* p_x */;
-  const double t3 = t0 * p0[1] /* p_y */;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t1 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t2 = t0 + t1;
+  const double t3 = 2.0 * t2;
   /* hidden */
-  out[0] = t4;
+  out[0] = t3;
 }
 
 /* out = the multiplier consistent with (q0, p0):
@@ -211,21 +210,19 @@ static void pendulum_poly_k2s2_lambda0(const double *q0, const double *p0, const
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = 4.0 * t2;
+  const double t4 = p0[0] /* p_x */ * p0[0] /* p_x */;
+  const double t5 = p0[1] /* p_y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
   /* consistent initial multiplier */
-  const double t5 = 2.0 * p0[0] /* p_x */;
-  const double t6 = 2.0 * p0[1] /* p_y */;
-  const double t7 = p0[0] /* p_x */ * t5;
-  const double t8 = p0[1] /* p_y */ * t6;
-  const double t9 = t7 + t8;
-  const double t10 = t9 - t0;
-  const double t11 = t10 / t4;
+  const double t7 = t6 - q0[1] /* y */;
+  const double t8 = 2.0 * t7;
+  const double t9 = t8 / t3;
   /* lambda */
-  out[0] = t11;
+  out[0] = t9;
 }
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
@@ -235,37 +232,39 @@ static void pendulum_poly_k2s2_project_p1(const double *q0, const double *p0, co
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = t1 * p0[0] /* p_x */;
-  const double t6 = t0 * p0[1] /* p_y */;
-  const double t7 = t5 + t6;
-  const double t8 = t7 / t4;
-  const double t9 = t1 * t8;
-  const double t10 = -t9;
-  const double t11 = t0 * t8;
-  const double t12 = -t11;
-  const double t13 = p0[0] /* p_x */ - t9;
-  const double t14 = p0[1] /* p_y */ - t11;
-  const double t15 = t13 * t13;
-  const double t16 = t14 * t14;
-  const double t17 = t15 + t16;
-  const double t18 = 0.5 * t17;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = 4.0 * t2;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t7 / t3;
+  const double t9 = q0[0] /* x */ * t8;
+  const double t10 = 2.0 * t9;
+  const double t11 = -t10;
+  const double t12 = q0[1] /* y */ * t8;
+  const double t13 = 2.0 * t12;
+  const double t14 = -t13;
+  const double t15 = p0[0] /* p_x */ - t10;
+  const double t16 = p0[1] /* p_y */ - t13;
+  const double t17 = t15 * t15;
+  const double t18 = t16 * t16;
+  const double t19 = t17 + t18;
+  const double t20 = 0.5 * t19;
   /* dp */
-  out[0] = t10;
-  out[1] = t12;
+  out[0] = t11;
+  out[1] = t14;
   /* kin */
-  out[2] = t18;
+  out[2] = t20;
   /* U */
   out[3] = q0[1] /* y */;
   /* pivot */
-  out[4] = t4;
+  out[4] = t3;
   /* adiag */
-  out[5] = t4;
+  out[5] = t3;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -275,39 +274,43 @@ static void pendulum_poly_k2s2_consistent(const double *q0, const double *p0, co
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  const double t0 = 2.0 * q0[1] /* y */;
-  const double t1 = 2.0 * q0[0] /* x */;
-  const double t2 = t1 * t1;
-  const double t3 = t0 * t0;
-  const double t4 = t2 + t3;
-  const double t5 = t1 * p0[0] /* p_x */;
-  const double t6 = t0 * p0[1] /* p_y */;
-  const double t7 = t5 + t6;
-  const double t8 = t7 / t4;
-  const double t9 = t1 * t8;
-  const double t10 = -t9;
-  const double t11 = t0 * t8;
-  const double t12 = -t11;
-  const double t13 = q0[0] /* x */ * q0[0] /* x */;
-  const double t14 = q0[1] /* y */ * q0[1] /* y */;
-  const double t15 = t13 + t14;
-  const double t16 = t15 - 1.0;
+  const double t0 = q0[0] /* x */ * q0[0] /* x */;
+  const double t1 = q0[1] /* y */ * q0[1] /* y */;
+  const double t2 = t0 + t1;
+  const double t3 = 4.0 * t2;
+  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t6 = t4 + t5;
+  const double t7 = 2.0 * t6;
+  const double t8 = t7 / t3;
+  const double t9 = q0[0] /* x */ * t8;
+  const double t10 = 2.0 * t9;
+  const double t11 = -t10;
+  const double t12 = q0[1] /* y */ * t8;
+  const double t13 = 2.0 * t12;
+  const double t14 = -t13;
+  const double t15 = q0[0] /* x */ * q0[0] /* x */;
+  const double t16 = q0[1] /* y */ * q0[1] /* y */;
+  const double t17 = t15 + t16;
+  const double t18 = t17 - 1.0;
   /* Newton step of q onto g = 0 (smallest in the M norm), p projected onto the hidden constraint */
-  const double t17 = t16 / t4;
-  const double t18 = t1 * t17;
-  const double t19 = t0 * t17;
-  const double t20 = -t18;
-  const double t21 = -t19;
+  const double t19 = t18 / t3;
+  const double t20 = q0[0] /* x */ * t19;
+  const double t21 = 2.0 * t20;
+  const double t22 = q0[1] /* y */ * t19;
+  const double t23 = 2.0 * t22;
+  const double t24 = -t21;
+  const double t25 = -t23;
   /* dq */
-  out[0] = t20;
-  out[1] = t21;
+  out[0] = t24;
+  out[1] = t25;
   /* dp */
-  out[2] = t10;
-  out[3] = t12;
+  out[2] = t11;
+  out[3] = t14;
   /* pivot */
-  out[4] = t4;
+  out[4] = t3;
   /* adiag */
-  out[5] = t4;
+  out[5] = t3;
 }
 
 void pendulum_poly_k2s2_params_default(pendulum_poly_k2s2_params *prm)
@@ -572,139 +575,125 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = x->q[1] /* y */ + t8;
-      const double t10 = 2.0 * t9;
-      const double t11 = 2.0 * t4;
-      const double t12 = gm0 * 0.78867513459481287;
-      const double t13 = t1 + t12;
-      const double t14 = h * t13;
-      const double t15 = x->q[0] /* x */ + t14;
-      const double t16 = gm1 * 0.78867513459481287;
-      const double t17 = t6 + t16;
-      const double t18 = h * t17;
-      const double t19 = x->q[1] /* y */ + t18;
-      const double t20 = 2.0 * t19;
-      const double t21 = 2.0 * t15;
+      const double t10 = gm0 * 0.78867513459481287;
+      const double t11 = t1 + t10;
+      const double t12 = h * t11;
+      const double t13 = x->q[0] /* x */ + t12;
+      const double t14 = gm1 * 0.78867513459481287;
+      const double t15 = t6 + t14;
+      const double t16 = h * t15;
+      const double t17 = x->q[1] /* y */ + t16;
       /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-      const double t22 = (-0.99999999999999989) * lm1;
-      const double t23 = lm0 + t22;
-      const double t24 = t11 * t23;
-      const double t25 = t10 * t23;
-      const double t26 = 0.5 * t24;
-      const double t27 = 0.5 * t25;
-      const double t28 = 1.0 + t27;
-      const double t29 = (-0.49999999999999994) * t24;
-      const double t30 = (-0.49999999999999994) * t25;
-      const double t31 = 0.99999999999999989 * lm1;
-      const double t32 = lm0 + t31;
-      const double t33 = t21 * t32;
-      const double t34 = t20 * t32;
-      const double t35 = 0.5 * t33;
-      const double t36 = t26 + t35;
-      const double t37 = 0.5 * t34;
-      const double t38 = t28 + t37;
-      const double t39 = 0.49999999999999994 * t33;
-      const double t40 = t29 + t39;
-      const double t41 = 0.49999999999999994 * t34;
-      const double t42 = t30 + t41;
-      const double t43 = 0.5 * t36;
-      const double t44 = 0.28867513459481292 * t40;
-      const double t45 = t43 - t44;
+      const double t18 = (-0.99999999999999989) * lm1;
+      const double t19 = lm0 + t18;
+      const double t20 = t4 * t19;
+      const double t21 = t9 * t19;
+      const double t22 = 1.0 + t21;
+      const double t23 = (-0.99999999999999989) * t20;
+      const double t24 = (-0.99999999999999989) * t21;
+      const double t25 = 0.99999999999999989 * lm1;
+      const double t26 = lm0 + t25;
+      const double t27 = t13 * t26;
+      const double t28 = t17 * t26;
+      const double t29 = t20 + t27;
+      const double t30 = t22 + t28;
+      const double t31 = 0.99999999999999989 * t27;
+      const double t32 = t23 + t31;
+      const double t33 = 0.99999999999999989 * t28;
+      const double t34 = t24 + t33;
+      const double t35 = 0.5 * t29;
+      const double t36 = 0.28867513459481292 * t32;
+      const double t37 = t35 - t36;
+      const double t38 = h * t37;
+      const double t39 = x->p[0] /* p_x */ - t38;
+      const double t40 = 0.5 * t30;
+      const double t41 = 0.28867513459481292 * t34;
+      const double t42 = t40 - t41;
+      const double t43 = h * t42;
+      const double t44 = x->p[1] /* p_y */ - t43;
+      const double t45 = 0.28867513459481292 * t29;
       const double t46 = h * t45;
-      const double t47 = x->p[0] /* p_x */ - t46;
-      const double t48 = 0.5 * t38;
-      const double t49 = 0.28867513459481292 * t42;
-      const double t50 = t48 - t49;
-      const double t51 = h * t50;
-      const double t52 = x->p[1] /* p_y */ - t51;
-      const double t53 = 0.28867513459481292 * t36;
-      const double t54 = h * t53;
-      const double t55 = 0.28867513459481292 * t38;
-      const double t56 = h * t55;
-      const double t57 = (-0.99999999999999989) * t54;
-      const double t58 = t47 - t57;
-      const double t59 = (-0.99999999999999989) * t56;
-      const double t60 = t52 - t59;
-      const double t61 = t11 * t58;
-      const double t62 = t10 * t60;
+      const double t47 = 0.28867513459481292 * t30;
+      const double t48 = h * t47;
+      const double t49 = (-0.99999999999999989) * t46;
+      const double t50 = t39 - t49;
+      const double t51 = (-0.99999999999999989) * t48;
+      const double t52 = t44 - t51;
+      const double t53 = t4 * t50;
+      const double t54 = t9 * t52;
+      const double t55 = t53 + t54;
+      const double t56 = (-0.99999999999999989) * t55;
+      const double t57 = 0.99999999999999989 * t46;
+      const double t58 = t39 - t57;
+      const double t59 = 0.99999999999999989 * t48;
+      const double t60 = t44 - t59;
+      const double t61 = t13 * t58;
+      const double t62 = t17 * t60;
       const double t63 = t61 + t62;
-      const double t64 = 0.5 * t63;
-      const double t65 = (-0.49999999999999994) * t63;
-      const double t66 = 0.99999999999999989 * t54;
-      const double t67 = t47 - t66;
-      const double t68 = 0.99999999999999989 * t56;
-      const double t69 = t52 - t68;
-      const double t70 = t21 * t67;
-      const double t71 = t20 * t69;
-      const double t72 = t70 + t71;
-      const double t73 = 0.5 * t72;
-      const double t74 = t64 + t73;
-      const double t75 = 0.49999999999999994 * t72;
-      const double t76 = t65 + t75;
-      const double t77 = t74 + g0[0];
-      const double t78 = fa[2] * t77;
-      const double t79 = t76 - t78;
-      const double t80 = fa[3] * t79;
-      const double t81 = fa[1] * t80;
-      const double t82 = t77 - t81;
-      const double t83 = fa[0] * t82;
-      const double t84 = lm0 + t83;
-      const double t85 = lm1 + t80;
+      const double t64 = t55 + t63;
+      const double t65 = 0.99999999999999989 * t63;
+      const double t66 = t56 + t65;
+      const double t67 = t64 + g0[0];
+      const double t68 = fa[2] * t67;
+      const double t69 = t66 - t68;
+      const double t70 = fa[3] * t69;
+      const double t71 = fa[1] * t70;
+      const double t72 = t67 - t71;
+      const double t73 = fa[0] * t72;
+      const double t74 = lm0 + t73;
+      const double t75 = lm1 + t70;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-      const double t86 = (-0.99999999999999989) * t85;
-      const double t87 = t84 + t86;
-      const double t88 = t11 * t87;
-      const double t89 = t10 * t87;
-      const double t90 = 0.5 * t88;
-      const double t91 = 0.5 * t89;
-      const double t92 = 1.0 + t91;
-      const double t93 = (-0.49999999999999994) * t88;
-      const double t94 = (-0.49999999999999994) * t89;
-      const double t95 = 0.99999999999999989 * t85;
-      const double t96 = t84 + t95;
-      const double t97 = t21 * t96;
-      const double t98 = t20 * t96;
-      const double t99 = 0.5 * t97;
-      const double t100 = t90 + t99;
-      const double t101 = 0.5 * t98;
-      const double t102 = t92 + t101;
-      const double t103 = 0.49999999999999994 * t97;
-      const double t104 = t93 + t103;
-      const double t105 = 0.49999999999999994 * t98;
-      const double t106 = t94 + t105;
-      const double t107 = 0.5 * t100;
-      const double t108 = 0.28867513459481292 * t104;
-      const double t109 = t107 - t108;
-      const double t110 = h * t109;
-      const double t111 = x->p[0] /* p_x */ - t110;
-      const double t112 = 0.5 * t102;
-      const double t113 = 0.28867513459481292 * t106;
-      const double t114 = t112 - t113;
-      const double t115 = h * t114;
-      const double t116 = x->p[1] /* p_y */ - t115;
-      const double t117 = 0.28867513459481292 * t100;
-      const double t118 = h * t117;
-      const double t119 = -t118;
-      const double t120 = 0.28867513459481292 * t102;
-      const double t121 = h * t120;
-      const double t122 = -t121;
-      const double t123 = h * t100;
-      const double t124 = -t123;
-      const double t125 = h * t102;
-      const double t126 = -t125;
+      const double t76 = (-0.99999999999999989) * t75;
+      const double t77 = t74 + t76;
+      const double t78 = t4 * t77;
+      const double t79 = t9 * t77;
+      const double t80 = 1.0 + t79;
+      const double t81 = (-0.99999999999999989) * t78;
+      const double t82 = (-0.99999999999999989) * t79;
+      const double t83 = 0.99999999999999989 * t75;
+      const double t84 = t74 + t83;
+      const double t85 = t13 * t84;
+      const double t86 = t17 * t84;
+      const double t87 = t78 + t85;
+      const double t88 = t80 + t86;
+      const double t89 = 0.99999999999999989 * t85;
+      const double t90 = t81 + t89;
+      const double t91 = 0.99999999999999989 * t86;
+      const double t92 = t82 + t91;
+      const double t93 = 0.5 * t87;
+      const double t94 = 0.28867513459481292 * t90;
+      const double t95 = t93 - t94;
+      const double t96 = h * t95;
+      const double t97 = x->p[0] /* p_x */ - t96;
+      const double t98 = 0.5 * t88;
+      const double t99 = 0.28867513459481292 * t92;
+      const double t100 = t98 - t99;
+      const double t101 = h * t100;
+      const double t102 = x->p[1] /* p_y */ - t101;
+      const double t103 = 0.28867513459481292 * t87;
+      const double t104 = h * t103;
+      const double t105 = -t104;
+      const double t106 = 0.28867513459481292 * t88;
+      const double t107 = h * t106;
+      const double t108 = -t107;
+      const double t109 = h * t87;
+      const double t110 = -t109;
+      const double t111 = h * t88;
+      const double t112 = -t111;
       /* gam */
-      sw0 = t111;
-      sw1 = t116;
-      sw2 = t119;
-      sw3 = t122;
+      sw0 = t97;
+      sw1 = t102;
+      sw2 = t105;
+      sw3 = t108;
       /* dp */
-      sw4 = t124;
-      sw5 = t126;
+      sw4 = t110;
+      sw5 = t112;
       /* lam */
-      sw6 = t84;
-      sw7 = t85;
+      sw6 = t74;
+      sw7 = t75;
       /* theta */
-      sw8 = t104;
-      sw9 = t106;
+      sw8 = t90;
+      sw9 = t92;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

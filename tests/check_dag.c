@@ -269,6 +269,11 @@ static const struct {
     {"x ~ ~", "x"},      {"x 1 ^", "x"},         {"x 0 ^", "1"},         {"x 1 /", "x"},
     {"x sin 0 *", "0"},  {"x y * y x * -", "0"}, {"x y + ~ ~", "y x +"}, {"x y + 1 ^", "x y +"},
     {"x sin 0 ^", "1"},  {"0 x ~ -", "x"},       {"x y ~ +", "x y -"},   {"x p * 1 *", "p x *"},
+    /* powers of two float up products and common ones out of sums (exact) */
+    {"0.5 x * 2 y * *", "x y *"},                {"0.5 x x * * x * 2 y * *", "x x * x * y *"},
+    {"2 x * y *", "2 x y * *"},                  {"2 x * 2 y * +", "2 x y + *"},
+    {"2 x * -2 y * +", "2 x y - *"},             {"4 x * y * 3 *", "12 x y * *"},
+    {"2 x * 4 y * +", "4 y * 2 x * +"},          {"3 x * y *", "3 x * y *"},
 };
 
 START_TEST(test_simplify)
@@ -278,6 +283,38 @@ START_TEST(test_simplify)
     int want = rpn(d, simplify_cases[i].want);
     ck_assert_msg(rpn(d, simplify_cases[i].e) == want, "'%s' does not simplify to '%s'", simplify_cases[i].e,
                   simplify_cases[i].want);
+  }
+}
+END_TEST
+
+/* The power-of-two floating is exact: each expression evaluates bitwise as
+ * the same arithmetic done in C in the written order, at random points. */
+static double pow2_written(const double *v)
+{
+  double r2 = v[0] * v[0] + v[1] * v[1], s = sqrt(r2), inv = 1 / s, k = (0.5 * (inv * inv)) * inv;
+  return 0.3 * ((k * (2 * v[0])) - (2 * v[1]) * (0.5 * v[2])) + 0.25 * ((2 * v[0]) * (2 * v[1]));
+}
+
+START_TEST(test_pow2_exact)
+{
+  Dag *d = dag_new();
+  int e = rpn(d, "0.3 0.5 1 x x * y y * + sqrt / 2 ^ * 1 x x * y y * + sqrt / * 2 x * * 2 y * 0.5 z * * - * "
+                 "0.25 2 x * 2 y * * * +");
+  unsigned char *mark = calloc((size_t)d->n, 1);
+  ck_assert_ptr_nonnull(mark);
+  dag_reach(d, &e, 1, mark);
+  for (int id = 0; id < d->n; id++) { /* the factors 2 and 1/2 all floated away */
+    const Node *n = &d->nodes[id];
+    int two = n->op == OP_MUL && (dag_is_const(d, n->a, 2) || dag_is_const(d, n->a, 0.5) ||
+                                  dag_is_const(d, n->b, 2) || dag_is_const(d, n->b, 0.5));
+    ck_assert_msg(!mark[id] || !two, "node %d is a product by 2 or 1/2", id);
+  }
+  free(mark);
+  srand(SEED);
+  for (int pt = 0; pt < 1000; pt++) {
+    double v[3] = {uniform(-3, 3), uniform(-3, 3), uniform(-3, 3)};
+    double got = dag_eval(d, e, v, NULL), want = pow2_written(v);
+    ck_assert_msg(got == want, "at (%g, %g, %g): %.17g, written order %.17g", v[0], v[1], v[2], got, want);
   }
 }
 END_TEST
@@ -468,6 +505,7 @@ Suite *dag_suite(void)
   tcase_add_test(tc, test_fold_values);
   tcase_add_test(tc, test_fold_nonfinite);
   tcase_add_test(tc, test_simplify);
+  tcase_add_test(tc, test_pow2_exact);
   tcase_add_test(tc, test_degree);
   tcase_add_test(tc, test_auto_k);
   tcase_add_test(tc, test_eval);
