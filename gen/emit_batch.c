@@ -20,13 +20,16 @@ void emit_batch_header(Emitter *e, int lanes) {
   out(e, "#define %s_W %d\n\n", e->P, lanes);
   tmpl(e, "typedef struct {\n  $P_real t[$P_W], q[$P_M * $P_W], p[$P_M * $P_W], lambda[");
   out(e, "%d * %s_W];\n", nu1, e->P);
-  tmpl(e, "  unsigned char idle[$P_W];  /* nonzero: the lane is not stepped (cleared by $P_batch_set) */\n"
-          "  /* private, per lane as in $P_state */\n"
+  tmpl(e, "  /* private, per lane as in $P_state */\n"
           "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n"
           "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W];\n"
           "  $P_real pinc[$P_S * $P_M * $P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
-  tmpl(e, "} $P_batch;\n\n"
+  /* idle last: every array before it starts at a multiple of W reals, so a
+   * vector of one value's lanes never straddles two cache lines more than
+   * the struct's own alignment makes it */
+  tmpl(e, "  unsigned char idle[$P_W];  /* nonzero: the lane is not stepped (cleared by $P_batch_set) */\n"
+          "} $P_batch;\n\n"
           "typedef struct {\n"
           "  int code[$P_W];            /* the lane's return code, as $P_step's ($P_OK for idle lanes) */\n"
           "  int iters[$P_W];           /* fixed-point iterations (0: failed or idle before the first) */\n"
@@ -129,15 +132,20 @@ static void emit_predict_uniform(Emitter *e, int poly) {
           "          if (c != 0)\n            for (l = 0; l < $P_M * $P_W; l++) a[l] += c * x->gam[i * $P_M * $P_W + l];\n"
           "        }\n      }\n");
   if (poly) {
-    tmpl(e, "    if (two0)  /* the two-step start */\n"
-            "      for (j = 0; j < $P_S; j++)\n"
-            "        for (l = 0; l < $P_M * $P_W; l++) {\n"
-            "          $R b = 0;\n");
-    for (int i = 0; i < e->me->s; i++)
-      out(e, "          b += %s_E2[2 * %s_S * j + %d] * x->gam[%d * %s_M * %s_W + l] +\n"
-             "               %s_E2[2 * %s_S * j + %s_S + %d] * x->gam2[%d * %s_M * %s_W + l];\n",
-          e->P, e->P, i, i, e->P, e->P, e->P, e->P, e->P, i, i, e->P, e->P);
-    tmpl(e, "          gam[j * $P_M * $P_W + l] = b;\n        }\n    else if (ref)\n");
+    int s = e->me->s;
+    tmpl(e, "    if (two0) {  /* the two-step start, its coefficients E2 as literals */\n");
+    for (int j = 0; j < s; j++) {
+      tmpl(e, "      for (l = 0; l < $P_M * $P_W; l++) {\n        $R b = 0;\n");
+      for (int i = 0; i < s; i++) {
+        char a[40], b[40];
+        format_real(e, a, sizeof a, e->me->E2[2 * s * j + i]);
+        format_real(e, b, sizeof b, e->me->E2[2 * s * j + s + i]);
+        out(e, "        b += %s * x->gam[%d * %s_M * %s_W + l] + %s * x->gam2[%d * %s_M * %s_W + l];\n", a, i, e->P,
+            e->P, b, i, e->P, e->P);
+      }
+      out(e, "        gam[%d * %s_M * %s_W + l] = b;\n      }\n", j, e->P, e->P);
+    }
+    tmpl(e, "    } else if (ref)\n");
   } else
     tmpl(e, "    if (ref)\n");
   tmpl(e, "      for (l = 0; l < $P_S * $P_M * $P_W; l++) ref[l] = gam[l];\n"

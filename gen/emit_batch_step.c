@@ -37,8 +37,8 @@ static void emit_pivots(Emitter *e) {
 // The iteration's tests after a sweep, as in $P_step, for every lane at
 // once. The sweep read gam (and lam) and wrote sw, whose gamma (and
 // multiplier) the next sweep reads: no copy while every lane iterates on.
-// act[l]: lane l iterates (on return: in the next sweep); a lane that stops
-// gets rc[l] and iters[l] = it, and while other lanes iterate on (a next
+// act[l]: lane l iterates (on return: in the next sweep; 0 or 1); a lane
+// that stops gets rc[l] and iters[l] = it (it counts its sweeps), and while other lanes iterate on (a next
 // sweep follows), sw gets its gamma (and multiplier) back from gam (lam), so
 // the sweeps that the other lanes still need recompute its last sweep
 // bitwise and the last sweep leaves every lane's own results in sw (ngo:
@@ -107,7 +107,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $M code = sing[l] ? $P_ESINGULAR : bad[l] ? $P_ENONFINITE : (okl | noise[l]) ? $P_OK : $P_ENOCONV;\n"
           "    $M as = -(a & stop);  /* all ones or zero: the writes as blends, which vectorise */\n"
           "    stall[l] ^= (stall[l] ^ stl) & -a;\n    rc[l] ^= (rc[l] ^ code) & as;\n"
-          "    iters[l] ^= (iters[l] ^ it) & as;\n    run[l] = a & (stop == 0);\n  }\n"
+          "    iters[l] += a;  /* the sweeps it iterated: it, when it stops now */\n    run[l] = a & (stop == 0);\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n    nrun += (int)run[l];\n    act[l] = run[l];\n  }\n");
   if (poly) /* read from the third sweep on */
     tmpl(e, "  *nfresh = 0;\n  if (nrun > 0 && it >= 2) {\n    $M any = 0;\n"
@@ -232,8 +232,11 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
           "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++) {\n"
           "        $R piv = pr[($[project_p1.pivot]i) * $P_W + l], dia = pr[($[project_p1.adiag]i) * $P_W + l];\n"
           "        sg[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n      }\n"
-          "    for (i = 0; i < $<project_p1>; i++)\n"
-          "      for (l = 0; l < $P_W; l++) nf[l] |= !isfinite(pr[i * $P_W + l]);\n"
+          "    {  /* any value not finite: x - x is 0 for the finite ones, NaN for the others */\n"
+          "      $R z[$P_W];\n      for (l = 0; l < $P_W; l++) z[l] = 0;\n"
+          "      for (i = 0; i < $<project_p1>; i++)\n"
+          "        for (l = 0; l < $P_W; l++) z[l] += pr[i * $P_W + l] - pr[i * $P_W + l];\n"
+          "      for (l = 0; l < $P_W; l++) nf[l] |= z[l] != 0;\n    }\n"
           "    for (l = 0; l < $P_W; l++) {\n"
           "      $R K = pr[($[project_p1.kin]0) * $P_W + l], U1 = pr[($[project_p1.U]0) * $P_W + l], ho = x->H0[l];\n"
           "      $M keep = (x->hprev[l] != 0) & (fabs$f(Hn[l] - ho) <= 64 * $P_TOL * (K + fabs$f(U1)));\n"
@@ -409,7 +412,10 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
   if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
   if (itol_wanted(e) && adaptive) tmpl(e, "    itl[l] = $P_TOL;\n");
-  tmpl(e, "    rc[l] = rc0;\n    idle |= x->idle[l];\n  }\n"
+  /* the idle lanes in a loop of their own: a byte's reduction in the loop above
+   * kept gcc from vectorising its stores */
+  tmpl(e, "    rc[l] = rc0;\n  }\n"
+          "  for (l = 0; l < $P_W; l++) idle |= x->idle[l];\n"
           "  if (idle)  /* mostly none */\n    for (l = 0; l < $P_W; l++) rc[l] = x->idle[l] ? $P_OK : rc0;\n");
   if (poly) tmpl(e, "  for (i = 0; i < $P_S * $P_NU * $P_W; i++) lin[i] = 0;\n");
   tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, in, 0, 0);\n"
@@ -471,15 +477,16 @@ static void emit_step_body(Emitter *e, int adaptive) {
   if (adaptive) tmpl(e, "  if ((tried = $P_batch_last(x, h, tol, sw, go, cl, d1, prm, est, rc)) != 0) goto out;\n");
   emit_commit(e, poly, adaptive);
   if (adaptive) tmpl(e, "out:\n");
-  tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
-          "    nfail += rc[l] != $P_OK;\n"
-          "    if (!st) continue;\n"
-          "    st->code[l] = (int)rc[l];\n    st->iters[l] = (int)iters[l];\n    st->increment[l] = iters[l] ? inc[l] : 0;\n");
-  tmpl(e, adaptive ? "    st->err_est[l] = est[l];\n  }\n"
-                     "  if (st) {\n    st->h = tried ? 0 : h;\n    st->rejected = 0;\n  }\n"
+  tmpl(e, "  for (l = 0; l < $P_W; l++) nfail += rc[l] != $P_OK;\n"
+          "  if (st) {\n"
+          "    for (l = 0; l < $P_W; l++) {\n"
+          "      st->code[l] = (int)rc[l];\n      st->iters[l] = (int)iters[l];\n"
+          "      st->increment[l] = iters[l] ? inc[l] : 0;\n");
+  tmpl(e, adaptive ? "      st->err_est[l] = est[l];\n    }\n"
+                     "    st->h = tried ? 0 : h;\n    st->rejected = 0;\n  }\n"
                      "  return tried ? tried : nfail;\n}\n\n"
-                   : "    st->err_est[l] = 0;\n  }\n"
-                     "  if (st) {\n    st->h = h;\n    st->rejected = 0;\n  }\n"
+                   : "      st->err_est[l] = 0;\n    }\n"
+                     "    st->h = h;\n    st->rejected = 0;\n  }\n"
                      "  return nfail;\n}\n\n");
 }
 
