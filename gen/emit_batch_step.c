@@ -38,8 +38,9 @@ static void emit_pivots(Emitter *e) {
 // once. The sweep read gam (and lam) and wrote sw, whose gamma (and
 // multiplier) the next sweep reads: no copy while every lane iterates on.
 // act[l]: lane l iterates (on return: in the next sweep; 0 or 1); a lane
-// that stops gets rc[l] and iters[l] = it (it counts its sweeps), and while other lanes iterate on (a next
-// sweep follows), sw gets its gamma (and multiplier) back from gam (lam), so
+// that stops gets rc[l] and iters[l] = it (iters counts its sweeps), and
+// while other lanes iterate on (a next sweep follows), sw gets its gamma
+// (and multiplier) back from gam (lam), so
 // the sweeps that the other lanes still need recompute its last sweep
 // bitwise and the last sweep leaves every lane's own results in sw (ngo:
 // the number of lanes that iterate in this step, so that the common case,
