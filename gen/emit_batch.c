@@ -164,7 +164,7 @@ static void emit_predict(Emitter *e) {
   tmpl(e, "$P_LANE_INLINE void $P_batch_predict(const $P_batch *restrict x, $R h, int cold_all, const $R *restrict par,\n"
           "    $R *restrict gam, $R *restrict ref, $M *restrict twos)\n{\n"
           "  $R mp[$P_M * $P_W], r[$P_W], ec[$P_S * $P_S * $P_W];\n  $M cold[$P_W], two[$P_W], same[$P_W];\n"
-          "  int i, j, l, m, d, uni = !cold_all;\n");
+          "  int i, j, l, m, d;\n  $M uni = !cold_all;  /* as wide as the reals: its reduction vectorises */\n");
   emit_predict_uniform(e, poly);
   tmpl(e, "  $(minv_p q0=x->q p0=x->p prm=par out=mp);\n"
           "  for (l = 0; l < $P_W; l++) {\n"

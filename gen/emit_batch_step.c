@@ -62,7 +62,8 @@ static void emit_lane_test(Emitter *e, int poly) {
   tmpl(e, itol_wanted(e) ? ", $R tol, $R *restrict itl)\n{\n" : ")\n{\n");
   if (!poly) tmpl(e, "  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
   tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
-          "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W];\n  int i, l, nrun = 0;\n  (void)lam;\n"
+          "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W], nr = 0;  /* nr: a wide sum */\n"
+          "  int i, l, nrun;\n  (void)lam;\n"
           "  for (l = 0; l < $P_W; l++) bad[l] = sing[l] = 0;\n");
   /* a result is not finite where r - r is not 0 (inf - inf and NaN are NaN): their sum
    * over the results is one test a lane, in a loop the compiler vectorises */
@@ -109,7 +110,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $M as = -(a & stop);  /* all ones or zero: the writes as blends, which vectorise */\n"
           "    stall[l] ^= (stall[l] ^ stl) & -a;\n    rc[l] ^= (rc[l] ^ code) & as;\n"
           "    iters[l] += a;  /* the sweeps it iterated: it, when it stops now */\n    run[l] = a & (stop == 0);\n  }\n"
-          "  for (l = 0; l < $P_W; l++) {\n    nrun += (int)run[l];\n    act[l] = run[l];\n  }\n");
+          "  for (l = 0; l < $P_W; l++) {\n    nr += run[l];\n    act[l] = run[l];\n  }\n  nrun = (int)nr;\n");
   if (poly) /* read from the third sweep on */
     tmpl(e, "  *nfresh = 0;\n  if (nrun > 0 && it >= 2) {\n    $M any = 0;\n"
             "    for (l = 0; l < $P_W; l++) any |= fresh[l] = run[l] & (inc[l] > incp[l] / 8);\n"
@@ -478,7 +479,8 @@ static void emit_step_body(Emitter *e, int adaptive) {
   if (adaptive) tmpl(e, "  if ((tried = $P_batch_last(x, h, tol, sw, go, cl, d1, prm, est, rc)) != 0) goto out;\n");
   emit_commit(e, poly, adaptive);
   if (adaptive) tmpl(e, "out:\n");
-  tmpl(e, "  for (l = 0; l < $P_W; l++) nfail += rc[l] != $P_OK;\n"
+  tmpl(e, "  {\n    $M n = 0;  /* a wide sum: it vectorises */\n"
+          "    for (l = 0; l < $P_W; l++) n += rc[l] != $P_OK;\n    nfail = (int)n;\n  }\n"
           "  if (st) {\n"
           "    for (l = 0; l < $P_W; l++) {\n"
           "      st->code[l] = (int)rc[l];\n      st->iters[l] = (int)iters[l];\n"
