@@ -1,10 +1,15 @@
 /* method.c - the constants of HBVM(k,s) and the choice of k.
  *
- * Gauss-Legendre nodes and weights on [0,1] come from GSL; the shifted,
- * normalised Legendre polynomials P_j(x) = sqrt(2j+1) L_j(2x-1) from their
- * three-term recurrence; the integrals int_0^c P_j from the closed form of
- * METHOD.md. All are computed once here in double precision and printed
- * into the generated code with 17 significant digits. */
+ * Gauss-Legendre nodes and weights on [0,1] come from GSL, refined by
+ * Newton's method in long double; the shifted, normalised Legendre
+ * polynomials P_j(x) = sqrt(2j+1) L_j(2x-1) from their three-term
+ * recurrence; the integrals int_0^c P_j from the closed form of METHOD.md.
+ * The tables of the stages (c, b, P_j(c), b P_j(c), int_0^c P_j) are
+ * computed in long double and rounded once, so that a value that is exact,
+ * such as P_1 = +-1 at the nodes of k = 2, is exact in the table and the
+ * DAG folds its product away (GSL's nodes were up to a few ulps off); the
+ * warm start's tables in double. All are printed into the generated code
+ * with 17 significant digits. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -15,19 +20,42 @@
 
 #define NONPOLY_EXTRA_K 12 /* k = 2s + 12 for a non-polynomial U or g */
 
-// P_j(x) = sqrt(2j+1) L_j(2x-1): orthonormal on [0,1].
-static double legendre_shifted(int j, double x) {
-  double t = 2 * x - 1, lm1 = 1, l = t;
-  if (j == 0) return 1;
-  for (int n = 1; n < j; n++) {
-    double next = ((2 * n + 1) * t * l - n * lm1) / (n + 1);
+// The Legendre polynomial L_j(t) on [-1,1] by its three-term recurrence,
+// in long double; *prev gets L_{j-1}(t) (0 for j = 0).
+static long double legendre_ld(int j, long double t, long double *prev) {
+  long double lm1 = 0, l = 1;
+  for (int n = 0; n < j; n++) {
+    long double next = n == 0 ? t : ((2 * n + 1) * t * l - n * lm1) / (n + 1);
     lm1 = l;
     l = next;
   }
-  return sqrt(2.0 * j + 1) * l;
+  if (prev) *prev = lm1;
+  return l;
 }
 
-static double xi(int j) { return 1 / (2 * sqrt(fabs(4.0 * j * j - 1))); }
+// P_j(x) = sqrt(2j+1) L_j(2x-1): orthonormal on [0,1]; long double in, long
+// double out, so that the tables round the exact values once (P_1 at the
+// nodes of k = 2 is exactly +-1, not 1 - 2^-53).
+static long double pshift_ld(int j, long double x) { return sqrtl(2.0L * j + 1) * legendre_ld(j, 2 * x - 1, NULL); }
+
+static double legendre_shifted(int j, double x) { return (double)pshift_ld(j, x); }
+
+static long double xi_ld(int j) { return 1 / (2 * sqrtl(fabsl(4.0L * j * j - 1))); }
+
+// Gauss node l of k on [0,1] (GSL's, in double) refined by two Newton steps
+// on L_k(2x-1) in long double, and its weight 1 / ((1 - t^2) L_k'(t)^2).
+static long double gauss_node_ld(int k, double c, long double *weight) {
+  long double t = 2.0L * c - 1, prev, l, dl = 1;
+  for (int it = 0; it < 2; it++) {
+    l = legendre_ld(k, t, &prev);
+    dl = k * (t * l - prev) / (t * t - 1);
+    t -= l / dl;
+  }
+  l = legendre_ld(k, t, &prev);
+  dl = k * (t * l - prev) / (t * t - 1);
+  *weight = 1 / ((1 - t * t) * dl * dl);
+  return (1 + t) / 2;
+}
 
 static double binomial(int n, int k) {
   double r = 1;
@@ -158,15 +186,19 @@ Method *method_new(int k, int s, MultFamily family) {
   me->W = arena_alloc((size_t)k * s * sizeof(double));
   me->Phat = arena_alloc((size_t)k * s * sizeof(double));
   me->xi = arena_alloc((size_t)(s + 1) * sizeof(double));
-  for (int j = 0; j <= s; j++) me->xi[j] = xi(j);
-  for (int l = 0; l < k; l++)
+  for (int j = 0; j <= s; j++) me->xi[j] = (double)xi_ld(j);
+  for (int l = 0; l < k; l++) {
+    long double b, c = gauss_node_ld(k, me->c[l], &b); /* each table entry rounded once */
+    me->c[l] = (double)c;
+    me->b[l] = (double)b;
     for (int j = 0; j < s; j++) {
-      double c = me->c[l];
-      me->Phat[l * s + j] = legendre_shifted(j, c);
-      me->W[l * s + j] = me->b[l] * me->Phat[l * s + j];
+      long double P = pshift_ld(j, c);
+      me->Phat[l * s + j] = (double)P;
+      me->W[l * s + j] = (double)(b * P);
       me->Ihat[l * s + j] =
-          j == 0 ? c : xi(j + 1) * legendre_shifted(j + 1, c) - xi(j) * legendre_shifted(j - 1, c);
+          (double)(j == 0 ? c : xi_ld(j + 1) * pshift_ld(j + 1, c) - xi_ld(j) * pshift_ld(j - 1, c));
     }
+  }
   /* Warm start: gamma_j of the next step (size r*h) from this step's
    * polynomial: E_ji(r) = int_0^1 P_j(x) P_i(1 + r x) dx = sum_d E_jid r^d,
    * with E_jid = P_i^(d)(1)/d! * int_0^1 P_j(x) x^d dx (exact by Gauss). */

@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518713   b_1 = 0.5
+ *   c_1 = 0.21132486540518711   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Model defaults for q0 and p0. */
@@ -270,7 +270,7 @@ conical_k2s2_OUT_OF_LINE void conical_k2s2_predict(const conical_k2s2_state *x, 
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < conical_k2s2_M; l++) gam[0 * conical_k2s2_M + l] += x->gam[0 * conical_k2s2_M + l];
     for (l = 0; l < conical_k2s2_M; l++) gam[0 * conical_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * conical_k2s2_M + l];
-    for (l = 0; l < conical_k2s2_M; l++) gam[1 * conical_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * conical_k2s2_M + l];
+    for (l = 0; l < conical_k2s2_M; l++) gam[1 * conical_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * conical_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -278,7 +278,7 @@ conical_k2s2_OUT_OF_LINE void conical_k2s2_predict(const conical_k2s2_state *x, 
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < conical_k2s2_M; l++) gam[0 * conical_k2s2_M + l] += e * x->gam[1 * conical_k2s2_M + l];
-    e = 0.99999999999999967;
+    e = 0.99999999999999989;
     e = e * r;
     for (l = 0; l < conical_k2s2_M; l++) gam[1 * conical_k2s2_M + l] += e * x->gam[1 * conical_k2s2_M + l];
   }
@@ -395,25 +395,25 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
       const double t0 = gm0 * 0.5;
-      const double t1 = gm3 * 0.28867513459481292;
+      const double t1 = gm3 * 0.28867513459481287;
       const double t2 = t0 - t1;
       const double t3 = h * t2;
       const double t4 = x->q[0] /* x */ + t3;
-      const double t5 = gm0 * 0.28867513459481292;
+      const double t5 = gm0 * 0.28867513459481287;
       const double t6 = h * t5;
       const double t7 = 0.5 * gm1;
-      const double t8 = 0.28867513459481292 * gm4;
+      const double t8 = 0.28867513459481287 * gm4;
       const double t9 = t7 - t8;
       const double t10 = h * t9;
       const double t11 = x->q[1] /* y */ + t10;
-      const double t12 = 0.28867513459481292 * gm1;
+      const double t12 = 0.28867513459481287 * gm1;
       const double t13 = h * t12;
       const double t14 = 0.5 * gm2;
-      const double t15 = 0.28867513459481292 * gm5;
+      const double t15 = 0.28867513459481287 * gm5;
       const double t16 = t14 - t15;
       const double t17 = h * t16;
       const double t18 = x->q[2] /* z */ + t17;
-      const double t19 = 0.28867513459481292 * gm2;
+      const double t19 = 0.28867513459481287 * gm2;
       const double t20 = h * t19;
       /* multiplier system A lambda = r */
       const double t21 = t4 * t4;
@@ -423,7 +423,7 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
       const double t25 = t23 + t24;
       const double t26 = h * t25;
       const double t27 = 2.0 * t26;
-      const double t28 = t20 * 0.57735026918962584;
+      const double t28 = t20 * 0.57735026918962573;
       const double t29 = t18 + t28;
       const double t30 = h * t29;
       const double t31 = t4 * x->p[0] /* p_x */;
@@ -447,26 +447,26 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
       const double t48 = 2.0 * t47;
       const double t49 = t20 * t39;
       const double t50 = 2.0 * t49;
-      const double t51 = 0.57735026918962584 * t45;
+      const double t51 = 0.57735026918962573 * t45;
       const double t52 = t40 - t51;
       const double t53 = h * t52;
       const double t54 = x->p[0] /* p_x */ - t53;
-      const double t55 = 0.57735026918962584 * t47;
+      const double t55 = 0.57735026918962573 * t47;
       const double t56 = t41 - t55;
       const double t57 = h * t56;
       const double t58 = x->p[1] /* p_y */ - t57;
       const double t59 = 0.5 * t44;
-      const double t60 = 0.57735026918962584 * t49;
+      const double t60 = 0.57735026918962573 * t49;
       const double t61 = t59 - t60;
       const double t62 = h * t61;
       const double t63 = x->p[2] /* p_z */ - t62;
-      const double t64 = 0.57735026918962584 * t40;
+      const double t64 = 0.57735026918962573 * t40;
       const double t65 = h * t64;
       const double t66 = -t65;
-      const double t67 = 0.57735026918962584 * t41;
+      const double t67 = 0.57735026918962573 * t41;
       const double t68 = h * t67;
       const double t69 = -t68;
-      const double t70 = 0.28867513459481292 * t44;
+      const double t70 = 0.28867513459481287 * t44;
       const double t71 = h * t70;
       const double t72 = -t71;
       const double t73 = h * t40;

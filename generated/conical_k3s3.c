@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
+ *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -274,9 +274,7 @@ conical_k3s3_OUT_OF_LINE void conical_k3s3_predict(const conical_k3s3_state *x, 
     for (l = 0; l < conical_k3s3_M; l++) gam[0 * conical_k3s3_M + l] += 13.416407864998739 * x->gam[2 * conical_k3s3_M + l];
     for (l = 0; l < conical_k3s3_M; l++) gam[1 * conical_k3s3_M + l] += x->gam[1 * conical_k3s3_M + l];
     for (l = 0; l < conical_k3s3_M; l++) gam[1 * conical_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * conical_k3s3_M + l];
-    for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * conical_k3s3_M + l];
-    for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += 3.8459253727671276e-16 * x->gam[1 * conical_k3s3_M + l];
-    for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += 1.0000000000000016 * x->gam[2 * conical_k3s3_M + l];
+    for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += 0.99999999999999989 * x->gam[2 * conical_k3s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -295,13 +293,9 @@ conical_k3s3_OUT_OF_LINE void conical_k3s3_predict(const conical_k3s3_state *x, 
     e = e * r + 3.8729833462074175;
     e = e * r;
     for (l = 0; l < conical_k3s3_M; l++) gam[1 * conical_k3s3_M + l] += e * x->gam[2 * conical_k3s3_M + l];
-    for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * conical_k3s3_M + l];
-    e = 1.9229626863835638e-16;
-    e = e * r + 1.9229626863835638e-16;
-    for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += e * x->gam[1 * conical_k3s3_M + l];
-    e = 1.0000000000000007;
-    e = e * r + 7.4476024597418194e-16;
-    e = e * r + 2.4825341532472731e-16;
+    e = 0.99999999999999989;
+    e = e * r;
+    e = e * r;
     for (l = 0; l < conical_k3s3_M; l++) gam[2 * conical_k3s3_M + l] += e * x->gam[2 * conical_k3s3_M + l];
   }
 }
@@ -415,37 +409,37 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
       const double t0 = gm0 * 0.5;
-      const double t1 = gm3 * 0.28867513459481292;
+      const double t1 = gm3 * 0.28867513459481287;
       const double t2 = t0 - t1;
       const double t3 = h * t2;
       const double t4 = x->q[0] /* x */ + t3;
-      const double t5 = gm0 * 0.28867513459481292;
-      const double t6 = gm6 * 0.12909944487358055;
+      const double t5 = gm0 * 0.28867513459481287;
+      const double t6 = gm6 * 0.12909944487358058;
       const double t7 = t5 - t6;
       const double t8 = h * t7;
-      const double t9 = gm3 * 0.12909944487358055;
+      const double t9 = gm3 * 0.12909944487358058;
       const double t10 = h * t9;
       const double t11 = 0.5 * gm1;
-      const double t12 = 0.28867513459481292 * gm4;
+      const double t12 = 0.28867513459481287 * gm4;
       const double t13 = t11 - t12;
       const double t14 = h * t13;
       const double t15 = x->q[1] /* y */ + t14;
-      const double t16 = 0.28867513459481292 * gm1;
-      const double t17 = 0.12909944487358055 * gm7;
+      const double t16 = 0.28867513459481287 * gm1;
+      const double t17 = 0.12909944487358058 * gm7;
       const double t18 = t16 - t17;
       const double t19 = h * t18;
-      const double t20 = 0.12909944487358055 * gm4;
+      const double t20 = 0.12909944487358058 * gm4;
       const double t21 = h * t20;
       const double t22 = 0.5 * gm2;
-      const double t23 = 0.28867513459481292 * gm5;
+      const double t23 = 0.28867513459481287 * gm5;
       const double t24 = t22 - t23;
       const double t25 = h * t24;
       const double t26 = x->q[2] /* z */ + t25;
-      const double t27 = 0.28867513459481292 * gm2;
-      const double t28 = 0.12909944487358055 * gm8;
+      const double t27 = 0.28867513459481287 * gm2;
+      const double t28 = 0.12909944487358058 * gm8;
       const double t29 = t27 - t28;
       const double t30 = h * t29;
-      const double t31 = 0.12909944487358055 * gm5;
+      const double t31 = 0.12909944487358058 * gm5;
       const double t32 = h * t31;
       /* multiplier system A lambda = r */
       const double t33 = t4 * t4;
@@ -455,7 +449,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       const double t37 = t35 + t36;
       const double t38 = h * t37;
       const double t39 = 2.0 * t38;
-      const double t40 = t30 * 0.57735026918962584;
+      const double t40 = t30 * 0.57735026918962573;
       const double t41 = t26 + t40;
       const double t42 = h * t41;
       const double t43 = t4 * x->p[0] /* p_x */;
@@ -485,41 +479,41 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
       const double t66 = 2.0 * t65;
       const double t67 = t32 * t51;
       const double t68 = 2.0 * t67;
-      const double t69 = 0.57735026918962584 * t57;
+      const double t69 = 0.57735026918962573 * t57;
       const double t70 = t52 - t69;
       const double t71 = h * t70;
       const double t72 = x->p[0] /* p_x */ - t71;
-      const double t73 = 0.57735026918962584 * t59;
+      const double t73 = 0.57735026918962573 * t59;
       const double t74 = t53 - t73;
       const double t75 = h * t74;
       const double t76 = x->p[1] /* p_y */ - t75;
       const double t77 = 0.5 * t56;
-      const double t78 = 0.57735026918962584 * t61;
+      const double t78 = 0.57735026918962573 * t61;
       const double t79 = t77 - t78;
       const double t80 = h * t79;
       const double t81 = x->p[2] /* p_z */ - t80;
-      const double t82 = 0.57735026918962584 * t52;
-      const double t83 = t63 * 0.2581988897471611;
+      const double t82 = 0.57735026918962573 * t52;
+      const double t83 = t63 * 0.25819888974716115;
       const double t84 = t82 - t83;
       const double t85 = h * t84;
       const double t86 = -t85;
-      const double t87 = 0.57735026918962584 * t53;
-      const double t88 = t65 * 0.2581988897471611;
+      const double t87 = 0.57735026918962573 * t53;
+      const double t88 = t65 * 0.25819888974716115;
       const double t89 = t87 - t88;
       const double t90 = h * t89;
       const double t91 = -t90;
-      const double t92 = 0.28867513459481292 * t56;
-      const double t93 = t67 * 0.2581988897471611;
+      const double t92 = 0.28867513459481287 * t56;
+      const double t93 = t67 * 0.25819888974716115;
       const double t94 = t92 - t93;
       const double t95 = h * t94;
       const double t96 = -t95;
-      const double t97 = t57 * 0.2581988897471611;
+      const double t97 = t57 * 0.25819888974716115;
       const double t98 = h * t97;
       const double t99 = -t98;
-      const double t100 = t59 * 0.2581988897471611;
+      const double t100 = t59 * 0.25819888974716115;
       const double t101 = h * t100;
       const double t102 = -t101;
-      const double t103 = t61 * 0.2581988897471611;
+      const double t103 = t61 * 0.25819888974716115;
       const double t104 = h * t103;
       const double t105 = -t104;
       const double t106 = h * t52;

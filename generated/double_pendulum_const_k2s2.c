@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518713   b_1 = 0.5
+ *   c_1 = 0.21132486540518711   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Model defaults for q0 and p0. */
@@ -376,7 +376,7 @@ double_pendulum_const_k2s2_OUT_OF_LINE void double_pendulum_const_k2s2_predict(c
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[0 * double_pendulum_const_k2s2_M + l] += x->gam[0 * double_pendulum_const_k2s2_M + l];
     for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[0 * double_pendulum_const_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * double_pendulum_const_k2s2_M + l];
-    for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[1 * double_pendulum_const_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * double_pendulum_const_k2s2_M + l];
+    for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[1 * double_pendulum_const_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * double_pendulum_const_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -384,7 +384,7 @@ double_pendulum_const_k2s2_OUT_OF_LINE void double_pendulum_const_k2s2_predict(c
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[0 * double_pendulum_const_k2s2_M + l] += e * x->gam[1 * double_pendulum_const_k2s2_M + l];
-    e = 0.99999999999999967;
+    e = 0.99999999999999989;
     e = e * r;
     for (l = 0; l < double_pendulum_const_k2s2_M; l++) gam[1 * double_pendulum_const_k2s2_M + l] += e * x->gam[1 * double_pendulum_const_k2s2_M + l];
   }
@@ -504,35 +504,35 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       const double t0 = x->q[2] /* x2 */ - x->q[0] /* x1 */;
       const double t1 = x->q[3] /* y2 */ - x->q[1] /* y1 */;
       const double t2 = 0.5 * gm0;
-      const double t3 = gm4 * 0.28867513459481292;
+      const double t3 = gm4 * 0.28867513459481287;
       const double t4 = t2 - t3;
       const double t5 = h * t4;
       const double t6 = x->q[0] /* x1 */ + t5;
-      const double t7 = gm0 * 0.28867513459481292;
+      const double t7 = gm0 * 0.28867513459481287;
       const double t8 = h * t7;
       const double t9 = 0.5 * gm1;
-      const double t10 = 0.28867513459481292 * gm5;
+      const double t10 = 0.28867513459481287 * gm5;
       const double t11 = t9 - t10;
       const double t12 = h * t11;
       const double t13 = x->q[1] /* y1 */ + t12;
-      const double t14 = 0.28867513459481292 * gm1;
+      const double t14 = 0.28867513459481287 * gm1;
       const double t15 = h * t14;
       const double t16 = t5 - t0;
       const double t17 = 0.5 * gm2;
-      const double t18 = 0.28867513459481292 * gm6;
+      const double t18 = 0.28867513459481287 * gm6;
       const double t19 = t17 - t18;
       const double t20 = h * t19;
       const double t21 = t16 - t20;
-      const double t22 = 0.28867513459481292 * gm2;
+      const double t22 = 0.28867513459481287 * gm2;
       const double t23 = h * t22;
       const double t24 = t8 - t23;
       const double t25 = t12 - t1;
       const double t26 = 0.5 * gm3;
-      const double t27 = 0.28867513459481292 * gm7;
+      const double t27 = 0.28867513459481287 * gm7;
       const double t28 = t26 - t27;
       const double t29 = h * t28;
       const double t30 = t25 - t29;
-      const double t31 = 0.28867513459481292 * gm3;
+      const double t31 = 0.28867513459481287 * gm3;
       const double t32 = h * t31;
       const double t33 = t15 - t32;
       const double t34 = t0 - t5;
@@ -556,10 +556,10 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       const double t51 = t15 * t30;
       const double t52 = t50 + t51;
       const double t53 = t52 - t49;
-      const double t54 = t53 * 1.1547005383792517;
+      const double t54 = t53 * 1.1547005383792515;
       const double t55 = t46 + t54;
       const double t56 = h * t55;
-      const double t57 = t15 * 0.57735026918962584;
+      const double t57 = t15 * 0.57735026918962573;
       const double t58 = t13 + t57;
       const double t59 = h * t58;
       const double t60 = t6 * x->p[0] /* p_x1 */;
@@ -569,7 +569,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       const double t64 = t63 - t59;
       const double t65 = t64 + g0[0];
       const double t66 = t49 - t52;
-      const double t67 = 1.1547005383792517 * t66;
+      const double t67 = 1.1547005383792515 * t66;
       const double t68 = t46 + t67;
       const double t69 = h * t68;
       const double t70 = t21 * t21;
@@ -626,34 +626,34 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
       const double t120 = 2.0 * t119;
       const double t121 = (-2.0) * t115;
       const double t122 = (-2.0) * t118;
-      const double t123 = 0.57735026918962584 * t116;
+      const double t123 = 0.57735026918962573 * t116;
       const double t124 = t105 - t123;
       const double t125 = h * t124;
       const double t126 = x->p[0] /* p_x1 */ - t125;
       const double t127 = 0.5 * t108;
-      const double t128 = 0.57735026918962584 * t119;
+      const double t128 = 0.57735026918962573 * t119;
       const double t129 = t127 - t128;
       const double t130 = h * t129;
       const double t131 = x->p[1] /* p_y1 */ - t130;
-      const double t132 = t115 * (-0.57735026918962584);
+      const double t132 = t115 * (-0.57735026918962573);
       const double t133 = t109 - t132;
       const double t134 = h * t133;
       const double t135 = x->p[2] /* p_x2 */ - t134;
       const double t136 = 0.5 * t112;
-      const double t137 = t118 * (-0.57735026918962584);
+      const double t137 = t118 * (-0.57735026918962573);
       const double t138 = t136 - t137;
       const double t139 = h * t138;
       const double t140 = x->p[3] /* p_y2 */ - t139;
-      const double t141 = 0.57735026918962584 * t105;
+      const double t141 = 0.57735026918962573 * t105;
       const double t142 = h * t141;
       const double t143 = -t142;
-      const double t144 = 0.28867513459481292 * t108;
+      const double t144 = 0.28867513459481287 * t108;
       const double t145 = h * t144;
       const double t146 = -t145;
-      const double t147 = 0.57735026918962584 * t109;
+      const double t147 = 0.57735026918962573 * t109;
       const double t148 = h * t147;
       const double t149 = -t148;
-      const double t150 = 0.28867513459481292 * t112;
+      const double t150 = 0.28867513459481287 * t112;
       const double t151 = h * t150;
       const double t152 = -t151;
       const double t153 = h * t105;

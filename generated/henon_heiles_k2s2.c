@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518713   b_1 = 0.5
+ *   c_1 = 0.21132486540518711   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Model defaults for q0 and p0. */
@@ -152,7 +152,7 @@ henon_heiles_k2s2_OUT_OF_LINE void henon_heiles_k2s2_predict(const henon_heiles_
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[0 * henon_heiles_k2s2_M + l] += x->gam[0 * henon_heiles_k2s2_M + l];
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[0 * henon_heiles_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * henon_heiles_k2s2_M + l];
-    for (l = 0; l < henon_heiles_k2s2_M; l++) gam[1 * henon_heiles_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * henon_heiles_k2s2_M + l];
+    for (l = 0; l < henon_heiles_k2s2_M; l++) gam[1 * henon_heiles_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * henon_heiles_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -160,7 +160,7 @@ henon_heiles_k2s2_OUT_OF_LINE void henon_heiles_k2s2_predict(const henon_heiles_
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[0 * henon_heiles_k2s2_M + l] += e * x->gam[1 * henon_heiles_k2s2_M + l];
-    e = 0.99999999999999967;
+    e = 0.99999999999999989;
     e = e * r;
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[1 * henon_heiles_k2s2_M + l] += e * x->gam[1 * henon_heiles_k2s2_M + l];
   }
@@ -258,13 +258,13 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
   for (it = 1; it <= henon_heiles_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.21132486540518713;
-      const double t1 = gm2 * (-0.28867513459481292);
+      const double t0 = gm0 * 0.21132486540518711;
+      const double t1 = gm2 * (-0.28867513459481287);
       const double t2 = t0 + t1;
       const double t3 = h * t2;
       const double t4 = t3 + x->q[0] /* x */;
-      const double t5 = 0.21132486540518713 * gm1;
-      const double t6 = (-0.28867513459481292) * gm3;
+      const double t5 = 0.21132486540518711 * gm1;
+      const double t6 = (-0.28867513459481287) * gm3;
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = t8 + x->q[1] /* y */;
@@ -276,64 +276,61 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
       const double t15 = 0.5 + t9;
       const double t16 = t9 + t14;
       const double t17 = t4 * t15;
-      const double t18 = t17 * (-0.99999999999999989);
-      const double t19 = t16 * (-0.49999999999999994);
       /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t20 = gm0 * 0.78867513459481287;
-      const double t21 = t1 + t20;
-      const double t22 = h * t21;
-      const double t23 = x->q[0] /* x */ + t22;
-      const double t24 = gm1 * 0.78867513459481287;
-      const double t25 = t6 + t24;
-      const double t26 = h * t25;
-      const double t27 = x->q[1] /* y */ + t26;
-      const double t28 = t23 * t23;
-      const double t29 = t27 * t27;
-      const double t30 = 3.0 * t29;
-      const double t31 = (-0.33333333333333331) * t30;
-      const double t32 = t28 + t31;
-      const double t33 = 0.5 + t27;
-      const double t34 = t27 + t32;
-      const double t35 = t23 * t33;
-      const double t36 = t17 + t35;
-      const double t37 = t16 + t34;
-      const double t38 = t35 * 0.99999999999999989;
-      const double t39 = t18 + t38;
-      const double t40 = t34 * 0.49999999999999994;
-      const double t41 = t19 + t40;
+      const double t18 = gm0 * 0.78867513459481287;
+      const double t19 = t1 + t18;
+      const double t20 = h * t19;
+      const double t21 = x->q[0] /* x */ + t20;
+      const double t22 = gm1 * 0.78867513459481287;
+      const double t23 = t6 + t22;
+      const double t24 = h * t23;
+      const double t25 = x->q[1] /* y */ + t24;
+      const double t26 = t21 * t21;
+      const double t27 = t25 * t25;
+      const double t28 = 3.0 * t27;
+      const double t29 = (-0.33333333333333331) * t28;
+      const double t30 = t26 + t29;
+      const double t31 = 0.5 + t25;
+      const double t32 = t25 + t30;
+      const double t33 = t21 * t31;
+      const double t34 = t17 + t33;
+      const double t35 = t16 + t32;
+      const double t36 = t33 - t17;
+      const double t37 = t16 - t32;
+      const double t38 = (-0.5) * t37;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t42 = 0.5 * t36;
-      const double t43 = t39 * 0.28867513459481292;
-      const double t44 = t42 - t43;
-      const double t45 = h * t44;
-      const double t46 = x->p[0] /* p_x */ - t45;
-      const double t47 = t37 * 0.25;
-      const double t48 = t41 * 0.28867513459481292;
-      const double t49 = t47 - t48;
+      const double t39 = 0.5 * t34;
+      const double t40 = t36 * 0.28867513459481287;
+      const double t41 = t39 - t40;
+      const double t42 = h * t41;
+      const double t43 = x->p[0] /* p_x */ - t42;
+      const double t44 = t35 * 0.25;
+      const double t45 = t37 * (-0.14433756729740643);
+      const double t46 = t44 - t45;
+      const double t47 = h * t46;
+      const double t48 = x->p[1] /* p_y */ - t47;
+      const double t49 = t34 * 0.28867513459481287;
       const double t50 = h * t49;
-      const double t51 = x->p[1] /* p_y */ - t50;
-      const double t52 = t36 * 0.28867513459481292;
+      const double t51 = -t50;
+      const double t52 = t35 * 0.14433756729740643;
       const double t53 = h * t52;
       const double t54 = -t53;
-      const double t55 = t37 * 0.14433756729740646;
-      const double t56 = h * t55;
-      const double t57 = -t56;
-      const double t58 = h * t36;
+      const double t55 = h * t34;
+      const double t56 = -t55;
+      const double t57 = h * t35;
+      const double t58 = 0.5 * t57;
       const double t59 = -t58;
-      const double t60 = h * t37;
-      const double t61 = 0.5 * t60;
-      const double t62 = -t61;
       /* gam */
-      sw0 = t46;
-      sw1 = t51;
-      sw2 = t54;
-      sw3 = t57;
+      sw0 = t43;
+      sw1 = t48;
+      sw2 = t51;
+      sw3 = t54;
       /* dp */
-      sw4 = t59;
-      sw5 = t62;
+      sw4 = t56;
+      sw5 = t59;
       /* theta */
-      sw6 = t39;
-      sw7 = t41;
+      sw6 = t36;
+      sw7 = t38;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
+ *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -239,13 +239,13 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
   for (it = 1; it <= henon_heiles_k3s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.1127016653792583;
-      const double t1 = gm2 * (-0.17320508075688779);
+      const double t0 = gm0 * 0.11270166537925831;
+      const double t1 = gm2 * (-0.17320508075688773);
       const double t2 = t0 + t1;
       const double t3 = h * t2;
       const double t4 = t3 + x->q[0] /* x */;
-      const double t5 = 0.1127016653792583 * gm1;
-      const double t6 = (-0.17320508075688779) * gm3;
+      const double t5 = 0.11270166537925831 * gm1;
+      const double t6 = (-0.17320508075688773) * gm3;
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = t8 + x->q[1] /* y */;
@@ -263,12 +263,12 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       const double t21 = t16 * (-0.37267799624996495);
       /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
       const double t22 = 0.5 * gm0;
-      const double t23 = gm2 * (-0.43301270189221935);
+      const double t23 = gm2 * (-0.4330127018922193);
       const double t24 = t22 + t23;
       const double t25 = h * t24;
       const double t26 = x->q[0] /* x */ + t25;
       const double t27 = 0.5 * gm1;
-      const double t28 = gm3 * (-0.43301270189221935);
+      const double t28 = gm3 * (-0.4330127018922193);
       const double t29 = t27 + t28;
       const double t30 = h * t29;
       const double t31 = x->q[1] /* y */ + t30;
@@ -311,19 +311,19 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
       const double t67 = t21 + t66;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
       const double t68 = 0.5 * t61;
-      const double t69 = t65 * 0.28867513459481292;
+      const double t69 = t65 * 0.28867513459481287;
       const double t70 = t68 - t69;
       const double t71 = h * t70;
       const double t72 = x->p[0] /* p_x */ - t71;
       const double t73 = 0.5 * t63;
-      const double t74 = t67 * 0.28867513459481292;
+      const double t74 = t67 * 0.28867513459481287;
       const double t75 = t73 - t74;
       const double t76 = h * t75;
       const double t77 = x->p[1] /* p_y */ - t76;
-      const double t78 = t61 * 0.28867513459481292;
+      const double t78 = t61 * 0.28867513459481287;
       const double t79 = h * t78;
       const double t80 = -t79;
-      const double t81 = t63 * 0.28867513459481292;
+      const double t81 = t63 * 0.28867513459481287;
       const double t82 = h * t81;
       const double t83 = -t82;
       const double t84 = h * t61;

@@ -41,20 +41,20 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 16 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.0052995325041750307   b_1 = 0.013576229705877048
- *   c_2 = 0.0277124884633837   b_2 = 0.031126761969323947
+ *   c_1 = 0.0052995325041750333   b_1 = 0.013576229705877048
+ *   c_2 = 0.02771248846338371   b_2 = 0.031126761969323947
  *   c_3 = 0.067184398806084122   b_3 = 0.047579255841246393
- *   c_4 = 0.1222977958224985   b_4 = 0.062314485627766938
+ *   c_4 = 0.12229779582249849   b_4 = 0.062314485627766938
  *   c_5 = 0.19106187779867811   b_5 = 0.074797994408288368
  *   c_6 = 0.27099161117138632   b_6 = 0.084578259697501268
  *   c_7 = 0.35919822461037054   b_7 = 0.091301707522461792
  *   c_8 = 0.45249374508118129   b_8 = 0.094725305227534251
  *   c_9 = 0.54750625491881877   b_9 = 0.094725305227534251
  *   c_10 = 0.64080177538962946   b_10 = 0.091301707522461792
- *   c_11 = 0.72900838882861363   b_11 = 0.084578259697501268
+ *   c_11 = 0.72900838882861374   b_11 = 0.084578259697501268
  *   c_12 = 0.80893812220132189   b_12 = 0.074797994408288368
  *   c_13 = 0.87770220417750155   b_13 = 0.062314485627766938
- *   c_14 = 0.93281560119391593   b_14 = 0.047579255841246393
+ *   c_14 = 0.93281560119391582   b_14 = 0.047579255841246393
  *   c_15 = 0.9722875115366163   b_15 = 0.031126761969323947
  *   c_16 = 0.99470046749582497   b_16 = 0.013576229705877048
  */
@@ -162,8 +162,8 @@ kepler_k16s2_OUT_OF_LINE void kepler_k16s2_predict(const kepler_k16s2_state *x, 
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += 1.0000000000000002 * x->gam[0 * kepler_k16s2_M + l];
     for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += 3.4641016151377544 * x->gam[1 * kepler_k16s2_M + l];
-    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += (-2.0816681711721685e-17) * x->gam[0 * kepler_k16s2_M + l];
-    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += 0.99999999999999989 * x->gam[1 * kepler_k16s2_M + l];
+    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += (-1.3877787807814457e-17) * x->gam[0 * kepler_k16s2_M + l];
+    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += x->gam[1 * kepler_k16s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -171,9 +171,9 @@ kepler_k16s2_OUT_OF_LINE void kepler_k16s2_predict(const kepler_k16s2_state *x, 
     e = 1.732050807568877;
     e = e * r + 1.7320508075688776;
     for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += e * x->gam[1 * kepler_k16s2_M + l];
-    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += (-2.0816681711721685e-17) * x->gam[0 * kepler_k16s2_M + l];
-    e = 0.99999999999999989;
-    e = e * r + (-3.6055550369691825e-17);
+    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += (-1.3877787807814457e-17) * x->gam[0 * kepler_k16s2_M + l];
+    e = 1.0;
+    e = e * r + (-2.4037033579794548e-17);
     for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += e * x->gam[1 * kepler_k16s2_M + l];
   }
 }
@@ -270,13 +270,13 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
   for (it = 1; it <= kepler_k16s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 16: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.0052995325041750307;
-      const double t1 = gm2 * (-0.0091304148291319609);
+      const double t0 = gm0 * 0.0052995325041750333;
+      const double t1 = gm2 * (-0.0091304148291318533);
       const double t2 = t0 + t1;
       const double t3 = h * t2;
       const double t4 = t3 + x->q[0] /* x */;
-      const double t5 = 0.0052995325041750307 * gm1;
-      const double t6 = (-0.0091304148291319609) * gm3;
+      const double t5 = 0.0052995325041750333 * gm1;
+      const double t6 = (-0.0091304148291318533) * gm3;
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = t8 + x->q[1] /* y */;
@@ -294,13 +294,13 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t21 = t18 * (-0.02326548558383789);
       const double t22 = t17 * (-0.02326548558383789);
       /* stage 2 of 16: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t23 = gm0 * 0.0277124884633837;
-      const double t24 = gm2 * (-0.046669254150292716);
+      const double t23 = gm0 * 0.02771248846338371;
+      const double t24 = gm2 * (-0.046669254150292674);
       const double t25 = t23 + t24;
       const double t26 = h * t25;
       const double t27 = x->q[0] /* x */ + t26;
-      const double t28 = gm1 * 0.0277124884633837;
-      const double t29 = gm3 * (-0.046669254150292716);
+      const double t28 = gm1 * 0.02771248846338371;
+      const double t29 = gm3 * (-0.046669254150292674);
       const double t30 = t28 + t29;
       const double t31 = h * t30;
       const double t32 = x->q[1] /* y */ + t31;
@@ -317,18 +317,18 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t43 = t19 + t42;
       const double t44 = t40 * 0.031126761969323947;
       const double t45 = t20 + t44;
-      const double t46 = t41 * (-0.050924999041981028);
+      const double t46 = t41 * (-0.050924999041981035);
       const double t47 = t21 + t46;
-      const double t48 = t40 * (-0.050924999041981028);
+      const double t48 = t40 * (-0.050924999041981035);
       const double t49 = t22 + t48;
       /* stage 3 of 16: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
       const double t50 = gm0 * 0.067184398806084122;
-      const double t51 = gm2 * (-0.10854875923261334);
+      const double t51 = gm2 * (-0.10854875923261331);
       const double t52 = t50 + t51;
       const double t53 = h * t52;
       const double t54 = x->q[0] /* x */ + t53;
       const double t55 = gm1 * 0.067184398806084122;
-      const double t56 = gm3 * (-0.10854875923261334);
+      const double t56 = gm3 * (-0.10854875923261331);
       const double t57 = t55 + t56;
       const double t58 = h * t57;
       const double t59 = x->q[1] /* y */ + t58;
@@ -345,18 +345,18 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t70 = t43 + t69;
       const double t71 = t67 * 0.047579255841246393;
       const double t72 = t45 + t71;
-      const double t73 = t68 * (-0.071336397747567615);
+      const double t73 = t68 * (-0.071336397747567629);
       const double t74 = t47 + t73;
-      const double t75 = t67 * (-0.071336397747567615);
+      const double t75 = t67 * (-0.071336397747567629);
       const double t76 = t49 + t75;
       /* stage 4 of 16: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t77 = gm0 * 0.1222977958224985;
-      const double t78 = gm2 * (-0.18592014360731468);
+      const double t77 = gm0 * 0.12229779582249849;
+      const double t78 = gm2 * (-0.1859201436073146);
       const double t79 = t77 + t78;
       const double t80 = h * t79;
       const double t81 = x->q[0] /* x */ + t80;
-      const double t82 = gm1 * 0.1222977958224985;
-      const double t83 = gm3 * (-0.18592014360731468);
+      const double t82 = gm1 * 0.12229779582249849;
+      const double t83 = gm3 * (-0.1859201436073146);
       const double t84 = t82 + t83;
       const double t85 = h * t84;
       const double t86 = x->q[1] /* y */ + t85;
@@ -401,18 +401,18 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t124 = t97 + t123;
       const double t125 = t121 * 0.074797994408288368;
       const double t126 = t99 + t125;
-      const double t127 = t122 * (-0.080048293627215647);
+      const double t127 = t122 * (-0.080048293627215661);
       const double t128 = t101 + t127;
-      const double t129 = t121 * (-0.080048293627215647);
+      const double t129 = t121 * (-0.080048293627215661);
       const double t130 = t103 + t129;
       /* stage 6 of 16: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
       const double t131 = gm0 * 0.27099161117138632;
-      const double t132 = gm2 * (-0.34217557068677351);
+      const double t132 = gm2 * (-0.34217557068677346);
       const double t133 = t131 + t132;
       const double t134 = h * t133;
       const double t135 = x->q[0] /* x */ + t134;
       const double t136 = gm1 * 0.27099161117138632;
-      const double t137 = gm3 * (-0.34217557068677351);
+      const double t137 = gm3 * (-0.34217557068677346);
       const double t138 = t136 + t137;
       const double t139 = h * t138;
       const double t140 = x->q[1] /* y */ + t139;
@@ -429,9 +429,9 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t151 = t124 + t150;
       const double t152 = t148 * 0.084578259697501268;
       const double t153 = t126 + t152;
-      const double t154 = t149 * (-0.067096637922900867);
+      const double t154 = t149 * (-0.067096637922900881);
       const double t155 = t128 + t154;
-      const double t156 = t148 * (-0.067096637922900867);
+      const double t156 = t148 * (-0.067096637922900881);
       const double t157 = t130 + t156;
       /* stage 7 of 16: Q = q0 + h sum_j Ihat[7][j] gamma_j, grad U(Q), grad g(Q) */
       const double t158 = gm0 * 0.35919822461037054;
@@ -457,9 +457,9 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t178 = t151 + t177;
       const double t179 = t175 * 0.091301707522461792;
       const double t180 = t153 + t179;
-      const double t181 = t176 * (-0.044532559180448031);
+      const double t181 = t176 * (-0.044532559180448038);
       const double t182 = t155 + t181;
-      const double t183 = t175 * (-0.044532559180448031);
+      const double t183 = t175 * (-0.044532559180448038);
       const double t184 = t157 + t183;
       /* stage 8 of 16: Q = q0 + h sum_j Ihat[8][j] gamma_j, grad U(Q), grad g(Q) */
       const double t185 = gm0 * 0.45249374508118129;
@@ -485,9 +485,9 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t205 = t178 + t204;
       const double t206 = t202 * 0.094725305227534251;
       const double t207 = t180 + t206;
-      const double t208 = t203 * (-0.015588611411642563);
+      const double t208 = t203 * (-0.015588611411642564);
       const double t209 = t182 + t208;
-      const double t210 = t202 * (-0.015588611411642563);
+      const double t210 = t202 * (-0.015588611411642564);
       const double t211 = t184 + t210;
       /* stage 9 of 16: Q = q0 + h sum_j Ihat[9][j] gamma_j, grad U(Q), grad g(Q) */
       const double t212 = gm0 * 0.54750625491881877;
@@ -511,9 +511,9 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t230 = t205 + t229;
       const double t231 = 0.094725305227534251 * t227;
       const double t232 = t207 + t231;
-      const double t233 = t228 * 0.015588611411642582;
+      const double t233 = t228 * 0.015588611411642564;
       const double t234 = t209 + t233;
-      const double t235 = t227 * 0.015588611411642582;
+      const double t235 = t227 * 0.015588611411642564;
       const double t236 = t211 + t235;
       /* stage 10 of 16: Q = q0 + h sum_j Ihat[10][j] gamma_j, grad U(Q), grad g(Q) */
       const double t237 = gm0 * 0.64080177538962946;
@@ -537,204 +537,198 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
       const double t255 = t230 + t254;
       const double t256 = 0.091301707522461792 * t252;
       const double t257 = t232 + t256;
-      const double t258 = t253 * 0.044532559180448031;
+      const double t258 = t253 * 0.044532559180448038;
       const double t259 = t234 + t258;
-      const double t260 = t252 * 0.044532559180448031;
+      const double t260 = t252 * 0.044532559180448038;
       const double t261 = t236 + t260;
       /* stage 11 of 16: Q = q0 + h sum_j Ihat[11][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t262 = gm0 * 0.72900838882861363;
-      const double t263 = gm2 * (-0.34217557068677357);
-      const double t264 = t262 + t263;
-      const double t265 = h * t264;
-      const double t266 = x->q[0] /* x */ + t265;
-      const double t267 = gm1 * 0.72900838882861363;
-      const double t268 = gm3 * (-0.34217557068677357);
-      const double t269 = t267 + t268;
-      const double t270 = h * t269;
-      const double t271 = x->q[1] /* y */ + t270;
-      const double t272 = t266 * t266;
-      const double t273 = t271 * t271;
-      const double t274 = t272 + t273;
-      const double t275 = sqrt(t274);
-      const double t276 = 1.0 / t275;
-      const double t277 = t276 * t276;
-      const double t278 = t276 * t277;
-      const double t279 = t271 * t278;
-      const double t280 = t266 * t278;
-      const double t281 = 0.084578259697501268 * t280;
-      const double t282 = t255 + t281;
-      const double t283 = 0.084578259697501268 * t279;
-      const double t284 = t257 + t283;
-      const double t285 = t280 * 0.067096637922900854;
-      const double t286 = t259 + t285;
-      const double t287 = t279 * 0.067096637922900854;
-      const double t288 = t261 + t287;
+      const double t262 = gm0 * 0.72900838882861374;
+      const double t263 = t132 + t262;
+      const double t264 = h * t263;
+      const double t265 = x->q[0] /* x */ + t264;
+      const double t266 = gm1 * 0.72900838882861374;
+      const double t267 = t137 + t266;
+      const double t268 = h * t267;
+      const double t269 = x->q[1] /* y */ + t268;
+      const double t270 = t265 * t265;
+      const double t271 = t269 * t269;
+      const double t272 = t270 + t271;
+      const double t273 = sqrt(t272);
+      const double t274 = 1.0 / t273;
+      const double t275 = t274 * t274;
+      const double t276 = t274 * t275;
+      const double t277 = t269 * t276;
+      const double t278 = t265 * t276;
+      const double t279 = 0.084578259697501268 * t278;
+      const double t280 = t255 + t279;
+      const double t281 = 0.084578259697501268 * t277;
+      const double t282 = t257 + t281;
+      const double t283 = t278 * 0.067096637922900881;
+      const double t284 = t259 + t283;
+      const double t285 = t277 * 0.067096637922900881;
+      const double t286 = t261 + t285;
       /* stage 12 of 16: Q = q0 + h sum_j Ihat[12][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t289 = gm0 * 0.80893812220132189;
-      const double t290 = t105 + t289;
-      const double t291 = h * t290;
-      const double t292 = x->q[0] /* x */ + t291;
-      const double t293 = gm1 * 0.80893812220132189;
-      const double t294 = t110 + t293;
-      const double t295 = h * t294;
-      const double t296 = x->q[1] /* y */ + t295;
-      const double t297 = t292 * t292;
-      const double t298 = t296 * t296;
-      const double t299 = t297 + t298;
-      const double t300 = sqrt(t299);
-      const double t301 = 1.0 / t300;
-      const double t302 = t301 * t301;
-      const double t303 = t301 * t302;
-      const double t304 = t296 * t303;
-      const double t305 = t292 * t303;
-      const double t306 = 0.074797994408288368 * t305;
+      const double t287 = gm0 * 0.80893812220132189;
+      const double t288 = t105 + t287;
+      const double t289 = h * t288;
+      const double t290 = x->q[0] /* x */ + t289;
+      const double t291 = gm1 * 0.80893812220132189;
+      const double t292 = t110 + t291;
+      const double t293 = h * t292;
+      const double t294 = x->q[1] /* y */ + t293;
+      const double t295 = t290 * t290;
+      const double t296 = t294 * t294;
+      const double t297 = t295 + t296;
+      const double t298 = sqrt(t297);
+      const double t299 = 1.0 / t298;
+      const double t300 = t299 * t299;
+      const double t301 = t299 * t300;
+      const double t302 = t294 * t301;
+      const double t303 = t290 * t301;
+      const double t304 = 0.074797994408288368 * t303;
+      const double t305 = t280 + t304;
+      const double t306 = 0.074797994408288368 * t302;
       const double t307 = t282 + t306;
-      const double t308 = 0.074797994408288368 * t304;
+      const double t308 = t303 * 0.080048293627215661;
       const double t309 = t284 + t308;
-      const double t310 = t305 * 0.080048293627215647;
+      const double t310 = t302 * 0.080048293627215661;
       const double t311 = t286 + t310;
-      const double t312 = t304 * 0.080048293627215647;
-      const double t313 = t288 + t312;
       /* stage 13 of 16: Q = q0 + h sum_j Ihat[13][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t314 = gm0 * 0.87770220417750155;
-      const double t315 = gm2 * (-0.18592014360731457);
-      const double t316 = t314 + t315;
-      const double t317 = h * t316;
-      const double t318 = x->q[0] /* x */ + t317;
-      const double t319 = gm1 * 0.87770220417750155;
-      const double t320 = gm3 * (-0.18592014360731457);
-      const double t321 = t319 + t320;
-      const double t322 = h * t321;
-      const double t323 = x->q[1] /* y */ + t322;
-      const double t324 = t318 * t318;
-      const double t325 = t323 * t323;
-      const double t326 = t324 + t325;
-      const double t327 = sqrt(t326);
-      const double t328 = 1.0 / t327;
-      const double t329 = t328 * t328;
-      const double t330 = t328 * t329;
-      const double t331 = t323 * t330;
-      const double t332 = t318 * t330;
-      const double t333 = 0.062314485627766938 * t332;
-      const double t334 = t307 + t333;
-      const double t335 = 0.062314485627766938 * t331;
-      const double t336 = t309 + t335;
-      const double t337 = t332 * 0.081532199185879339;
-      const double t338 = t311 + t337;
-      const double t339 = t331 * 0.081532199185879339;
-      const double t340 = t313 + t339;
+      const double t312 = gm0 * 0.87770220417750155;
+      const double t313 = t78 + t312;
+      const double t314 = h * t313;
+      const double t315 = x->q[0] /* x */ + t314;
+      const double t316 = gm1 * 0.87770220417750155;
+      const double t317 = t83 + t316;
+      const double t318 = h * t317;
+      const double t319 = x->q[1] /* y */ + t318;
+      const double t320 = t315 * t315;
+      const double t321 = t319 * t319;
+      const double t322 = t320 + t321;
+      const double t323 = sqrt(t322);
+      const double t324 = 1.0 / t323;
+      const double t325 = t324 * t324;
+      const double t326 = t324 * t325;
+      const double t327 = t319 * t326;
+      const double t328 = t315 * t326;
+      const double t329 = 0.062314485627766938 * t328;
+      const double t330 = t305 + t329;
+      const double t331 = 0.062314485627766938 * t327;
+      const double t332 = t307 + t331;
+      const double t333 = t328 * 0.081532199185879339;
+      const double t334 = t309 + t333;
+      const double t335 = t327 * 0.081532199185879339;
+      const double t336 = t311 + t335;
       /* stage 14 of 16: Q = q0 + h sum_j Ihat[14][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t341 = gm0 * 0.93281560119391593;
-      const double t342 = gm2 * (-0.10854875923261328);
-      const double t343 = t341 + t342;
-      const double t344 = h * t343;
-      const double t345 = x->q[0] /* x */ + t344;
-      const double t346 = gm1 * 0.93281560119391593;
-      const double t347 = gm3 * (-0.10854875923261328);
-      const double t348 = t346 + t347;
-      const double t349 = h * t348;
-      const double t350 = x->q[1] /* y */ + t349;
-      const double t351 = t345 * t345;
-      const double t352 = t350 * t350;
-      const double t353 = t351 + t352;
-      const double t354 = sqrt(t353);
-      const double t355 = 1.0 / t354;
-      const double t356 = t355 * t355;
-      const double t357 = t355 * t356;
-      const double t358 = t350 * t357;
-      const double t359 = t345 * t357;
-      const double t360 = 0.047579255841246393 * t359;
-      const double t361 = t334 + t360;
-      const double t362 = 0.047579255841246393 * t358;
-      const double t363 = t336 + t362;
-      const double t364 = t359 * 0.071336397747567629;
-      const double t365 = t338 + t364;
-      const double t366 = t358 * 0.071336397747567629;
-      const double t367 = t340 + t366;
+      const double t337 = gm0 * 0.93281560119391582;
+      const double t338 = t51 + t337;
+      const double t339 = h * t338;
+      const double t340 = x->q[0] /* x */ + t339;
+      const double t341 = gm1 * 0.93281560119391582;
+      const double t342 = t56 + t341;
+      const double t343 = h * t342;
+      const double t344 = x->q[1] /* y */ + t343;
+      const double t345 = t340 * t340;
+      const double t346 = t344 * t344;
+      const double t347 = t345 + t346;
+      const double t348 = sqrt(t347);
+      const double t349 = 1.0 / t348;
+      const double t350 = t349 * t349;
+      const double t351 = t349 * t350;
+      const double t352 = t344 * t351;
+      const double t353 = t340 * t351;
+      const double t354 = 0.047579255841246393 * t353;
+      const double t355 = t330 + t354;
+      const double t356 = 0.047579255841246393 * t352;
+      const double t357 = t332 + t356;
+      const double t358 = t353 * 0.071336397747567629;
+      const double t359 = t334 + t358;
+      const double t360 = t352 * 0.071336397747567629;
+      const double t361 = t336 + t360;
       /* stage 15 of 16: Q = q0 + h sum_j Ihat[15][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t368 = gm0 * 0.9722875115366163;
-      const double t369 = t24 + t368;
-      const double t370 = h * t369;
-      const double t371 = x->q[0] /* x */ + t370;
-      const double t372 = gm1 * 0.9722875115366163;
-      const double t373 = t29 + t372;
-      const double t374 = h * t373;
-      const double t375 = x->q[1] /* y */ + t374;
-      const double t376 = t371 * t371;
-      const double t377 = t375 * t375;
-      const double t378 = t376 + t377;
-      const double t379 = sqrt(t378);
-      const double t380 = 1.0 / t379;
-      const double t381 = t380 * t380;
-      const double t382 = t380 * t381;
-      const double t383 = t375 * t382;
-      const double t384 = t371 * t382;
-      const double t385 = 0.031126761969323947 * t384;
+      const double t362 = gm0 * 0.9722875115366163;
+      const double t363 = t24 + t362;
+      const double t364 = h * t363;
+      const double t365 = x->q[0] /* x */ + t364;
+      const double t366 = gm1 * 0.9722875115366163;
+      const double t367 = t29 + t366;
+      const double t368 = h * t367;
+      const double t369 = x->q[1] /* y */ + t368;
+      const double t370 = t365 * t365;
+      const double t371 = t369 * t369;
+      const double t372 = t370 + t371;
+      const double t373 = sqrt(t372);
+      const double t374 = 1.0 / t373;
+      const double t375 = t374 * t374;
+      const double t376 = t374 * t375;
+      const double t377 = t369 * t376;
+      const double t378 = t365 * t376;
+      const double t379 = 0.031126761969323947 * t378;
+      const double t380 = t355 + t379;
+      const double t381 = 0.031126761969323947 * t377;
+      const double t382 = t357 + t381;
+      const double t383 = t378 * 0.050924999041981035;
+      const double t384 = t359 + t383;
+      const double t385 = t377 * 0.050924999041981035;
       const double t386 = t361 + t385;
-      const double t387 = 0.031126761969323947 * t383;
-      const double t388 = t363 + t387;
-      const double t389 = t384 * 0.050924999041981028;
-      const double t390 = t365 + t389;
-      const double t391 = t383 * 0.050924999041981028;
-      const double t392 = t367 + t391;
       /* stage 16 of 16: Q = q0 + h sum_j Ihat[16][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t393 = gm0 * 0.99470046749582497;
-      const double t394 = t1 + t393;
-      const double t395 = h * t394;
-      const double t396 = x->q[0] /* x */ + t395;
-      const double t397 = gm1 * 0.99470046749582497;
-      const double t398 = t6 + t397;
-      const double t399 = h * t398;
-      const double t400 = x->q[1] /* y */ + t399;
-      const double t401 = t396 * t396;
-      const double t402 = t400 * t400;
-      const double t403 = t401 + t402;
-      const double t404 = sqrt(t403);
-      const double t405 = 1.0 / t404;
-      const double t406 = t405 * t405;
-      const double t407 = t405 * t406;
-      const double t408 = t400 * t407;
-      const double t409 = t396 * t407;
-      const double t410 = 0.013576229705877048 * t409;
+      const double t387 = gm0 * 0.99470046749582497;
+      const double t388 = t1 + t387;
+      const double t389 = h * t388;
+      const double t390 = x->q[0] /* x */ + t389;
+      const double t391 = gm1 * 0.99470046749582497;
+      const double t392 = t6 + t391;
+      const double t393 = h * t392;
+      const double t394 = x->q[1] /* y */ + t393;
+      const double t395 = t390 * t390;
+      const double t396 = t394 * t394;
+      const double t397 = t395 + t396;
+      const double t398 = sqrt(t397);
+      const double t399 = 1.0 / t398;
+      const double t400 = t399 * t399;
+      const double t401 = t399 * t400;
+      const double t402 = t394 * t401;
+      const double t403 = t390 * t401;
+      const double t404 = 0.013576229705877048 * t403;
+      const double t405 = t380 + t404;
+      const double t406 = 0.013576229705877048 * t402;
+      const double t407 = t382 + t406;
+      const double t408 = t403 * 0.02326548558383789;
+      const double t409 = t384 + t408;
+      const double t410 = t402 * 0.02326548558383789;
       const double t411 = t386 + t410;
-      const double t412 = 0.013576229705877048 * t408;
-      const double t413 = t388 + t412;
-      const double t414 = t409 * 0.02326548558383789;
-      const double t415 = t390 + t414;
-      const double t416 = t408 * 0.02326548558383789;
-      const double t417 = t392 + t416;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t418 = 0.5 * t411;
-      const double t419 = t415 * 0.28867513459481292;
-      const double t420 = t418 - t419;
-      const double t421 = h * t420;
-      const double t422 = x->p[0] /* p_x */ - t421;
-      const double t423 = 0.5 * t413;
-      const double t424 = t417 * 0.28867513459481292;
-      const double t425 = t423 - t424;
+      const double t412 = 0.5 * t405;
+      const double t413 = t409 * 0.28867513459481287;
+      const double t414 = t412 - t413;
+      const double t415 = h * t414;
+      const double t416 = x->p[0] /* p_x */ - t415;
+      const double t417 = 0.5 * t407;
+      const double t418 = t411 * 0.28867513459481287;
+      const double t419 = t417 - t418;
+      const double t420 = h * t419;
+      const double t421 = x->p[1] /* p_y */ - t420;
+      const double t422 = t405 * 0.28867513459481287;
+      const double t423 = h * t422;
+      const double t424 = -t423;
+      const double t425 = t407 * 0.28867513459481287;
       const double t426 = h * t425;
-      const double t427 = x->p[1] /* p_y */ - t426;
-      const double t428 = t411 * 0.28867513459481292;
-      const double t429 = h * t428;
-      const double t430 = -t429;
-      const double t431 = t413 * 0.28867513459481292;
-      const double t432 = h * t431;
-      const double t433 = -t432;
-      const double t434 = h * t411;
-      const double t435 = -t434;
-      const double t436 = h * t413;
-      const double t437 = -t436;
+      const double t427 = -t426;
+      const double t428 = h * t405;
+      const double t429 = -t428;
+      const double t430 = h * t407;
+      const double t431 = -t430;
       /* gam */
-      sw0 = t422;
-      sw1 = t427;
-      sw2 = t430;
-      sw3 = t433;
+      sw0 = t416;
+      sw1 = t421;
+      sw2 = t424;
+      sw3 = t427;
       /* dp */
-      sw4 = t435;
-      sw5 = t437;
+      sw4 = t429;
+      sw5 = t431;
       /* theta */
-      sw6 = t415;
-      sw7 = t417;
+      sw6 = t409;
+      sw7 = t411;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

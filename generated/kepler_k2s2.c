@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518713   b_1 = 0.5
+ *   c_1 = 0.21132486540518711   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Model defaults for q0 and p0. */
@@ -148,7 +148,7 @@ kepler_k2s2_OUT_OF_LINE void kepler_k2s2_predict(const kepler_k2s2_state *x, dou
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < kepler_k2s2_M; l++) gam[0 * kepler_k2s2_M + l] += x->gam[0 * kepler_k2s2_M + l];
     for (l = 0; l < kepler_k2s2_M; l++) gam[0 * kepler_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * kepler_k2s2_M + l];
-    for (l = 0; l < kepler_k2s2_M; l++) gam[1 * kepler_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * kepler_k2s2_M + l];
+    for (l = 0; l < kepler_k2s2_M; l++) gam[1 * kepler_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * kepler_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -156,7 +156,7 @@ kepler_k2s2_OUT_OF_LINE void kepler_k2s2_predict(const kepler_k2s2_state *x, dou
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < kepler_k2s2_M; l++) gam[0 * kepler_k2s2_M + l] += e * x->gam[1 * kepler_k2s2_M + l];
-    e = 0.99999999999999967;
+    e = 0.99999999999999989;
     e = e * r;
     for (l = 0; l < kepler_k2s2_M; l++) gam[1 * kepler_k2s2_M + l] += e * x->gam[1 * kepler_k2s2_M + l];
   }
@@ -254,13 +254,13 @@ static int kepler_k2s2_step_within(kepler_k2s2_state *x, kepler_k2s2_real h_, do
   for (it = 1; it <= kepler_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.21132486540518713;
-      const double t1 = gm2 * (-0.28867513459481292);
+      const double t0 = gm0 * 0.21132486540518711;
+      const double t1 = gm2 * (-0.28867513459481287);
       const double t2 = t0 + t1;
       const double t3 = h * t2;
       const double t4 = t3 + x->q[0] /* x */;
-      const double t5 = 0.21132486540518713 * gm1;
-      const double t6 = (-0.28867513459481292) * gm3;
+      const double t5 = 0.21132486540518711 * gm1;
+      const double t6 = (-0.28867513459481287) * gm3;
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = t8 + x->q[1] /* y */;
@@ -273,66 +273,64 @@ static int kepler_k2s2_step_within(kepler_k2s2_state *x, kepler_k2s2_real h_, do
       const double t16 = t14 * t15;
       const double t17 = t9 * t16;
       const double t18 = t4 * t16;
-      const double t19 = t18 * (-0.49999999999999994);
-      const double t20 = t17 * (-0.49999999999999994);
       /* stage 2 of 2: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t21 = gm0 * 0.78867513459481287;
-      const double t22 = t1 + t21;
-      const double t23 = h * t22;
-      const double t24 = x->q[0] /* x */ + t23;
-      const double t25 = gm1 * 0.78867513459481287;
-      const double t26 = t6 + t25;
-      const double t27 = h * t26;
-      const double t28 = x->q[1] /* y */ + t27;
-      const double t29 = t24 * t24;
-      const double t30 = t28 * t28;
-      const double t31 = t29 + t30;
-      const double t32 = sqrt(t31);
-      const double t33 = 1.0 / t32;
-      const double t34 = t33 * t33;
-      const double t35 = t33 * t34;
-      const double t36 = t28 * t35;
-      const double t37 = t24 * t35;
-      const double t38 = t18 + t37;
-      const double t39 = t17 + t36;
-      const double t40 = t37 * 0.49999999999999994;
-      const double t41 = t19 + t40;
-      const double t42 = t36 * 0.49999999999999994;
-      const double t43 = t20 + t42;
+      const double t19 = gm0 * 0.78867513459481287;
+      const double t20 = t1 + t19;
+      const double t21 = h * t20;
+      const double t22 = x->q[0] /* x */ + t21;
+      const double t23 = gm1 * 0.78867513459481287;
+      const double t24 = t6 + t23;
+      const double t25 = h * t24;
+      const double t26 = x->q[1] /* y */ + t25;
+      const double t27 = t22 * t22;
+      const double t28 = t26 * t26;
+      const double t29 = t27 + t28;
+      const double t30 = sqrt(t29);
+      const double t31 = 1.0 / t30;
+      const double t32 = t31 * t31;
+      const double t33 = t31 * t32;
+      const double t34 = t26 * t33;
+      const double t35 = t22 * t33;
+      const double t36 = t18 + t35;
+      const double t37 = t17 + t34;
+      const double t38 = t18 - t35;
+      const double t39 = (-0.5) * t38;
+      const double t40 = t17 - t34;
+      const double t41 = (-0.5) * t40;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t44 = t38 * 0.25;
-      const double t45 = t41 * 0.28867513459481292;
-      const double t46 = t44 - t45;
-      const double t47 = h * t46;
-      const double t48 = x->p[0] /* p_x */ - t47;
-      const double t49 = t39 * 0.25;
-      const double t50 = t43 * 0.28867513459481292;
-      const double t51 = t49 - t50;
-      const double t52 = h * t51;
-      const double t53 = x->p[1] /* p_y */ - t52;
-      const double t54 = t38 * 0.14433756729740646;
-      const double t55 = h * t54;
-      const double t56 = -t55;
-      const double t57 = t39 * 0.14433756729740646;
-      const double t58 = h * t57;
-      const double t59 = -t58;
-      const double t60 = h * t38;
-      const double t61 = 0.5 * t60;
-      const double t62 = -t61;
-      const double t63 = h * t39;
-      const double t64 = 0.5 * t63;
-      const double t65 = -t64;
+      const double t42 = t36 * 0.25;
+      const double t43 = t38 * (-0.14433756729740643);
+      const double t44 = t42 - t43;
+      const double t45 = h * t44;
+      const double t46 = x->p[0] /* p_x */ - t45;
+      const double t47 = t37 * 0.25;
+      const double t48 = t40 * (-0.14433756729740643);
+      const double t49 = t47 - t48;
+      const double t50 = h * t49;
+      const double t51 = x->p[1] /* p_y */ - t50;
+      const double t52 = t36 * 0.14433756729740643;
+      const double t53 = h * t52;
+      const double t54 = -t53;
+      const double t55 = t37 * 0.14433756729740643;
+      const double t56 = h * t55;
+      const double t57 = -t56;
+      const double t58 = h * t36;
+      const double t59 = 0.5 * t58;
+      const double t60 = -t59;
+      const double t61 = h * t37;
+      const double t62 = 0.5 * t61;
+      const double t63 = -t62;
       /* gam */
-      sw0 = t48;
-      sw1 = t53;
-      sw2 = t56;
-      sw3 = t59;
+      sw0 = t46;
+      sw1 = t51;
+      sw2 = t54;
+      sw3 = t57;
       /* dp */
-      sw4 = t62;
-      sw5 = t65;
+      sw4 = t60;
+      sw5 = t63;
       /* theta */
-      sw6 = t41;
-      sw7 = t43;
+      sw6 = t39;
+      sw7 = t41;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

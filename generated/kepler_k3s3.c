@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
+ *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -152,9 +152,7 @@ kepler_k3s3_OUT_OF_LINE void kepler_k3s3_predict(const kepler_k3s3_state *x, dou
     for (l = 0; l < kepler_k3s3_M; l++) gam[0 * kepler_k3s3_M + l] += 13.416407864998739 * x->gam[2 * kepler_k3s3_M + l];
     for (l = 0; l < kepler_k3s3_M; l++) gam[1 * kepler_k3s3_M + l] += x->gam[1 * kepler_k3s3_M + l];
     for (l = 0; l < kepler_k3s3_M; l++) gam[1 * kepler_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * kepler_k3s3_M + l];
-    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * kepler_k3s3_M + l];
-    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += 3.8459253727671276e-16 * x->gam[1 * kepler_k3s3_M + l];
-    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += 1.0000000000000016 * x->gam[2 * kepler_k3s3_M + l];
+    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += 0.99999999999999989 * x->gam[2 * kepler_k3s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -173,13 +171,9 @@ kepler_k3s3_OUT_OF_LINE void kepler_k3s3_predict(const kepler_k3s3_state *x, dou
     e = e * r + 3.8729833462074175;
     e = e * r;
     for (l = 0; l < kepler_k3s3_M; l++) gam[1 * kepler_k3s3_M + l] += e * x->gam[2 * kepler_k3s3_M + l];
-    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * kepler_k3s3_M + l];
-    e = 1.9229626863835638e-16;
-    e = e * r + 1.9229626863835638e-16;
-    for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += e * x->gam[1 * kepler_k3s3_M + l];
-    e = 1.0000000000000007;
-    e = e * r + 7.4476024597418194e-16;
-    e = e * r + 2.4825341532472731e-16;
+    e = 0.99999999999999989;
+    e = e * r;
+    e = e * r;
     for (l = 0; l < kepler_k3s3_M; l++) gam[2 * kepler_k3s3_M + l] += e * x->gam[2 * kepler_k3s3_M + l];
   }
 }
@@ -274,17 +268,17 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
   for (it = 1; it <= kepler_k3s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.1127016653792583;
-      const double t1 = gm2 * (-0.17320508075688779);
+      const double t0 = gm0 * 0.11270166537925831;
+      const double t1 = gm2 * (-0.17320508075688773);
       const double t2 = t0 + t1;
-      const double t3 = gm4 * 0.1732050807568877;
+      const double t3 = gm4 * 0.17320508075688773;
       const double t4 = t2 + t3;
       const double t5 = h * t4;
       const double t6 = t5 + x->q[0] /* x */;
-      const double t7 = 0.1127016653792583 * gm1;
-      const double t8 = (-0.17320508075688779) * gm3;
+      const double t7 = 0.11270166537925831 * gm1;
+      const double t8 = (-0.17320508075688773) * gm3;
       const double t9 = t7 + t8;
-      const double t10 = 0.1732050807568877 * gm5;
+      const double t10 = 0.17320508075688773 * gm5;
       const double t11 = t9 + t10;
       const double t12 = h * t11;
       const double t13 = t12 + x->q[1] /* y */;
@@ -301,16 +295,16 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
       const double t24 = t21 * 0.27777777777777779;
       const double t25 = t22 * (-0.37267799624996495);
       const double t26 = t21 * (-0.37267799624996495);
-      const double t27 = t22 * 0.24845199749997668;
-      const double t28 = t21 * 0.24845199749997668;
+      const double t27 = t22 * 0.24845199749997662;
+      const double t28 = t21 * 0.24845199749997662;
       /* stage 2 of 3: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
       const double t29 = 0.5 * gm0;
-      const double t30 = gm2 * (-0.43301270189221935);
+      const double t30 = gm2 * (-0.4330127018922193);
       const double t31 = t29 + t30;
       const double t32 = h * t31;
       const double t33 = x->q[0] /* x */ + t32;
       const double t34 = 0.5 * gm1;
-      const double t35 = gm3 * (-0.43301270189221935);
+      const double t35 = gm3 * (-0.4330127018922193);
       const double t36 = t34 + t35;
       const double t37 = h * t36;
       const double t38 = x->q[1] /* y */ + t37;
@@ -334,13 +328,13 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
       /* stage 3 of 3: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
       const double t56 = gm0 * 0.8872983346207417;
       const double t57 = t1 + t56;
-      const double t58 = gm4 * (-0.1732050807568877);
+      const double t58 = (-0.17320508075688773) * gm4;
       const double t59 = t57 + t58;
       const double t60 = h * t59;
       const double t61 = x->q[0] /* x */ + t60;
       const double t62 = gm1 * 0.8872983346207417;
       const double t63 = t8 + t62;
-      const double t64 = gm5 * (-0.1732050807568877);
+      const double t64 = (-0.17320508075688773) * gm5;
       const double t65 = t63 + t64;
       const double t66 = h * t65;
       const double t67 = x->q[1] /* y */ + t66;
@@ -361,35 +355,35 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
       const double t82 = t25 + t81;
       const double t83 = t75 * 0.37267799624996495;
       const double t84 = t26 + t83;
-      const double t85 = 0.24845199749997668 * t76;
+      const double t85 = 0.24845199749997662 * t76;
       const double t86 = t53 + t85;
-      const double t87 = 0.24845199749997668 * t75;
+      const double t87 = 0.24845199749997662 * t75;
       const double t88 = t55 + t87;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
       const double t89 = 0.5 * t78;
-      const double t90 = t82 * 0.28867513459481292;
+      const double t90 = t82 * 0.28867513459481287;
       const double t91 = t89 - t90;
       const double t92 = h * t91;
       const double t93 = x->p[0] /* p_x */ - t92;
       const double t94 = 0.5 * t80;
-      const double t95 = t84 * 0.28867513459481292;
+      const double t95 = t84 * 0.28867513459481287;
       const double t96 = t94 - t95;
       const double t97 = h * t96;
       const double t98 = x->p[1] /* p_y */ - t97;
-      const double t99 = t78 * 0.28867513459481292;
-      const double t100 = t86 * 0.12909944487358055;
+      const double t99 = t78 * 0.28867513459481287;
+      const double t100 = t86 * 0.12909944487358058;
       const double t101 = t99 - t100;
       const double t102 = h * t101;
       const double t103 = -t102;
-      const double t104 = t80 * 0.28867513459481292;
-      const double t105 = t88 * 0.12909944487358055;
+      const double t104 = t80 * 0.28867513459481287;
+      const double t105 = t88 * 0.12909944487358058;
       const double t106 = t104 - t105;
       const double t107 = h * t106;
       const double t108 = -t107;
-      const double t109 = t82 * 0.12909944487358055;
+      const double t109 = t82 * 0.12909944487358058;
       const double t110 = h * t109;
       const double t111 = -t110;
-      const double t112 = t84 * 0.12909944487358055;
+      const double t112 = t84 * 0.12909944487358058;
       const double t113 = h * t112;
       const double t114 = -t113;
       const double t115 = h * t78;

@@ -41,8 +41,8 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.033765242898423975   b_1 = 0.085662246189585178
- *   c_2 = 0.16939530676686776   b_2 = 0.1803807865240693
+ *   c_1 = 0.033765242898423989   b_1 = 0.085662246189585178
+ *   c_2 = 0.16939530676686773   b_2 = 0.1803807865240693
  *   c_3 = 0.38069040695840156   b_3 = 0.23395696728634552
  *   c_4 = 0.61930959304159849   b_4 = 0.23395696728634552
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
@@ -234,10 +234,10 @@ static int kepler_k6s1_step_within(kepler_k6s1_state *x, kepler_k6s1_real h_, do
   for (it = 1; it <= kepler_k6s1_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.033765242898423975;
+      const double t0 = gm0 * 0.033765242898423989;
       const double t1 = h * t0;
       const double t2 = t1 + x->q[0] /* x */;
-      const double t3 = 0.033765242898423975 * gm1;
+      const double t3 = 0.033765242898423989 * gm1;
       const double t4 = h * t3;
       const double t5 = t4 + x->q[1] /* y */;
       const double t6 = t2 * t2;
@@ -252,10 +252,10 @@ static int kepler_k6s1_step_within(kepler_k6s1_state *x, kepler_k6s1_real h_, do
       const double t15 = t14 * 0.085662246189585178;
       const double t16 = t13 * 0.085662246189585178;
       /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t17 = gm0 * 0.16939530676686776;
+      const double t17 = gm0 * 0.16939530676686773;
       const double t18 = h * t17;
       const double t19 = x->q[0] /* x */ + t18;
-      const double t20 = gm1 * 0.16939530676686776;
+      const double t20 = gm1 * 0.16939530676686773;
       const double t21 = h * t20;
       const double t22 = x->q[1] /* y */ + t21;
       const double t23 = t19 * t19;

@@ -41,8 +41,8 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.033765242898423975   b_1 = 0.085662246189585178
- *   c_2 = 0.16939530676686776   b_2 = 0.1803807865240693
+ *   c_1 = 0.033765242898423989   b_1 = 0.085662246189585178
+ *   c_2 = 0.16939530676686773   b_2 = 0.1803807865240693
  *   c_3 = 0.38069040695840156   b_3 = 0.23395696728634552
  *   c_4 = 0.61930959304159849   b_4 = 0.23395696728634552
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
@@ -152,8 +152,8 @@ kepler_k6s2_OUT_OF_LINE void kepler_k6s2_predict(const kepler_k6s2_state *x, dou
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < kepler_k6s2_M; l++) gam[0 * kepler_k6s2_M + l] += x->gam[0 * kepler_k6s2_M + l];
     for (l = 0; l < kepler_k6s2_M; l++) gam[0 * kepler_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * kepler_k6s2_M + l];
-    for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * kepler_k6s2_M + l];
-    for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += x->gam[1 * kepler_k6s2_M + l];
+    for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * kepler_k6s2_M + l];
+    for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += 0.99999999999999989 * x->gam[1 * kepler_k6s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -161,9 +161,9 @@ kepler_k6s2_OUT_OF_LINE void kepler_k6s2_predict(const kepler_k6s2_state *x, dou
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < kepler_k6s2_M; l++) gam[0 * kepler_k6s2_M + l] += e * x->gam[1 * kepler_k6s2_M + l];
-    for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += 5.5511151231257827e-17 * x->gam[0 * kepler_k6s2_M + l];
+    for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * kepler_k6s2_M + l];
     e = 0.99999999999999989;
-    e = e * r + 9.6148134319178191e-17;
+    e = e * r + (-4.8074067159589095e-17);
     for (l = 0; l < kepler_k6s2_M; l++) gam[1 * kepler_k6s2_M + l] += e * x->gam[1 * kepler_k6s2_M + l];
   }
 }
@@ -260,13 +260,13 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
   for (it = 1; it <= kepler_k6s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.033765242898423975;
-      const double t1 = gm2 * (-0.056508419605012766);
+      const double t0 = gm0 * 0.033765242898423989;
+      const double t1 = gm2 * (-0.056508419605012711);
       const double t2 = t0 + t1;
       const double t3 = h * t2;
       const double t4 = t3 + x->q[0] /* x */;
-      const double t5 = 0.033765242898423975 * gm1;
-      const double t6 = (-0.056508419605012766) * gm3;
+      const double t5 = 0.033765242898423989 * gm1;
+      const double t6 = (-0.056508419605012711) * gm3;
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = t8 + x->q[1] /* y */;
@@ -284,13 +284,13 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
       const double t21 = t18 * (-0.13835177248998257);
       const double t22 = t17 * (-0.13835177248998257);
       /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t23 = gm0 * 0.16939530676686776;
-      const double t24 = gm2 * (-0.24370047841099157);
+      const double t23 = gm0 * 0.16939530676686773;
+      const double t24 = gm2 * (-0.24370047841099149);
       const double t25 = t23 + t24;
       const double t26 = h * t25;
       const double t27 = x->q[0] /* x */ + t26;
-      const double t28 = gm1 * 0.16939530676686776;
-      const double t29 = gm3 * (-0.24370047841099157);
+      const double t28 = gm1 * 0.16939530676686773;
+      const double t29 = gm3 * (-0.24370047841099149);
       const double t30 = t28 + t29;
       const double t31 = h * t30;
       const double t32 = x->q[1] /* y */ + t31;
@@ -307,18 +307,18 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
       const double t43 = t19 + t42;
       const double t44 = t40 * 0.1803807865240693;
       const double t45 = t20 + t44;
-      const double t46 = t41 * (-0.20658078042518249);
+      const double t46 = t41 * (-0.20658078042518252);
       const double t47 = t21 + t46;
-      const double t48 = t40 * (-0.20658078042518249);
+      const double t48 = t40 * (-0.20658078042518252);
       const double t49 = t22 + t48;
       /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
       const double t50 = gm0 * 0.38069040695840156;
-      const double t51 = gm2 * (-0.40835734144399111);
+      const double t51 = gm2 * (-0.40835734144399105);
       const double t52 = t50 + t51;
       const double t53 = h * t52;
       const double t54 = x->q[0] /* x */ + t53;
       const double t55 = gm1 * 0.38069040695840156;
-      const double t56 = gm3 * (-0.40835734144399111);
+      const double t56 = gm3 * (-0.40835734144399105);
       const double t57 = t55 + t56;
       const double t58 = h * t57;
       const double t59 = x->q[1] /* y */ + t58;
@@ -335,122 +335,120 @@ static int kepler_k6s2_step_within(kepler_k6s2_state *x, kepler_k6s2_real h_, do
       const double t70 = t43 + t69;
       const double t71 = t67 * 0.23395696728634552;
       const double t72 = t45 + t71;
-      const double t73 = t68 * (-0.096694544181506401);
+      const double t73 = t68 * (-0.096694544181506428);
       const double t74 = t47 + t73;
-      const double t75 = t67 * (-0.096694544181506401);
+      const double t75 = t67 * (-0.096694544181506428);
       const double t76 = t49 + t75;
       /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
       const double t77 = gm0 * 0.61930959304159849;
-      const double t78 = gm2 * (-0.40835734144399105);
-      const double t79 = t77 + t78;
-      const double t80 = h * t79;
-      const double t81 = x->q[0] /* x */ + t80;
-      const double t82 = gm1 * 0.61930959304159849;
-      const double t83 = gm3 * (-0.40835734144399105);
-      const double t84 = t82 + t83;
-      const double t85 = h * t84;
-      const double t86 = x->q[1] /* y */ + t85;
-      const double t87 = t81 * t81;
-      const double t88 = t86 * t86;
-      const double t89 = t87 + t88;
-      const double t90 = sqrt(t89);
-      const double t91 = 1.0 / t90;
-      const double t92 = t91 * t91;
-      const double t93 = t91 * t92;
-      const double t94 = t86 * t93;
-      const double t95 = t81 * t93;
-      const double t96 = 0.23395696728634552 * t95;
-      const double t97 = t70 + t96;
-      const double t98 = 0.23395696728634552 * t94;
-      const double t99 = t72 + t98;
-      const double t100 = t95 * 0.096694544181506442;
-      const double t101 = t74 + t100;
-      const double t102 = t94 * 0.096694544181506442;
-      const double t103 = t76 + t102;
+      const double t78 = t51 + t77;
+      const double t79 = h * t78;
+      const double t80 = x->q[0] /* x */ + t79;
+      const double t81 = gm1 * 0.61930959304159849;
+      const double t82 = t56 + t81;
+      const double t83 = h * t82;
+      const double t84 = x->q[1] /* y */ + t83;
+      const double t85 = t80 * t80;
+      const double t86 = t84 * t84;
+      const double t87 = t85 + t86;
+      const double t88 = sqrt(t87);
+      const double t89 = 1.0 / t88;
+      const double t90 = t89 * t89;
+      const double t91 = t89 * t90;
+      const double t92 = t84 * t91;
+      const double t93 = t80 * t91;
+      const double t94 = 0.23395696728634552 * t93;
+      const double t95 = t70 + t94;
+      const double t96 = 0.23395696728634552 * t92;
+      const double t97 = t72 + t96;
+      const double t98 = t93 * 0.096694544181506428;
+      const double t99 = t74 + t98;
+      const double t100 = t92 * 0.096694544181506428;
+      const double t101 = t76 + t100;
       /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t104 = gm0 * 0.83060469323313224;
-      const double t105 = t24 + t104;
-      const double t106 = h * t105;
-      const double t107 = x->q[0] /* x */ + t106;
-      const double t108 = gm1 * 0.83060469323313224;
-      const double t109 = t29 + t108;
-      const double t110 = h * t109;
-      const double t111 = x->q[1] /* y */ + t110;
-      const double t112 = t107 * t107;
-      const double t113 = t111 * t111;
-      const double t114 = t112 + t113;
-      const double t115 = sqrt(t114);
-      const double t116 = 1.0 / t115;
-      const double t117 = t116 * t116;
-      const double t118 = t116 * t117;
-      const double t119 = t111 * t118;
-      const double t120 = t107 * t118;
-      const double t121 = 0.1803807865240693 * t120;
+      const double t102 = gm0 * 0.83060469323313224;
+      const double t103 = t24 + t102;
+      const double t104 = h * t103;
+      const double t105 = x->q[0] /* x */ + t104;
+      const double t106 = gm1 * 0.83060469323313224;
+      const double t107 = t29 + t106;
+      const double t108 = h * t107;
+      const double t109 = x->q[1] /* y */ + t108;
+      const double t110 = t105 * t105;
+      const double t111 = t109 * t109;
+      const double t112 = t110 + t111;
+      const double t113 = sqrt(t112);
+      const double t114 = 1.0 / t113;
+      const double t115 = t114 * t114;
+      const double t116 = t114 * t115;
+      const double t117 = t109 * t116;
+      const double t118 = t105 * t116;
+      const double t119 = 0.1803807865240693 * t118;
+      const double t120 = t95 + t119;
+      const double t121 = 0.1803807865240693 * t117;
       const double t122 = t97 + t121;
-      const double t123 = 0.1803807865240693 * t119;
+      const double t123 = t118 * 0.20658078042518252;
       const double t124 = t99 + t123;
-      const double t125 = t120 * 0.20658078042518249;
+      const double t125 = t117 * 0.20658078042518252;
       const double t126 = t101 + t125;
-      const double t127 = t119 * 0.20658078042518249;
-      const double t128 = t103 + t127;
       /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t129 = gm0 * 0.96623475710157603;
-      const double t130 = t1 + t129;
-      const double t131 = h * t130;
-      const double t132 = x->q[0] /* x */ + t131;
-      const double t133 = gm1 * 0.96623475710157603;
-      const double t134 = t6 + t133;
-      const double t135 = h * t134;
-      const double t136 = x->q[1] /* y */ + t135;
-      const double t137 = t132 * t132;
-      const double t138 = t136 * t136;
-      const double t139 = t137 + t138;
-      const double t140 = sqrt(t139);
-      const double t141 = 1.0 / t140;
-      const double t142 = t141 * t141;
-      const double t143 = t141 * t142;
-      const double t144 = t136 * t143;
-      const double t145 = t132 * t143;
-      const double t146 = 0.085662246189585178 * t145;
+      const double t127 = gm0 * 0.96623475710157603;
+      const double t128 = t1 + t127;
+      const double t129 = h * t128;
+      const double t130 = x->q[0] /* x */ + t129;
+      const double t131 = gm1 * 0.96623475710157603;
+      const double t132 = t6 + t131;
+      const double t133 = h * t132;
+      const double t134 = x->q[1] /* y */ + t133;
+      const double t135 = t130 * t130;
+      const double t136 = t134 * t134;
+      const double t137 = t135 + t136;
+      const double t138 = sqrt(t137);
+      const double t139 = 1.0 / t138;
+      const double t140 = t139 * t139;
+      const double t141 = t139 * t140;
+      const double t142 = t134 * t141;
+      const double t143 = t130 * t141;
+      const double t144 = 0.085662246189585178 * t143;
+      const double t145 = t120 + t144;
+      const double t146 = 0.085662246189585178 * t142;
       const double t147 = t122 + t146;
-      const double t148 = 0.085662246189585178 * t144;
+      const double t148 = t143 * 0.13835177248998257;
       const double t149 = t124 + t148;
-      const double t150 = t145 * 0.13835177248998257;
+      const double t150 = t142 * 0.13835177248998257;
       const double t151 = t126 + t150;
-      const double t152 = t144 * 0.13835177248998257;
-      const double t153 = t128 + t152;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t154 = 0.5 * t147;
-      const double t155 = t151 * 0.28867513459481292;
-      const double t156 = t154 - t155;
-      const double t157 = h * t156;
-      const double t158 = x->p[0] /* p_x */ - t157;
-      const double t159 = 0.5 * t149;
-      const double t160 = t153 * 0.28867513459481292;
-      const double t161 = t159 - t160;
-      const double t162 = h * t161;
-      const double t163 = x->p[1] /* p_y */ - t162;
-      const double t164 = t147 * 0.28867513459481292;
-      const double t165 = h * t164;
-      const double t166 = -t165;
-      const double t167 = t149 * 0.28867513459481292;
-      const double t168 = h * t167;
+      const double t152 = 0.5 * t145;
+      const double t153 = t149 * 0.28867513459481287;
+      const double t154 = t152 - t153;
+      const double t155 = h * t154;
+      const double t156 = x->p[0] /* p_x */ - t155;
+      const double t157 = 0.5 * t147;
+      const double t158 = t151 * 0.28867513459481287;
+      const double t159 = t157 - t158;
+      const double t160 = h * t159;
+      const double t161 = x->p[1] /* p_y */ - t160;
+      const double t162 = t145 * 0.28867513459481287;
+      const double t163 = h * t162;
+      const double t164 = -t163;
+      const double t165 = t147 * 0.28867513459481287;
+      const double t166 = h * t165;
+      const double t167 = -t166;
+      const double t168 = h * t145;
       const double t169 = -t168;
       const double t170 = h * t147;
       const double t171 = -t170;
-      const double t172 = h * t149;
-      const double t173 = -t172;
       /* gam */
-      sw0 = t158;
-      sw1 = t163;
-      sw2 = t166;
-      sw3 = t169;
+      sw0 = t156;
+      sw1 = t161;
+      sw2 = t164;
+      sw3 = t167;
       /* dp */
-      sw4 = t171;
-      sw5 = t173;
+      sw4 = t169;
+      sw5 = t171;
       /* theta */
-      sw6 = t151;
-      sw7 = t153;
+      sw6 = t149;
+      sw7 = t151;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

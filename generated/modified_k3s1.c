@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
+ *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -368,13 +368,13 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
       const double t2 = 0.5 * t1;
       const double t3 = t0 + t1;
       /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t4 = gm0 * 0.1127016653792583;
+      const double t4 = gm0 * 0.11270166537925831;
       const double t5 = h * t4;
       const double t6 = x->q[0] /* q[1] */ + t5;
-      const double t7 = 0.1127016653792583 * gm1;
+      const double t7 = 0.11270166537925831 * gm1;
       const double t8 = h * t7;
       const double t9 = x->q[1] /* q[2] */ + t8;
-      const double t10 = gm2 * 0.1127016653792583;
+      const double t10 = gm2 * 0.11270166537925831;
       const double t11 = h * t10;
       const double t12 = x->q[2] /* q[3] */ + t11;
       const double t13 = t12 * t12 * t12;

@@ -41,8 +41,8 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.033765242898423975   b_1 = 0.085662246189585178
- *   c_2 = 0.16939530676686776   b_2 = 0.1803807865240693
+ *   c_1 = 0.033765242898423989   b_1 = 0.085662246189585178
+ *   c_2 = 0.16939530676686773   b_2 = 0.1803807865240693
  *   c_3 = 0.38069040695840156   b_3 = 0.23395696728634552
  *   c_4 = 0.61930959304159849   b_4 = 0.23395696728634552
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
@@ -146,10 +146,12 @@ pendulum_angle_k6s3_OUT_OF_LINE void pendulum_angle_k6s3_predict(const pendulum_
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[0 * pendulum_angle_k6s3_M + l] += x->gam[0 * pendulum_angle_k6s3_M + l];
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[0 * pendulum_angle_k6s3_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_angle_k6s3_M + l];
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[0 * pendulum_angle_k6s3_M + l] += 13.416407864998739 * x->gam[2 * pendulum_angle_k6s3_M + l];
-    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += 5.5511151231257827e-17 * x->gam[0 * pendulum_angle_k6s3_M + l];
-    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += x->gam[1 * pendulum_angle_k6s3_M + l];
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * pendulum_angle_k6s3_M + l];
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_angle_k6s3_M + l];
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += 7.745966692414834 * x->gam[2 * pendulum_angle_k6s3_M + l];
-    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += 1.0000000000000002 * x->gam[2 * pendulum_angle_k6s3_M + l];
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += 2.7755575615628914e-17 * x->gam[0 * pendulum_angle_k6s3_M + l];
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += (-4.8074067159589095e-17) * x->gam[1 * pendulum_angle_k6s3_M + l];
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += 0.99999999999999978 * x->gam[2 * pendulum_angle_k6s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -161,17 +163,21 @@ pendulum_angle_k6s3_OUT_OF_LINE void pendulum_angle_k6s3_predict(const pendulum_
     e = e * r + 6.7082039324993694;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[0 * pendulum_angle_k6s3_M + l] += e * x->gam[2 * pendulum_angle_k6s3_M + l];
-    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += 5.5511151231257827e-17 * x->gam[0 * pendulum_angle_k6s3_M + l];
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * pendulum_angle_k6s3_M + l];
     e = 0.99999999999999989;
-    e = e * r + 9.6148134319178191e-17;
+    e = e * r + (-4.8074067159589095e-17);
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += e * x->gam[1 * pendulum_angle_k6s3_M + l];
     e = 3.872983346207417;
     e = e * r + 3.872983346207417;
-    e = e * r + 1.2412670766236366e-16;
+    e = e * r + (-6.2063353831181828e-17);
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[1 * pendulum_angle_k6s3_M + l] += e * x->gam[2 * pendulum_angle_k6s3_M + l];
-    e = 1.0000000000000002;
-    e = e * r;
-    e = e * r;
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += 2.7755575615628914e-17 * x->gam[0 * pendulum_angle_k6s3_M + l];
+    e = (-9.6148134319178191e-17);
+    e = e * r + 4.8074067159589095e-17;
+    for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += e * x->gam[1 * pendulum_angle_k6s3_M + l];
+    e = 1.0;
+    e = e * r + (-3.7238012298709097e-16);
+    e = e * r + 6.2063353831181828e-17;
     for (l = 0; l < pendulum_angle_k6s3_M; l++) gam[2 * pendulum_angle_k6s3_M + l] += e * x->gam[2 * pendulum_angle_k6s3_M + l];
   }
 }
@@ -265,20 +271,20 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   for (it = 1; it <= pendulum_angle_k6s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t0 = gm0 * 0.033765242898423975;
-      const double t1 = gm1 * (-0.056508419605012766);
+      const double t0 = gm0 * 0.033765242898423989;
+      const double t1 = gm1 * (-0.056508419605012711);
       const double t2 = t0 + t1;
-      const double t3 = gm2 * 0.068025568234204442;
+      const double t3 = gm2 * 0.068025568234204511;
       const double t4 = t2 + t3;
       const double t5 = h * t4;
       const double t6 = t5 + x->q[0] /* theta */;
       const double t7 = sin(t6);
       const double t8 = t7 * 0.085662246189585178;
       const double t9 = t7 * (-0.13835177248998257);
-      const double t10 = t7 * 0.15405118368989568;
+      const double t10 = t7 * 0.15405118368989565;
       /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t11 = gm0 * 0.16939530676686776;
-      const double t12 = gm1 * (-0.24370047841099157);
+      const double t11 = gm0 * 0.16939530676686773;
+      const double t12 = gm1 * (-0.24370047841099149);
       const double t13 = t11 + t12;
       const double t14 = gm2 * 0.20802702904656017;
       const double t15 = t13 + t14;
@@ -287,93 +293,92 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       const double t18 = sin(t17);
       const double t19 = t18 * 0.1803807865240693;
       const double t20 = t8 + t19;
-      const double t21 = t18 * (-0.20658078042518249);
+      const double t21 = t18 * (-0.20658078042518252);
       const double t22 = t9 + t21;
-      const double t23 = t18 * 0.062839649419340643;
+      const double t23 = t18 * 0.062839649419340685;
       const double t24 = t10 + t23;
       /* stage 3 of 6: Q = q0 + h sum_j Ihat[3][j] gamma_j, grad U(Q), grad g(Q) */
       const double t25 = gm0 * 0.38069040695840156;
-      const double t26 = gm1 * (-0.40835734144399111);
+      const double t26 = gm1 * (-0.40835734144399105);
       const double t27 = t25 + t26;
-      const double t28 = gm2 * 0.1257969473866733;
+      const double t28 = gm2 * 0.12579694738667332;
       const double t29 = t27 + t28;
       const double t30 = h * t29;
       const double t31 = x->q[0] /* theta */ + t30;
       const double t32 = sin(t31);
       const double t33 = t32 * 0.23395696728634552;
       const double t34 = t20 + t33;
-      const double t35 = t32 * (-0.096694544181506401);
+      const double t35 = t32 * (-0.096694544181506428);
       const double t36 = t22 + t35;
-      const double t37 = t32 * (-0.21689083310923635);
+      const double t37 = t32 * (-0.21689083310923632);
       const double t38 = t24 + t37;
       /* stage 4 of 6: Q = q0 + h sum_j Ihat[4][j] gamma_j, grad U(Q), grad g(Q) */
       const double t39 = gm0 * 0.61930959304159849;
-      const double t40 = gm1 * (-0.40835734144399105);
-      const double t41 = t39 + t40;
-      const double t42 = gm2 * (-0.12579694738667335);
-      const double t43 = t41 + t42;
-      const double t44 = h * t43;
-      const double t45 = x->q[0] /* theta */ + t44;
-      const double t46 = sin(t45);
-      const double t47 = 0.23395696728634552 * t46;
-      const double t48 = t34 + t47;
-      const double t49 = t46 * 0.096694544181506442;
-      const double t50 = t36 + t49;
-      const double t51 = t46 * (-0.21689083310923629);
-      const double t52 = t38 + t51;
+      const double t40 = t26 + t39;
+      const double t41 = gm2 * (-0.12579694738667332);
+      const double t42 = t40 + t41;
+      const double t43 = h * t42;
+      const double t44 = x->q[0] /* theta */ + t43;
+      const double t45 = sin(t44);
+      const double t46 = 0.23395696728634552 * t45;
+      const double t47 = t34 + t46;
+      const double t48 = t45 * 0.096694544181506428;
+      const double t49 = t36 + t48;
+      const double t50 = (-0.21689083310923632) * t45;
+      const double t51 = t38 + t50;
       /* stage 5 of 6: Q = q0 + h sum_j Ihat[5][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t53 = gm0 * 0.83060469323313224;
-      const double t54 = t12 + t53;
-      const double t55 = gm2 * (-0.20802702904656017);
-      const double t56 = t54 + t55;
-      const double t57 = h * t56;
-      const double t58 = x->q[0] /* theta */ + t57;
-      const double t59 = sin(t58);
-      const double t60 = 0.1803807865240693 * t59;
-      const double t61 = t48 + t60;
-      const double t62 = t59 * 0.20658078042518249;
-      const double t63 = t50 + t62;
-      const double t64 = 0.062839649419340643 * t59;
-      const double t65 = t52 + t64;
+      const double t52 = gm0 * 0.83060469323313224;
+      const double t53 = t12 + t52;
+      const double t54 = gm2 * (-0.20802702904656017);
+      const double t55 = t53 + t54;
+      const double t56 = h * t55;
+      const double t57 = x->q[0] /* theta */ + t56;
+      const double t58 = sin(t57);
+      const double t59 = 0.1803807865240693 * t58;
+      const double t60 = t47 + t59;
+      const double t61 = t58 * 0.20658078042518252;
+      const double t62 = t49 + t61;
+      const double t63 = 0.062839649419340685 * t58;
+      const double t64 = t51 + t63;
       /* stage 6 of 6: Q = q0 + h sum_j Ihat[6][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t66 = gm0 * 0.96623475710157603;
-      const double t67 = t1 + t66;
-      const double t68 = gm2 * (-0.068025568234204442);
-      const double t69 = t67 + t68;
-      const double t70 = h * t69;
-      const double t71 = x->q[0] /* theta */ + t70;
-      const double t72 = sin(t71);
-      const double t73 = 0.085662246189585178 * t72;
-      const double t74 = t61 + t73;
-      const double t75 = t72 * 0.13835177248998257;
-      const double t76 = t63 + t75;
-      const double t77 = 0.15405118368989568 * t72;
-      const double t78 = t65 + t77;
+      const double t65 = gm0 * 0.96623475710157603;
+      const double t66 = t1 + t65;
+      const double t67 = gm2 * (-0.068025568234204511);
+      const double t68 = t66 + t67;
+      const double t69 = h * t68;
+      const double t70 = x->q[0] /* theta */ + t69;
+      const double t71 = sin(t70);
+      const double t72 = 0.085662246189585178 * t71;
+      const double t73 = t60 + t72;
+      const double t74 = t71 * 0.13835177248998257;
+      const double t75 = t62 + t74;
+      const double t76 = 0.15405118368989565 * t71;
+      const double t77 = t64 + t76;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] (psi_i + rho_i lambda)] */
-      const double t79 = t74 * 0.5;
-      const double t80 = t76 * 0.28867513459481292;
-      const double t81 = t79 - t80;
-      const double t82 = h * t81;
-      const double t83 = x->p[0] /* p_theta */ - t82;
-      const double t84 = t74 * 0.28867513459481292;
-      const double t85 = t78 * 0.12909944487358055;
-      const double t86 = t84 - t85;
-      const double t87 = h * t86;
-      const double t88 = -t87;
-      const double t89 = t76 * 0.12909944487358055;
-      const double t90 = h * t89;
-      const double t91 = -t90;
-      const double t92 = h * t74;
-      const double t93 = -t92;
+      const double t78 = t73 * 0.5;
+      const double t79 = t75 * 0.28867513459481287;
+      const double t80 = t78 - t79;
+      const double t81 = h * t80;
+      const double t82 = x->p[0] /* p_theta */ - t81;
+      const double t83 = t73 * 0.28867513459481287;
+      const double t84 = t77 * 0.12909944487358058;
+      const double t85 = t83 - t84;
+      const double t86 = h * t85;
+      const double t87 = -t86;
+      const double t88 = t75 * 0.12909944487358058;
+      const double t89 = h * t88;
+      const double t90 = -t89;
+      const double t91 = h * t73;
+      const double t92 = -t91;
       /* gam */
-      sw0 = t83;
-      sw1 = t88;
-      sw2 = t91;
+      sw0 = t82;
+      sw1 = t87;
+      sw2 = t90;
       /* dp */
-      sw3 = t93;
+      sw3 = t92;
       /* theta */
-      sw4 = t76;
-      sw5 = t78;
+      sw4 = t75;
+      sw5 = t77;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

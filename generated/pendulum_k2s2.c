@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518713   b_1 = 0.5
+ *   c_1 = 0.21132486540518711   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Model defaults for q0 and p0. */
@@ -245,7 +245,7 @@ pendulum_k2s2_OUT_OF_LINE void pendulum_k2s2_predict(const pendulum_k2s2_state *
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < pendulum_k2s2_M; l++) gam[0 * pendulum_k2s2_M + l] += x->gam[0 * pendulum_k2s2_M + l];
     for (l = 0; l < pendulum_k2s2_M; l++) gam[0 * pendulum_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_k2s2_M + l];
-    for (l = 0; l < pendulum_k2s2_M; l++) gam[1 * pendulum_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * pendulum_k2s2_M + l];
+    for (l = 0; l < pendulum_k2s2_M; l++) gam[1 * pendulum_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -253,7 +253,7 @@ pendulum_k2s2_OUT_OF_LINE void pendulum_k2s2_predict(const pendulum_k2s2_state *
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < pendulum_k2s2_M; l++) gam[0 * pendulum_k2s2_M + l] += e * x->gam[1 * pendulum_k2s2_M + l];
-    e = 0.99999999999999967;
+    e = 0.99999999999999989;
     e = e * r;
     for (l = 0; l < pendulum_k2s2_M; l++) gam[1 * pendulum_k2s2_M + l] += e * x->gam[1 * pendulum_k2s2_M + l];
   }
@@ -370,18 +370,18 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
       const double t0 = gm0 * 0.5;
-      const double t1 = gm2 * 0.28867513459481292;
+      const double t1 = gm2 * 0.28867513459481287;
       const double t2 = t0 - t1;
       const double t3 = h * t2;
       const double t4 = x->q[0] /* x */ + t3;
-      const double t5 = gm0 * 0.28867513459481292;
+      const double t5 = gm0 * 0.28867513459481287;
       const double t6 = h * t5;
       const double t7 = 0.5 * gm1;
-      const double t8 = 0.28867513459481292 * gm3;
+      const double t8 = 0.28867513459481287 * gm3;
       const double t9 = t7 - t8;
       const double t10 = h * t9;
       const double t11 = x->q[1] /* y */ + t10;
-      const double t12 = 0.28867513459481292 * gm1;
+      const double t12 = 0.28867513459481287 * gm1;
       const double t13 = h * t12;
       /* multiplier system A lambda = r */
       const double t14 = t4 * t4;
@@ -389,7 +389,7 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       const double t16 = t14 + t15;
       const double t17 = h * t16;
       const double t18 = 2.0 * t17;
-      const double t19 = t13 * 0.57735026918962584;
+      const double t19 = t13 * 0.57735026918962573;
       const double t20 = t11 + t19;
       const double t21 = h * t20;
       const double t22 = t4 * x->p[0] /* p_x */;
@@ -408,19 +408,19 @@ static int pendulum_k2s2_step_within(pendulum_k2s2_state *x, pendulum_k2s2_real 
       const double t34 = 2.0 * t33;
       const double t35 = t13 * t28;
       const double t36 = 2.0 * t35;
-      const double t37 = 0.57735026918962584 * t33;
+      const double t37 = 0.57735026918962573 * t33;
       const double t38 = t29 - t37;
       const double t39 = h * t38;
       const double t40 = x->p[0] /* p_x */ - t39;
       const double t41 = 0.5 * t32;
-      const double t42 = 0.57735026918962584 * t35;
+      const double t42 = 0.57735026918962573 * t35;
       const double t43 = t41 - t42;
       const double t44 = h * t43;
       const double t45 = x->p[1] /* p_y */ - t44;
-      const double t46 = 0.57735026918962584 * t29;
+      const double t46 = 0.57735026918962573 * t29;
       const double t47 = h * t46;
       const double t48 = -t47;
-      const double t49 = 0.28867513459481292 * t32;
+      const double t49 = 0.28867513459481287 * t32;
       const double t50 = h * t49;
       const double t51 = -t50;
       const double t52 = h * t29;

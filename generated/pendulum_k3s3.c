@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 3 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.1127016653792583   b_1 = 0.27777777777777779
+ *   c_1 = 0.11270166537925831   b_1 = 0.27777777777777779
  *   c_2 = 0.5   b_2 = 0.44444444444444442
  *   c_3 = 0.8872983346207417   b_3 = 0.27777777777777779
  */
@@ -249,9 +249,7 @@ pendulum_k3s3_OUT_OF_LINE void pendulum_k3s3_predict(const pendulum_k3s3_state *
     for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += 13.416407864998739 * x->gam[2 * pendulum_k3s3_M + l];
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += x->gam[1 * pendulum_k3s3_M + l];
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * pendulum_k3s3_M + l];
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * pendulum_k3s3_M + l];
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 3.8459253727671276e-16 * x->gam[1 * pendulum_k3s3_M + l];
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 1.0000000000000016 * x->gam[2 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 0.99999999999999989 * x->gam[2 * pendulum_k3s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -270,13 +268,9 @@ pendulum_k3s3_OUT_OF_LINE void pendulum_k3s3_predict(const pendulum_k3s3_state *
     e = e * r + 3.8729833462074175;
     e = e * r;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += e * x->gam[2 * pendulum_k3s3_M + l];
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 1.1102230246251565e-16 * x->gam[0 * pendulum_k3s3_M + l];
-    e = 1.9229626863835638e-16;
-    e = e * r + 1.9229626863835638e-16;
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += e * x->gam[1 * pendulum_k3s3_M + l];
-    e = 1.0000000000000007;
-    e = e * r + 7.4476024597418194e-16;
-    e = e * r + 2.4825341532472731e-16;
+    e = 0.99999999999999989;
+    e = e * r;
+    e = e * r;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += e * x->gam[2 * pendulum_k3s3_M + l];
   }
 }
@@ -389,26 +383,26 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
     { /* the kernel sweep, inline */
       /* affine derivative entries, projected in closed form */
       const double t0 = gm0 * 0.5;
-      const double t1 = gm2 * 0.28867513459481292;
+      const double t1 = gm2 * 0.28867513459481287;
       const double t2 = t0 - t1;
       const double t3 = h * t2;
       const double t4 = x->q[0] /* x */ + t3;
-      const double t5 = gm0 * 0.28867513459481292;
-      const double t6 = gm4 * 0.12909944487358055;
+      const double t5 = gm0 * 0.28867513459481287;
+      const double t6 = gm4 * 0.12909944487358058;
       const double t7 = t5 - t6;
       const double t8 = h * t7;
-      const double t9 = gm2 * 0.12909944487358055;
+      const double t9 = gm2 * 0.12909944487358058;
       const double t10 = h * t9;
       const double t11 = 0.5 * gm1;
-      const double t12 = 0.28867513459481292 * gm3;
+      const double t12 = 0.28867513459481287 * gm3;
       const double t13 = t11 - t12;
       const double t14 = h * t13;
       const double t15 = x->q[1] /* y */ + t14;
-      const double t16 = 0.28867513459481292 * gm1;
-      const double t17 = 0.12909944487358055 * gm5;
+      const double t16 = 0.28867513459481287 * gm1;
+      const double t17 = 0.12909944487358058 * gm5;
       const double t18 = t16 - t17;
       const double t19 = h * t18;
-      const double t20 = 0.12909944487358055 * gm3;
+      const double t20 = 0.12909944487358058 * gm3;
       const double t21 = h * t20;
       /* multiplier system A lambda = r */
       const double t22 = t4 * t4;
@@ -416,7 +410,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       const double t24 = t22 + t23;
       const double t25 = h * t24;
       const double t26 = 2.0 * t25;
-      const double t27 = t19 * 0.57735026918962584;
+      const double t27 = t19 * 0.57735026918962573;
       const double t28 = t15 + t27;
       const double t29 = h * t28;
       const double t30 = t4 * x->p[0] /* p_x */;
@@ -439,29 +433,29 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
       const double t46 = 2.0 * t45;
       const double t47 = t21 * t36;
       const double t48 = 2.0 * t47;
-      const double t49 = 0.57735026918962584 * t41;
+      const double t49 = 0.57735026918962573 * t41;
       const double t50 = t37 - t49;
       const double t51 = h * t50;
       const double t52 = x->p[0] /* p_x */ - t51;
       const double t53 = 0.5 * t40;
-      const double t54 = 0.57735026918962584 * t43;
+      const double t54 = 0.57735026918962573 * t43;
       const double t55 = t53 - t54;
       const double t56 = h * t55;
       const double t57 = x->p[1] /* p_y */ - t56;
-      const double t58 = 0.57735026918962584 * t37;
-      const double t59 = t45 * 0.2581988897471611;
+      const double t58 = 0.57735026918962573 * t37;
+      const double t59 = t45 * 0.25819888974716115;
       const double t60 = t58 - t59;
       const double t61 = h * t60;
       const double t62 = -t61;
-      const double t63 = 0.28867513459481292 * t40;
-      const double t64 = t47 * 0.2581988897471611;
+      const double t63 = 0.28867513459481287 * t40;
+      const double t64 = t47 * 0.25819888974716115;
       const double t65 = t63 - t64;
       const double t66 = h * t65;
       const double t67 = -t66;
-      const double t68 = t41 * 0.2581988897471611;
+      const double t68 = t41 * 0.25819888974716115;
       const double t69 = h * t68;
       const double t70 = -t69;
-      const double t71 = t43 * 0.2581988897471611;
+      const double t71 = t43 * 0.25819888974716115;
       const double t72 = h * t71;
       const double t73 = -t72;
       const double t74 = h * t37;

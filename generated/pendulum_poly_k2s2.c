@@ -41,7 +41,7 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.21132486540518713   b_1 = 0.5
+ *   c_1 = 0.21132486540518711   b_1 = 0.5
  *   c_2 = 0.78867513459481287   b_2 = 0.5
  */
 /* Model defaults for q0 and p0. */
@@ -55,13 +55,13 @@ static void pendulum_poly_k2s2_factor(const double *q0, const double *p0, const 
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   /* grad g at the stages */
-  const double t0 = gam[0] * 0.21132486540518713;
-  const double t1 = gam[2] * (-0.28867513459481292);
+  const double t0 = gam[0] * 0.21132486540518711;
+  const double t1 = gam[2] * (-0.28867513459481287);
   const double t2 = t0 + t1;
   const double t3 = h * t2;
   const double t4 = q0[0] /* x */ + t3;
-  const double t5 = gam[1] * 0.21132486540518713;
-  const double t6 = gam[3] * (-0.28867513459481292);
+  const double t5 = gam[1] * 0.21132486540518711;
+  const double t6 = gam[3] * (-0.28867513459481287);
   const double t7 = t5 + t6;
   const double t8 = h * t7;
   const double t9 = q0[1] /* y */ + t8;
@@ -76,80 +76,68 @@ static void pendulum_poly_k2s2_factor(const double *q0, const double *p0, const 
   /* the multiplier matrix A, factored once per step */
   const double t18 = t4 + t13;
   const double t19 = t9 + t17;
-  const double t20 = t4 * (-0.99999999999999989);
-  const double t21 = t13 * 0.99999999999999989;
-  const double t22 = t20 + t21;
-  const double t23 = t9 * (-0.99999999999999989);
-  const double t24 = t17 * 0.99999999999999989;
-  const double t25 = t23 + t24;
-  const double t26 = t4 * 0.99999999999999978;
-  const double t27 = t13 * 0.99999999999999978;
-  const double t28 = t26 + t27;
-  const double t29 = t9 * 0.99999999999999978;
-  const double t30 = t17 * 0.99999999999999978;
-  const double t31 = t29 + t30;
-  const double t32 = 0.5 * t18;
-  const double t33 = 0.28867513459481292 * t22;
-  const double t34 = t32 - t33;
-  const double t35 = 0.5 * t19;
-  const double t36 = 0.28867513459481292 * t25;
-  const double t37 = t35 - t36;
-  const double t38 = t18 * t34;
-  const double t39 = t19 * t37;
-  const double t40 = t38 + t39;
-  const double t41 = 0.28867513459481292 * t18;
-  const double t42 = 0.28867513459481292 * t19;
-  const double t43 = t22 * t41;
-  const double t44 = t25 * t42;
-  const double t45 = t43 + t44;
-  const double t46 = t40 + t45;
-  const double t47 = h * t46;
-  const double t48 = 0.5 * t22;
-  const double t49 = 0.28867513459481292 * t28;
-  const double t50 = t48 - t49;
-  const double t51 = 0.5 * t25;
-  const double t52 = 0.28867513459481292 * t31;
-  const double t53 = t51 - t52;
-  const double t54 = t18 * t50;
-  const double t55 = t19 * t53;
-  const double t56 = t54 + t55;
-  const double t57 = t22 * t33;
-  const double t58 = t25 * t36;
-  const double t59 = t57 + t58;
-  const double t60 = t56 + t59;
-  const double t61 = h * t60;
-  const double t62 = t22 * t34;
-  const double t63 = t25 * t37;
-  const double t64 = t62 + t63;
-  const double t65 = t28 * t41;
-  const double t66 = t31 * t42;
-  const double t67 = t65 + t66;
-  const double t68 = t64 + t67;
-  const double t69 = h * t68;
-  const double t70 = t22 * t50;
-  const double t71 = t25 * t53;
-  const double t72 = t70 + t71;
-  const double t73 = t28 * t33;
-  const double t74 = t31 * t36;
-  const double t75 = t73 + t74;
-  const double t76 = t72 + t75;
-  const double t77 = h * t76;
-  const double t78 = t69 / t47;
-  const double t79 = t61 * t78;
-  const double t80 = t77 - t79;
-  const double t81 = 1.0 / t47;
-  const double t82 = 1.0 / t80;
+  const double t20 = t13 - t4;
+  const double t21 = t17 - t9;
+  const double t22 = 0.5 * t18;
+  const double t23 = 0.28867513459481287 * t20;
+  const double t24 = t22 - t23;
+  const double t25 = 0.5 * t19;
+  const double t26 = 0.28867513459481287 * t21;
+  const double t27 = t25 - t26;
+  const double t28 = t18 * t24;
+  const double t29 = t19 * t27;
+  const double t30 = t28 + t29;
+  const double t31 = 0.28867513459481287 * t18;
+  const double t32 = 0.28867513459481287 * t19;
+  const double t33 = t20 * t31;
+  const double t34 = t21 * t32;
+  const double t35 = t33 + t34;
+  const double t36 = t30 + t35;
+  const double t37 = h * t36;
+  const double t38 = 0.5 * t20;
+  const double t39 = t38 - t31;
+  const double t40 = 0.5 * t21;
+  const double t41 = t40 - t32;
+  const double t42 = t18 * t39;
+  const double t43 = t19 * t41;
+  const double t44 = t42 + t43;
+  const double t45 = t20 * t23;
+  const double t46 = t21 * t26;
+  const double t47 = t45 + t46;
+  const double t48 = t44 + t47;
+  const double t49 = h * t48;
+  const double t50 = t20 * t24;
+  const double t51 = t21 * t27;
+  const double t52 = t50 + t51;
+  const double t53 = t18 * t31;
+  const double t54 = t19 * t32;
+  const double t55 = t53 + t54;
+  const double t56 = t52 + t55;
+  const double t57 = h * t56;
+  const double t58 = t20 * t39;
+  const double t59 = t21 * t41;
+  const double t60 = t58 + t59;
+  const double t61 = t18 * t23;
+  const double t62 = t19 * t26;
+  const double t63 = t61 + t62;
+  const double t64 = t60 + t63;
+  const double t65 = h * t64;
+  const double t66 = t57 / t37;
+  const double t67 = t49 * t66;
+  const double t68 = t65 - t67;
+  const double t69 = 1.0 / t37;
+  const double t70 = 1.0 / t68;
   /* lu */
-  out[0] = t81;
-  out[1] = t61;
-  out[2] = t78;
-  out[3] = t82;
+  out[0] = t69;
+  out[1] = t49;
+  out[2] = t66;
+  out[3] = t70;
   /* pivot */
-  out[4] = t47;
-  out[5] = t80;
+  out[4] = t37;
+  out[5] = t68;
   /* adiag */
-  out[6] = t47;
-  out[7] = t77;
+  out[6] = t37;
+  out[7] = t65;
 }
 
 /* out = M^-1 p0: the first step's prediction of gamma_0 */
@@ -398,22 +386,22 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
       for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) ref[i] = 0;
       for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[0 * pendulum_poly_k2s2_M + l] += x->gam[0 * pendulum_poly_k2s2_M + l];
       for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[0 * pendulum_poly_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_poly_k2s2_M + l];
-      for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[1 * pendulum_poly_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * pendulum_poly_k2s2_M + l];
+      for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[1 * pendulum_poly_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_poly_k2s2_M + l];
     }
     for (l = 0; l < pendulum_poly_k2s2_M; l++)
-      gam[0 * pendulum_poly_k2s2_M + l] += (-5.5000000000000036) * x->gam[0 * pendulum_poly_k2s2_M + l] + 6.5000000000000036 * x->gam2[0 * pendulum_poly_k2s2_M + l];
+      gam[0 * pendulum_poly_k2s2_M + l] += (-5.5000000000000009) * x->gam[0 * pendulum_poly_k2s2_M + l] + 6.5000000000000009 * x->gam2[0 * pendulum_poly_k2s2_M + l];
     for (l = 0; l < pendulum_poly_k2s2_M; l++)
-      gam[0 * pendulum_poly_k2s2_M + l] += 16.454482671904344 * x->gam[1 * pendulum_poly_k2s2_M + l] + 9.5262794416288337 * x->gam2[1 * pendulum_poly_k2s2_M + l];
+      gam[0 * pendulum_poly_k2s2_M + l] += 16.454482671904337 * x->gam[1 * pendulum_poly_k2s2_M + l] + 9.5262794416288283 * x->gam2[1 * pendulum_poly_k2s2_M + l];
     for (l = 0; l < pendulum_poly_k2s2_M; l++)
-      gam[1 * pendulum_poly_k2s2_M + l] += (-4.3301270189221963) * x->gam[0 * pendulum_poly_k2s2_M + l] + 4.3301270189221963 * x->gam2[0 * pendulum_poly_k2s2_M + l];
+      gam[1 * pendulum_poly_k2s2_M + l] += (-4.3301270189221945) * x->gam[0 * pendulum_poly_k2s2_M + l] + 4.3301270189221945 * x->gam2[0 * pendulum_poly_k2s2_M + l];
     for (l = 0; l < pendulum_poly_k2s2_M; l++)
-      gam[1 * pendulum_poly_k2s2_M + l] += 9.5000000000000071 * x->gam[1 * pendulum_poly_k2s2_M + l] + 6.5000000000000071 * x->gam2[1 * pendulum_poly_k2s2_M + l];
+      gam[1 * pendulum_poly_k2s2_M + l] += 9.5000000000000053 * x->gam[1 * pendulum_poly_k2s2_M + l] + 6.5000000000000044 * x->gam2[1 * pendulum_poly_k2s2_M + l];
     return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += x->gam[0 * pendulum_poly_k2s2_M + l];
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_poly_k2s2_M + l];
-    for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[1 * pendulum_poly_k2s2_M + l] += 0.99999999999999967 * x->gam[1 * pendulum_poly_k2s2_M + l];
+    for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[1 * pendulum_poly_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_poly_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -421,7 +409,7 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += e * x->gam[1 * pendulum_poly_k2s2_M + l];
-    e = 0.99999999999999967;
+    e = 0.99999999999999989;
     e = e * r;
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[1 * pendulum_poly_k2s2_M + l] += e * x->gam[1 * pendulum_poly_k2s2_M + l];
   }
@@ -565,13 +553,13 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
     }
     { /* the kernel sweep, inline */
       /* grad g at the stages */
-      const double t0 = gm0 * 0.21132486540518713;
-      const double t1 = gm2 * (-0.28867513459481292);
+      const double t0 = gm0 * 0.21132486540518711;
+      const double t1 = gm2 * (-0.28867513459481287);
       const double t2 = t0 + t1;
       const double t3 = h * t2;
       const double t4 = x->q[0] /* x */ + t3;
-      const double t5 = gm1 * 0.21132486540518713;
-      const double t6 = gm3 * (-0.28867513459481292);
+      const double t5 = gm1 * 0.21132486540518711;
+      const double t6 = gm3 * (-0.28867513459481287);
       const double t7 = t5 + t6;
       const double t8 = h * t7;
       const double t9 = x->q[1] /* y */ + t8;
@@ -584,116 +572,98 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
       const double t16 = h * t15;
       const double t17 = x->q[1] /* y */ + t16;
       /* the multiplier coefficients: lambda += A^-1 C(lambda) */
-      const double t18 = (-0.99999999999999989) * lm1;
-      const double t19 = lm0 + t18;
-      const double t20 = t4 * t19;
-      const double t21 = t9 * t19;
-      const double t22 = 1.0 + t21;
-      const double t23 = (-0.99999999999999989) * t20;
-      const double t24 = (-0.99999999999999989) * t21;
-      const double t25 = 0.99999999999999989 * lm1;
-      const double t26 = lm0 + t25;
-      const double t27 = t13 * t26;
-      const double t28 = t17 * t26;
-      const double t29 = t20 + t27;
-      const double t30 = t22 + t28;
-      const double t31 = 0.99999999999999989 * t27;
-      const double t32 = t23 + t31;
-      const double t33 = 0.99999999999999989 * t28;
-      const double t34 = t24 + t33;
-      const double t35 = 0.5 * t29;
-      const double t36 = 0.28867513459481292 * t32;
-      const double t37 = t35 - t36;
-      const double t38 = h * t37;
-      const double t39 = x->p[0] /* p_x */ - t38;
-      const double t40 = 0.5 * t30;
-      const double t41 = 0.28867513459481292 * t34;
-      const double t42 = t40 - t41;
-      const double t43 = h * t42;
-      const double t44 = x->p[1] /* p_y */ - t43;
-      const double t45 = 0.28867513459481292 * t29;
-      const double t46 = h * t45;
-      const double t47 = 0.28867513459481292 * t30;
-      const double t48 = h * t47;
-      const double t49 = (-0.99999999999999989) * t46;
-      const double t50 = t39 - t49;
-      const double t51 = (-0.99999999999999989) * t48;
-      const double t52 = t44 - t51;
-      const double t53 = t4 * t50;
-      const double t54 = t9 * t52;
-      const double t55 = t53 + t54;
-      const double t56 = (-0.99999999999999989) * t55;
-      const double t57 = 0.99999999999999989 * t46;
-      const double t58 = t39 - t57;
-      const double t59 = 0.99999999999999989 * t48;
-      const double t60 = t44 - t59;
-      const double t61 = t13 * t58;
-      const double t62 = t17 * t60;
-      const double t63 = t61 + t62;
-      const double t64 = t55 + t63;
-      const double t65 = 0.99999999999999989 * t63;
-      const double t66 = t56 + t65;
-      const double t67 = t64 + g0[0];
-      const double t68 = fa[2] * t67;
-      const double t69 = t66 - t68;
-      const double t70 = fa[3] * t69;
-      const double t71 = fa[1] * t70;
-      const double t72 = t67 - t71;
-      const double t73 = fa[0] * t72;
-      const double t74 = lm0 + t73;
-      const double t75 = lm1 + t70;
+      const double t18 = lm0 - lm1;
+      const double t19 = t4 * t18;
+      const double t20 = t9 * t18;
+      const double t21 = 1.0 + t20;
+      const double t22 = lm0 + lm1;
+      const double t23 = t13 * t22;
+      const double t24 = t17 * t22;
+      const double t25 = t19 + t23;
+      const double t26 = t21 + t24;
+      const double t27 = t23 - t19;
+      const double t28 = t24 - t20;
+      const double t29 = 0.5 * t25;
+      const double t30 = 0.28867513459481287 * t27;
+      const double t31 = t29 - t30;
+      const double t32 = h * t31;
+      const double t33 = x->p[0] /* p_x */ - t32;
+      const double t34 = 0.5 * t26;
+      const double t35 = 0.28867513459481287 * t28;
+      const double t36 = t34 - t35;
+      const double t37 = h * t36;
+      const double t38 = x->p[1] /* p_y */ - t37;
+      const double t39 = 0.28867513459481287 * t25;
+      const double t40 = h * t39;
+      const double t41 = 0.28867513459481287 * t26;
+      const double t42 = h * t41;
+      const double t43 = t33 + t40;
+      const double t44 = t38 + t42;
+      const double t45 = t4 * t43;
+      const double t46 = t9 * t44;
+      const double t47 = t45 + t46;
+      const double t48 = t33 - t40;
+      const double t49 = t38 - t42;
+      const double t50 = t13 * t48;
+      const double t51 = t17 * t49;
+      const double t52 = t50 + t51;
+      const double t53 = t47 + t52;
+      const double t54 = t52 - t47;
+      const double t55 = t53 + g0[0];
+      const double t56 = fa[2] * t55;
+      const double t57 = t54 - t56;
+      const double t58 = fa[3] * t57;
+      const double t59 = fa[1] * t58;
+      const double t60 = t55 - t59;
+      const double t61 = fa[0] * t60;
+      const double t62 = lm0 + t61;
+      const double t63 = lm1 + t58;
       /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)] */
-      const double t76 = (-0.99999999999999989) * t75;
-      const double t77 = t74 + t76;
-      const double t78 = t4 * t77;
-      const double t79 = t9 * t77;
-      const double t80 = 1.0 + t79;
-      const double t81 = (-0.99999999999999989) * t78;
-      const double t82 = (-0.99999999999999989) * t79;
-      const double t83 = 0.99999999999999989 * t75;
-      const double t84 = t74 + t83;
-      const double t85 = t13 * t84;
-      const double t86 = t17 * t84;
-      const double t87 = t78 + t85;
-      const double t88 = t80 + t86;
-      const double t89 = 0.99999999999999989 * t85;
-      const double t90 = t81 + t89;
-      const double t91 = 0.99999999999999989 * t86;
-      const double t92 = t82 + t91;
-      const double t93 = 0.5 * t87;
-      const double t94 = 0.28867513459481292 * t90;
-      const double t95 = t93 - t94;
-      const double t96 = h * t95;
-      const double t97 = x->p[0] /* p_x */ - t96;
-      const double t98 = 0.5 * t88;
-      const double t99 = 0.28867513459481292 * t92;
-      const double t100 = t98 - t99;
-      const double t101 = h * t100;
-      const double t102 = x->p[1] /* p_y */ - t101;
-      const double t103 = 0.28867513459481292 * t87;
-      const double t104 = h * t103;
-      const double t105 = -t104;
-      const double t106 = 0.28867513459481292 * t88;
-      const double t107 = h * t106;
-      const double t108 = -t107;
-      const double t109 = h * t87;
-      const double t110 = -t109;
-      const double t111 = h * t88;
-      const double t112 = -t111;
+      const double t64 = t62 - t63;
+      const double t65 = t4 * t64;
+      const double t66 = t9 * t64;
+      const double t67 = 1.0 + t66;
+      const double t68 = t62 + t63;
+      const double t69 = t13 * t68;
+      const double t70 = t17 * t68;
+      const double t71 = t65 + t69;
+      const double t72 = t67 + t70;
+      const double t73 = t69 - t65;
+      const double t74 = t70 - t66;
+      const double t75 = 0.5 * t71;
+      const double t76 = 0.28867513459481287 * t73;
+      const double t77 = t75 - t76;
+      const double t78 = h * t77;
+      const double t79 = x->p[0] /* p_x */ - t78;
+      const double t80 = 0.5 * t72;
+      const double t81 = 0.28867513459481287 * t74;
+      const double t82 = t80 - t81;
+      const double t83 = h * t82;
+      const double t84 = x->p[1] /* p_y */ - t83;
+      const double t85 = 0.28867513459481287 * t71;
+      const double t86 = h * t85;
+      const double t87 = -t86;
+      const double t88 = 0.28867513459481287 * t72;
+      const double t89 = h * t88;
+      const double t90 = -t89;
+      const double t91 = h * t71;
+      const double t92 = -t91;
+      const double t93 = h * t72;
+      const double t94 = -t93;
       /* gam */
-      sw0 = t97;
-      sw1 = t102;
-      sw2 = t105;
-      sw3 = t108;
+      sw0 = t79;
+      sw1 = t84;
+      sw2 = t87;
+      sw3 = t90;
       /* dp */
-      sw4 = t110;
-      sw5 = t112;
+      sw4 = t92;
+      sw5 = t94;
       /* lam */
-      sw6 = t74;
-      sw7 = t75;
+      sw6 = t62;
+      sw7 = t63;
       /* theta */
-      sw8 = t90;
-      sw9 = t92;
+      sw8 = t73;
+      sw9 = t74;
     }
     /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */
     inc_old = inc;

@@ -41,8 +41,8 @@
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
- *   c_1 = 0.033765242898423975   b_1 = 0.085662246189585178
- *   c_2 = 0.16939530676686776   b_2 = 0.1803807865240693
+ *   c_1 = 0.033765242898423989   b_1 = 0.085662246189585178
+ *   c_2 = 0.16939530676686773   b_2 = 0.1803807865240693
  *   c_3 = 0.38069040695840156   b_3 = 0.23395696728634552
  *   c_4 = 0.61930959304159849   b_4 = 0.23395696728634552
  *   c_5 = 0.83060469323313224   b_5 = 0.1803807865240693
@@ -967,31 +967,31 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       const double t67 = t21 - t32;
       const double t68 = t49 + t67;
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t69 = gm0 * 0.033765242898423975;
+      const double t69 = gm0 * 0.033765242898423989;
       const double t70 = h * t69;
       const double t71 = x->q[0] /* x1 */ + t70;
-      const double t72 = gm1 * 0.033765242898423975;
+      const double t72 = gm1 * 0.033765242898423989;
       const double t73 = h * t72;
       const double t74 = x->q[1] /* y1 */ + t73;
-      const double t75 = gm2 * 0.033765242898423975;
+      const double t75 = gm2 * 0.033765242898423989;
       const double t76 = h * t75;
       const double t77 = x->q[2] /* z1 */ + t76;
-      const double t78 = gm3 * 0.033765242898423975;
+      const double t78 = gm3 * 0.033765242898423989;
       const double t79 = h * t78;
       const double t80 = x->q[3] /* x2 */ + t79;
-      const double t81 = gm4 * 0.033765242898423975;
+      const double t81 = gm4 * 0.033765242898423989;
       const double t82 = h * t81;
       const double t83 = x->q[4] /* y2 */ + t82;
-      const double t84 = gm5 * 0.033765242898423975;
+      const double t84 = gm5 * 0.033765242898423989;
       const double t85 = h * t84;
       const double t86 = x->q[5] /* z2 */ + t85;
-      const double t87 = gm6 * 0.033765242898423975;
+      const double t87 = gm6 * 0.033765242898423989;
       const double t88 = h * t87;
       const double t89 = x->q[6] /* x3 */ + t88;
-      const double t90 = gm7 * 0.033765242898423975;
+      const double t90 = gm7 * 0.033765242898423989;
       const double t91 = h * t90;
       const double t92 = x->q[7] /* y3 */ + t91;
-      const double t93 = gm8 * 0.033765242898423975;
+      const double t93 = gm8 * 0.033765242898423989;
       const double t94 = h * t93;
       const double t95 = x->q[8] /* z3 */ + t94;
       const double t96 = t71 * t71;
@@ -1040,31 +1040,31 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
       const double t139 = t120 * 0.085662246189585178;
       const double t140 = t119 * 0.085662246189585178;
       /* stage 2 of 6: Q = q0 + h sum_j Ihat[2][j] gamma_j, grad U(Q), grad g(Q) */
-      const double t141 = gm0 * 0.16939530676686776;
+      const double t141 = gm0 * 0.16939530676686773;
       const double t142 = h * t141;
       const double t143 = x->q[0] /* x1 */ + t142;
-      const double t144 = gm1 * 0.16939530676686776;
+      const double t144 = gm1 * 0.16939530676686773;
       const double t145 = h * t144;
       const double t146 = x->q[1] /* y1 */ + t145;
-      const double t147 = gm2 * 0.16939530676686776;
+      const double t147 = gm2 * 0.16939530676686773;
       const double t148 = h * t147;
       const double t149 = x->q[2] /* z1 */ + t148;
-      const double t150 = gm3 * 0.16939530676686776;
+      const double t150 = gm3 * 0.16939530676686773;
       const double t151 = h * t150;
       const double t152 = x->q[3] /* x2 */ + t151;
-      const double t153 = gm4 * 0.16939530676686776;
+      const double t153 = gm4 * 0.16939530676686773;
       const double t154 = h * t153;
       const double t155 = x->q[4] /* y2 */ + t154;
-      const double t156 = gm5 * 0.16939530676686776;
+      const double t156 = gm5 * 0.16939530676686773;
       const double t157 = h * t156;
       const double t158 = x->q[5] /* z2 */ + t157;
-      const double t159 = gm6 * 0.16939530676686776;
+      const double t159 = gm6 * 0.16939530676686773;
       const double t160 = h * t159;
       const double t161 = x->q[6] /* x3 */ + t160;
-      const double t162 = gm7 * 0.16939530676686776;
+      const double t162 = gm7 * 0.16939530676686773;
       const double t163 = h * t162;
       const double t164 = x->q[7] /* y3 */ + t163;
-      const double t165 = gm8 * 0.16939530676686776;
+      const double t165 = gm8 * 0.16939530676686773;
       const double t166 = h * t165;
       const double t167 = x->q[8] /* z3 */ + t166;
       const double t168 = t143 * t143;
