@@ -117,13 +117,18 @@ static int node_degree(const Dag *d, const Node *n) {
   }
 }
 
+// The slot of node *proto in the hash table: its id's, or the empty one
+// where it would go.
+static uint64_t slot_of(const Dag *d, const Node *proto) {
+  uint64_t h = hash_node(proto) & (uint64_t)(d->tcap - 1);
+  while (d->table[h] >= 0 && !same_node(&d->nodes[d->table[h]], proto)) h = (h + 1) & (uint64_t)(d->tcap - 1);
+  return h;
+}
+
 // Find or create the node *proto; returns its id.
 static int intern(Dag *d, Node proto) {
-  uint64_t h = hash_node(&proto) & (uint64_t)(d->tcap - 1);
-  while (d->table[h] >= 0) {
-    if (same_node(&d->nodes[d->table[h]], &proto)) return d->table[h];
-    h = (h + 1) & (uint64_t)(d->tcap - 1);
-  }
+  uint64_t h = slot_of(d, &proto);
+  if (d->table[h] >= 0) return d->table[h];
   if (d->n >= MAX_NODES)
     fatal_at(d->where, "the model needs more than %d expression nodes%s", MAX_NODES,
              d->where_note ? d->where_note : d->where.line ? " (the limit was reached building this statement)" : "");
@@ -144,6 +149,14 @@ static Node leaf(Op op) {
   n.op = (unsigned char)op;
   n.a = n.b = -1;
   return n;
+}
+
+// The node op(a, b) if the DAG has it, else -1 (nothing is created).
+static int existing(const Dag *d, Op op, int a, int b) {
+  Node n = leaf(op);
+  n.a = a;
+  n.b = b;
+  return d->table[slot_of(d, &n)];
 }
 
 int dag_const(Dag *d, double v) {
@@ -274,6 +287,9 @@ static int simplify(Dag *d, Op op, int a, int b) {
     if (dag_is_zero(d, a)) return dag_op(d, OP_NEG, b, -1);
     if (a == b) return dag_const(d, 0);
     if (is_neg(d, b)) return dag_op(d, OP_ADD, a, d->nodes[b].a);
+    if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_ADD, d->nodes[a].a, b), -1); /* -a - b = -(a + b) */
+    if (existing(d, OP_SUB, b, a) >= 0) /* a - b = -(b - a), shared */
+      return dag_op(d, OP_NEG, existing(d, OP_SUB, b, a), -1);
     return float_pow2_sum(d, op, a, b);
   case OP_MUL:
     if (dag_is_zero(d, a) || dag_is_zero(d, b)) return dag_const(d, 0);

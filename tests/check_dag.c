@@ -274,6 +274,8 @@ static const struct {
     {"2 x * y *", "2 x y * *"},                  {"2 x * 2 y * +", "2 x y + *"},
     {"2 x * -2 y * +", "2 x y - *"},             {"4 x * y * 3 *", "12 x y * *"},
     {"2 x * 4 y * +", "4 y * 2 x * +"},          {"3 x * y *", "3 x * y *"},
+    /* differences shared with their reverse, negations out of differences (exact) */
+    {"x y - y x - +", "0"},                      {"x ~ y -", "x y + ~"},
 };
 
 START_TEST(test_simplify)
