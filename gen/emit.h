@@ -52,6 +52,7 @@ int emit_kernel_inline(Emitter *e, KernelId k);
 int energy_defect_wanted(const Emitter *e);
 int mult_err_wanted(const Emitter *e);
 int itol_wanted(const Emitter *e);
+void emit_two_step_start(Emitter *e, const char *ind, const char *row);
 void emit_step_factor(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */

@@ -132,19 +132,10 @@ static void emit_predict_uniform(Emitter *e, int poly) {
           "          if (c != 0)\n            for (l = 0; l < $P_M * $P_W; l++) a[l] += c * x->gam[i * $P_M * $P_W + l];\n"
           "        }\n      }\n");
   if (poly) {
-    int s = e->me->s;
+    char row[80];
+    snprintf(row, sizeof row, "%s_M * %s_W", e->P, e->P);
     tmpl(e, "    if (two0) {  /* the two-step start, its coefficients E2 as literals */\n");
-    for (int j = 0; j < s; j++) {
-      tmpl(e, "      for (l = 0; l < $P_M * $P_W; l++) {\n        $R b = 0;\n");
-      for (int i = 0; i < s; i++) {
-        char a[40], b[40];
-        format_real(e, a, sizeof a, e->me->E2[2 * s * j + i]);
-        format_real(e, b, sizeof b, e->me->E2[2 * s * j + s + i]);
-        out(e, "        b += %s * x->gam[%d * %s_M * %s_W + l] + %s * x->gam2[%d * %s_M * %s_W + l];\n", a, i, e->P,
-            e->P, b, i, e->P, e->P);
-      }
-      out(e, "        gam[%d * %s_M * %s_W + l] = b;\n      }\n", j, e->P, e->P);
-    }
+    emit_two_step_start(e, "      ", row);
     tmpl(e, "    } else if (ref)\n");
   } else
     tmpl(e, "    if (ref)\n");

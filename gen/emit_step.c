@@ -806,6 +806,24 @@ static void emit_warm_term(Emitter *e, const char *ind, const char *to, int j, i
       i, e->P);
 }
 
+// The two-step start into gam, each value summed from 0 over the S steps
+// in that order, E2's coefficients as literals, one loop a row: gamma_j =
+// sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, row the length of a
+// row of x->gam (M for the step, M W for --batch's lanes). ind: the indent.
+void emit_two_step_start(Emitter *e, const char *ind, const char *row) {
+  int s = e->me->s;
+  for (int j = 0; j < s; j++) {
+    out(e, "%sfor (l = 0; l < %s; l++) {\n%s  %s b = 0;\n", ind, row, ind, real_type(e, 0));
+    for (int i = 0; i < s; i++) {
+      char a[40], b[40];
+      format_real(e, a, sizeof a, e->me->E2[2 * s * j + i]);
+      format_real(e, b, sizeof b, e->me->E2[2 * s * j + s + i]);
+      out(e, "%s  b += %s * x->gam[%d * %s + l] + %s * x->gam2[%d * %s + l];\n", ind, a, i, row, b, i, row);
+    }
+    out(e, "%s  gam[%d * %s + l] = b;\n%s}\n", ind, j, row, ind);
+  }
+}
+
 // The warm start of a step as long as the last one, into to:
 // gamma_j += E[j][i](1) gamma_i, the zero terms left out.
 static void emit_predict_same_size(Emitter *e, const char *ind, const char *to) {
@@ -877,21 +895,15 @@ static void emit_predict(Emitter *e) {
    * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
    * (pendulum, h = 0.1); the polynomial family restores H every step. */
   if (poly) {
-    int s = e->me->s;
     tmpl(e, "  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i\n"
             "                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */\n"
             "    if (ref) {  /* the one-step start, for the estimate */\n"
             "      for (i = 0; i < $P_S * $P_M; i++) ref[i] = 0;\n");
     emit_predict_same_size(e, "      ", "ref");
     tmpl(e, "    }\n");
-    for (int j = 0; j < s; j++)
-      for (int i = 0; i < s; i++) {
-        char a[40], b[40];
-        format_real(e, a, sizeof a, e->me->E2[2 * s * j + i]);
-        format_real(e, b, sizeof b, e->me->E2[2 * s * j + s + i]);
-        out(e, "    for (l = 0; l < %s_M; l++)\n      gam[%d * %s_M + l] += %s * x->gam[%d * %s_M + l] + %s * x->gam2[%d * %s_M + l];\n",
-            e->P, j, e->P, a, i, e->P, b, i, e->P);
-      }
+    char row[80];
+    snprintf(row, sizeof row, "%s_M", e->P);
+    emit_two_step_start(e, "    ", row);
     tmpl(e, "    return 1;\n  }\n");
   }
   tmpl(e, "  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */\n");

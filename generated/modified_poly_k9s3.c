@@ -1129,24 +1129,27 @@ modified_poly_k9s3_OUT_OF_LINE int modified_poly_k9s3_predict(const modified_pol
       for (l = 0; l < modified_poly_k9s3_M; l++) ref[2 * modified_poly_k9s3_M + l] += (-2.4037033579794548e-17) * x->gam[1 * modified_poly_k9s3_M + l];
       for (l = 0; l < modified_poly_k9s3_M; l++) ref[2 * modified_poly_k9s3_M + l] += 0.99999999999999967 * x->gam[2 * modified_poly_k9s3_M + l];
     }
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[0 * modified_poly_k9s3_M + l] += 69.499999999999417 * x->gam[0 * modified_poly_k9s3_M + l] + (-68.499999999999417) * x->gam2[0 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[0 * modified_poly_k9s3_M + l] += (-121.78482240718566) * x->gam[1 * modified_poly_k9s3_M + l] + (-112.04203661461078) * x->gam2[1 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[0 * modified_poly_k9s3_M + l] += 166.44731007513903 * x->gam[2 * modified_poly_k9s3_M + l] + (-101.88084722483329) * x->gam2[2 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[1 * modified_poly_k9s3_M + l] += 63.219854476263507 * x->gam[0 * modified_poly_k9s3_M + l] + (-63.219854476263507) * x->gam2[0 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[1 * modified_poly_k9s3_M + l] += (-114.06249999999912) * x->gam[1 * modified_poly_k9s3_M + l] + (-103.93749999999915) * x->gam2[1 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[1 * modified_poly_k9s3_M + l] += 146.25353361115623 * x->gam[2 * modified_poly_k9s3_M + l] + (-95.420627192184469) * x->gam2[2 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[2 * modified_poly_k9s3_M + l] += 23.478713763747635 * x->gam[0 * modified_poly_k9s3_M + l] + (-23.478713763747631) * x->gam2[0 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[2 * modified_poly_k9s3_M + l] += (-42.360755349143339) * x->gam[1 * modified_poly_k9s3_M + l] + (-38.971894921211863) * x->gam2[1 * modified_poly_k9s3_M + l];
-    for (l = 0; l < modified_poly_k9s3_M; l++)
-      gam[2 * modified_poly_k9s3_M + l] += 50.562499999999574 * x->gam[2 * modified_poly_k9s3_M + l] + (-36.437499999999758) * x->gam2[2 * modified_poly_k9s3_M + l];
+    for (l = 0; l < modified_poly_k9s3_M; l++) {
+      double b = 0;
+      b += 69.499999999999417 * x->gam[0 * modified_poly_k9s3_M + l] + (-68.499999999999417) * x->gam2[0 * modified_poly_k9s3_M + l];
+      b += (-121.78482240718566) * x->gam[1 * modified_poly_k9s3_M + l] + (-112.04203661461078) * x->gam2[1 * modified_poly_k9s3_M + l];
+      b += 166.44731007513903 * x->gam[2 * modified_poly_k9s3_M + l] + (-101.88084722483329) * x->gam2[2 * modified_poly_k9s3_M + l];
+      gam[0 * modified_poly_k9s3_M + l] = b;
+    }
+    for (l = 0; l < modified_poly_k9s3_M; l++) {
+      double b = 0;
+      b += 63.219854476263507 * x->gam[0 * modified_poly_k9s3_M + l] + (-63.219854476263507) * x->gam2[0 * modified_poly_k9s3_M + l];
+      b += (-114.06249999999912) * x->gam[1 * modified_poly_k9s3_M + l] + (-103.93749999999915) * x->gam2[1 * modified_poly_k9s3_M + l];
+      b += 146.25353361115623 * x->gam[2 * modified_poly_k9s3_M + l] + (-95.420627192184469) * x->gam2[2 * modified_poly_k9s3_M + l];
+      gam[1 * modified_poly_k9s3_M + l] = b;
+    }
+    for (l = 0; l < modified_poly_k9s3_M; l++) {
+      double b = 0;
+      b += 23.478713763747635 * x->gam[0 * modified_poly_k9s3_M + l] + (-23.478713763747631) * x->gam2[0 * modified_poly_k9s3_M + l];
+      b += (-42.360755349143339) * x->gam[1 * modified_poly_k9s3_M + l] + (-38.971894921211863) * x->gam2[1 * modified_poly_k9s3_M + l];
+      b += 50.562499999999574 * x->gam[2 * modified_poly_k9s3_M + l] + (-36.437499999999758) * x->gam2[2 * modified_poly_k9s3_M + l];
+      gam[2 * modified_poly_k9s3_M + l] = b;
+    }
     return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */

@@ -322,8 +322,11 @@ pendulum_poly_k1s1_OUT_OF_LINE int pendulum_poly_k1s1_predict(const pendulum_pol
       for (i = 0; i < pendulum_poly_k1s1_S * pendulum_poly_k1s1_M; i++) ref[i] = 0;
       for (l = 0; l < pendulum_poly_k1s1_M; l++) ref[0 * pendulum_poly_k1s1_M + l] += x->gam[0 * pendulum_poly_k1s1_M + l];
     }
-    for (l = 0; l < pendulum_poly_k1s1_M; l++)
-      gam[0 * pendulum_poly_k1s1_M + l] += 2.0 * x->gam[0 * pendulum_poly_k1s1_M + l] + (-1.0) * x->gam2[0 * pendulum_poly_k1s1_M + l];
+    for (l = 0; l < pendulum_poly_k1s1_M; l++) {
+      double b = 0;
+      b += 2.0 * x->gam[0 * pendulum_poly_k1s1_M + l] + (-1.0) * x->gam2[0 * pendulum_poly_k1s1_M + l];
+      gam[0 * pendulum_poly_k1s1_M + l] = b;
+    }
     return 1;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
