@@ -253,12 +253,15 @@ static int pow2_scaled(const Dag *d, int id, double *scale, int *x) {
 // underflows), so such a factor floats up the products until it cancels
 // (the 2 of d(x^2)/dx against a 1/2) or merges into a constant (a weight,
 // merge_factors), and its own multiplication is gone. -1 when neither factor
-// is scaled.
+// is scaled, or when the two scales' product would leave the normal range
+// (2^1000 * 2^1000: no constant may be infinite, and none subnormal).
 static int float_pow2(Dag *d, int a, int b) {
   double sa = 1, sb = 1;
   int xa = a, xb = b, fa = pow2_scaled(d, a, &sa, &xa), fb = pow2_scaled(d, b, &sb, &xb);
   if (!fa && !fb) return -1;
-  return dag_op(d, OP_MUL, dag_const(d, sa * sb), dag_op(d, OP_MUL, xa, xb));
+  double scale = sa * sb;
+  if (!isfinite(scale) || fabs(scale) < 0x1p-1000) return -1;
+  return dag_op(d, OP_MUL, dag_const(d, scale), dag_op(d, OP_MUL, xa, xb));
 }
 
 // (2^e x) +- (2^e y) -> 2^e (x +- y): the common power of two floats on

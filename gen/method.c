@@ -8,8 +8,10 @@
  * computed in long double and rounded once, so that a value that is exact,
  * such as P_1 = +-1 at the nodes of k = 2, is exact in the table and the
  * DAG folds its product away (GSL's nodes were up to a few ulps off); the
- * warm start's tables in double. All are printed into the generated code
- * with 17 significant digits. */
+ * rounding is faithful, not always correct (a value within about 1e-19 of
+ * a tie between two doubles may go either way); the warm start's tables in
+ * double. All are printed into the generated code with 17 significant
+ * digits. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -42,8 +44,8 @@ static double legendre_shifted(int j, double x) { return (double)pshift_ld(j, x)
 
 static long double xi_ld(int j) { return 1 / (2 * sqrtl(fabsl(4.0L * j * j - 1))); }
 
-// Gauss node l of k on [0,1] (GSL's, in double) refined by two Newton steps
-// on L_k(2x-1) in long double, and its weight 1 / ((1 - t^2) L_k'(t)^2).
+// The Gauss node c of k on [0,1] (GSL's, in double) refined by two Newton
+// steps on L_k(2x-1) in long double, and its weight 1 / ((1 - t^2) L_k'(t)^2).
 static long double gauss_node_ld(int k, double c, long double *weight) {
   long double t = 2.0L * c - 1, prev, l, dl = 1;
   for (int it = 0; it < 2; it++) {

@@ -312,6 +312,16 @@ START_TEST(test_pow2_exact)
     ck_assert_msg(!mark[id] || !two, "node %d is a product by 2 or 1/2", id);
   }
   free(mark);
+  /* scales whose product leaves the normal range stay where they are */
+  int big = dag_const(d, 0x1p1000), tiny = dag_const(d, 0x1p-1000), x = rpn(d, "x"), y = rpn(d, "y");
+  int huge = dag_mul(d, dag_mul(d, big, x), dag_mul(d, big, y)), small = dag_mul(d, dag_mul(d, tiny, x), dag_mul(d, tiny, y));
+  for (int id = 0; id < d->n; id++)
+    ck_assert_msg(!bad_const(d, id) && !(d->nodes[id].op == OP_CONST && d->nodes[id].val != 0 &&
+                                         fabs(d->nodes[id].val) < 0x1p-1000),
+                  "node %d is the constant %g", id, d->nodes[id].val);
+  double v[3] = {0.75, -1.5, 0};
+  ck_assert(dag_eval(d, huge, v, NULL) == (0x1p1000 * 0.75) * (0x1p1000 * -1.5));
+  ck_assert(dag_eval(d, small, v, NULL) == (0x1p-1000 * 0.75) * (0x1p-1000 * -1.5));
   srand(SEED);
   for (int pt = 0; pt < 1000; pt++) {
     double v[3] = {uniform(-3, 3), uniform(-3, 3), uniform(-3, 3)};
