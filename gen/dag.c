@@ -285,15 +285,16 @@ static int simplify(Dag *d, Op op, int a, int b) {
     if (is_neg(d, b)) return dag_op(d, OP_SUB, a, d->nodes[b].a);
     if (is_neg(d, a)) return dag_op(d, OP_SUB, b, d->nodes[a].a);
     return float_pow2_sum(d, op, a, b);
-  case OP_SUB:
+  case OP_SUB: {
     if (dag_is_zero(d, b)) return a;
     if (dag_is_zero(d, a)) return dag_op(d, OP_NEG, b, -1);
     if (a == b) return dag_const(d, 0);
     if (is_neg(d, b)) return dag_op(d, OP_ADD, a, d->nodes[b].a);
     if (is_neg(d, a)) return dag_op(d, OP_NEG, dag_op(d, OP_ADD, d->nodes[a].a, b), -1); /* -a - b = -(a + b) */
-    if (existing(d, OP_SUB, b, a) >= 0) /* a - b = -(b - a), shared */
-      return dag_op(d, OP_NEG, existing(d, OP_SUB, b, a), -1);
+    int reverse = existing(d, OP_SUB, b, a);
+    if (reverse >= 0) return dag_op(d, OP_NEG, reverse, -1); /* a - b = -(b - a), shared */
     return float_pow2_sum(d, op, a, b);
+  }
   case OP_MUL:
     if (dag_is_zero(d, a) || dag_is_zero(d, b)) return dag_const(d, 0);
     if (dag_is_const(d, a, 1)) return b;
