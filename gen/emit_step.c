@@ -886,17 +886,14 @@ static void emit_predict(Emitter *e) {
             "{\n");
   else
     tmpl(e, "$P_OUT_OF_LINE void $P_predict(const $P_state *x, $R h, int cold, const $P_params *prm, $R *gam)\n{\n");
-  tmpl(e, "  int i, l;\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n");
-  tmpl(e, poly ? "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return 0;\n  }\n"
-               : "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n");
+  tmpl(e, "  int i, l;\n");
   /* The two-step start saves 7-25% of the sweeps (bench/README.md), in the
    * polynomial family only: it changes where the iteration stops, and the
    * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
    * (pendulum, h = 0.1); the polynomial family restores H every step. */
   if (poly) {
-    tmpl(e, "  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i\n"
-            "                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */\n"
+    tmpl(e, "  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:\n"
+            "      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */\n"
             "    if (ref) {  /* the one-step start, for the estimate */\n"
             "      for (i = 0; i < $P_S * $P_M; i++) ref[i] = 0;\n");
     emit_predict_same_size(e, "      ", "ref");
@@ -906,6 +903,10 @@ static void emit_predict(Emitter *e) {
     emit_two_step_start(e, "    ", row);
     tmpl(e, "    return 1;\n  }\n");
   }
+  /* the other starts add into gam, or set gamma_0 alone */
+  tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = 0;\n");
+  tmpl(e, poly ? "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return 0;\n  }\n"
+               : "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n");
   tmpl(e, "  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */\n");
   emit_predict_same_size(e, "    ", "gam");
   tmpl(e, "  } else {\n");

@@ -444,13 +444,8 @@ void conical_poly_k2s2_hidden(const conical_poly_k2s2_state *x, const conical_po
 conical_poly_k2s2_OUT_OF_LINE int conical_poly_k2s2_predict(const conical_poly_k2s2_state *x, double h, int cold, const conical_poly_k2s2_params *prm, double *gam, double *ref)
 {
   int i, l;
-  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) gam[i] = 0;
-  if (cold || x->hprev == 0) {
-    conical_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return 0;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:
+      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */
     if (ref) {  /* the one-step start, for the estimate */
       for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) ref[i] = 0;
       for (l = 0; l < conical_poly_k2s2_M; l++) ref[0 * conical_poly_k2s2_M + l] += x->gam[0 * conical_poly_k2s2_M + l];
@@ -470,6 +465,11 @@ conical_poly_k2s2_OUT_OF_LINE int conical_poly_k2s2_predict(const conical_poly_k
       gam[1 * conical_poly_k2s2_M + l] = b;
     }
     return 1;
+  }
+  for (i = 0; i < conical_poly_k2s2_S * conical_poly_k2s2_M; i++) gam[i] = 0;
+  if (cold || x->hprev == 0) {
+    conical_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return 0;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < conical_poly_k2s2_M; l++) gam[0 * conical_poly_k2s2_M + l] += x->gam[0 * conical_poly_k2s2_M + l];

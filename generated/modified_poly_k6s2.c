@@ -647,13 +647,8 @@ void modified_poly_k6s2_hidden(const modified_poly_k6s2_state *x, const modified
 modified_poly_k6s2_OUT_OF_LINE int modified_poly_k6s2_predict(const modified_poly_k6s2_state *x, double h, int cold, const modified_poly_k6s2_params *prm, double *gam, double *ref)
 {
   int i, l;
-  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) gam[i] = 0;
-  if (cold || x->hprev == 0) {
-    modified_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return 0;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:
+      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */
     if (ref) {  /* the one-step start, for the estimate */
       for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) ref[i] = 0;
       for (l = 0; l < modified_poly_k6s2_M; l++) ref[0 * modified_poly_k6s2_M + l] += x->gam[0 * modified_poly_k6s2_M + l];
@@ -674,6 +669,11 @@ modified_poly_k6s2_OUT_OF_LINE int modified_poly_k6s2_predict(const modified_pol
       gam[1 * modified_poly_k6s2_M + l] = b;
     }
     return 1;
+  }
+  for (i = 0; i < modified_poly_k6s2_S * modified_poly_k6s2_M; i++) gam[i] = 0;
+  if (cold || x->hprev == 0) {
+    modified_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return 0;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < modified_poly_k6s2_M; l++) gam[0 * modified_poly_k6s2_M + l] += x->gam[0 * modified_poly_k6s2_M + l];

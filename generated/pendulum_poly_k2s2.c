@@ -375,13 +375,8 @@ void pendulum_poly_k2s2_hidden(const pendulum_poly_k2s2_state *x, const pendulum
 pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_poly_k2s2_state *x, double h, int cold, const pendulum_poly_k2s2_params *prm, double *gam, double *ref)
 {
   int i, l;
-  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) gam[i] = 0;
-  if (cold || x->hprev == 0) {
-    pendulum_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return 0;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:
+      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */
     if (ref) {  /* the one-step start, for the estimate */
       for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) ref[i] = 0;
       for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[0 * pendulum_poly_k2s2_M + l] += x->gam[0 * pendulum_poly_k2s2_M + l];
@@ -401,6 +396,11 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
       gam[1 * pendulum_poly_k2s2_M + l] = b;
     }
     return 1;
+  }
+  for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) gam[i] = 0;
+  if (cold || x->hprev == 0) {
+    pendulum_poly_k2s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return 0;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += x->gam[0 * pendulum_poly_k2s2_M + l];

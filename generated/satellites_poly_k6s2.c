@@ -4487,13 +4487,8 @@ void satellites_poly_k6s2_hidden(const satellites_poly_k6s2_state *x, const sate
 satellites_poly_k6s2_OUT_OF_LINE int satellites_poly_k6s2_predict(const satellites_poly_k6s2_state *x, double h, int cold, const satellites_poly_k6s2_params *prm, double *gam, double *ref)
 {
   int i, l;
-  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) gam[i] = 0;
-  if (cold || x->hprev == 0) {
-    satellites_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return 0;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:
+      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */
     if (ref) {  /* the one-step start, for the estimate */
       for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) ref[i] = 0;
       for (l = 0; l < satellites_poly_k6s2_M; l++) ref[0 * satellites_poly_k6s2_M + l] += x->gam[0 * satellites_poly_k6s2_M + l];
@@ -4514,6 +4509,11 @@ satellites_poly_k6s2_OUT_OF_LINE int satellites_poly_k6s2_predict(const satellit
       gam[1 * satellites_poly_k6s2_M + l] = b;
     }
     return 1;
+  }
+  for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) gam[i] = 0;
+  if (cold || x->hprev == 0) {
+    satellites_poly_k6s2_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return 0;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += x->gam[0 * satellites_poly_k6s2_M + l];

@@ -7618,13 +7618,8 @@ void satellites_poly_k6s3_hidden(const satellites_poly_k6s3_state *x, const sate
 satellites_poly_k6s3_OUT_OF_LINE int satellites_poly_k6s3_predict(const satellites_poly_k6s3_state *x, double h, int cold, const satellites_poly_k6s3_params *prm, double *gam, double *ref)
 {
   int i, l;
-  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
-  if (cold || x->hprev == 0) {
-    satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
-    return 0;
-  }
-  if (h == x->hprev && h == x->hprev2) { /* from the last two steps: gamma_j = sum_i
-                                            * E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i */
+  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:
+      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */
     if (ref) {  /* the one-step start, for the estimate */
       for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) ref[i] = 0;
       for (l = 0; l < satellites_poly_k6s3_M; l++) ref[0 * satellites_poly_k6s3_M + l] += x->gam[0 * satellites_poly_k6s3_M + l];
@@ -7659,6 +7654,11 @@ satellites_poly_k6s3_OUT_OF_LINE int satellites_poly_k6s3_predict(const satellit
       gam[2 * satellites_poly_k6s3_M + l] = b;
     }
     return 1;
+  }
+  for (i = 0; i < satellites_poly_k6s3_S * satellites_poly_k6s3_M; i++) gam[i] = 0;
+  if (cold || x->hprev == 0) {
+    satellites_poly_k6s3_minv_p(x->q, x->p, 0, 0, 0, 0, 0, prm, gam);
+    return 0;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < satellites_poly_k6s3_M; l++) gam[0 * satellites_poly_k6s3_M + l] += x->gam[0 * satellites_poly_k6s3_M + l];
