@@ -479,6 +479,17 @@ void dag_reach(const Dag *d, const int *roots, int nroots, unsigned char *mark) 
   }
 }
 
+// The operations reachable from the roots: nodes with an operand, so no
+// input, parameter or constant.
+long dag_count_ops(const Dag *d, const int *roots, int nroots) {
+  unsigned char *mark = xcalloc((size_t)d->n + 1, 1);
+  dag_reach(d, roots, nroots, mark);
+  long ops = 0;
+  for (int id = 0; id < d->n; id++) ops += mark[id] && d->nodes[id].a >= 0;
+  free(mark);
+  return ops;
+}
+
 // Evaluate the roots at the given inputs and parameter values.
 void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inputs, const double *params,
                    double *out) {

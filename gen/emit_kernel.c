@@ -489,11 +489,15 @@ static int section_here(const Emitter *e, int sec) {
 static void emit_ops(Emitter *e, const int *ops, int from, int to) {
   const Dag *d = e->mod->dag;
   int sec = -1, shown = -1;
+  const char *said = NULL; /* a section built again under the same label is not labelled twice */
   for (int i = from; i < to; i++) {
     int id = ops[i];
     while (sec + 1 < d->marks.n && d->marks.v[sec + 1] <= id) sec++;
     if (sec >= 0 && sec != shown) {
-      if (section_here(e, sec)) out(e, "%s  /* %s */\n", body_indent(e), d->labels[sec]);
+      if (section_here(e, sec) && !(said && !strcmp(said, d->labels[sec]))) {
+        out(e, "%s  /* %s */\n", body_indent(e), d->labels[sec]);
+        said = d->labels[sec];
+      }
       shown = sec;
     }
     e->temp[id] = i;

@@ -272,6 +272,7 @@ int dag_is_zero(const Dag *d, int n);
 void dag_section(Dag *d, const char *label);
 double op_apply(Op op, double a, double b);
 void dag_reach(const Dag *d, const int *roots, int nroots, unsigned char *mark);
+long dag_count_ops(const Dag *d, const int *roots, int nroots); /* nodes with an operand */
 double dag_eval(const Dag *d, int root, const double *inputs, const double *params);
 void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inputs, const double *params,
                    double *out);

@@ -112,13 +112,7 @@ void step_stage_point(Build *b, int l, int *Q) {
 // when their straight-line code, k times the operations of the roots,
 // would reach mod->stage_loop operations.
 static int stages_rolled(Build *b, const int *roots, int n) {
-  Dag *d = b->d;
-  unsigned char *mark = xcalloc((size_t)d->n + 1, 1);
-  dag_reach(d, roots, n, mark);
-  long ops = 0;
-  for (int id = 0; id < d->n; id++) ops += mark[id] && d->nodes[id].a >= 0;
-  free(mark);
-  return (long)b->k * ops >= b->mod->stage_loop;
+  return (long)b->k * dag_count_ops(b->d, roots, n) >= b->mod->stage_loop;
 }
 
 // Stage points, model derivatives at each stage, and their projections

@@ -505,6 +505,21 @@ START_TEST(test_loop_nodes)
 }
 END_TEST
 
+// dag_count_ops counts each shared operation once, and no input or
+// constant: (x + y) (x + y) - 3 x is an add, a product, a product by 3 and
+// a difference.
+START_TEST(test_count_ops)
+{
+  Dag *d = dag_new();
+  int e = rpn(d, "x y + x y + * 3 x * -"), sum = rpn(d, "x y +");
+  ck_assert_int_eq(dag_count_ops(d, &e, 1), 4);
+  ck_assert_int_eq(dag_count_ops(d, &sum, 1), 1);
+  int both[2] = {e, sum}, leaf = dag_input(d, 0);
+  ck_assert_int_eq(dag_count_ops(d, both, 2), 4);
+  ck_assert_int_eq(dag_count_ops(d, &leaf, 1), 0);
+}
+END_TEST
+
 Suite *dag_suite(void)
 {
   Suite *s = suite_create("dag");
@@ -522,6 +537,7 @@ Suite *dag_suite(void)
   tcase_add_test(tc, test_auto_k);
   tcase_add_test(tc, test_eval);
   tcase_add_test(tc, test_subst);
+  tcase_add_test(tc, test_count_ops);
   suite_add_tcase(s, tc);
   return s;
 }
