@@ -186,18 +186,17 @@ static void emit_predict(Emitter *e) {
 }
 
 // Whether the batch step calls kernel id: those of the step and its
-// diagnostics; lambda0 only the polynomial family's (the constant one's
-// sweep gives the multiplier), consistent only for the Newton step after an
-// adaptive iteration stopped at its tolerance (itol_wanted).
+// diagnostics; consistent only for the Newton step after an adaptive
+// iteration stopped at its tolerance (itol_wanted). (The multiplier after a
+// step comes from the sweep, or from project_p1's factors: no lambda0.)
 static int batch_kernel_wanted(const Emitter *e, KernelId id) {
-  int poly = e->st->kern[K_FACTOR].nout > 0;
   if (!e->st->kern[id].nout) return 0;
-  return id == K_LAMBDA0 ? poly : id == K_CONSISTENT ? itol_wanted(e) : 1;
+  return id == K_CONSISTENT ? itol_wanted(e) : 1;
 }
 
 // The batch half of NAME.c: the kernels over lanes, then the functions.
 void emit_batch_source(Emitter *e, int lanes) {
-  static const KernelId used[] = {K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_PROJECT, K_LAMBDA0, K_CONSISTENT};
+  static const KernelId used[] = {K_SWEEP, K_FACTOR, K_MINV_P, K_ENERGY, K_G, K_HIDDEN, K_PROJECT, K_CONSISTENT};
   e->lanes = lanes;
   tmpl(e, "\n/* ---- --batch: the kernels above as loops over $P_W lanes; value i of lane l is\n"
           " * at [i * $P_W + l]. Each lane does the scalar kernel's operations in its order. ---- */\n\n"

@@ -220,7 +220,7 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
   }
   tmpl(e, "  {\n"
           "    $R q1[$P_M * $P_W], p1[$P_M * $P_W], qc1[$P_M * $P_W], pc1[$P_M * $P_W], H0[$P_W], beta[$P_W];\n"
-          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam0[$P_NU * $P_W], pco[$P_M * $P_W];\n"
+          "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam[$P_NU * $P_W], pco[$P_M * $P_W];\n"
           "    $M sg[$P_W], nf[$P_W], cm[$P_W];\n"
           "    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n"
           "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
@@ -236,7 +236,7 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
           "        sg[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n      }\n"
           "    {  /* any value not finite: x - x is 0 for the finite ones, NaN for the others */\n"
           "      $R z[$P_W];\n      for (l = 0; l < $P_W; l++) z[l] = 0;\n"
-          "      for (i = 0; i < $<project_p1>; i++)\n"
+          "      for (i = 0; i < $<project_p1.lamv>; i++)\n"
           "        for (l = 0; l < $P_W; l++) z[l] += pr[i * $P_W + l] - pr[i * $P_W + l];\n"
           "      for (l = 0; l < $P_W; l++) nf[l] |= z[l] != 0;\n    }\n"
           "    for (l = 0; l < $P_W; l++) {\n"
@@ -262,10 +262,12 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
           "        x->qc[i * $P_W + l] = cm[l] ? qc1[i * $P_W + l] : x->qc[i * $P_W + l];\n"
           "        x->pc[i * $P_W + l] = cm[l] ? pc1[i * $P_W + l] : x->pc[i * $P_W + l];\n"
           "        x->pcorr[i * $P_W + l] = cm[l] ? pco[i * $P_W + l] : x->pcorr[i * $P_W + l];\n      }\n"
-          "    /* the multiplier consistent with the new (q, p), for the lanes that moved */\n"
-          "    $(lambda0 q0=x->q p0=x->p prm=par out=lam0);\n"
+          "    /* the multiplier consistent with the new (q, p), for the lanes that moved (in a\n"
+          "     * loop of its own: with the selects, GCC 12 left it scalar) */\n"
+          "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++)\n"
+          "        lam[i * $P_W + l] = beta[l] * beta[l] * pr[($[project_p1.lamv]i) * $P_W + l] - pr[($[project_p1.lamu]i) * $P_W + l];\n"
           "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++) {\n"
-          "        $R v = lam0[i * $P_W + l];\n"
+          "        $R v = lam[i * $P_W + l];\n"
           "        v = isfinite(v) ? v : 0;\n        x->lambda[i * $P_W + l] = cm[l] ? v : x->lambda[i * $P_W + l];\n      }\n");
   emit_commit_common(e);
 }

@@ -354,7 +354,7 @@ static void emit_end_poly(Emitter *e) {
           "  for (i = 0; i < $P_NU; i++) {\n"
           "    $W piv = pr[$[project_p1.pivot]i], dia = pr[$[project_p1.adiag]i];\n"
           "    if (isfinite(piv) && isfinite(dia) && !(fabs$g(piv) > $P_SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n  }\n"
-          "  for (i = 0; i < $<project_p1>; i++)\n    if (!isfinite(pr[i])) return $P_ENONFINITE;\n"
+          "  for (i = 0; i < $<project_p1.lamv>; i++)\n    if (!isfinite(pr[i])) return $P_ENONFINITE;\n"
           "  /* and rescaled, p1 = beta (p1 + dp), so that H(q1, p1) = H0, the energy of the run:\n"
           "   * taken anew on the first step, or when the state or parameters were changed\n"
           "   * since the last step (H(q0, p0) differs from H0 by more than round-off). No\n"
@@ -378,8 +378,11 @@ static void emit_end_poly(Emitter *e) {
   tmpl(e, "    x->pcorr[i] = ($R)(p1[i] - phat[i]);\n  }\n");
   emit_commit_gamma(e);
   emit_commit_pinc(e);
-  tmpl(e, "  x->H0 = H0;\n");
-  emit_set_lambda(e);
+  tmpl(e, "  x->H0 = H0;\n"
+          "  /* the multiplier consistent with (q1, p1), from the projection's factors (0 where not finite) */\n"
+          "  for (i = 0; i < $P_NU; i++) {\n"
+          "    $W lam = beta * beta * pr[$[project_p1.lamv]i] - pr[$[project_p1.lamu]i];\n"
+          "    x->lambda[i] = isfinite(lam) ? ($R)lam : 0;\n  }\n");
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 

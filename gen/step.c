@@ -372,29 +372,20 @@ static void build_initial_values(Build *b) {
   step_result(b->st, K_INITIAL, "p0", SZ_M, 1, b->m, mod->p0n);
 }
 
-// The multiplier consistent with (q0, p0): differentiating the hidden
-// constraint G' M^-1 p = 0 along the flow gives
-//   (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U,  v = M^-1 p,
-// where v' Hess(g_a) v is the derivative of w_a(q) = grad g_a(q)' v along v
-// (one more reverse sweep, with v held constant). For NAME_init.
-static void build_initial_multiplier(Build *b, const int *q, const int *v) {
+// The curvature terms hvv[a] = v' Hess(g_a)(q) v for the velocity v (any
+// nodes, v may depend on q): the derivative of w_a(q) = grad g_a(q)' u along
+// u, with u the momentum inputs held constant while differentiating, then
+// u := v.
+void step_curvature(Build *b, const int *q, const int *v, int *hvv) {
   Dag *d = b->d;
   Model *mod = b->mod;
-  int m = b->m, nu = b->nu;
-  b->owners = 1u << K_LAMBDA0;
-  step_section(b, "consistent initial multiplier");
-  int *gu = step_nodes(m), *mgu = step_nodes(m);
-  int *B = step_nodes(nu * nu), *r = step_nodes(nu), *piv = step_nodes(nu), *lambda0 = step_nodes(nu);
-  int z = dag_const(d, 0), ndw = 0;
-  int **G = step_jacobian_at(b, q);
-  dag_subst(d, mod->gradU, m, q, m, gu);
-  minv_apply(mod, d, gu, mgu);
-  step_gram(b, G, B);
+  int m = b->m, nu = b->nu, z = dag_const(d, 0), ndw = 0;
+  int first = b->st->in[IN_P0].first, *u = step_nodes(m), *at_u = step_nodes(nu), *map = step_nodes(first + m);
+  for (int i = 0; i < m; i++) u[i] = step_in(b, IN_P0, i);
   SparseVec *dw = arena_alloc((size_t)(nu + 1) * sizeof *dw); /* grad w_a, sparse, then at q */
   for (int a = 0; a < nu; a++) {
     int w = z;
-    for (int e = 0; e < mod->jac[a].n; e++)
-      w = dag_add(d, w, dag_mul(d, mod->jac[a].e[e].node, v[mod->jac[a].e[e].coord]));
+    for (int e = 0; e < mod->jac[a].n; e++) w = dag_add(d, w, dag_mul(d, mod->jac[a].e[e].node, u[mod->jac[a].e[e].coord]));
     ad_gradient_sparse(d, w, m, &dw[a]);
     ndw += dw[a].n;
   }
@@ -403,14 +394,47 @@ static void build_initial_multiplier(Build *b, const int *q, const int *v) {
     for (int e = 0; e < dw[a].n; e++) roots[t++] = dw[a].e[e].node;
   dag_subst(d, roots, ndw, q, m, img); /* all in one pass over the DAG */
   for (int a = 0, t = 0; a < nu; a++) {
-    int hvv = z, gmu = z;
-    for (int e = 0; e < dw[a].n; e++) hvv = dag_add(d, hvv, dag_mul(d, img[t++], v[dw[a].e[e].coord]));
+    at_u[a] = z;
+    for (int e = 0; e < dw[a].n; e++) at_u[a] = dag_add(d, at_u[a], dag_mul(d, img[t++], u[dw[a].e[e].coord]));
+  }
+  for (int k = 0; k < first; k++) map[k] = dag_input(d, k);
+  memcpy(map + first, v, (size_t)m * sizeof(int));
+  dag_subst(d, at_u, nu, map, first + m, hvv);
+}
+
+// gmu[a] = grad g_a(q)' M^-1 grad U(q), G the dense columns of grad g at q.
+void step_force_along(Build *b, const int *q, int **G, int *gmu) {
+  Dag *d = b->d;
+  Model *mod = b->mod;
+  int m = b->m, *gu = step_nodes(m), *mgu = step_nodes(m);
+  dag_subst(d, mod->gradU, m, q, m, gu);
+  minv_apply(mod, d, gu, mgu);
+  for (int a = 0; a < b->nu; a++) {
+    gmu[a] = dag_const(d, 0);
     for (int e = 0; e < mod->jac[a].n; e++) {
       int i = mod->jac[a].e[e].coord;
-      gmu = dag_add(d, gmu, dag_mul(d, G[a][i], mgu[i]));
+      gmu[a] = dag_add(d, gmu[a], dag_mul(d, G[a][i], mgu[i]));
     }
-    r[a] = dag_sub(d, hvv, gmu);
   }
+}
+
+// The multiplier consistent with (q0, p0): differentiating the hidden
+// constraint G' M^-1 p = 0 along the flow gives
+//   (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U,  v = M^-1 p
+// (step_curvature, step_force_along). For NAME_init and NAME_project; the
+// polynomial family's step has it from its projection's factors.
+static void build_initial_multiplier(Build *b, const int *q, const int *v) {
+  Dag *d = b->d;
+  int nu = b->nu;
+  b->owners = 1u << K_LAMBDA0;
+  step_section(b, "consistent initial multiplier");
+  int *B = step_nodes(nu * nu), *r = step_nodes(nu), *piv = step_nodes(nu), *lambda0 = step_nodes(nu);
+  int *hvv = step_nodes(nu), *gmu = step_nodes(nu);
+  int **G = step_jacobian_at(b, q);
+  step_force_along(b, q, G, gmu);
+  step_gram(b, G, B);
+  step_curvature(b, q, v, hvv);
+  for (int a = 0; a < nu; a++) r[a] = dag_sub(d, hvv[a], gmu[a]);
   lu_solve_ordered(d, B, r, nu, lambda0, piv, NULL);
   step_result(b->st, K_LAMBDA0, "lambda", SZ_NU, 1, nu, lambda0);
 }

@@ -37,6 +37,8 @@ int **step_jacobian_at(Build *b, const int *q);       /* dense columns of grad g
 void step_gram(Build *b, int **G, int *B);            /* B = G' M^-1 G */
 void step_project_momenta(Build *b, int **G, const int *B, const int *p, int *dp, int *pivot, int *adiag);
 int step_dot_col(Build *b, int j, int a, const int *v);
+void step_curvature(Build *b, const int *q, const int *v, int *hvv); /* v' Hess(g_a)(q) v */
+void step_force_along(Build *b, const int *q, int **G, int *gmu);    /* grad g_a(q)' M^-1 grad U(q) */
 int step_coupled(Build *b, const IntVec *touch, int *pair, int a, int *out); /* constraints coupled with a */
 void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
 

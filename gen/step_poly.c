@@ -260,15 +260,27 @@ static void build_projection(Build *b) {
   for (int i = 0; i < m; i++) kin = dag_add(d, kin, dag_mul(d, pt[i], v[i]));
   kin = dag_mul(d, dag_const(d, 0.5), kin);
   dag_subst(d, &mod->U, 1, q, m, &U);
+  /* the multiplier consistent with (q1, beta (p1 + dp)), as the two
+   * solutions (G1' M^-1 G1) lamv = [v' Hess(g_a) v]_a and
+   * (G1' M^-1 G1) lamu = G1' M^-1 grad U, v = M^-1 (p1 + dp), by the
+   * projection's factors: lambda = beta^2 lamv - lamu */
+  int *hvv = step_nodes(nu), *gmu = step_nodes(nu), *lamv = step_nodes(nu), *lamu = step_nodes(nu), *unused = step_nodes(nu);
+  step_curvature(b, q, v, hvv);
+  step_force_along(b, q, G, gmu);
+  lu_solve_ordered(d, B, hvv, nu, lamv, unused, NULL);
+  lu_solve_ordered(d, B, gmu, nu, lamu, unused, NULL);
   Step *st = b->st;
   step_result(st, K_PROJECT, "dp", SZ_M, 1, m, dp);
   step_result(st, K_PROJECT, "kin", SZ_ONE, 1, 1, &kin);
   step_result(st, K_PROJECT, "U", SZ_ONE, 1, 1, &U);
   step_result(st, K_PROJECT, "pivot", SZ_NU, 1, nu, pivot);
   step_result(st, K_PROJECT, "adiag", SZ_NU, 1, nu, adiag);
+  step_result(st, K_PROJECT, "lamv", SZ_NU, 1, nu, lamv);
+  step_result(st, K_PROJECT, "lamu", SZ_NU, 1, nu, lamu);
   st->kern[K_PROJECT].what = "The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the\n"
                              " * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)\n"
-                             " * and diagonal (NU) of G1' M^-1 G1.";
+                             " * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,\n"
+                             " * beta^2 lamv - lamu, as lamv (NU) and lamu (NU).";
 }
 
 // The kernels of the polynomial family: "factor" (the frozen multiplier

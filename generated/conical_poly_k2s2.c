@@ -189,12 +189,12 @@ static void conical_poly_k2s2_energy_kernel(const double *q0, const double *p0, 
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* energy */
   const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
   const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
   const double t3 = p0[2] /* p_z */ * p0[2] /* p_z */;
   const double t4 = t2 + t3;
+  /* energy */
   const double t5 = 0.5 * t4;
   const double t6 = q0[2] /* z */ + t5;
   /* H */
@@ -259,55 +259,64 @@ static void conical_poly_k2s2_lambda0(const double *q0, const double *p0, const 
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1. */
+ * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
 static void conical_poly_k2s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = 2.0 * q0[2] /* z */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[0] /* x */ * q0[0] /* x */;
-  const double t1 = q0[1] /* y */ * q0[1] /* y */;
-  const double t2 = t0 + t1;
-  const double t3 = q0[2] /* z */ * q0[2] /* z */;
-  const double t4 = t2 + t3;
-  const double t5 = 4.0 * t4;
-  const double t6 = q0[0] /* x */ * p0[0] /* p_x */;
-  const double t7 = q0[1] /* y */ * p0[1] /* p_y */;
-  const double t8 = t6 + t7;
-  const double t9 = q0[2] /* z */ * p0[2] /* p_z */;
-  const double t10 = t8 + t9;
-  const double t11 = 2.0 * t10;
-  const double t12 = t11 / t5;
-  const double t13 = q0[0] /* x */ * t12;
-  const double t14 = 2.0 * t13;
-  const double t15 = -t14;
-  const double t16 = q0[1] /* y */ * t12;
-  const double t17 = 2.0 * t16;
-  const double t18 = -t17;
-  const double t19 = q0[2] /* z */ * t12;
-  const double t20 = 2.0 * t19;
-  const double t21 = -t20;
-  const double t22 = p0[0] /* p_x */ - t14;
-  const double t23 = p0[1] /* p_y */ - t17;
-  const double t24 = p0[2] /* p_z */ - t20;
-  const double t25 = t22 * t22;
+  const double t1 = q0[0] /* x */ * q0[0] /* x */;
+  const double t2 = q0[1] /* y */ * q0[1] /* y */;
+  const double t3 = t1 + t2;
+  const double t4 = q0[2] /* z */ * q0[2] /* z */;
+  const double t5 = t3 + t4;
+  const double t6 = 4.0 * t5;
+  const double t7 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t8 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t9 = t7 + t8;
+  const double t10 = q0[2] /* z */ * p0[2] /* p_z */;
+  const double t11 = t9 + t10;
+  const double t12 = 2.0 * t11;
+  const double t13 = t12 / t6;
+  const double t14 = q0[0] /* x */ * t13;
+  const double t15 = 2.0 * t14;
+  const double t16 = -t15;
+  const double t17 = q0[1] /* y */ * t13;
+  const double t18 = 2.0 * t17;
+  const double t19 = -t18;
+  const double t20 = q0[2] /* z */ * t13;
+  const double t21 = 2.0 * t20;
+  const double t22 = -t21;
+  const double t23 = p0[0] /* p_x */ - t15;
+  const double t24 = p0[1] /* p_y */ - t18;
+  const double t25 = p0[2] /* p_z */ - t21;
   const double t26 = t23 * t23;
-  const double t27 = t25 + t26;
-  const double t28 = t24 * t24;
-  const double t29 = t27 + t28;
-  const double t30 = 0.5 * t29;
+  const double t27 = t24 * t24;
+  const double t28 = t26 + t27;
+  const double t29 = t25 * t25;
+  const double t30 = t28 + t29;
+  const double t31 = 0.5 * t30;
+  const double t32 = 2.0 * t30;
+  const double t33 = t32 / t6;
+  const double t34 = t0 / t6;
   /* dp */
-  out[0] = t15;
-  out[1] = t18;
-  out[2] = t21;
+  out[0] = t16;
+  out[1] = t19;
+  out[2] = t22;
   /* kin */
-  out[3] = t30;
+  out[3] = t31;
   /* U */
   out[4] = q0[2] /* z */;
   /* pivot */
-  out[5] = t5;
+  out[5] = t6;
   /* adiag */
-  out[6] = t5;
+  out[6] = t6;
+  /* lamv */
+  out[7] = t33;
+  /* lamu */
+  out[8] = t34;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -906,7 +915,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_poly_k2s2_ENONFINITE;
   for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) /* the rest of p's polynomial, for conical_poly_k2s2_dense */
     if (!isfinite(sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i])) return conical_poly_k2s2_ENONFINITE;
-  double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 2 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
+  double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 4 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = conical_poly_k2s2_energy(x, prm);
   double qc1[conical_poly_k2s2_M], pc1[conical_poly_k2s2_M];
   for (i = 0; i < conical_poly_k2s2_M; i++) {
@@ -977,10 +986,10 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   for (i = 0; i < conical_poly_k2s2_M; i++) x->pinc[i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + i];
   for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) x->pinc[conical_poly_k2s2_M + i] = (double)sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i];
   x->H0 = H0;
-  {
-    double lam[conical_poly_k2s2_NU];
-    conical_poly_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
-    for (i = 0; i < conical_poly_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  /* the multiplier consistent with (q1, p1), from the projection's factors (0 where not finite) */
+  for (i = 0; i < conical_poly_k2s2_NU; i++) {
+    double lam = beta * beta * pr[conical_poly_k2s2_M + 2 + 2 * conical_poly_k2s2_NU + i] - pr[conical_poly_k2s2_M + 2 + 3 * conical_poly_k2s2_NU + i];
+    x->lambda[i] = isfinite(lam) ? (double)lam : 0;
   }
   conical_poly_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;

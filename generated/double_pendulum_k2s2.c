@@ -358,10 +358,10 @@ static void double_pendulum_k2s2_energy_kernel(const double *q0, const double *p
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   const double t0 = q0[1] /* y1 */ + q0[3] /* y2 */;
-  /* energy */
   const double t1 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
   const double t2 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
   const double t3 = t1 + t2;
+  /* energy */
   const double t4 = p0[2] /* p_x2 */ * p0[2] /* p_x2 */;
   const double t5 = t3 + t4;
   const double t6 = p0[3] /* p_y2 */ * p0[3] /* p_y2 */;
@@ -442,28 +442,28 @@ static void double_pendulum_k2s2_lambda0(const double *q0, const double *p0, con
   const double t16 = t8 * t15;
   const double t17 = t14 - t16;
   const double t18 = 4.0 * t17;
-  const double t19 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
-  const double t20 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
-  const double t21 = t19 + t20;
+  const double t19 = p0[3] /* p_y2 */ - p0[1] /* p_y1 */;
+  const double t20 = p0[2] /* p_x2 */ - p0[0] /* p_x1 */;
+  const double t21 = p0[0] /* p_x1 */ * p0[0] /* p_x1 */;
+  const double t22 = p0[1] /* p_y1 */ * p0[1] /* p_y1 */;
+  const double t23 = t21 + t22;
+  const double t24 = p0[0] /* p_x1 */ * t20;
+  const double t25 = p0[1] /* p_y1 */ * t19;
+  const double t26 = t24 + t25;
+  const double t27 = p0[2] /* p_x2 */ * t20;
+  const double t28 = t27 - t26;
+  const double t29 = p0[3] /* p_y2 */ * t19;
+  const double t30 = t28 + t29;
   /* consistent initial multiplier */
-  const double t22 = p0[3] /* p_y2 */ - p0[1] /* p_y1 */;
-  const double t23 = p0[2] /* p_x2 */ - p0[0] /* p_x1 */;
-  const double t24 = t21 - q0[1] /* y1 */;
-  const double t25 = 2.0 * t24;
-  const double t26 = p0[0] /* p_x1 */ * t23;
-  const double t27 = p0[1] /* p_y1 */ * t22;
-  const double t28 = t26 + t27;
-  const double t29 = p0[2] /* p_x2 */ * t23;
-  const double t30 = t29 - t28;
-  const double t31 = p0[3] /* p_y2 */ * t22;
-  const double t32 = t30 + t31;
-  const double t33 = t15 * t24;
-  const double t34 = t32 + t33;
+  const double t31 = t23 - q0[1] /* y1 */;
+  const double t32 = 2.0 * t31;
+  const double t33 = t15 * t31;
+  const double t34 = t30 + t33;
   const double t35 = 2.0 * t34;
   const double t36 = t35 / t18;
   const double t37 = t8 * t36;
   const double t38 = 4.0 * t37;
-  const double t39 = t25 + t38;
+  const double t39 = t32 + t38;
   const double t40 = t39 / t6;
   /* lambda */
   out[0] = t40;
@@ -472,91 +472,124 @@ static void double_pendulum_k2s2_lambda0(const double *q0, const double *p0, con
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1. */
+ * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
 static void double_pendulum_k2s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
+  const double t2 = 2.0 * q0[1] /* y1 */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t2 = q0[0] /* x1 */ * q0[0] /* x1 */;
-  const double t3 = q0[0] /* x1 */ * t0;
-  const double t4 = q0[1] /* y1 */ * q0[1] /* y1 */;
-  const double t5 = t2 + t4;
-  const double t6 = 4.0 * t5;
-  const double t7 = q0[1] /* y1 */ * t1;
-  const double t8 = t3 + t7;
-  const double t9 = 4.0 * t8;
-  const double t10 = t0 * t0;
-  const double t11 = t1 * t1;
-  const double t12 = t10 + t11;
-  const double t13 = t10 + t12;
+  const double t3 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t4 = q0[0] /* x1 */ * t0;
+  const double t5 = q0[1] /* y1 */ * q0[1] /* y1 */;
+  const double t6 = t3 + t5;
+  const double t7 = 4.0 * t6;
+  const double t8 = q0[1] /* y1 */ * t1;
+  const double t9 = t4 + t8;
+  const double t10 = 4.0 * t9;
+  const double t11 = t0 * t0;
+  const double t12 = t1 * t1;
+  const double t13 = t11 + t12;
   const double t14 = t11 + t13;
-  const double t15 = 4.0 * t14;
-  const double t16 = q0[0] /* x1 */ * p0[0] /* p_x1 */;
-  const double t17 = q0[1] /* y1 */ * p0[1] /* p_y1 */;
-  const double t18 = t16 + t17;
-  const double t19 = 2.0 * t18;
-  const double t20 = t0 * p0[0] /* p_x1 */;
-  const double t21 = t1 * p0[1] /* p_y1 */;
-  const double t22 = t20 + t21;
-  const double t23 = t0 * p0[2] /* p_x2 */;
-  const double t24 = t23 - t22;
-  const double t25 = t1 * p0[3] /* p_y2 */;
-  const double t26 = t24 + t25;
-  const double t27 = t9 / t6;
-  const double t28 = t8 * t27;
-  const double t29 = t14 - t28;
-  const double t30 = 4.0 * t29;
-  const double t31 = t18 * t27;
-  const double t32 = t26 + t31;
-  const double t33 = 2.0 * t32;
-  const double t34 = t33 / t30;
-  const double t35 = t8 * t34;
-  const double t36 = 4.0 * t35;
-  const double t37 = t19 + t36;
-  const double t38 = t37 / t6;
-  const double t39 = q0[0] /* x1 */ * t38;
-  const double t40 = t0 * t34;
-  const double t41 = 2.0 * t40;
-  const double t42 = -t41;
-  const double t43 = t40 - t39;
-  const double t44 = 2.0 * t43;
-  const double t45 = q0[1] /* y1 */ * t38;
-  const double t46 = t1 * t34;
-  const double t47 = 2.0 * t46;
-  const double t48 = -t47;
-  const double t49 = t46 - t45;
-  const double t50 = 2.0 * t49;
-  const double t51 = p0[0] /* p_x1 */ + t44;
-  const double t52 = p0[1] /* p_y1 */ + t50;
-  const double t53 = p0[2] /* p_x2 */ - t41;
-  const double t54 = p0[3] /* p_y2 */ - t47;
-  const double t55 = t51 * t51;
+  const double t15 = t12 + t14;
+  const double t16 = 4.0 * t15;
+  const double t17 = q0[0] /* x1 */ * p0[0] /* p_x1 */;
+  const double t18 = q0[1] /* y1 */ * p0[1] /* p_y1 */;
+  const double t19 = t17 + t18;
+  const double t20 = 2.0 * t19;
+  const double t21 = t0 * p0[0] /* p_x1 */;
+  const double t22 = t1 * p0[1] /* p_y1 */;
+  const double t23 = t21 + t22;
+  const double t24 = t0 * p0[2] /* p_x2 */;
+  const double t25 = t24 - t23;
+  const double t26 = t1 * p0[3] /* p_y2 */;
+  const double t27 = t25 + t26;
+  const double t28 = t10 / t7;
+  const double t29 = t9 * t28;
+  const double t30 = t15 - t29;
+  const double t31 = 4.0 * t30;
+  const double t32 = t19 * t28;
+  const double t33 = t27 + t32;
+  const double t34 = 2.0 * t33;
+  const double t35 = t34 / t31;
+  const double t36 = t9 * t35;
+  const double t37 = 4.0 * t36;
+  const double t38 = t20 + t37;
+  const double t39 = t38 / t7;
+  const double t40 = q0[0] /* x1 */ * t39;
+  const double t41 = t0 * t35;
+  const double t42 = 2.0 * t41;
+  const double t43 = -t42;
+  const double t44 = t41 - t40;
+  const double t45 = 2.0 * t44;
+  const double t46 = q0[1] /* y1 */ * t39;
+  const double t47 = t1 * t35;
+  const double t48 = 2.0 * t47;
+  const double t49 = -t48;
+  const double t50 = t47 - t46;
+  const double t51 = 2.0 * t50;
+  const double t52 = p0[0] /* p_x1 */ + t45;
+  const double t53 = p0[1] /* p_y1 */ + t51;
+  const double t54 = p0[2] /* p_x2 */ - t42;
+  const double t55 = p0[3] /* p_y2 */ - t48;
   const double t56 = t52 * t52;
-  const double t57 = t55 + t56;
-  const double t58 = t53 * t53;
-  const double t59 = t57 + t58;
-  const double t60 = t54 * t54;
-  const double t61 = t59 + t60;
-  const double t62 = 0.5 * t61;
-  const double t63 = q0[1] /* y1 */ + q0[3] /* y2 */;
+  const double t57 = t53 * t53;
+  const double t58 = t56 + t57;
+  const double t59 = t54 * t54;
+  const double t60 = t58 + t59;
+  const double t61 = t55 * t55;
+  const double t62 = t60 + t61;
+  const double t63 = 0.5 * t62;
+  const double t64 = q0[1] /* y1 */ + q0[3] /* y2 */;
+  const double t65 = t55 - t53;
+  const double t66 = t54 - t52;
+  const double t67 = 2.0 * t58;
+  const double t68 = t52 * t66;
+  const double t69 = t53 * t65;
+  const double t70 = t68 + t69;
+  const double t71 = t54 * t66;
+  const double t72 = t71 - t70;
+  const double t73 = t55 * t65;
+  const double t74 = t72 + t73;
+  const double t75 = t28 * t58;
+  const double t76 = t74 + t75;
+  const double t77 = 2.0 * t76;
+  const double t78 = t77 / t31;
+  const double t79 = t9 * t78;
+  const double t80 = 4.0 * t79;
+  const double t81 = t67 + t80;
+  const double t82 = t81 / t7;
+  const double t83 = q0[1] /* y1 */ * t28;
+  const double t84 = 2.0 * t83;
+  const double t85 = t84 / t31;
+  const double t86 = t9 * t85;
+  const double t87 = 4.0 * t86;
+  const double t88 = t2 + t87;
+  const double t89 = t88 / t7;
   /* dp */
-  out[0] = t44;
-  out[1] = t50;
-  out[2] = t42;
-  out[3] = t48;
+  out[0] = t45;
+  out[1] = t51;
+  out[2] = t43;
+  out[3] = t49;
   /* kin */
-  out[4] = t62;
+  out[4] = t63;
   /* U */
-  out[5] = t63;
+  out[5] = t64;
   /* pivot */
-  out[6] = t6;
-  out[7] = t30;
+  out[6] = t7;
+  out[7] = t31;
   /* adiag */
-  out[8] = t6;
-  out[9] = t15;
+  out[8] = t7;
+  out[9] = t16;
+  /* lamv */
+  out[10] = t82;
+  out[11] = t78;
+  /* lamu */
+  out[12] = t89;
+  out[13] = t85;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -1322,7 +1355,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k2s2_ENONFINITE;
   for (i = 0; i < (double_pendulum_k2s2_S - 1) * double_pendulum_k2s2_M; i++) /* the rest of p's polynomial, for double_pendulum_k2s2_dense */
     if (!isfinite(sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i])) return double_pendulum_k2s2_ENONFINITE;
-  double q1[double_pendulum_k2s2_M], p1[double_pendulum_k2s2_M], pr[double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU + 1], K, U1, beta = 1;
+  double q1[double_pendulum_k2s2_M], p1[double_pendulum_k2s2_M], pr[double_pendulum_k2s2_M + 2 + 4 * double_pendulum_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k2s2_energy(x, prm);
   double qc1[double_pendulum_k2s2_M], pc1[double_pendulum_k2s2_M];
   for (i = 0; i < double_pendulum_k2s2_M; i++) {
@@ -1393,10 +1426,10 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
   for (i = 0; i < double_pendulum_k2s2_M; i++) x->pinc[i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + i];
   for (i = 0; i < (double_pendulum_k2s2_S - 1) * double_pendulum_k2s2_M; i++) x->pinc[double_pendulum_k2s2_M + i] = (double)sw[double_pendulum_k2s2_S * double_pendulum_k2s2_M + double_pendulum_k2s2_M + double_pendulum_k2s2_S * double_pendulum_k2s2_NU + i];
   x->H0 = H0;
-  {
-    double lam[double_pendulum_k2s2_NU];
-    double_pendulum_k2s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
-    for (i = 0; i < double_pendulum_k2s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  /* the multiplier consistent with (q1, p1), from the projection's factors (0 where not finite) */
+  for (i = 0; i < double_pendulum_k2s2_NU; i++) {
+    double lam = beta * beta * pr[double_pendulum_k2s2_M + 2 + 2 * double_pendulum_k2s2_NU + i] - pr[double_pendulum_k2s2_M + 2 + 3 * double_pendulum_k2s2_NU + i];
+    x->lambda[i] = isfinite(lam) ? (double)lam : 0;
   }
   double_pendulum_k2s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;

@@ -365,12 +365,12 @@ static void modified_poly_k6s2_energy_kernel(const double *q0, const double *p0,
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   const double t0 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
+  const double t1 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
   /* energy */
-  const double t1 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
-  const double t2 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
-  const double t3 = t1 + t2;
-  const double t4 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
-  const double t5 = t3 + t4;
+  const double t2 = p0[0] /* p_q[1] */ * p0[0] /* p_q[1] */;
+  const double t3 = p0[1] /* p_q[2] */ * p0[1] /* p_q[2] */;
+  const double t4 = t2 + t3;
+  const double t5 = t1 + t4;
   const double t6 = 0.5 * t5;
   const double t7 = t0 + t6;
   /* H */
@@ -428,25 +428,25 @@ static void modified_poly_k6s2_lambda0(const double *q0, const double *p0, const
   const double t7 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
   const double t8 = 4.0 * t7;
   const double t9 = t6 + t8;
-  const double t10 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
-  /* consistent initial multiplier */
-  const double t11 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
-  const double t12 = 6.0 * p0[0] /* p_q[1] */;
-  const double t13 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
-  const double t14 = 5.0 * t13;
-  const double t15 = t12 * t14;
-  const double t16 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
-  const double t17 = 3.0 * t16;
-  const double t18 = p0[1] /* p_q[2] */ * t17;
-  const double t19 = p0[0] /* p_q[1] */ * t15;
-  const double t20 = p0[1] /* p_q[2] */ * t18;
-  const double t21 = 4.0 * t20;
-  const double t22 = t19 + t21;
-  const double t23 = 2.0 * t10;
-  const double t24 = t22 + t23;
-  const double t25 = q0[2] /* q[3] */ * t11;
+  const double t10 = 6.0 * p0[0] /* p_q[1] */;
+  const double t11 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t12 = 5.0 * t11;
+  const double t13 = t10 * t12;
+  const double t14 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
+  const double t15 = 3.0 * t14;
+  const double t16 = p0[1] /* p_q[2] */ * t15;
+  const double t17 = p0[0] /* p_q[1] */ * t13;
+  const double t18 = p0[1] /* p_q[2] */ * t16;
+  const double t19 = 4.0 * t18;
+  const double t20 = t17 + t19;
+  const double t21 = p0[2] /* p_q[3] */ * p0[2] /* p_q[3] */;
+  const double t22 = 2.0 * t21;
+  const double t23 = t20 + t22;
+  const double t24 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
+  const double t25 = q0[2] /* q[3] */ * t24;
   const double t26 = t25 * 8.0;
-  const double t27 = t24 - t26;
+  /* consistent initial multiplier */
+  const double t27 = t23 - t26;
   const double t28 = t27 / t9;
   /* lambda */
   out[0] = t28;
@@ -454,7 +454,8 @@ static void modified_poly_k6s2_lambda0(const double *q0, const double *p0, const
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1. */
+ * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
 static void modified_poly_k6s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k6s2_params *prm, double *out)
 {
@@ -496,6 +497,24 @@ static void modified_poly_k6s2_project_p1(const double *q0, const double *p0, co
   const double t33 = t31 + t32;
   const double t34 = 0.5 * t33;
   const double t35 = (q0[2] /* q[3] */ * q0[2] /* q[3] */) * (q0[2] /* q[3] */ * q0[2] /* q[3] */);
+  const double t36 = (q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t37 = 5.0 * t36;
+  const double t38 = q0[1] /* q[2] */ * q0[1] /* q[2] */;
+  const double t39 = 3.0 * t38;
+  const double t40 = 6.0 * t26;
+  const double t41 = t37 * t40;
+  const double t42 = t27 * t39;
+  const double t43 = t26 * t41;
+  const double t44 = t27 * t42;
+  const double t45 = 4.0 * t44;
+  const double t46 = t43 + t45;
+  const double t47 = 2.0 * t32;
+  const double t48 = t46 + t47;
+  const double t49 = q0[2] /* q[3] */ * q0[2] /* q[3] */ * q0[2] /* q[3] */;
+  const double t50 = q0[2] /* q[3] */ * t49;
+  const double t51 = t50 * 8.0;
+  const double t52 = t48 / t9;
+  const double t53 = t51 / t9;
   /* dp */
   out[0] = t19;
   out[1] = t22;
@@ -508,6 +527,10 @@ static void modified_poly_k6s2_project_p1(const double *q0, const double *p0, co
   out[5] = t9;
   /* adiag */
   out[6] = t9;
+  /* lamv */
+  out[7] = t52;
+  /* lamu */
+  out[8] = t53;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -1408,7 +1431,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k6s2_ENONFINITE;
   for (i = 0; i < (modified_poly_k6s2_S - 1) * modified_poly_k6s2_M; i++) /* the rest of p's polynomial, for modified_poly_k6s2_dense */
     if (!isfinite(sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + i])) return modified_poly_k6s2_ENONFINITE;
-  double q1[modified_poly_k6s2_M], p1[modified_poly_k6s2_M], pr[modified_poly_k6s2_M + 2 + 2 * modified_poly_k6s2_NU + 1], K, U1, beta = 1;
+  double q1[modified_poly_k6s2_M], p1[modified_poly_k6s2_M], pr[modified_poly_k6s2_M + 2 + 4 * modified_poly_k6s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k6s2_energy(x, prm);
   double qc1[modified_poly_k6s2_M], pc1[modified_poly_k6s2_M];
   for (i = 0; i < modified_poly_k6s2_M; i++) {
@@ -1479,10 +1502,10 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
   for (i = 0; i < modified_poly_k6s2_M; i++) x->pinc[i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + i];
   for (i = 0; i < (modified_poly_k6s2_S - 1) * modified_poly_k6s2_M; i++) x->pinc[modified_poly_k6s2_M + i] = (double)sw[modified_poly_k6s2_S * modified_poly_k6s2_M + modified_poly_k6s2_M + modified_poly_k6s2_S * modified_poly_k6s2_NU + i];
   x->H0 = H0;
-  {
-    double lam[modified_poly_k6s2_NU];
-    modified_poly_k6s2_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
-    for (i = 0; i < modified_poly_k6s2_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  /* the multiplier consistent with (q1, p1), from the projection's factors (0 where not finite) */
+  for (i = 0; i < modified_poly_k6s2_NU; i++) {
+    double lam = beta * beta * pr[modified_poly_k6s2_M + 2 + 2 * modified_poly_k6s2_NU + i] - pr[modified_poly_k6s2_M + 2 + 3 * modified_poly_k6s2_NU + i];
+    x->lambda[i] = isfinite(lam) ? (double)lam : 0;
   }
   modified_poly_k6s2_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;

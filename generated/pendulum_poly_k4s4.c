@@ -674,10 +674,10 @@ static void pendulum_poly_k4s4_energy_kernel(const double *q0, const double *p0,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* energy */
   const double t0 = p0[0] /* p_x */ * p0[0] /* p_x */;
   const double t1 = p0[1] /* p_y */ * p0[1] /* p_y */;
   const double t2 = t0 + t1;
+  /* energy */
   const double t3 = 0.5 * t2;
   const double t4 = q0[1] /* y */ + t3;
   /* H */
@@ -734,44 +734,53 @@ static void pendulum_poly_k4s4_lambda0(const double *q0, const double *p0, const
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1. */
+ * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
 static void pendulum_poly_k4s4_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
+  const double t0 = 2.0 * q0[1] /* y */;
   /* projection onto the hidden constraint at q1, kinetic energy after it, U(q1) */
-  const double t0 = q0[0] /* x */ * q0[0] /* x */;
-  const double t1 = q0[1] /* y */ * q0[1] /* y */;
-  const double t2 = t0 + t1;
-  const double t3 = 4.0 * t2;
-  const double t4 = q0[0] /* x */ * p0[0] /* p_x */;
-  const double t5 = q0[1] /* y */ * p0[1] /* p_y */;
-  const double t6 = t4 + t5;
-  const double t7 = 2.0 * t6;
-  const double t8 = t7 / t3;
-  const double t9 = q0[0] /* x */ * t8;
-  const double t10 = 2.0 * t9;
-  const double t11 = -t10;
-  const double t12 = q0[1] /* y */ * t8;
-  const double t13 = 2.0 * t12;
-  const double t14 = -t13;
-  const double t15 = p0[0] /* p_x */ - t10;
-  const double t16 = p0[1] /* p_y */ - t13;
-  const double t17 = t15 * t15;
+  const double t1 = q0[0] /* x */ * q0[0] /* x */;
+  const double t2 = q0[1] /* y */ * q0[1] /* y */;
+  const double t3 = t1 + t2;
+  const double t4 = 4.0 * t3;
+  const double t5 = q0[0] /* x */ * p0[0] /* p_x */;
+  const double t6 = q0[1] /* y */ * p0[1] /* p_y */;
+  const double t7 = t5 + t6;
+  const double t8 = 2.0 * t7;
+  const double t9 = t8 / t4;
+  const double t10 = q0[0] /* x */ * t9;
+  const double t11 = 2.0 * t10;
+  const double t12 = -t11;
+  const double t13 = q0[1] /* y */ * t9;
+  const double t14 = 2.0 * t13;
+  const double t15 = -t14;
+  const double t16 = p0[0] /* p_x */ - t11;
+  const double t17 = p0[1] /* p_y */ - t14;
   const double t18 = t16 * t16;
-  const double t19 = t17 + t18;
-  const double t20 = 0.5 * t19;
+  const double t19 = t17 * t17;
+  const double t20 = t18 + t19;
+  const double t21 = 0.5 * t20;
+  const double t22 = 2.0 * t20;
+  const double t23 = t22 / t4;
+  const double t24 = t0 / t4;
   /* dp */
-  out[0] = t11;
-  out[1] = t14;
+  out[0] = t12;
+  out[1] = t15;
   /* kin */
-  out[2] = t20;
+  out[2] = t21;
   /* U */
   out[3] = q0[1] /* y */;
   /* pivot */
-  out[4] = t3;
+  out[4] = t4;
   /* adiag */
-  out[5] = t3;
+  out[5] = t4;
+  /* lamv */
+  out[6] = t23;
+  /* lamu */
+  out[7] = t24;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -1737,7 +1746,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k4s4_ENONFINITE;
   for (i = 0; i < (pendulum_poly_k4s4_S - 1) * pendulum_poly_k4s4_M; i++) /* the rest of p's polynomial, for pendulum_poly_k4s4_dense */
     if (!isfinite(sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + i])) return pendulum_poly_k4s4_ENONFINITE;
-  double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
+  double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 4 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k4s4_energy(x, prm);
   double qc1[pendulum_poly_k4s4_M], pc1[pendulum_poly_k4s4_M];
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
@@ -1808,10 +1817,10 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   for (i = 0; i < pendulum_poly_k4s4_M; i++) x->pinc[i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + i];
   for (i = 0; i < (pendulum_poly_k4s4_S - 1) * pendulum_poly_k4s4_M; i++) x->pinc[pendulum_poly_k4s4_M + i] = (double)sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + i];
   x->H0 = H0;
-  {
-    double lam[pendulum_poly_k4s4_NU];
-    pendulum_poly_k4s4_lambda0(x->q, x->p, 0, 0, 0, 0, 0, prm, lam);
-    for (i = 0; i < pendulum_poly_k4s4_NU; i++) x->lambda[i] = isfinite(lam[i]) ? lam[i] : 0;
+  /* the multiplier consistent with (q1, p1), from the projection's factors (0 where not finite) */
+  for (i = 0; i < pendulum_poly_k4s4_NU; i++) {
+    double lam = beta * beta * pr[pendulum_poly_k4s4_M + 2 + 2 * pendulum_poly_k4s4_NU + i] - pr[pendulum_poly_k4s4_M + 2 + 3 * pendulum_poly_k4s4_NU + i];
+    x->lambda[i] = isfinite(lam) ? (double)lam : 0;
   }
   pendulum_poly_k4s4_add(&x->t, &x->tc, h);
   x->hprev2 = x->hprev;
