@@ -9,8 +9,9 @@
  * such as P_1 = +-1 at the nodes of k = 2, is exact in the table and the
  * DAG folds its product away (GSL's nodes were up to a few ulps off); the
  * rounding is faithful, not always correct (a value within about 1e-19 of
- * a tie between two doubles may go either way); the warm start's tables in
- * double. All are printed into the generated code with 17 significant
+ * a tie between two doubles may go either way). The warm start's E from
+ * its closed form the same way; the two-step start's E2 from a linear
+ * solve in double. All are printed into the generated code with 17 significant
  * digits. */
 #include <math.h>
 #include <stdlib.h>
@@ -59,8 +60,8 @@ static long double gauss_node_ld(int k, double c, long double *weight) {
   return (1 + t) / 2;
 }
 
-static double binomial(int n, int k) {
-  double r = 1;
+static long double binomial_ld(int n, int k) {
+  long double r = 1;
   for (int i = 1; i <= k; i++) r = r * (n - k + i) / i;
   return r;
 }
@@ -203,23 +204,23 @@ Method *method_new(int k, int s, MultFamily family) {
   }
   /* Warm start: gamma_j of the next step (size r*h) from this step's
    * polynomial: E_ji(r) = int_0^1 P_j(x) P_i(1 + r x) dx = sum_d E_jid r^d,
-   * with E_jid = P_i^(d)(1)/d! * int_0^1 P_j(x) x^d dx (exact by Gauss). */
+   * with P_i(1 + y) = sqrt(2i+1) sum_d C(i,d) C(i+d,d) y^d and
+   * int_0^1 P_j(x) x^d dx = sqrt(2j+1) d!^2 / ((d-j)! (d+j+1)!) for d >= j
+   * (0 below): E_jid is 0 unless j <= d <= i, and E_jjj = 1, so a same-size
+   * start takes gamma_j as it is (in long double, rounded once). */
   me->E = arena_alloc((size_t)s * s * s * sizeof(double));
-  for (int i = 0; i < s; i++) {
-    double *mono = calloc((size_t)s, sizeof(double)); /* P_i(x) = sum_n mono[n] x^n */
-    for (int n = 0; n <= i; n++)
-      mono[n] = sqrt(2.0 * i + 1) * ((i + n) % 2 ? -1 : 1) * binomial(i, n) * binomial(i + n, n);
-    for (int d = 0; d <= i; d++) {
-      double taylor = 0;
-      for (int n = d; n <= i; n++) taylor += mono[n] * binomial(n, d);
-      for (int j = 0; j < s; j++) {
-        double moment = 0;
-        for (int l = 0; l < k; l++) moment += me->W[l * s + j] * pow(me->c[l], d);
-        me->E[(j * s + i) * s + d] = taylor * moment;
+  for (int j = 0; j < s; j++)
+    for (int i = 0; i < s; i++)
+      for (int d = 0; d < s; d++) {
+        long double v = 0;
+        if (j <= d && d <= i) {
+          v = sqrtl((2.0L * i + 1) * (2.0L * j + 1)) * binomial_ld(i, d) * binomial_ld(i + d, d);
+          for (int n = 1; n <= d; n++) v *= n; /* d!^2 / ((d-j)! (d+j+1)!) = d!/(d+j+1)! * d!/(d-j)! */
+          for (int n = 1; n <= d + j + 1; n++) v /= n;
+          for (int n = d - j + 1; n <= d; n++) v *= n;
+        }
+        me->E[(j * s + i) * s + d] = (double)v;
       }
-    }
-    free(mono);
-  }
   me->E2 = two_step_table(s);
   return me;
 }

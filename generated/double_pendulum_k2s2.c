@@ -778,7 +778,7 @@ double_pendulum_k2s2_OUT_OF_LINE int double_pendulum_k2s2_predict(const double_p
       for (i = 0; i < double_pendulum_k2s2_S * double_pendulum_k2s2_M; i++) ref[i] = 0;
       for (l = 0; l < double_pendulum_k2s2_M; l++) ref[0 * double_pendulum_k2s2_M + l] += x->gam[0 * double_pendulum_k2s2_M + l];
       for (l = 0; l < double_pendulum_k2s2_M; l++) ref[0 * double_pendulum_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * double_pendulum_k2s2_M + l];
-      for (l = 0; l < double_pendulum_k2s2_M; l++) ref[1 * double_pendulum_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * double_pendulum_k2s2_M + l];
+      for (l = 0; l < double_pendulum_k2s2_M; l++) ref[1 * double_pendulum_k2s2_M + l] += x->gam[1 * double_pendulum_k2s2_M + l];
     }
     for (l = 0; l < double_pendulum_k2s2_M; l++) {
       double b = 0;
@@ -802,7 +802,7 @@ double_pendulum_k2s2_OUT_OF_LINE int double_pendulum_k2s2_predict(const double_p
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += x->gam[0 * double_pendulum_k2s2_M + l];
     for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * double_pendulum_k2s2_M + l];
-    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[1 * double_pendulum_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * double_pendulum_k2s2_M + l];
+    for (l = 0; l < double_pendulum_k2s2_M; l++) gam[1 * double_pendulum_k2s2_M + l] += x->gam[1 * double_pendulum_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -810,7 +810,7 @@ double_pendulum_k2s2_OUT_OF_LINE int double_pendulum_k2s2_predict(const double_p
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < double_pendulum_k2s2_M; l++) gam[0 * double_pendulum_k2s2_M + l] += e * x->gam[1 * double_pendulum_k2s2_M + l];
-    e = 0.99999999999999989;
+    e = 1.0;
     e = e * r;
     for (l = 0; l < double_pendulum_k2s2_M; l++) gam[1 * double_pendulum_k2s2_M + l] += e * x->gam[1 * double_pendulum_k2s2_M + l];
   }

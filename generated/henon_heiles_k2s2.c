@@ -152,7 +152,7 @@ henon_heiles_k2s2_OUT_OF_LINE void henon_heiles_k2s2_predict(const henon_heiles_
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[0 * henon_heiles_k2s2_M + l] += x->gam[0 * henon_heiles_k2s2_M + l];
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[0 * henon_heiles_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * henon_heiles_k2s2_M + l];
-    for (l = 0; l < henon_heiles_k2s2_M; l++) gam[1 * henon_heiles_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * henon_heiles_k2s2_M + l];
+    for (l = 0; l < henon_heiles_k2s2_M; l++) gam[1 * henon_heiles_k2s2_M + l] += x->gam[1 * henon_heiles_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -160,7 +160,7 @@ henon_heiles_k2s2_OUT_OF_LINE void henon_heiles_k2s2_predict(const henon_heiles_
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[0 * henon_heiles_k2s2_M + l] += e * x->gam[1 * henon_heiles_k2s2_M + l];
-    e = 0.99999999999999989;
+    e = 1.0;
     e = e * r;
     for (l = 0; l < henon_heiles_k2s2_M; l++) gam[1 * henon_heiles_k2s2_M + l] += e * x->gam[1 * henon_heiles_k2s2_M + l];
   }

@@ -160,20 +160,18 @@ kepler_k16s2_OUT_OF_LINE void kepler_k16s2_predict(const kepler_k16s2_state *x, 
     return;
   }
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
-    for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += 1.0000000000000002 * x->gam[0 * kepler_k16s2_M + l];
+    for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += x->gam[0 * kepler_k16s2_M + l];
     for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += 3.4641016151377544 * x->gam[1 * kepler_k16s2_M + l];
-    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += (-1.3877787807814457e-17) * x->gam[0 * kepler_k16s2_M + l];
     for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += x->gam[1 * kepler_k16s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
-    for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += 1.0000000000000002 * x->gam[0 * kepler_k16s2_M + l];
-    e = 1.732050807568877;
-    e = e * r + 1.7320508075688776;
+    for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += x->gam[0 * kepler_k16s2_M + l];
+    e = 1.7320508075688772;
+    e = e * r + 1.7320508075688772;
     for (l = 0; l < kepler_k16s2_M; l++) gam[0 * kepler_k16s2_M + l] += e * x->gam[1 * kepler_k16s2_M + l];
-    for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += (-1.3877787807814457e-17) * x->gam[0 * kepler_k16s2_M + l];
     e = 1.0;
-    e = e * r + (-2.4037033579794548e-17);
+    e = e * r;
     for (l = 0; l < kepler_k16s2_M; l++) gam[1 * kepler_k16s2_M + l] += e * x->gam[1 * kepler_k16s2_M + l];
   }
 }

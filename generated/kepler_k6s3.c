@@ -153,12 +153,9 @@ kepler_k6s3_OUT_OF_LINE void kepler_k6s3_predict(const kepler_k6s3_state *x, dou
     for (l = 0; l < kepler_k6s3_M; l++) gam[0 * kepler_k6s3_M + l] += x->gam[0 * kepler_k6s3_M + l];
     for (l = 0; l < kepler_k6s3_M; l++) gam[0 * kepler_k6s3_M + l] += 3.4641016151377544 * x->gam[1 * kepler_k6s3_M + l];
     for (l = 0; l < kepler_k6s3_M; l++) gam[0 * kepler_k6s3_M + l] += 13.416407864998739 * x->gam[2 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += 0.99999999999999989 * x->gam[1 * kepler_k6s3_M + l];
+    for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += x->gam[1 * kepler_k6s3_M + l];
     for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += 7.745966692414834 * x->gam[2 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += 2.7755575615628914e-17 * x->gam[0 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += (-4.8074067159589095e-17) * x->gam[1 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += 0.99999999999999978 * x->gam[2 * kepler_k6s3_M + l];
+    for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += x->gam[2 * kepler_k6s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -170,21 +167,16 @@ kepler_k6s3_OUT_OF_LINE void kepler_k6s3_predict(const kepler_k6s3_state *x, dou
     e = e * r + 6.7082039324993694;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < kepler_k6s3_M; l++) gam[0 * kepler_k6s3_M + l] += e * x->gam[2 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += (-2.7755575615628914e-17) * x->gam[0 * kepler_k6s3_M + l];
-    e = 0.99999999999999989;
-    e = e * r + (-4.8074067159589095e-17);
+    e = 1.0;
+    e = e * r;
     for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += e * x->gam[1 * kepler_k6s3_M + l];
     e = 3.872983346207417;
     e = e * r + 3.872983346207417;
-    e = e * r + (-6.2063353831181828e-17);
+    e = e * r;
     for (l = 0; l < kepler_k6s3_M; l++) gam[1 * kepler_k6s3_M + l] += e * x->gam[2 * kepler_k6s3_M + l];
-    for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += 2.7755575615628914e-17 * x->gam[0 * kepler_k6s3_M + l];
-    e = (-9.6148134319178191e-17);
-    e = e * r + 4.8074067159589095e-17;
-    for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += e * x->gam[1 * kepler_k6s3_M + l];
     e = 1.0;
-    e = e * r + (-3.7238012298709097e-16);
-    e = e * r + 6.2063353831181828e-17;
+    e = e * r;
+    e = e * r;
     for (l = 0; l < kepler_k6s3_M; l++) gam[2 * kepler_k6s3_M + l] += e * x->gam[2 * kepler_k6s3_M + l];
   }
 }

@@ -297,8 +297,7 @@ modified_k6s2_OUT_OF_LINE void modified_k6s2_predict(const modified_k6s2_state *
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < modified_k6s2_M; l++) gam[0 * modified_k6s2_M + l] += x->gam[0 * modified_k6s2_M + l];
     for (l = 0; l < modified_k6s2_M; l++) gam[0 * modified_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * modified_k6s2_M + l];
-    for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_k6s2_M + l];
-    for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += 0.99999999999999989 * x->gam[1 * modified_k6s2_M + l];
+    for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += x->gam[1 * modified_k6s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -306,9 +305,8 @@ modified_k6s2_OUT_OF_LINE void modified_k6s2_predict(const modified_k6s2_state *
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < modified_k6s2_M; l++) gam[0 * modified_k6s2_M + l] += e * x->gam[1 * modified_k6s2_M + l];
-    for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * modified_k6s2_M + l];
-    e = 0.99999999999999989;
-    e = e * r + (-4.8074067159589095e-17);
+    e = 1.0;
+    e = e * r;
     for (l = 0; l < modified_k6s2_M; l++) gam[1 * modified_k6s2_M + l] += e * x->gam[1 * modified_k6s2_M + l];
   }
 }

@@ -301,36 +301,30 @@ modified_k9s3_OUT_OF_LINE void modified_k9s3_predict(const modified_k9s3_state *
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += x->gam[0 * modified_k9s3_M + l];
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += 3.4641016151377544 * x->gam[1 * modified_k9s3_M + l];
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += 13.416407864998739 * x->gam[2 * modified_k9s3_M + l];
-    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += 0.99999999999999989 * x->gam[1 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += x->gam[1 * modified_k9s3_M + l];
     for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += 7.745966692414834 * x->gam[2 * modified_k9s3_M + l];
-    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += 1.3877787807814457e-17 * x->gam[0 * modified_k9s3_M + l];
-    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += (-2.4037033579794548e-17) * x->gam[1 * modified_k9s3_M + l];
-    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += 0.99999999999999967 * x->gam[2 * modified_k9s3_M + l];
+    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += x->gam[2 * modified_k9s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += x->gam[0 * modified_k9s3_M + l];
-    e = 1.732050807568877;
+    e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
     e = 4.4721359549995796;
-    e = e * r + 6.7082039324993685;
+    e = e * r + 6.7082039324993694;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < modified_k9s3_M; l++) gam[0 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
-    e = 0.99999999999999989;
+    e = 1.0;
     e = e * r;
     for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
     e = 3.872983346207417;
     e = e * r + 3.872983346207417;
     e = e * r;
     for (l = 0; l < modified_k9s3_M; l++) gam[1 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
-    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += 1.3877787807814457e-17 * x->gam[0 * modified_k9s3_M + l];
-    e = (-4.8074067159589095e-17);
-    e = e * r + 2.4037033579794548e-17;
-    for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[1 * modified_k9s3_M + l];
-    e = 0.99999999999999989;
-    e = e * r + (-1.8619006149354548e-16);
-    e = e * r + 3.1031676915590914e-17;
+    e = 1.0;
+    e = e * r;
+    e = e * r;
     for (l = 0; l < modified_k9s3_M; l++) gam[2 * modified_k9s3_M + l] += e * x->gam[2 * modified_k9s3_M + l];
   }
 }

@@ -248,8 +248,8 @@ pendulum_k3s3_OUT_OF_LINE void pendulum_k3s3_predict(const pendulum_k3s3_state *
     for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_k3s3_M + l];
     for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += 13.416407864998739 * x->gam[2 * pendulum_k3s3_M + l];
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += x->gam[1 * pendulum_k3s3_M + l];
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += 7.7459666924148349 * x->gam[2 * pendulum_k3s3_M + l];
-    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += 0.99999999999999989 * x->gam[2 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += 7.745966692414834 * x->gam[2 * pendulum_k3s3_M + l];
+    for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += x->gam[2 * pendulum_k3s3_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -257,18 +257,18 @@ pendulum_k3s3_OUT_OF_LINE void pendulum_k3s3_predict(const pendulum_k3s3_state *
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += e * x->gam[1 * pendulum_k3s3_M + l];
-    e = 4.4721359549995805;
+    e = 4.4721359549995796;
     e = e * r + 6.7082039324993694;
     e = e * r + 2.2360679774997898;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[0 * pendulum_k3s3_M + l] += e * x->gam[2 * pendulum_k3s3_M + l];
     e = 1.0;
     e = e * r;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += e * x->gam[1 * pendulum_k3s3_M + l];
-    e = 3.8729833462074175;
-    e = e * r + 3.8729833462074175;
+    e = 3.872983346207417;
+    e = e * r + 3.872983346207417;
     e = e * r;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[1 * pendulum_k3s3_M + l] += e * x->gam[2 * pendulum_k3s3_M + l];
-    e = 0.99999999999999989;
+    e = 1.0;
     e = e * r;
     e = e * r;
     for (l = 0; l < pendulum_k3s3_M; l++) gam[2 * pendulum_k3s3_M + l] += e * x->gam[2 * pendulum_k3s3_M + l];

@@ -390,7 +390,7 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
       for (i = 0; i < pendulum_poly_k2s2_S * pendulum_poly_k2s2_M; i++) ref[i] = 0;
       for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[0 * pendulum_poly_k2s2_M + l] += x->gam[0 * pendulum_poly_k2s2_M + l];
       for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[0 * pendulum_poly_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_poly_k2s2_M + l];
-      for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[1 * pendulum_poly_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_poly_k2s2_M + l];
+      for (l = 0; l < pendulum_poly_k2s2_M; l++) ref[1 * pendulum_poly_k2s2_M + l] += x->gam[1 * pendulum_poly_k2s2_M + l];
     }
     for (l = 0; l < pendulum_poly_k2s2_M; l++) {
       double b = 0;
@@ -414,7 +414,7 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += x->gam[0 * pendulum_poly_k2s2_M + l];
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += 3.4641016151377544 * x->gam[1 * pendulum_poly_k2s2_M + l];
-    for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[1 * pendulum_poly_k2s2_M + l] += 0.99999999999999989 * x->gam[1 * pendulum_poly_k2s2_M + l];
+    for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[1 * pendulum_poly_k2s2_M + l] += x->gam[1 * pendulum_poly_k2s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -422,7 +422,7 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[0 * pendulum_poly_k2s2_M + l] += e * x->gam[1 * pendulum_poly_k2s2_M + l];
-    e = 0.99999999999999989;
+    e = 1.0;
     e = e * r;
     for (l = 0; l < pendulum_poly_k2s2_M; l++) gam[1 * pendulum_poly_k2s2_M + l] += e * x->gam[1 * pendulum_poly_k2s2_M + l];
   }

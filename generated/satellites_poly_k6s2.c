@@ -4363,8 +4363,7 @@ satellites_poly_k6s2_OUT_OF_LINE int satellites_poly_k6s2_predict(const satellit
       for (i = 0; i < satellites_poly_k6s2_S * satellites_poly_k6s2_M; i++) ref[i] = 0;
       for (l = 0; l < satellites_poly_k6s2_M; l++) ref[0 * satellites_poly_k6s2_M + l] += x->gam[0 * satellites_poly_k6s2_M + l];
       for (l = 0; l < satellites_poly_k6s2_M; l++) ref[0 * satellites_poly_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * satellites_poly_k6s2_M + l];
-      for (l = 0; l < satellites_poly_k6s2_M; l++) ref[1 * satellites_poly_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * satellites_poly_k6s2_M + l];
-      for (l = 0; l < satellites_poly_k6s2_M; l++) ref[1 * satellites_poly_k6s2_M + l] += 0.99999999999999989 * x->gam[1 * satellites_poly_k6s2_M + l];
+      for (l = 0; l < satellites_poly_k6s2_M; l++) ref[1 * satellites_poly_k6s2_M + l] += x->gam[1 * satellites_poly_k6s2_M + l];
     }
     for (l = 0; l < satellites_poly_k6s2_M; l++) {
       double b = 0;
@@ -4388,8 +4387,7 @@ satellites_poly_k6s2_OUT_OF_LINE int satellites_poly_k6s2_predict(const satellit
   if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += x->gam[0 * satellites_poly_k6s2_M + l];
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += 3.4641016151377544 * x->gam[1 * satellites_poly_k6s2_M + l];
-    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * satellites_poly_k6s2_M + l];
-    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += 0.99999999999999989 * x->gam[1 * satellites_poly_k6s2_M + l];
+    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += x->gam[1 * satellites_poly_k6s2_M + l];
   } else {
     const double r = h / x->hprev;
     double e;
@@ -4397,9 +4395,8 @@ satellites_poly_k6s2_OUT_OF_LINE int satellites_poly_k6s2_predict(const satellit
     e = 1.7320508075688772;
     e = e * r + 1.7320508075688772;
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[0 * satellites_poly_k6s2_M + l] += e * x->gam[1 * satellites_poly_k6s2_M + l];
-    for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += (-2.7755575615628914e-17) * x->gam[0 * satellites_poly_k6s2_M + l];
-    e = 0.99999999999999989;
-    e = e * r + (-4.8074067159589095e-17);
+    e = 1.0;
+    e = e * r;
     for (l = 0; l < satellites_poly_k6s2_M; l++) gam[1 * satellites_poly_k6s2_M + l] += e * x->gam[1 * satellites_poly_k6s2_M + l];
   }
   return 0;
