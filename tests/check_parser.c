@@ -15,6 +15,7 @@
 
 #include <check.h>
 #include <ctype.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +25,51 @@
 #include <unistd.h>
 
 #include "hbvmgen.h"
+
+// P_j(x) = sqrt(2j+1) L_j(2x-1), by the recurrence (the test's own).
+static double shifted_legendre(int j, double x) {
+  double t = 2 * x - 1, prev = 0, cur = 1;
+  for (int n = 0; n < j; n++) {
+    double next = n == 0 ? t : ((2 * n + 1) * t * cur - n * prev) / (n + 1);
+    prev = cur;
+    cur = next;
+  }
+  return sqrt(2.0 * j + 1) * cur;
+}
+
+// The warm start's E_ji(r) = sum_d E[(j*s+i)*s+d] r^d = int_0^1 P_j(x)
+// P_i(1 + r x) dx: its zero coefficients exactly 0 (d < j or d > i), the
+// diagonal exactly r^j, so that a same-size start copies gamma_j, and at
+// r = 1/2 the integral by the method's own Gauss nodes (exact for this
+// degree) within the quadrature's round-off, 64 ulps of the sum of its
+// terms' magnitudes (they cancel: E_45(1/2) = 0.93 for s = 7 from terms
+// of magnitudes summing to 173).
+START_TEST(test_warm_start_table)
+{
+  for (int s = 1; s <= 12; s++) {
+    Method *me = method_new(s, s, MULT_POLY);
+    double r = 0.5;
+    for (int j = 0; j < s; j++)
+      for (int i = 0; i < s; i++) {
+        const double *c = me->E + (j * s + i) * s;
+        double horner = 0, quad = 0, mass = 0;
+        for (int d = s - 1; d >= 0; d--) {
+          if (d < j || d > i) ck_assert_msg(c[d] == 0, "s=%d E[%d][%d][%d] = %g", s, j, i, d, c[d]);
+          horner = horner * r + c[d];
+        }
+        if (i == j) ck_assert_msg(c[j] == 1, "s=%d E[%d][%d][%d] = %.17g", s, j, j, j, c[j]);
+        for (int l = 0; l < s; l++) {
+          double term = me->b[l] * shifted_legendre(j, me->c[l]) * shifted_legendre(i, 1 + r * me->c[l]);
+          quad += term;
+          mass += fabs(term);
+        }
+        ck_assert_msg(fabs(horner - quad) <= 64 * DBL_EPSILON * mass, "s=%d E_%d%d(1/2) %.17g, quadrature %.17g", s, j,
+                      i, horner, quad);
+      }
+    arena_free_all();
+  }
+}
+END_TEST
 
 Suite *parser_suite(void);
 
@@ -688,6 +734,7 @@ Suite *parser_suite(void)
   tcase_add_loop_test(fe, test_mass, 0, NCASES(mass_cases));
   tcase_add_test(fe, test_mass_params);
   tcase_add_test(fe, test_potential_default);
+  tcase_add_test(fe, test_warm_start_table);
   tcase_add_test(fe, test_constraints);
   tcase_add_test(fe, test_sum_and_indexing);
   tcase_add_loop_test(fe, test_functions, 0, NCASES(function_cases));
