@@ -21,6 +21,7 @@
 #include "bplain_k3s3.h"
 #include "bpoly_k3s3.h"
 #include "bsat_k6s2.h"
+#include "bsatpoly_k6s2.h"
 
 /* Lane l starts from the model's initial values after l scalar steps of
  * h (1 + l / 8), so the lanes differ in state and in the previous step (lane
@@ -94,6 +95,7 @@ BATCH_TEST(bfloat_k2s2, 0.05, 12)
 BATCH_TEST(bfloatpoly_k2s2, 0.05, 12)
 BATCH_TEST(bchain_k2s2, 0.005, 8)
 BATCH_TEST(bsat_k6s2, 0.05, 8)
+BATCH_TEST(bsatpoly_k6s2, 0.05, 8) /* the multiplier force from the moments R_jr */
 BATCH_TEST(bkepler_k16s2, 0.03, 12)
 BATCH_TEST(bmass_k2s2, 0.05, 12)
 BATCH_TEST(bdense_k2s2, 0.005, 8)
@@ -176,6 +178,7 @@ ADAPTIVE_TEST(bconst_k2s2, 0.5, 1e-6, 30)
 ADAPTIVE_TEST(bkepler_k16s2, 0.5, 1e-8, 30)
 ADAPTIVE_TEST(bchain_k2s2, 0.05, 1e-6, 20)
 ADAPTIVE_TEST(bsat_k6s2, 0.5, 1e-6, 20)
+ADAPTIVE_TEST(bsatpoly_k6s2, 0.5, 1e-6, 20)
 ADAPTIVE_TEST(bfloatpoly_k2s2, 0.5, 1e-4, 20)
 
 /* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
@@ -213,6 +216,7 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_bfloatpoly_k2s2);
   tcase_add_test(tc, test_bchain_k2s2);
   tcase_add_test(tc, test_bsat_k6s2);
+  tcase_add_test(tc, test_bsatpoly_k6s2);
   tcase_add_test(tc, test_bkepler_k16s2);
   tcase_add_test(tc, test_bmass_k2s2);
   tcase_add_test(tc, test_bdense_k2s2);
@@ -225,6 +229,7 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_adaptive_bkepler_k16s2);
   tcase_add_test(tc, test_adaptive_bchain_k2s2);
   tcase_add_test(tc, test_adaptive_bsat_k6s2);
+  tcase_add_test(tc, test_adaptive_bsatpoly_k6s2);
   tcase_add_test(tc, test_adaptive_bfloatpoly_k2s2);
   suite_add_tcase(s, tc);
   return s;
