@@ -12,10 +12,11 @@
  *   R_jr = sum_l b_l P_j(c_l) P_r(c_l) G_l,
  * which the kernel "factor" builds from the predicted stage data and
  * factors once per step (lu.c, minimum-degree order: a chain's blocks keep
- * their band). The sweep takes Theta_j stage by stage or, where that is
- * shorter by a tenth, as psi_j + sum_r R_jr lambda_r from the moments R at
- * its own stage data (sweep_ops). Each sweep then updates lambda <- lambda + A^-1 C(lambda)
- * with that frozen factor and recomputes Theta and gamma (docs/method-poly.md
+ * their band). The sweep takes Theta_j and C_i stage by stage or, where
+ * that is shorter by a tenth, from the moments R at its own stage data
+ * (sweep_ops): Theta_j = psi_j + sum_r R_jr lambda_r and C_i = sum_j R_ij'
+ * gamma_j (+ g(q0)/h), since b_l P_i(c_l) V_l sums to them. Each sweep then
+ * updates lambda <- lambda + A^-1 C(lambda) with that frozen factor and recomputes Theta and gamma (docs/method-poly.md
  * section 5: as few sweeps as re-solving A every sweep while h is small;
  * where the iteration slows down the step template calls "factor" again at
  * the current gamma, which keeps it converging to the h of the constant
@@ -191,14 +192,21 @@ static int **force_coefficients(Build *b, int ***G, int ****R, const int *lam) {
 }
 
 // The conditions C[i*nu + a] = sum_l b_l P_i(c_l) G_l[:, a]' V_l (+ g_a(q0)/h
-// for i = 0) for the velocity coefficients gam (s*m nodes).
-static int *conditions(Build *b, int ***G, const int *gam) {
+// for i = 0) for the velocity coefficients gam (s*m nodes), V_l = sum_j
+// P_j(c_l) gamma_j: from the stage Jacobians G (R NULL), or from their
+// moments as sum_j R_ij[:, a]' gamma_j, which leaves the G_l dead once the
+// moments hold them.
+static int *conditions(Build *b, int ***G, int ****R, const int *gam) {
   Dag *d = b->d;
   const Method *me = b->me;
   int m = b->m, nu = b->nu, s = b->s, z = dag_const(d, 0);
   int *C = step_nodes(s * nu), *V = step_nodes(m);
   for (int t = 0; t < s * nu; t++) C[t] = z;
-  for (int l = 0; l < b->k; l++) {
+  if (R)
+    for (int i = 0; i < s; i++)
+      for (int a = 0; a < nu; a++)
+        for (int j = 0; j < s; j++) C[i * nu + a] = dag_add(d, C[i * nu + a], dot_sparse(b, a, R[i][j][a], gam + j * m));
+  for (int l = 0; l < b->k && !R; l++) {
     for (int i = 0; i < m; i++) {
       V[i] = z;
       for (int j = 0; j < s; j++) V[i] = dag_add(d, V[i], dag_mul(d, dag_const(d, me->Phat[l * s + j]), gam[j * m + i]));
@@ -221,7 +229,7 @@ static int **sweep_force(Build *b, int ***G, int ****R, const LuFactor *in, cons
   int n = b->s * b->nu, *gam = step_nodes(b->s * b->m), *dp = step_nodes(b->m), *delta = step_nodes(n);
   step_section(b, "the multiplier coefficients: lambda += A^-1 C(lambda)");
   step_gamma(b, force_coefficients(b, G, R, lam), gam, dp);
-  lu_apply(d, in, conditions(b, G, gam), delta);
+  lu_apply(d, in, conditions(b, G, R, gam), delta);
   for (int t = 0; t < n; t++) lam1[t] = dag_add(d, lam[t], delta[t]);
   step_section(b, "new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i(lambda)]");
   return force_coefficients(b, G, R, lam1);
@@ -317,12 +325,13 @@ void build_poly_multiplier(Build *b) {
   b->owners = 1u << K_SWEEP;
   int *lam = step_nodes(n), *lam1 = step_nodes(n);
   for (int t = 0; t < n; t++) lam[t] = step_in(b, IN_LAM, t);
-  /* the force from the moments where that saves a tenth of the sweep's
-   * operations: with fewer stages per moment (k small against s) the stage
-   * form is shorter, and below a tenth the moments, live from before the
-   * first force to the last, cost more stores than they save (the
-   * satellites (6,3): 1% fewer operations, 2% more instructions a step;
-   * (6,2): 12% fewer operations, 6% fewer instructions) */
+  /* the force and the conditions from the moments where that saves a tenth
+   * of the sweep's operations: with fewer stages per moment (k small against
+   * s) the stage form is shorter, and below a tenth the moments, live from
+   * before the first force to the last, cost more stores than they save
+   * (whole runs, instructions: the satellites (6,3), 7% fewer operations, +3%;
+   * (6,2), 25% fewer, -5%; the modified pendulum (6,2), (9,3), (12,4), 11-30%
+   * fewer, -7% to -9%) */
   int **theta = sweep_force(b, G, NULL, &in, lam, lam1);
   long ops = sweep_ops(b, theta, lam1);
   int *lam1r = step_nodes(n), **theta_r = sweep_force(b, G, R, &in, lam, lam1r);
