@@ -16,11 +16,11 @@
  * that is shorter by a tenth, from the moments R at its own stage data
  * (sweep_ops): Theta_j = psi_j + sum_r R_jr lambda_r and C_i = sum_j R_ij'
  * gamma_j (+ g(q0)/h), since b_l P_i(c_l) V_l sums to them. Each sweep then
- * updates lambda <- lambda + A^-1 C(lambda) with that frozen factor and recomputes Theta and gamma (docs/method-poly.md
- * section 5: as few sweeps as re-solving A every sweep while h is small;
- * where the iteration slows down the step template calls "factor" again at
- * the current gamma, which keeps it converging to the h of the constant
- * family).
+ * updates lambda <- lambda + A^-1 C(lambda) with that frozen factor and
+ * recomputes Theta and gamma (docs/method-poly.md section 5: as few
+ * sweeps as re-solving A every sweep while h is small; where the iteration
+ * slows down the step template calls "factor" again at the current gamma,
+ * which keeps it converging to the h of the constant family).
  *
  * After the iteration the step projects p1 onto the hidden constraint at
  * q1 and rescales it so that H keeps its value; the kernel "project_p1" gives
@@ -65,10 +65,10 @@ static int dot_sparse(Build *b, int a, const int *col, const int *v) {
 
 // The moments R_jr = sum_l b_l P_j(c_l) P_r(c_l) G_l of the stage Jacobians
 // over the structural nonzeros: R[j][r][a][e], symmetric in (j, r), so the
-// pairs r < j share the nodes of (r, j). They build the matrix A and the
-// multiplier's force sum_l b_l P_j(c_l) G_l Lambda_l = sum_r R_jr lambda_r,
-// which so needs the s(s+1)/2 moments across the sweep's solve rather than
-// the k stage Jacobians.
+// pairs r < j share the nodes of (r, j). They build the matrix A, and in
+// the moment form the multiplier's force sum_l b_l P_j(c_l) G_l Lambda_l =
+// sum_r R_jr lambda_r and the conditions, so that the sweep keeps the
+// s(s+1)/2 moments rather than the k stage Jacobians.
 static int ****jacobian_moments(Build *b, int ***G) {
   Dag *d = b->d;
   const Method *me = b->me;
@@ -327,11 +327,11 @@ void build_poly_multiplier(Build *b) {
   for (int t = 0; t < n; t++) lam[t] = step_in(b, IN_LAM, t);
   /* the force and the conditions from the moments where that saves a tenth
    * of the sweep's operations: with fewer stages per moment (k small against
-   * s) the stage form is shorter, and below a tenth the moments, live from
-   * before the first force to the last, cost more stores than they save
-   * (whole runs, instructions: the satellites (6,3), 7% fewer operations, +3%;
-   * (6,2), 25% fewer, -5%; the modified pendulum (6,2), (9,3), (12,4), 11-30%
-   * fewer, -7% to -9%) */
+   * s) the stage form is shorter, and a smaller saving did not show in the
+   * instructions (callgrind, whole runs against the stage form: the
+   * satellites (6,3), 7% fewer operations, +3% instructions; (6,2), 25%
+   * fewer, -11%; the modified pendulum (9,3) and (12,4), 20% and 11% fewer,
+   * -9% and -7%) */
   int **theta = sweep_force(b, G, NULL, &in, lam, lam1);
   long ops = sweep_ops(b, theta, lam1);
   int *lam1r = step_nodes(n), **theta_r = sweep_force(b, G, R, &in, lam, lam1r);
