@@ -10,14 +10,13 @@
  * DAG folds its product away (GSL's nodes were up to a few ulps off); the
  * rounding is faithful, not always correct (a value within about 1e-19 of
  * a tie between two doubles may go either way). The warm start's E from
- * its closed form the same way; the two-step start's E2 from a linear
- * solve in double. All are printed into the generated code with 17 significant
+ * its closed form the same way, the two-step start's E2 from a linear
+ * solve in long double. All are printed into the generated code with 17 significant
  * digits. */
 #include <math.h>
 #include <stdlib.h>
 
 #include <gsl/gsl_integration.h>
-#include <gsl/gsl_linalg.h>
 
 #include "hbvmgen.h"
 
@@ -41,7 +40,6 @@ static long double legendre_ld(int j, long double t, long double *prev) {
 // nodes of k = 2 is exactly +-1, not 1 - 2^-53).
 static long double pshift_ld(int j, long double x) { return sqrtl(2.0L * j + 1) * legendre_ld(j, 2 * x - 1, NULL); }
 
-static double legendre_shifted(int j, double x) { return (double)pshift_ld(j, x); }
 
 static long double xi_ld(int j) { return 1 / (2 * sqrtl(fabsl(4.0L * j * j - 1))); }
 
@@ -125,43 +123,73 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+// Solve A x = b in place for n unknowns (A row-major n x n, b into x) by
+// Gaussian elimination with partial pivoting, in long double.
+static void solve_ld(long double *A, long double *b, int n) {
+  for (int c = 0; c < n; c++) {
+    int p = c;
+    for (int r = c + 1; r < n; r++)
+      if (fabsl(A[r * n + c]) > fabsl(A[p * n + c])) p = r;
+    for (int t = 0; t < n && p != c; t++) {
+      long double a = A[c * n + t];
+      A[c * n + t] = A[p * n + t];
+      A[p * n + t] = a;
+    }
+    long double bb = b[c];
+    b[c] = b[p];
+    b[p] = bb;
+    for (int r = c + 1; r < n; r++) {
+      long double f = A[r * n + c] / A[c * n + c];
+      for (int t = c; t < n; t++) A[r * n + t] -= f * A[c * n + t];
+      b[r] -= f * b[c];
+    }
+  }
+  for (int c = n - 1; c >= 0; c--) {
+    for (int t = c + 1; t < n; t++) b[c] -= A[c * n + t] * b[t];
+    b[c] /= A[c * n + c];
+  }
+}
+
 // The two-step warm start for steps of equal size: the polynomial p of
 // degree 2s-1 whose Legendre coefficients on the last step [0,1] and the one
 // before [-1,0] are gamma and gamma_prev, projected on the next step [1,2]:
 // gamma_next_j = sum_i E2[j][i] gamma_i + E2[j][s + i] gamma_prev_i. With
 // p in the Legendre basis of [-1,2] (well conditioned), E2 = V C^-1 where
 // C[i][d] = int_0^1 P_i(x) phi_d(x) dx (and phi_d(x - 1) for rows s + i),
-// V[j][d] = int_0^1 P_j(x) phi_d(1 + x) dx, by Gauss with 2s nodes (exact).
+// V[j][d] = int_0^1 P_j(x) phi_d(1 + x) dx, by Gauss with 2s nodes (exact),
+// all in long double and rounded once (so that E2 for s = 2 holds -5.5, 6.5
+// and 9.5, not values a few ulps off).
 static double *two_step_table(int s) {
   int n = 2 * s;
-  gsl_matrix *C = gsl_matrix_calloc((size_t)n, (size_t)n), *V = gsl_matrix_calloc((size_t)s, (size_t)n);
-  gsl_permutation *perm = gsl_permutation_alloc((size_t)n);
-  gsl_vector *row = gsl_vector_alloc((size_t)n);
+  long double *C = calloc((size_t)n * n, sizeof *C), *V = calloc((size_t)s * n, sizeof *V);
+  long double *row = malloc((size_t)n * sizeof *row);
   gsl_integration_glfixed_table *t = gsl_integration_glfixed_table_alloc((size_t)n);
-  if (!C || !V || !perm || !row || !t) internal_error("cannot build the two-step warm start for s=%d", s);
+  if (!C || !V || !row || !t) internal_error("cannot build the two-step warm start for s=%d", s);
   for (int l = 0; l < n; l++) {
-    double x, w;
-    gsl_integration_glfixed_point(0, 1, (size_t)l, &x, &w, t);
+    double x0, w0;
+    gsl_integration_glfixed_point(0, 1, (size_t)l, &x0, &w0, t);
+    long double w, x = gauss_node_ld(n, x0, &w);
     for (int d = 0; d < n; d++)
       for (int i = 0; i < s; i++) {
-        double Pi = legendre_shifted(i, x) * w;
-        *gsl_matrix_ptr(C, (size_t)d, (size_t)i) += Pi * legendre_shifted(d, (x + 1) / 3); /* C' */
-        *gsl_matrix_ptr(C, (size_t)d, (size_t)(s + i)) += Pi * legendre_shifted(d, x / 3);
-        *gsl_matrix_ptr(V, (size_t)i, (size_t)d) += Pi * legendre_shifted(d, (x + 2) / 3);
+        long double Pi = pshift_ld(i, x) * w;
+        C[d * n + i] += Pi * pshift_ld(d, (x + 1) / 3); /* C', row d */
+        C[d * n + s + i] += Pi * pshift_ld(d, x / 3);
+        V[i * n + d] += Pi * pshift_ld(d, (x + 2) / 3);
       }
   }
-  int sign;
-  gsl_linalg_LU_decomp(C, perm, &sign); /* of C', as filled */
   double *E2 = arena_alloc((size_t)s * n * sizeof(double));
+  long double *A = malloc((size_t)n * n * sizeof *A);
+  if (!A) internal_error("cannot build the two-step warm start for s=%d", s);
   for (int j = 0; j < s; j++) { /* row j of V C^-1: C' y = V[j]' */
-    gsl_vector_view vj = gsl_matrix_row(V, (size_t)j);
-    gsl_linalg_LU_solve(C, perm, &vj.vector, row);
-    for (int i = 0; i < n; i++) E2[j * n + i] = gsl_vector_get(row, (size_t)i);
+    for (int e = 0; e < n * n; e++) A[e] = C[e];
+    for (int i = 0; i < n; i++) row[i] = V[j * n + i];
+    solve_ld(A, row, n);
+    for (int i = 0; i < n; i++) E2[j * n + i] = (double)row[i];
   }
-  gsl_matrix_free(C);
-  gsl_matrix_free(V);
-  gsl_permutation_free(perm);
-  gsl_vector_free(row);
+  free(A);
+  free(C);
+  free(V);
+  free(row);
   gsl_integration_glfixed_table_free(t);
   return E2;
 }

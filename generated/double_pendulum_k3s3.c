@@ -1418,23 +1418,23 @@ double_pendulum_k3s3_OUT_OF_LINE int double_pendulum_k3s3_predict(const double_p
     }
     for (l = 0; l < double_pendulum_k3s3_M; l++) {
       double b = 0;
-      b += 69.499999999999417 * x->gam[0 * double_pendulum_k3s3_M + l] + (-68.499999999999417) * x->gam2[0 * double_pendulum_k3s3_M + l];
-      b += (-121.78482240718566) * x->gam[1 * double_pendulum_k3s3_M + l] + (-112.04203661461078) * x->gam2[1 * double_pendulum_k3s3_M + l];
-      b += 166.44731007513903 * x->gam[2 * double_pendulum_k3s3_M + l] + (-101.88084722483329) * x->gam2[2 * double_pendulum_k3s3_M + l];
+      b += 69.5 * x->gam[0 * double_pendulum_k3s3_M + l] + (-68.5) * x->gam2[0 * double_pendulum_k3s3_M + l];
+      b += (-121.78482240718668) * x->gam[1 * double_pendulum_k3s3_M + l] + (-112.04203661461175) * x->gam2[1 * double_pendulum_k3s3_M + l];
+      b += 166.44731007514059 * x->gam[2 * double_pendulum_k3s3_M + l] + (-101.88084722483417) * x->gam2[2 * double_pendulum_k3s3_M + l];
       gam[0 * double_pendulum_k3s3_M + l] = b;
     }
     for (l = 0; l < double_pendulum_k3s3_M; l++) {
       double b = 0;
-      b += 63.219854476263507 * x->gam[0 * double_pendulum_k3s3_M + l] + (-63.219854476263507) * x->gam2[0 * double_pendulum_k3s3_M + l];
-      b += (-114.06249999999912) * x->gam[1 * double_pendulum_k3s3_M + l] + (-103.93749999999915) * x->gam2[1 * double_pendulum_k3s3_M + l];
-      b += 146.25353361115623 * x->gam[2 * double_pendulum_k3s3_M + l] + (-95.420627192184469) * x->gam2[2 * double_pendulum_k3s3_M + l];
+      b += 63.219854476264018 * x->gam[0 * double_pendulum_k3s3_M + l] + (-63.219854476264018) * x->gam2[0 * double_pendulum_k3s3_M + l];
+      b += (-114.0625) * x->gam[1 * double_pendulum_k3s3_M + l] + (-103.9375) * x->gam2[1 * double_pendulum_k3s3_M + l];
+      b += 146.25353361115759 * x->gam[2 * double_pendulum_k3s3_M + l] + (-95.420627192185236) * x->gam2[2 * double_pendulum_k3s3_M + l];
       gam[1 * double_pendulum_k3s3_M + l] = b;
     }
     for (l = 0; l < double_pendulum_k3s3_M; l++) {
       double b = 0;
-      b += 23.478713763747635 * x->gam[0 * double_pendulum_k3s3_M + l] + (-23.478713763747631) * x->gam2[0 * double_pendulum_k3s3_M + l];
-      b += (-42.360755349143339) * x->gam[1 * double_pendulum_k3s3_M + l] + (-38.971894921211863) * x->gam2[1 * double_pendulum_k3s3_M + l];
-      b += 50.562499999999574 * x->gam[2 * double_pendulum_k3s3_M + l] + (-36.437499999999758) * x->gam2[2 * double_pendulum_k3s3_M + l];
+      b += 23.478713763747791 * x->gam[0 * double_pendulum_k3s3_M + l] + (-23.478713763747791) * x->gam2[0 * double_pendulum_k3s3_M + l];
+      b += (-42.360755349143624) * x->gam[1 * double_pendulum_k3s3_M + l] + (-38.971894921212133) * x->gam2[1 * double_pendulum_k3s3_M + l];
+      b += 50.5625 * x->gam[2 * double_pendulum_k3s3_M + l] + (-36.4375) * x->gam2[2 * double_pendulum_k3s3_M + l];
       gam[2 * double_pendulum_k3s3_M + l] = b;
     }
     return 1;

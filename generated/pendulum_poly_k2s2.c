@@ -394,14 +394,14 @@ pendulum_poly_k2s2_OUT_OF_LINE int pendulum_poly_k2s2_predict(const pendulum_pol
     }
     for (l = 0; l < pendulum_poly_k2s2_M; l++) {
       double b = 0;
-      b += (-5.5000000000000009) * x->gam[0 * pendulum_poly_k2s2_M + l] + 6.5000000000000009 * x->gam2[0 * pendulum_poly_k2s2_M + l];
-      b += 16.454482671904337 * x->gam[1 * pendulum_poly_k2s2_M + l] + 9.5262794416288283 * x->gam2[1 * pendulum_poly_k2s2_M + l];
+      b += (-5.5) * x->gam[0 * pendulum_poly_k2s2_M + l] + 6.5 * x->gam2[0 * pendulum_poly_k2s2_M + l];
+      b += 16.454482671904334 * x->gam[1 * pendulum_poly_k2s2_M + l] + 9.5262794416288248 * x->gam2[1 * pendulum_poly_k2s2_M + l];
       gam[0 * pendulum_poly_k2s2_M + l] = b;
     }
     for (l = 0; l < pendulum_poly_k2s2_M; l++) {
       double b = 0;
-      b += (-4.3301270189221945) * x->gam[0 * pendulum_poly_k2s2_M + l] + 4.3301270189221945 * x->gam2[0 * pendulum_poly_k2s2_M + l];
-      b += 9.5000000000000053 * x->gam[1 * pendulum_poly_k2s2_M + l] + 6.5000000000000044 * x->gam2[1 * pendulum_poly_k2s2_M + l];
+      b += (-4.3301270189221936) * x->gam[0 * pendulum_poly_k2s2_M + l] + 4.3301270189221936 * x->gam2[0 * pendulum_poly_k2s2_M + l];
+      b += 9.5 * x->gam[1 * pendulum_poly_k2s2_M + l] + 6.5 * x->gam2[1 * pendulum_poly_k2s2_M + l];
       gam[1 * pendulum_poly_k2s2_M + l] = b;
     }
     return 1;

@@ -920,34 +920,34 @@ pendulum_poly_k4s4_OUT_OF_LINE int pendulum_poly_k4s4_predict(const pendulum_pol
     }
     for (l = 0; l < pendulum_poly_k4s4_M; l++) {
       double b = 0;
-      b += (-910.18750000018576) * x->gam[0 * pendulum_poly_k4s4_M + l] + 911.18750000018565 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-      b += 1626.0709487810864 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1533.8392432780267 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-      b += (-2046.4214621585029) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1716.042418482846 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-      b += 1911.2482261102225 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1199.1631589607086 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+      b += (-910.18749999999977) * x->gam[0 * pendulum_poly_k4s4_M + l] + 911.18749999999977 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+      b += 1626.0709487807562 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1533.8392432777136 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+      b += (-2046.4214621580884) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1716.0424184824944 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+      b += 1911.2482261098464 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1199.1631589604624 * x->gam2[3 * pendulum_poly_k4s4_M + l];
       gam[0 * pendulum_poly_k4s4_M + l] = b;
     }
     for (l = 0; l < pendulum_poly_k4s4_M; l++) {
       double b = 0;
-      b += (-990.62480875412496) * x->gam[0 * pendulum_poly_k4s4_M + l] + 990.62480875412484 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-      b += 1762.4375000003547 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1670.1875000003374 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-      b += (-2219.9456417547103) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1874.2818781056314 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-      b += 2030.3674438467733 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1315.485635433527 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+      b += (-990.62480875392453) * x->gam[0 * pendulum_poly_k4s4_M + l] + 990.62480875392453 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+      b += 1762.4374999999995 * x->gam[1 * pendulum_poly_k4s4_M + l] + 1670.1874999999998 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+      b += (-2219.9456417542633) * x->gam[2 * pendulum_poly_k4s4_M + l] + 1874.2818781052515 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+      b += 2030.3674438463715 * x->gam[3 * pendulum_poly_k4s4_M + l] + 1315.4856354332605 * x->gam2[3 * pendulum_poly_k4s4_M + l];
       gam[1 * pendulum_poly_k4s4_M + l] = b;
     }
     for (l = 0; l < pendulum_poly_k4s4_M; l++) {
       double b = 0;
-      b += (-506.88865964958586) * x->gam[0 * pendulum_poly_k4s4_M + l] + 506.8886596495858 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-      b += 898.77419777943976 * x->gam[1 * pendulum_poly_k4s4_M + l] + 857.13962680770112 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-      b += (-1127.6875000002283) * x->gam[2 * pendulum_poly_k4s4_M + l] + 967.43750000019327 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-      b += 999.13079551207454 * x->gam[3 * pendulum_poly_k4s4_M + l] + 684.73341275299549 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+      b += (-506.88865964948349) * x->gam[0 * pendulum_poly_k4s4_M + l] + 506.88865964948349 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+      b += 898.77419777925854 * x->gam[1 * pendulum_poly_k4s4_M + l] + 857.13962680752877 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+      b += (-1127.6874999999998) * x->gam[2 * pendulum_poly_k4s4_M + l] + 967.43749999999977 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+      b += 999.13079551186797 * x->gam[3 * pendulum_poly_k4s4_M + l] + 684.73341275285986 * x->gam2[3 * pendulum_poly_k4s4_M + l];
       gam[2 * pendulum_poly_k4s4_M + l] = b;
     }
     for (l = 0; l < pendulum_poly_k4s4_M; l++) {
       double b = 0;
-      b += (-150.64246527377097) * x->gam[0 * pendulum_poly_k4s4_M + l] + 150.64246527377094 * x->gam2[0 * pendulum_poly_k4s4_M + l];
-      b += 266.07580128842818 * x->gam[1 * pendulum_poly_k4s4_M + l] + 255.76500597477477 * x->gam2[1 * pendulum_poly_k4s4_M + l];
-      b += (-330.93071286720345) * x->gam[2 * pendulum_poly_k4s4_M + l] + 290.99717433127074 * x->gam2[2 * pendulum_poly_k4s4_M + l];
-      b += 283.43750000006224 * x->gam[3 * pendulum_poly_k4s4_M + l] + 208.43750000004093 * x->gam2[3 * pendulum_poly_k4s4_M + l];
+      b += (-150.6424652737401) * x->gam[0 * pendulum_poly_k4s4_M + l] + 150.6424652737401 * x->gam2[0 * pendulum_poly_k4s4_M + l];
+      b += 266.07580128837338 * x->gam[1 * pendulum_poly_k4s4_M + l] + 255.76500597472278 * x->gam2[1 * pendulum_poly_k4s4_M + l];
+      b += (-330.93071286713473) * x->gam[2 * pendulum_poly_k4s4_M + l] + 290.99717433121231 * x->gam2[2 * pendulum_poly_k4s4_M + l];
+      b += 283.43749999999994 * x->gam[3 * pendulum_poly_k4s4_M + l] + 208.43749999999997 * x->gam2[3 * pendulum_poly_k4s4_M + l];
       gam[3 * pendulum_poly_k4s4_M + l] = b;
     }
     return 1;
