@@ -12,9 +12,10 @@
  *   R_jr = sum_l b_l P_j(c_l) P_r(c_l) G_l,
  * which the kernel "factor" builds from the predicted stage data and
  * factors once per step (lu.c, minimum-degree order: a chain's blocks keep
- * their band). The sweep takes Theta_j and C_i stage by stage or, where
- * that is shorter by a tenth, from the moments R at its own stage data
- * (sweep_ops): Theta_j = psi_j + sum_r R_jr lambda_r and C_i = sum_j R_ij'
+ * their band); the moments of gradient entries affine in q come in closed
+ * form from q0 and gamma where that is shorter. The sweep takes Theta_j and
+ * C_i stage by stage or, where that is shorter by a tenth, from the moments
+ * R at its own gamma (sweep_ops): Theta_j = psi_j + sum_r R_jr lambda_r and C_i = sum_j R_ij'
  * gamma_j (+ g(q0)/h), since b_l P_i(c_l) V_l sums to them. Each sweep then
  * updates lambda <- lambda + A^-1 C(lambda) with that frozen factor and
  * recomputes Theta and gamma (docs/method-poly.md section 5: as few
@@ -63,16 +64,39 @@ static int dot_sparse(Build *b, int a, const int *col, const int *v) {
   return acc;
 }
 
+// h sum_t Y_t gamma_t,i with Y_t = sum_l b_l P_j(c_l) P_r(c_l) Ihat[l][t]:
+// the moment (j, r) of the stage points' excursion Q_l - q0 in coordinate i,
+// built once per (j, r, i) into the cache yg (-1: not yet).
+static int excursion_moment(Build *b, int j, int r, int i, int *yg) {
+  Dag *d = b->d;
+  const Method *me = b->me;
+  int s = b->s, *slot = yg + (j * s + r) * b->m + i;
+  if (*slot >= 0) return *slot;
+  int acc = dag_const(d, 0);
+  for (int t = 0; t < s; t++) {
+    long double y = 0;
+    for (int l = 0; l < b->k; l++) y += (long double)me->W[l * s + j] * me->Phat[l * s + r] * me->Ihat[l * s + t];
+    acc = dag_add(d, acc, dag_mul(d, dag_const(d, (double)y), step_in(b, IN_GAM, t * b->m + i)));
+  }
+  return *slot = dag_mul(d, b->h, acc);
+}
+
 // The moments R_jr = sum_l b_l P_j(c_l) P_r(c_l) G_l of the stage Jacobians
 // over the structural nonzeros: R[j][r][a][e], symmetric in (j, r), so the
 // pairs r < j share the nodes of (r, j). They build the matrix A, and in
 // the moment form the multiplier's force sum_l b_l P_j(c_l) G_l Lambda_l =
 // sum_r R_jr lambda_r and the conditions, so that the sweep keeps the
-// s(s+1)/2 moments rather than the k stage Jacobians.
-static int ****jacobian_moments(Build *b, int ***G) {
+// s(s+1)/2 moments rather than the k stage Jacobians. With closed, an entry
+// affine in q (every entry of a quadratic constraint's gradient) has them
+// in closed form, g(q0) [j == r] + grad g . (the excursion's moment),
+// without the stages.
+static int ****jacobian_moments(Build *b, int ***G, int closed) {
   Dag *d = b->d;
   const Method *me = b->me;
-  int nu = b->nu, s = b->s;
+  const Model *mod = b->mod;
+  int m = b->m, nu = b->nu, s = b->s, *yg = step_nodes(s * s * m), *q0 = step_nodes(m);
+  for (int t = 0; t < s * s * m; t++) yg[t] = -1;
+  for (int i = 0; i < m; i++) q0[i] = step_in(b, IN_Q0, i);
   int ****R = arena_alloc((size_t)s * sizeof(int ***));
   for (int j = 0; j < s; j++) {
     R[j] = arena_alloc((size_t)s * sizeof(int **));
@@ -83,13 +107,20 @@ static int ****jacobian_moments(Build *b, int ***G) {
       }
       R[j][r] = arena_alloc((size_t)nu * sizeof(int *));
       for (int a = 0; a < nu; a++) {
-        R[j][r][a] = step_nodes(b->mod->jac[a].n);
-        for (int e = 0; e < b->mod->jac[a].n; e++) {
-          int acc = dag_const(d, 0);
-          for (int l = 0; l < b->k; l++) {
-            double w = me->W[l * s + j] * me->Phat[l * s + r];
-            acc = dag_add(d, acc, dag_mul(d, dag_const(d, w), G[l][a][e]));
-          }
+        R[j][r][a] = step_nodes(mod->jac[a].n);
+        for (int e = 0; e < mod->jac[a].n; e++) {
+          int node = mod->jac[a].e[e].node, acc = dag_const(d, 0);
+          if (closed && (d->nodes[node].deg == 0 || d->nodes[node].deg == 1)) { /* affine: in closed form */
+            SparseVec grad;
+            ad_gradient_sparse(d, node, m, &grad);
+            if (j == r) dag_subst(d, &node, 1, q0, m, &acc);
+            for (int t = 0; t < grad.n; t++)
+              acc = dag_add(d, acc, dag_mul(d, grad.e[t].node, excursion_moment(b, j, r, grad.e[t].coord, yg)));
+          } else
+            for (int l = 0; l < b->k; l++) {
+              double w = me->W[l * s + j] * me->Phat[l * s + r];
+              acc = dag_add(d, acc, dag_mul(d, dag_const(d, w), G[l][a][e]));
+            }
           R[j][r][a][e] = acc;
         }
       }
@@ -302,8 +333,15 @@ void build_poly_multiplier(Build *b) {
   int ***G = stage_jacobians(b);
   b->owners = 1u << K_FACTOR;
   step_section(b, "the multiplier matrix A, factored once per step");
-  int ****R = jacobian_moments(b, G);
-  int *A = multiplier_matrix(b, R), *pivot = step_nodes(n), *adiag = step_nodes(n);
+  /* the moments of affine entries in closed form where that makes A shorter:
+   * with more stages than s (whole runs: the satellites (6,2) and (6,3) -13%
+   * and -11% instructions), not at k = s (chain8 (4,4) would be +2.5%) */
+  int ****R = jacobian_moments(b, G, 0), ****Rc = jacobian_moments(b, G, 1);
+  int *A = multiplier_matrix(b, R), *Ac = multiplier_matrix(b, Rc), *pivot = step_nodes(n), *adiag = step_nodes(n);
+  if (dag_count_ops(d, Ac, n * n) < dag_count_ops(d, A, n * n)) {
+    R = Rc;
+    A = Ac;
+  }
   LuFactor f;
   lu_factor(d, A, n, &f, pivot, adiag);
   /* the factor's structural nonzeros are its results, and the sweep's input lu */
@@ -328,10 +366,11 @@ void build_poly_multiplier(Build *b) {
   /* the force and the conditions from the moments where that saves a tenth
    * of the sweep's operations: with fewer stages per moment (k small against
    * s) the stage form is shorter, and a smaller saving did not show in the
-   * instructions (callgrind, whole runs against the stage form: the
-   * satellites (6,3), 7% fewer operations, +3% instructions; (6,2), 25%
-   * fewer, -11%; the modified pendulum (9,3) and (12,4), 20% and 11% fewer,
-   * -9% and -7%) */
+   * instructions (callgrind, whole runs against the stage form, the moments
+   * summed over the stages: the satellites (6,3), 7% fewer operations, +3%
+   * instructions; (6,2), 25% fewer, -11%; the modified pendulum (9,3) and
+   * (12,4), 20% and 11% fewer, -9% and -7%; with the closed form for the
+   * satellites' affine entries their (6,3) saves 14% and takes this form) */
   int **theta = sweep_force(b, G, NULL, &in, lam, lam1);
   long ops = sweep_ops(b, theta, lam1);
   int *lam1r = step_nodes(n), **theta_r = sweep_force(b, G, R, &in, lam, lam1r);
