@@ -230,6 +230,7 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
           "        q1[i * $P_W + l] = q;\n        qc1[i * $P_W + l] = qc;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n      }\n"
           "    for (l = 0; l < $P_W; l++) sg[l] = nf[l] = 0;\n");
   if (adaptive && itol_wanted(e)) emit_lane_newton(e);
+  /* as in NAME_step, the finiteness test stops before the multiplier's lamv, lamu */
   tmpl(e, "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
           "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++) {\n"
           "        $R piv = pr[($[project_p1.pivot]i) * $P_W + l], dia = pr[($[project_p1.adiag]i) * $P_W + l];\n"

@@ -349,6 +349,8 @@ static void emit_end_poly(Emitter *e) {
             "        gam[i] += d / h;\n      }\n    }\n  }\n");
   tmpl(e, "  $W phat[$P_M];  /* p1 before the projection, the end of p's polynomial */\n"
           "  for (i = 0; i < $P_M; i++) phat[i] = p1[i];\n");
+  /* the finiteness test stops before the multiplier's lamv and lamu, the last
+   * results: a multiplier not finite is stored as 0, not a failed step */
   tmpl(e, "  /* p1 projected onto grad g(q1)' M^-1 p1 = 0: p1 + pr[dp], q1 untouched */\n"
           "  $(project_p1 q0=q1 p0=p1 out=pr);\n"
           "  for (i = 0; i < $P_NU; i++) {\n"

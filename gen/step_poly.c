@@ -94,9 +94,14 @@ static int ****jacobian_moments(Build *b, int ***G, int closed) {
   Dag *d = b->d;
   const Method *me = b->me;
   const Model *mod = b->mod;
-  int m = b->m, nu = b->nu, s = b->s, *yg = step_nodes(s * s * m), *q0 = step_nodes(m);
+  int m = b->m, nu = b->nu, s = b->s, *yg = step_nodes(s * s * m), *q0 = step_nodes(m), nnz = 0;
   for (int t = 0; t < s * s * m; t++) yg[t] = -1;
   for (int i = 0; i < m; i++) q0[i] = step_in(b, IN_Q0, i);
+  for (int a = 0; a < nu; a++) nnz += mod->jac[a].n;
+  /* per affine entry, on first use: its gradient and its value at q0 */
+  SparseVec *grad = arena_alloc((size_t)(nnz + 1) * sizeof *grad);
+  int *at_q0 = step_nodes(nnz + 1);
+  for (int t = 0; t < nnz; t++) grad[t].n = at_q0[t] = -1;
   int ****R = arena_alloc((size_t)s * sizeof(int ***));
   for (int j = 0; j < s; j++) {
     R[j] = arena_alloc((size_t)s * sizeof(int **));
@@ -106,16 +111,17 @@ static int ****jacobian_moments(Build *b, int ***G, int closed) {
         continue;
       }
       R[j][r] = arena_alloc((size_t)nu * sizeof(int *));
-      for (int a = 0; a < nu; a++) {
+      for (int a = 0, at = 0; a < nu; a++) {
         R[j][r][a] = step_nodes(mod->jac[a].n);
-        for (int e = 0; e < mod->jac[a].n; e++) {
+        for (int e = 0; e < mod->jac[a].n; e++, at++) {
           int node = mod->jac[a].e[e].node, acc = dag_const(d, 0);
           if (closed && (d->nodes[node].deg == 0 || d->nodes[node].deg == 1)) { /* affine: in closed form */
-            SparseVec grad;
-            ad_gradient_sparse(d, node, m, &grad);
-            if (j == r) dag_subst(d, &node, 1, q0, m, &acc);
-            for (int t = 0; t < grad.n; t++)
-              acc = dag_add(d, acc, dag_mul(d, grad.e[t].node, excursion_moment(b, j, r, grad.e[t].coord, yg)));
+            SparseVec *gr = &grad[at];
+            if (gr->n < 0) ad_gradient_sparse(d, node, m, gr);
+            if (j == r && at_q0[at] < 0) dag_subst(d, &node, 1, q0, m, &at_q0[at]);
+            if (j == r) acc = at_q0[at];
+            for (int t = 0; t < gr->n; t++)
+              acc = dag_add(d, acc, dag_mul(d, gr->e[t].node, excursion_moment(b, j, r, gr->e[t].coord, yg)));
           } else
             for (int l = 0; l < b->k; l++) {
               double w = me->W[l * s + j] * me->Phat[l * s + r];
