@@ -40,7 +40,6 @@ static long double legendre_ld(int j, long double t, long double *prev) {
 // nodes of k = 2 is exactly +-1, not 1 - 2^-53).
 static long double pshift_ld(int j, long double x) { return sqrtl(2.0L * j + 1) * legendre_ld(j, 2 * x - 1, NULL); }
 
-
 static long double xi_ld(int j) { return 1 / (2 * sqrtl(fabsl(4.0L * j * j - 1))); }
 
 // The Gauss node c of k on [0,1] (GSL's, in double) refined by two Newton
