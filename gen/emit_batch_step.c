@@ -58,7 +58,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "$P_LANE_INLINE int $P_batch_test(const $P_batch *restrict x, $R h, int it, $R *restrict sw, const $R *restrict gam,\n"
           "    const $R *restrict lam, const $M *restrict go, $M *restrict act, $R *restrict inc, $R *restrict incp,\n"
           "    $R *restrict inc_min, $M *restrict stall, $M *restrict rc, $M *restrict iters");
-  tmpl(e, poly ? ",\n    $M *restrict fresh, int *restrict nfresh, int ngo" : ", int ngo");
+  tmpl(e, poly ? ",\n    $R *restrict rho, $M *restrict fresh, int *restrict nfresh, int ngo" : ", int ngo");
   tmpl(e, itol_wanted(e) ? ", $R tol, $R *restrict itl)\n{\n" : ")\n{\n");
   if (!poly) tmpl(e, "  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
   tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
@@ -95,12 +95,16 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   if (itol_wanted(e))
     tmpl(e, "    $R ti = itl ? itl[l] : $P_TOL;  /* the fixed step passes none: its test is $P_TOL's */\n"
-            "    ok[l] = (in <= ti) | ((it > 1) & (in < old) & (in * in <= ti * (old - in)));  /* $P_converged, as masks */\n");
+            "    $R rh = $P_contraction(in, old, incp[l], it);\n"
+            "    ok[l] = (in <= ti) | ((rh < 1) & (in * rh <= ti * (1 - rh)));  /* $P_converged, as masks */\n");
   else
-    tmpl(e, poly ? "    ok[l] = (in <= $P_TOL) | ((it > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
+    tmpl(e, poly ? "    $R rh = $P_contraction(in, old, incp[l], it);\n"
+                   "    ok[l] = (in <= $P_TOL) | ((rh < 1) & (in * rh <= $P_TOL * (1 - rh)));\n"
                  : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n");
-  if (poly) tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* for the factor's refresh (fresh) */\n");
+  if (poly)
+    tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* for the factor's refresh (fresh) */\n"
+            "    rho[l] = act[l] ? rh : rho[l];  /* for the test of the lanes' Newton steps */\n");
   tmpl(e, "    inc[l] = act[l] ? in : old;\n"
           "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n"
@@ -163,10 +167,10 @@ static void emit_lane_newton(Emitter *e) {
   tmpl(e, "    $M nc[$P_W];  /* the Newton steps' code, before the projection's */\n"
           "    {  /* the lanes whose iteration stopped at the tolerance: q1 onto g = 0 ($P_step_within) */\n"
           "      $R g1[$P_NU * $P_W], cs[($<consistent>) * $P_W];\n      $M ea[$P_W], off[$P_W], any = 0;\n      int n;\n"
-          "      for (l = 0; l < $P_W; l++) {  /* the test on the last increment (inc) and the one before (incp) */\n"
-          "        $R in = inc[l], old = incp[l];  /* $P_converged at itl and at $P_TOL, as masks */\n"
-          "        $M at = (in <= itl[l]) | ((iters[l] > 1) & (in < old) & (in * in <= itl[l] * (old - in)));\n"
-          "        $M round = (in <= $P_TOL) | ((iters[l] > 1) & (in < old) & (in * in <= $P_TOL * (old - in)));\n"
+          "      for (l = 0; l < $P_W; l++) {  /* the test on the last increment (inc) and contraction (rho) */\n"
+          "        $R in = inc[l], rh = rho[l];  /* $P_converged at itl and at $P_TOL, as masks */\n"
+          "        $M at = (in <= itl[l]) | ((rh < 1) & (in * rh <= itl[l] * (1 - rh)));\n"
+          "        $M round = (in <= $P_TOL) | ((rh < 1) & (in * rh <= $P_TOL * (1 - rh)));\n"
           "        nc[l] = $P_OK;\n        ea[l] = go[l] & at & (round == 0);\n        any |= ea[l];\n      }\n"
           "      for (n = 0; n < $P_NEWTON && any; n++) {\n"
           "        $(g q0=q1 prm=par out=g1);\n"
@@ -221,14 +225,14 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
   tmpl(e, "  {\n"
           "    $R q1[$P_M * $P_W], p1[$P_M * $P_W], qc1[$P_M * $P_W], pc1[$P_M * $P_W], H0[$P_W], beta[$P_W];\n"
           "    $R pr[($<project_p1> + 1) * $P_W], Hn[$P_W], lam[$P_NU * $P_W], pco[$P_M * $P_W];\n"
-          "    $M sg[$P_W], nf[$P_W], cm[$P_W];\n"
+          "    $M sg[$P_W], nf[$P_W], gd[$P_W], cm[$P_W];\n"
           "    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n"
           "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++) {\n"
           "        $R q = x->q[i * $P_W + l], qc = x->qc[i * $P_W + l], p = x->p[i * $P_W + l], pc = x->pc[i * $P_W + l];\n"
           "        $P_add(&q, &qc, h * sw[($[sweep.gam]i) * $P_W + l]);\n"
           "        $P_add(&p, &pc, sw[($[sweep.dp]i) * $P_W + l]);\n"
           "        q1[i * $P_W + l] = q;\n        qc1[i * $P_W + l] = qc;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n      }\n"
-          "    for (l = 0; l < $P_W; l++) sg[l] = nf[l] = 0;\n");
+          "    for (l = 0; l < $P_W; l++) sg[l] = nf[l] = gd[l] = 0;\n");
   if (adaptive && itol_wanted(e)) emit_lane_newton(e);
   /* as in NAME_step, the finiteness test stops before the multiplier's lamv, lamu */
   tmpl(e, "    $(project_p1 q0=q1 p0=p1 prm=par out=pr);\n"
@@ -252,8 +256,11 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
           "        $P_add(&p, &pc, d + (beta[l] - 1) * (ph + d));\n"
           "        pco[i * $P_W + l] = p - ph;\n        p1[i * $P_W + l] = p;\n        pc1[i * $P_W + l] = pc;\n"
           "        nf[l] |= !isfinite(q1[i * $P_W + l]) | !isfinite(p);\n      }\n"
+          "    for (i = 0; i < $P_NU; i++)  /* g(q1) above round-off: not converged (emit_end_poly) */\n"
+          "      for (l = 0; l < $P_W; l++)\n"
+          "        gd[l] |= !(fabs$f(pr[($[project_p1.g]i) * $P_W + l]) <= $P_GSTEP * pr[($[project_p1.gscale]i) * $P_W + l] + $P_GTOL);\n"
           "    for (l = 0; l < $P_W; l++) {\n"
-          "      $M code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : $P_OK;\n");
+          "      $M code = sg[l] ? $P_ESINGULAR : nf[l] ? $P_ENONFINITE : gd[l] ? $P_ENOCONV : $P_OK;\n");
   if (adaptive && itol_wanted(e)) tmpl(e, "      code = nc[l] != $P_OK ? nc[l] : code;  /* the Newton steps' first, as in $P_step_within */\n");
   tmpl(e, "      rc[l] = go[l] ? code : rc[l];\n      cm[l] = go[l] & (code == $P_OK);\n"
           "      x->H0[l] = cm[l] ? H0[l] : x->H0[l];\n    }\n"
@@ -409,12 +416,16 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
           "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
-  if (poly) tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n  $M fresh[$P_W];\n  int nfresh = 0;\n");
+  if (poly)
+    tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n"
+            "  $R rho[$P_W];  /* each lane's contraction at its last test ($P_contraction) */\n"
+            "  $M fresh[$P_W];\n  int nfresh = 0;\n");
   if (itol_wanted(e) && adaptive) tmpl(e, "  $R itl[$P_W];  /* where each lane's iteration stops ($P_itol) */\n");
   if (adaptive) tmpl(e, "  int early = 0, tried = 0;\n");
   tmpl(e, "  $P_batch_params(prm, par);\n"
           "  for (l = 0; l < $P_W; l++) {\n"
           "    inc[l] = incp[l] = inc_min[l] = HUGE_VAL;\n    stall[l] = iters[l] = 0;\n");
+  if (poly) tmpl(e, "    rho[l] = 1;\n");
   if (adaptive) tmpl(e, "    est[l] = d1[l] = 0;\n    cl[l] = (cold != 0) | (x->hprev[l] == 0);\n");
   if (itol_wanted(e) && adaptive) tmpl(e, "    itl[l] = $P_TOL;\n");
   /* the idle lanes in a loop of their own: a byte's reduction in the loop above
@@ -462,7 +473,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
   if (adaptive)
     tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, in, ref, two, go, cl, d1, est, rc)) {\n"
             "      tried = -1;\n      goto out;\n    }\n");
-  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, fresh, &nfresh, ngo"
+  tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, rho, fresh, &nfresh, ngo"
                : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo");
   tmpl(e, !itol_wanted(e) ? ");\n" : adaptive ? ", tol, itl);\n" : ", 0, 0);\n");
   tmpl(e, "    {  /* this sweep's results are the next one's input */\n      $R *t = in;\n      in = sw;\n      sw = t;\n    }\n");

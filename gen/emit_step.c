@@ -159,6 +159,9 @@ static void emit_prelude(Emitter *e, const EmitOptions *o) {
   for (int i = 0; i < 5; i++)
     out(e, "#ifndef %s_%s\n#define %s_%s %s\n#endif\n", e->P, limits[e->single][i][0], e->P, limits[e->single][i][0],
         limits[e->single][i][1]);
+  if (e->st->kern[K_FACTOR].nout) /* the polynomial family's test of g(q1) (emit_end_poly) */
+    out(e, "#ifndef %s_GSTEP\n#define %s_GSTEP %s  /* |g(q1)| above this (256 ulps) of sum_i |dg/dq_i q_i|: not converged */\n#endif\n",
+        e->P, e->P, e->single ? "3.05e-5f" : "5.6843418860808015e-14");
   out(e, "\n");
   out(e, "/* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = %d (the kernels below use\n", me->k);
   out(e, " * their products with P_j and int_0^c P_j, folded into the code):\n");
@@ -367,14 +370,19 @@ static void emit_end_poly(Emitter *e) {
   if (wide)
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    p1[i] = beta * (p1[i] + pr[$[project_p1.dp]i]);\n"
-            "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
-            "  /* q1, p1 rounded once into q, p; what the rounding lost is the new qc, pc */\n"
-            "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = ($R)q1[i];\n    x->p[i] = ($R)p1[i];\n");
+            "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n");
   else
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    $P_add(&p1[i], &pc1[i], pr[$[project_p1.dp]i] + (beta - 1) * (p1[i] + pr[$[project_p1.dp]i]));\n"
-            "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n"
-            "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
+            "    if (!isfinite(q1[i]) || !isfinite(p1[i])) return $P_ENONFINITE;\n  }\n");
+  tmpl(e, "  /* g(q1) at round-off, or the iteration stopped short of convergence: no step */\n"
+          "  for (i = 0; i < $P_NU; i++)\n"
+          "    if (!(fabs$g(pr[$[project_p1.g]i]) <= $P_GSTEP * pr[$[project_p1.gscale]i] + $P_GTOL)) return $P_ENOCONV;\n");
+  if (wide)
+    tmpl(e, "  /* q1, p1 rounded once into q, p; what the rounding lost is the new qc, pc */\n"
+            "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = ($R)q1[i];\n    x->p[i] = ($R)p1[i];\n");
+  else
+    tmpl(e, "  for (i = 0; i < $P_M; i++) {\n    x->q[i] = q1[i];\n    x->p[i] = p1[i];\n"
             "    x->qc[i] = qc1[i];\n    x->pc[i] = pc1[i];\n");
   if (wide && e->compensated) tmpl(e, "    x->qc[i] = ($R)(x->q[i] - q1[i]);\n    x->pc[i] = ($R)(x->p[i] - p1[i]);\n");
   tmpl(e, "    x->pcorr[i] = ($R)(p1[i] - phat[i]);\n  }\n");
@@ -550,11 +558,14 @@ static void emit_convergence(Emitter *e) {
               "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
               "     * the end of the step restores H, g and the hidden constraint. */\n"
               "    if (tol > 0 && it == 1) tit = $P_itol(tol, scale);  /* once a step, at the first sweep's scale */\n"
-              "    if ($P_converged(inc, inc_old, it, tit)) {\n"
-              "      attol = !$P_converged(inc, inc_old, it, $P_TOL);\n");
+              "    rho = $P_contraction(inc, inc_old, inc_old2, it);\n"
+              "    if ($P_converged(inc, rho, tit)) {\n"
+              "      attol = !$P_converged(inc, rho, $P_TOL);\n");
     else
-      tmpl(e, " */\n    if (inc <= $P_TOL || (it > 1 && inc < inc_old && inc * inc <= $P_TOL * (inc_old - inc))) {\n");
-    tmpl(e, "      rc = $P_OK;\n      break;\n    }\n");
+      tmpl(e, " */\n    rho = $P_contraction(inc, inc_old, inc_old2, it);\n"
+              "    if (inc <= $P_TOL || (rho < 1 && inc * rho <= $P_TOL * (1 - rho))) {\n");
+    tmpl(e, "      rc = $P_OK;\n      break;\n    }\n"
+            "    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */\n");
   } else {
     tmpl(e, "    /* converged: the increment is far below an ulp of the state ($P_TOL / 256), or\n"
             "     * within 2 ulps ($P_TOL) and falling by less than 4x (round-off noise). Iterating\n"
@@ -741,9 +752,31 @@ static void emit_itol(Emitter *e) {
           "  t = t < $P_ITOLMAX ? t : $P_ITOLMAX;\n"
           "  return ((tol > 0) & (scale > 0) & (t > $P_TOL)) ? t : $P_TOL;\n}\n\n"
           "/* The iteration's stopping test at the threshold t: the increment inc within t, or the\n"
-          " * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */\n"
-          "static int $P_converged($R inc, $R inc_old, int it, $R t)\n{\n"
-          "  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));\n}\n\n");
+          " * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of $P_contraction\n"
+          " * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */\n"
+          "static int $P_converged($R inc, $R rho, $R t)\n{\n"
+          "  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));\n}\n\n");
+}
+
+// NAME_contraction: the contraction rate rho of the polynomial family's
+// iteration that its stopping test reads, the larger of the last two ratios
+// of increments, so from the third sweep on (1, not known, before). One
+// ratio, read from the second sweep on, took the first sweep's increment
+// (the predictor's error, which the sweep removes faster than the slowest
+// part of the iteration's error) and a sweep that followed a refresh of the
+// factor for the contraction: at s >= 6 in float and s >= 14 in double such
+// a ratio was far below the true rate, and steps were accepted with g(q1) up
+// to 1 (issue 30, item 1; tests/check_poly.c).
+static void emit_contraction(Emitter *e) {
+  tmpl(e, "/* The iteration's contraction rate after sweep it: the larger of the last two ratios of\n"
+          " * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third\n"
+          " * sweep. One ratio underrates it where the error has parts that contract at different\n"
+          " * rates (the predictor's error, a refreshed factor), and the test then stopped early. */\n"
+          "static $R $P_contraction($R inc, $R inc_old, $R inc_old2, int it)\n{\n"
+          "  $R r, r0;\n"
+          "  if (it < 3) return 1;\n"
+          "  r = inc / inc_old;\n  r0 = inc_old / inc_old2;\n"
+          "  return r0 > r ? r0 : r;\n}\n\n");
 }
 
 // The head of a loop over the coordinates, in NAME_defect and NAME_mult_err:
@@ -969,6 +1002,7 @@ static void emit_step(Emitter *e) {
   int defect = energy_defect_wanted(e), mult = mult_err_wanted(e);
   if (defect) emit_defect(e);
   emit_tolc(e);
+  if (poly) emit_contraction(e);
   if (itol_wanted(e)) emit_itol(e);
   if (mult) emit_mult_err(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
@@ -981,7 +1015,7 @@ static void emit_step(Emitter *e) {
           "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;\n"
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
-  if (poly) tmpl(e, "  $R ref[$P_S * $P_M];\n  int two;\n");
+  if (poly) tmpl(e, "  $R ref[$P_S * $P_M], inc_old2 = HUGE_VAL, rho;\n  int two;\n");
   if (itol_wanted(e))
     tmpl(e, "  $R tit = $P_TOL;  /* where the iteration stops ($P_itol) */\n"
             "  int attol = 0;  /* it stopped there, above round-off */\n");

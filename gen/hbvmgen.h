@@ -415,7 +415,7 @@ typedef enum {
   K_COUNT
 } KernelId;
 
-#define MAX_BLOCKS 8
+#define MAX_BLOCKS 12
 
 /* A straight-line function of the generated solver: its results are
  * consecutive blocks of out[]. A kernel with no blocks is not emitted. */

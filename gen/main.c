@@ -529,6 +529,8 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
 
 // Report that the degree of U or of a constraint needs k > MAX_K, at the
 // statement (U) or list element (g) that has it.
+#define FLOAT_POLY_MAX_S 7 /* the largest s of the poly family in float */
+
 static void report_degree(const Model *mod, int s, int k) {
   const char *why;
   int best = -1;
@@ -569,6 +571,13 @@ int main(int argc, char **argv) {
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
   if (k > MAX_K) {
     report_degree(mod, o.s, k);
+    rc = 1;
+  } else if (fam == MULT_POLY && o.single && o.s > FLOAT_POLY_MAX_S) {
+    /* measured (issue 30): from s = 8 the iteration in float stalls above float's
+     * round-off, and g(q1) of the pendulum reaches 500 ulps */
+    error_at(mod->g_loc[0], "in float (--real float) the poly family's iteration reaches round-off only up to "
+                            "s = %d, not s = %d: pass a smaller -s, --multiplier const or --real double",
+             FLOAT_POLY_MAX_S, o.s);
     rc = 1;
   } else if (o.check_only) {
     print_check(mod, &o, k, why, fam);

@@ -322,10 +322,22 @@ static void build_projection(Build *b) {
   step_result(st, K_PROJECT, "adiag", SZ_NU, 1, nu, adiag);
   step_result(st, K_PROJECT, "lamv", SZ_NU, 1, nu, lamv);
   step_result(st, K_PROJECT, "lamu", SZ_NU, 1, nu, lamu);
+  /* g(q1) and its round-off scale sum_i |dg_a/dq_i q_i|: the step fails where its
+   * iteration left g above round-off (emit_end_poly) */
+  int *g1 = step_nodes(nu), *gscale = step_nodes(nu);
+  dag_subst(d, mod->g, nu, q, m, g1);
+  for (int a = 0; a < nu; a++) {
+    gscale[a] = z;
+    for (int i = 0; i < m; i++)
+      gscale[a] = dag_add(d, gscale[a], dag_op(d, OP_ABS, dag_mul(d, G[a][i], q[i]), -1));
+  }
+  step_result(st, K_PROJECT, "g", SZ_NU, 1, nu, g1);
+  step_result(st, K_PROJECT, "gscale", SZ_NU, 1, nu, gscale);
   st->kern[K_PROJECT].what = "The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the\n"
                              " * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)\n"
-                             " * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,\n"
-                             " * beta^2 lamv - lamu, as lamv (NU) and lamu (NU).";
+                             " * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,\n"
+                             " * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its\n"
+                             " * round-off scale sum_i |dg/dq_i q_i| (NU).";
 }
 
 // The kernels of the polynomial family: "factor" (the frozen multiplier

@@ -38,6 +38,9 @@
 #ifndef conical_poly_k2s2_STALL
 #define conical_poly_k2s2_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
+#ifndef conical_poly_k2s2_GSTEP
+#define conical_poly_k2s2_GSTEP 5.6843418860808015e-14  /* |g(q1)| above this (256 ulps) of sum_i |dg/dq_i q_i|: not converged */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 2 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -194,7 +197,6 @@ static void conical_poly_k2s2_g(const double *q0, const double *p0, const double
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* g(q0) */
   const double t0 = q0[0] /* x */ * q0[0] /* x */;
   const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
@@ -247,8 +249,9 @@ static void conical_poly_k2s2_lambda0(const double *q0, const double *p0, const 
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
- * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
+ * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its
+ * round-off scale sum_i |dg/dq_i q_i| (NU). */
 static void conical_poly_k2s2_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const conical_poly_k2s2_params *prm, double *out)
 {
@@ -289,6 +292,20 @@ static void conical_poly_k2s2_project_p1(const double *q0, const double *p0, con
   const double t32 = 2.0 * t30;
   const double t33 = t32 / t6;
   const double t34 = t0 / t6;
+  const double t35 = q0[0] /* x */ * q0[0] /* x */;
+  const double t36 = q0[1] /* y */ * q0[1] /* y */;
+  const double t37 = t35 + t36;
+  const double t38 = q0[2] /* z */ * q0[2] /* z */;
+  const double t39 = t37 + t38;
+  const double t40 = t39 - 1.0;
+  const double t41 = 2.0 * t1;
+  const double t42 = fabs(t41);
+  const double t43 = 2.0 * t2;
+  const double t44 = fabs(t43);
+  const double t45 = t42 + t44;
+  const double t46 = 2.0 * t4;
+  const double t47 = fabs(t46);
+  const double t48 = t45 + t47;
   /* dp */
   out[0] = t16;
   out[1] = t19;
@@ -305,6 +322,10 @@ static void conical_poly_k2s2_project_p1(const double *q0, const double *p0, con
   out[7] = t33;
   /* lamu */
   out[8] = t34;
+  /* g */
+  out[9] = t40;
+  /* gscale */
+  out[10] = t48;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -541,6 +562,19 @@ conical_poly_k2s2_OUT_OF_LINE double conical_poly_k2s2_err_est(const double *gam
 #define conical_poly_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* The iteration's contraction rate after sweep it: the larger of the last two ratios of
+ * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third
+ * sweep. One ratio underrates it where the error has parts that contract at different
+ * rates (the predictor's error, a refreshed factor), and the test then stopped early. */
+static double conical_poly_k2s2_contraction(double inc, double inc_old, double inc_old2, int it)
+{
+  double r, r0;
+  if (it < 3) return 1;
+  r = inc / inc_old;
+  r0 = inc_old / inc_old2;
+  return r0 > r ? r0 : r;
+}
+
 #ifndef conical_poly_k2s2_ITERC
 #define conical_poly_k2s2_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
@@ -561,10 +595,11 @@ static double conical_poly_k2s2_itol(double tol, double scale)
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the
- * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
-static int conical_poly_k2s2_converged(double inc, double inc_old, int it, double t)
+ * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of conical_poly_k2s2_contraction
+ * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */
+static int conical_poly_k2s2_converged(double inc, double rho, double t)
 {
-  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));
 }
 
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
@@ -578,7 +613,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   int it, i, stall = 0, rc = conical_poly_k2s2_ENOCONV;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return conical_poly_k2s2_EBADSTEP;
-  double ref[conical_poly_k2s2_S * conical_poly_k2s2_M];
+  double ref[conical_poly_k2s2_S * conical_poly_k2s2_M], inc_old2 = HUGE_VAL, rho;
   int two;
   double tit = conical_poly_k2s2_TOL;  /* where the iteration stops (conical_poly_k2s2_itol) */
   int attol = 0;  /* it stopped there, above round-off */
@@ -852,11 +887,13 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
      * conical_poly_k2s2_step_adaptive the error allowed is the step's tolerance's share (conical_poly_k2s2_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = conical_poly_k2s2_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (conical_poly_k2s2_converged(inc, inc_old, it, tit)) {
-      attol = !conical_poly_k2s2_converged(inc, inc_old, it, conical_poly_k2s2_TOL);
+    rho = conical_poly_k2s2_contraction(inc, inc_old, inc_old2, it);
+    if (conical_poly_k2s2_converged(inc, rho, tit)) {
+      attol = !conical_poly_k2s2_converged(inc, rho, conical_poly_k2s2_TOL);
       rc = conical_poly_k2s2_OK;
       break;
     }
+    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. conical_poly_k2s2_STALL sweeps without one are a stall: converged if it is at
@@ -903,7 +940,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return conical_poly_k2s2_ENONFINITE;
   for (i = 0; i < (conical_poly_k2s2_S - 1) * conical_poly_k2s2_M; i++) /* the rest of p's polynomial, for conical_poly_k2s2_dense */
     if (!isfinite(sw[conical_poly_k2s2_S * conical_poly_k2s2_M + conical_poly_k2s2_M + conical_poly_k2s2_S * conical_poly_k2s2_NU + i])) return conical_poly_k2s2_ENONFINITE;
-  double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 4 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
+  double q1[conical_poly_k2s2_M], p1[conical_poly_k2s2_M], pr[conical_poly_k2s2_M + 2 + 6 * conical_poly_k2s2_NU + 1], K, U1, beta = 1;
   double H0, Hn = conical_poly_k2s2_energy(x, prm);
   double qc1[conical_poly_k2s2_M], pc1[conical_poly_k2s2_M];
   for (i = 0; i < conical_poly_k2s2_M; i++) {
@@ -960,6 +997,9 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     conical_poly_k2s2_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return conical_poly_k2s2_ENONFINITE;
   }
+  /* g(q1) at round-off, or the iteration stopped short of convergence: no step */
+  for (i = 0; i < conical_poly_k2s2_NU; i++)
+    if (!(fabs(pr[conical_poly_k2s2_M + 2 + 4 * conical_poly_k2s2_NU + i]) <= conical_poly_k2s2_GSTEP * pr[conical_poly_k2s2_M + 2 + 5 * conical_poly_k2s2_NU + i] + conical_poly_k2s2_GTOL)) return conical_poly_k2s2_ENOCONV;
   for (i = 0; i < conical_poly_k2s2_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];

@@ -38,6 +38,9 @@
 #ifndef double_pendulum_k4s4_STALL
 #define double_pendulum_k4s4_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
+#ifndef double_pendulum_k4s4_GSTEP
+#define double_pendulum_k4s4_GSTEP 5.6843418860808015e-14  /* |g(q1)| above this (256 ulps) of sum_i |dg/dq_i q_i|: not converged */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 4 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -2260,7 +2263,6 @@ static void double_pendulum_k4s4_g(const double *q0, const double *p0, const dou
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
   const double t0 = q0[2] /* x2 */ - q0[0] /* x1 */;
   const double t1 = q0[3] /* y2 */ - q0[1] /* y1 */;
-  /* g(q0) */
   const double t2 = q0[0] /* x1 */ * q0[0] /* x1 */;
   const double t3 = q0[1] /* y1 */ * q0[1] /* y1 */;
   const double t4 = t2 + t3;
@@ -2353,8 +2355,9 @@ static void double_pendulum_k4s4_lambda0(const double *q0, const double *p0, con
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
- * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
+ * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its
+ * round-off scale sum_i |dg/dq_i q_i| (NU). */
 static void double_pendulum_k4s4_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const double_pendulum_k4s4_params *prm, double *out)
 {
@@ -2450,6 +2453,34 @@ static void double_pendulum_k4s4_project_p1(const double *q0, const double *p0, 
   const double t87 = 4.0 * t86;
   const double t88 = t2 + t87;
   const double t89 = t88 / t7;
+  const double t90 = q0[0] /* x1 */ * q0[0] /* x1 */;
+  const double t91 = q0[1] /* y1 */ * q0[1] /* y1 */;
+  const double t92 = t90 + t91;
+  const double t93 = t92 - 1.0;
+  const double t94 = t0 * t0;
+  const double t95 = t1 * t1;
+  const double t96 = t94 + t95;
+  const double t97 = t96 - 1.0;
+  const double t98 = 2.0 * t3;
+  const double t99 = fabs(t98);
+  const double t100 = 2.0 * t5;
+  const double t101 = fabs(t100);
+  const double t102 = t99 + t101;
+  const double t103 = 2.0 * t4;
+  const double t104 = -t103;
+  const double t105 = fabs(t104);
+  const double t106 = 2.0 * t8;
+  const double t107 = -t106;
+  const double t108 = fabs(t107);
+  const double t109 = t105 + t108;
+  const double t110 = q0[2] /* x2 */ * t0;
+  const double t111 = 2.0 * t110;
+  const double t112 = fabs(t111);
+  const double t113 = t109 + t112;
+  const double t114 = q0[3] /* y2 */ * t1;
+  const double t115 = 2.0 * t114;
+  const double t116 = fabs(t115);
+  const double t117 = t113 + t116;
   /* dp */
   out[0] = t45;
   out[1] = t51;
@@ -2471,6 +2502,12 @@ static void double_pendulum_k4s4_project_p1(const double *q0, const double *p0, 
   /* lamu */
   out[12] = t89;
   out[13] = t85;
+  /* g */
+  out[14] = t93;
+  out[15] = t97;
+  /* gscale */
+  out[16] = t102;
+  out[17] = t117;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -2818,6 +2855,19 @@ double_pendulum_k4s4_OUT_OF_LINE double double_pendulum_k4s4_err_est(const doubl
 #define double_pendulum_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* The iteration's contraction rate after sweep it: the larger of the last two ratios of
+ * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third
+ * sweep. One ratio underrates it where the error has parts that contract at different
+ * rates (the predictor's error, a refreshed factor), and the test then stopped early. */
+static double double_pendulum_k4s4_contraction(double inc, double inc_old, double inc_old2, int it)
+{
+  double r, r0;
+  if (it < 3) return 1;
+  r = inc / inc_old;
+  r0 = inc_old / inc_old2;
+  return r0 > r ? r0 : r;
+}
+
 #ifndef double_pendulum_k4s4_ITERC
 #define double_pendulum_k4s4_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
@@ -2838,10 +2888,11 @@ static double double_pendulum_k4s4_itol(double tol, double scale)
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the
- * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
-static int double_pendulum_k4s4_converged(double inc, double inc_old, int it, double t)
+ * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of double_pendulum_k4s4_contraction
+ * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */
+static int double_pendulum_k4s4_converged(double inc, double rho, double t)
 {
-  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
@@ -2855,7 +2906,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   int it, i, stall = 0, rc = double_pendulum_k4s4_ENOCONV;
   double_pendulum_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return double_pendulum_k4s4_EBADSTEP;
-  double ref[double_pendulum_k4s4_S * double_pendulum_k4s4_M];
+  double ref[double_pendulum_k4s4_S * double_pendulum_k4s4_M], inc_old2 = HUGE_VAL, rho;
   int two;
   double tit = double_pendulum_k4s4_TOL;  /* where the iteration stops (double_pendulum_k4s4_itol) */
   int attol = 0;  /* it stopped there, above round-off */
@@ -4038,11 +4089,13 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
      * double_pendulum_k4s4_step_adaptive the error allowed is the step's tolerance's share (double_pendulum_k4s4_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = double_pendulum_k4s4_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (double_pendulum_k4s4_converged(inc, inc_old, it, tit)) {
-      attol = !double_pendulum_k4s4_converged(inc, inc_old, it, double_pendulum_k4s4_TOL);
+    rho = double_pendulum_k4s4_contraction(inc, inc_old, inc_old2, it);
+    if (double_pendulum_k4s4_converged(inc, rho, tit)) {
+      attol = !double_pendulum_k4s4_converged(inc, rho, double_pendulum_k4s4_TOL);
       rc = double_pendulum_k4s4_OK;
       break;
     }
+    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. double_pendulum_k4s4_STALL sweeps without one are a stall: converged if it is at
@@ -4125,7 +4178,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return double_pendulum_k4s4_ENONFINITE;
   for (i = 0; i < (double_pendulum_k4s4_S - 1) * double_pendulum_k4s4_M; i++) /* the rest of p's polynomial, for double_pendulum_k4s4_dense */
     if (!isfinite(sw[double_pendulum_k4s4_S * double_pendulum_k4s4_M + double_pendulum_k4s4_M + double_pendulum_k4s4_S * double_pendulum_k4s4_NU + i])) return double_pendulum_k4s4_ENONFINITE;
-  double q1[double_pendulum_k4s4_M], p1[double_pendulum_k4s4_M], pr[double_pendulum_k4s4_M + 2 + 4 * double_pendulum_k4s4_NU + 1], K, U1, beta = 1;
+  double q1[double_pendulum_k4s4_M], p1[double_pendulum_k4s4_M], pr[double_pendulum_k4s4_M + 2 + 6 * double_pendulum_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = double_pendulum_k4s4_energy(x, prm);
   double qc1[double_pendulum_k4s4_M], pc1[double_pendulum_k4s4_M];
   for (i = 0; i < double_pendulum_k4s4_M; i++) {
@@ -4182,6 +4235,9 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     double_pendulum_k4s4_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return double_pendulum_k4s4_ENONFINITE;
   }
+  /* g(q1) at round-off, or the iteration stopped short of convergence: no step */
+  for (i = 0; i < double_pendulum_k4s4_NU; i++)
+    if (!(fabs(pr[double_pendulum_k4s4_M + 2 + 4 * double_pendulum_k4s4_NU + i]) <= double_pendulum_k4s4_GSTEP * pr[double_pendulum_k4s4_M + 2 + 5 * double_pendulum_k4s4_NU + i] + double_pendulum_k4s4_GTOL)) return double_pendulum_k4s4_ENOCONV;
   for (i = 0; i < double_pendulum_k4s4_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];

@@ -38,6 +38,9 @@
 #ifndef modified_poly_k9s3_STALL
 #define modified_poly_k9s3_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
+#ifndef modified_poly_k9s3_GSTEP
+#define modified_poly_k9s3_GSTEP 5.6843418860808015e-14  /* |g(q1)| above this (256 ulps) of sum_i |dg/dq_i q_i|: not converged */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 9 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -754,7 +757,6 @@ static void modified_poly_k9s3_g(const double *q0, const double *p0, const doubl
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* g(q0) */
   const double t0 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
   const double t1 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
   const double t2 = t0 + t1;
@@ -826,8 +828,9 @@ static void modified_poly_k9s3_lambda0(const double *q0, const double *p0, const
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
- * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
+ * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its
+ * round-off scale sum_i |dg/dq_i q_i| (NU). */
 static void modified_poly_k9s3_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const modified_poly_k9s3_params *prm, double *out)
 {
@@ -887,6 +890,21 @@ static void modified_poly_k9s3_project_p1(const double *q0, const double *p0, co
   const double t51 = t50 * 8.0;
   const double t52 = t48 / t9;
   const double t53 = t51 / t9;
+  const double t54 = (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */) * (q0[0] /* q[1] */ * q0[0] /* q[1] */ * q0[0] /* q[1] */);
+  const double t55 = (q0[1] /* q[2] */ * q0[1] /* q[2] */) * (q0[1] /* q[2] */ * q0[1] /* q[2] */);
+  const double t56 = t54 + t55;
+  const double t57 = q0[2] /* q[3] */ * q0[2] /* q[3] */;
+  const double t58 = t56 + t57;
+  const double t59 = t58 - 0.625;
+  const double t60 = q0[0] /* q[1] */ * t2;
+  const double t61 = fabs(t60);
+  const double t62 = q0[1] /* q[2] */ * t0;
+  const double t63 = 4.0 * t62;
+  const double t64 = fabs(t63);
+  const double t65 = t61 + t64;
+  const double t66 = 2.0 * t7;
+  const double t67 = fabs(t66);
+  const double t68 = t65 + t67;
   /* dp */
   out[0] = t19;
   out[1] = t22;
@@ -903,6 +921,10 @@ static void modified_poly_k9s3_project_p1(const double *q0, const double *p0, co
   out[7] = t52;
   /* lamu */
   out[8] = t53;
+  /* g */
+  out[9] = t59;
+  /* gscale */
+  out[10] = t68;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -1166,6 +1188,19 @@ modified_poly_k9s3_OUT_OF_LINE double modified_poly_k9s3_err_est(const double *g
 #define modified_poly_k9s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* The iteration's contraction rate after sweep it: the larger of the last two ratios of
+ * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third
+ * sweep. One ratio underrates it where the error has parts that contract at different
+ * rates (the predictor's error, a refreshed factor), and the test then stopped early. */
+static double modified_poly_k9s3_contraction(double inc, double inc_old, double inc_old2, int it)
+{
+  double r, r0;
+  if (it < 3) return 1;
+  r = inc / inc_old;
+  r0 = inc_old / inc_old2;
+  return r0 > r ? r0 : r;
+}
+
 #ifndef modified_poly_k9s3_ITERC
 #define modified_poly_k9s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
@@ -1186,10 +1221,11 @@ static double modified_poly_k9s3_itol(double tol, double scale)
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the
- * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
-static int modified_poly_k9s3_converged(double inc, double inc_old, int it, double t)
+ * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of modified_poly_k9s3_contraction
+ * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */
+static int modified_poly_k9s3_converged(double inc, double rho, double t)
 {
-  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));
 }
 
 /* One step of HBVM(9,3). Iterates the sweep until the increment reaches round-off
@@ -1203,7 +1239,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   int it, i, stall = 0, rc = modified_poly_k9s3_ENOCONV;
   modified_poly_k9s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return modified_poly_k9s3_EBADSTEP;
-  double ref[modified_poly_k9s3_S * modified_poly_k9s3_M];
+  double ref[modified_poly_k9s3_S * modified_poly_k9s3_M], inc_old2 = HUGE_VAL, rho;
   int two;
   double tit = modified_poly_k9s3_TOL;  /* where the iteration stops (modified_poly_k9s3_itol) */
   int attol = 0;  /* it stopped there, above round-off */
@@ -2118,11 +2154,13 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
      * modified_poly_k9s3_step_adaptive the error allowed is the step's tolerance's share (modified_poly_k9s3_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = modified_poly_k9s3_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (modified_poly_k9s3_converged(inc, inc_old, it, tit)) {
-      attol = !modified_poly_k9s3_converged(inc, inc_old, it, modified_poly_k9s3_TOL);
+    rho = modified_poly_k9s3_contraction(inc, inc_old, inc_old2, it);
+    if (modified_poly_k9s3_converged(inc, rho, tit)) {
+      attol = !modified_poly_k9s3_converged(inc, rho, modified_poly_k9s3_TOL);
       rc = modified_poly_k9s3_OK;
       break;
     }
+    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. modified_poly_k9s3_STALL sweeps without one are a stall: converged if it is at
@@ -2179,7 +2217,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return modified_poly_k9s3_ENONFINITE;
   for (i = 0; i < (modified_poly_k9s3_S - 1) * modified_poly_k9s3_M; i++) /* the rest of p's polynomial, for modified_poly_k9s3_dense */
     if (!isfinite(sw[modified_poly_k9s3_S * modified_poly_k9s3_M + modified_poly_k9s3_M + modified_poly_k9s3_S * modified_poly_k9s3_NU + i])) return modified_poly_k9s3_ENONFINITE;
-  double q1[modified_poly_k9s3_M], p1[modified_poly_k9s3_M], pr[modified_poly_k9s3_M + 2 + 4 * modified_poly_k9s3_NU + 1], K, U1, beta = 1;
+  double q1[modified_poly_k9s3_M], p1[modified_poly_k9s3_M], pr[modified_poly_k9s3_M + 2 + 6 * modified_poly_k9s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = modified_poly_k9s3_energy(x, prm);
   double qc1[modified_poly_k9s3_M], pc1[modified_poly_k9s3_M];
   for (i = 0; i < modified_poly_k9s3_M; i++) {
@@ -2236,6 +2274,9 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     modified_poly_k9s3_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return modified_poly_k9s3_ENONFINITE;
   }
+  /* g(q1) at round-off, or the iteration stopped short of convergence: no step */
+  for (i = 0; i < modified_poly_k9s3_NU; i++)
+    if (!(fabs(pr[modified_poly_k9s3_M + 2 + 4 * modified_poly_k9s3_NU + i]) <= modified_poly_k9s3_GSTEP * pr[modified_poly_k9s3_M + 2 + 5 * modified_poly_k9s3_NU + i] + modified_poly_k9s3_GTOL)) return modified_poly_k9s3_ENOCONV;
   for (i = 0; i < modified_poly_k9s3_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];

@@ -38,6 +38,9 @@
 #ifndef pendulum_poly_k4s4_STALL
 #define pendulum_poly_k4s4_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
+#ifndef pendulum_poly_k4s4_GSTEP
+#define pendulum_poly_k4s4_GSTEP 5.6843418860808015e-14  /* |g(q1)| above this (256 ulps) of sum_i |dg/dq_i q_i|: not converged */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 4 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -618,7 +621,6 @@ static void pendulum_poly_k4s4_g(const double *q0, const double *p0, const doubl
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
   (void)q0; (void)p0; (void)gam; (void)h; (void)g0; (void)lam; (void)lu; (void)prm;
-  /* g(q0) */
   const double t0 = q0[0] /* x */ * q0[0] /* x */;
   const double t1 = q0[1] /* y */ * q0[1] /* y */;
   const double t2 = t0 + t1;
@@ -663,8 +665,9 @@ static void pendulum_poly_k4s4_lambda0(const double *q0, const double *p0, const
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
- * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
+ * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its
+ * round-off scale sum_i |dg/dq_i q_i| (NU). */
 static void pendulum_poly_k4s4_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const pendulum_poly_k4s4_params *prm, double *out)
 {
@@ -695,6 +698,15 @@ static void pendulum_poly_k4s4_project_p1(const double *q0, const double *p0, co
   const double t22 = 2.0 * t20;
   const double t23 = t22 / t4;
   const double t24 = t0 / t4;
+  const double t25 = q0[0] /* x */ * q0[0] /* x */;
+  const double t26 = q0[1] /* y */ * q0[1] /* y */;
+  const double t27 = t25 + t26;
+  const double t28 = t27 - 1.0;
+  const double t29 = 2.0 * t1;
+  const double t30 = fabs(t29);
+  const double t31 = 2.0 * t2;
+  const double t32 = fabs(t31);
+  const double t33 = t30 + t32;
   /* dp */
   out[0] = t12;
   out[1] = t15;
@@ -710,6 +722,10 @@ static void pendulum_poly_k4s4_project_p1(const double *q0, const double *p0, co
   out[6] = t23;
   /* lamu */
   out[7] = t24;
+  /* g */
+  out[8] = t28;
+  /* gscale */
+  out[9] = t33;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -997,6 +1013,19 @@ pendulum_poly_k4s4_OUT_OF_LINE double pendulum_poly_k4s4_err_est(const double *g
 #define pendulum_poly_k4s4_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* The iteration's contraction rate after sweep it: the larger of the last two ratios of
+ * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third
+ * sweep. One ratio underrates it where the error has parts that contract at different
+ * rates (the predictor's error, a refreshed factor), and the test then stopped early. */
+static double pendulum_poly_k4s4_contraction(double inc, double inc_old, double inc_old2, int it)
+{
+  double r, r0;
+  if (it < 3) return 1;
+  r = inc / inc_old;
+  r0 = inc_old / inc_old2;
+  return r0 > r ? r0 : r;
+}
+
 #ifndef pendulum_poly_k4s4_ITERC
 #define pendulum_poly_k4s4_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
@@ -1017,10 +1046,11 @@ static double pendulum_poly_k4s4_itol(double tol, double scale)
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the
- * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
-static int pendulum_poly_k4s4_converged(double inc, double inc_old, int it, double t)
+ * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of pendulum_poly_k4s4_contraction
+ * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */
+static int pendulum_poly_k4s4_converged(double inc, double rho, double t)
 {
-  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));
 }
 
 /* One step of HBVM(4,4). Iterates the sweep until the increment reaches round-off
@@ -1034,7 +1064,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   int it, i, stall = 0, rc = pendulum_poly_k4s4_ENOCONV;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return pendulum_poly_k4s4_EBADSTEP;
-  double ref[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M];
+  double ref[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M], inc_old2 = HUGE_VAL, rho;
   int two;
   double tit = pendulum_poly_k4s4_TOL;  /* where the iteration stops (pendulum_poly_k4s4_itol) */
   int attol = 0;  /* it stopped there, above round-off */
@@ -1616,11 +1646,13 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
      * pendulum_poly_k4s4_step_adaptive the error allowed is the step's tolerance's share (pendulum_poly_k4s4_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = pendulum_poly_k4s4_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (pendulum_poly_k4s4_converged(inc, inc_old, it, tit)) {
-      attol = !pendulum_poly_k4s4_converged(inc, inc_old, it, pendulum_poly_k4s4_TOL);
+    rho = pendulum_poly_k4s4_contraction(inc, inc_old, inc_old2, it);
+    if (pendulum_poly_k4s4_converged(inc, rho, tit)) {
+      attol = !pendulum_poly_k4s4_converged(inc, rho, pendulum_poly_k4s4_TOL);
       rc = pendulum_poly_k4s4_OK;
       break;
     }
+    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. pendulum_poly_k4s4_STALL sweeps without one are a stall: converged if it is at
@@ -1675,7 +1707,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return pendulum_poly_k4s4_ENONFINITE;
   for (i = 0; i < (pendulum_poly_k4s4_S - 1) * pendulum_poly_k4s4_M; i++) /* the rest of p's polynomial, for pendulum_poly_k4s4_dense */
     if (!isfinite(sw[pendulum_poly_k4s4_S * pendulum_poly_k4s4_M + pendulum_poly_k4s4_M + pendulum_poly_k4s4_S * pendulum_poly_k4s4_NU + i])) return pendulum_poly_k4s4_ENONFINITE;
-  double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 4 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
+  double q1[pendulum_poly_k4s4_M], p1[pendulum_poly_k4s4_M], pr[pendulum_poly_k4s4_M + 2 + 6 * pendulum_poly_k4s4_NU + 1], K, U1, beta = 1;
   double H0, Hn = pendulum_poly_k4s4_energy(x, prm);
   double qc1[pendulum_poly_k4s4_M], pc1[pendulum_poly_k4s4_M];
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
@@ -1732,6 +1764,9 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     pendulum_poly_k4s4_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return pendulum_poly_k4s4_ENONFINITE;
   }
+  /* g(q1) at round-off, or the iteration stopped short of convergence: no step */
+  for (i = 0; i < pendulum_poly_k4s4_NU; i++)
+    if (!(fabs(pr[pendulum_poly_k4s4_M + 2 + 4 * pendulum_poly_k4s4_NU + i]) <= pendulum_poly_k4s4_GSTEP * pr[pendulum_poly_k4s4_M + 2 + 5 * pendulum_poly_k4s4_NU + i] + pendulum_poly_k4s4_GTOL)) return pendulum_poly_k4s4_ENOCONV;
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];

@@ -38,6 +38,9 @@
 #ifndef satellites_poly_k6s3_STALL
 #define satellites_poly_k6s3_STALL 8  /* sweeps without a new smallest increment that make a stall */
 #endif
+#ifndef satellites_poly_k6s3_GSTEP
+#define satellites_poly_k6s3_GSTEP 5.6843418860808015e-14  /* |g(q1)| above this (256 ulps) of sum_i |dg/dq_i q_i|: not converged */
+#endif
 
 /* Gauss-Legendre nodes c_l and weights b_l on [0,1], k = 6 (the kernels below use
  * their products with P_j and int_0^c P_j, folded into the code):
@@ -6176,7 +6179,6 @@ static void satellites_poly_k6s3_g(const double *q0, const double *p0, const dou
   const double t6 = q0[6] /* x3 */ - q0[0] /* x1 */;
   const double t7 = q0[7] /* y3 */ - q0[1] /* y1 */;
   const double t8 = q0[8] /* z3 */ - q0[2] /* z1 */;
-  /* g(q0) */
   const double t9 = t0 * t0;
   const double t10 = t1 * t1;
   const double t11 = t9 + t10;
@@ -6474,8 +6476,9 @@ static void satellites_poly_k6s3_lambda0(const double *q0, const double *p0, con
 
 /* The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the
  * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)
- * and diagonal (NU) of G1' M^-1 G1, and the multiplier at the rescaled end,
- * beta^2 lamv - lamu, as lamv (NU) and lamu (NU). */
+ * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,
+ * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its
+ * round-off scale sum_i |dg/dq_i q_i| (NU). */
 static void satellites_poly_k6s3_project_p1(const double *q0, const double *p0, const double *gam, double h,
     const double *g0, const double *lam, const double *lu, const satellites_poly_k6s3_params *prm, double *out)
 {
@@ -6814,6 +6817,102 @@ static void satellites_poly_k6s3_project_p1(const double *q0, const double *p0, 
   const double t330 = 4.0 * t329;
   const double t331 = t328 + t330;
   const double t332 = t331 / t26;
+  const double t333 = t0 * t0;
+  const double t334 = t1 * t1;
+  const double t335 = t333 + t334;
+  const double t336 = t2 * t2;
+  const double t337 = t335 + t336;
+  const double t338 = t337 - 1.0;
+  const double t339 = t3 * t3;
+  const double t340 = t4 * t4;
+  const double t341 = t339 + t340;
+  const double t342 = t5 * t5;
+  const double t343 = t341 + t342;
+  const double t344 = t343 - 1.0;
+  const double t345 = t6 * t6;
+  const double t346 = t7 * t7;
+  const double t347 = t345 + t346;
+  const double t348 = t8 * t8;
+  const double t349 = t347 + t348;
+  const double t350 = t349 - 1.0;
+  const double t351 = q0[0] /* x1 */ * t0;
+  const double t352 = 2.0 * t351;
+  const double t353 = fabs(t352);
+  const double t354 = q0[1] /* y1 */ * t1;
+  const double t355 = 2.0 * t354;
+  const double t356 = fabs(t355);
+  const double t357 = t353 + t356;
+  const double t358 = q0[2] /* z1 */ * t2;
+  const double t359 = 2.0 * t358;
+  const double t360 = fabs(t359);
+  const double t361 = t357 + t360;
+  const double t362 = q0[3] /* x2 */ * t0;
+  const double t363 = 2.0 * t362;
+  const double t364 = -t363;
+  const double t365 = fabs(t364);
+  const double t366 = t361 + t365;
+  const double t367 = q0[4] /* y2 */ * t1;
+  const double t368 = 2.0 * t367;
+  const double t369 = -t368;
+  const double t370 = fabs(t369);
+  const double t371 = t366 + t370;
+  const double t372 = q0[5] /* z2 */ * t2;
+  const double t373 = 2.0 * t372;
+  const double t374 = -t373;
+  const double t375 = fabs(t374);
+  const double t376 = t371 + t375;
+  const double t377 = q0[3] /* x2 */ * t3;
+  const double t378 = 2.0 * t377;
+  const double t379 = fabs(t378);
+  const double t380 = q0[4] /* y2 */ * t4;
+  const double t381 = 2.0 * t380;
+  const double t382 = fabs(t381);
+  const double t383 = t379 + t382;
+  const double t384 = q0[5] /* z2 */ * t5;
+  const double t385 = 2.0 * t384;
+  const double t386 = fabs(t385);
+  const double t387 = t383 + t386;
+  const double t388 = q0[6] /* x3 */ * t3;
+  const double t389 = 2.0 * t388;
+  const double t390 = -t389;
+  const double t391 = fabs(t390);
+  const double t392 = t387 + t391;
+  const double t393 = q0[7] /* y3 */ * t4;
+  const double t394 = 2.0 * t393;
+  const double t395 = -t394;
+  const double t396 = fabs(t395);
+  const double t397 = t392 + t396;
+  const double t398 = q0[8] /* z3 */ * t5;
+  const double t399 = 2.0 * t398;
+  const double t400 = -t399;
+  const double t401 = fabs(t400);
+  const double t402 = t397 + t401;
+  const double t403 = q0[0] /* x1 */ * t6;
+  const double t404 = 2.0 * t403;
+  const double t405 = -t404;
+  const double t406 = fabs(t405);
+  const double t407 = q0[1] /* y1 */ * t7;
+  const double t408 = 2.0 * t407;
+  const double t409 = -t408;
+  const double t410 = fabs(t409);
+  const double t411 = t406 + t410;
+  const double t412 = q0[2] /* z1 */ * t8;
+  const double t413 = 2.0 * t412;
+  const double t414 = -t413;
+  const double t415 = fabs(t414);
+  const double t416 = t411 + t415;
+  const double t417 = q0[6] /* x3 */ * t6;
+  const double t418 = 2.0 * t417;
+  const double t419 = fabs(t418);
+  const double t420 = t416 + t419;
+  const double t421 = q0[7] /* y3 */ * t7;
+  const double t422 = 2.0 * t421;
+  const double t423 = fabs(t422);
+  const double t424 = t420 + t423;
+  const double t425 = q0[8] /* z3 */ * t8;
+  const double t426 = 2.0 * t425;
+  const double t427 = fabs(t426);
+  const double t428 = t424 + t427;
   /* dp */
   out[0] = t126;
   out[1] = t130;
@@ -6844,6 +6943,14 @@ static void satellites_poly_k6s3_project_p1(const double *q0, const double *p0, 
   out[20] = t332;
   out[21] = t325;
   out[22] = t321;
+  /* g */
+  out[23] = t338;
+  out[24] = t344;
+  out[25] = t350;
+  /* gscale */
+  out[26] = t376;
+  out[27] = t402;
+  out[28] = t428;
 }
 
 /* The projection onto the constraints, at (q0, p0): out = the Newton step dq onto g = 0,
@@ -7304,6 +7411,19 @@ satellites_poly_k6s3_OUT_OF_LINE double satellites_poly_k6s3_err_est(const doubl
 #define satellites_poly_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* The iteration's contraction rate after sweep it: the larger of the last two ratios of
+ * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third
+ * sweep. One ratio underrates it where the error has parts that contract at different
+ * rates (the predictor's error, a refreshed factor), and the test then stopped early. */
+static double satellites_poly_k6s3_contraction(double inc, double inc_old, double inc_old2, int it)
+{
+  double r, r0;
+  if (it < 3) return 1;
+  r = inc / inc_old;
+  r0 = inc_old / inc_old2;
+  return r0 > r ? r0 : r;
+}
+
 #ifndef satellites_poly_k6s3_ITERC
 #define satellites_poly_k6s3_ITERC 0.1  /* the iteration error allowed, over the step's tolerance */
 #endif
@@ -7324,10 +7444,11 @@ static double satellites_poly_k6s3_itol(double tol, double scale)
 }
 
 /* The iteration's stopping test at the threshold t: the increment inc within t, or the
- * error it leaves in gamma, rho inc / (1 - rho), rho = inc / inc_old (Hairer & Wanner IV.8). */
-static int satellites_poly_k6s3_converged(double inc, double inc_old, int it, double t)
+ * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of satellites_poly_k6s3_contraction
+ * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */
+static int satellites_poly_k6s3_converged(double inc, double rho, double t)
 {
-  return inc <= t || (it > 1 && inc < inc_old && inc * inc <= t * (inc_old - inc));
+  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));
 }
 
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
@@ -7341,7 +7462,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
   int it, i, stall = 0, rc = satellites_poly_k6s3_ENOCONV;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   if (!(h != 0 && isfinite(h))) return satellites_poly_k6s3_EBADSTEP;
-  double ref[satellites_poly_k6s3_S * satellites_poly_k6s3_M];
+  double ref[satellites_poly_k6s3_S * satellites_poly_k6s3_M], inc_old2 = HUGE_VAL, rho;
   int two;
   double tit = satellites_poly_k6s3_TOL;  /* where the iteration stops (satellites_poly_k6s3_itol) */
   int attol = 0;  /* it stopped there, above round-off */
@@ -7423,11 +7544,13 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
      * satellites_poly_k6s3_step_adaptive the error allowed is the step's tolerance's share (satellites_poly_k6s3_itol):
      * the end of the step restores H, g and the hidden constraint. */
     if (tol > 0 && it == 1) tit = satellites_poly_k6s3_itol(tol, scale);  /* once a step, at the first sweep's scale */
-    if (satellites_poly_k6s3_converged(inc, inc_old, it, tit)) {
-      attol = !satellites_poly_k6s3_converged(inc, inc_old, it, satellites_poly_k6s3_TOL);
+    rho = satellites_poly_k6s3_contraction(inc, inc_old, inc_old2, it);
+    if (satellites_poly_k6s3_converged(inc, rho, tit)) {
+      attol = !satellites_poly_k6s3_converged(inc, rho, satellites_poly_k6s3_TOL);
       rc = satellites_poly_k6s3_OK;
       break;
     }
+    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. satellites_poly_k6s3_STALL sweeps without one are a stall: converged if it is at
@@ -7454,7 +7577,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
   if (!isfinite(x->t + h) || !isfinite(x->tc)) return satellites_poly_k6s3_ENONFINITE;
   for (i = 0; i < (satellites_poly_k6s3_S - 1) * satellites_poly_k6s3_M; i++) /* the rest of p's polynomial, for satellites_poly_k6s3_dense */
     if (!isfinite(sw[satellites_poly_k6s3_S * satellites_poly_k6s3_M + satellites_poly_k6s3_M + satellites_poly_k6s3_S * satellites_poly_k6s3_NU + i])) return satellites_poly_k6s3_ENONFINITE;
-  double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 4 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
+  double q1[satellites_poly_k6s3_M], p1[satellites_poly_k6s3_M], pr[satellites_poly_k6s3_M + 2 + 6 * satellites_poly_k6s3_NU + 1], K, U1, beta = 1;
   double H0, Hn = satellites_poly_k6s3_energy(x, prm);
   double qc1[satellites_poly_k6s3_M], pc1[satellites_poly_k6s3_M];
   for (i = 0; i < satellites_poly_k6s3_M; i++) {
@@ -7511,6 +7634,9 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     satellites_poly_k6s3_add(&p1[i], &pc1[i], pr[i] + (beta - 1) * (p1[i] + pr[i]));
     if (!isfinite(q1[i]) || !isfinite(p1[i])) return satellites_poly_k6s3_ENONFINITE;
   }
+  /* g(q1) at round-off, or the iteration stopped short of convergence: no step */
+  for (i = 0; i < satellites_poly_k6s3_NU; i++)
+    if (!(fabs(pr[satellites_poly_k6s3_M + 2 + 4 * satellites_poly_k6s3_NU + i]) <= satellites_poly_k6s3_GSTEP * pr[satellites_poly_k6s3_M + 2 + 5 * satellites_poly_k6s3_NU + i] + satellites_poly_k6s3_GTOL)) return satellites_poly_k6s3_ENOCONV;
   for (i = 0; i < satellites_poly_k6s3_M; i++) {
     x->q[i] = q1[i];
     x->p[i] = p1[i];
