@@ -35,6 +35,7 @@ typedef struct {
 } Loc;
 
 void *arena_alloc(size_t size);          /* zeroed; dies cleanly on exhaustion */
+int *step_nodes(int n);                  /* n node ids (at least 1), zeroed, for step*.c and lu.c */
 char *arena_strndup(const char *s, size_t n);
 void arena_free_all(void);
 
