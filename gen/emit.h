@@ -1,10 +1,16 @@
-/* emit.h - what the two halves of the emitter share.
+/* emit.h - what the emitter's files share, one section per file.
  *
  * emit_kernel.c prints kernels: straight-line C from the DAG, addressing
- * inputs and results through the blocks of the Step. emit_step.c prints
- * everything around them (header, constants, the public functions and the
- * step's predict / iterate / commit templates), naming the kernels' inputs
- * and results only through those blocks. */
+ * inputs and results through the blocks of the Step. The other emit_*.c
+ * print everything around them, naming the kernels' inputs and results
+ * only through those blocks. Layers, each calling only those below it:
+ *   emit_solver.c (entry points: emit_check, emit_solver)
+ *   emit_step.c, emit_project.c, emit_batch.c
+ *   emit_api.c, emit_iterate.c, emit_end.c, emit_batch_step.c
+ *   emit_estimate.c, emit_predict.c
+ *   emit_choice.c
+ *   emit_kernel.c
+ * (emit_main.c, the driver, stands apart.) */
 #ifndef EMIT_H
 #define EMIT_H
 
@@ -37,6 +43,7 @@ typedef struct {
   int fused;       /* the step's iteration has the sweep inlined, gamma in locals */
 } Emitter;
 
+/* emit_kernel.c: printing, and the kernels */
 void out(Emitter *e, const char *fmt, ...);
 const char *real_type(const Emitter *e, int wide);
 const char *math_suffix(const Emitter *e, int wide);
@@ -48,12 +55,44 @@ int kernel_inlinable(const Emitter *e, KernelId k);
 int sweep_reduces(const Emitter *e);
 int emit_kernel_inline(Emitter *e, KernelId k);
 
-/* emit_step.c, for the batch's adaptive step too */
-int energy_defect_wanted(const Emitter *e);
+/* emit_choice.c: what the model, method and options choose for the step */
+int step_order(const Emitter *e);
 int mult_err_wanted(const Emitter *e);
 int itol_wanted(const Emitter *e);
+int energy_defect_wanted(const Emitter *e);
+
+/* emit_api.c: NAME.h, and NAME.c's prelude, kernels and public functions */
+void emit_header(Emitter *e, const EmitOptions *o);
+void emit_header_end(Emitter *e);
+void emit_prelude(Emitter *e, const EmitOptions *o);
+void emit_kernels(Emitter *e);
+void emit_set_lambda(Emitter *e);
+void emit_public(Emitter *e);
+void emit_events(Emitter *e);
+
+/* emit_predict.c: NAME_predict (the warm start, with NAME_add) and NAME_dense */
+double same_size_coefficient(const Emitter *e, int t);
 void emit_two_step_start(Emitter *e, const char *ind, const char *row);
+void emit_predict(Emitter *e);
+void emit_dense(Emitter *e);
+
+/* emit_estimate.c: the error estimates, NAME_step and NAME_step_adaptive */
+void emit_estimators(Emitter *e);
 void emit_step_factor(Emitter *e);
+void emit_step_adaptive(Emitter *e);
+
+/* emit_iterate.c: the step's fixed-point iteration (the block "iterate") */
+void emit_fixed_point(Emitter *e);
+
+/* emit_end.c: the end of a step by family, the commit */
+void emit_end_poly(Emitter *e);
+void emit_end_const(Emitter *e);
+
+/* emit_step.c: NAME_step_within as named blocks */
+void emit_step(Emitter *e);
+
+/* emit_project.c: NAME_project */
+void emit_project(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);

@@ -150,7 +150,7 @@ static void emit_predict_uniform(Emitter *e, int poly) {
 // lane's own one chosen. Lanes that all take the two-step start come from the
 // same last steps, so they take the uniform path above, never this one. For the adaptive step, ref (when not NULL) gets the
 // one-step start and twos (when not NULL) the lanes that took the two-step.
-static void emit_predict(Emitter *e) {
+static void emit_batch_predict(Emitter *e) {
   int poly = e->st->kern[K_FACTOR].nout > 0;
   tmpl(e, "$P_LANE_INLINE void $P_batch_predict(const $P_batch *restrict x, $R h, int cold_all, const $R *restrict par,\n"
           "    $R *restrict gam, $R *restrict ref, $M *restrict twos)\n{\n"
@@ -210,7 +210,7 @@ void emit_batch_source(Emitter *e, int lanes) {
   out(e, "\n");
   emit_set_get(e);
   emit_params_observers(e);
-  emit_predict(e);
+  emit_batch_predict(e);
   emit_batch_step(e);
   e->lanes = 0;
 }

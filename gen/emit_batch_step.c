@@ -158,7 +158,7 @@ static void emit_commit_common(Emitter *e) {
 }
 
 // In NAME_batch_within, before the projection: the Newton steps of
-// emit_end_poly (emit_step.c) onto g = 0 in the lanes whose iteration
+// emit_end_poly (emit_end.c) onto g = 0 in the lanes whose iteration
 // stopped at the tolerance above round-off (the test of NAME_step_within on
 // its last increments: it met the tolerance's, not round-off's), each while
 // its g(q1) is not at round-off, at most NAME_NEWTON; a failure's code nc[l]
@@ -199,7 +199,7 @@ static void emit_lane_newton(Emitter *e) {
 
 // The end of the step for the lanes whose iteration converged (go[l]):
 // the constant family's update, or the polynomial family's projection,
-// rescale and multiplier (emit_end_poly in emit_step.c), as masked loops
+// rescale and multiplier (emit_end_poly in emit_end.c), as masked loops
 // over the lanes; every lane computes, only the lanes in cm[] are written.
 static void emit_commit(Emitter *e, int poly, int adaptive) {
   if (!poly) {

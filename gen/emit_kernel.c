@@ -8,7 +8,7 @@
  * significant digits. All kernels share one signature, printed from the
  * Step's input blocks (q0, p0, gamma, h, g0, ..., params -> out[]), so that
  * the input slots of the DAG map to the same C names everywhere. This file
- * also holds the small printing helpers emit_step.c uses: out, tmpl (the
+ * also holds the small printing helpers the other emitters use: out, tmpl (the
  * template expander, which also names kernel calls and result offsets from
  * the blocks) and format_real.
  *

@@ -13,7 +13,8 @@
  *     step_poly.c       the order-2s family (polynomial multiplier, projection)
  *     lu.c              linear systems of DAG nodes, factored at generation time
  *   emit_kernel.c       C text of the kernels: straight-line code from the DAG (emit.h)
- *   emit_step.c         C text of NAME.h / NAME.c around them: types, step templates
+ *   emit_solver.c       C text of NAME.h / NAME.c around them (emit.h lists its files:
+ *                       the API, the step's blocks, the error control, the prediction)
  *   emit_batch.c        --batch W: the same step over W lanes in struct-of-arrays form
  *   emit_main.c         C text of NAME_main.c, the standalone driver
  *   main.c              the command line
@@ -34,6 +35,7 @@ typedef struct {
 } Loc;
 
 void *arena_alloc(size_t size);          /* zeroed; dies cleanly on exhaustion */
+int *step_nodes(int n);                  /* n node ids (at least 1), zeroed, for step*.c and lu.c */
 char *arena_strndup(const char *s, size_t n);
 void arena_free_all(void);
 
@@ -439,7 +441,7 @@ Step *step_build(Model *mod, const Method *meth);
 const Slots *step_block(const Step *st, KernelId k, const char *name);
 int kernel_size(const Kernel *k);   /* slots of out[] */
 
-/* ---- emit_kernel.c, emit_step.c, emit_batch.c, emit_main.c ---- */
+/* ---- emit_solver.c, emit_main.c (emit.h: the emitter's own files) ---- */
 
 typedef struct {
   const char *name;     /* C prefix */

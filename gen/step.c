@@ -24,8 +24,6 @@
 
 #define MAX_POLY_COEFS 4096 /* s nu: the polynomial multiplier's (s nu)^2 matrix */
 
-int *step_nodes(int n) { return arena_alloc((size_t)(n > 0 ? n : 1) * sizeof(int)); }
-
 static int *zeros(Dag *d, int n) {
   int *v = step_nodes(n), z = dag_const(d, 0);
   for (int i = 0; i < n; i++) v[i] = z;

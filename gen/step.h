@@ -25,7 +25,6 @@ typedef struct {
   int **theta;    /* s x m: the force's coefficients Theta_j of the sweep's result */
 } Build;
 
-int *step_nodes(int n);
 void step_section(Build *b, const char *label);       /* dag_section, labelled for b->owners */
 int step_in(Build *b, int block, int i);              /* input node i of an input block */
 int step_apply_x(Build *b, int j, int i, int **v);     /* sum_r X[j][r] v[r][i] */

@@ -53,6 +53,10 @@ void *arena_alloc(size_t size) {
   return p;
 }
 
+// An array of n node ids (at least 1) in the arena, zeroed: the step builders'
+// (step*.c, lu.c) storage, here so that lu.c need not call up into step.c.
+int *step_nodes(int n) { return arena_alloc((size_t)(n > 0 ? n : 1) * sizeof(int)); }
+
 char *arena_strndup(const char *s, size_t n) {
   char *p = arena_alloc(n + 1);
   memcpy(p, s, n);

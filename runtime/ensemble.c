@@ -780,10 +780,3 @@ out:
 #endif
   return status;
 }
-
-int hbvmrt_main_batch(const hbvmrt_model *model, const hbvmrt_batch *batch, int argc, char **argv)
-{
-  if (hbvmrt_ensemble_wanted(argc, argv))
-    return hbvmrt_ensemble_main(model, batch, argc, argv);
-  return hbvmrt_main(model, argc, argv);
-}

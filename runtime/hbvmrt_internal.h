@@ -1,7 +1,8 @@
 /* hbvmrt_internal.h - what the runtime's files share; not installed, not
  * seen by generated code.  One section per file: args.c parses the driver
  * options into an hbvmrt_opts, csv.c writes the header and rows, run.c
- * (hbvmrt_main) ties them to the loop. */
+ * (hbvmrt_run) ties them to the loop of one run, ensemble.c to many;
+ * driver.c (hbvmrt_main) chooses between the two. */
 #ifndef HBVMRT_INTERNAL_H
 #define HBVMRT_INTERNAL_H
 
@@ -143,6 +144,10 @@ int hbvmrt_advance(const hbvmrt_model *md, void *x, const void *prm, double h, i
 /* The halves of a step h that failed with code at depth, as hbvmrt_advance. */
 int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int code, int depth,
                  const hbvmrt_steps *cb, int *stopped);
+
+/* run.c: one run of the standalone driver (hbvmrt_main without an ensemble) */
+
+int hbvmrt_run(const hbvmrt_model *md, int argc, char **argv);
 
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 

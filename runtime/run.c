@@ -1,4 +1,4 @@
-/* run.c - hbvmrt_main: the standalone driver's loop (SPEC section 4).
+/* run.c - hbvmrt_run: the standalone driver's loop (SPEC section 4).
  *
  * After the options (args.c) it allocates the state and params blocks, fills
  * the params with the defaults and the --param values, initialises the state
@@ -550,15 +550,14 @@ static int simulate(Run *r)
   return out_failed ? 1 : r->fail_code != 0 ? 2 : 0;
 }
 
-/* The standalone driver: see hbvmrt.h and the comment at the top. */
-int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv)
+/* The standalone driver's one run (driver.c sends it every run that is not an
+ * ensemble): see hbvmrt.h and the comment at the top. */
+int hbvmrt_run(const hbvmrt_model *model, int argc, char **argv)
 {
   hbvmrt_opts o;
   Run r;
   int status;
 
-  if (hbvmrt_ensemble_wanted(argc, argv))
-    return hbvmrt_ensemble_main(model, NULL, argc, argv);   /* ensemble.c */
   status = hbvmrt_parse_args(model, argc, argv, &o);
   if (status != HBVMRT_ARGS_RUN) {
     hbvmrt_opts_free(&o);

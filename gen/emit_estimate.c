@@ -1,0 +1,332 @@
+/* emit_estimate.c - the step's error control: NAME_err_est and the
+ * other parts of the local error, and NAME_step / NAME_step_adaptive.
+ *
+ * emit_estimators prints, before the step that calls them: NAME_err_est
+ * (the velocity's part, from the converged gamma and the predictor's
+ * error d1), NAME_defect (the quadrature's part, where k nodes do not
+ * integrate H exactly and no rescale restores it), NAME_TOLC, NAME_itol and
+ * NAME_converged (where the adaptive step's iteration stops, polynomial
+ * family) and NAME_mult_err (the constant multiplier's part). After the
+ * step, emit_step_adaptive prints NAME_step (a fixed step: no tolerance)
+ * and NAME_step_adaptive, whose controller's factor (emit_step_factor) the
+ * batch's adaptive step prints too. Which parts a solver has is decided in
+ * emit_choice.c. */
+#include <stdio.h>
+
+#include "emit.h"
+
+// The constant of NAME_err_est: the geometric mean of true / estimate over
+// the problems of tests/check_errest.c (docs/api.md), by s.
+static double err_constant(const Emitter *e) {
+  static const double order2s[] = {0.068, 8.7e-3, 5.1e-4, 2.8e-5};
+  int s = e->me->s;
+  return order2s[s < 4 ? s - 1 : 3];
+}
+
+// The constant of NAME_err_est's cold estimate (the first step, no warm
+// start): the largest true / (|h gamma_{s-1}| rho^(s+1)) over the cold steps
+// of tests/check_errest.c's problems and Kepler, h from 0.01 to 3 (true
+// errors above 1e-12), rounded up: an estimate that is never below the
+// truth there, as the first step's size is a guess (docs/api.md).
+static double cold_constant(const Emitter *e) {
+  int s = e->me->s;
+  return s <= 2 ? 70 : s <= 4 ? 40 : 250;
+}
+
+// The order p of the estimate per unit step, for the controller (h^p): the
+// step's order, but 3 for NAME_mult_err's error in q (h^4 a step: q is of
+// order 4 under the constant multiplier, p of order 2 across the hidden
+// constraint, docs/api.md).
+static int controller_order(const Emitter *e) { return mult_err_wanted(e) ? 3 : step_order(e); }
+
+// NAME_err_est: the local error estimate of a converged step from what the
+// step has anyway (docs/api.md, "The local error estimate"). The Legendre
+// coefficients of the velocity of a smooth solution fall like
+// |gamma_j| ~ |v| rho^j, rho ~ h / (its time scale), and the local error of
+// the order 2s is ~ h |v| rho^2s. The predictor's error d1 (the first sweep's
+// increment) is the first coefficient the extrapolation lacks,
+// d1 ~ h |v| rho^s, so with v = max |gamma_0| (a norm over the whole vector)
+//   local error ~ h |v| (d1 / |h v|)^2 = d1^2 / |h v|.
+// Where the velocity vanishes (a pendulum's turning point) this is too large,
+// never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
+// The first step after NAME_init has no warm start (its predictor is
+// gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
+// is the whole velocity): there, at s >= 2, the estimate is the same model
+// read off the converged coefficients, NAME_COLDC |h gamma_{s-1}| rho^(s+1),
+// with rho the slower of the two-step decays (|gamma_{s-1}| / |gamma_{s-3}|)^(1/2)
+// and (|gamma_{s-2}| / |gamma_{s-4}|)^(1/2): odd and even coefficients can fall
+// at different rates (Kepler's perihelion; from rest, v = a t + O(t^3) makes
+// gamma_2 and gamma_3 both O(h^3)). At s = 2, gamma_1 / gamma_0, which is
+// 1/sqrt(3) from rest whatever h: there (rho >= 0.35) NAME_COLDC_REST.
+// The constant multiplier's own error (order 2) is NAME_mult_err's.
+static void emit_err_est(Emitter *e) {
+  int s = e->me->s, p = 2 * s;
+  const char *g = math_suffix(e, e->wide_step);
+  tmpl(e, "/* max |gamma_j| over the coordinates */\n"
+          "static $R $P_coef(const $W *gam, int j)\n{\n  $R c = 0;\n  int i;\n  for (i = 0; i < $P_M; i++)\n");
+  out(e, "    if (fabs%s(gam[j * %s_M + i]) > c) c = (%s)fabs%s(gam[j * %s_M + i]);\n  return c;\n}\n\n", g, e->P,
+      real_type(e, 0), g, e->P);
+  tmpl(e, "/* The local error estimate of a step (max norm in q) from its converged gamma and\n"
+          " * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:\n");
+  out(e, " * |h v| (d1 / |h v|)^(%d/%d), v = gamma_0 (docs/api.md). */\n", p, s);
+  tmpl(e, "#ifndef $P_ERRC\n");
+  char c[40];
+  format_real(e, c, sizeof c, err_constant(e));
+  out(e, "#define %s_ERRC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
+  if (s >= 2) {
+    format_real(e, c, sizeof c, cold_constant(e));
+    out(e, "#ifndef %s_COLDC\n#define %s_COLDC %s  /* the first step's: measured, docs/api.md */\n#endif\n", e->P,
+        e->P, c);
+  }
+  if (s == 2) {
+    format_real(e, c, sizeof c, 0.05);
+    out(e, "#ifndef %s_COLDC_REST\n#define %s_COLDC_REST %s  /* the same from rest: measured, docs/api.md */\n"
+           "#endif\n", e->P, e->P, c);
+  }
+  tmpl(e, "$P_OUT_OF_LINE $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v, r;\n  int i;\n");
+  tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
+  if (s >= 2) {
+    out(e, "  if (cold) {  /* no warm start: %s_COLDC |h gamma_%d| rho^%d */\n", e->P, s - 1, s + 1);
+    out(e, "    %s c = %s_coef(gam, %d)", real_type(e, 0), e->P, s - 1);
+    if (s != 3) out(e, ", b = %s_coef(gam, %d)", e->P, s - 2);
+    if (s >= 3) out(e, ", a = %s_coef(gam, %d)", e->P, s - 3);
+    if (s >= 4) out(e, ", z = %s_coef(gam, %d), t", e->P, s - 4);
+    out(e, ";\n    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < %d */\n", s);
+    if (s == 2)
+      tmpl(e, "    r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */\n"
+              "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
+              "    v = (r < ($R)0.35 ? $P_COLDC : $P_COLDC_REST) * fabs$f(h) * c;\n");
+    else {
+      out(e, "    r = sqrt%s(c / a);  /* the slower of the two-step decays */\n", math_suffix(e, 0));
+      if (s >= 4) out(e, "    t = sqrt%s(b / z);\n    if (t > r) r = t;\n", math_suffix(e, 0));
+      tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
+              "    v = $P_COLDC * fabs$f(h) * c;\n");
+    }
+    out(e, "    for (i = 0; i < %d; i++) v *= r;\n    return v;\n  }\n", s + 1);
+  } else
+    tmpl(e, "  (void)cold;  /* at s = 1 the cold predictor's error is the warm one's */\n");
+  tmpl(e, "  if (!(v > d1)) return d1;  /* rho >= 1: no asymptotic range */\n  r = d1 / v;\n");
+  tmpl(e, "  v *= $P_ERRC;\n");
+  out(e, "  for (i = 0; i < %d; i++) v *= r;\n  return v;\n}\n\n", p / s);
+}
+
+// NAME_TOLC, the share of tol allowed per unit step (NAME_step_adaptive).
+static void emit_tolc(Emitter *e) {
+  out(e, "#ifndef %s_TOLC\n#define %s_TOLC %s  /* the local error allowed per unit step, over tol */\n#endif\n\n",
+      e->P, e->P, e->single ? "0.01f" : "0.01");
+}
+
+// NAME_itol: where the adaptive step's iteration stops (docs/api.md, "The
+// iteration under a tolerance"). The step's tolerance tol (1 + scale) bounds
+// its local error in q; the iteration error the converged test leaves in q,
+// rho inc / (1 - rho) scale (inc relative to scale), is allowed NAME_ITERC of
+// it. Capped at NAME_ITOLMAX, so that the Newton steps onto g = 0 at the end
+// of the step (each squares the error of the last) bring g back to round-off
+// in one or two (NAME_NEWTON at most), and at least NAME_TOL, the fixed
+// step's round-off test.
+static void emit_itol(Emitter *e) {
+  out(e, "#ifndef %s_ITERC\n#define %s_ITERC %s  /* the iteration error allowed, over the step's tolerance */\n#endif\n",
+      e->P, e->P, e->single ? "0.1f" : "0.1");
+  out(e, "#ifndef %s_ITOLMAX\n#define %s_ITOLMAX %s  /* at most: one or two Newton steps put g back at round-off */\n#endif\n",
+      e->P, e->P, e->single ? "1e-4f" : "1e-8");
+  out(e, "#ifndef %s_NEWTON\n#define %s_NEWTON 3  /* Newton steps onto g = 0 after it, at most */\n#endif\n", e->P, e->P);
+  tmpl(e, "/* The scaled increment at which the iteration of $P_step_adaptive stops: the error\n"
+          " * rho inc / (1 - rho) it leaves within $P_ITERC times the step's tolerance tol (1 + scale),\n"
+          " * between $P_TOL and $P_ITOLMAX; $P_TOL (round-off) for a fixed step (tol 0). */\n"
+          "static $R $P_itol($R tol, $R scale)\n{\n"
+          "  $R t = $P_ITERC * tol * (1 + scale) / (scale > 0 ? scale : 1);\n"
+          "  t = t < $P_ITOLMAX ? t : $P_ITOLMAX;\n"
+          "  return ((tol > 0) & (scale > 0) & (t > $P_TOL)) ? t : $P_TOL;\n}\n\n"
+          "/* The iteration's stopping test at the threshold t: the increment inc within t, or the\n"
+          " * error it leaves in gamma, rho inc / (1 - rho), with rho the contraction of $P_contraction\n"
+          " * (Hairer & Wanner IV.8); rho = 1 (not known yet) leaves only the first. */\n"
+          "static int $P_converged($R inc, $R rho, $R t)\n{\n"
+          "  return inc <= t || (rho < 1 && inc * rho <= t * (1 - rho));\n}\n\n");
+}
+
+// NAME_contraction: the contraction rate rho of the polynomial family's
+// iteration that its stopping test reads, the larger of the last two ratios
+// of increments, so from the third sweep on (1, not known, before). One
+// ratio, read from the second sweep on, took the first sweep's increment
+// (the predictor's error, which the sweep removes faster than the slowest
+// part of the iteration's error) and a sweep that followed a refresh of the
+// factor for the contraction: at s >= 6 in float and s >= 14 in double such
+// a ratio was far below the true rate, and steps were accepted with g(q1) up
+// to 1 (issue 30, item 1; tests/check_poly.c).
+static void emit_contraction(Emitter *e) {
+  tmpl(e, "/* The iteration's contraction rate after sweep it: the larger of the last two ratios of\n"
+          " * its increments inc / inc_old and inc_old / inc_old2; 1 (not known) before the third\n"
+          " * sweep. One ratio underrates it where the error has parts that contract at different\n"
+          " * rates (the predictor's error, a refreshed factor), and the test then stopped early. */\n"
+          "static $R $P_contraction($R inc, $R inc_old, $R inc_old2, int it)\n{\n"
+          "  $R r, r0;\n"
+          "  if (it < 3) return 1;\n"
+          "  r = inc / inc_old;\n  r0 = inc_old / inc_old2;\n"
+          "  return r0 > r ? r0 : r;\n}\n\n");
+}
+
+// The head of a loop over the coordinates, in NAME_defect and NAME_mult_err:
+// the step's end (q1, p1) = x + (h sw[gam], sw[dp]) from the converged sweep,
+// before the commit, and dp = max |p1 - p0|; the caller closes the loop.
+static void emit_step_end_loop(Emitter *e) {
+  tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
+          "    q1[i] = x->q[i] + h * ($R)sw[$[sweep.gam]i];\n    p1[i] = x->p[i] + ($R)sw[$[sweep.dp]i];\n"
+          "    if (fabs$f(p1[i] - x->p[i]) > dp) dp = fabs$f(p1[i] - x->p[i]);\n");
+}
+
+#define MULT_ERRC 0.12 /* NAME_MULTC: the geometric mean of true / estimate (docs/api.md) */
+
+// NAME_mult_err: the constant multiplier's part of a step's local error,
+// beside the velocity's order 2s that NAME_err_est sees. Measured (docs/api.md,
+// "The local error estimate"): under the constant multiplier q has order 4,
+// and p's local error is, to three digits, dp1, its projection onto the hidden
+// constraint at q1 (the kernel "consistent"), ~ h^2 and alternating in sign
+// from step to step (dp1 ~ -dp0 + the step's own part). So the step's own
+// part is dp1 + dp0, and q's error ~ h |M^-1 (dp1 + dp0)| (h / tau), tau the
+// motion's time scale, for which h / tau ~ |p1 - p0| / (|p0| + |p1 - p0|) (at
+// most 1, where the momentum vanishes). True / estimate 0.45-1.7 in geometric
+// mean on five problems, s = 2, 3, 4, at most 4.3x below on any step; the
+// velocity's coefficients alone erred 50x high (the satellites) and 30x low
+// (pendulum, s = 3). Under the adaptive step also p's error: TOLC |h| times
+// that velocity, so that it stays within tol (1 + max|q|) a step (it does not
+// add up over the steps; the total dp1 would keep what a large step left and
+// shrink h to the floor, measured). Not finite (a singular G' M^-1 G): 0,
+// NAME_err_est alone.
+static void emit_mult_err(Emitter *e) {
+  char c[40];
+  format_real(e, c, sizeof c, MULT_ERRC);
+  tmpl(e, "#ifndef $P_MULTC\n");
+  out(e, "#define %s_MULTC %s  /* measured: docs/api.md */\n#endif\n", e->P, c);
+  tmpl(e, "/* The constant multiplier's part of the local error in q, which $P_err_est does not\n"
+          " * see: h |M^-1 (dp1 + dp0)| |p1 - p0| / (|p0| + |p1 - p0|), dp0 and dp1 the projections\n"
+          " * of p0 and p1 onto the hidden constraint at q0 and q1, (q1, p1) = x + (h sw[gam], sw[dp]).\n"
+          " * For $P_step_adaptive (adaptive 1) at least $P_TOLC |h| |M^-1 (dp1 + dp0)|: p's error, the\n"
+          " * velocity across the hidden constraint that the step adds, within tol (1 + max|q|); it\n"
+          " * alternates in sign from step to step and does not add up. */\n"
+          "static $R $P_mult_err(const $P_state *x, const $W *sw, $R h, const $P_params *prm, int adaptive)\n{\n"
+          "  $R q1[$P_M], p1[$P_M], pr[$<consistent>], dp0[$P_M], v[$P_M], vd = 0, dp = 0, p0 = 0, est;\n"
+          "  int i;\n");
+  emit_step_end_loop(e);
+  tmpl(e, "    if (fabs$f(x->p[i]) > p0) p0 = fabs$f(x->p[i]);\n  }\n"
+          "  $(consistent q0=x->q p0=x->p out=pr);\n"
+          "  for (i = 0; i < $P_M; i++) dp0[i] = pr[$[consistent.dp]i];\n"
+          "  $(consistent q0=q1 p0=p1 out=pr);\n"
+          "  for (i = 0; i < $P_M; i++) dp0[i] += pr[$[consistent.dp]i];  /* dp1 + dp0 */\n"
+          "  $(minv_p q0=q1 p0=dp0 out=v);\n"
+          "  for (i = 0; i < $P_M; i++)\n    if (fabs$f(v[i]) > vd) vd = fabs$f(v[i]);\n"
+          "  est = dp > 0 ? $P_MULTC * fabs$f(h) * vd * (dp / (p0 + dp)) : 0;\n"
+          "  if (adaptive && $P_TOLC * fabs$f(h) * vd > est) est = $P_TOLC * fabs$f(h) * vd;\n"
+          "  return isfinite(est) ? est : 0;\n}\n\n");
+}
+
+// NAME_defect: the quadrature's part of a step's local error, which
+// NAME_err_est does not see. The step's energy defect |H(q1, p1) - H(q0, p0)|
+// beyond round-off (64 ulps of |K| + |U|), as the displacement across the
+// energy surface it takes, over the force |p1 - p0| / h; (q1, p1) from the
+// converged sweep, before the commit (no copy of the state: a step over the
+// tolerance with it is rejected as NAME_step_within rejects any, unwritten).
+static void emit_defect(Emitter *e) {
+  tmpl(e, "/* The quadrature's part of the local error (the $P_K nodes do not integrate H exactly\n"
+          " * for this model), which $P_err_est does not see: the energy defect of the step from\n"
+          " * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */\n"
+          "static $R $P_defect(const $P_state *x, const $W *sw, $R h, const $P_params *prm)\n{\n"
+          "  $R q1[$P_M], p1[$P_M], z[$P_M], H0, U0, H1, dH, dp = 0;\n  int i;\n");
+  emit_step_end_loop(e);
+  tmpl(e, "    z[i] = 0;\n  }\n"
+          "  $(energy_kernel q0=x->q p0=x->p out=&H0);\n"
+          "  $(energy_kernel q0=x->q p0=z out=&U0);\n"
+          "  $(energy_kernel q0=q1 p0=p1 out=&H1);\n"
+          "  dH = fabs$f(H1 - H0) - $P_NOISETOL * (fabs$f(H0 - U0) + fabs$f(U0));\n"
+          "  return dH > 0 && dp > 0 ? dH * fabs$f(h) / dp : 0;\n}\n\n");
+}
+
+// The functions NAME_step_within calls for its error, printed before it:
+// NAME_err_est, then NAME_defect, NAME_TOLC, NAME_itol (and NAME_converged),
+// NAME_mult_err where the solver has them (emit_choice.c).
+void emit_estimators(Emitter *e) {
+  emit_err_est(e);
+  if (energy_defect_wanted(e)) emit_defect(e);
+  emit_tolc(e);
+  if (e->st->kern[K_FACTOR].nout) emit_contraction(e);
+  if (itol_wanted(e)) emit_itol(e);
+  if (mult_err_wanted(e)) emit_mult_err(e);
+}
+
+// The controller's factor for the next step, fac, from err, the error over
+// its tolerance (NAME_step_adaptive, NAME_batch_step_adaptive): the
+// standard 0.9 err^(-1/p) for the step's order p, within [0.2, grow]. The
+// p-th root is a chain of square and cube roots when p = 2^a 3^b (every
+// order of s = 1, 2, 3, 4, 6, 8, 9, 12, ...): cheaper than pow, and on a
+// microcontroller by far (sqrtf is one instruction of a Cortex-M4F, powf a
+// library call of a thousand cycles).
+void emit_step_factor(Emitter *e) {
+  int p = controller_order(e), a = 0, b = 0;
+  const char *f = math_suffix(e, 0);
+  while (p % 2 == 0) p /= 2, a++;
+  while (p % 3 == 0) p /= 3, b++;
+  if (p != 1) {
+    out(e, "      fac = err > 0 ? (%s)0.9 * pow%s(err, (%s)-1 / %d) : grow;\n", real_type(e, 0), f, real_type(e, 0),
+        controller_order(e));
+  } else {
+    out(e, "      fac = err > 0 ? (%s)0.9 / ", real_type(e, 0));
+    for (int i = 0; i < b; i++) out(e, "cbrt%s(", f);
+    for (int i = 0; i < a; i++) out(e, "sqrt%s(", f);
+    out(e, "err");
+    for (int i = 0; i < a + b; i++) out(e, ")");
+    out(e, " : grow;  /* 0.9 err^(-1/%d) */\n", controller_order(e));
+  }
+  tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n");
+}
+
+// NAME_step_adaptive: NAME_step with its error estimate tested before the
+// commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
+// and relative at once, so that the errors of the steps up to T add up to
+// about tol T, whatever their number), else retried from the unchanged state
+// with a smaller step. The next step from the standard controller of
+// Hairer, Norsett and Wanner (I.II.4) for an error of order h^p per unit
+// step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
+// rejection; after the first step (hprev 0: from the caller's guess) within
+// [h/5, 100h], as CVODE lets its first step grow 1e4x: the ramp from a small
+// guess took three steps of the satellites' 9 to 33 (2026-11-26,
+// bench/README.md). A failed step is retried with half the step. After three
+// tries over the tolerance the tries start cold (no warm start): the warm
+// start carries the previous step's error into the estimate at every h.
+void emit_step_adaptive(Emitter *e) {
+  tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
+          "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");
+  out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
+      e->P, e->P, e->single ? "1e-5f" : "1e-12");
+  if (controller_order(e) == step_order(e))
+    out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
+  else
+    out(e, "/* The exponent of the controller: %d, the order of the estimate in q per unit step\n"
+           " * (%s_mult_err: q is of order 4, p of order %d across the hidden constraint). */\n",
+        controller_order(e), e->P, step_order(e));
+  tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
+          "  $P_stats s;\n  $R hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */\n"
+          "  int rc, rejected = 0, misses = 0;\n"
+          "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
+          "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
+          "  tol *= $P_TOLC;\n"
+          "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
+          "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
+          "     * previous step's error, which no smaller h removes from the estimate */\n"
+          "    rc = $P_step_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, &s);\n"
+          "    if (rc == $P_EREJECT) misses++;\n"
+          "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
+          "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
+          "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");
+  tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n        int i;\n"
+          "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "        err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n      }\n");
+  emit_step_factor(e);
+  tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
+          "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
+          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n        }\n"
+          "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
+          "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
+          "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
+          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n      }\n"
+          "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
+}

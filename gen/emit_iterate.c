@@ -1,0 +1,254 @@
+/* emit_iterate.c - the step's fixed-point iteration.
+ *
+ * emit_fixed_point prints, inside NAME_step_within, the iteration block
+ * (see emit_step.c for what it may assume and must leave): for the
+ * polynomial family the multiplier matrix factored at the predicted gamma
+ * (emit_factor), then the loop of at most NAME_MAXITER sweeps. Each sweep
+ * computes the sweep kernel at the current gamma (a call, or with e->fused
+ * its body inline on scalar locals gm0.., sw0.., lm0..: emit_fused_*),
+ * the scaled increment, after the first sweep the predictor's error d1
+ * and the early rejection under NAME_step_adaptive (emit_first_sweep),
+ * the finiteness and pivot checks of its results, and the test for
+ * convergence or a stall (emit_convergence). The polynomial family
+ * refactors when the increments fall slowly. The fused locals are written
+ * back to gam[] and sw[] at the end, for the rest of the step. */
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "emit.h"
+
+// Factor the polynomial family's multiplier matrix at the current gamma
+// into fa[], returning from the step when a pivot is not finite or is
+// negligible (the system is singular). indent: the code's indentation.
+static void emit_factor(Emitter *e, const char *indent) {
+  char text[1024];
+  snprintf(text, sizeof text,
+           "%s$(factor q0=%s gam=gam h=h out=fa);\n"
+           "%sfor (j = 0; j < $P_S * $P_NU; j++) {\n"
+           "%s  $W piv = fa[$[factor.pivot]j], dia = fa[$[factor.adiag]j];\n"
+           "%s  if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
+           "%s  if (!(fabs$g(piv) > $P_SINGTOL * fabs$g(dia))) return $P_ESINGULAR;\n"
+           "%s}\n",
+           indent, e->wide_step ? "q0w" : "x->q", indent, indent, indent, indent, indent);
+  tmpl(e, text);
+}
+
+// Where result block name of the sweep starts in its out[].
+static int sweep_at(const Emitter *e, const char *name) {
+  return step_block(e->st, K_SWEEP, name)->first;
+}
+
+// tmpl of a printf format's result.
+static void tmplf(Emitter *e, const char *fmt, ...) {
+  char text[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(text, sizeof text, fmt, ap);
+  va_end(ap);
+  tmpl(e, text);
+}
+
+// "if (!isfinite(sw0) || ... || !isfinite(sw{n-1})) rc = CODE;", the finiteness
+// test of the fused step's first n results.
+static void emit_all_finite(Emitter *e, int n) {
+  out(e, "    if (");
+  for (int i = 0; i < n; i++) out(e, "%s!isfinite(sw%d)", i ? (i % 6 ? " || " : " ||\n        ") : "", i);
+  tmpl(e, ") rc = $P_ENONFINITE;\n");
+}
+
+// After the first sweep: d1, the predictor's error (the increment; after the
+// two-step start, the one-step start's miss, which the estimate is built on),
+// and the error estimate, with which NAME_step_adaptive rejects a step the
+// first sweep already puts over its tolerance rather than after the
+// iteration has converged. gamma (gm0, ... in the fused step) is the sweep's.
+// Not on a cold try (no warm start): one sweep from the cold predictor leaves
+// the highest coefficients far from their converged values, and the early
+// test rejected chain8's first step from rest (s = 3, tol 1e-12) down to the
+// floor; there the converged estimate decides.
+static void emit_first_sweep(Emitter *e) {
+  tmpl(e, "    if (it == 1 && (st || tol > 0)) {  /* for $P_err_est: only when someone reads it */\n"
+          "      d1 = inc;  /* the predictor's error */\n");
+  if (e->fused)
+    for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
+  if (e->st->kern[K_FACTOR].nout)
+    tmpl(e, "      if (two)  /* the two-step start: the one-step start's miss */\n"
+            "        for (d1 = 0, i = 0; i < $P_S * $P_M; i++) {\n"
+            "          $R v = fabs$g(h * (gam[i] - ref[i]));\n"
+            "          if (v > d1) d1 = v;\n        }\n");
+  tmpl(e, "      if (tol > 0 && !(cold || x->hprev == 0)) {  /* $P_step_adaptive's, warm tries only */\n"
+          "        est = $P_err_est(gam, h, d1, 0);\n"
+          "        if (!(est <= tol * (1 + scale))) {\n"
+          "          if (st) {\n            st->iters = 1;\n            st->increment = inc;\n"
+          "            st->err_est = est;\n            st->h = h;\n            st->rejected = 0;\n          }\n"
+          "          return $P_EREJECT;\n        }\n      }\n    }\n");
+}
+
+// The fused step's locals: gamma as gm0, gm1, ... (from the predicted
+// gam[]), the sweep's results as sw0, sw1, ... and, for the polynomial
+// family, the multiplier's coefficients as lm0, lm1, ...
+static void emit_fused_locals(Emitter *e) {
+  int sm = e->me->s * e->mod->m, n = kernel_size(&e->st->kern[K_SWEEP]);
+  out(e, "  /* the iteration's values in locals: gamma, the sweep's results%s */\n",
+      e->st->kern[K_FACTOR].nout ? ", the multiplier" : "");
+  for (int i = 0; i < sm; i++) out(e, "%s%s gm%d = gam[%d]", i ? "," : "  ", i ? "" : real_type(e, 0), i, i);
+  out(e, ";\n");
+  for (int i = 0; i < n; i++) out(e, "%s%s%s sw%d = 0", i ? "," : "  ", i ? "" : real_type(e, 0), i && i % 8 == 0 ? "\n   " : "", i);
+  out(e, ";\n");
+  if (e->st->kern[K_FACTOR].nout) {
+    for (int i = 0; i < e->me->s * e->mod->nu; i++) out(e, "%s%s lm%d = 0", i ? "," : "  ", i ? "" : real_type(e, 0), i);
+    out(e, ";\n");
+  }
+}
+
+// The fused step's sweep and increment: the sweep kernel's body inline,
+// reading gamma (and lambda) from locals and leaving its results in locals,
+// then the increment unrolled: the same operations in the same order as
+// the loops over sw[] and gam[] of the plain step, so the same bits.
+static void emit_fused_sweep(Emitter *e) {
+  int m = e->mod->m, sm = e->me->s * m, g = sweep_at(e, "gam");
+  e->arg[IN_Q0] = "x->q";
+  e->arg[IN_P0] = "x->p";
+  e->arg[IN_GAM] = "gm";
+  e->arg[IN_LAM] = "lm";
+  e->arg[IN_LU] = "fa";
+  e->local = 1u << IN_GAM | 1u << IN_LAM;
+  e->res = "sw";
+  emit_kernel_inline(e, K_SWEEP);
+  memset(e->arg, 0, sizeof e->arg);
+  e->local = 0;
+  e->res = NULL;
+  tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
+          "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n    {\n      $R v;\n");
+  for (int i = 0; i < m; i++)
+    tmplf(e, "      v = fabs$f(x->q[%d]) + fabs$g(h * sw%d);\n      if (v > scale) scale = v;\n", i, g + i);
+  for (int i = 0; i < sm; i++) {
+    tmplf(e, "      v = fabs$g(h * (sw%d - gm%d));\n      if (v > inc) inc = v;\n", g + i, i);
+    out(e, "      gm%d = sw%d;\n", i, g + i);
+  }
+  out(e, "    }\n");
+  emit_first_sweep(e);
+  out(e, "    if (scale > 0) inc /= scale;\n");
+}
+
+// The plain step's sweep (a call), increment and the checks of its results.
+static void emit_sweep_checks(Emitter *e) {
+  int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
+  char call[128];
+  snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s%s out=sw);\n", wide ? "q0w" : "x->q",
+           wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "", poly ? " lam=lam lu=fa" : "");
+  tmpl(e, call);
+  tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
+          "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
+          "    for (i = 0; i < $P_M; i++) {\n"
+          "      $R v = fabs$f(x->q[i]) + fabs$g(h * sw[$[sweep.gam]i]);\n"
+          "      if (v > scale) scale = v;\n    }\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) {\n"
+          "      $R v = fabs$g(h * (sw[$[sweep.gam]i] - gam[i]));\n"
+          "      if (v > inc) inc = v;\n"
+          "      gam[i] = sw[$[sweep.gam]i];\n    }\n");
+  emit_first_sweep(e);
+  tmpl(e, "    if (scale > 0) inc /= scale;\n");
+  if (poly)
+    tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
+            "    for (i = 0; i < $<sweep.theta>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+  else if (e->mod->nu) /* before the finiteness test: a zero pivot makes lambda 0/0 */
+    tmpl(e, "    for (i = 0; i < $P_NU; i++) {\n"
+            "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
+            "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
+
+            "    }\n"
+            "    if (rc == $P_ESINGULAR) break;\n");
+  if (!poly) tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+}
+
+// The same for the fused step: the sweep inline, then its checks on the
+// locals, in the plain step's order.
+static void emit_fused_checks(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
+  emit_fused_sweep(e);
+  if (poly) {
+    for (int i = 0; i < e->me->s * nu; i++) out(e, "    lm%d = sw%d;\n", i, sweep_at(e, "lam") + i);
+    emit_all_finite(e, sweep_at(e, "theta"));
+    return;
+  }
+  if (nu) {
+    for (int i = 0; i < nu; i++)
+      tmplf(e, "    {\n      $R piv = sw%d, dia = sw%d;\n"
+               "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
+               "    }\n", sweep_at(e, "pivot") + i, sweep_at(e, "adiag") + i);
+    tmpl(e, "    if (rc == $P_ESINGULAR) break;\n");
+  }
+  emit_all_finite(e, sweep_at(e, "pivot"));
+}
+
+// The end of an iteration: failure, convergence or a stall.
+static void emit_convergence(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
+  if (poly) { /* the end of the step restores H and the hidden constraint */
+    tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
+            "     * leaves in gamma is: rho inc / (1 - rho), rho = inc / inc_old the contraction (the\n"
+            "     * standard test, Hairer & Wanner IV.8), which saves the sweep that would only\n"
+            "     * confirm it. Iterating further would not help H, which the rescale keeps.");
+    if (itol_wanted(e))
+      tmpl(e, " Under\n"
+              "     * $P_step_adaptive the error allowed is the step's tolerance's share ($P_itol):\n"
+              "     * the end of the step restores H, g and the hidden constraint. */\n"
+              "    if (tol > 0 && it == 1) tit = $P_itol(tol, scale);  /* once a step, at the first sweep's scale */\n"
+              "    rho = $P_contraction(inc, inc_old, inc_old2, it);\n"
+              "    if ($P_converged(inc, rho, tit)) {\n"
+              "      attol = !$P_converged(inc, rho, $P_TOL);\n");
+    else
+      tmpl(e, " */\n    rho = $P_contraction(inc, inc_old, inc_old2, it);\n"
+              "    if (inc <= $P_TOL || (rho < 1 && inc * rho <= $P_TOL * (1 - rho))) {\n");
+    tmpl(e, "      rc = $P_OK;\n      break;\n    }\n"
+            "    inc_old2 = inc_old;  /* the sweep overwrites inc_old: the increment before it */\n");
+  } else {
+    tmpl(e, "    /* converged: the increment is far below an ulp of the state ($P_TOL / 256), or\n"
+            "     * within 2 ulps ($P_TOL) and falling by less than 4x (round-off noise). Iterating\n"
+            "     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a\n"
+            "     * random walk over millions of steps (bench/results/longrun.txt). */\n"
+            "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) { rc = $P_OK; break; }\n");
+  }
+  tmpl(e, "    /* otherwise progress is a new smallest increment: those of a converging sweep\n"
+          "     * need not fall every time (X_s has complex eigenvalues), so a rise alone is\n"
+          "     * no failure. $P_STALL sweeps without one are a stall: converged if it is at\n"
+          "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
+          "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
+          "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n");
+}
+
+// The fixed-point iteration of the step: gamma swept until the increment
+// reaches round-off (or NAME_itol's threshold) or stalls, leaving gam[] and
+// sw[] at the last sweep and rc set (emit_step.c, "iterate").
+void emit_fixed_point(Emitter *e) {
+  int poly = e->st->kern[K_FACTOR].nout > 0;
+  if (poly) {
+    tmpl(e, e->fused ? "  $W fa[$<factor> + 1];\n" : "  $W fa[$<factor> + 1], lam[$P_S * $P_NU];\n");
+    tmpl(e, e->fused ? "  int j;\n" : "  int j;\n  for (i = 0; i < $P_S * $P_NU; i++) lam[i] = 0;\n");
+    tmpl(e, ""
+            "  /* the multiplier matrix at the predicted stages, factored once for all sweeps\n"
+            "   * (again below when the iteration slows down) */\n");
+    emit_factor(e, "  ");
+  }
+  if (e->fused) emit_fused_locals(e);
+  tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
+  if (poly) {
+    tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"
+            "     * small; where the increments fall by less than 8x it is refreshed at the\n"
+            "     * current gamma, which keeps the iteration converging up to the h of the\n"
+            "     * constant family (pendulum, s = 3: 2.4 instead of 0.84) */\n"
+            "    if (it > 2 && inc > inc_old / 8) {\n");
+    for (int i = 0; e->fused && i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
+    emit_factor(e, "      ");
+    tmpl(e, "    }\n");
+  }
+  if (e->fused) emit_fused_checks(e);
+  else emit_sweep_checks(e);
+  emit_convergence(e);
+  if (e->fused) { /* the rest of the step reads the arrays */
+    for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "  gam[%d] = gm%d;\n", i, i);
+    for (int i = 0; i < kernel_size(&e->st->kern[K_SWEEP]); i++) out(e, "  sw[%d] = sw%d;\n", i, i);
+  }
+}
