@@ -307,7 +307,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "with the maxima of |H-H0|, |g_i| and |hc_i| over every step, the failed\n"
     "steps retried smaller and the smallest and largest |h| taken.\n"
     "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"
-    "included) or an output error, 2 a failed step or projection.\n", out);
+    "included) or an output error, 2 a failed step or projection, or an\n"
+    "event that is not a number.\n", out);
   free(prm);
   if (fflush(out) != 0 || ferror(out)) {
     hbvmrt_error(md, "cannot write the help text");

@@ -96,12 +96,13 @@ typedef struct {
 } hbvmrt_events;
 
 /* Set up for --events / --stop-at (nothing when neither is given) at the
- * initial state x: 0, or -1 after reporting. */
+ * initial state x: 0, or -1 after reporting (an event not a number at x). */
 int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_opts *o, const void *prm,
                        const void *x);
 /* After a step h from x0 to x: the events inside it written in time order;
  * returns 1 when the --stop-at event occurred (x is then the state at it),
- * -1 once writing failed, else 0. */
+ * 2 after reporting an event that is not a number at x (the run fails
+ * there), -1 once writing failed, else 0. */
 int hbvmrt_events_step(hbvmrt_events *ev, const void *x0, void *x, double h);
 /* Close the events CSV: 0, or -1 after reporting a write error. */
 int hbvmrt_events_close(hbvmrt_events *ev);

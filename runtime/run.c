@@ -19,7 +19,7 @@
  *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
- * a failed step), 2 a failed step. */
+ * a failed step), 2 a failed step or an event that is not a number. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
@@ -52,6 +52,7 @@ typedef struct {
   long grid_k;                /* --dt: the next row is at t = grid_k DT */
   hbvmrt_events ev;           /* --events, --stop-at */
   int stopped;                /* the --stop-at event ended the run */
+  int event_nan;              /* ... or an event that is not a number, reported */
 } Run;
 
 /* The progress line: drawn only on a terminal, after a second, at most ten
@@ -385,8 +386,11 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
     r->h_min = fabs(h);
   if (fabs(h) > r->h_max)
     r->h_max = fabs(h);
-  if (r->ev.md && hbvmrt_events_step(&r->ev, r->x0, r->x, h) == 1)
-    r->stopped = 1;
+  if (r->ev.md) {
+    int found = hbvmrt_events_step(&r->ev, r->x0, r->x, h);
+    r->event_nan = found == 2;
+    r->stopped = found == 1 || found == 2;
+  }
   observe(r);
   if (r->o->dt > 0)
     grid_rows(r);
@@ -547,7 +551,7 @@ static int simulate(Run *r)
   if (r->ev.md && hbvmrt_events_close(&r->ev) != 0)
     out_failed = 1;
   summary(r, seconds);
-  return out_failed ? 1 : r->fail_code != 0 ? 2 : 0;
+  return out_failed ? 1 : r->fail_code != 0 || r->event_nan ? 2 : 0;
 }
 
 /* The standalone driver: see hbvmrt.h and the comment at the top. */
