@@ -427,7 +427,7 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
 /* The checks that need every option: -T against -N, and N from the span. */
 static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
 {
-  double n, T;
+  double T;
 
   if (seen->have_T && seen->have_N) {
     hbvmrt_error(md, "-T and -N cannot be used together");
@@ -442,16 +442,12 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
   T = seen->have_T ? seen->T : HBVMRT_DEFAULT_T;
   o->T = T;
   o->to_T = 1;
-  /* the 1e-9 keeps T/h = 1000.0000000000001 from becoming 1001 steps; a
-   * span T > 0 shorter than |h| is still one step, as ceil(T/|h|) says */
-  n = ceil(T / fabs(o->h) - 1e-9);
-  if (n < 1)
-    n = T > 0 ? 1 : 0;
-  if (n >= (double)LONG_MAX) {
-    hbvmrt_error(md, "too many steps: T/|h| = %g", n);
+  /* a span T > 0 shorter than |h| is still one step (span.c) */
+  o->nsteps = hbvmrt_span_steps(T, o->h);
+  if (o->nsteps < 0) {
+    hbvmrt_error(md, "too many steps: T/|h| = %g (at most 2^53)", T / fabs(o->h));
     return -1;
   }
-  o->nsteps = (long)n;
   return 0;
 }
 

@@ -465,6 +465,8 @@ static void steps_scalar(Traj *tr, long from, double fail_h, int fail_code)
   }
   if (code != 0)
     tr->r[0] = code;
+  else
+    hbvmrt_span_land(md, &e->o, x);
 }
 
 /* Trajectories [first, first + n) one after another. */
@@ -549,6 +551,7 @@ static void run_batch(const Ens *e, Work *w, long first, long n)
     if (done[l])
       continue;  /* finished on the scalar path */
     e->bt->get(w->b, l, w->x);
+    hbvmrt_span_land(md, &e->o, w->x);
     finish(e, result(e, first + l), w->x, prm);
   }
 }

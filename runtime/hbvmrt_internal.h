@@ -121,6 +121,12 @@ int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0,
 double hbvmrt_state_time(const hbvmrt_model *md, const void *x);
 /* The end of the span: T in the direction of h. */
 double hbvmrt_span_end(const hbvmrt_opts *o);
+/* The number of fixed steps of |h| over the span T >= 0 (0 for T = 0), or
+ * -1 when there are too many to count (2^53 or more). */
+long hbvmrt_span_steps(double T, double h);
+/* The state x of a run of -T that ended within round-off of the span's end:
+ * its t set to that end exactly. */
+void hbvmrt_span_land(const hbvmrt_model *md, const hbvmrt_opts *o, void *x);
 /* Step n of N of a fixed-step run from x: h, the last shortened to end on T. */
 double hbvmrt_fixed_step(const hbvmrt_model *md, const hbvmrt_opts *o, long n, const void *x);
 /* One adaptive step toward t_end from x, of at most *h (the last shortened

@@ -461,6 +461,7 @@ static void loop_adaptive(Run *r, Progress *pg)
     n++;
     taken(r, &st, st.h);
     if (r->stopped || at_end) {   /* at the event, or on T */
+      hbvmrt_span_land(r->md, r->o, r->x);
       step_row(r);
       return;
     }
@@ -494,6 +495,8 @@ static void loop(Run *r, Progress *pg)
       step_row(r);
       return;
     }
+    if (n == N)
+      hbvmrt_span_land(r->md, r->o, r->x);
     if ((n % K == 0 || n == N) && step_row(r) != 0)
       return;
     if (pg->on && n >= pg->next)

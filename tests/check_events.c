@@ -336,6 +336,24 @@ START_TEST(event_not_a_number)
 }
 END_TEST
 
+/* A run of -T ends on T exactly, whatever the rounding of its steps left in
+ * t: the last step (shortened) or its halves (-h 4.1 fails and is halved)
+ * ended 1 ulp off (7.6999999999999993, 13.100000000000001), so did --tol. */
+START_TEST(span_end_exact)
+{
+  static const struct {
+    const char *args;
+    double T;
+  } runs[] = {{"-h 0.7 -T 7.7", 7.7}, {"-h 2.1 -T 7.7", 7.7}, {"-h 4.1 -T 13.1", 13.1}, {"-h 3.3 -T 20.3", 20.3},
+              {"-h -2.1 -T 7.7", -7.7}};
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, runs[_i].args, ev, &nev, rows, 9, &nrows, MAXROWS), 0);
+  ck_assert_msg(rows[(nrows - 1) * 9] == runs[_i].T, "%s ended at t = %.17g", runs[_i].args, rows[(nrows - 1) * 9]);
+}
+END_TEST
+
 /* The options are checked before the run: an unknown event, a grid step
  * that is not positive, events asked of a model without any. */
 START_TEST(bad_options)
@@ -366,6 +384,7 @@ Suite *events_suite(void) {
   tcase_add_test(tc, zero_at_step_end);
   tcase_add_loop_test(tc, stop_at_step_end, 0, 4);
   tcase_add_test(tc, event_not_a_number);
+  tcase_add_loop_test(tc, span_end_exact, 0, 5);
   tcase_add_loop_test(tc, dt_grid, 0, sizeof dt_runs / sizeof dt_runs[0]);
   suite_add_tcase(s, tc);
   return s;

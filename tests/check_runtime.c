@@ -14,6 +14,7 @@
 #include <check.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +23,7 @@
 #include <unistd.h>
 
 #include "hbvmrt.h"
+#include "hbvmrt_internal.h"       /* hbvmrt_span_steps */
 
 #define HALVINGS 8              /* HBVMRT_HALVINGS of runtime/hbvmrt_internal.h */
 
@@ -778,6 +780,41 @@ START_TEST(step_retried)
 }
 END_TEST
 
+/* The number of steps of a span, hbvmrt_span_steps(T, h): the least N with
+ * N |h| >= T up to a sliver s = 1e-9 |h| + 8 eps T (round-off of T and N h),
+ * so that the last step, T - (N-1) |h|, is neither 0 nor a sliver (s < last
+ * <= |h| + s), also past 2^24 steps, where ceil(T/|h| - 1e-9) counted one
+ * step too many (-h 0.01 -T 262144.03: 26214404, the last step 0 after
+ * 26214403). */
+START_TEST(span_steps)
+{
+  static const struct {
+    double T, h;
+    long n;
+  } known[] = {{262144.03, 0.01, 26214403}, {1, 0.3, 4}, {1, 0.1, 10}, {10, 0.01, 1000}, {100, 0.3, 334},
+               {0, 0.1, 0}, {0.05, 0.1, 1}, {1, -0.1, 10}, {1e-300, 1, 1}, {7.7, 2.1, 4}};
+  unsigned long seed = 12345;
+  int i;
+
+  for (i = 0; i < (int)(sizeof known / sizeof known[0]); i++)
+    ck_assert_msg(hbvmrt_span_steps(known[i].T, known[i].h) == known[i].n, "T=%.17g h=%g: %ld steps, not %ld",
+                  known[i].T, known[i].h, hbvmrt_span_steps(known[i].T, known[i].h), known[i].n);
+  ck_assert_int_eq(hbvmrt_span_steps(1e300, 1e-300), -1);       /* too many to count */
+  for (i = 0; i < 200000; i++) {           /* T = k h + a rest of decimals, up to 2^40 steps */
+    double h, T, last, sliver;
+    long n;
+    seed = seed * 6364136223846793005UL + 1442695040888963407UL;
+    h = (double)(1 + (seed >> 40) % 999) / 1000.0;
+    T = ldexp((double)((seed >> 20) % 1000000) / 1e6 + 1, (int)(seed % 40)) * h + (double)((seed >> 8) % 100) / 100.0;
+    n = hbvmrt_span_steps(T, h);
+    last = fma(-(double)(n - 1), h, T);
+    sliver = 1e-9 * h + 8 * DBL_EPSILON * T;
+    ck_assert_msg(n >= 1 && last > sliver && last <= h + sliver, "T=%.17g h=%.17g: %ld steps, the last %g", T, h, n,
+                  last);
+  }
+}
+END_TEST
+
 /* -T is hit exactly: the last step is shortened (0.3, 0.3, 0.3, 0.1) */
 START_TEST(span_hit_exactly)
 {
@@ -1056,6 +1093,7 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, step_failure_every);
   tcase_add_test(run_, step_retried);
   tcase_add_test(run_, span_hit_exactly);
+  tcase_add_test(run_, span_steps);
   tcase_add_test(run_, no_progress_off_terminal);
   tcase_add_test(run_, progress_on_terminal);
   tcase_set_timeout(run_, 30);
