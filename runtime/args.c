@@ -10,6 +10,7 @@
  * so the loop never meets a bad one: the first problem is reported as one line
  * `NAME: error: ...` on stderr and the driver exits with status 1. */
 #include <ctype.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -271,11 +272,12 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --tol TOL          adaptive steps: each step's error estimate within\n"
     "                     0.01 TOL |h| (1 + max|q|), so that the error at T is\n"
     "                     about TOL T (1 + max|q|); -h is the first step, -T is\n"
-    "                     hit exactly; --every K counts the steps taken\n"
+    "                     hit exactly; --every K counts the steps taken;\n"
+    "                     TOL >= eps^2 (4.9e-32 in double, 1.4e-14 in float)\n"
     "  --dt DT            CSV rows at t = 0, DT, 2 DT, .. (DT > 0) whatever the\n"
     "                     steps are, each a step of the method from the start\n"
     "                     of the step containing it (as accurate as the steps),\n"
-    "                     instead of a row per step (--every)\n"
+    "                     instead of a row per step (--every); at most 1e9 rows\n"
     "  --events FILE      write each event of the model when it occurs, as\n"
     "                     rows event,t,x..,p_x.. ('-' for stdout), located to\n"
     "                     1e-12 relative in t\n"
@@ -286,7 +288,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
     "                     (coordinates, p_ and a coordinate, params) and a row\n"
     "                     per trajectory; --csv gets a summary row for each\n"
-    "  --sweep NAME=A:B:N N trajectories, NAME (a column as above) from A to B\n"
+    "  --sweep NAME=A:B:N N trajectories, NAME (a column as above) from A to B;\n"
+    "                     at most 1e7 trajectories, with --ensemble too\n"
     "  --threads N        threads for --ensemble/--sweep (OpenMP runtime only)\n"
     "  --help             this text\n", out);
   if (md->nparams > 0) {
@@ -350,6 +353,16 @@ static int parse_stop_at(const hbvmrt_model *md, const char *val, hbvmrt_opts *o
   return -1;
 }
 
+/* The smallest --tol: eps^2 of the solver's real type (4.9e-32 in double,
+ * 1.4e-14 in float). Far below what its round-off lets a step meet, and
+ * where the controller's tol |h| stays a normal number: a subnormal tol
+ * (1e-310) made NAME_step_adaptive loop forever. */
+static double min_tol(const hbvmrt_model *md)
+{
+  double eps = md->eps > 0 ? md->eps : DBL_EPSILON;
+  return eps * eps;
+}
+
 /* Store one option's value in o (or seen); -1 after reporting an error. */
 static int apply(const hbvmrt_model *md, const Option *op, const char *val,
                  hbvmrt_opts *o, Seen *seen)
@@ -397,6 +410,11 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
       return -1;
     if (!(o->tol > 0)) {
       hbvmrt_error(md, "--tol must be > 0 (got %s)", val);
+      return -1;
+    }
+    if (o->tol < min_tol(md)) {
+      hbvmrt_error(md, "--tol must be >= %.2g, the square of the solver's precision: no step meets a smaller one "
+                   "(got %s)", min_tol(md), val);
       return -1;
     }
     if (!md->step_adaptive) {
@@ -451,6 +469,19 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
   return 0;
 }
 
+/* --dt against the span (-T, or N steps of h): at most HBVMRT_MAX_ROWS rows
+ * (--dt 1e-300 ran forever); -1 after reporting. */
+static int check_grid(const hbvmrt_model *md, const hbvmrt_opts *o)
+{
+  double span = o->to_T ? o->T : (double)o->nsteps * fabs(o->h);
+
+  if (!(o->dt > 0) || span / o->dt <= HBVMRT_MAX_ROWS)
+    return 0;
+  hbvmrt_error(md, "--dt %g gives %.3g rows over the span %g: at most %.0e", o->dt, span / o->dt, span,
+               HBVMRT_MAX_ROWS);
+  return -1;
+}
+
 /* Parse argv into *o (which hbvmrt_opts_free releases in every case).
  * Returns HBVMRT_ARGS_RUN, HBVMRT_ARGS_DONE after --help, or
  * HBVMRT_ARGS_ERROR after printing the one-line error. */
@@ -495,7 +526,7 @@ int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
     if (apply(md, op, val, o, &seen) != 0)
       return HBVMRT_ARGS_ERROR;
   }
-  return finish(md, o, &seen) == 0 ? HBVMRT_ARGS_RUN : HBVMRT_ARGS_ERROR;
+  return finish(md, o, &seen) == 0 && check_grid(md, o) == 0 ? HBVMRT_ARGS_RUN : HBVMRT_ARGS_ERROR;
 }
 
 void hbvmrt_opts_free(hbvmrt_opts *o)

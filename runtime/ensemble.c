@@ -199,8 +199,12 @@ static int read_sweep(Ens *e)
   long i;
 
   if (!eq || sscanf(eq + 1, "%lf:%lf:%lf%c", &a, &b, &n, &tail) != 3 || !isfinite(a) || !isfinite(b) ||
-      n != floor(n) || n < 1 || n > 1e9) {
+      n != floor(n) || n < 1) {
     hbvmrt_error(e->md, "invalid value '%s' for --sweep (expected NAME=A:B:N, N >= 1 whole)", e->sweep);
+    return -1;
+  }
+  if (n > (double)HBVMRT_MAX_TRAJ) {
+    hbvmrt_error(e->md, "--sweep: %.0f trajectories, at most %ld", n, HBVMRT_MAX_TRAJ);
     return -1;
   }
   if (add_columns(e, 1) || column(e, 0, e->sweep, (size_t)(eq - e->sweep)))

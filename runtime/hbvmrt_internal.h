@@ -28,6 +28,10 @@
 #define HBVMRT_HALVINGS 8
 /* The most lanes of a batch (hbvmgen --batch W: W <= 64). */
 #define HBVMRT_MAX_LANES 64
+/* The most CSV rows --dt may ask for (span / DT), and the most trajectories
+ * of --sweep or --ensemble (their results are kept until all are done). */
+#define HBVMRT_MAX_ROWS 1e9
+#define HBVMRT_MAX_TRAJ 10000000L
 
 /* The driver options once parsed and checked. */
 typedef struct {

@@ -188,6 +188,13 @@ START_TEST(test_errors)
     snprintf(cmd, sizeof cmd, "%s/pe %s -N 1 2>/dev/null", dir, bad[i]);
     ck_assert_msg(sh(cmd) == 1, "%s: expected exit status 1", bad[i]);
   }
+  /* --sweep N allocated 8 N bytes at once, N up to 1e9: now at most 1e7 */
+  snprintf(cmd, sizeof cmd, "%s/pe --sweep x=0:1:10000001 -N 1 2>%s/err.txt", dir, dir);
+  ck_assert_int_eq(sh(cmd), 1);
+  snprintf(cmd, sizeof cmd, "%s/err.txt", dir);
+  char *err = read_text(cmd);
+  ck_assert_msg(err && strstr(err, "pe: error: --sweep: 10000001 trajectories, at most 10000000"), "%s", err);
+  free(err);
 }
 END_TEST
 

@@ -370,6 +370,14 @@ START_TEST(bad_options)
   ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --stop-at cross:0", ev, &nev, rows, 9, &nrows, 8), 1);
   ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --dt 0", ev, &nev, rows, 9, &nrows, 8), 1);
   ck_assert_int_eq(run(&none, "-N 3", ev, &nev, rows, 9, &nrows, 8), 1); /* run() passes --events */
+  /* what ran forever: a subnormal --tol, a grid of 1e300 rows */
+  static const char *const endless[] = {"-T 1 --tol 1e-310", "-T 1 --tol 1e-320", "-T 1 --tol 1e-33",
+                                        "-T 1 --dt 1e-300", "-N 10 --dt 1e-12", "-T 1e10 --dt 1"};
+  for (size_t i = 0; i < sizeof endless / sizeof endless[0]; i++) {
+    ck_assert_msg(run(&pendulum_events_k4s4_model, endless[i], ev, &nev, rows, 9, &nrows, 8) == 1, "%s", endless[i]);
+    ck_assert_msg(strstr(run_err, strstr(endless[i], "--tol") ? "--tol must be >= 4.9e-32" : "rows over the span"),
+                  "%s: %s", endless[i], run_err);
+  }
 }
 END_TEST
 
