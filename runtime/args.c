@@ -9,6 +9,8 @@
  * may also be attached: `-h0.01`, `--every=10`.  Every value is checked here,
  * so the loop never meets a bad one: the first problem is reported as one line
  * `NAME: error: ...` on stderr and the driver exits with status 1. */
+#define _XOPEN_SOURCE 700   /* realpath, stat */
+
 #include <ctype.h>
 #include <float.h>
 #include <limits.h>
@@ -17,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "hbvmrt_internal.h"
 
@@ -279,8 +282,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "                     of the step containing it (as accurate as the steps),\n"
     "                     instead of a row per step (--every); at most 1e9 rows\n"
     "  --events FILE      write each event of the model when it occurs, as\n"
-    "                     rows event,t,x..,p_x.. ('-' for stdout), located to\n"
-    "                     1e-12 relative in t\n"
+    "                     rows event,t,x..,p_x.. ('-' for stdout; not the\n"
+    "                     --csv file), located to 1e-12 relative in t\n"
     "  --stop-at NAME[:COUNT]  end the run at the COUNT-th (default 1st)\n"
     "                     occurrence of the event NAME, its state the last\n"
     "                     state of the run\n"
@@ -469,6 +472,60 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
   return 0;
 }
 
+/* Path resolved as far as it exists: its directory's real path, then its
+ * last component ("F" in that directory); NULL when the directory has none. */
+static char *resolved(const char *path)
+{
+  const char *slash = strrchr(path, '/');
+  char *dir = slash ? malloc((size_t)(slash - path) + 2) : NULL, *real, *out = NULL;
+
+  if (slash && !dir)
+    return NULL;
+  if (dir) {
+    memcpy(dir, path, (size_t)(slash - path) + 1);
+    dir[slash - path + 1] = '\0';
+  }
+  real = realpath(dir ? dir : ".", NULL);
+  if (real && (out = malloc(strlen(real) + strlen(path) + 2)))
+    sprintf(out, "%s/%s", real, slash ? slash + 1 : path);
+  free(dir);
+  free(real);
+  return out;
+}
+
+/* Whether two output paths are one file that both would write: the same
+ * text, both stdout ("-"), the same regular file when they exist (device
+ * and inode: F, ./F, a link), the same directory and name when they do
+ * not. Two devices (/dev/null twice) are not refused. */
+static int same_output(const char *a, const char *b)
+{
+  struct stat sa, sb;
+  char *ra, *rb;
+  int same;
+
+  if (!strcmp(a, b))
+    return 1;
+  if (!strcmp(a, "-") || !strcmp(b, "-"))
+    return 0;
+  if (stat(a, &sa) == 0 && stat(b, &sb) == 0)
+    return S_ISREG(sa.st_mode) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  ra = resolved(a);
+  rb = resolved(b);
+  same = ra && rb && !strcmp(ra, rb);
+  free(ra);
+  free(rb);
+  return same;
+}
+
+/* --csv and --events: not the same file (they overwrote each other). */
+static int check_outputs(const hbvmrt_model *md, const hbvmrt_opts *o)
+{
+  if (!o->csv || !o->events || !same_output(o->csv, o->events))
+    return 0;
+  hbvmrt_error(md, "--csv and --events name the same file ('%s', '%s'): give each its own", o->csv, o->events);
+  return -1;
+}
+
 /* --dt against the span (-T, or N steps of h): at most HBVMRT_MAX_ROWS rows
  * (--dt 1e-300 ran forever); -1 after reporting. */
 static int check_grid(const hbvmrt_model *md, const hbvmrt_opts *o)
@@ -526,7 +583,8 @@ int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
     if (apply(md, op, val, o, &seen) != 0)
       return HBVMRT_ARGS_ERROR;
   }
-  return finish(md, o, &seen) == 0 && check_grid(md, o) == 0 ? HBVMRT_ARGS_RUN : HBVMRT_ARGS_ERROR;
+  return finish(md, o, &seen) == 0 && check_grid(md, o) == 0 && check_outputs(md, o) == 0 ? HBVMRT_ARGS_RUN
+                                                                                          : HBVMRT_ARGS_ERROR;
 }
 
 void hbvmrt_opts_free(hbvmrt_opts *o)

@@ -764,7 +764,7 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
   }
   status = failed ? 2 : 0;
   if (e.rank == 0 && e.o.csv) {
-    FILE *f = strcmp(e.o.csv, "-") ? fopen(e.o.csv, "w") : stdout;
+    FILE *f = hbvmrt_out_open(e.o.csv);
     if (!f || write_results(&e, f) != 0 || (f != stdout ? fclose(f) : fflush(f)) != 0) {
       hbvmrt_error(md, "cannot write '%s': %s", e.o.csv, strerror(errno ? errno : EIO));
       status = 1;

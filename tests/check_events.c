@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <fcntl.h>
 #include <float.h>
 
 #include "errest.h"
@@ -354,6 +355,34 @@ START_TEST(span_end_exact)
 }
 END_TEST
 
+/* --csv and --events naming one file (in other words too: ./F, a//F) or
+ * both stdout are refused: the two CSVs overwrote each other. */
+START_TEST(same_output_twice)
+{
+  static Row ev[8];
+  static double rows[8 * 9];
+  char path[] = "/tmp/hbvm-same-XXXXXX", args[256];
+  const char *base = path + 5;
+  int nev, nrows, fd = mkstemp(path);
+  ck_assert(fd >= 0);
+  close(fd);
+  unlink(path); /* first as a file that does not exist yet */
+  for (int exists = 0; exists < 2; exists++) {
+    const char *fmt[] = {"-N 3 --csv %s --events %s", "-N 3 --csv %s --events /tmp/./%s", "-N 3 --events %s --csv /tmp//%s"};
+    for (int k = 0; k < 3; k++) {
+      snprintf(args, sizeof args, fmt[k], path, k ? base : path);
+      ck_assert_msg(run(&pendulum_events_k4s4_model, args, ev, &nev, rows, 9, &nrows, 8) == 1, "%s: not refused", args);
+      ck_assert_msg(strstr(run_err, "--csv and --events name the same file"), "%s: %s", args, run_err);
+    }
+    fd = open(path, O_WRONLY | O_CREAT, 0600);
+    ck_assert(fd >= 0);
+    close(fd);
+  }
+  unlink(path);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --csv - --events -", ev, &nev, rows, 9, &nrows, 8), 1);
+}
+END_TEST
+
 /* The options are checked before the run: an unknown event, a grid step
  * that is not positive, events asked of a model without any. */
 START_TEST(bad_options)
@@ -393,6 +422,7 @@ Suite *events_suite(void) {
   tcase_add_loop_test(tc, stop_at_step_end, 0, 4);
   tcase_add_test(tc, event_not_a_number);
   tcase_add_loop_test(tc, span_end_exact, 0, 5);
+  tcase_add_test(tc, same_output_twice);
   tcase_add_loop_test(tc, dt_grid, 0, sizeof dt_runs / sizeof dt_runs[0]);
   suite_add_tcase(s, tc);
   return s;

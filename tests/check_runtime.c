@@ -19,6 +19,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -940,6 +942,44 @@ START_TEST(disk_full)
 }
 END_TEST
 
+/* Past the file size limit (ulimit -f) a write fails as on a full disk:
+ * reported, exit status 1, where the driver died of SIGXFSZ (status 153 in
+ * a shell), without a word. Run in a child, whose limit is 8 KiB. */
+START_TEST(file_size_limit)
+{
+  static const char *const outs[] = {"--csv @", "--csv - --quiet"};
+  char cmd[128];
+  Result r;
+  pid_t pid;
+  int status, fd;
+
+  snprintf(cmd, sizeof cmd, "-h 0.01 -N 10000 %s", outs[_i]);
+  fflush(stdout);
+  fflush(stderr);
+  pid = fork();
+  ck_assert_int_ge(pid, 0);
+  if (pid == 0) {
+    struct rlimit lim = {8192, 8192};
+    setrlimit(RLIMIT_FSIZE, &lim);
+    r = run(&osc, cmd);
+    fd = open("/tmp/check_runtime_fsize", O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    if (fd >= 0) {
+      ssize_t n = write(fd, r.err, strlen(r.err) < 4000 ? strlen(r.err) : 4000);
+      (void)n;
+      close(fd);
+    }
+    _exit(r.status);
+  }
+  ck_assert_int_eq(waitpid(pid, &status, 0), pid);
+  ck_assert_msg(WIFEXITED(status), "the driver died of signal %d", WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  ck_assert_int_eq(WEXITSTATUS(status), 1);
+  r.err = slurp("/tmp/check_runtime_fsize");
+  unlink("/tmp/check_runtime_fsize");
+  ck_assert_msg(strstr(r.err, "osc: error: cannot write '") && strstr(r.err, strerror(EFBIG)), "%s", r.err);
+  free(r.err);
+}
+END_TEST
+
 /* Initial values off the constraints: refused (status 1, the sizes named)
  * by a driver that can project, run as they are by an older one, projected
  * with --project (reported, g and hc zero at t = 0); a projection that fails
@@ -1074,6 +1114,7 @@ Suite *runtime_suite(void)
   tcase_add_test(csv, csv_to_stdout);
   tcase_add_test(csv, no_csv);
   tcase_add_test(csv, disk_full);
+  tcase_add_loop_test(csv, file_size_limit, 0, 2);
   suite_add_tcase(s, csv);
 
   tcase_add_loop_test(args, bad_args, 0,
