@@ -155,6 +155,24 @@ int hbvmrt_advance(const hbvmrt_model *md, void *x, const void *prm, double h, i
 int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int code, int depth,
                  const hbvmrt_steps *cb, int *stopped);
 
+/* table.c: a CSV table of numbers (--ensemble FILE) */
+
+typedef struct {
+  char *text;          /* the file, which the names point into */
+  int ncol;
+  char **names;        /* the ncol column names of the header */
+  int *name_col;       /* ... and the column (byte) where each starts */
+  long header_line;
+  long nrow;
+  double *val;         /* nrow x ncol, row by row */
+} hbvmrt_table;
+
+/* Read path into *tb (which hbvmrt_table_free releases in every case): 0,
+ * or -1 after an error naming the file, line and column; at most max_rows
+ * rows, and at least one. */
+int hbvmrt_table_read(const hbvmrt_model *md, const char *path, long max_rows, hbvmrt_table *tb);
+void hbvmrt_table_free(hbvmrt_table *tb);
+
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 
 int hbvmrt_ensemble_wanted(int argc, char **argv);
