@@ -163,27 +163,29 @@ static int own_options(Ens *e, int argc, char **argv, char **rest, int *nrest)
   return 0;
 }
 
-/* The column called name: a coordinate (x, x[3]), a momentum (p_x) or a
- * param; -1 after an error naming it, after where (a place in the file). */
+/* The column called name: a coordinate (x, x[3]), a param, or a momentum
+ * (p_ and a coordinate), looked up by the exact name first, so that a param
+ * p_x of a driver from before hbvmgen refused such names is that param, not
+ * the momentum of x; -1 after an error naming it, after where (a place in
+ * the file). */
 static int column(Ens *e, int c, const char *name, size_t len, const char *where)
 {
   const hbvmrt_model *md = e->md;
   int i;
 
-  for (i = 0; i < md->m; i++) {
-    const char *n = md->names[i];
-    if (strlen(n) == len && !strncmp(n, name, len)) {
+  for (i = 0; i < md->m; i++)
+    if (strlen(md->names[i]) == len && !strncmp(md->names[i], name, len)) {
       e->kind[c] = COL_Q, e->index[c] = i;
       return 0;
     }
-    if (len > 2 && !strncmp(name, "p_", 2) && strlen(n) == len - 2 && !strncmp(n, name + 2, len - 2)) {
-      e->kind[c] = COL_P, e->index[c] = i;
-      return 0;
-    }
-  }
   for (i = 0; i < md->nparams; i++)
     if (strlen(md->params[i].name) == len && !strncmp(md->params[i].name, name, len)) {
       e->kind[c] = COL_PARAM, e->index[c] = i;
+      return 0;
+    }
+  for (i = 0; len > 2 && !strncmp(name, "p_", 2) && i < md->m; i++)
+    if (strlen(md->names[i]) == len - 2 && !strncmp(md->names[i], name + 2, len - 2)) {
+      e->kind[c] = COL_P, e->index[c] = i;
       return 0;
     }
   hbvmrt_error(md, "%sunknown column '%.*s' (a coordinate, p_ and a coordinate, or a parameter)", where, (int)len,

@@ -1013,6 +1013,30 @@ START_TEST(inconsistent_start)
 }
 END_TEST
 
+/* An ensemble's column is looked up by its exact name first: a param p_x
+ * (which a driver from before hbvmgen refused the name may have) is that
+ * param, where --sweep p_x set the momentum of x (so the start, off the
+ * constraint q.p = 0, was refused: status -1). Here it is ring's k = 2, the
+ * rate of the rotation: x = cos 0.2 after a step of 0.1. */
+static const hbvmrt_param px_param[] = {{"p_x", offsetof(RingParams, k)}};
+static const char *const ring_names[] = {"x", "y"};
+
+START_TEST(column_exact_name)
+{
+  hbvmrt_model md = ring_projecting();
+  Result r;
+
+  md.names = ring_names;
+  md.params = px_param;
+  r = run(&md, "--sweep p_x=2:2:1 -h 0.1 -N 1 --csv @");
+  ck_assert_msg(r.status == 0, "status %d: %s", r.status, r.err);
+  ck_assert_int_eq(strncmp(r.csv, "traj,status,steps,t,x,y,p_x,p_y,", 32), 0);
+  ck_assert_double_eq(cell(r.csv, 0, 1), 0);
+  ck_assert_double_eq_tol(cell(r.csv, 0, 4), cos(0.2), 1e-15);
+  done(&r);
+}
+END_TEST
+
 START_TEST(help)
 {
   Result r = run(&ring, "--help");
@@ -1123,6 +1147,7 @@ Suite *runtime_suite(void)
   tcase_add_test(args, param_last_wins);
   tcase_add_test(args, q0_alone);
   tcase_add_test(args, help);
+  tcase_add_test(args, column_exact_name);
   suite_add_tcase(s, args);
 
   tcase_add_test(run_, summary_nu0);
