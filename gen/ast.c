@@ -771,6 +771,53 @@ static void warn_unused(Ctx *cx) {
                unused[i]->name);
 }
 
+// Refuse a scalar coordinate or a param whose name is also another column of
+// the standalone driver's outputs, so that every column name says one thing:
+// its CSV (t, the coordinates, p_ and a coordinate, lambda_a, H, g_a, hc_a for
+// a = 1..nu), an ensemble's input (coordinates, p_..., params) and summary
+// (traj, status, steps, ..., iters_max), the events CSV (event, a reserved
+// word, and t). A param p_x beside a coordinate x could not be swept (--sweep
+// p_x set the momentum), and coordinates x, p_x gave the header
+// t,x,p_x,p_x,p_p_x,H. Array elements (x[3], p_x[3]) hold brackets and cannot
+// clash; events and constraints give no column a name of theirs. Reported in
+// file order.
+static void check_column_names(Ctx *cx, int nu) {
+  static const char summary[] = "in an ensemble's summary";
+  static const char *const fixed[][2] = {{"t", "the time"},   {"H", "the energy"},     {"traj", summary},
+                                         {"status", summary}, {"steps", summary},      {"max_dH", summary},
+                                         {"max_g", summary},  {"max_hc", summary},     {"iters_mean", summary},
+                                         {"iters_max", summary}};
+  static const char *const numbered[][2] = {
+      {"lambda_", "the multiplier of constraint"}, {"g_", "constraint"}, {"hc_", "the hidden constraint"}};
+  Sym **named = arena_alloc((size_t)(cx->nsyms + 1) * sizeof *named);
+  int n = 0;
+  for (int b = 0; b < cx->nbuckets; b++)
+    for (Sym *s = cx->buckets[b]; s; s = s->next)
+      if (s->kind == SYM_COORD || s->kind == SYM_PARAM) named[n++] = s;
+  qsort(named, (size_t)n, sizeof *named, by_location);
+  for (int i = 0; i < n; i++) {
+    const char *name = named[i]->name;
+    char what[200] = "";
+    for (size_t k = 0; k < sizeof fixed / sizeof fixed[0] && !*what; k++)
+      if (!strcmp(name, fixed[k][0])) snprintf(what, sizeof what, "%s", fixed[k][1]);
+    for (size_t k = 0; k < sizeof numbered / sizeof numbered[0] && !*what; k++) {
+      size_t len = strlen(numbered[k][0]);
+      const char *digits = name + len;
+      if (strncmp(name, numbered[k][0], len) || digits[0] < '1' || digits[0] > '9' || strlen(digits) > 4 ||
+          strspn(digits, "0123456789") != strlen(digits) || atoi(digits) > nu)
+        continue;
+      snprintf(what, sizeof what, "%s %s", numbered[k][1], digits);
+    }
+    const Sym *c = !*what && !strncmp(name, "p_", 2) ? lookup(cx, name + 2) : NULL;
+    if (c && c->kind == SYM_COORD)
+      snprintf(what, sizeof what, "the momentum of the coordinate '%s' of line %d, column %d", c->name, c->loc.line,
+               c->loc.col);
+    if (*what)
+      error_at(named[i]->loc, "'%s' cannot name a %s: it is a column of the driver's output already (%s); rename it",
+               name, named[i]->kind == SYM_PARAM ? "param" : "coordinate", what);
+  }
+}
+
 // Analyse the statements of a model. Returns NULL if any error was reported.
 Model *analyse(const char *file, Stmt *prog) {
   Ctx *cx = xcalloc(1, sizeof *cx);
@@ -816,6 +863,7 @@ Model *analyse(const char *file, Stmt *prog) {
   mod->g = cx->g.v;
   mod->g_loc = arena_alloc((size_t)(mod->nu + 1) * sizeof(Loc));
   for (int a = 0; a < mod->nu; a++) mod->g_loc[a] = (Loc){cx->g_line.v[a], cx->g_col.v[a]};
+  check_column_names(cx, mod->nu);
   if (mod->m > 0 && mod->nu > mod->m && !diag_error_count())
     error_at(mod->g_loc[mod->m], "more constraints than coordinates: constraint %d of %d, with %d coordinate%s (the "
              "constraints cannot be independent)", mod->m + 1, mod->nu, mod->m, mod->m == 1 ? "" : "s");

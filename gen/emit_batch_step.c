@@ -357,12 +357,17 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // shared step hh: accepted when every active lane converged within its
 // tolerance, else retried from the unchanged lanes, smaller (halved after a
 // failure), cold after three tries over the tolerance. Below the smallest
-// step every active lane fails: ENOCONV, or its own failure.
+// step every active lane fails: ENOCONV, or its own failure. A bad h or tol
+// fails every active lane with EBADSTEP; the return value is then, as after
+// any failure, the number of lanes that failed (never the -1, -2 of a try).
 static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
           "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
-          "  if (!(hh != 0 && isfinite(hh))) return $P_batch_within(x, hh, 0, 0, prm, st);\n"
+          "  if (!(hh != 0 && isfinite(hh))) {  /* every active lane fails: say how many, as below */\n"
+          "    $P_batch_within(x, hh, 0, 0, prm, s);\n"
+          "    for (l = 0; l < $P_W; l++) nact += s->code[l] != $P_OK;\n"
+          "    return nact;\n  }\n"
           "  tol *= $P_TOLC;\n"
           "  for (l = 0; l < $P_W; l++)\n    if (!x->idle[l]) {\n      nact++;\n"
           "      if (fabs$f(x->t[l]) > tmax) tmax = fabs$f(x->t[l]);\n"

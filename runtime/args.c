@@ -9,13 +9,17 @@
  * may also be attached: `-h0.01`, `--every=10`.  Every value is checked here,
  * so the loop never meets a bad one: the first problem is reported as one line
  * `NAME: error: ...` on stderr and the driver exits with status 1. */
+#define _XOPEN_SOURCE 700   /* realpath, stat */
+
 #include <ctype.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "hbvmrt_internal.h"
 
@@ -271,14 +275,15 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --tol TOL          adaptive steps: each step's error estimate within\n"
     "                     0.01 TOL |h| (1 + max|q|), so that the error at T is\n"
     "                     about TOL T (1 + max|q|); -h is the first step, -T is\n"
-    "                     hit exactly; --every K counts the steps taken\n"
+    "                     hit exactly; --every K counts the steps taken;\n"
+    "                     TOL >= eps^2 (4.9e-32 in double, 1.4e-14 in float)\n"
     "  --dt DT            CSV rows at t = 0, DT, 2 DT, .. (DT > 0) whatever the\n"
     "                     steps are, each a step of the method from the start\n"
     "                     of the step containing it (as accurate as the steps),\n"
-    "                     instead of a row per step (--every)\n"
+    "                     instead of a row per step (--every); at most 1e9 rows\n"
     "  --events FILE      write each event of the model when it occurs, as\n"
-    "                     rows event,t,x..,p_x.. ('-' for stdout), located to\n"
-    "                     1e-12 relative in t\n"
+    "                     rows event,t,x..,p_x.. ('-' for stdout; not the\n"
+    "                     --csv file), located to 1e-12 relative in t\n"
     "  --stop-at NAME[:COUNT]  end the run at the COUNT-th (default 1st)\n"
     "                     occurrence of the event NAME, its state the last\n"
     "                     state of the run\n"
@@ -286,7 +291,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
     "                     (coordinates, p_ and a coordinate, params) and a row\n"
     "                     per trajectory; --csv gets a summary row for each\n"
-    "  --sweep NAME=A:B:N N trajectories, NAME (a column as above) from A to B\n"
+    "  --sweep NAME=A:B:N N trajectories, NAME (a column as above) from A to B;\n"
+    "                     at most 1e7 trajectories, with --ensemble too\n"
     "  --threads N        threads for --ensemble/--sweep (OpenMP runtime only)\n"
     "  --help             this text\n", out);
   if (md->nparams > 0) {
@@ -307,7 +313,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "with the maxima of |H-H0|, |g_i| and |hc_i| over every step, the failed\n"
     "steps retried smaller and the smallest and largest |h| taken.\n"
     "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"
-    "included) or an output error, 2 a failed step or projection.\n", out);
+    "included) or an output error, 2 a failed step or projection, or an\n"
+    "event that is not a number.\n", out);
   free(prm);
   if (fflush(out) != 0 || ferror(out)) {
     hbvmrt_error(md, "cannot write the help text");
@@ -347,6 +354,16 @@ static int parse_stop_at(const hbvmrt_model *md, const char *val, hbvmrt_opts *o
     fprintf(stderr, " %s", md->event_names[i]);
   fputc('\n', stderr);
   return -1;
+}
+
+/* The smallest --tol: eps^2 of the solver's real type (4.9e-32 in double,
+ * 1.4e-14 in float). Far below what its round-off lets a step meet, and
+ * where the controller's tol |h| stays a normal number: a subnormal tol
+ * (1e-310) made NAME_step_adaptive loop forever. */
+static double min_tol(const hbvmrt_model *md)
+{
+  double eps = md->eps > 0 ? md->eps : DBL_EPSILON;
+  return eps * eps;
 }
 
 /* Store one option's value in o (or seen); -1 after reporting an error. */
@@ -398,6 +415,11 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
       hbvmrt_error(md, "--tol must be > 0 (got %s)", val);
       return -1;
     }
+    if (o->tol < min_tol(md)) {
+      hbvmrt_error(md, "--tol must be >= %.2g, the square of the solver's precision: no step meets a smaller one "
+                   "(got %s)", min_tol(md), val);
+      return -1;
+    }
     if (!md->step_adaptive) {
       hbvmrt_error(md, "--tol needs a driver generated with error control "
                    "(hbvmgen 0.1.0 or later, --main)");
@@ -426,7 +448,7 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
 /* The checks that need every option: -T against -N, and N from the span. */
 static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
 {
-  double n, T;
+  double T;
 
   if (seen->have_T && seen->have_N) {
     hbvmrt_error(md, "-T and -N cannot be used together");
@@ -441,17 +463,80 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
   T = seen->have_T ? seen->T : HBVMRT_DEFAULT_T;
   o->T = T;
   o->to_T = 1;
-  /* the 1e-9 keeps T/h = 1000.0000000000001 from becoming 1001 steps; a
-   * span T > 0 shorter than |h| is still one step, as ceil(T/|h|) says */
-  n = ceil(T / fabs(o->h) - 1e-9);
-  if (n < 1)
-    n = T > 0 ? 1 : 0;
-  if (n >= (double)LONG_MAX) {
-    hbvmrt_error(md, "too many steps: T/|h| = %g", n);
+  /* a span T > 0 shorter than |h| is still one step (span.c) */
+  o->nsteps = hbvmrt_span_steps(T, o->h);
+  if (o->nsteps < 0) {
+    hbvmrt_error(md, "too many steps: T/|h| = %g (at most 2^53)", T / fabs(o->h));
     return -1;
   }
-  o->nsteps = (long)n;
   return 0;
+}
+
+/* Path resolved as far as it exists: its directory's real path, then its
+ * last component ("F" in that directory); NULL when the directory has none. */
+static char *resolved(const char *path)
+{
+  const char *slash = strrchr(path, '/');
+  char *dir = slash ? malloc((size_t)(slash - path) + 2) : NULL, *real, *out = NULL;
+
+  if (slash && !dir)
+    return NULL;
+  if (dir) {
+    memcpy(dir, path, (size_t)(slash - path) + 1);
+    dir[slash - path + 1] = '\0';
+  }
+  real = realpath(dir ? dir : ".", NULL);
+  if (real && (out = malloc(strlen(real) + strlen(path) + 2)))
+    sprintf(out, "%s/%s", real, slash ? slash + 1 : path);
+  free(dir);
+  free(real);
+  return out;
+}
+
+/* Whether two output paths are one file that both would write: the same
+ * text, both stdout ("-"), the same regular file when they exist (device
+ * and inode: F, ./F, a link), the same directory and name when they do
+ * not. Two devices (/dev/null twice) are not refused. */
+static int same_output(const char *a, const char *b)
+{
+  struct stat sa, sb;
+  char *ra, *rb;
+  int same;
+
+  if (!strcmp(a, b))
+    return 1;
+  if (!strcmp(a, "-") || !strcmp(b, "-"))
+    return 0;
+  if (stat(a, &sa) == 0 && stat(b, &sb) == 0)
+    return S_ISREG(sa.st_mode) && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  ra = resolved(a);
+  rb = resolved(b);
+  same = ra && rb && !strcmp(ra, rb);
+  free(ra);
+  free(rb);
+  return same;
+}
+
+/* --csv and --events: not the same file (they overwrote each other). */
+static int check_outputs(const hbvmrt_model *md, const hbvmrt_opts *o)
+{
+  if (!o->csv || !o->events || !same_output(o->csv, o->events))
+    return 0;
+  hbvmrt_error(md, "--csv and --events name the same file ('%s', '%s'): give each its own", o->csv, o->events);
+  return -1;
+}
+
+/* --dt against the span (-T, or N steps of h): at most HBVMRT_MAX_ROWS rows
+ * (--dt 1e-300 ran forever); -1 after reporting. */
+static int check_grid(const hbvmrt_model *md, const hbvmrt_opts *o)
+{
+  double span = o->to_T ? o->T : (double)o->nsteps * fabs(o->h);
+
+  if (!(o->dt > 0) || span / o->dt <= HBVMRT_MAX_ROWS)
+    return 0;
+  hbvmrt_error(md, "--dt %g gives %.3g rows over the span %g: at most %.0e", o->dt, span / o->dt, span,
+               HBVMRT_MAX_ROWS);
+  return -1;
 }
 
 /* Parse argv into *o (which hbvmrt_opts_free releases in every case).
@@ -498,7 +583,8 @@ int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
     if (apply(md, op, val, o, &seen) != 0)
       return HBVMRT_ARGS_ERROR;
   }
-  return finish(md, o, &seen) == 0 ? HBVMRT_ARGS_RUN : HBVMRT_ARGS_ERROR;
+  return finish(md, o, &seen) == 0 && check_grid(md, o) == 0 && check_outputs(md, o) == 0 ? HBVMRT_ARGS_RUN
+                                                                                          : HBVMRT_ARGS_ERROR;
 }
 
 void hbvmrt_opts_free(hbvmrt_opts *o)

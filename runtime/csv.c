@@ -9,7 +9,10 @@
  * reads back to the same doubles.  Errors are
  * not reported here: the functions return -1 once the stream is in error and
  * the caller says what failed. */
+#define _POSIX_C_SOURCE 200809L   /* SIGXFSZ */
+
 #include <errno.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -106,9 +109,14 @@ int hbvmrt_csv_event_row(FILE *f, const hbvmrt_model *md, const char *name, cons
 }
 
 /* An output file of the driver: path, or stdout for "-"; NULL (errno set)
- * when it cannot be opened. */
+ * when it cannot be opened. A write past the file size limit (ulimit -f)
+ * then fails with EFBIG, reported as a full disk is, instead of the
+ * SIGXFSZ that killed the process without a word. */
 FILE *hbvmrt_out_open(const char *path)
 {
+#ifdef SIGXFSZ
+  signal(SIGXFSZ, SIG_IGN);
+#endif
   return strcmp(path, "-") == 0 ? stdout : fopen(path, "w");
 }
 

@@ -111,38 +111,50 @@ int hbvmrt_ensemble_wanted(int argc, char **argv)
 }
 
 /* Take --ensemble, --sweep, --threads out of argv (into e), leaving the
- * driver's own options in *rest for hbvmrt_parse_args. */
+ * driver's own options in *rest for hbvmrt_parse_args. Each takes its value
+ * as the next argument or attached, --ensemble=F, as the driver's options. */
 static int own_options(Ens *e, int argc, char **argv, char **rest, int *nrest)
 {
-  int i;
+  static const char *const own[] = {"--ensemble", "--sweep", "--threads"};
+  int i, k;
 
   *nrest = 0;
   for (i = 0; i < argc; i++) {
-    const char *a = argv[i], **to = NULL;
+    const char *a = argv[i], **to = NULL, *val = NULL;
     char *end;
-    if (i > 0 && (!strcmp(a, "--ensemble") || !strcmp(a, "--sweep") || !strcmp(a, "--threads"))) {
-      if (i + 1 >= argc) {
-        hbvmrt_error(e->md, "option %s needs a value", a);
-        return -1;
-      }
-      if (!strcmp(a, "--threads")) {
-        long v = strtol(argv[++i], &end, 10);
-        if (*end || v < 1 || v > 4096) {
-          hbvmrt_error(e->md, "--threads needs a whole number from 1 to 4096, got '%s'", argv[i]);
-          return -1;
-        }
-        e->threads = (int)v;
-        continue;
-      }
-      to = a[2] == 'e' ? &e->file : &e->sweep;
-      if (*to) {
-        hbvmrt_error(e->md, "%s given twice", a);
-        return -1;
-      }
-      *to = argv[++i];
+    size_t n = 0;
+    for (k = 0; i > 0 && k < 3; k++) {
+      n = strlen(own[k]);
+      if (!strncmp(a, own[k], n) && (a[n] == '\0' || a[n] == '='))
+        break;
+    }
+    if (i == 0 || k == 3) {
+      rest[(*nrest)++] = argv[i];
       continue;
     }
-    rest[(*nrest)++] = argv[i];
+    if (a[n] == '=')
+      val = a + n + 1;
+    else if (i + 1 < argc)
+      val = argv[++i];
+    else {
+      hbvmrt_error(e->md, "option %s needs a value", a);
+      return -1;
+    }
+    if (k == 2) {
+      long v = strtol(val, &end, 10);
+      if (end == val || *end || v < 1 || v > 4096) {
+        hbvmrt_error(e->md, "--threads needs a whole number from 1 to 4096, got '%s'", val);
+        return -1;
+      }
+      e->threads = (int)v;
+      continue;
+    }
+    to = k == 0 ? &e->file : &e->sweep;
+    if (*to) {
+      hbvmrt_error(e->md, "%s given twice", own[k]);
+      return -1;
+    }
+    *to = val;
   }
   if (e->file && e->sweep) {
     hbvmrt_error(e->md, "--ensemble and --sweep cannot be used together");
@@ -151,30 +163,33 @@ static int own_options(Ens *e, int argc, char **argv, char **rest, int *nrest)
   return 0;
 }
 
-/* The column called name: a coordinate (x, x[3]), a momentum (p_x) or a
- * param; -1 after an error naming it. */
-static int column(Ens *e, int c, const char *name, size_t len)
+/* The column called name: a coordinate (x, x[3]), a param, or a momentum
+ * (p_ and a coordinate), looked up by the exact name first, so that a param
+ * p_x of a driver from before hbvmgen refused such names is that param, not
+ * the momentum of x; -1 after an error naming it, after where (a place in
+ * the file). */
+static int column(Ens *e, int c, const char *name, size_t len, const char *where)
 {
   const hbvmrt_model *md = e->md;
   int i;
 
-  for (i = 0; i < md->m; i++) {
-    const char *n = md->names[i];
-    if (strlen(n) == len && !strncmp(n, name, len)) {
+  for (i = 0; i < md->m; i++)
+    if (strlen(md->names[i]) == len && !strncmp(md->names[i], name, len)) {
       e->kind[c] = COL_Q, e->index[c] = i;
       return 0;
     }
-    if (len > 2 && !strncmp(name, "p_", 2) && strlen(n) == len - 2 && !strncmp(n, name + 2, len - 2)) {
-      e->kind[c] = COL_P, e->index[c] = i;
-      return 0;
-    }
-  }
   for (i = 0; i < md->nparams; i++)
     if (strlen(md->params[i].name) == len && !strncmp(md->params[i].name, name, len)) {
       e->kind[c] = COL_PARAM, e->index[c] = i;
       return 0;
     }
-  hbvmrt_error(md, "unknown column '%.*s' (a coordinate, p_ and a coordinate, or a parameter)", (int)len, name);
+  for (i = 0; len > 2 && !strncmp(name, "p_", 2) && i < md->m; i++)
+    if (strlen(md->names[i]) == len - 2 && !strncmp(md->names[i], name + 2, len - 2)) {
+      e->kind[c] = COL_P, e->index[c] = i;
+      return 0;
+    }
+  hbvmrt_error(md, "%sunknown column '%.*s' (a coordinate, p_ and a coordinate, or a parameter)", where, (int)len,
+               name);
   return -1;
 }
 
@@ -199,11 +214,15 @@ static int read_sweep(Ens *e)
   long i;
 
   if (!eq || sscanf(eq + 1, "%lf:%lf:%lf%c", &a, &b, &n, &tail) != 3 || !isfinite(a) || !isfinite(b) ||
-      n != floor(n) || n < 1 || n > 1e9) {
+      n != floor(n) || n < 1) {
     hbvmrt_error(e->md, "invalid value '%s' for --sweep (expected NAME=A:B:N, N >= 1 whole)", e->sweep);
     return -1;
   }
-  if (add_columns(e, 1) || column(e, 0, e->sweep, (size_t)(eq - e->sweep)))
+  if (n > (double)HBVMRT_MAX_TRAJ) {
+    hbvmrt_error(e->md, "--sweep: %.0f trajectories, at most %ld", n, HBVMRT_MAX_TRAJ);
+    return -1;
+  }
+  if (add_columns(e, 1) || column(e, 0, e->sweep, (size_t)(eq - e->sweep), "--sweep: "))
     return -1;
   e->nrow = (long)n;
   if (!(e->val = calloc((size_t)e->nrow, sizeof *e->val))) {
@@ -216,73 +235,25 @@ static int read_sweep(Ens *e)
 }
 
 /* --ensemble FILE: a header of column names, then one row of numbers per
- * trajectory (blank lines and lines starting with # skipped). */
+ * trajectory (table.c), each column one of column()'s. */
 static int read_ensemble(Ens *e)
 {
-  FILE *f = fopen(e->file, "r");
-  char *line = NULL, *p;
-  size_t cap = 0;
-  long lineno = 0, rcap = 0;
-  int rc = -1, c;
+  hbvmrt_table tb;
+  char where[512];
+  int c, rc = -1;
 
-  if (!f) {
-    hbvmrt_error(e->md, "cannot open '%s': %s", e->file, strerror(errno));
-    return -1;
+  if (hbvmrt_table_read(e->md, e->file, HBVMRT_MAX_TRAJ, &tb) == 0 && add_columns(e, tb.ncol) == 0) {
+    for (c = 0; c < tb.ncol; c++) {
+      snprintf(where, sizeof where, "%s:%ld:%d: ", e->file, tb.header_line, tb.name_col[c]);
+      if (column(e, c, tb.names[c], strlen(tb.names[c]), where) != 0)
+        break;
+    }
+    rc = c == tb.ncol ? 0 : -1;
+    e->nrow = tb.nrow;
+    e->val = tb.val;
+    tb.val = NULL;
   }
-  while (getline(&line, &cap, f) > 0) {
-    lineno++;
-    line[strcspn(line, "\r\n")] = 0;
-    if (!line[strspn(line, " \t")] || line[0] == '#')
-      continue;
-    if (!e->kind) {               /* the header */
-      int n = 1;
-      for (p = line; *p; p++)
-        n += *p == ',';
-      if (add_columns(e, n))
-        goto done;
-      for (c = 0, p = line; c < n; c++) {
-        size_t len = strcspn(p, ",");
-        char *s = p;
-        while (*s == ' ' || *s == '\t')
-          s++, len--;
-        while (len > 0 && (s[len - 1] == ' ' || s[len - 1] == '\t'))
-          len--;
-        if (column(e, c, s, len))
-          goto done;
-        p += strcspn(p, ",") + (c + 1 < n);
-      }
-      continue;
-    }
-    if (e->nrow == rcap) {
-      double *v;
-      rcap = rcap ? 2 * rcap : 64;
-      if (!(v = realloc(e->val, (size_t)rcap * (size_t)e->ncol * sizeof *v))) {
-        hbvmrt_error(e->md, "out of memory");
-        goto done;
-      }
-      e->val = v;
-    }
-    for (c = 0, p = line; c < e->ncol; c++) {
-      char *end;
-      double v = strtod(p, &end);
-      while (*end == ' ' || *end == '\t')
-        end++;
-      if (end == p || !isfinite(v) || (*end != (c + 1 < e->ncol ? ',' : '\0'))) {
-        hbvmrt_error(e->md, "%s:%ld: expected %d finite numbers separated by commas", e->file, lineno, e->ncol);
-        goto done;
-      }
-      e->val[e->nrow * e->ncol + c] = v;
-      p = end + 1;
-    }
-    e->nrow++;
-  }
-  if (!e->kind)
-    hbvmrt_error(e->md, "%s: no header line (column names)", e->file);
-  else
-    rc = 0;
-done:
-  free(line);
-  fclose(f);
+  hbvmrt_table_free(&tb);
   return rc;
 }
 
@@ -465,6 +436,8 @@ static void steps_scalar(Traj *tr, long from, double fail_h, int fail_code)
   }
   if (code != 0)
     tr->r[0] = code;
+  else
+    hbvmrt_span_land(md, &e->o, x);
 }
 
 /* Trajectories [first, first + n) one after another. */
@@ -549,6 +522,7 @@ static void run_batch(const Ens *e, Work *w, long first, long n)
     if (done[l])
       continue;  /* finished on the scalar path */
     e->bt->get(w->b, l, w->x);
+    hbvmrt_span_land(md, &e->o, w->x);
     finish(e, result(e, first + l), w->x, prm);
   }
 }
@@ -757,7 +731,7 @@ int hbvmrt_ensemble_main(const hbvmrt_model *md, const hbvmrt_batch *bt, int arg
   }
   status = failed ? 2 : 0;
   if (e.rank == 0 && e.o.csv) {
-    FILE *f = strcmp(e.o.csv, "-") ? fopen(e.o.csv, "w") : stdout;
+    FILE *f = hbvmrt_out_open(e.o.csv);
     if (!f || write_results(&e, f) != 0 || (f != stdout ? fclose(f) : fflush(f)) != 0) {
       hbvmrt_error(md, "cannot write '%s': %s", e.o.csv, strerror(errno ? errno : EIO));
       status = 1;

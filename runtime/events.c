@@ -4,7 +4,10 @@
  * After every step from x0 to x the event functions are compared at both
  * ends: an event whose sign changes (in its direction: rising from < 0 to
  * >= 0, falling from > 0 to <= 0, or either) occurred inside the step; a
- * value exactly 0 at the start is not a change, so an event is found once.
+ * value exactly 0 at the start is not a change, so an event is found once,
+ * and one exactly 0 at the end is found there (theta = 1), either way.
+ * An event whose value is not a number has no sign to compare: the run
+ * stops there with an error rather than miss a crossing next to it.
  * Two changes inside one step cancel and are not seen: the step must be
  * shorter than the time between two occurrences.
  *
@@ -48,12 +51,15 @@ static double dense_value(hbvmrt_events *ev, const void *x, double theta, int i)
 }
 
 /* Stage 1: theta of the root of event i on the dense output of the step h
- * (x its end), bracketed by fa = value at 0 and fb = value at 1. */
+ * (x its end), bracketed by fa = value at 0 (never 0) and fb = value at 1:
+ * 1 when fb is 0, so that below both ends have a sign, opposite ones. */
 static double locate(hbvmrt_events *ev, const void *x, double h, int i, double fa, double fb)
 {
   double a = 0, b = 1, tol = HBVMRT_EVENT_TOL * (1 + fabs(hbvmrt_state_time(ev->md, x))) / fabs(h);
   int side = 0, it;
 
+  if (fb == 0)
+    return 1;
   for (it = 0; it < 200 && b - a > tol; it++) {
     double c = (a * fb - b * fa) / (fb - fa), fc;
     if (!(c > a && c < b))
@@ -121,6 +127,25 @@ static void polish(hbvmrt_events *ev, const void *x0, const void *x, double h, i
   md->dense(x, theta, ev->z);
 }
 
+/* The first event whose value in v is not a number, reported as at the
+ * state x (after, when given, the value v0 it had at x0); -1 if none. */
+static int not_a_number(const hbvmrt_events *ev, const double *v, const void *x, const double *v0, const void *x0)
+{
+  const hbvmrt_model *md = ev->md;
+  int i;
+
+  for (i = 0; i < md->nevents; i++)
+    if (isnan(v[i])) {
+      fprintf(stderr, "%s: error: event '%s' is not a number at t=%.15g", md->name, md->event_names[i],
+              hbvmrt_state_time(md, x));
+      if (v0)
+        fprintf(stderr, " (%.3g at t=%.15g)", v0[i], hbvmrt_state_time(md, x0));
+      fputs(": its sign changes cannot be found\n", stderr);
+      return i;
+    }
+  return -1;
+}
+
 int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_opts *o, const void *prm,
                        const void *x)
 {
@@ -146,6 +171,8 @@ int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_o
     return -1;
   }
   md->events(x, prm, ev->v0);
+  if (not_a_number(ev, ev->v0, x, NULL, NULL) >= 0)
+    return -1;
   if (!o->events)
     return 0;
   ev->path = o->events;
@@ -180,6 +207,8 @@ int hbvmrt_events_step(hbvmrt_events *ev, const void *x0, void *x, double h)
   if (!md)
     return 0;
   md->events(x, ev->prm, ev->v1);
+  if (not_a_number(ev, ev->v1, x, ev->v0, x0) >= 0)
+    return 2;
   for (i = 0; i < md->nevents; i++)
     if (crossed(md->event_dirs[i], ev->v0[i], ev->v1[i])) {
       ev->theta[i] = locate(ev, x, h, i, ev->v0[i], ev->v1[i]);

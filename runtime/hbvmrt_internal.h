@@ -29,6 +29,10 @@
 #define HBVMRT_HALVINGS 8
 /* The most lanes of a batch (hbvmgen --batch W: W <= 64). */
 #define HBVMRT_MAX_LANES 64
+/* The most CSV rows --dt may ask for (span / DT), and the most trajectories
+ * of --sweep or --ensemble (their results are kept until all are done). */
+#define HBVMRT_MAX_ROWS 1e9
+#define HBVMRT_MAX_TRAJ 10000000L
 
 /* The driver options once parsed and checked. */
 typedef struct {
@@ -97,12 +101,13 @@ typedef struct {
 } hbvmrt_events;
 
 /* Set up for --events / --stop-at (nothing when neither is given) at the
- * initial state x: 0, or -1 after reporting. */
+ * initial state x: 0, or -1 after reporting (an event not a number at x). */
 int hbvmrt_events_open(hbvmrt_events *ev, const hbvmrt_model *md, const hbvmrt_opts *o, const void *prm,
                        const void *x);
 /* After a step h from x0 to x: the events inside it written in time order;
  * returns 1 when the --stop-at event occurred (x is then the state at it),
- * -1 once writing failed, else 0. */
+ * 2 after reporting an event that is not a number at x (the run fails
+ * there), -1 once writing failed, else 0. */
 int hbvmrt_events_step(hbvmrt_events *ev, const void *x0, void *x, double h);
 /* Close the events CSV: 0, or -1 after reporting a write error. */
 int hbvmrt_events_close(hbvmrt_events *ev);
@@ -121,6 +126,12 @@ int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0,
 double hbvmrt_state_time(const hbvmrt_model *md, const void *x);
 /* The end of the span: T in the direction of h. */
 double hbvmrt_span_end(const hbvmrt_opts *o);
+/* The number of fixed steps of |h| over the span T >= 0 (0 for T = 0), or
+ * -1 when there are too many to count (2^53 or more). */
+long hbvmrt_span_steps(double T, double h);
+/* The state x of a run of -T that ended within round-off of the span's end:
+ * its t set to that end exactly. */
+void hbvmrt_span_land(const hbvmrt_model *md, const hbvmrt_opts *o, void *x);
 /* Step n of N of a fixed-step run from x: h, the last shortened to end on T. */
 double hbvmrt_fixed_step(const hbvmrt_model *md, const hbvmrt_opts *o, long n, const void *x);
 /* One adaptive step toward t_end from x, of at most *h (the last shortened
@@ -148,6 +159,24 @@ int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int
 /* run.c: one run of the standalone driver (hbvmrt_main without an ensemble) */
 
 int hbvmrt_run(const hbvmrt_model *md, int argc, char **argv);
+
+/* table.c: a CSV table of numbers (--ensemble FILE) */
+
+typedef struct {
+  char *text;          /* the file, which the names point into */
+  int ncol;
+  char **names;        /* the ncol column names of the header */
+  int *name_col;       /* ... and the column (byte) where each starts */
+  long header_line;
+  long nrow;
+  double *val;         /* nrow x ncol, row by row */
+} hbvmrt_table;
+
+/* Read path into *tb (which hbvmrt_table_free releases in every case): 0,
+ * or -1 after an error naming the file, line and column; at most max_rows
+ * rows, and at least one. */
+int hbvmrt_table_read(const hbvmrt_model *md, const char *path, long max_rows, hbvmrt_table *tb);
+void hbvmrt_table_free(hbvmrt_table *tb);
 
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 

@@ -19,7 +19,7 @@
  *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
- * a failed step), 2 a failed step. */
+ * a failed step), 2 a failed step or an event that is not a number. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
@@ -52,6 +52,7 @@ typedef struct {
   long grid_k;                /* --dt: the next row is at t = grid_k DT */
   hbvmrt_events ev;           /* --events, --stop-at */
   int stopped;                /* the --stop-at event ended the run */
+  int event_nan;              /* ... or an event that is not a number, reported */
 } Run;
 
 /* The progress line: drawn only on a terminal, after a second, at most ten
@@ -385,8 +386,11 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
     r->h_min = fabs(h);
   if (fabs(h) > r->h_max)
     r->h_max = fabs(h);
-  if (r->ev.md && hbvmrt_events_step(&r->ev, r->x0, r->x, h) == 1)
-    r->stopped = 1;
+  if (r->ev.md) {
+    int found = hbvmrt_events_step(&r->ev, r->x0, r->x, h);
+    r->event_nan = found == 2;
+    r->stopped = found == 1 || found == 2;
+  }
   observe(r);
   if (r->o->dt > 0)
     grid_rows(r);
@@ -457,6 +461,7 @@ static void loop_adaptive(Run *r, Progress *pg)
     n++;
     taken(r, &st, st.h);
     if (r->stopped || at_end) {   /* at the event, or on T */
+      hbvmrt_span_land(r->md, r->o, r->x);
       step_row(r);
       return;
     }
@@ -490,6 +495,8 @@ static void loop(Run *r, Progress *pg)
       step_row(r);
       return;
     }
+    if (n == N)
+      hbvmrt_span_land(r->md, r->o, r->x);
     if ((n % K == 0 || n == N) && step_row(r) != 0)
       return;
     if (pg->on && n >= pg->next)
@@ -547,7 +554,7 @@ static int simulate(Run *r)
   if (r->ev.md && hbvmrt_events_close(&r->ev) != 0)
     out_failed = 1;
   summary(r, seconds);
-  return out_failed ? 1 : r->fail_code != 0 ? 2 : 0;
+  return out_failed ? 1 : r->fail_code != 0 || r->event_nan ? 2 : 0;
 }
 
 /* The standalone driver's one run (driver.c sends it every run that is not an

@@ -2,6 +2,7 @@
  * retrying a failed fixed step with halved steps: what the driver (run.c)
  * and the ensemble runner (ensemble.c) both do, so that a trajectory of an
  * ensemble ends where a single run of it ends. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -18,6 +19,45 @@ double hbvmrt_state_time(const hbvmrt_model *md, const void *x)
 double hbvmrt_span_end(const hbvmrt_opts *o)
 {
   return o->h < 0 ? -o->T : o->T;
+}
+
+/* The number N of steps of |h| over the span T: the least N with N |h| >= T
+ * up to a sliver of 1e-9 |h| + 8 eps T, so that the last step, T - (N-1)
+ * |h|, is neither 0 nor a sliver (-h 0.1 -T 1 is 10 steps, though 10 times
+ * 0.1 is not 1 in binary). The 8 eps T is the rounding of T and of N times
+ * h, which T/|h| = 26214403 in decimals leaves (-h 0.01 -T 262144.03: 2.4e-11
+ * over 26214403 steps of the double 0.01). ceil(T/|h| - 1e-9) is the first
+ * guess; it is corrected with the residual T - n |h| rounded once (fma),
+ * since past 2^24 steps the quotient's own rounding exceeds the 1e-9 (that
+ * run gave 26214404 steps, the last one 0). -1 from 2^53 steps on, where n
+ * is no longer a double exactly. */
+long hbvmrt_span_steps(double T, double h)
+{
+  double a = fabs(h), sliver = 1e-9 * a + 8 * DBL_EPSILON * T, n = ceil(T / a - 1e-9);
+
+  if (!(T > 0))
+    return 0;
+  if (n < 1)
+    n = 1;
+  if (!(n < 9007199254740992.0))
+    return -1;
+  while (fma(-n, a, T) > sliver)
+    n++;
+  while (n > 1 && fma(-(n - 1), a, T) <= sliver)
+    n--;
+  return (long)n;
+}
+
+/* The state's t ends within a few ulps of the span's end T (its last step
+ * T - t is added to t with the compensation the step carries, and halves
+ * add theirs): it is set to T, which the run meant, so that the last row
+ * and an ensemble's summary say T (7.6999999999999993 at -h 2.1 -T 7.7). */
+void hbvmrt_span_land(const hbvmrt_model *md, const hbvmrt_opts *o, void *x)
+{
+  double end = hbvmrt_span_end(o), t = hbvmrt_state_time(md, x), eps = md->eps > 0 ? md->eps : DBL_EPSILON;
+
+  if (o->to_T && t != end && fabs(t - end) <= 8 * eps * fabs(end))
+    memcpy((char *)x + md->off_t, &end, sizeof end);
 }
 
 /* Step n of the N of a fixed-step run (1 <= n <= N) from the state x: h,

@@ -203,6 +203,23 @@ START_TEST(test_defaults_and_idle) {
   ck_assert(!memcmp(&b, &c, sizeof b));
   for (l = 0; l < bconst_k2s2_W; l++) b.idle[l] = 0;
   ck_assert_int_eq(bconst_k2s2_batch_step(&b, 0, NULL, NULL), bconst_k2s2_W); /* EBADSTEP in every lane */
+  /* the adaptive step too: a bad h or tol fails every active lane, and says how many */
+  {
+    static const double bad[][2] = {{0, 1e-6}, {NAN, 1e-6}, {0.05, 0}, {0.05, -1}, {0.05, NAN}, {INFINITY, 1e-6}};
+    bconst_k2s2_batch_stats bs;
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+      double h = bad[k][0];
+      memcpy(&c, &b, sizeof b);
+      b.idle[2] = 1;
+      ck_assert_int_eq(bconst_k2s2_batch_step_adaptive(&b, &h, bad[k][1], NULL, &bs), bconst_k2s2_W - 1);
+      ck_assert_int_eq(bs.code[0], bconst_k2s2_EBADSTEP);
+      ck_assert_int_eq(bs.code[2], bconst_k2s2_OK);
+      ck_assert(bs.h == 0);
+      ck_assert_int_eq(bconst_k2s2_batch_step_adaptive(&b, &h, bad[k][1], NULL, NULL), bconst_k2s2_W - 1);
+      b.idle[2] = 0;
+      ck_assert(!memcmp(&b, &c, sizeof b));
+    }
+  }
 }
 END_TEST
 

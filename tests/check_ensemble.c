@@ -188,6 +188,85 @@ START_TEST(test_errors)
     snprintf(cmd, sizeof cmd, "%s/pe %s -N 1 2>/dev/null", dir, bad[i]);
     ck_assert_msg(sh(cmd) == 1, "%s: expected exit status 1", bad[i]);
   }
+  /* --sweep N allocated 8 N bytes at once, N up to 1e9: now at most 1e7 */
+  snprintf(cmd, sizeof cmd, "%s/pe --sweep x=0:1:10000001 -N 1 2>%s/err.txt", dir, dir);
+  ck_assert_int_eq(sh(cmd), 1);
+  snprintf(cmd, sizeof cmd, "%s/err.txt", dir);
+  char *err = read_text(cmd);
+  ck_assert_msg(err && strstr(err, "pe: error: --sweep: 10000001 trajectories, at most 10000000"), "%s", err);
+  free(err);
+}
+END_TEST
+
+/* The ensemble file in.csv of n bytes, run with -N 1 as --ensemble in.csv
+ * (or --ensemble=in.csv when attached): the exit status, and the first line
+ * of stderr in line (size bytes). */
+static int run_input(const char *bytes, size_t n, int attached, char *line, size_t size)
+{
+  char cmd[1024], path[256];
+  snprintf(path, sizeof path, "%s/in.csv", dir);
+  FILE *f = fopen(path, "wb");
+  ck_assert_ptr_nonnull(f);
+  ck_assert_uint_eq(fwrite(bytes, 1, n, f), n);
+  fclose(f);
+  snprintf(cmd, sizeof cmd, "%s/pe --ensemble%s%s -N 1 --csv %s/out.csv 2>%s/err.txt", dir, attached ? "=" : " ", path,
+           dir, dir);
+  int rc = sh(cmd);
+  snprintf(path, sizeof path, "%s/err.txt", dir);
+  char *err = read_text(path);
+  ck_assert_ptr_nonnull(err);
+  snprintf(line, size, "%.*s", (int)strcspn(err, "\n"), err);
+  free(err);
+  return rc;
+}
+
+/* The ensemble file's malformed inputs, each an error naming the file, the
+ * line and the column (status 1), and the line ends and marks that are
+ * fine: CR alone (which dropped every row: trajectories=0, exit 0), CR LF,
+ * a UTF-8 BOM (which made the first column unknown), --ensemble=F (which
+ * was refused). A header alone, a repeated column, a NUL byte exited 0. */
+START_TEST(test_input_file)
+{
+#define ROW1 "0.6, -0.8, 0, 0"
+#define ROW2 "0.8, -0.6, 0, 0"
+  static const struct {
+    const char *bytes;
+    size_t n;
+    const char *want; /* stderr's first line from "in.csv" on, or "" for success (2 trajectories) */
+  } cases[] = {
+      {"x,y,p_x,p_y\r" ROW1 "\r" ROW2 "\r", 0, ""},
+      {"x,y,p_x,p_y\r\n" ROW1 "\r\n\r\n" ROW2, 0, ""},
+      {"\xEF\xBB\xBFx,y,p_x,p_y\n" ROW1 "\n" ROW2 "\n", 0, ""},
+      {"# no rows\nx,y,p_x,p_y\n\n", 0, "in.csv: no trajectories: the header (line 2) and no rows"},
+      {"", 0, "in.csv: no header line (column names)"},
+      {"x,y,x\n0,-1,0\n", 0, "in.csv:1:5: column 'x' given twice (first at column 1)"},
+      {"x, y ,p_x,p_y\n" ROW1 "\n0.8, -0.6\0, 0, 0\n", 47, "in.csv:3:10: a NUL byte"},
+      {"x,y,p_x,p_y\n" ROW1 "\n0.8,abc,0,0\n", 0, "in.csv:3:5: 'abc' is not a finite number"},
+      {"x,y,p_x,p_y\n" ROW1 "\n0.8,-0.6,0\n", 0, "in.csv:3:11: expected 4 numbers, got 3"},
+      {"x,y,p_x,p_y\n" ROW1 ",5\n", 0, "in.csv:2:16: expected 4 numbers, got more"},
+      {"x,y,p_x,p_y\n" ROW1 "\n0.8,,0,0\n", 0, "in.csv:3:5: an empty field (expected 4 numbers)"},
+      {"x,y,p_x,p_y\n0.6 0.1,-0.8,0,0\n", 0, "in.csv:2:5: expected a comma"},
+      {"x,y,p_x,p_y\n0.6,nan,0,0\n", 0, "in.csv:2:5: 'nan' is not a finite number"},
+      {"x,,p_x\n", 0, "in.csv:1:3: column 2 has no name"},
+      {"x, zz\n1,2\n", 0, "in.csv:1:4: unknown column 'zz'"},
+  };
+  char line[1024], want[1100];
+  build("pe", "../models/pendulum.ham", "-s 2 --batch 2", 0);
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    size_t n = cases[i].n ? cases[i].n : strlen(cases[i].bytes);
+    int rc = run_input(cases[i].bytes, n, 0, line, sizeof line);
+    if (!*cases[i].want) {
+      ck_assert_msg(rc == 0 && strstr(line, "trajectories=2 ok=2 "), "case %zu: exit %d, %s", i, rc, line);
+      continue;
+    }
+    snprintf(want, sizeof want, "pe: error: %s/%s", dir, cases[i].want);
+    ck_assert_msg(rc == 1 && !strncmp(line, want, strlen(want)), "case %zu: exit %d, '%s', not '%s'", i, rc, line,
+                  want);
+  }
+  ck_assert_int_eq(run_input(cases[0].bytes, strlen(cases[0].bytes), 1, line, sizeof line), 0);
+  ck_assert_msg(strstr(line, "trajectories=2 ok=2 "), "%s", line);
+#undef ROW1
+#undef ROW2
 }
 END_TEST
 
@@ -215,6 +294,7 @@ Suite *ensemble_suite(void)
   tcase_add_test(tc, test_sweep_and_mpi);
   tcase_add_test(tc, test_span_and_tol);
   tcase_add_test(tc, test_errors);
+  tcase_add_test(tc, test_input_file);
   suite_add_tcase(s, tc);
   return s;
 }

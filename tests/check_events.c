@@ -8,6 +8,10 @@
  *             with --tol, rising and falling ones apart;
  *   kepler    e = 0.6: y = 0 at t = n pi and the aphelia (p_x = 0 rising) at
  *             odd multiples of pi, to 1e-10 absolute, with --tol and fixed h;
+ *   ramp      events exactly 0 at a step's end (tests/models/ramp_events.ham),
+ *             rising, falling and either way: each reported once, at that
+ *             end, not at the step's start; one inside a step; one 0 at
+ *             t = 0 (no occurrence); an event that is not a number fails;
  *   --stop-at ends on the state of its event; --dt writes rows at exactly
  *             k DT, with fixed and adaptive steps, that match the closed
  *             form of Kepler to the dense output's accuracy. */
@@ -20,12 +24,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <fcntl.h>
 #include <float.h>
 
 #include "errest.h"
 #include "hbvmrt.h"
 #include "kepler_events_k4s4.h"
 #include "pendulum_events_k4s4.h"
+#include "ramp_events_k2s2.h"
 
 Suite *events_suite(void);
 
@@ -71,6 +77,19 @@ static const char *const names_xy[] = {"x", "y"};
 
 EV_MODEL(pendulum_events_k4s4)
 EV_MODEL(kepler_events_k4s4)
+EV_MODEL(ramp_events_k2s2)
+
+/* the ramp with its param a, which --param sets */
+static const hbvmrt_param ramp_params[] = {{"a", offsetof(ramp_events_k2s2_params, a)}};
+
+static hbvmrt_model ramp_model(void) {
+  hbvmrt_model md = ramp_events_k2s2_model;
+  md.nparams = 1;
+  md.params = ramp_params;
+  return md;
+}
+
+static char run_err[4096]; /* the stderr of the last run() */
 
 typedef struct {
   char name[32];
@@ -92,12 +111,16 @@ static int run(const hbvmrt_model *md, const char *args, Row *ev, int *nev, doub
   int argc = 0;
   for (char *tok = strtok(buf, " "); tok && argc < 31; tok = strtok(NULL, " ")) argv[argc++] = tok;
   argv[argc] = NULL;
-  FILE *saved = fopen("/dev/null", "w");
+  FILE *saved = tmpfile();
+  ck_assert(saved != NULL);
   int err = dup(2);
-  dup2(fileno(saved), 2); /* the summary line */
+  dup2(fileno(saved), 2); /* the summary line, the errors */
   int status = hbvmrt_main(md, argc, argv);
+  fflush(stderr);
   dup2(err, 2);
   close(err);
+  rewind(saved);
+  run_err[fread(run_err, 1, sizeof run_err - 1, saved)] = 0;
   fclose(saved);
   FILE *f = fopen(evpath, "r");
   ck_assert(f != NULL);
@@ -253,6 +276,113 @@ START_TEST(dt_grid)
 }
 END_TEST
 
+/* The ramp's events, 0 exactly at step ends of h = 0.25 and 0.125 (t = 1
+ * and 2): each found once, at that end (rising ones were found at the
+ * step's start, t = 0.75 and 1.75); the ones inside a step at 0.625; yzero,
+ * 0 at t = 0, not there. Ties in time keep the model's order. */
+START_TEST(zero_at_step_end)
+{
+  static const struct {
+    const char *name;
+    double t;
+  } want[] = {{"mid", 0.625}, {"midf", 0.625},    {"midany", 0.625}, {"up", 1},   {"down", 1},
+              {"upany", 1},   {"downany", 1},     {"yzero", 2},      {"xzero", 2}};
+  static const char *const runs[] = {"-h 0.25 -T 3", "-h 0.125 -T 3"};
+  static Row ev[64];
+  static double rows[64 * 6];
+  int nev, nrows;
+  hbvmrt_model md = ramp_model();
+  for (int r = 0; r < 2; r++) {
+    ck_assert_int_eq(run(&md, runs[r], ev, &nev, rows, 6, &nrows, 64), 0);
+    ck_assert_msg(nev == 9, "%s: %d events, not 9", runs[r], nev);
+    for (int i = 0; i < nev; i++) {
+      ck_assert_str_eq(ev[i].name, want[i].name);
+      ck_assert_msg(ev[i].t == want[i].t, "%s: %s at t = %.17g, not %g", runs[r], ev[i].name, ev[i].t, want[i].t);
+    }
+  }
+}
+END_TEST
+
+/* --stop-at an event 0 at a step's end stops there, not a step early: its
+ * state (t = 1, p_x = 0) is the last row. */
+START_TEST(stop_at_step_end)
+{
+  static const char *const runs[] = {"-h 0.25 -T 3 --stop-at up", "-h 0.25 -T 3 --stop-at down",
+                                     "-h 0.25 -T 3 --stop-at upany", "-h 0.25 -T 3 --stop-at xzero"};
+  static Row ev[64];
+  static double rows[64 * 6];
+  int nev, nrows;
+  hbvmrt_model md = ramp_model();
+  ck_assert_int_eq(run(&md, runs[_i], ev, &nev, rows, 6, &nrows, 64), 0);
+  const double *last = rows + (nrows - 1) * 6;
+  double t = _i == 3 ? 2 : 1;
+  ck_assert_msg(last[0] == t && last[_i == 3 ? 1 : 3] == 0, "%s: the run ended at t = %.17g", runs[_i], last[0]);
+}
+END_TEST
+
+/* An event that is not a number after a step (hole at a = 0, for 0.6 < t <
+ * 0.9: positive at t = 0.5, NaN at 0.75, positive again at 1, crossing 0 in
+ * both steps) cannot be searched: the run fails there, naming it, rather
+ * than miss its crossings. At the initial state it is refused. */
+START_TEST(event_not_a_number)
+{
+  static Row ev[64];
+  static double rows[64 * 6];
+  int nev, nrows;
+  hbvmrt_model md = ramp_model();
+  ck_assert_int_eq(run(&md, "-h 0.25 -T 3 --param a=0", ev, &nev, rows, 6, &nrows, 64), 2);
+  ck_assert_msg(strstr(run_err, "ramp_events_k2s2: error: event 'hole' is not a number at t=0.75"), "%s", run_err);
+  ck_assert_int_eq(run(&md, "-h 0.25 -T 3 --param a=-1", ev, &nev, rows, 6, &nrows, 64), 1);
+  ck_assert_msg(strstr(run_err, "ramp_events_k2s2: error: event 'hole' is not a number at t=0"), "%s", run_err);
+}
+END_TEST
+
+/* A run of -T ends on T exactly, whatever the rounding of its steps left in
+ * t: the last step (shortened) or its halves (-h 4.1 fails and is halved)
+ * ended 1 ulp off (7.6999999999999993, 13.100000000000001), so did --tol. */
+START_TEST(span_end_exact)
+{
+  static const struct {
+    const char *args;
+    double T;
+  } runs[] = {{"-h 0.7 -T 7.7", 7.7}, {"-h 2.1 -T 7.7", 7.7}, {"-h 4.1 -T 13.1", 13.1}, {"-h 3.3 -T 20.3", 20.3},
+              {"-h -2.1 -T 7.7", -7.7}};
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, runs[_i].args, ev, &nev, rows, 9, &nrows, MAXROWS), 0);
+  ck_assert_msg(rows[(nrows - 1) * 9] == runs[_i].T, "%s ended at t = %.17g", runs[_i].args, rows[(nrows - 1) * 9]);
+}
+END_TEST
+
+/* --csv and --events naming one file (in other words too: ./F, a//F) or
+ * both stdout are refused: the two CSVs overwrote each other. */
+START_TEST(same_output_twice)
+{
+  static Row ev[8];
+  static double rows[8 * 9];
+  char path[] = "/tmp/hbvm-same-XXXXXX", args[256];
+  const char *base = path + 5;
+  int nev, nrows, fd = mkstemp(path);
+  ck_assert(fd >= 0);
+  close(fd);
+  unlink(path); /* first as a file that does not exist yet */
+  for (int exists = 0; exists < 2; exists++) {
+    const char *fmt[] = {"-N 3 --csv %s --events %s", "-N 3 --csv %s --events /tmp/./%s", "-N 3 --events %s --csv /tmp//%s"};
+    for (int k = 0; k < 3; k++) {
+      snprintf(args, sizeof args, fmt[k], path, k ? base : path);
+      ck_assert_msg(run(&pendulum_events_k4s4_model, args, ev, &nev, rows, 9, &nrows, 8) == 1, "%s: not refused", args);
+      ck_assert_msg(strstr(run_err, "--csv and --events name the same file"), "%s: %s", args, run_err);
+    }
+    fd = open(path, O_WRONLY | O_CREAT, 0600);
+    ck_assert(fd >= 0);
+    close(fd);
+  }
+  unlink(path);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --csv - --events -", ev, &nev, rows, 9, &nrows, 8), 1);
+}
+END_TEST
+
 /* The options are checked before the run: an unknown event, a grid step
  * that is not positive, events asked of a model without any. */
 START_TEST(bad_options)
@@ -269,6 +399,14 @@ START_TEST(bad_options)
   ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --stop-at cross:0", ev, &nev, rows, 9, &nrows, 8), 1);
   ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-N 3 --dt 0", ev, &nev, rows, 9, &nrows, 8), 1);
   ck_assert_int_eq(run(&none, "-N 3", ev, &nev, rows, 9, &nrows, 8), 1); /* run() passes --events */
+  /* what ran forever: a subnormal --tol, a grid of 1e300 rows */
+  static const char *const endless[] = {"-T 1 --tol 1e-310", "-T 1 --tol 1e-320", "-T 1 --tol 1e-33",
+                                        "-T 1 --dt 1e-300", "-N 10 --dt 1e-12", "-T 1e10 --dt 1"};
+  for (size_t i = 0; i < sizeof endless / sizeof endless[0]; i++) {
+    ck_assert_msg(run(&pendulum_events_k4s4_model, endless[i], ev, &nev, rows, 9, &nrows, 8) == 1, "%s", endless[i]);
+    ck_assert_msg(strstr(run_err, strstr(endless[i], "--tol") ? "--tol must be >= 4.9e-32" : "rows over the span"),
+                  "%s: %s", endless[i], run_err);
+  }
 }
 END_TEST
 
@@ -280,6 +418,11 @@ Suite *events_suite(void) {
   tcase_add_loop_test(tc, kepler_crossings, 0, sizeof kepler_runs / sizeof kepler_runs[0]);
   tcase_add_test(tc, stop_at_event);
   tcase_add_test(tc, bad_options);
+  tcase_add_test(tc, zero_at_step_end);
+  tcase_add_loop_test(tc, stop_at_step_end, 0, 4);
+  tcase_add_test(tc, event_not_a_number);
+  tcase_add_loop_test(tc, span_end_exact, 0, 5);
+  tcase_add_test(tc, same_output_twice);
   tcase_add_loop_test(tc, dt_grid, 0, sizeof dt_runs / sizeof dt_runs[0]);
   suite_add_tcase(s, tc);
   return s;

@@ -14,14 +14,18 @@
 #include <check.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "hbvmrt.h"
+#include "hbvmrt_internal.h"       /* hbvmrt_span_steps */
 
 #define HALVINGS 8              /* HBVMRT_HALVINGS of runtime/hbvmrt_internal.h */
 
@@ -778,6 +782,41 @@ START_TEST(step_retried)
 }
 END_TEST
 
+/* The number of steps of a span, hbvmrt_span_steps(T, h): the least N with
+ * N |h| >= T up to a sliver s = 1e-9 |h| + 8 eps T (round-off of T and N h),
+ * so that the last step, T - (N-1) |h|, is neither 0 nor a sliver (s < last
+ * <= |h| + s), also past 2^24 steps, where ceil(T/|h| - 1e-9) counted one
+ * step too many (-h 0.01 -T 262144.03: 26214404, the last step 0 after
+ * 26214403). */
+START_TEST(span_steps)
+{
+  static const struct {
+    double T, h;
+    long n;
+  } known[] = {{262144.03, 0.01, 26214403}, {1, 0.3, 4}, {1, 0.1, 10}, {10, 0.01, 1000}, {100, 0.3, 334},
+               {0, 0.1, 0}, {0.05, 0.1, 1}, {1, -0.1, 10}, {1e-300, 1, 1}, {7.7, 2.1, 4}};
+  unsigned long seed = 12345;
+  int i;
+
+  for (i = 0; i < (int)(sizeof known / sizeof known[0]); i++)
+    ck_assert_msg(hbvmrt_span_steps(known[i].T, known[i].h) == known[i].n, "T=%.17g h=%g: %ld steps, not %ld",
+                  known[i].T, known[i].h, hbvmrt_span_steps(known[i].T, known[i].h), known[i].n);
+  ck_assert_int_eq(hbvmrt_span_steps(1e300, 1e-300), -1);       /* too many to count */
+  for (i = 0; i < 200000; i++) {           /* T = k h + a rest of decimals, up to 2^40 steps */
+    double h, T, last, sliver;
+    long n;
+    seed = seed * 6364136223846793005UL + 1442695040888963407UL;
+    h = (double)(1 + (seed >> 40) % 999) / 1000.0;
+    T = ldexp((double)((seed >> 20) % 1000000) / 1e6 + 1, (int)(seed % 40)) * h + (double)((seed >> 8) % 100) / 100.0;
+    n = hbvmrt_span_steps(T, h);
+    last = fma(-(double)(n - 1), h, T);
+    sliver = 1e-9 * h + 8 * DBL_EPSILON * T;
+    ck_assert_msg(n >= 1 && last > sliver && last <= h + sliver, "T=%.17g h=%.17g: %ld steps, the last %g", T, h, n,
+                  last);
+  }
+}
+END_TEST
+
 /* -T is hit exactly: the last step is shortened (0.3, 0.3, 0.3, 0.1) */
 START_TEST(span_hit_exactly)
 {
@@ -903,6 +942,44 @@ START_TEST(disk_full)
 }
 END_TEST
 
+/* Past the file size limit (ulimit -f) a write fails as on a full disk:
+ * reported, exit status 1, where the driver died of SIGXFSZ (status 153 in
+ * a shell), without a word. Run in a child, whose limit is 8 KiB. */
+START_TEST(file_size_limit)
+{
+  static const char *const outs[] = {"--csv @", "--csv - --quiet"};
+  char cmd[128];
+  Result r;
+  pid_t pid;
+  int status, fd;
+
+  snprintf(cmd, sizeof cmd, "-h 0.01 -N 10000 %s", outs[_i]);
+  fflush(stdout);
+  fflush(stderr);
+  pid = fork();
+  ck_assert_int_ge(pid, 0);
+  if (pid == 0) {
+    struct rlimit lim = {8192, 8192};
+    setrlimit(RLIMIT_FSIZE, &lim);
+    r = run(&osc, cmd);
+    fd = open("/tmp/check_runtime_fsize", O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    if (fd >= 0) {
+      ssize_t n = write(fd, r.err, strlen(r.err) < 4000 ? strlen(r.err) : 4000);
+      (void)n;
+      close(fd);
+    }
+    _exit(r.status);
+  }
+  ck_assert_int_eq(waitpid(pid, &status, 0), pid);
+  ck_assert_msg(WIFEXITED(status), "the driver died of signal %d", WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  ck_assert_int_eq(WEXITSTATUS(status), 1);
+  r.err = slurp("/tmp/check_runtime_fsize");
+  unlink("/tmp/check_runtime_fsize");
+  ck_assert_msg(strstr(r.err, "osc: error: cannot write '") && strstr(r.err, strerror(EFBIG)), "%s", r.err);
+  free(r.err);
+}
+END_TEST
+
 /* Initial values off the constraints: refused (status 1, the sizes named)
  * by a driver that can project, run as they are by an older one, projected
  * with --project (reported, g and hc zero at t = 0); a projection that fails
@@ -932,6 +1009,30 @@ START_TEST(inconsistent_start)
   r = run(&ringp, "--q0 0.6,0.8 --p0 -0.8,0.6 -N 2 --csv @");
   ck_assert_int_eq(r.status, 0);
   ck_assert(cell(r.csv, 0, 1) == 0.6 && cell(r.csv, 0, 4) == 0.6);
+  done(&r);
+}
+END_TEST
+
+/* An ensemble's column is looked up by its exact name first: a param p_x
+ * (which a driver from before hbvmgen refused the name may have) is that
+ * param, where --sweep p_x set the momentum of x (so the start, off the
+ * constraint q.p = 0, was refused: status -1). Here it is ring's k = 2, the
+ * rate of the rotation: x = cos 0.2 after a step of 0.1. */
+static const hbvmrt_param px_param[] = {{"p_x", offsetof(RingParams, k)}};
+static const char *const ring_names[] = {"x", "y"};
+
+START_TEST(column_exact_name)
+{
+  hbvmrt_model md = ring_projecting();
+  Result r;
+
+  md.names = ring_names;
+  md.params = px_param;
+  r = run(&md, "--sweep p_x=2:2:1 -h 0.1 -N 1 --csv @");
+  ck_assert_msg(r.status == 0, "status %d: %s", r.status, r.err);
+  ck_assert_int_eq(strncmp(r.csv, "traj,status,steps,t,x,y,p_x,p_y,", 32), 0);
+  ck_assert_double_eq(cell(r.csv, 0, 1), 0);
+  ck_assert_double_eq_tol(cell(r.csv, 0, 4), cos(0.2), 1e-15);
   done(&r);
 }
 END_TEST
@@ -1037,6 +1138,7 @@ Suite *runtime_suite(void)
   tcase_add_test(csv, csv_to_stdout);
   tcase_add_test(csv, no_csv);
   tcase_add_test(csv, disk_full);
+  tcase_add_loop_test(csv, file_size_limit, 0, 2);
   suite_add_tcase(s, csv);
 
   tcase_add_loop_test(args, bad_args, 0,
@@ -1045,6 +1147,7 @@ Suite *runtime_suite(void)
   tcase_add_test(args, param_last_wins);
   tcase_add_test(args, q0_alone);
   tcase_add_test(args, help);
+  tcase_add_test(args, column_exact_name);
   suite_add_tcase(s, args);
 
   tcase_add_test(run_, summary_nu0);
@@ -1056,6 +1159,7 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, step_failure_every);
   tcase_add_test(run_, step_retried);
   tcase_add_test(run_, span_hit_exactly);
+  tcase_add_test(run_, span_steps);
   tcase_add_test(run_, no_progress_off_terminal);
   tcase_add_test(run_, progress_on_terminal);
   tcase_set_timeout(run_, 30);
