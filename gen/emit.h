@@ -55,6 +55,12 @@ int itol_wanted(const Emitter *e);
 void emit_two_step_start(Emitter *e, const char *ind, const char *row);
 void emit_step_factor(Emitter *e);
 
+/* emit_newton.c: the iteration of --iteration newton (hooks in emit_step.c) */
+int emit_is_newton(const Emitter *e);
+void emit_newton_helpers(Emitter *e);
+void emit_newton_iteration(Emitter *e);
+void emit_newton_stats(Emitter *e);
+
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);
 void emit_batch_source(Emitter *e, int lanes);

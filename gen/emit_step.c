@@ -61,8 +61,9 @@ static void emit_header(Emitter *e, const EmitOptions *o) {
           "  $P_real increment; /* last scaled increment of the iteration */\n"
           "  $P_real err_est;   /* estimate of the step's local error in q (max norm) */\n"
           "  $P_real h;         /* the step taken */\n"
-          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n"
-          "} $P_stats;\n\n"
+          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n");
+  if (emit_is_newton(e)) emit_newton_stats(e);
+  tmpl(e, "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
           " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
           " * that is singular)\n");
@@ -971,6 +972,7 @@ static void emit_step(Emitter *e) {
   emit_tolc(e);
   if (itol_wanted(e)) emit_itol(e);
   if (mult) emit_mult_err(e);
+  if (emit_is_newton(e)) emit_newton_helpers(e);
   out(e, "/* One step of HBVM(%d,%d). Iterates the sweep until the increment reaches round-off\n", e->me->k, e->me->s);
   tmpl(e, itol_wanted(e) ? " * (under $P_step_adaptive, tol > 0: the threshold of $P_itol)\n"
                            " * or stops decreasing; commits to *x only on success. */\n"
@@ -1013,20 +1015,23 @@ static void emit_step(Emitter *e) {
     emit_factor(e, "  ");
   }
   if (e->fused) emit_fused_locals(e);
-  tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
-  if (poly) {
-    tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"
-            "     * small; where the increments fall by less than 8x it is refreshed at the\n"
-            "     * current gamma, which keeps the iteration converging up to the h of the\n"
-            "     * constant family (pendulum, s = 3: 2.4 instead of 0.84) */\n"
-            "    if (it > 2 && inc > inc_old / 8) {\n");
-    for (int i = 0; e->fused && i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
-    emit_factor(e, "      ");
-    tmpl(e, "    }\n");
+  if (emit_is_newton(e)) emit_newton_iteration(e); /* in place of the fixed-point loop */
+  else { /* the fixed-point loop */
+    tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
+    if (poly) {
+      tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"
+              "     * small; where the increments fall by less than 8x it is refreshed at the\n"
+              "     * current gamma, which keeps the iteration converging up to the h of the\n"
+              "     * constant family (pendulum, s = 3: 2.4 instead of 0.84) */\n"
+              "    if (it > 2 && inc > inc_old / 8) {\n");
+      for (int i = 0; e->fused && i < e->me->s * e->mod->m; i++) out(e, "      gam[%d] = gm%d;\n", i, i);
+      emit_factor(e, "      ");
+      tmpl(e, "    }\n");
+    }
+    if (e->fused) emit_fused_checks(e);
+    else emit_sweep_checks(e);
+    emit_convergence(e);
   }
-  if (e->fused) emit_fused_checks(e);
-  else emit_sweep_checks(e);
-  emit_convergence(e);
   if (e->fused) { /* the rest of the step reads the arrays */
     for (int i = 0; i < e->me->s * e->mod->m; i++) out(e, "  gam[%d] = gm%d;\n", i, i);
     for (int i = 0; i < kernel_size(&e->st->kern[K_SWEEP]); i++) out(e, "  sw[%d] = sw%d;\n", i, i);
@@ -1202,12 +1207,16 @@ static void emit_step_adaptive(Emitter *e) {
   emit_step_factor(e);
   tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
-          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n        }\n"
+          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n");
+  if (emit_is_newton(e)) tmpl(e, "          st->factors = s.factors;\n");
+  tmpl(e, "        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
           "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
           "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
-          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n      }\n"
+          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n");
+  if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");
+  tmpl(e, "      }\n"
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
 }
 
@@ -1241,7 +1250,7 @@ static void emit_dense(Emitter *e) {
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {.f = hf, .mod = mod, .me = me, .st = st, .P = o->name, .single = o->single,
                .compensated = o->compensated, .wide_step = o->wide_step, .kid = K_SWEEP};
-  e.fused = !o->wide_step && kernel_inlinable(&e, K_SWEEP);
+  e.fused = !o->wide_step && !emit_is_newton(&e) && kernel_inlinable(&e, K_SWEEP);
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   e.f = cf;
