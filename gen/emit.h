@@ -6,7 +6,7 @@
  * only through those blocks. Layers, each calling only those below it:
  *   emit_solver.c (entry points: emit_check, emit_solver)
  *   emit_step.c, emit_project.c, emit_batch.c
- *   emit_api.c, emit_iterate.c, emit_end.c, emit_batch_step.c
+ *   emit_api.c, emit_iterate.c, emit_newton.c, emit_end.c, emit_batch_step.c
  *   emit_estimate.c, emit_predict.c
  *   emit_choice.c
  *   emit_kernel.c
@@ -93,6 +93,13 @@ void emit_step(Emitter *e);
 
 /* emit_project.c: NAME_project */
 void emit_project(Emitter *e);
+
+/* emit_newton.c: the iteration of --iteration newton (emit_iterate chooses it; the
+ * stats field in emit_api.c, emit_estimate.c) */
+int emit_is_newton(const Emitter *e);
+void emit_newton_helpers(Emitter *e);
+void emit_newton_iteration(Emitter *e);
+void emit_newton_stats(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);

@@ -61,8 +61,9 @@ void emit_header(Emitter *e, const EmitOptions *o) {
           "  $P_real increment; /* last scaled increment of the iteration */\n"
           "  $P_real err_est;   /* estimate of the step's local error in q (max norm) */\n"
           "  $P_real h;         /* the step taken */\n"
-          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n"
-          "} $P_stats;\n\n"
+          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n");
+  if (emit_is_newton(e)) emit_newton_stats(e);
+  tmpl(e, "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"
           " * defaults). lambda starts as the multiplier consistent with (q0, p0) at prm (0 if\n"
           " * that is singular)\n");

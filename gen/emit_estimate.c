@@ -322,11 +322,15 @@ void emit_step_adaptive(Emitter *e) {
   emit_step_factor(e);
   tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n"
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
-          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n        }\n"
+          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n");
+  if (emit_is_newton(e)) tmpl(e, "          st->factors = s.factors;\n");
+  tmpl(e, "        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
           "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
           "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
-          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n      }\n"
+          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n");
+  if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");
+  tmpl(e, "      }\n"
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
 }

@@ -95,8 +95,12 @@ static void emit_step_predict(Emitter *e) {
 }
 
 // iterate: the step's equations solved for gamma (the contract above). The
-// one place that chooses the iteration: today the fixed-point sweep loop.
-static void emit_iterate(Emitter *e) { emit_fixed_point(e); }
+// one place that chooses the iteration: the fixed-point sweep loop, or
+// simplified Newton (--iteration newton, emit_newton.c).
+static void emit_iterate(Emitter *e) {
+  if (emit_is_newton(e)) emit_newton_iteration(e); /* emit_newton.c */
+  else emit_fixed_point(e);
+}
 
 // estimate: the step's error estimate and stats, and the tests that end
 // the step before anything is written.
@@ -127,6 +131,7 @@ static void emit_step_end(Emitter *e) {
 void emit_step(Emitter *e) {
   emit_predict(e);
   emit_estimators(e);
+  if (emit_is_newton(e)) emit_newton_helpers(e);
   emit_step_head(e);
   emit_step_predict(e);
   emit_iterate(e);

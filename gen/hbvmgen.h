@@ -370,9 +370,17 @@ typedef enum {
   MULT_POLY   /* a polynomial of degree s-1, then projection and rescale: order 2s (step_poly.c) */
 } MultFamily;
 
+/* How the step's equations are solved (--iteration). */
+typedef enum {
+  ITER_FIXED, /* fixed-point sweeps: converge while h omega < ~3 */
+  ITER_NEWTON /* simplified Newton on gamma (step_newton.c, emit_newton.c) */
+} IterKind;
+#define NEWTON_MAX_S 8 /* the largest s of --iteration newton (its eigenbasis is checked up to it) */
+
 typedef struct {
   int k, s;
   MultFamily family;
+  IterKind iteration;
   double *c, *b;      /* k nodes and weights on [0,1] */
   double *Ihat;       /* k x s: integral_0^{c_l} P_j */
   double *W;          /* k x s: b_l P_j(c_l) */
@@ -414,6 +422,8 @@ typedef enum {
   K_CONSISTENT, /* NAME_project: a Newton step onto g = 0, p projected onto the hidden constraint */
   K_INITIAL,    /* the model's q0, p0 as functions of the params (when they use any) */
   K_EVENTS,     /* the model's event functions at (q0, p0) (when it has events) */
+  K_NFACTOR,    /* --iteration newton: the Newton matrix, factored (step_newton.c) */
+  K_NSOLVE,     /* --iteration newton: the correction for a residual */
   K_COUNT
 } KernelId;
 

@@ -46,6 +46,11 @@ static const char usage[] =
     "                (2s where the true multiplier is constant); poly: a polynomial of\n"
     "                degree s-1, then p projected onto the hidden constraint and rescaled\n"
     "                to the energy: order 2s. Default: poly for s >= 2 with constraints\n"
+    "  --iteration I fixed or newton: how the step's equations are solved. fixed\n"
+    "                (default): fixed-point sweeps, which converge while h omega < ~3 (omega\n"
+    "                the fastest frequency of the linearised model); newton: simplified\n"
+    "                Newton with the Hessian of U, for stiff models and long steps (no\n"
+    "                constraints yet; not with --batch or --wide-step; docs/method-newton.md)\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k, and the\n"
     "                size of the code it would write (nothing is written)\n"
@@ -81,6 +86,7 @@ typedef struct {
   int batch;      /* --batch W, 0 without */
   long mass_loop; /* --mass-loop N, 0 for the default */
   long stage_loop; /* --stage-loop N, 0 for the default */
+  int iteration;   /* --iteration: an IterKind */
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -144,6 +150,11 @@ static int parse_args(int argc, char **argv, Options *o) {
       const char *v = argv[++i];
       if (strcmp(v, "const") && strcmp(v, "poly")) return fail("--multiplier needs 'const' or 'poly', got '%s'", v);
       o->multiplier = !strcmp(v, "poly") ? MULT_POLY : MULT_CONST;
+    } else if (!strcmp(a, "--iteration")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      const char *v = argv[++i];
+      if (strcmp(v, "fixed") && strcmp(v, "newton")) return fail("--iteration needs 'fixed' or 'newton', got '%s'", v);
+      o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : ITER_FIXED;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -184,6 +195,13 @@ static int parse_args(int argc, char **argv, Options *o) {
     return fail("-k must be at least -s (%s)", buf);
   }
   if (o->batch && o->wide_step) return fail("%s", "--batch cannot be used with --wide-step (long double does not vectorise)");
+  if (o->iteration == ITER_NEWTON && (o->batch || o->wide_step))
+    return fail("--iteration newton cannot be used with %s (not yet)", o->batch ? "--batch" : "--wide-step");
+  if (o->iteration == ITER_NEWTON && o->s > NEWTON_MAX_S) {
+    char buf[64];
+    snprintf(buf, sizeof buf, "s=%d > %d", o->s, NEWTON_MAX_S);
+    return fail("--iteration newton needs a smaller -s (%s)", buf);
+  }
   if (o->name && bad_name(o->name, NULL)) return 1;
   return 0;
 }
@@ -272,6 +290,8 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
            "(%d where the true multiplier is constant)\n", 2 * o->s);
   else
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
+  if (o->iteration == ITER_NEWTON)
+    printf("iteration: newton (simplified Newton, the Newton matrix factored once a step, docs/method-newton.md)\n");
   if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
   else
     printf("M: with params: %s, computed from them in every kernel call\n",
@@ -467,7 +487,8 @@ static EmitOptions emit_options(const Options *o) {
 // Returns 1 when the step cannot be emitted (the reason reported), else 0;
 // without a temporary file the line says so and the status stays 0.
 static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam) {
-  const Method *me = method_new(k, o->s, fam);
+  Method *me = method_new(k, o->s, fam);
+  me->iteration = (IterKind)o->iteration;
   Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
   if (!st || emit_check(mod, st, &eo)) return 1;
@@ -543,7 +564,7 @@ static void report_degree(const Model *mod, int s, int k) {
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0};
+  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name && bad_name(o.name = default_name(o.model), o.model)) return 1;
@@ -569,7 +590,10 @@ int main(int argc, char **argv) {
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
-  if (k > MAX_K) {
+  if (o.iteration == ITER_NEWTON && mod->nu) {
+    error_at(mod->g_loc[0], "--iteration newton does not handle constraints yet: pass --iteration fixed");
+    rc = 1;
+  } else if (k > MAX_K) {
     report_degree(mod, o.s, k);
     rc = 1;
   } else if (fam == MULT_POLY && o.single && o.s > FLOAT_POLY_MAX_S) {
@@ -583,7 +607,8 @@ int main(int argc, char **argv) {
     print_check(mod, &o, k, why, fam);
     rc = print_check_code(&o, mod, k, fam);
   } else {
-    const Method *me = method_new(k, o.s, fam);
+    Method *me = method_new(k, o.s, fam);
+    me->iteration = (IterKind)o.iteration;
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }

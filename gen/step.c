@@ -561,6 +561,8 @@ static const struct {
                       0},
     [K_INITIAL] = {"initial", "out = the model's q0 (M) and p0 (M) at the parameters prm", 0},
     [K_EVENTS] = {"events_kernel", "out = the model's event functions at (q0, p0), in the order written", 0},
+    [K_NFACTOR] = {"newton_factor", NULL, 0},
+    [K_NSOLVE] = {"newton_solve", NULL, 0},
 };
 
 Step *step_build(Model *mod, const Method *me) {
@@ -596,5 +598,6 @@ Step *step_build(Model *mod, const Method *me) {
     build_const_multiplier(&b);
   }
   build_diagnostics(&b);
+  if (me->iteration == ITER_NEWTON) build_newton(&b);
   return st;
 }

@@ -44,6 +44,25 @@ void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, 
 void build_const_multiplier(Build *b);
 void build_poly_multiplier(Build *b);
 
+/* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
+ * A[j][r] = sum_i X[j][i] sum_l b_l P_i(c_l) Ihat[l][r] in a real eigenbasis:
+ * Lambda block diagonal, a block per real eigenvalue a (b = 0) or pair a +- ib
+ * (columns col, col + 1 of T). */
+typedef struct {
+  int col, pair;
+  double a, b;
+} NewtonBlock;
+
+typedef struct {
+  int s, nblocks;
+  NewtonBlock *blk;
+  double *T, *Tinv; /* s x s */
+} NewtonBasis;
+
+void newton_method_matrix(const Method *me, double *A); /* s x s */
+void newton_basis(const Method *me, NewtonBasis *nb);
+void build_newton(Build *b);
+
 /* lu.c: linear systems of DAG nodes, solved at generation time in structure */
 void lu_solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag);
 

@@ -24,6 +24,7 @@ Suite *errest_suite(void);
 Suite *adaptive_suite(void);
 Suite *dense_suite(void);
 Suite *events_suite(void);
+Suite *newton_suite(void);
 
 int main(void) {
   SRunner *sr = srunner_create(parser_suite());
@@ -48,6 +49,7 @@ int main(void) {
   srunner_add_suite(sr, adaptive_suite());
   srunner_add_suite(sr, dense_suite());
   srunner_add_suite(sr, events_suite());
+  srunner_add_suite(sr, newton_suite());
   srunner_run_all(sr, CK_NORMAL);
   int failed = srunner_ntests_failed(sr);
   srunner_free(sr);

@@ -1,0 +1,98 @@
+/* emit_newton.c - C text of the step's iteration under --iteration newton.
+ *
+ * In place of the fixed-point loop of emit_step.c: simplified Newton on
+ * F(gamma) = Phi(gamma) - gamma, Phi the sweep kernel (its result gam is
+ * Phi at its input). The Newton matrix I + h^2 A (x) M^-1 J is factored by
+ * the kernel "newton_factor" at the predicted polynomial, and again at the
+ * current one where the increments fall by less than half (the rule of
+ * Radau5 and IDA, within the step); "newton_solve" gives the correction.
+ * The factor is not kept across steps (first version: one or more
+ * factorisations every step).
+ *
+ * Stopping: as the fixed-point step of the constant family, on the scaled
+ * increment |h dgamma| / (max |q| + |h gamma_0|): far below an ulp
+ * (TOL / 256), or within 2 ulps and no longer falling 4x (round-off noise);
+ * a stall (STALL iterations without a new smallest increment) is converged
+ * only at round-off (NOISETOL). The step commits the gamma the last sweep
+ * was evaluated at (not Phi of it, which in a stiff component magnifies
+ * gamma's round-off by (h omega)^2), with p1 - p0 from that same sweep: the
+ * discrete energy balance then holds up to the residual's round-off. So the
+ * error left is that gamma's, the last increment itself, and the shortcut
+ * of the polynomial family's test, rho inc / (1 - rho) (the error of the
+ * next iterate, which has no sweep), does not apply: with it the stiff FPU
+ * chain (omega = 1000, h omega = 10) lost 1e-12 of H a step. */
+#include "emit.h"
+
+int emit_is_newton(const Emitter *e) { return e->st->kern[K_NSOLVE].nout > 0; }
+
+// NAME_newton_factor: the kernel "newton_factor" at gam, its pivots checked.
+static void emit_factor_checked(Emitter *e) {
+  tmpl(e, "#ifndef $P_REFRESH\n#define $P_REFRESH 4  /* factorisations of the Newton matrix a step, at most */\n#endif\n"
+          "/* The Newton matrix I + h^2 A (x) M^-1 J at the polynomial gam, factored into nf.\n"
+          " * Returns $P_OK, $P_ENONFINITE, or $P_ENOCONV for a singular matrix (a pivot below\n"
+          " * $P_SINGTOL of its diagonal entry: h too long for a J with negative curvature). */\n"
+          "static int $P_newton_factor_checked(const $P_state *x, const $R *gam, $R h, const $P_params *prm, $R *nf)\n{\n"
+          "  int i;\n"
+          "  $(newton_factor q0=x->q gam=gam h=h out=nf);\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) {\n"
+          "    $R piv = nf[$[newton_factor.pivot]i], dia = nf[$[newton_factor.adiag]i];\n"
+          "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
+          "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ENOCONV;\n  }\n"
+          "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
+}
+
+// What NAME_step_within needs before its body: the checked factorisation.
+void emit_newton_helpers(Emitter *e) { emit_factor_checked(e); }
+
+// The loop of NAME_step_within: from the predicted gam to the converged one,
+// leaving sw the sweep at it (sw[gam] replaced by gam itself), it the
+// iterations, nfac the factorisations, d1 the first correction.
+void emit_newton_iteration(Emitter *e) {
+  tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
+          "   * factored at the predicted polynomial, again where the iteration slows down */\n"
+          "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M];\n"
+          "  int nfac = 1;\n"
+          "  rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n"
+          "  if (rc != $P_OK) return rc;\n"
+          "  rc = $P_ENOCONV;\n"
+          "  for (it = 1; it <= $P_MAXITER; it++) {\n"
+          "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n"
+          "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
+          "    if (rc == $P_ENONFINITE) break;\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) res[i] = sw[$[sweep.gam]i] - gam[i];\n"
+          "    $(newton_solve gam=res lu=nf out=dg);\n"
+          "    /* increment: max |h dgamma| over max |q| + |h gamma_0| */\n"
+          "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
+          "    for (i = 0; i < $P_M; i++) {\n"
+          "      $R v = fabs$f(x->q[i]) + fabs$f(h * gam[i]);\n"
+          "      if (v > scale) scale = v;\n    }\n"
+          "    for (i = 0; i < $P_S * $P_M; i++)  /* (a NaN becomes inc: the factor is not finite) */\n"
+          "      if (!(fabs$f(h * dg[i]) <= inc)) inc = fabs$f(h * dg[i]);\n"
+          "    if (it == 1) d1 = inc;  /* the predictor's error, for $P_err_est */\n"
+          "    if (scale > 0) inc /= scale;\n"
+          "    if (!isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
+          "    /* converged at the gamma of this sweep (whose error is this increment): the\n"
+          "     * increment far below an ulp, or within 2 ulps and no longer falling 4x (noise) */\n"
+          "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) {\n"
+          "      rc = $P_OK;\n      break;\n    }\n"
+          "    /* a stall ($P_STALL iterations without a new smallest increment): converged only at\n"
+          "     * round-off ($P_NOISETOL) */\n"
+          "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
+          "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) gam[i] += dg[i];\n"
+          "    /* contracting by less than 2x (rho > 1/2) above round-off: J refreshed at the\n"
+          "     * current polynomial */\n"
+          "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n"
+          "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n"
+          "      nfac++;\n"
+          "      if (rf != $P_OK) { rc = rf; break; }\n"
+          "    }\n  }\n"
+          "  /* the step is the one at the gamma the sweep was evaluated at */\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n"
+          "  if (st) st->factors = nfac;\n");
+}
+
+// The field of NAME_stats the Newton iteration adds.
+void emit_newton_stats(Emitter *e) {
+  tmpl(e, "  int factors;       /* factorisations of the Newton matrix (--iteration newton) */\n");
+}
