@@ -5,9 +5,11 @@
 
 #include "conical_k1s1.h"
 
-#if defined(__FAST_MATH__) && !defined(conical_k1s1_ALLOW_FAST_MATH)
-/* -ffast-math would remove the finiteness checks and undo the compensated sums */
-#error "compile without -ffast-math (docs/api.md), or define conical_k1s1_ALLOW_FAST_MATH"
+#if (defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__)) && \
+    !defined(conical_k1s1_ALLOW_FAST_MATH)
+/* -ffast-math would remove the finiteness checks and undo the compensated sums;
+ * -ffinite-math-only alone removes the checks (a step of h = inf returned 0) */
+#error "compile without -ffast-math and -ffinite-math-only (docs/api.md), or define conical_k1s1_ALLOW_FAST_MATH"
 #endif
 
 /* NAME_predict and NAME_err_est stay out of NAME_step_within: inlined, they changed

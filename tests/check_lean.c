@@ -340,6 +340,23 @@ START_TEST(limits_settable_with_D) {
 }
 END_TEST
 
+/* NAME.c refuses to compile under -ffast-math and under -ffinite-math-only
+ * alone (issue 30, item 9: with the latter, a step of h = inf returned 0 and
+ * NaN in q), unless NAME_ALLOW_FAST_MATH is defined; plain flags compile. */
+START_TEST(unsafe_math_refused) {
+  static const struct { const char *flags; int ok; } cases[] = {
+      {"", 1}, {"-ffast-math", 0}, {"-ffinite-math-only", 0}, {"-ffinite-math-only -Dpendulum_k2s2_ALLOW_FAST_MATH", 1}};
+  char cmd[512];
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    snprintf(cmd, sizeof cmd, "cc -std=c99 %s -I../generated -fsyntax-only ../generated/pendulum_k2s2.c 2>/dev/null",
+             cases[i].flags);
+    int rc = system(cmd);
+    ck_assert_msg((rc == 0) == cases[i].ok, "cc %s: exit %d, want %s", cases[i].flags, rc,
+                  cases[i].ok ? "success" : "an #error");
+  }
+}
+END_TEST
+
 Suite *lean_suite(void) {
   Suite *s = suite_create("lean");
   TCase *tc = tcase_create("structure");
@@ -348,6 +365,7 @@ Suite *lean_suite(void) {
   tcase_add_test(tc, dense_mass_is_a_table);
   tcase_add_test(tc, no_event_code_without_events);
   tcase_add_test(tc, corpus_models_compile);
+  tcase_add_test(tc, unsafe_math_refused);
   tcase_add_test(tc, limits_settable_with_D);
   tcase_add_test(tc, no_multiplier_code_without_constraints);
   tcase_add_test(tc, no_force_code_without_potential);
