@@ -461,6 +461,9 @@ static int install(const char *dir, const char *name, char *const *final, const 
 // 100, 200, 400 and 1000 constrained coordinates, 1.8, 3.8, 7.9 and 19.7 MB of
 // C, took 12, 30, 80 and 200 s and 0.34, 0.40, 0.44 and 3.2 GB.
 #define LARGE_C_BYTES 4000000L /* 4 MB */
+// From this size on NAME.c is refused (nothing is written): at 19.7 MB gcc
+// took 200 s and 3.2 GB, and the 124 MB of variables x[100000] none finished.
+#define MAX_C_BYTES 32000000L /* 32 MB */
 
 // The note on a large NAME.c at path (nothing when it is smaller, or when it
 // cannot be read back: it was just written).
@@ -527,6 +530,15 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
   }
   int emitted = rc ? 0 : emit_solver(f[H], f[C], mod, me, st, &eo) == 0;
   if (emitted && o->emit_main) emitted = emit_driver(f[MAIN], mod, me, &eo) == 0;
+  long csize = f[C] ? ftell(f[C]) : 0;
+  if (!rc && emitted && csize > MAX_C_BYTES) {
+    fprintf(stderr,
+            "hbvmgen: error: '%s' would be %.1f MB of C, above the %.0f MB no compiler handles in reasonable time "
+            "(gcc -O2: 200 s and 3.2 GB at 19.7 MB); --stage-loop N and --mass-loop N roll the stages and M^-1 "
+            "into loops where they can (docs/embedding.md, \"Large models\")\n",
+            final[C], (double)csize / 1e6, MAX_C_BYTES / 1e6);
+    rc = 2; /* reported: no second message */
+  }
   for (int i = 0; i < nfiles; i++) {
     if (!f[i]) continue;
     int bad = ferror(f[i]), err = errno;
@@ -548,10 +560,10 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
   return rc != 0;
 }
 
-// Report that the degree of U or of a constraint needs k > MAX_K, at the
-// statement (U) or list element (g) that has it.
 #define FLOAT_POLY_MAX_S 7 /* the largest s of the poly family in float */
 
+// Report that the degree of U or of a constraint needs k > MAX_K, at the
+// statement (U) or list element (g) that has it.
 static void report_degree(const Model *mod, int s, int k) {
   const char *why;
   int best = -1;

@@ -357,6 +357,31 @@ START_TEST(unsafe_math_refused) {
 }
 END_TEST
 
+/* A model whose C would pass MAX_C_BYTES (32 MB) is refused with a message
+ * naming the size and --stage-loop / --mass-loop, and nothing is written
+ * (issue 30, item 10: variables x[100000] wrote 124 MB that no compiler
+ * finished); 30000 coordinates would write 37.6 MB. */
+START_TEST(huge_c_refused) {
+  char dir[] = "/tmp/hbvm-huge-XXXXXX", cmd[1024];
+  ck_assert(mkdtemp(dir) != NULL);
+  snprintf(cmd, sizeof cmd, "%s/big.ham", dir);
+  FILE *f = fopen(cmd, "w");
+  ck_assert(f != NULL);
+  fputs("variables x[30000]\nM = identity\nU = sum(i in 1..30000, x[i]^2)\n"
+        "q0 = [1 for i in 1..30000]\np0 = [0 for i in 1..30000]\n", f);
+  fclose(f);
+  snprintf(cmd, sizeof cmd, "../gen/hbvmgen -o %s %s/big.ham 2> %s/err", dir, dir, dir);
+  int rc = system(cmd);
+  ck_assert_msg(WIFEXITED(rc) && WEXITSTATUS(rc) == 1, "%s: exit %d, want 1", cmd, rc);
+  snprintf(cmd, sizeof cmd, "%s/err", dir);
+  char *err = read_text(cmd);
+  ck_assert_msg(err && strstr(err, "would be 37.6 MB of C") && strstr(err, "--stage-loop"), "message: %s", err);
+  free(err);
+  snprintf(cmd, sizeof cmd, "test ! -e %s/big.c && test ! -e %s/big.h && rm -rf %s", dir, dir, dir);
+  ck_assert_msg(system(cmd) == 0, "a file was written, or %s could not be removed", dir);
+}
+END_TEST
+
 Suite *lean_suite(void) {
   Suite *s = suite_create("lean");
   TCase *tc = tcase_create("structure");
@@ -366,6 +391,7 @@ Suite *lean_suite(void) {
   tcase_add_test(tc, no_event_code_without_events);
   tcase_add_test(tc, corpus_models_compile);
   tcase_add_test(tc, unsafe_math_refused);
+  tcase_add_test(tc, huge_c_refused);
   tcase_add_test(tc, limits_settable_with_D);
   tcase_add_test(tc, no_multiplier_code_without_constraints);
   tcase_add_test(tc, no_force_code_without_potential);
