@@ -1,4 +1,4 @@
-/* main.c - the hbvmgen command line (SPEC section 2).
+/* main.c - the hbvmgen command line (docs/hbvmgen.1, docs/api.md).
  *
  * Reads the model, runs the passes in order (parse, analyse, differentiate,
  * choose k, build the step, emit) and writes NAME.h, NAME.c and optionally
@@ -205,6 +205,18 @@ static const char *default_name(const char *path) {
     name[j++] = ok ? c : '_';
   }
   return name;
+}
+
+// Say so when the prefix default_name made of the file name at path is not
+// its base name as written (my-model.ham gives my_model, 2d.ham m2d).
+static void note_renamed(const char *path, const char *name) {
+  const char *base = strrchr(path, '/');
+  base = base ? base + 1 : path;
+  size_t n = strlen(base);
+  if (n > 4 && !strcmp(base + n - 4, ".ham")) n -= 4;
+  if (strlen(name) != n || strncmp(base, name, n))
+    fprintf(stderr, "hbvmgen: note: the emitted symbols of '%s' take the prefix '%s': '%.*s' is not a C identifier "
+            "(-n NAME chooses another)\n", path, name, (int)n, base);
 }
 
 static char *read_file(const char *path, size_t *len) {
@@ -544,7 +556,10 @@ int main(int argc, char **argv) {
   Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
-  if (!o.name && bad_name(o.name = default_name(o.model), o.model)) return 1;
+  if (!o.name) {
+    if (bad_name(o.name = default_name(o.model), o.model)) return 1;
+    note_renamed(o.model, o.name);
+  }
   signal(SIGXFSZ, SIG_IGN); /* past ulimit -f, a write fails (and is reported) instead of killing us */
   size_t len;
   char *src = read_file(o.model, &len);
