@@ -39,7 +39,7 @@ static const char usage[] =
     "  -s S          degree of the polynomial approximation, 1 <= S <= 20 (default 2)\n"
     "  -k K|auto     Gauss-Legendre nodes, S <= K <= 200 (default auto: the smallest k that\n"
     "                conserves H and g exactly for polynomial models; 2s+12 otherwise)\n"
-    "  -o DIR        where NAME.c and NAME.h are written (default generated)\n"
+    "  -o DIR        where NAME.c and NAME.h are written (default .: the current directory)\n"
     "  -n NAME       C prefix of every emitted symbol (default: the model file's base name)\n"
     "  --multiplier F  const or poly: how the Lagrange multiplier varies over a step.\n"
     "                const: constant, the paper's method, order 2 with constraints\n"
@@ -297,6 +297,7 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   for (int i = 0; i < mod->m; i++) ngrad += !dag_is_zero(mod->dag, mod->gradU[i]);
   printf("grad U: %d nonzero entries of %d\n", ngrad, mod->m);
   for (int i = 0; i < mod->nparams; i++) printf("param %s = %.17g\n", mod->params[i].name, mod->params[i].value);
+  method_advise(stdout, mod, o->s, k, fam);
 }
 
 /* ---- writing the output ----
@@ -553,7 +554,7 @@ static void report_degree(const Model *mod, int s, int k) {
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) {

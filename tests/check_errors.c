@@ -1,4 +1,4 @@
-/* check_errors.c - Check suite for bad input (SPEC section 1, "Errors").
+/* check_errors.c - Check suite for bad input (docs/language.md, "Errors and warnings").
  *
  * Every case runs the generator itself, ../gen/hbvmgen (the suite runs from
  * tests/), in a child with its own temporary output directory, stdout and

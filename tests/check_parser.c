@@ -624,7 +624,7 @@ START_TEST(test_layout)
 }
 END_TEST
 
-/* Every number format of SPEC section 1. */
+/* Every number format of docs/language.md. */
 START_TEST(test_numbers)
 {
   Model *mod = load("variables x[6]\nq0 = [12, 1.5, .5, 2e-3, 1.0E+10, 0.25e1]\n");
@@ -870,6 +870,60 @@ START_TEST(test_sugar_same_code)
 }
 END_TEST
 
+/* --check's advice for each kind of model (method_advise): the (s, k)
+ * measured best, whether the options given are those, what the constant
+ * multiplier and a kink mean, and the step size limit of the iteration at
+ * this s. A model with a kink is written into a temporary directory. */
+START_TEST(test_check_advice)
+{
+  static const struct {
+    const char *args, *want;
+  } cases[] = {
+      {"--check ../models/kepler.ham", "\nadvice: unconstrained and smooth: -s 6 -k 11 (order 12); on the outer"},
+      {"--check -s 6 -k 11 ../models/solar.ham", "\nadvice: unconstrained and smooth: -s 6 -k 11 (order 12), as chosen;"},
+      {"--check ../models/henon_heiles.ham", "\nadvice: unconstrained and smooth: -s 6 -k auto (order 12);"},
+      {"--check ../models/pendulum.ham", "\nadvice: constrained and smooth: -s 4 -k auto --multiplier poly (order 8); "},
+      {"--check -s 4 ../models/satellites.ham", " --multiplier poly (order 8), as chosen; "},
+      {"--check --multiplier const ../models/pendulum.ham", "\nadvice: --multiplier const has order 2 in p with"},
+      {"--check ../models/pendulum.ham", "stays below about 2.8 (docs/choosing.md, \"Stiffness\")\ncode: "},
+      {"--check -s 9 ../models/kepler.ham", "stays below about 5.7 (docs/choosing.md"},
+  };
+  char out[8192], args[256], dir[] = "/tmp/hbvm-advice-XXXXXX";
+  for (int i = 0; i < NCASES(cases); i++) {
+    ck_assert_int_eq(run_cli(cases[i].args, 0, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, cases[i].want) != NULL, "%s: no '%s' in\n%s", cases[i].args, cases[i].want, out);
+  }
+  ck_assert_ptr_nonnull(mkdtemp(dir));
+  snprintf(args, sizeof args, "%s/kink.ham", dir);
+  FILE *f = fopen(args, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs("variables x, y\nU = x^2 + max(y, 0)^2 + mod(x, 1)\n", f);
+  fclose(f);
+  snprintf(args, sizeof args, "--check %s/kink.ham", dir);
+  ck_assert_int_eq(run_cli(args, 0, out, sizeof out), 0);
+  ck_assert_msg(strstr(out, "\nadvice: U or g uses max, which has a kink or a jump: ") && !strstr(out, "smooth"),
+                "%s", out);
+  snprintf(args, sizeof args, "rm -r %s", dir);
+  ck_assert_int_eq(system(args), 0);
+}
+END_TEST
+
+/* Without -o the files go to the current directory (they went to
+ * generated/, the directory of the committed solvers, before). */
+START_TEST(test_default_output_dir)
+{
+  char here[1024], cmd[3072], dir[] = "/tmp/hbvm-cwd-XXXXXX";
+  ck_assert_ptr_nonnull(getcwd(here, sizeof here));
+  ck_assert_ptr_nonnull(mkdtemp(dir));
+  snprintf(cmd, sizeof cmd, "cd %s && %s/%s %s/../models/pendulum.ham 2>/dev/null", dir, here, GENERATOR, here);
+  ck_assert_int_eq(system(cmd), 0);
+  snprintf(cmd, sizeof cmd, "test -f %s/pendulum.c && test -f %s/pendulum.h && test ! -e %s/generated", dir, dir, dir);
+  ck_assert_msg(system(cmd) == 0, "hbvmgen without -o did not write pendulum.c and .h into the current directory");
+  snprintf(cmd, sizeof cmd, "rm -r %s", dir);
+  ck_assert_int_eq(system(cmd), 0);
+}
+END_TEST
+
 /* Bad command lines exit 1 with "hbvmgen: error: ..." on stderr. */
 static const char *const bad_options[] = {
     "--bogus ../models/pendulum.ham", "-s 0 ../models/pendulum.ham",   "-s x ../models/pendulum.ham",
@@ -957,6 +1011,8 @@ Suite *parser_suite(void)
   tcase_add_test(cli, test_check_code);
   tcase_add_test(cli, test_help);
   tcase_add_test(cli, test_sugar_same_code);
+  tcase_add_test(cli, test_check_advice);
+  tcase_add_test(cli, test_default_output_dir);
   tcase_add_loop_test(cli, test_bad_options, 0, NCASES(bad_options));
   suite_add_tcase(s, cli);
   return s;
