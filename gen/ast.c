@@ -31,6 +31,7 @@
 #endif
 #define MAX_INDEX 1000000000L
 #define MAX_EVENTS 1000
+#define MAX_CALL_NOTES 4 /* "in this call of" notes after one error, innermost first */
 
 typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_VALUES, SYM_PARAM, SYM_INDEX, SYM_FUNC, SYM_ARG } SymKind;
 
@@ -71,6 +72,8 @@ typedef struct {
   IntVec events;     /* the event statements, by number */
   int momenta;       /* lowering an event: p[i] is momentum i */
   int call_depth;    /* summed depths of the bodies of the calls being expanded */
+  int noted_error, notes; /* the error the last "in this call" notes follow, and their number */
+  Sym *free_syms;    /* undefined names, reused by define (loops and calls define many) */
 } Ctx;
 
 // Give n the depth one more than its deepest child. The first node deeper
@@ -185,7 +188,13 @@ static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
              kind == SYM_PARAM ? "param" : "definition", problem);
     return NULL;
   }
-  Sym *s = arena_alloc(sizeof *s);
+  Sym *s = cx->free_syms;
+  if (s) {
+    cx->free_syms = s->next;
+    memset(s, 0, sizeof *s);
+  } else {
+    s = arena_alloc(sizeof *s);
+  }
   s->kind = kind;
   s->name = name;
   s->loc = loc;
@@ -199,10 +208,12 @@ static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
 }
 
 // Remove a name defined for a while (an index variable, a parameter), and
-// bring back the name it hid.
+// bring back the name it hid; its Sym is kept for the next define.
 static void undefine(Ctx *cx, Sym *sym) {
   unlink_sym(cx, sym);
   if (sym->shadowed) link_sym(cx, sym->shadowed);
+  sym->next = cx->free_syms;
+  cx->free_syms = sym;
 }
 
 static int lower(Ctx *cx, const Ast *e);
@@ -449,7 +460,8 @@ static int bind_params(Ctx *cx, const Sym *f, const int *vals, Sym **bound) {
 // A call of function f of 'def': the arguments lowered here, then its body
 // where f was defined, seeing the names defined before it and its
 // parameters, each the node of its argument. An error in the body is
-// reported once, with a note at the call; a call costs one term of
+// reported once, with a note at the call (at the first MAX_CALL_NOTES calls
+// of a nest of them); a call costs one term of
 // MAX_WORK, so that functions calling others twice cannot expand
 // exponentially, and the bodies of the calls being expanded are at most
 // MAX_AST_DEPTH deep together, which bounds the recursion of lower.
@@ -461,21 +473,24 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
     return -1;
   }
   if (check_arity(e, nparams) < 0) return -1;
-  int *vals = arena_alloc((size_t)nparams * sizeof *vals), i = 0;
-  for (const Ast *a = e->args; a; a = a->next)
-    if ((vals[i++] = lower(cx, a)) < 0) return -1;
-  if (f->broken) return -1;
-  if (cx->work >= MAX_WORK || cx->call_depth + f->def->expr->depth > MAX_AST_DEPTH) {
+  /* on the heap: a call in a loop must not fill the arena */
+  int *vals = xmalloc((size_t)nparams * sizeof *vals), i = 0, ok = 1;
+  for (const Ast *a = e->args; a && ok; a = a->next) ok = (vals[i++] = lower(cx, a)) >= 0;
+  if (ok && !f->broken && (cx->work >= MAX_WORK || cx->call_depth + f->def->expr->depth > MAX_AST_DEPTH)) {
     error_at(e->loc, cx->work >= MAX_WORK ? "too many terms: sums, lists and calls may expand to at most %ld in all"
                                           : "calls of functions nested too deeply (more than %ld levels in all)",
              cx->work >= MAX_WORK ? MAX_WORK : (long)MAX_AST_DEPTH);
+    ok = 0;
+  }
+  if (!ok || f->broken) {
+    free(vals);
     return -1;
   }
   cx->work++;
   f->used = 1;
   int caller = cx->stmt, errors = diag_error_count(), node = -1;
   cx->stmt = f->stmt;
-  Sym **bound = arena_alloc((size_t)nparams * sizeof *bound);
+  Sym **bound = xmalloc((size_t)nparams * sizeof *bound);
   int nbound = bind_params(cx, f, vals, bound);
   if (nbound == nparams) {
     f->busy = 1;
@@ -485,9 +500,12 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
     f->busy = 0;
   }
   while (nbound > 0) undefine(cx, bound[--nbound]);
+  free(bound);
+  free(vals);
   cx->stmt = caller;
   if (node < 0 && diag_error_count() > errors) {
-    note_at(e->loc, "in this call of '%s'", e->name);
+    if (cx->noted_error != diag_error_count()) cx->noted_error = diag_error_count(), cx->notes = 0;
+    if (cx->notes++ < MAX_CALL_NOTES) note_at(e->loc, "in this call of '%s'", e->name);
     f->broken = 1;
   }
   return node;
@@ -498,40 +516,43 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
 // fn(cx, body, acc) which returns <0 on error.
 typedef int (*RangeFn)(Ctx *cx, const Ast *body, void *acc);
 
-static int iterated_list(Ctx *cx, const Ast *e, List *out);
+/* The values of a list an index variable runs over, on the heap (a list
+ * after 'in' is taken again at each iteration of the loops around it, so
+ * it must not stay in the arena). */
+typedef struct {
+  long *v;
+  int n, cap;
+} Longs;
+
+static int iterated_list(Ctx *cx, const Ast *e, Longs *out);
 
 static int for_range(Ctx *cx, const Ast *at, const Ast *body, RangeFn fn, void *acc) {
   long lo = 0, hi = -1;
-  List l = {{0}, {0}, {0}};
+  Longs vals = {NULL, 0, 0};
+  int rc = 0;
   if (!at->b) {
-    if (iterated_list(cx, at->a, &l) < 0) return -1;
-    hi = l.nodes.n - 1;
+    rc = iterated_list(cx, at->a, &vals);
+    hi = vals.n - 1;
   } else if (lower_int(cx, at->a, "a range bound", &lo) < 0 || lower_int(cx, at->b, "a range bound", &hi) < 0) {
-    return -1;
+    rc = -1;
   }
-  if (hi - lo + 1 > MAX_WORK - cx->work) {
+  if (rc == 0 && hi - lo + 1 > MAX_WORK - cx->work) {
     error_at(at->loc, "range %ld..%ld has too many terms: sums and lists may expand to at most %ld terms in all", lo,
              hi, MAX_WORK);
-    return -1;
+    rc = -1;
   }
-  long *vals = NULL;
-  if (!at->b) {
-    vals = arena_alloc((size_t)(l.nodes.n + 1) * sizeof *vals);
-    for (int i = 0; i < l.nodes.n; i++)
-      if (const_int(cx, l.nodes.v[i], (Loc){l.lines.v[i], l.cols.v[i]}, "a value of the list after 'in'", &vals[i]) < 0)
-        return -1;
+  Sym *iv = rc < 0 ? NULL : define(cx, at->name, at->name_loc, SYM_INDEX);
+  if (iv) {
+    iv->used = 1;
+    for (long i = lo; i <= hi && rc >= 0; i++) {
+      cx->work++;
+      iv->ival = at->b ? i : vals.v[i];
+      rc = fn(cx, body, acc);
+    }
+    undefine(cx, iv);
   }
-  Sym *iv = define(cx, at->name, at->name_loc, SYM_INDEX);
-  if (!iv) return -1;
-  iv->used = 1;
-  int rc = 0;
-  for (long i = lo; i <= hi && rc >= 0; i++) {
-    cx->work++;
-    iv->ival = vals ? vals[i] : i;
-    rc = fn(cx, body, acc);
-  }
-  undefine(cx, iv);
-  return rc;
+  free(vals.v);
+  return iv ? rc : -1;
 }
 
 // Add the term body to the sum *acc; the inner iterator of a sum over
@@ -596,17 +617,47 @@ static int flatten(Ctx *cx, const Ast *e, List *out) {
   return 0;
 }
 
+// Append v to the values of a list after 'in'.
+static void longs_push(Longs *out, long v) {
+  if (out->n == out->cap) {
+    out->cap = out->cap ? 2 * out->cap : 16;
+    out->v = xrealloc(out->v, (size_t)out->cap * sizeof *out->v);
+  }
+  out->v[out->n++] = v;
+}
+
+static const char list_value[] = "a value of the list after 'in'";
+
+static int list_values(Ctx *cx, const Ast *e, Longs *out);
+
+static int list_item(Ctx *cx, const Ast *body, void *acc) { return list_values(cx, body, acc); }
+
+// Append the values of e, an element of a list after 'in', to out: lists
+// and comprehensions nest and flatten, each value a constant integer.
+static int list_values(Ctx *cx, const Ast *e, Longs *out) {
+  if (e->kind == A_LIST) {
+    for (const Ast *a = e->args; a; a = a->next)
+      if (list_values(cx, a, out) < 0) return -1;
+    return 0;
+  }
+  if (e->kind == A_FOR) return for_range(cx, e, e->c, list_item, out);
+  long v;
+  if (lower_int(cx, e, list_value, &v) < 0) return -1;
+  longs_push(out, v);
+  return 0;
+}
+
 // The values of what an index variable runs over, e: a list, or the name
 // of an array of values.
-static int iterated_list(Ctx *cx, const Ast *e, List *out) {
-  if (e->kind == A_LIST || e->kind == A_FOR) return flatten(cx, e, out);
+static int iterated_list(Ctx *cx, const Ast *e, Longs *out) {
+  if (e->kind == A_LIST || e->kind == A_FOR) return list_values(cx, e, out);
   Sym *s = e->kind == A_NAME ? lookup(cx, e->name) : NULL;
   if (s && s->kind == SYM_VALUES && s->stmt <= cx->stmt) {
     s->used = 1;
+    long v;
     for (int i = 0; i < s->size; i++) {
-      intvec_push(&out->nodes, s->nodes[i]);
-      intvec_push(&out->lines, e->loc.line);
-      intvec_push(&out->cols, e->loc.col);
+      if (const_int(cx, s->nodes[i], e->loc, list_value, &v) < 0) return -1;
+      longs_push(out, v);
     }
     return s->size ? 0 : -1; /* an array in error has no values, and its error is said */
   }

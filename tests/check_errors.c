@@ -451,6 +451,31 @@ START_TEST(test_huge_tokens)
 }
 END_TEST
 
+/* Functions of def cannot expand without bound: 40 functions each calling
+ * the one before twice would make 2^40 calls (refused at MAX_WORK, 2e7
+ * calls: a few seconds), and a chain of 3000 each calling the one before
+ * would recurse deeper than expressions may nest. */
+START_TEST(test_def_expansion_bounded)
+{
+  Buf b = {0};
+  char line[96];
+  buf_str(&b, "variables x\ndef f1(a) = a\n");
+  for (int i = 2; i <= 40; i++) {
+    snprintf(line, sizeof line, "def f%d(a) = f%d(a) + f%d(a)\n", i, i - 1, i - 1);
+    buf_str(&b, line);
+  }
+  buf_str(&b, "U = f40(x)\n");
+  expect_rejected(&b, "2^40 calls", "error: too many terms: sums, lists and calls may expand to at most");
+  buf_str(&b, "variables x\ndef f1(a) = a + 1\n");
+  for (int i = 2; i <= 3000; i++) {
+    snprintf(line, sizeof line, "def f%d(a) = f%d(a) + 1\n", i, i - 1);
+    buf_str(&b, line);
+  }
+  buf_str(&b, "U = f3000(x)\n");
+  expect_rejected(&b, "3000 nested calls", "error: calls of functions nested too deeply");
+}
+END_TEST
+
 /* A small deterministic generator (xorshift32), independent of the C
  * library so the inputs are the same everywhere. */
 static unsigned next_random(unsigned *state)
@@ -553,6 +578,7 @@ Suite *errors_suite(void)
   tcase_add_test(robust, test_deep_brackets);
   tcase_add_test(robust, test_deep_chains);
   tcase_add_test(robust, test_huge_tokens);
+  tcase_add_test(robust, test_def_expansion_bounded);
   tcase_add_test(robust, test_step_node_limit);
   tcase_add_test(robust, test_random_bytes);
   tcase_add_test(robust, test_nul_bytes);
