@@ -74,7 +74,18 @@ typedef struct {
   int call_depth;    /* summed depths of the bodies of the calls being expanded */
   int noted_error, notes; /* the error the last "in this call" notes follow, and their number */
   Sym *free_syms;    /* undefined names, reused by define (loops and calls define many) */
+  struct Memo **memo; /* the calls expanded, by function and argument nodes (see find_call) */
+  int nmemo, memocap;
 } Ctx;
+
+/* A call of a function of def already expanded: f with these argument
+ * nodes (and the meaning of p, as in an event or not) gives node. */
+typedef struct Memo {
+  const Sym *f;
+  int momenta, node, nargs;
+  int *args;
+  struct Memo *next;
+} Memo;
 
 // Give n the depth one more than its deepest child. The first node deeper
 // than MAX_AST_DEPTH is an error (the parser goes on, nothing is lowered),
@@ -459,12 +470,46 @@ static int bind_params(Ctx *cx, const Sym *f, const int *vals, Sym **bound) {
 
 // A call of function f of 'def': the arguments lowered here, then its body
 // where f was defined, seeing the names defined before it and its
-// parameters, each the node of its argument. An error in the body is
+// parameters, each the node of its argument; once per distinct arguments
+// (find_call). An error in the body is
 // reported once, with a note at the call (at the first MAX_CALL_NOTES calls
 // of a nest of them); a call costs one term of
 // MAX_WORK, so that functions calling others twice cannot expand
 // exponentially, and the bodies of the calls being expanded are at most
 // MAX_AST_DEPTH deep together, which bounds the recursion of lower.
+static unsigned hash_call(const Sym *f, int momenta, const int *args, int n, int cap) {
+  unsigned h = (unsigned)(size_t)f * 2654435761u ^ (unsigned)momenta;
+  for (int i = 0; i < n; i++) h = (h ^ (unsigned)args[i]) * 16777619u;
+  return h & (unsigned)(cap - 1);
+}
+
+// The slot of the call of f with the argument nodes args (n of them) in the
+// calls already expanded: *slot is its entry, or NULL where a new one goes.
+// A body's value depends on nothing else (it sees only what was defined
+// before it, and its parameters), so a call is expanded once per distinct
+// arguments: f(a) = g(a) + g(a) costs one expansion of g, and functions
+// that call others twice expand in linear, not exponential, time.
+static Memo **find_call(Ctx *cx, const Sym *f, const int *args, int n) {
+  if (cx->nmemo >= cx->memocap) { /* grow (and create) the table, rehashing */
+    int cap = cx->memocap ? 2 * cx->memocap : 256;
+    Memo **t = arena_alloc((size_t)cap * sizeof *t);
+    for (int b = 0; b < cx->memocap; b++)
+      for (Memo *m = cx->memo[b], *next; m; m = next) {
+        next = m->next;
+        unsigned h = hash_call(m->f, m->momenta, m->args, m->nargs, cap);
+        m->next = t[h];
+        t[h] = m;
+      }
+    cx->memo = t;
+    cx->memocap = cap;
+  }
+  Memo **slot = &cx->memo[hash_call(f, cx->momenta, args, n, cx->memocap)];
+  for (; *slot; slot = &(*slot)->next)
+    if ((*slot)->f == f && (*slot)->momenta == cx->momenta && !memcmp((*slot)->args, args, (size_t)n * sizeof *args))
+      break;
+  return slot;
+}
+
 static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
   int nparams = 0;
   for (const Decl *p = f->def->decls; p; p = p->next) nparams++;
@@ -482,9 +527,10 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
              cx->work >= MAX_WORK ? MAX_WORK : (long)MAX_AST_DEPTH);
     ok = 0;
   }
-  if (!ok || f->broken) {
+  Memo **slot = ok && !f->broken ? find_call(cx, f, vals, nparams) : NULL;
+  if (!slot || *slot) {
     free(vals);
-    return -1;
+    return slot ? (cx->work++, (*slot)->node) : -1;
   }
   cx->work++;
   f->used = 1;
@@ -501,8 +547,15 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
   }
   while (nbound > 0) undefine(cx, bound[--nbound]);
   free(bound);
-  free(vals);
   cx->stmt = caller;
+  if (node >= 0) { /* remembered (its arguments into the arena: once per distinct call) */
+    Memo *m = arena_alloc(sizeof *m);
+    *m = (Memo){f, cx->momenta, node, nparams, arena_alloc((size_t)nparams * sizeof(int) + 1), NULL};
+    memcpy(m->args, vals, (size_t)nparams * sizeof(int));
+    *find_call(cx, f, vals, nparams) = m;
+    cx->nmemo++;
+  }
+  free(vals);
   if (node < 0 && diag_error_count() > errors) {
     if (cx->noted_error != diag_error_count()) cx->noted_error = diag_error_count(), cx->notes = 0;
     if (cx->notes++ < MAX_CALL_NOTES) note_at(e->loc, "in this call of '%s'", e->name);

@@ -265,7 +265,7 @@ static const char *nonsmooth_function(const Model *mod) {
   int *roots = xmalloc((size_t)(mod->nu + 1) * sizeof *roots);
   unsigned char *mark = xcalloc((size_t)d->n, 1);
   roots[0] = mod->U;
-  memcpy(roots + 1, mod->g, (size_t)mod->nu * sizeof *roots);
+  if (mod->nu) memcpy(roots + 1, mod->g, (size_t)mod->nu * sizeof *roots);
   dag_reach(d, roots, mod->nu + 1, mark);
   const char *found = NULL;
   for (int id = 0; id < d->n && !found; id++)

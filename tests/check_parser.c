@@ -576,6 +576,16 @@ START_TEST(test_def_functions)
   int n_twice = twice->dag->n;
   Model *once = load("variables x, y\nU = sin(x + y) * (x + y) + sin(x + y) * (x + y)\n");
   ck_assert_int_eq(n_twice, once->dag->n);
+  /* 40 functions each calling the one before twice: 2^39 calls of f1 written
+   * out, expanded once per distinct arguments (a few hundred nodes) */
+  char src[4096] = "variables x\ndef f1(a) = a\n";
+  for (int i = 2; i <= 40; i++)
+    snprintf(src + strlen(src), sizeof src - strlen(src), "def f%d(a) = f%d(a) + f%d(a)\n", i, i - 1, i - 1);
+  strcat(src, "U = f40(x)\n");
+  Model *chain = load(src);
+  const double one[] = {1};
+  assert_close(eval(chain, chain->U, one), ldexp(1, 39), "U of the doubling chain");
+  ck_assert_int_lt(chain->dag->n, 1000);
   static const char *const bad[] = {
       "variables x\ndef f(a) = a\nU = f(x, x)\n",        /* arity */
       "variables x\ndef f(a) = f(a)\nU = f(x)\n",        /* recursion */
