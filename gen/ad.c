@@ -12,7 +12,8 @@
  *
  * Where a function has a kink the sweep takes a subgradient, the same at
  * every tie: d abs(a) = sign(a), 0 at a = 0; d sign(a) = 0 everywhere (the
- * jump at 0 has no derivative); min and max pass the adjoint to the
+ * jump at 0 has no derivative), and so is d floor(a) (its jumps at the
+ * integers neither); min and max pass the adjoint to the
  * operand they select, and half to each when a = b, through
  * (1 -+ sign(a - b)) / 2, so at a tie the derivative is the mean of the
  * two one-sided ones. */
@@ -54,6 +55,7 @@ static void propagate(Sweep *sw, int id, int w) {
   case OP_INPUT:
   case OP_PARAM:
   case OP_SIGN:
+  case OP_FLOOR:
     return;
   case OP_ADD:
     accumulate(sw, a, w);

@@ -5,7 +5,10 @@
  * coordinates (input slots), constants, shared subexpressions or
  * parameters; index variables of `sum` and `for` are integers substituted
  * as constants while their body is lowered, so arrays, sums and
- * comprehensions are fully expanded. M, q0 and p0 depend on the final
+ * comprehensions are fully expanded. A function of `def` is expanded the
+ * same way at each call: its body is lowered with each parameter naming the
+ * argument's node, in the scope of the `def` (the names defined before it),
+ * and hash-consing in the DAG shares what two calls have in common. M, q0 and p0 depend on the final
  * number of coordinates and are lowered after the last statement (still
  * seeing only the names defined before them). So are the events, whose
  * expressions may also use the momenta p[1] .. p[m] (DAG inputs m .. 2m-1,
@@ -28,8 +31,9 @@
 #endif
 #define MAX_INDEX 1000000000L
 #define MAX_EVENTS 1000
+#define MAX_CALL_NOTES 4 /* "in this call of" notes after one error, innermost first */
 
-typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_VALUES, SYM_PARAM, SYM_INDEX } SymKind;
+typedef enum { SYM_COORD, SYM_ARRAY, SYM_VALUE, SYM_VALUES, SYM_PARAM, SYM_INDEX, SYM_FUNC, SYM_ARG } SymKind;
 
 typedef struct Sym Sym;
 struct Sym {
@@ -39,10 +43,14 @@ struct Sym {
   int stmt;      /* statement that defines it (file order) */
   int base;      /* COORD, ARRAY: first input slot; PARAM: parameter number */
   int size;      /* ARRAY, VALUES */
-  int node;      /* VALUE */
+  int node;      /* VALUE, ARG (a parameter of a function of def, during a call) */
   int *nodes;    /* VALUES: size nodes, the array defined by name = [...] */
   long ival;     /* INDEX */
+  const Stmt *def; /* FUNC: its statement */
+  int busy;      /* FUNC: its body is being expanded */
+  int broken;    /* FUNC: an error was reported in its body (once) */
   int used;
+  Sym *shadowed; /* a name this one hides while it is defined (see define) */
   Sym *next;     /* hash chain */
 };
 
@@ -63,7 +71,21 @@ typedef struct {
   const Stmt *prog;  /* all statements, to find a name defined too late */
   IntVec events;     /* the event statements, by number */
   int momenta;       /* lowering an event: p[i] is momentum i */
+  int call_depth;    /* summed depths of the bodies of the calls being expanded */
+  int noted_error, notes; /* the error the last "in this call" notes follow, and their number */
+  Sym *free_syms;    /* undefined names, reused by define (loops and calls define many) */
+  struct Memo **memo; /* the calls expanded, by function and argument nodes (see find_call) */
+  int nmemo, memocap;
 } Ctx;
+
+/* A call of a function of def already expanded: f with these argument
+ * nodes (and the meaning of p, as in an event or not) gives node. */
+typedef struct Memo {
+  const Sym *f;
+  int momenta, node, nargs;
+  int *args;
+  struct Memo *next;
+} Memo;
 
 // Give n the depth one more than its deepest child. The first node deeper
 // than MAX_AST_DEPTH is an error (the parser goes on, nothing is lowered),
@@ -135,18 +157,38 @@ static const char *sym_kind_name(const Ctx *cx, const Sym *s) {
   case SYM_VALUES: return "an array of values";
   case SYM_PARAM: return "a parameter";
   case SYM_INDEX: return "an index variable";
+  case SYM_FUNC: return "a function";
+  case SYM_ARG: return "a parameter of a function";
   }
   return "a name";
 }
 
-// Define a new name, or report that it exists (returns NULL then).
+static void unlink_sym(Ctx *cx, Sym *sym) {
+  Sym **p = &cx->buckets[hash_name(cx, sym->name)];
+  while (*p != sym) p = &(*p)->next;
+  *p = sym->next;
+  cx->nsyms--;
+}
+
+static void link_sym(Ctx *cx, Sym *s) {
+  if (++cx->nsyms > 2 * cx->nbuckets) grow_table(cx);
+  unsigned h = hash_name(cx, s->name);
+  s->next = cx->buckets[h];
+  cx->buckets[h] = s;
+}
+
+// Define a new name, or report that it exists (returns NULL then). A name
+// the statement being analysed cannot see (defined by a later statement, or
+// an index variable of the caller of a function being expanded) is hidden
+// while the new one, an index variable or a parameter, is defined.
 static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
   if (!strcmp(name, "pi")) {
     error_at(loc, "'pi' is the constant 3.14159... and cannot be redefined");
     return NULL;
   }
   Sym *old = lookup(cx, name);
-  if (old) {
+  int hide = old && old->stmt > cx->stmt;
+  if (old && !hide) {
     error_at(loc, "'%s' is defined twice (first as %s at line %d, column %d)", name, sym_kind_name(cx, old),
              old->loc.line, old->loc.col);
     return NULL;
@@ -157,23 +199,32 @@ static Sym *define(Ctx *cx, const char *name, Loc loc, SymKind kind) {
              kind == SYM_PARAM ? "param" : "definition", problem);
     return NULL;
   }
-  Sym *s = arena_alloc(sizeof *s);
+  Sym *s = cx->free_syms;
+  if (s) {
+    cx->free_syms = s->next;
+    memset(s, 0, sizeof *s);
+  } else {
+    s = arena_alloc(sizeof *s);
+  }
   s->kind = kind;
   s->name = name;
   s->loc = loc;
   s->stmt = cx->stmt;
-  if (++cx->nsyms > 2 * cx->nbuckets) grow_table(cx);
-  unsigned h = hash_name(cx, name);
-  s->next = cx->buckets[h];
-  cx->buckets[h] = s;
+  if (hide) {
+    unlink_sym(cx, old);
+    s->shadowed = old;
+  }
+  link_sym(cx, s);
   return s;
 }
 
+// Remove a name defined for a while (an index variable, a parameter), and
+// bring back the name it hid; its Sym is kept for the next define.
 static void undefine(Ctx *cx, Sym *sym) {
-  Sym **p = &cx->buckets[hash_name(cx, sym->name)];
-  while (*p != sym) p = &(*p)->next;
-  *p = sym->next;
-  cx->nsyms--;
+  unlink_sym(cx, sym);
+  if (sym->shadowed) link_sym(cx, sym->shadowed);
+  sym->next = cx->free_syms;
+  cx->free_syms = sym;
 }
 
 static int lower(Ctx *cx, const Ast *e);
@@ -181,30 +232,34 @@ static int lower(Ctx *cx, const Ast *e);
 // What a node that is not constant depends on, for messages.
 static const char *dependence(const Node *nd) { return nd->flags & DEP_INPUT ? "a coordinate" : "a parameter"; }
 
-// Lower e and require a constant integer (sizes, indices, ranges).
-static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
-  int n = lower(cx, e);
-  if (n < 0) return -1;
+// Require node n, the value of what at loc, to be a constant integer.
+static int const_int(Ctx *cx, int n, Loc loc, const char *what, long *out) {
   const Node *nd = &cx->d->nodes[n];
   if (nd->op != OP_CONST) {
-    error_at(e->loc, "%s must be a constant integer, but it depends on %s", what, dependence(nd));
+    error_at(loc, "%s must be a constant integer, but it depends on %s", what, dependence(nd));
     return -1;
   }
   if (nd->val != floor(nd->val)) {
-    error_at(e->loc, "%s must be an integer, got %.17g", what, nd->val);
+    error_at(loc, "%s must be an integer, got %.17g", what, nd->val);
     return -1;
   }
   if (fabs(nd->val) > MAX_INDEX) {
-    error_at(e->loc, "%s is %.17g, beyond the largest allowed magnitude, %ld", what, nd->val, MAX_INDEX);
+    error_at(loc, "%s is %.17g, beyond the largest allowed magnitude, %ld", what, nd->val, MAX_INDEX);
     return -1;
   }
   *out = (long)nd->val;
   return 0;
 }
 
+// Lower e and require a constant integer (sizes, indices, ranges).
+static int lower_int(Ctx *cx, const Ast *e, const char *what, long *out) {
+  int n = lower(cx, e);
+  return n < 0 ? -1 : const_int(cx, n, e->loc, what, out);
+}
+
 // Where statement st defines name (a definition, param or coordinate), or NULL.
 static const Loc *defines(const Stmt *st, const char *name) {
-  if ((st->kind == S_DEF || st->kind == S_PARAM) && !strcmp(st->name, name)) return &st->name_loc;
+  if ((st->kind == S_DEF || st->kind == S_PARAM || st->kind == S_FUNC) && !strcmp(st->name, name)) return &st->name_loc;
   if (st->kind == S_VARIABLES)
     for (const Decl *dc = st->decls; dc; dc = dc->next)
       if (!strcmp(dc->name, name)) return &dc->loc;
@@ -218,7 +273,7 @@ static const Loc *defines(const Stmt *st, const char *name) {
 static Sym *resolve(Ctx *cx, const char *name, Loc loc) {
   Sym *s = lookup(cx, name);
   if (s && s->stmt <= cx->stmt) return s;
-  const Loc *later = s ? &s->loc : NULL;
+  const Loc *later = s && s->kind != SYM_INDEX ? &s->loc : NULL; /* not a caller's index variable */
   int i = 0;
   for (const Stmt *st = cx->prog; st && !later; st = st->next, i++)
     if (i >= cx->stmt && (later = defines(st, name)) != NULL && i == cx->stmt) {
@@ -258,6 +313,10 @@ static int lower_name(Ctx *cx, const Ast *e) {
     return -1;
   case SYM_PARAM: return dag_param(cx->d, s->base);
   case SYM_INDEX: return dag_const(cx->d, (double)s->ival);
+  case SYM_ARG: return s->node;
+  case SYM_FUNC:
+    error_at(e->loc, "'%s' is a function: call it, as in %s(...)", e->name, e->name);
+    return -1;
   }
   return -1;
 }
@@ -333,55 +392,228 @@ static const struct {
     {"sin", OP_SIN},   {"cos", OP_COS},   {"tan", OP_TAN},     {"asin", OP_ASIN}, {"acos", OP_ACOS},
     {"atan", OP_ATAN}, {"atan2", OP_ATAN2}, {"sinh", OP_SINH}, {"cosh", OP_COSH}, {"tanh", OP_TANH},
     {"exp", OP_EXP},   {"log", OP_LOG},   {"sqrt", OP_SQRT},   {"pow", OP_POW},   {"abs", OP_ABS},
-    {"sign", OP_SIGN}, {"min", OP_MIN},   {"max", OP_MAX},
+    {"sign", OP_SIGN}, {"min", OP_MIN},   {"max", OP_MAX},     {"floor", OP_FLOOR},
 };
 
+/* ---- lists: g, q0, p0, diag(...), what an index variable runs over ---- */
+
+typedef struct {
+  IntVec nodes, lines, cols;
+} List;
+
+static int flatten(Ctx *cx, const Ast *e, List *out);
+
+#define FUNCTION_NAMES \
+  "sin cos tan asin acos atan atan2 sinh cosh tanh exp log sqrt pow abs sign min max floor mod"
+
+// The number of arguments of a call, checked against arity (reported).
+static int check_arity(const Ast *e, int arity) {
+  int nargs = 0;
+  for (const Ast *a = e->args; a; a = a->next) nargs++;
+  if (nargs == arity) return 0;
+  error_at(e->loc, "'%s' takes %d argument%s, got %d", e->name, arity, arity == 1 ? "" : "s", nargs);
+  return -1;
+}
+
+// mod(x, y) = x - y floor(x / y), which has the sign of y (as Python's %),
+// built from those operations: its derivatives are 1 and -floor(x / y).
+static int build_mod(Ctx *cx, int x, int y, Loc loc) {
+  if (dag_is_zero(cx->d, y)) {
+    error_at(loc, "mod(a, b) with b = 0: the remainder of a division by zero");
+    return -1;
+  }
+  int q = build(cx, OP_DIV, x, y, loc, "/");
+  if (q < 0) return -1;
+  int fl = build(cx, OP_FLOOR, q, -1, loc, "floor");
+  int prod = fl < 0 ? -1 : build(cx, OP_MUL, y, fl, loc, "*");
+  return prod < 0 ? -1 : build(cx, OP_SUB, x, prod, loc, "-");
+}
+
+static int lower_user_call(Ctx *cx, const Ast *e, Sym *f);
+
+// A call: of a function of the language, or of one defined with 'def'.
 static int lower_call(Ctx *cx, const Ast *e) {
   Op op = OP_COUNT;
   for (size_t i = 0; i < sizeof functions / sizeof functions[0]; i++)
     if (!strcmp(functions[i].name, e->name)) op = functions[i].op;
-  ASSERT(op != OP_COUNT);
-  int nargs = 0;
-  for (const Ast *a = e->args; a; a = a->next) nargs++;
-  int arity = op_arity(op);
-  if (nargs != arity) {
-    error_at(e->loc, "'%s' takes %d argument%s, got %d", e->name, arity, arity == 1 ? "" : "s", nargs);
+  int is_mod = !strcmp(e->name, "mod");
+  if (op == OP_COUNT && !is_mod) {
+    Sym *f = lookup(cx, e->name);
+    if (f && f->stmt <= cx->stmt && f->kind == SYM_FUNC) return lower_user_call(cx, e, f);
+    if (f && f->stmt <= cx->stmt)
+      error_at(e->loc, "'%s' is %s, not a function", e->name, sym_kind_name(cx, f));
+    else
+      error_at(e->loc, "'%.40s' is not a function (the functions are " FUNCTION_NAMES ", and those of 'def')",
+               e->name);
     return -1;
   }
+  int arity = is_mod ? 2 : op_arity(op);
+  if (check_arity(e, arity) < 0) return -1;
   int x = lower(cx, e->args);
   int y = arity == 2 ? lower(cx, e->args->next) : -1;
   if (x < 0 || (arity == 2 && y < 0)) return -1;
-  return build(cx, op, x, y, e->loc, e->name);
+  return is_mod ? build_mod(cx, x, y, e->loc) : build(cx, op, x, y, e->loc, e->name);
 }
 
-// Run body once for each integer i in [lo, hi] bound to name (a new index
-// variable), calling fn(cx, body, acc) which returns <0 on error.
-typedef int (*RangeFn)(Ctx *cx, const Ast *body, void *acc);
+// Bind the parameters of function f to the nodes vals, each hiding a name
+// the function cannot see (see define). Returns the number bound; fewer
+// than the parameters after an error.
+static int bind_params(Ctx *cx, const Sym *f, const int *vals, Sym **bound) {
+  int n = 0;
+  for (const Decl *p = f->def->decls; p; p = p->next, n++) {
+    if (!(bound[n] = define(cx, p->name, p->loc, SYM_ARG))) break;
+    bound[n]->node = vals[n];
+    bound[n]->used = 1;
+  }
+  return n;
+}
 
-static int for_range(Ctx *cx, const Ast *at, const char *name, const Ast *lo_e, const Ast *hi_e, const Ast *body,
-                     RangeFn fn, void *acc) {
-  long lo, hi;
-  if (lower_int(cx, lo_e, "a range bound", &lo) < 0 || lower_int(cx, hi_e, "a range bound", &hi) < 0) return -1;
-  if (hi - lo + 1 > MAX_WORK - cx->work) {
-    error_at(at->loc, "range %ld..%ld has too many terms: sums and lists may expand to at most %ld terms in all", lo,
-             hi, MAX_WORK);
+// A call of function f of 'def': the arguments lowered here, then its body
+// where f was defined, seeing the names defined before it and its
+// parameters, each the node of its argument; once per distinct arguments
+// (find_call). An error in the body is
+// reported once, with a note at the call (at the first MAX_CALL_NOTES calls
+// of a nest of them); a call costs one term of
+// MAX_WORK, so that functions calling others twice cannot expand
+// exponentially, and the bodies of the calls being expanded are at most
+// MAX_AST_DEPTH deep together, which bounds the recursion of lower.
+static unsigned hash_call(const Sym *f, int momenta, const int *args, int n, int cap) {
+  unsigned h = (unsigned)(size_t)f * 2654435761u ^ (unsigned)momenta;
+  for (int i = 0; i < n; i++) h = (h ^ (unsigned)args[i]) * 16777619u;
+  return h & (unsigned)(cap - 1);
+}
+
+// The slot of the call of f with the argument nodes args (n of them) in the
+// calls already expanded: *slot is its entry, or NULL where a new one goes.
+// A body's value depends on nothing else (it sees only what was defined
+// before it, and its parameters), so a call is expanded once per distinct
+// arguments: f(a) = g(a) + g(a) costs one expansion of g, and functions
+// that call others twice expand in linear, not exponential, time.
+static Memo **find_call(Ctx *cx, const Sym *f, const int *args, int n) {
+  if (cx->nmemo >= cx->memocap) { /* grow (and create) the table, rehashing */
+    int cap = cx->memocap ? 2 * cx->memocap : 256;
+    Memo **t = arena_alloc((size_t)cap * sizeof *t);
+    for (int b = 0; b < cx->memocap; b++)
+      for (Memo *m = cx->memo[b], *next; m; m = next) {
+        next = m->next;
+        unsigned h = hash_call(m->f, m->momenta, m->args, m->nargs, cap);
+        m->next = t[h];
+        t[h] = m;
+      }
+    cx->memo = t;
+    cx->memocap = cap;
+  }
+  Memo **slot = &cx->memo[hash_call(f, cx->momenta, args, n, cx->memocap)];
+  for (; *slot; slot = &(*slot)->next)
+    if ((*slot)->f == f && (*slot)->momenta == cx->momenta && !memcmp((*slot)->args, args, (size_t)n * sizeof *args))
+      break;
+  return slot;
+}
+
+static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
+  int nparams = 0;
+  for (const Decl *p = f->def->decls; p; p = p->next) nparams++;
+  if (f->busy) {
+    error_at(e->loc, "'%s' is used in its own definition", e->name);
     return -1;
   }
-  Sym *iv = define(cx, name, at->name_loc, SYM_INDEX);
-  if (!iv) return -1;
-  iv->used = 1;
-  int rc = 0;
-  for (long i = lo; i <= hi && rc >= 0; i++) {
-    cx->work++;
-    iv->ival = i;
-    rc = fn(cx, body, acc);
+  if (check_arity(e, nparams) < 0) return -1;
+  /* on the heap: a call in a loop must not fill the arena */
+  int *vals = xmalloc((size_t)nparams * sizeof *vals), i = 0, ok = 1;
+  for (const Ast *a = e->args; a && ok; a = a->next) ok = (vals[i++] = lower(cx, a)) >= 0;
+  if (ok && !f->broken && (cx->work >= MAX_WORK || cx->call_depth + f->def->expr->depth > MAX_AST_DEPTH)) {
+    error_at(e->loc, cx->work >= MAX_WORK ? "too many terms: sums, lists and calls may expand to at most %ld in all"
+                                          : "calls of functions nested too deeply (more than %ld levels in all)",
+             cx->work >= MAX_WORK ? MAX_WORK : (long)MAX_AST_DEPTH);
+    ok = 0;
   }
-  undefine(cx, iv);
-  return rc;
+  Memo **slot = ok && !f->broken ? find_call(cx, f, vals, nparams) : NULL;
+  if (!slot || *slot) {
+    free(vals);
+    return slot ? (cx->work++, (*slot)->node) : -1;
+  }
+  cx->work++;
+  f->used = 1;
+  int caller = cx->stmt, errors = diag_error_count(), node = -1;
+  cx->stmt = f->stmt;
+  Sym **bound = xmalloc((size_t)nparams * sizeof *bound);
+  int nbound = bind_params(cx, f, vals, bound);
+  if (nbound == nparams) {
+    f->busy = 1;
+    cx->call_depth += f->def->expr->depth;
+    node = lower(cx, f->def->expr);
+    cx->call_depth -= f->def->expr->depth;
+    f->busy = 0;
+  }
+  while (nbound > 0) undefine(cx, bound[--nbound]);
+  free(bound);
+  cx->stmt = caller;
+  if (node >= 0) { /* remembered (its arguments into the arena: once per distinct call) */
+    Memo *m = arena_alloc(sizeof *m);
+    *m = (Memo){f, cx->momenta, node, nparams, arena_alloc((size_t)nparams * sizeof(int) + 1), NULL};
+    memcpy(m->args, vals, (size_t)nparams * sizeof(int));
+    *find_call(cx, f, vals, nparams) = m;
+    cx->nmemo++;
+  }
+  free(vals);
+  if (node < 0 && diag_error_count() > errors) {
+    if (cx->noted_error != diag_error_count()) cx->noted_error = diag_error_count(), cx->notes = 0;
+    if (cx->notes++ < MAX_CALL_NOTES) note_at(e->loc, "in this call of '%s'", e->name);
+    f->broken = 1;
+  }
+  return node;
 }
 
+// Run body once for each value of index variable at->name (a new one) over
+// a range a..b (at->a, at->b) or a list (at->a, at->b NULL), calling
+// fn(cx, body, acc) which returns <0 on error.
+typedef int (*RangeFn)(Ctx *cx, const Ast *body, void *acc);
+
+/* The values of a list an index variable runs over, on the heap (a list
+ * after 'in' is taken again at each iteration of the loops around it, so
+ * it must not stay in the arena). */
+typedef struct {
+  long *v;
+  int n, cap;
+} Longs;
+
+static int iterated_list(Ctx *cx, const Ast *e, Longs *out);
+
+static int for_range(Ctx *cx, const Ast *at, const Ast *body, RangeFn fn, void *acc) {
+  long lo = 0, hi = -1;
+  Longs vals = {NULL, 0, 0};
+  int rc = 0;
+  if (!at->b) {
+    rc = iterated_list(cx, at->a, &vals);
+    hi = vals.n - 1;
+  } else if (lower_int(cx, at->a, "a range bound", &lo) < 0 || lower_int(cx, at->b, "a range bound", &hi) < 0) {
+    rc = -1;
+  }
+  if (rc == 0 && hi - lo + 1 > MAX_WORK - cx->work) {
+    error_at(at->loc, "range %ld..%ld has too many terms: sums and lists may expand to at most %ld terms in all", lo,
+             hi, MAX_WORK);
+    rc = -1;
+  }
+  Sym *iv = rc < 0 ? NULL : define(cx, at->name, at->name_loc, SYM_INDEX);
+  if (iv) {
+    iv->used = 1;
+    for (long i = lo; i <= hi && rc >= 0; i++) {
+      cx->work++;
+      iv->ival = at->b ? i : vals.v[i];
+      rc = fn(cx, body, acc);
+    }
+    undefine(cx, iv);
+  }
+  free(vals.v);
+  return iv ? rc : -1;
+}
+
+// Add the term body to the sum *acc; the inner iterator of a sum over
+// several, sum(i in A, j in B, e), adds its terms to the same sum, in the
+// order of the pairs, as e(i1, j1) + e(i1, j2) + ... written out would.
 static int sum_term(Ctx *cx, const Ast *body, void *acc) {
   int *sum = acc;
+  if (body->kind == A_SUM && body->op == ',') return for_range(cx, body, body->c, sum_term, acc);
   int t = lower(cx, body);
   if (t < 0) return -1;
   *sum = dag_add(cx->d, *sum, t);
@@ -410,7 +642,7 @@ static int lower(Ctx *cx, const Ast *e) {
   case A_CALL: return lower_call(cx, e);
   case A_SUM: {
     int sum = dag_const(cx->d, 0);
-    return for_range(cx, e, e->name, e->a, e->b, e->c, sum_term, &sum) < 0 ? -1 : sum;
+    return for_range(cx, e, e->c, sum_term, &sum) < 0 ? -1 : sum;
   }
   case A_LIST:
   case A_FOR: error_at(e->loc, "a list is not allowed here: expected a single value"); return -1;
@@ -419,14 +651,6 @@ static int lower(Ctx *cx, const Ast *e) {
   }
   return -1;
 }
-
-/* ---- lists: g, q0, p0, diag(...) ---- */
-
-typedef struct {
-  IntVec nodes, lines, cols;
-} List;
-
-static int flatten(Ctx *cx, const Ast *e, List *out);
 
 static int flatten_item(Ctx *cx, const Ast *body, void *acc) { return flatten(cx, body, acc); }
 
@@ -437,13 +661,61 @@ static int flatten(Ctx *cx, const Ast *e, List *out) {
       if (flatten(cx, a, out) < 0) return -1;
     return 0;
   }
-  if (e->kind == A_FOR) return for_range(cx, e, e->name, e->a, e->b, e->c, flatten_item, out);
+  if (e->kind == A_FOR) return for_range(cx, e, e->c, flatten_item, out);
   int n = lower(cx, e);
   if (n < 0) return -1;
   intvec_push(&out->nodes, n);
   intvec_push(&out->lines, e->loc.line);
   intvec_push(&out->cols, e->loc.col);
   return 0;
+}
+
+// Append v to the values of a list after 'in'.
+static void longs_push(Longs *out, long v) {
+  if (out->n == out->cap) {
+    out->cap = out->cap ? 2 * out->cap : 16;
+    out->v = xrealloc(out->v, (size_t)out->cap * sizeof *out->v);
+  }
+  out->v[out->n++] = v;
+}
+
+static const char list_value[] = "a value of the list after 'in'";
+
+static int list_values(Ctx *cx, const Ast *e, Longs *out);
+
+static int list_item(Ctx *cx, const Ast *body, void *acc) { return list_values(cx, body, acc); }
+
+// Append the values of e, an element of a list after 'in', to out: lists
+// and comprehensions nest and flatten, each value a constant integer.
+static int list_values(Ctx *cx, const Ast *e, Longs *out) {
+  if (e->kind == A_LIST) {
+    for (const Ast *a = e->args; a; a = a->next)
+      if (list_values(cx, a, out) < 0) return -1;
+    return 0;
+  }
+  if (e->kind == A_FOR) return for_range(cx, e, e->c, list_item, out);
+  long v;
+  if (lower_int(cx, e, list_value, &v) < 0) return -1;
+  longs_push(out, v);
+  return 0;
+}
+
+// The values of what an index variable runs over, e: a list, or the name
+// of an array of values.
+static int iterated_list(Ctx *cx, const Ast *e, Longs *out) {
+  if (e->kind == A_LIST || e->kind == A_FOR) return list_values(cx, e, out);
+  Sym *s = e->kind == A_NAME ? lookup(cx, e->name) : NULL;
+  if (s && s->kind == SYM_VALUES && s->stmt <= cx->stmt) {
+    s->used = 1;
+    long v;
+    for (int i = 0; i < s->size; i++) {
+      if (const_int(cx, s->nodes[i], e->loc, list_value, &v) < 0) return -1;
+      longs_push(out, v);
+    }
+    return s->size ? 0 : -1; /* an array in error has no values, and its error is said */
+  }
+  error_at(e->loc, "an index variable runs over a range 'a..b' or a list '[...]', not over a single value");
+  return -1;
 }
 
 // Flatten a list (q0, p0, diag entries, a row of M) into want nodes that
@@ -550,6 +822,25 @@ static void define_param(Ctx *cx, const Stmt *st) {
   p->name = st->name;
   p->loc = st->name_loc;
   p->value = n >= 0 ? cx->d->nodes[n].val : 0;
+}
+
+// def NAME(a, b, ...) = expr: a function, expanded at each call. Its
+// parameters are checked here as names (distinct, none already defined),
+// its body at each call.
+static void define_function(Ctx *cx, const Stmt *st) {
+  Sym *f = define(cx, st->name, st->name_loc, SYM_FUNC);
+  int ok = 1, n = 0;
+  for (const Decl *p = st->decls; p; p = p->next) n++;
+  Sym **params = arena_alloc((size_t)n * sizeof *params);
+  n = 0;
+  for (const Decl *p = st->decls; p; p = p->next)
+    if (!(params[n++] = define(cx, p->name, p->loc, SYM_ARG))) ok = 0;
+  while (n > 0)
+    if (params[--n]) undefine(cx, params[n]);
+  if (!f) return;
+  f->def = st;
+  f->broken = !ok;
+  f->used = !ok; /* no warning that it is unused on top of the error */
 }
 
 static int once(Stmt **slot, int *slot_stmt, Stmt *st, int stmt, const char *what) {
@@ -764,10 +1055,12 @@ static void warn_unused(Ctx *cx) {
   int n = 0;
   for (int b = 0; b < cx->nbuckets; b++)
     for (Sym *s = cx->buckets[b]; s; s = s->next)
-      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_VALUES || s->kind == SYM_PARAM)) unused[n++] = s;
+      if (!s->used && (s->kind == SYM_VALUE || s->kind == SYM_VALUES || s->kind == SYM_PARAM || s->kind == SYM_FUNC))
+        unused[n++] = s;
   qsort(unused, (size_t)n, sizeof *unused, by_location);
   for (int i = 0; i < n; i++)
-    warning_at(unused[i]->loc, "%s '%s' is never used", unused[i]->kind == SYM_PARAM ? "param" : "definition",
+    warning_at(unused[i]->loc, "%s '%s' is never used",
+               unused[i]->kind == SYM_PARAM ? "param" : unused[i]->kind == SYM_FUNC ? "function" : "definition",
                unused[i]->name);
 }
 
@@ -850,6 +1143,7 @@ Model *analyse(const char *file, Stmt *prog) {
     case S_Q0: once(&cx->q0, &cx->q0_stmt, st, stmt, "q0"); break;
     case S_P0: once(&cx->p0, &cx->p0_stmt, st, stmt, "p0"); break;
     case S_EVENT: intvec_push(&cx->events, stmt); break;
+    case S_FUNC: define_function(cx, st); break;
     }
   }
   if (mod->m == 0 && !diag_error_count()) error_at((Loc){1, 1}, "the model declares no coordinates: add 'variables x, ...'");

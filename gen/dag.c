@@ -210,6 +210,7 @@ double op_apply(Op op, double a, double b) {
   case OP_SIGN: return (a > 0) - (a < 0);
   case OP_MIN: return fmin(a, b);
   case OP_MAX: return fmax(a, b);
+  case OP_FLOOR: return floor(a);
   default: internal_error("op_apply on %s", op_name(op));
   }
   return 0;

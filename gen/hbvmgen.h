@@ -65,6 +65,7 @@ const char *c_name_problem(const char *name); /* why name cannot be a C identifi
 void diag_begin(const char *file, const char *src, size_t len);
 void error_at(Loc loc, const char *fmt, ...);
 void warning_at(Loc loc, const char *fmt, ...);
+void note_at(Loc loc, const char *fmt, ...); /* context of the error before it */
 void diag_end(void);                     /* prints the counts of warnings not shown */
 int diag_error_count(void);
 int diag_too_many(void);                 /* true once the error cap is hit */
@@ -78,10 +79,10 @@ typedef enum {
   A_INDEX,    /* name[a] */
   A_NEG,      /* -a */
   A_BIN,      /* a op b, op one of + - * / ^ */
-  A_CALL,     /* name(args), args a list via next */
-  A_SUM,      /* sum(name in a..b, c) */
+  A_CALL,     /* name(args), args a list via next: a function, or one of 'def' */
+  A_SUM,      /* sum(name in a..b, c), or sum(name in a, c) over the list a (b NULL) */
   A_LIST,     /* [args] */
-  A_FOR,      /* [c for name in a..b] */
+  A_FOR,      /* [c for name in a..b], or [c for name in a] over the list a (b NULL) */
   A_IDENTITY, /* identity */
   A_DIAG      /* diag(args) */
 } AstKind;
@@ -90,7 +91,7 @@ typedef struct Ast Ast;
 struct Ast {
   AstKind kind;
   Loc loc;
-  int op;            /* A_BIN: '+', '-', '*', '/', '^' */
+  int op;            /* A_BIN: '+', '-', '*', '/', '^'; A_SUM, A_FOR: ',' for an inner iterator */
   double num;        /* A_NUM */
   const char *name;  /* A_NAME, A_INDEX, A_CALL, A_SUM, A_FOR */
   Loc name_loc;      /* A_SUM, A_FOR: where the index variable is named */
@@ -100,7 +101,7 @@ struct Ast {
   int depth;         /* nesting depth, bounded by MAX_AST_DEPTH */
 };
 
-typedef enum { S_VARIABLES, S_DEF, S_PARAM, S_MASS, S_POTENTIAL, S_CONSTRAINTS, S_Q0, S_P0, S_EVENT } StmtKind;
+typedef enum { S_VARIABLES, S_DEF, S_PARAM, S_MASS, S_POTENTIAL, S_CONSTRAINTS, S_Q0, S_P0, S_EVENT, S_FUNC } StmtKind;
 
 typedef struct Decl Decl;
 struct Decl {          /* one name of a variables statement */
@@ -114,11 +115,11 @@ typedef struct Stmt Stmt;
 struct Stmt {
   StmtKind kind;
   Loc loc;
-  const char *name;    /* S_DEF, S_PARAM, S_EVENT */
+  const char *name;    /* S_DEF, S_PARAM, S_EVENT, S_FUNC */
   Loc name_loc;
   Ast *expr;
   int dir;             /* S_EVENT: the sign changes that count, 0 both, 1 rising, -1 falling */
-  Decl *decls;         /* S_VARIABLES */
+  Decl *decls;         /* S_VARIABLES; S_FUNC: its parameters */
   Stmt *next;
 };
 
@@ -161,6 +162,7 @@ Stmt *parse_model(const char *src, size_t len);   /* NULL for no statements; che
   X(SIGN, 1, NULL)               \
   X(MIN, 2, "fmin")              \
   X(MAX, 2, "fmax")              \
+  X(FLOOR, 1, "floor")           \
   X(VEC, 2, NULL)                \
   X(TROW, 1, NULL)               \
   X(SSUM, 1, NULL)
@@ -393,6 +395,7 @@ typedef struct {
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why);
 int method_quadrature_exact(int k, int s, int degU, int degg);
 Method *method_new(int k, int s, MultFamily family);
+void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam); /* --check's advice */
 
 /* ---- step.c, step_const.c, step_poly.c, lu.c: the step as a DAG ---- */
 

@@ -1,4 +1,4 @@
-/* main.c - the hbvmgen command line (SPEC section 2).
+/* main.c - the hbvmgen command line (docs/hbvmgen.1, docs/api.md).
  *
  * Reads the model, runs the passes in order (parse, analyse, differentiate,
  * choose k, build the step, emit) and writes NAME.h, NAME.c and optionally
@@ -39,7 +39,7 @@ static const char usage[] =
     "  -s S          degree of the polynomial approximation, 1 <= S <= 20 (default 2)\n"
     "  -k K|auto     Gauss-Legendre nodes, S <= K <= 200 (default auto: the smallest k that\n"
     "                conserves H and g exactly for polynomial models; 2s+12 otherwise)\n"
-    "  -o DIR        where NAME.c and NAME.h are written (default generated)\n"
+    "  -o DIR        where NAME.c and NAME.h are written (default .: the current directory)\n"
     "  -n NAME       C prefix of every emitted symbol (default: the model file's base name)\n"
     "  --multiplier F  const or poly: how the Lagrange multiplier varies over a step.\n"
     "                const: constant, the paper's method, order 2 with constraints\n"
@@ -225,6 +225,18 @@ static const char *default_name(const char *path) {
   return name;
 }
 
+// Say so when the prefix default_name made of the file name at path is not
+// its base name as written (my-model.ham gives my_model, 2d.ham m2d).
+static void note_renamed(const char *path, const char *name) {
+  const char *base = strrchr(path, '/');
+  base = base ? base + 1 : path;
+  size_t n = strlen(base);
+  if (n > 4 && !strcmp(base + n - 4, ".ham")) n -= 4;
+  if (strlen(name) != n || strncmp(base, name, n))
+    fprintf(stderr, "hbvmgen: note: the emitted symbols of '%s' take the prefix '%s': '%.*s' is not a C identifier "
+            "(-n NAME chooses another)\n", path, name, (int)n, base);
+}
+
 static char *read_file(const char *path, size_t *len) {
   FILE *f = fopen(path, "rb");
   if (!f) {
@@ -305,6 +317,7 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   for (int i = 0; i < mod->m; i++) ngrad += !dag_is_zero(mod->dag, mod->gradU[i]);
   printf("grad U: %d nonzero entries of %d\n", ngrad, mod->m);
   for (int i = 0; i < mod->nparams; i++) printf("param %s = %.17g\n", mod->params[i].name, mod->params[i].value);
+  method_advise(stdout, mod, o->s, k, fam);
 }
 
 /* ---- writing the output ----
@@ -576,10 +589,13 @@ static void report_degree(const Model *mod, int s, int k) {
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, "generated", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
-  if (!o.name && bad_name(o.name = default_name(o.model), o.model)) return 1;
+  if (!o.name) {
+    if (bad_name(o.name = default_name(o.model), o.model)) return 1;
+    note_renamed(o.model, o.name);
+  }
   signal(SIGXFSZ, SIG_IGN); /* past ulimit -f, a write fails (and is reported) instead of killing us */
   size_t len;
   char *src = read_file(o.model, &len);

@@ -1,4 +1,5 @@
-/* method.c - the constants of HBVM(k,s) and the choice of k.
+/* method.c - the constants of HBVM(k,s), the choice of k, and the advice
+ * of --check on s and k.
  *
  * Gauss-Legendre nodes and weights on [0,1] come from GSL, refined by
  * Newton's method in long double; the shifted, normalised Legendre
@@ -15,6 +16,7 @@
  * digits. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <gsl/gsl_integration.h>
 
@@ -105,7 +107,7 @@ int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why) {
     }
   }
   if ((degU == DEG_NONPOLY || degg == DEG_NONPOLY) && fam == MULT_POLY) {
-    *why = "U or g is not a polynomial: k = s for it (the rescale keeps H; measured, see method.c), and "
+    *why = "U or g is not a polynomial: k = s for it (the rescale keeps H; measured, docs/choosing.md), and "
            "the polynomial parts integrated exactly";
   } else if (degU == DEG_NONPOLY || degg == DEG_NONPOLY) {
     int need = 2 * s + NONPOLY_EXTRA_K;
@@ -250,4 +252,58 @@ Method *method_new(int k, int s, MultFamily family) {
       }
   me->E2 = two_step_table(s);
   return me;
+}
+
+// The name of a function of the language with a kink or a jump that U or g
+// uses, or NULL when they use none.
+static const char *nonsmooth_function(const Model *mod) {
+  static const struct {
+    Op op;
+    const char *name;
+  } kinks[] = {{OP_ABS, "abs"}, {OP_SIGN, "sign"}, {OP_MIN, "min"}, {OP_MAX, "max"}, {OP_FLOOR, "floor or mod"}};
+  const Dag *d = mod->dag;
+  int *roots = xmalloc((size_t)(mod->nu + 1) * sizeof *roots);
+  unsigned char *mark = xcalloc((size_t)d->n, 1);
+  roots[0] = mod->U;
+  if (mod->nu) memcpy(roots + 1, mod->g, (size_t)mod->nu * sizeof *roots);
+  dag_reach(d, roots, mod->nu + 1, mark);
+  const char *found = NULL;
+  for (int id = 0; id < d->n && !found; id++)
+    for (size_t i = 0; mark[id] && i < sizeof kinks / sizeof kinks[0]; i++)
+      if (d->nodes[id].op == kinks[i].op) found = kinks[i].name;
+  free(roots);
+  free(mark);
+  return found;
+}
+
+// --check's advice: the s and k measured best for this kind of model at
+// errors of 1e-6 and below (docs/choosing.md, where the figures come from:
+// the outer solar system, models/solar.ham, and the pendulum of
+// bench/results/work_precision.csv), whether the options given are those,
+// and what a kink, the constant multiplier or the step size limit of the
+// fixed-point iteration mean for it.
+void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam) {
+  const char *kink = nonsmooth_function(mod);
+  int smooth_poly = mod->degU != DEG_NONPOLY && mod->degg != DEG_NONPOLY;
+  if (kink) {
+    fprintf(f, "advice: U or g uses %s, which has a kink or a jump: each crossing costs accuracy whatever s is, "
+               "so a high s buys little; s = 2 and a step small near the kinks (docs/choosing.md, \"Kinks and "
+               "jumps\")\n", kink);
+  } else if (!mod->nu) {
+    int chosen = s == 6 && (smooth_poly ? method_quadrature_exact(k, s, mod->degU, 0) : k == 11);
+    fprintf(f, "advice: unconstrained and smooth: -s 6 %s(order 12)%s; on the outer solar system 24x (error "
+               "1e-7) to 130x (1e-11) less work than -s 2 -k 16 (docs/choosing.md)\n",
+            smooth_poly ? "-k auto " : "-k 11 ", chosen ? ", as chosen" : "");
+  } else {
+    fprintf(f, "advice: constrained and smooth: -s 4 -k auto --multiplier poly (order 8)%s; on the pendulum "
+               "2.4x (error 1e-6) to 6x (1e-10) faster than -s 2 (docs/choosing.md)\n",
+            s == 4 && fam == MULT_POLY ? ", as chosen" : "");
+    if (fam == MULT_CONST)
+      fprintf(f, "advice: --multiplier const has order %s with constraints; poly has order 2s\n",
+              s >= 2 ? "2 in p" : "2");
+  }
+  /* the largest h omega at which 50 steps of a harmonic oscillator converge, s = 1..6 (s = 8, 10: 5.7) */
+  static const double limit[] = {1.6, 2.8, 3.7, 4.7, 5.5, 5.7};
+  fprintf(f, "advice: the fixed-point iteration converges while h times the fastest frequency stays below "
+             "about %.1f (docs/choosing.md, \"Stiffness\")\n", limit[(s < 6 ? s : 6) - 1]);
 }

@@ -1,4 +1,4 @@
-/* parser.y - the grammar of the .ham model language (SPEC section 1).
+/* parser.y - the grammar of the .ham model language (docs/language.md).
  *
  * A pure, reentrant LALR(1) parser with locations. It builds a list of
  * statements whose expressions are syntax trees; all meaning (names,
@@ -101,6 +101,28 @@ static Decl *decl_reverse(Decl *list) {
   return prev;
 }
 
+/* The sums or comprehensions of iterators (linked by next, innermost first,
+ * each an A_FOR with its name, range or list in a and b, and no body yet)
+ * around body: [e for i in A for j in B] is [[e for j in B] for i in A],
+ * sum(i in A, j in B, e) is sum(i in A, sum(j in B, e)). Each node is at
+ * its iterator, the outermost at loc. */
+static Ast *nest(AstKind kind, Loc loc, Ast *iters, Ast *body) {
+  for (Ast *it = iters; it; it = it->next) {
+    body = ast_new(kind, it->next ? it->loc : loc, it->a, it->b, body);
+    body->name = it->name;
+    body->name_loc = it->name_loc;
+    body->op = it->next ? ',' : 0; /* an inner iterator, not a sum or list of its own */
+  }
+  return body;
+}
+
+static Ast *iterator(YYLTYPE l, YYLTYPE at, const char *name, Ast *from, Ast *to) {
+  Ast *n = ast_new(A_FOR, loc_of(at), from, to, NULL);
+  n->name = name;
+  n->name_loc = loc_of(l);
+  return n;
+}
+
 /* Reverse a list linked by next. */
 static Ast *list_reverse(Ast *list) {
   Ast *prev = NULL;
@@ -126,11 +148,11 @@ static Ast *list_reverse(Ast *list) {
 %token <str> FUNC "function name"
 %token <str> VARIABLES "'variables'" PARAM "'param'" KW_M "'M'" KW_U "'U'" KW_G "'g'"
 %token <str> Q0 "'q0'" P0 "'p0'" IDENTITY "'identity'" DIAG "'diag'" SUM "'sum'"
-%token <str> FOR "'for'" IN "'in'" EVENT "'event'" RISING "'rising'" FALLING "'falling'"
+%token <str> FOR "'for'" IN "'in'" EVENT "'event'" RISING "'rising'" FALLING "'falling'" DEF "'def'"
 %token DOTDOT "'..'"
 
-%type <ast> expr primary args arglist
-%type <decl> decls decl
+%type <ast> expr primary args arglist iter iters fors
+%type <decl> decls decl params
 %type <str> name reserved stmt_reserved
 %type <num> direction
 
@@ -138,6 +160,7 @@ static Ast *list_reverse(Ast *list) {
 %left '*' '/'
 %precedence UMINUS
 %right '^'
+%token ';' '=' ',' '[' ']' '(' ')' /* numbered in this order, the order expected tokens are listed in */
 
 %%
 
@@ -160,7 +183,16 @@ stmt
   | EVENT name '=' expr direction
                                 { add_stmt(ps, S_EVENT, @1, $4); ps->last->name = $2; ps->last->name_loc = loc_of(@2);
                                   ps->last->dir = (int)$5; }
+  | DEF name '(' params ')' '=' expr
+                                { add_stmt(ps, S_FUNC, @1, $7); ps->last->name = $2; ps->last->name_loc = loc_of(@2);
+                                  ps->last->decls = decl_reverse($4); }
   | stmt_reserved '=' expr      { reserved_name(@1, $1); }
+  ;
+
+/* The parameters of a function of 'def', in reverse. */
+params
+  : name                        { $$ = arena_alloc(sizeof(Decl)); $$->name = $1; $$->loc = loc_of(@1); }
+  | params ',' name             { $$ = arena_alloc(sizeof(Decl)); $$->name = $3; $$->loc = loc_of(@3); $$->next = $1; }
   ;
 
 /* Which sign changes of an event count: both (0), rising (1), falling (-1). */
@@ -177,7 +209,7 @@ name
   ;
 
 reserved
-  : stmt_reserved | VARIABLES | PARAM | KW_M | KW_U | KW_G | Q0 | P0 | EVENT | RISING | FALLING
+  : stmt_reserved | VARIABLES | PARAM | KW_M | KW_U | KW_G | Q0 | P0 | EVENT | RISING | FALLING | DEF
   ;
 
 /* The reserved words that cannot start a statement. */
@@ -212,13 +244,29 @@ primary
   | NAME '[' expr ']'           { $$ = ast_new(A_INDEX, loc_of(@1), $3, NULL, NULL); $$->name = $1; }
   | '(' expr ')'                { $$ = $2; }
   | FUNC '(' args ')'           { $$ = leaf_name(A_CALL, @1, $1); ast_set_args($$, $3); }
-  | SUM '(' name IN expr DOTDOT expr ',' expr ')'
-                                { $$ = ast_new(A_SUM, loc_of(@1), $5, $7, $9); $$->name = $3; $$->name_loc = loc_of(@3); }
+  | NAME '(' args ')'           { $$ = leaf_name(A_CALL, @1, $1); ast_set_args($$, $3); }
+  | SUM '(' iters ',' expr ')'  { $$ = nest(A_SUM, loc_of(@1), $3, $5); }
   | '[' args ']'                { $$ = ast_new(A_LIST, loc_of(@1), NULL, NULL, NULL); ast_set_args($$, $2); }
-  | '[' expr FOR name IN expr DOTDOT expr ']'
-                                { $$ = ast_new(A_FOR, loc_of(@1), $6, $8, $2); $$->name = $4; $$->name_loc = loc_of(@4); }
+  | '[' expr fors ']'           { $$ = nest(A_FOR, loc_of(@1), $3, $2); }
   | IDENTITY                    { $$ = ast_new(A_IDENTITY, loc_of(@1), NULL, NULL, NULL); }
   | DIAG '(' args ')'           { $$ = ast_new(A_DIAG, loc_of(@1), NULL, NULL, NULL); ast_set_args($$, $3); }
+  ;
+
+/* What an index variable runs over: a range of integers, or a list. */
+iter
+  : name IN expr DOTDOT expr    { $$ = iterator(@1, @1, $1, $3, $5); }
+  | name IN expr                { $$ = iterator(@1, @1, $1, $3, NULL); }
+  ;
+
+/* The iterators of a sum, and the 'for' clauses of a comprehension, in reverse. */
+iters
+  : iter
+  | iters ',' iter              { $3->next = $1; $$ = $3; }
+  ;
+
+fors
+  : FOR iter                    { $$ = $2; $$->loc = loc_of(@1); }
+  | fors FOR iter               { $3->loc = loc_of(@2); $3->next = $1; $$ = $3; }
   ;
 
 args
@@ -251,7 +299,7 @@ static int is_reserved(yysymbol_kind_t k) {
   case YYSYMBOL_FUNC: case YYSYMBOL_VARIABLES: case YYSYMBOL_PARAM: case YYSYMBOL_KW_M: case YYSYMBOL_KW_U:
   case YYSYMBOL_KW_G: case YYSYMBOL_Q0: case YYSYMBOL_P0: case YYSYMBOL_IDENTITY: case YYSYMBOL_DIAG:
   case YYSYMBOL_SUM: case YYSYMBOL_FOR: case YYSYMBOL_IN: case YYSYMBOL_EVENT: case YYSYMBOL_RISING:
-  case YYSYMBOL_FALLING: return 1;
+  case YYSYMBOL_FALLING: case YYSYMBOL_DEF: return 1;
   default: return 0;
   }
 }
@@ -279,8 +327,8 @@ static int is_char(yysymbol_kind_t t, const char *set) {
 }
 
 /* The expected tokens as they read best: the tokens that can start an
- * expression as "an expression", the five operators (and '[' of indexing
- * with them) as "an operator", any other token by its name. Fills words,
+ * expression as "an expression", the five operators (and '[' of indexing,
+ * '(' of a call with them) as "an operator", any other token by its name. Fills words,
  * returns their number. */
 static int describe_expected(const yysymbol_kind_t *expected, int n, const char **words) {
   int expr = 0, nops = 0, k = 0;
@@ -294,7 +342,7 @@ static int describe_expected(const yysymbol_kind_t *expected, int n, const char 
     yysymbol_kind_t t = expected[i];
     int starts = t == YYSYMBOL_NUMBER || t == YYSYMBOL_NAME || t == YYSYMBOL_FUNC || t == YYSYMBOL_SUM ||
                  t == YYSYMBOL_IDENTITY || t == YYSYMBOL_DIAG || is_char(t, "+-([");
-    if (!(expr && starts) && !(nops == 5 && is_char(t, "+-*/^["))) words[k++] = yysymbol_name(t);
+    if (!(expr && starts) && !(nops == 5 && is_char(t, "+-*/^[("))) words[k++] = yysymbol_name(t);
   }
   return k;
 }
@@ -308,11 +356,6 @@ static int yyreport_syntax_error(const yypcontext_t *ctx, yyscan_t scanner, Pars
   if (ps->fatal || diag_too_many()) return 0;
   char msg[MSG_SIZE] = "";
   yysymbol_kind_t tok = yypcontext_token(ctx);
-  if (tok == YYTRANSLATE('(') && ps->after_name) {
-    error_at(ps->name_loc, "'%.40s' is not a function (the functions are sin cos tan asin acos atan atan2 sinh "
-             "cosh tanh exp log sqrt pow abs sign min max)", ps->text);
-    return 0;
-  }
   /* a name after an event's expression, on its line (the unexpected token, or the one before): a
    * mistyped direction */
   int word = tok == YYSYMBOL_NAME || is_reserved(tok); /* the lexer's name_loc, text are this token's */

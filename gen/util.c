@@ -290,6 +290,16 @@ void error_at(Loc loc, const char *fmt, ...) {
   if (nerrors == MAX_ERRORS) fprintf(stderr, "%s: note: too many errors, stopping\n", diag_file);
 }
 
+// Say where the error just reported arose (a call of a function of 'def'),
+// unless that error was not shown.
+void note_at(Loc loc, const char *fmt, ...) {
+  va_list ap;
+  if (nerrors >= MAX_ERRORS) return;
+  va_start(ap, fmt);
+  report("note", loc, fmt, ap);
+  va_end(ap);
+}
+
 // Report a warning at loc; beyond MAX_LIKE of one kind (one format), only count it.
 void warning_at(Loc loc, const char *fmt, ...) {
   va_list ap;

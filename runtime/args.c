@@ -1,4 +1,4 @@
-/* args.c - the standalone driver's options (SPEC section 4).
+/* args.c - the standalone driver's options (docs/api.md, "The standalone driver").
  *
  *   NAME [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..] [--p0 a,b,..]
  *        [--param name=value] [--project] [--csv FILE] [--tol TOL] [--dt DT]

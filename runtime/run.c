@@ -1,4 +1,4 @@
-/* run.c - hbvmrt_run: the standalone driver's loop (SPEC section 4).
+/* run.c - hbvmrt_run: the standalone driver's loop (docs/api.md, "The standalone driver").
  *
  * After the options (args.c) it allocates the state and params blocks, fills
  * the params with the defaults and the --param values, initialises the state
@@ -171,7 +171,7 @@ static int check_initial(Run *r)
   return status;
 }
 
-/* Allocate the blocks, set the params and the initial state (SPEC 3:
+/* Allocate the blocks, set the params and the initial state (docs/api.md:
  * NULL q0/p0 means the model defaults, at the run's params when the driver
  * can say so), checked against the constraints.  The exit status after
  * reporting, or 0. */
@@ -518,8 +518,9 @@ static void report_failure(const Run *r)
     fprintf(stderr, "code %d\n", r->fail_code);
 }
 
-/* The summary line of SPEC 4; without constraints max_g and max_hc are
- * kept, as a plain 0, so every run's line has the same fields. */
+/* The summary line (docs/api.md, "The standalone driver"); without
+ * constraints max_g and max_hc are kept, as a plain 0, so every run's line
+ * has the same fields. */
 static void summary(const Run *r, double seconds)
 {
   double mean = r->steps > 0 ? r->iters_sum / (double)r->steps : 0.0;

@@ -1,5 +1,5 @@
 #!/bin/sh
-# arm_build.sh - the embedded build check of SPEC section 3, run from tests/
+# arm_build.sh - the embedded build check of docs/api.md ("The float variant"), run from tests/
 # by check_stress.c (or by hand: cd tests && sh arm_build.sh).
 #
 # Every committed solver (generated/*_k*s*.c, not the drivers *_main.c) must

@@ -3,14 +3,20 @@
  *   - the embedding examples of docs/embedding.md (docs/examples/embed.c
  *     and embed.cpp) are compiled with gcc and g++ against a pendulum
  *     generated into a temporary directory, run, and their printed state
- *     compared with an independent RK4 solution of the pendulum, and
+ *     compared with an independent RK4 solution of the pendulum and with
+ *     the lines docs/embedding.md shows after ./embed and ./embed_cpp, and
  *     docs/embedding.md shows both files verbatim;
  *   - `make install PREFIX=TMP` installs what docs/hbvmgen.1 lists, and the
  *     C example and a standalone driver build with `pkg-config --cflags
  *     --libs hbvmrt` (PKG_CONFIG_PATH=TMP/lib/pkgconfig) and nothing else
  *     but the generated directory; the driver's CSV header names the
  *     model's columns; DESTDIR stages without changing the prefix;
- *   - the man page documents every option of `hbvmgen --help`;
+ *   - the man page and docs/api.md document every option of `hbvmgen
+ *     --help`, and --help every option of the man page;
+ *   - no source comment cites a section of the retired SPEC (docs/ is the
+ *     contract), --check's output names no source file of the generator,
+ *     and every relative link of README.md and of the pages in docs/ names
+ *     a file that exists;
  *   - the stack bound of docs/api.md holds for the committed solvers at -O0
  *     and -O2 (gcc -fstack-usage).
  * Under the sanitizers (HBVM_SANITIZED) the installed runtime is
@@ -105,29 +111,6 @@ static void check_example_output(const char *program)
   ck_assert_msg(dH <= 1e-13 && g <= 1e-13, "%s: |H - H0| = %g, |g| = %g", program, dH, g);
 }
 
-START_TEST(embedding_examples_c_and_cpp)
-{
-  char tmpl[] = "/tmp/hbvm-docs-XXXXXX", cmd[1024];
-  const char *d = fresh_dir(tmpl);
-  snprintf(cmd, sizeof cmd, "../gen/hbvmgen -o %s ../models/pendulum.ham", d);
-  ck_assert_int_eq(sh(cmd), 0);
-  snprintf(cmd, sizeof cmd,
-           "gcc -O2 -std=c99 -Wall -Wextra -pedantic -Werror -I%s ../docs/examples/embed.c %s/pendulum.c -lm "
-           "-o %s/embed_c", d, d, d);
-  ck_assert_msg(sh(cmd) == 0, "the C example does not build: %s", cmd);
-  snprintf(cmd, sizeof cmd,
-           "gcc -O2 -std=c99 -Wall -Wextra -pedantic -Werror -c %s/pendulum.c -o %s/pendulum.o && "
-           "g++ -O2 -Wall -Wextra -pedantic -Werror -I%s ../docs/examples/embed.cpp %s/pendulum.o -lm -o %s/embed_cpp",
-           d, d, d, d, d);
-  ck_assert_msg(sh(cmd) == 0, "the C++ example does not build: %s", cmd);
-  snprintf(cmd, sizeof cmd, "%s/embed_c", d);
-  check_example_output(cmd);
-  snprintf(cmd, sizeof cmd, "%s/embed_cpp", d);
-  check_example_output(cmd);
-  remove_dir(d);
-}
-END_TEST
-
 /* The whole of a file, malloc'd. */
 static char *slurp(const char *path)
 {
@@ -140,6 +123,50 @@ static char *slurp(const char *path)
   fclose(f);
   return buf;
 }
+
+/* What program prints, exactly as docs/embedding.md shows it on the
+ * indented line after "    ./NAME" (NAME the program's base name). */
+static void check_shown_output(const char *program)
+{
+  char line[256], shown[256], cmd[64];
+  first_line(program, line, sizeof line);
+  char *doc = slurp("../docs/embedding.md");
+  snprintf(cmd, sizeof cmd, "    ./%s\n    ", strrchr(program, '/') + 1);
+  const char *at = strstr(doc, cmd);
+  ck_assert_msg(at != NULL, "docs/embedding.md does not show what ./%s prints", strrchr(program, '/') + 1);
+  at += strlen(cmd);
+  size_t n = strcspn(at, "\n");
+  ck_assert_uint_lt(n, sizeof shown);
+  memcpy(shown, at, n);
+  shown[n] = '\0';
+  ck_assert_msg(!strcmp(line, shown), "docs/embedding.md shows '%s', %s prints '%s'", shown, program, line);
+  free(doc);
+}
+
+START_TEST(embedding_examples_c_and_cpp)
+{
+  char tmpl[] = "/tmp/hbvm-docs-XXXXXX", cmd[1024];
+  const char *d = fresh_dir(tmpl);
+  snprintf(cmd, sizeof cmd, "../gen/hbvmgen -o %s ../models/pendulum.ham", d);
+  ck_assert_int_eq(sh(cmd), 0);
+  snprintf(cmd, sizeof cmd,
+           "gcc -O2 -std=c99 -Wall -Wextra -pedantic -Werror -I%s ../docs/examples/embed.c %s/pendulum.c -lm "
+           "-o %s/embed", d, d, d);
+  ck_assert_msg(sh(cmd) == 0, "the C example does not build: %s", cmd);
+  snprintf(cmd, sizeof cmd,
+           "gcc -O2 -std=c99 -Wall -Wextra -pedantic -Werror -c %s/pendulum.c -o %s/pendulum.o && "
+           "g++ -O2 -Wall -Wextra -pedantic -Werror -I%s ../docs/examples/embed.cpp %s/pendulum.o -lm -o %s/embed_cpp",
+           d, d, d, d, d);
+  ck_assert_msg(sh(cmd) == 0, "the C++ example does not build: %s", cmd);
+  snprintf(cmd, sizeof cmd, "%s/embed", d);
+  check_example_output(cmd);
+  check_shown_output(cmd);
+  snprintf(cmd, sizeof cmd, "%s/embed_cpp", d);
+  check_example_output(cmd);
+  check_shown_output(cmd);
+  remove_dir(d);
+}
+END_TEST
 
 /* docs/embedding.md shows the example files verbatim. */
 START_TEST(embedding_doc_shows_the_examples)
@@ -204,37 +231,118 @@ START_TEST(install_and_pkg_config)
 }
 END_TEST
 
-/* Every option `hbvmgen --help` lists appears in the man page, spelt as
- * roff spells it (\- for each dash). */
-START_TEST(man_page_covers_help)
+/* The options of `hbvmgen --help`: each word starting with '-' on a line
+ * that starts with "  -", into opts (at most max); returns their number. */
+static int help_options(char opts[][32], int max)
 {
-  FILE *man = fopen("../docs/hbvmgen.1", "r"), *help = popen("../gen/hbvmgen --help", "r");
-  ck_assert_ptr_nonnull(man);
+  FILE *help = popen("../gen/hbvmgen --help", "r");
   ck_assert_ptr_nonnull(help);
-  static char page[1 << 16];
-  size_t n = fread(page, 1, sizeof page - 1, man);
-  page[n] = '\0';
-  fclose(man);
   char line[512];
-  int options = 0;
+  int n = 0;
   while (fgets(line, sizeof line, help)) {
     if (strncmp(line, "  -", 3))
       continue;
-    for (char *w = strtok(line, " ,|\n"); w && w[0] == '-'; w = strtok(NULL, " ,|\n")) {
-      char roff[128];
-      size_t k = 0;
-      for (const char *c = w; *c && k + 3 < sizeof roff; c++) {
-        if (*c == '-')
-          roff[k++] = '\\';
-        roff[k++] = *c;
-      }
-      roff[k] = '\0';
-      ck_assert_msg(strstr(page, roff) != NULL, "docs/hbvmgen.1 does not document %s", w);
-      options++;
-    }
+    for (char *w = strtok(line, " ,|\n"); w && w[0] == '-' && n < max; w = strtok(NULL, " ,|\n"))
+      snprintf(opts[n++], 32, "%s", w);
   }
   ck_assert_int_eq(pclose(help), 0);
-  ck_assert_int_ge(options, 12);
+  return n;
+}
+
+/* Every option `hbvmgen --help` lists appears in the man page, spelt as
+ * roff spells it (\- for each dash), and in docs/api.md ("The generator's
+ * options", in backquotes). */
+START_TEST(man_page_and_api_cover_help)
+{
+  char opts[64][32];
+  int n = help_options(opts, 64);
+  char *page = slurp("../docs/hbvmgen.1"), *api = slurp("../docs/api.md");
+  for (int i = 0; i < n; i++) {
+    char roff[128], quoted[64];
+    size_t k = 0;
+    for (const char *c = opts[i]; *c && k + 3 < sizeof roff; c++) {
+      if (*c == '-')
+        roff[k++] = '\\';
+      roff[k++] = *c;
+    }
+    roff[k] = '\0';
+    ck_assert_msg(strstr(page, roff) != NULL, "docs/hbvmgen.1 does not document %s", opts[i]);
+    quoted[0] = '`';
+    strcpy(quoted + 1, opts[i]);
+    ck_assert_msg(strstr(api, quoted) != NULL, "docs/api.md does not document %s", opts[i]);
+  }
+  ck_assert_int_ge(n, 12);
+  free(page);
+  free(api);
+}
+END_TEST
+
+/* Every option the man page documents (the words starting with \- on the
+ * line after each .TP of its OPTIONS section) is an option of --help. */
+START_TEST(help_covers_man_page)
+{
+  char opts[64][32], *page = slurp("../docs/hbvmgen.1");
+  int nhelp = help_options(opts, 64), documented = 0;
+  const char *sec = strstr(page, "\n.SH OPTIONS\n"), *end = sec ? strstr(sec + 1, "\n.SH ") : NULL;
+  ck_assert_msg(sec && end, "docs/hbvmgen.1 has no OPTIONS section");
+  for (const char *tp = strstr(sec, "\n.TP\n"); tp && tp < end; tp = strstr(tp + 1, "\n.TP\n")) {
+    char line[256];
+    const char *at = tp + 5;
+    size_t len = strcspn(at, "\n");
+    snprintf(line, sizeof line, "%.*s", (int)(len < sizeof line ? len : sizeof line - 1), at);
+    for (char *w = strtok(line, " \","); w; w = strtok(NULL, " \",")) {
+      if (strncmp(w, "\\-", 2))
+        continue;
+      char opt[32];
+      size_t k = 0;
+      for (const char *c = w; *c && k + 1 < sizeof opt; c++)
+        if (*c != '\\')
+          opt[k++] = *c;
+      opt[k] = '\0';
+      int found = 0;
+      for (int i = 0; i < nhelp; i++)
+        found |= !strcmp(opts[i], opt);
+      ck_assert_msg(found, "docs/hbvmgen.1 documents %s, which hbvmgen --help does not list", opt);
+      documented++;
+    }
+  }
+  ck_assert_int_ge(documented, 12);
+  free(page);
+}
+END_TEST
+
+/* Source comments point at docs/, not at the retired SPEC (its "section
+ * N"), and what --check prints names no source file of the generator
+ * (gen/NAME.c) where a user would look for an explanation. */
+START_TEST(no_pointers_to_sources)
+{
+  char pattern[] = "SPEC_section";
+  pattern[4] = ' '; /* not written out, so that this file does not match */
+  char cmd[512];
+  snprintf(cmd, sizeof cmd,
+           "! grep -rn -e '%s' -e 'SPEC [0-9]' ../gen ../runtime ../tests ../scripts ../bench ../Makefile "
+           "--include='*.[chly]' --include='*.sh' --include=Makefile >&2",
+           pattern);
+  ck_assert_msg(sh(cmd) == 0, "a source comment cites the SPEC instead of docs/ (listed above)");
+  static const char *const runs[] = {"../models/satellites.ham", "-s 1 ../models/satellites.ham",
+                                     "../models/kepler.ham", "../models/modified.ham"};
+  for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+    snprintf(cmd, sizeof cmd, "../gen/hbvmgen --check %s 2>&1 | grep -E '(gen/|\\<)[a-z_]+\\.[chly]\\>' | "
+             "grep -v -E '\\<[a-z_]+\\.[ch] [0-9.]+ (MB|bytes)' >&2", runs[i]);
+    ck_assert_msg(sh(cmd) != 0, "hbvmgen --check %s names a source file (above)", runs[i]);
+  }
+}
+END_TEST
+
+/* Every relative link [text](path) of README.md and of the pages in docs/
+ * names a file that exists (from the linking file's directory). */
+START_TEST(relative_links_resolve)
+{
+  const char *cmd =
+      "cd .. && for f in README.md docs/*.md; do d=$(dirname \"$f\"); "
+      "grep -o '](\\([^)#:]*\\)' \"$f\" | sed 's/^](//' | while read -r t; do "
+      "[ -e \"$d/$t\" ] || { echo \"$f: no $t\" >&2; echo x; }; done; done | grep -q x";
+  ck_assert_msg(sh(cmd) != 0, "README.md or docs/ link to a file that does not exist (listed above)");
 }
 END_TEST
 
@@ -320,7 +428,10 @@ Suite *docs_suite(void)
   tcase_add_test(tc, embedding_examples_c_and_cpp);
   tcase_add_test(tc, embedding_doc_shows_the_examples);
   tcase_add_test(tc, install_and_pkg_config);
-  tcase_add_test(tc, man_page_covers_help);
+  tcase_add_test(tc, man_page_and_api_cover_help);
+  tcase_add_test(tc, help_covers_man_page);
+  tcase_add_test(tc, no_pointers_to_sources);
+  tcase_add_test(tc, relative_links_resolve);
   tcase_add_test(tc, stack_bound_holds);
   suite_add_tcase(s, tc);
   return s;

@@ -1,4 +1,4 @@
-/* check_errors.c - Check suite for bad input (SPEC section 1, "Errors").
+/* check_errors.c - Check suite for bad input (docs/language.md, "Errors and warnings").
  *
  * Every case runs the generator itself, ../gen/hbvmgen (the suite runs from
  * tests/), in a child with its own temporary output directory, stdout and
@@ -451,6 +451,24 @@ START_TEST(test_huge_tokens)
 }
 END_TEST
 
+/* Functions of def cannot recurse deeper than expressions may nest: a
+ * chain of 3000, each calling the one before, is refused. (Exponential
+ * expansion, functions calling the one before twice, is test_def_functions
+ * in check_parser.c: expanded once per distinct arguments.) */
+START_TEST(test_def_expansion_bounded)
+{
+  Buf b = {0};
+  char line[96];
+  buf_str(&b, "variables x\ndef f1(a) = a + 1\n");
+  for (int i = 2; i <= 3000; i++) {
+    snprintf(line, sizeof line, "def f%d(a) = f%d(a) + 1\n", i, i - 1);
+    buf_str(&b, line);
+  }
+  buf_str(&b, "U = f3000(x)\n");
+  expect_rejected(&b, "3000 nested calls", "error: calls of functions nested too deeply");
+}
+END_TEST
+
 /* A small deterministic generator (xorshift32), independent of the C
  * library so the inputs are the same everywhere. */
 static unsigned next_random(unsigned *state)
@@ -553,6 +571,7 @@ Suite *errors_suite(void)
   tcase_add_test(robust, test_deep_brackets);
   tcase_add_test(robust, test_deep_chains);
   tcase_add_test(robust, test_huge_tokens);
+  tcase_add_test(robust, test_def_expansion_bounded);
   tcase_add_test(robust, test_step_node_limit);
   tcase_add_test(robust, test_random_bytes);
   tcase_add_test(robust, test_nul_bytes);

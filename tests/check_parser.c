@@ -1,15 +1,17 @@
 /* check_parser.c - Check suite for the front end (gen/lexer.l, parser.y,
  * ast.c, mass.c) and the command line (gen/main.c).
  *
- * Small models, one per statement form of SPEC section 1, go through the
+ * Small models, one per statement form of docs/language.md, go through the
  * front end in-process (diag_begin, parse_model, analyse,
  * model_differentiate); each test asserts what the analysed Model holds:
  * m, nu, degrees, the kind of M and its inverse, q0 and p0, and the values
- * of U and g at a point (dag_eval). Table-driven cases cover the fifteen
+ * of U and g at a point (dag_eval). Table-driven cases cover the twenty
  * functions, operator precedence and number formats.
  * The command line is run as ../gen/hbvmgen (the suite runs from tests/):
  * the first line of --check on each model in models/ for s = 1, 2, 3,
- * --help, --version and bad options.
+ * --help, --version and bad options; models/solar.ham (def, double sums
+ * and comprehensions) and tests/models/solar_plain.ham (the same written
+ * out) generate the same C.
  * The suite is exposed as parser_suite(); the project's runner calls it. */
 #define _POSIX_C_SOURCE 200809L   /* popen, pclose, dup */
 
@@ -24,6 +26,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "generate.h"
 #include "hbvmgen.h"
 
 // P_j(x) = sqrt(2j+1) L_j(2x-1), by the recurrence (the test's own).
@@ -142,6 +145,13 @@ static int refused(const char *src)
   dup2(saved, 2);
   close(saved);
   return bad;
+}
+
+/* Each of the n models of bad is refused. */
+static void assert_refused(const char *const *bad, int n)
+{
+  for (int i = 0; i < n; i++)
+    ck_assert_msg(refused(bad[i]), "accepted:\n%s", bad[i]);
 }
 
 /* The value of node at coordinates q, parameters at their defaults. */
@@ -370,7 +380,7 @@ START_TEST(test_sum_and_indexing)
 }
 END_TEST
 
-/* The eighteen functions against the C library at (x, y) = (0.3, 0.7). */
+/* The twenty functions against the C library at (x, y) = (0.3, 0.7). */
 static double fn_abs(double x, double y) { return fabs(x - y); }
 static double fn_sin(double x, double y) { (void)y; return sin(x); }
 static double fn_cos(double x, double y) { (void)y; return cos(x); }
@@ -385,6 +395,8 @@ static double fn_exp(double x, double y) { (void)y; return exp(x); }
 static double fn_log(double x, double y) { (void)y; return log(x); }
 static double fn_sqrt(double x, double y) { (void)y; return sqrt(x); }
 static double fn_sign(double x, double y) { return (x - y > 0) - (x - y < 0); }
+static double fn_floor(double x, double y) { return floor(y / x); }
+static double fn_mod(double x, double y) { return (x - y) - x * floor((x - y) / x); }
 
 static const struct {
   const char *expr;
@@ -393,7 +405,8 @@ static const struct {
     {"sin(x)", fn_sin},   {"cos(x)", fn_cos},     {"tan(x)", fn_tan},   {"asin(x)", fn_asin}, {"acos(x)", fn_acos},
     {"atan(x)", fn_atan}, {"atan2(x, y)", atan2}, {"sinh(x)", fn_sinh}, {"cosh(x)", fn_cosh}, {"tanh(x)", fn_tanh},
     {"exp(x)", fn_exp},   {"log(x)", fn_log},     {"sqrt(x)", fn_sqrt}, {"pow(x, y)", pow},   {"abs(x - y)", fn_abs},
-    {"sign(x - y)", fn_sign}, {"min(x, y)", fmin}, {"max(x, y)", fmax},
+    {"sign(x - y)", fn_sign}, {"min(x, y)", fmin}, {"max(x, y)", fmax}, {"floor(y / x)", fn_floor},
+    {"mod(x - y, x)", fn_mod},
 };
 
 START_TEST(test_functions)
@@ -461,28 +474,129 @@ START_TEST(test_value_arrays)
 }
 END_TEST
 
+/* U(x, y) and its gradient at a point. */
+typedef struct {
+  double q[2], U, dx, dy;
+} Point;
+
+static void assert_points(const Model *mod, const Point *pts, int n)
+{
+  for (int i = 0; i < n; i++) {
+    assert_close(eval(mod, mod->U, pts[i].q), pts[i].U, "U");
+    assert_close(eval(mod, mod->gradU[0], pts[i].q), pts[i].dx, "dU/dx");
+    assert_close(eval(mod, mod->gradU[1], pts[i].q), pts[i].dy, "dU/dy");
+  }
+}
+
 /* min, max and sign: values on both sides and at a tie, derivatives the
  * subgradients of ad.c (half to each operand of min/max at a tie). */
 START_TEST(test_min_max_sign)
 {
   Model *mod = load("variables x, y\nU = 3 * min(x, y) + 5 * max(x, 2*y) + 7 * sign(x) * x\n");
-  static const struct {
-    double q[2], U, dx, dy;
-  } pts[] = {
+  static const Point pts[] = {
       {{1, 2}, 3 * 1 + 5 * 4 + 7, 3 + 7, 10},
       {{3, 1}, 3 * 1 + 5 * 3 + 21, 5 + 7, 3},
       {{2, 1}, 3 * 1 + 5 * 2 + 14, 2.5 + 7, 3 + 5},    /* tie of max: half each */
       {{-1, -1}, -3 - 5 - 7 * -1, 1.5 + 5 - 7, 1.5},   /* tie of min: half each */
       {{0, 1}, 0 + 10 + 0, 3 + 0, 10},                 /* sign(0) = 0, d sign = 0 */
   };
-  for (int i = 0; i < NCASES(pts); i++) {
-    assert_close(eval(mod, mod->U, pts[i].q), pts[i].U, "U");
-    assert_close(eval(mod, mod->gradU[0], pts[i].q), pts[i].dx, "dU/dx");
-    assert_close(eval(mod, mod->gradU[1], pts[i].q), pts[i].dy, "dU/dy");
-  }
+  assert_points(mod, pts, NCASES(pts));
   ck_assert_int_eq(mod->degU, DEG_NONPOLY);
   ck_assert(refused("variables x\nU = min(x)\n"));
   ck_assert(refused("variables x\nU = sign(x, 1)\n"));
+}
+END_TEST
+
+/* floor and mod: values on both sides of a jump and at one, the sign of
+ * mod that of its divisor (as Python's %), derivatives floor' = 0 and
+ * mod(x, y) = x - y floor(x / y): d/dx 1, d/dy -floor(x / y). */
+START_TEST(test_floor_mod)
+{
+  Model *mod = load("variables x, y\nU = floor(x) + 10 * mod(x, y)\n");
+  static const Point pts[] = {
+      {{2.5, 2}, 2 + 10 * 0.5, 10, -10},
+      {{-0.5, 2}, -1 + 10 * 1.5, 10, 10},   /* floor(-0.5) = -1, mod(-0.5, 2) = 1.5 */
+      {{3, 2}, 3 + 10 * 1, 10, -10},        /* at a jump: the right-hand value */
+      {{2.5, -2}, 2 + 10 * -1.5, 10, 20},   /* mod(2.5, -2) = -1.5 */
+  };
+  assert_points(mod, pts, NCASES(pts));
+  ck_assert_int_eq(mod->degU, DEG_NONPOLY);
+  mod = load("variables x\nq0 = [mod(7, 3) + 10 * mod(-7, 3) + 100 * floor(-2.5)]\n");
+  assert_close(mod->q0[0], 1 + 10 * 2 - 300, "q0");
+  static const char *const bad[] = {"variables x\nU = floor(x, 1)\n", "variables x\nU = mod(x)\n",
+                                     "variables x\nU = mod(x, 0)\n"};
+  assert_refused(bad, NCASES(bad));
+}
+END_TEST
+
+/* Double comprehensions and sums over several index variables (the inner
+ * range may use the outer variable), and index variables that run over a
+ * list, written out or named: each expands in the order written. */
+START_TEST(test_iterators)
+{
+  Model *mod = load("variables x[7]\n"
+                    "pick = [3, 1]\n"
+                    "g = [x[i] - 10 * j for i in 1..2 for j in i..2]\n"
+                    "g = [x[b] for b in [3, 1]]\n"
+                    "g = [x[b] + c for b in pick for c in [5]]\n"
+                    "U = sum(i in 1..2, j in i + 1..3, x[i] * x[j]) + sum(b in [1, 3], 100 * x[b])\n"
+                    "q0 = [1 for i in 1..7]\n");
+  const double q[] = {1, 2, 3, 0, 0, 0, 0};
+  const double want[] = {1 - 10, 1 - 20, 2 - 20, 3, 1, 3 + 5, 1 + 5};
+  ck_assert_int_eq(mod->nu, 7);
+  for (int a = 0; a < 7; a++)
+    assert_close(eval(mod, mod->g[a], q), want[a], "g");
+  assert_close(eval(mod, mod->U, q), 2 + 3 + 6 + 100 * (1 + 3), "U");
+  mod = load("variables x, y\nU = sum(b in [], x) + x\ng = [x - y * i * j for i in [1, 2] for j in [i]]\nq0 = [1, 1]\n");
+  ck_assert_int_eq(mod->nu, 2);
+  static const char *const bad[] = {"variables x\nU = sum(b in [1, x], x)\n", "variables x\nU = sum(b in [1.5], x)\n",
+                                     "variables x\nU = sum(b in 2, x)\n",
+                                     "variables x\ng = [x for i in 1..2 for i in 1..2]\n"};
+  assert_refused(bad, NCASES(bad));
+}
+END_TEST
+
+/* Functions of def: expanded at each call with the parameters bound to the
+ * arguments (usable as indices when constant integers), in the scope of
+ * the def: a caller's index variable of the same name, or a name defined
+ * after the def, is hidden, not clashed with. Calls with equal arguments
+ * share their nodes. */
+START_TEST(test_def_functions)
+{
+  Model *mod = load("variables x[3]\n"
+                    "def d(i, j) = x[i] - x[j]\n"
+                    "def r2(i, j) = d(i, j)^2 + sum(k in 1..1, 0 * x[k])\n"
+                    "U = sum(k in 1..2, j in k + 1..3, r2(k, j)) + r2(1, 2)\n"
+                    "j = 4\n"
+                    "g = d(3, 1) * j - 8\n");
+  const double q[] = {1, 2, 4};
+  assert_close(eval(mod, mod->U, q), 1 + 9 + 4 + 1, "U");
+  assert_close(eval(mod, mod->g[0], q), 3 * 4 - 8, "g");
+  Model *twice = load("variables x, y\ndef f(a) = sin(a) * a\nU = f(x + y) + f(x + y)\n");
+  int n_twice = twice->dag->n;
+  Model *once = load("variables x, y\nU = sin(x + y) * (x + y) + sin(x + y) * (x + y)\n");
+  ck_assert_int_eq(n_twice, once->dag->n);
+  /* 40 functions each calling the one before twice: 2^39 calls of f1 written
+   * out, expanded once per distinct arguments (a few hundred nodes) */
+  char src[4096] = "variables x\ndef f1(a) = a\n";
+  for (int i = 2; i <= 40; i++)
+    snprintf(src + strlen(src), sizeof src - strlen(src), "def f%d(a) = f%d(a) + f%d(a)\n", i, i - 1, i - 1);
+  strcat(src, "U = f40(x)\n");
+  Model *chain = load(src);
+  const double one[] = {1};
+  assert_close(eval(chain, chain->U, one), ldexp(1, 39), "U of the doubling chain");
+  ck_assert_int_lt(chain->dag->n, 1000);
+  static const char *const bad[] = {
+      "variables x\ndef f(a) = a\nU = f(x, x)\n",        /* arity */
+      "variables x\ndef f(a) = f(a)\nU = f(x)\n",        /* recursion */
+      "variables x\ndef f(x) = x\nU = f(x)\n",           /* a parameter named as a coordinate */
+      "variables x\ndef f(a, a) = a\nU = f(x, x)\n",     /* twice */
+      "variables x\nU = f(x)\ndef f(a) = a\n",           /* used before its def */
+      "variables x\ndef f(a) = a * y\ny = 2\nU = f(x)\n", /* the body sees only earlier names */
+      "variables x\ndef f(a) = a\nU = f\n",              /* not called */
+      "variables x\nU = x(1)\n",                         /* not a function */
+  };
+  assert_refused(bad, NCASES(bad));
 }
 END_TEST
 
@@ -520,7 +634,7 @@ START_TEST(test_layout)
 }
 END_TEST
 
-/* Every number format of SPEC section 1. */
+/* Every number format of docs/language.md. */
 START_TEST(test_numbers)
 {
   Model *mod = load("variables x[6]\nq0 = [12, 1.5, .5, 2e-3, 1.0E+10, 0.25e1]\n");
@@ -611,8 +725,7 @@ START_TEST(test_refused)
       "variables x\nU = y\n", "variables x[2]\nU = x[3]\n", "variables x\nM = [[1, 2], [3, 4]]\n",
       "variables x\nU = (x\n", "", "variables x\nq0 = [1, 2]\n",
   };
-  for (int i = 0; i < NCASES(bad); i++)
-    ck_assert_msg(refused(bad[i]), "accepted:\n%s", bad[i]);
+  assert_refused(bad, NCASES(bad));
 }
 END_TEST
 
@@ -707,6 +820,120 @@ START_TEST(test_help)
 }
 END_TEST
 
+/* src with every name of a temporary, a letter then digits (b12, t345),
+ * replaced by one numbered in order of first appearance, so that two
+ * sources compare equal when they differ only in how their temporaries are
+ * numbered (malloc'd; src is freed). */
+static char *renumber_temporaries(char *src)
+{
+  enum { MAXID = 1000000 };
+  int *num[26] = {NULL}, next = 0;
+  char *res = malloc(4 * strlen(src) + 1), *out = res; /* "b1" -> "T1000" at worst */
+  ck_assert_ptr_nonnull(res);
+  for (const char *c = src; *c;) {
+    size_t digits = 0;
+    int word = (c == src || !(isalnum((unsigned char)c[-1]) || c[-1] == '_')) && islower((unsigned char)c[0]);
+    while (word && isdigit((unsigned char)c[1 + digits]))
+      digits++;
+    if (!digits || digits > 6 || isalnum((unsigned char)c[1 + digits]) || c[1 + digits] == '_') {
+      *out++ = *c++;
+      continue;
+    }
+    int **map = &num[c[0] - 'a'];
+    if (!*map)
+      ck_assert_ptr_nonnull(*map = calloc(MAXID, sizeof **map));
+    long id = strtol(c + 1, NULL, 10);
+    if (!(*map)[id])
+      (*map)[id] = ++next;
+    out += sprintf(out, "T%d", (*map)[id]);
+    c += 1 + digits;
+  }
+  *out = '\0';
+  for (int p = 0; p < 26; p++)
+    free(num[p]);
+  free(src);
+  return res;
+}
+
+/* The new forms (def, sums over two index variables, double
+ * comprehensions) expand exactly as the model written out by hand: the
+ * outer solar system in both forms generates the same C but for the
+ * numbering of its temporaries, so the same trajectories. */
+START_TEST(test_sugar_same_code)
+{
+  char *sugar = read_text("../models/solar.ham"), *plain = read_text("../tests/models/solar_plain.ham");
+  ck_assert_ptr_nonnull(sugar);
+  ck_assert_ptr_nonnull(plain);
+  ck_assert_msg(strstr(sugar, "def ") && strstr(sugar, " for c in 1..3]") && !strstr(plain, "def "),
+                "the two models are not the two forms");
+  char *a = generate_source(sugar, "-s 3"), *b = generate_source(plain, "-s 3");
+  ck_assert_ptr_nonnull(a);
+  ck_assert_ptr_nonnull(b);
+  ck_assert_msg(strcmp(a, b) != 0, "the same numbering: the test would not see a difference");
+  a = renumber_temporaries(a);
+  b = renumber_temporaries(b);
+  ck_assert_msg(strcmp(a, b) == 0, "models/solar.ham and tests/models/solar_plain.ham generate different code");
+  free(sugar);
+  free(plain);
+  free(a);
+  free(b);
+}
+END_TEST
+
+/* --check's advice for each kind of model (method_advise): the (s, k)
+ * measured best, whether the options given are those, what the constant
+ * multiplier and a kink mean, and the step size limit of the iteration at
+ * this s. A model with a kink is written into a temporary directory. */
+START_TEST(test_check_advice)
+{
+  static const struct {
+    const char *args, *want;
+  } cases[] = {
+      {"--check ../models/kepler.ham", "\nadvice: unconstrained and smooth: -s 6 -k 11 (order 12); on the outer"},
+      {"--check -s 6 -k 11 ../models/solar.ham", "\nadvice: unconstrained and smooth: -s 6 -k 11 (order 12), as chosen;"},
+      {"--check ../models/henon_heiles.ham", "\nadvice: unconstrained and smooth: -s 6 -k auto (order 12);"},
+      {"--check ../models/pendulum.ham", "\nadvice: constrained and smooth: -s 4 -k auto --multiplier poly (order 8); "},
+      {"--check -s 4 ../models/satellites.ham", " --multiplier poly (order 8), as chosen; "},
+      {"--check --multiplier const ../models/pendulum.ham", "\nadvice: --multiplier const has order 2 in p with"},
+      {"--check ../models/pendulum.ham", "stays below about 2.8 (docs/choosing.md, \"Stiffness\")\ncode: "},
+      {"--check -s 9 ../models/kepler.ham", "stays below about 5.7 (docs/choosing.md"},
+  };
+  char out[8192], args[256], dir[] = "/tmp/hbvm-advice-XXXXXX";
+  for (int i = 0; i < NCASES(cases); i++) {
+    ck_assert_int_eq(run_cli(cases[i].args, 0, out, sizeof out), 0);
+    ck_assert_msg(strstr(out, cases[i].want) != NULL, "%s: no '%s' in\n%s", cases[i].args, cases[i].want, out);
+  }
+  ck_assert_ptr_nonnull(mkdtemp(dir));
+  snprintf(args, sizeof args, "%s/kink.ham", dir);
+  FILE *f = fopen(args, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs("variables x, y\nU = x^2 + max(y, 0)^2 + mod(x, 1)\n", f);
+  fclose(f);
+  snprintf(args, sizeof args, "--check %s/kink.ham", dir);
+  ck_assert_int_eq(run_cli(args, 0, out, sizeof out), 0);
+  ck_assert_msg(strstr(out, "\nadvice: U or g uses max, which has a kink or a jump: ") && !strstr(out, "smooth"),
+                "%s", out);
+  snprintf(args, sizeof args, "rm -r %s", dir);
+  ck_assert_int_eq(system(args), 0);
+}
+END_TEST
+
+/* Without -o the files go to the current directory (they went to
+ * generated/, the directory of the committed solvers, before). */
+START_TEST(test_default_output_dir)
+{
+  char here[1024], cmd[3072], dir[] = "/tmp/hbvm-cwd-XXXXXX";
+  ck_assert_ptr_nonnull(getcwd(here, sizeof here));
+  ck_assert_ptr_nonnull(mkdtemp(dir));
+  snprintf(cmd, sizeof cmd, "cd %s && %s/%s %s/../models/pendulum.ham 2>/dev/null", dir, here, GENERATOR, here);
+  ck_assert_int_eq(system(cmd), 0);
+  snprintf(cmd, sizeof cmd, "test -f %s/pendulum.c && test -f %s/pendulum.h && test ! -e %s/generated", dir, dir, dir);
+  ck_assert_msg(system(cmd) == 0, "hbvmgen without -o did not write pendulum.c and .h into the current directory");
+  snprintf(cmd, sizeof cmd, "rm -r %s", dir);
+  ck_assert_int_eq(system(cmd), 0);
+}
+END_TEST
+
 /* Bad command lines exit 1 with "hbvmgen: error: ..." on stderr. */
 static const char *const bad_options[] = {
     "--bogus ../models/pendulum.ham", "-s 0 ../models/pendulum.ham",   "-s x ../models/pendulum.ham",
@@ -774,6 +1001,9 @@ Suite *parser_suite(void)
   tcase_add_loop_test(fe, test_functions_fold, 0, NCASES(function_cases));
   tcase_add_test(fe, test_value_arrays);
   tcase_add_test(fe, test_min_max_sign);
+  tcase_add_test(fe, test_floor_mod);
+  tcase_add_test(fe, test_iterators);
+  tcase_add_test(fe, test_def_functions);
   tcase_add_test(fe, test_initial_values);
   tcase_add_test(fe, test_layout);
   tcase_add_test(fe, test_numbers);
@@ -790,6 +1020,9 @@ Suite *parser_suite(void)
   tcase_add_test(cli, test_check_options);
   tcase_add_test(cli, test_check_code);
   tcase_add_test(cli, test_help);
+  tcase_add_test(cli, test_sugar_same_code);
+  tcase_add_test(cli, test_check_advice);
+  tcase_add_test(cli, test_default_output_dir);
   tcase_add_loop_test(cli, test_bad_options, 0, NCASES(bad_options));
   suite_add_tcase(s, cli);
   return s;

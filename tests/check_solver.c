@@ -1,7 +1,7 @@
 /* check_solver.c - properties of the generated solvers beyond the paper's
  * tables: HBVM(s,s) is s-stage Gauss collocation, order 2s on an
  * unconstrained problem, exact energy conservation with -k auto for a cubic
- * potential, the failure contract of SPEC section 3, and generated/ being
+ * potential, the failure contract of docs/api.md, and generated/ being
  * what the generator emits now. */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>

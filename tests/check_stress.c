@@ -1,7 +1,7 @@
 /* check_stress.c - stress tests of the generated solvers' failure contract
- * (SPEC section 3: a failed step returns a nonzero code and leaves the state
- * exactly as it was, byte for byte; a step never leaves a NaN or an
- * infinity in the state).
+ * (docs/api.md, "Functions": a failed step returns a nonzero code and
+ * leaves the state exactly as it was, byte for byte; a step never leaves a
+ * NaN or an infinity in the state).
  *
  *   sweep      every committed solver (generated/LIST) and every test-only
  *              solver (tests/models/LIST, double precision): from the
