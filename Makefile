@@ -1,6 +1,8 @@
 # hbvmgen - one flat Makefile.
 #   make            the generator gen/hbvmgen and runtime/libhbvmrt.a
-#   make check      install missing packages, build, run every test suite (plain and sanitized)
+#   make check      install missing packages, build, run the test suites (plain and
+#                   sanitized; see "make check, make check-long" below)
+#   make check-long the long test cases, and every case under the sanitizers
 #   make demo       generate, build and run the pendulum with HBVM(2,2)
 #   make generated  regenerate the committed solvers in generated/
 #   make tables     the paper's tables beside ours (docs/tables.md)
@@ -46,8 +48,9 @@ LIBRT_OMP:= $(B)/libhbvmrt_omp.a
 LIBRT_MPI:= $(B)/libhbvmrt_mpi.a
 MPICC    ?= mpicc
 
-.PHONY: all deps check demo generated tables figures bench fuzz clean install uninstall
-all: $(HBVMGEN) $(LIBRT) $(LIBRT_OMP) $(if $(MPI),$(LIBRT_MPI))
+.PHONY: all deps check check-long check-build check-san-build check-san-all-build demo generated tables figures bench fuzz clean install uninstall
+BINS     := $(HBVMGEN) $(LIBRT) $(LIBRT_OMP) $(if $(MPI),$(LIBRT_MPI))
+all: $(BINS)
 	@cmp -s $(HBVMGEN) gen/hbvmgen || cp $(HBVMGEN) gen/hbvmgen
 	@cmp -s $(LIBRT) runtime/libhbvmrt.a || cp $(LIBRT) runtime/libhbvmrt.a
 	@cmp -s $(LIBRT_OMP) runtime/libhbvmrt_omp.a || cp $(LIBRT_OMP) runtime/libhbvmrt_omp.a
@@ -120,25 +123,97 @@ $(B)/tgen/stamp: tests/models/LIST $(wildcard tests/models/*.ham) $(wildcard mod
 $(B)/tgen/%.o: $(B)/tgen/stamp
 	$(CC) $(WARN) -Werror $(CFLAGS) $(SAN) -I$(B)/tgen -c -o $@ $(B)/tgen/$*.c
 
-$(B)/tests/%.o: tests/%.c $(B)/tgen/stamp
-	@mkdir -p $(@D)
-	$(CC) $(ALLCFLAGS) $(GSL) $(CHECK) -Igen -I$(B)/gen -Iruntime -Igenerated -I$(B)/tgen -Itests -c -o $@ $<
+# make check's sanitized run (SAN_SOLVERS=plain) links the plain build's
+# solvers (build/generated, build/tgen) into build-san/tests/runner-mix: the
+# generator, runtime and tests are instrumented, and each solver is compiled
+# once for both runs. The full sanitized runner, build-san/tests/runner (make
+# check-long, make SANITIZE=1 check), instruments the solvers too.
+ifeq ($(SANITIZE)$(SAN_SOLVERS),1plain)
+SB       := build
+RUNNER   := $(B)/tests/runner-mix
+build/tgen/stamp:
+	@echo "$@: missing; SAN_SOLVERS=plain links the plain build's solvers (make build/tests/runner first)" >&2; exit 1
+build/generated/%.o build/tgen/%.o:
+	@echo "$@: missing; SAN_SOLVERS=plain links the plain build's solvers (make build/tests/runner first)" >&2; exit 1
+else
+SB       := $(B)
+RUNNER   := $(B)/tests/runner
+endif
 
-$(B)/tests/runner: $(TEST_OBJ) $(GEN_OBJ) $(SOLV_OBJ) $(TSOLV_OBJ) $(LIBRT)
+$(B)/tests/%.o: tests/%.c $(SB)/tgen/stamp
+	@mkdir -p $(@D)
+	$(CC) $(ALLCFLAGS) $(GSL) $(CHECK) -Igen -I$(B)/gen -Iruntime -Igenerated -I$(SB)/tgen -Itests -c -o $@ $<
+
+$(RUNNER): $(TEST_OBJ) $(GEN_OBJ) $(patsubst $(B)/%,$(SB)/%,$(SOLV_OBJ) $(TSOLV_OBJ)) $(LIBRT)
 	$(CC) $(SAN) -o $@ $^ $(CHECKLIB) $(GSLLIB) -lm
 
-# make check runs every suite twice: as built, then built with ASan and UBSan
-# (make SANITIZE=1 check runs only the latter); the plain binaries are put
-# back in place at the end.
+# ---- make check, make check-long ----
+# One runner per suite of tests/suites.def, CHECK_JOBS of them at a time; the
+# test cases tagged "long" (tcase_set_tags) run in check-long only, those
+# tagged "numeric" (they exercise only the generated solvers' arithmetic) are
+# left out of check's sanitized run. What runs where:
+#   make check       plain: every suite, no "long" case;
+#                    sanitized (runner-mix): every suite, no "long" or "numeric" case
+#   make check-long  plain: the "long" cases;
+#                    sanitized (runner, solvers instrumented too): every case
+#   make SANITIZE=1 check   the latter alone
+# Each suite's output is printed whole when it ends (build/check/RUN/SUITE.log,
+# with Check's XML log of every test's time beside it), then the run's total
+# in Check's words; the target fails when any suite fails.
+SUITES     := $(shell sed -n 's/^SUITE(\([A-Za-z0-9_]*\))$$/\1/p' tests/suites.def)
+CHECK_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+# -jCHECK_JOBS, unless this make already shares a job server (make -jN check)
+CHECK_J     = $(if $(findstring jobserver,$(MAKEFLAGS)),,-j$(CHECK_JOBS))
+CK         := build/check
+# the suites that take longest start first, so that no job is left alone at the end
+CHECK_FIRST:= ensemble init errors docs install runtime
+CHECK_ORDER:= $(foreach s,$(CHECK_FIRST),$(filter $(s),$(SUITES))) $(filter-out $(CHECK_FIRST),$(SUITES))
+SUBMAKE     = $(MAKE) --no-print-directory
+
+# $(call suite_rule,RUN,RUNNER,ENVIRONMENT): the rule running one suite of run
+# RUN: its output in $(CK)/RUN/SUITE.log, its exit status in SUITE.rc.
+define suite_rule
+$(CK)/$1/%.rc: FORCE
+	@mkdir -p $$(@D) && rm -f $$(@D)/$$*.xml
+	@cd tests && env $3 CK_XML_LOG_FILE_NAME=../$(CK)/$1/$$*.xml ../$2 $$* >../$(CK)/$1/$$*.log 2>&1; \
+	  echo $$$$? >../$$@; cat ../$(CK)/$1/$$*.log
+check-run-$1: $(CHECK_ORDER:%=$(CK)/$1/%.rc)
+	@scripts/check_total.sh $(CK)/$1 "$1" $(SUITES)
+endef
+$(eval $(call suite_rule,plain,build/tests/runner,CK_EXCLUDE_TAGS=long HBVM_SANITIZED=))
+$(eval $(call suite_rule,sanitized,build-san/tests/runner-mix,CK_EXCLUDE_TAGS='long sanlong' HBVM_SANITIZED=1))
+$(eval $(call suite_rule,long,build/tests/runner,CK_INCLUDE_TAGS=long HBVM_SANITIZED=))
+$(eval $(call suite_rule,sanitized-all,build-san/tests/runner,HBVM_SANITIZED=1))
+
+# Build a sanitized runner quietly (its log in $(CK)/), for a run beside another.
+# $1: make's variables for it.
+san_build = mkdir -p $(CK) && $(SUBMAKE) SANITIZE=1 $1 >$(CK)/san-build.log 2>&1 || { cat $(CK)/san-build.log; exit 1; }
+check-build: $(RUNNER) $(BINS)
+check-san-build:
+	+@$(call san_build,SAN_SOLVERS=plain check-build)
+check-san-all-build:
+	+@$(call san_build,check-build)
+
+# Run $1 with the sanitized generator and runtime in gen/ and runtime/, where
+# the tests take them from; the plain ones are put back, whatever the result.
+san_run = $(SUBMAKE) SANITIZE=1 all && { st=0; $(SUBMAKE) $(CHECK_J) check-run-$1 || st=$$?; $(SUBMAKE) all; exit $$st; }
+
 check: deps
 	@scripts/deps.sh embedded clang mpi
-	@$(MAKE) --no-print-directory $(B)/tests/runner all
-	cd tests && HBVM_SANITIZED=$(if $(SANITIZE),1,) ../$(B)/tests/runner
-ifndef SANITIZE
-	@echo "== the same suites under -fsanitize=address,undefined"
-	@$(MAKE) --no-print-directory SANITIZE=1 check
-	@$(MAKE) --no-print-directory all
+ifdef SANITIZE
+	+@$(SUBMAKE) $(CHECK_J) $(RUNNER) all
+	+@$(SUBMAKE) SANITIZE= $(CHECK_J) check-run-sanitized-all
+else
+	+@$(SUBMAKE) $(CHECK_J) build/tests/runner all
+	+@$(SUBMAKE) $(CHECK_J) check-san-build check-run-plain
+	+@$(call san_run,sanitized)
 endif
+
+check-long: deps
+	@scripts/deps.sh embedded clang mpi
+	+@$(SUBMAKE) $(CHECK_J) build/tests/runner all
+	+@$(SUBMAKE) $(CHECK_J) check-san-all-build check-run-long
+	+@$(call san_run,sanitized-all)
 
 generated: all
 	scripts/regen.sh gen/hbvmgen generated
