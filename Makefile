@@ -6,7 +6,8 @@
 #   make demo       generate, build and run the pendulum with HBVM(2,2)
 #   make generated  regenerate the committed solvers in generated/
 #   make tables     the paper's tables beside ours (docs/tables.md)
-#   make install    hbvmgen, libhbvmrt.a, hbvmrt.h, hbvmgen.1, hbvmrt.pc under
+#   make install    hbvmgen, the runtimes (libhbvmrt.a, .so, _omp.a, _mpi.a with MPI=1),
+#                   hbvmrt.h, hbvmgen.1, the .pc files, the docs under
 #                   $(DESTDIR)$(PREFIX) (PREFIX=/usr/local); make uninstall
 #   make SANITIZE=1 ...   everything with -fsanitize=address,undefined
 
@@ -46,10 +47,11 @@ HBVMGEN  := $(B)/hbvmgen
 LIBRT    := $(B)/libhbvmrt.a
 LIBRT_OMP:= $(B)/libhbvmrt_omp.a
 LIBRT_MPI:= $(B)/libhbvmrt_mpi.a
+LIBRT_SO := $(B)/libhbvmrt.so
 MPICC    ?= mpicc
 
 .PHONY: all deps check check-long check-build check-san-build check-san-all-build demo generated tables figures bench fuzz clean install uninstall
-BINS     := $(HBVMGEN) $(LIBRT) $(LIBRT_OMP) $(if $(MPI),$(LIBRT_MPI))
+BINS     := $(HBVMGEN) $(LIBRT) $(LIBRT_OMP) $(LIBRT_SO) $(if $(MPI),$(LIBRT_MPI))
 all: $(BINS)
 	@cmp -s $(HBVMGEN) gen/hbvmgen || cp $(HBVMGEN) gen/hbvmgen
 	@cmp -s $(LIBRT) runtime/libhbvmrt.a || cp $(LIBRT) runtime/libhbvmrt.a
@@ -242,33 +244,72 @@ bench: deps
 	@$(MAKE) --no-print-directory all
 	bench/run.sh
 
-# Installation. The pkg-config file is made from runtime/hbvmrt.pc.in with
-# the prefix and directories of this install, so a program finds the
-# runtime with `pkg-config --cflags --libs hbvmrt` alone.
+# Installation. The pkg-config files (hbvmrt, hbvmrt_omp, and with MPI=1
+# hbvmrt_mpi) are made from runtime/hbvmrt.pc.in with the prefix and
+# directories of this install, so a program finds a runtime with
+# `pkg-config --cflags --libs hbvmrt` alone. Every path is quoted for the
+# shell ($(call shq,...)): PREFIX and DESTDIR may hold spaces and quotes.
+# The generator is installed stripped (STRIP= keeps its symbols).
 PREFIX     ?= /usr/local
 BINDIR     ?= $(PREFIX)/bin
 LIBDIR     ?= $(PREFIX)/lib
 INCLUDEDIR ?= $(PREFIX)/include
 MANDIR     ?= $(PREFIX)/share/man
 PCDIR      ?= $(LIBDIR)/pkgconfig
+DOCDIR     ?= $(PREFIX)/share/doc/hbvmgen
+STRIP      ?= strip
 VERSION    := $(shell sed -n 's/^\#define HBVMGEN_VERSION "\(.*\)"/\1/p' gen/hbvmgen.h)
+SOMAJOR    := $(firstword $(subst ., ,$(VERSION)))
+PC_NAMES   := hbvmrt hbvmrt_omp $(if $(MPI),hbvmrt_mpi)
+PC_WHAT_hbvmrt_omp   := , ensembles on OpenMP threads
+PC_WHAT_hbvmrt_mpi   := , ensembles on MPI ranks (link with mpicc) and OpenMP threads
+PC_OPENMP_hbvmrt_omp := -fopenmp
+PC_OPENMP_hbvmrt_mpi := -fopenmp
+DOC_FILES  := README.md $(wildcard docs/*.md docs/*.png)
+# a make value as one shell word
+shq         = '$(subst ','\'',$1)'
+PC_ENV      = PC_PREFIX=$(call shq,$(PREFIX)) PC_LIBDIR=$(call shq,$(LIBDIR)) \
+              PC_INCLUDEDIR=$(call shq,$(INCLUDEDIR)) PC_VERSION=$(call shq,$(VERSION))
+# $(call inst,MODE,FILES,DIR): install FILES into $(DESTDIR)DIR
+inst        = install -m $1 $2 $(call shq,$(DESTDIR)$3)
 
-$(B)/hbvmrt.pc: runtime/hbvmrt.pc.in gen/hbvmgen.h FORCE
+# The runtime as a shared library too: objects compiled with -fPIC, the file
+# libhbvmrt.so.VERSION with the soname libhbvmrt.so.MAJOR.
+$(B)/runtime-pic/%.o: runtime/%.c
 	@mkdir -p $(@D)
-	sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@LIBDIR@|$(LIBDIR)|g' -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|g' \
-	    -e 's|@VERSION@|$(VERSION)|g' runtime/hbvmrt.pc.in > $@
+	$(CC) $(ALLCFLAGS) -fPIC -Iruntime -c -o $@ $<
 
-install: all $(B)/hbvmrt.pc
-	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(PCDIR)
-	install -m 755 gen/hbvmgen $(DESTDIR)$(BINDIR)/hbvmgen
-	install -m 644 runtime/libhbvmrt.a $(DESTDIR)$(LIBDIR)/libhbvmrt.a
-	install -m 644 runtime/hbvmrt.h $(DESTDIR)$(INCLUDEDIR)/hbvmrt.h
-	install -m 644 docs/hbvmgen.1 $(DESTDIR)$(MANDIR)/man1/hbvmgen.1
-	install -m 644 $(B)/hbvmrt.pc $(DESTDIR)$(PCDIR)/hbvmrt.pc
+$(LIBRT_SO): $(patsubst runtime/%.c,$(B)/runtime-pic/%.o,$(wildcard runtime/*.c))
+	$(CC) $(SAN) -shared -Wl,-soname,libhbvmrt.so.$(SOMAJOR) -o $@ $^ -lm
+
+# The .pc files are written straight into place (a file in build/ would be
+# shared by two installs running at once, as two test suites may).
+install: all
+	install -d $(call shq,$(DESTDIR)$(BINDIR)) $(call shq,$(DESTDIR)$(LIBDIR)) $(call shq,$(DESTDIR)$(INCLUDEDIR)) \
+	  $(call shq,$(DESTDIR)$(MANDIR)/man1) $(call shq,$(DESTDIR)$(PCDIR)) \
+	  $(call shq,$(DESTDIR)$(DOCDIR)/examples) $(call shq,$(DESTDIR)$(DOCDIR)/models)
+	install -m 755 $(if $(STRIP),-s --strip-program=$(call shq,$(STRIP))) $(HBVMGEN) $(call shq,$(DESTDIR)$(BINDIR)/hbvmgen)
+	$(call inst,644,$(LIBRT) $(LIBRT_OMP) $(if $(MPI),$(LIBRT_MPI)),$(LIBDIR))
+	$(call inst,755,$(LIBRT_SO),$(LIBDIR)/libhbvmrt.so.$(VERSION))
+	ln -sf libhbvmrt.so.$(VERSION) $(call shq,$(DESTDIR)$(LIBDIR)/libhbvmrt.so.$(SOMAJOR))
+	ln -sf libhbvmrt.so.$(SOMAJOR) $(call shq,$(DESTDIR)$(LIBDIR)/libhbvmrt.so)
+	$(call inst,644,runtime/hbvmrt.h,$(INCLUDEDIR))
+	$(call inst,644,docs/hbvmgen.1,$(MANDIR)/man1)
+	$(foreach n,$(PC_NAMES),$(PC_ENV) PC_NAME=$(n) PC_WHAT=$(call shq,$(PC_WHAT_$(n))) \
+	  PC_OPENMP=$(call shq,$(PC_OPENMP_$(n))) scripts/pcfile.sh runtime/hbvmrt.pc.in >$(call shq,$(DESTDIR)$(PCDIR)/$(n).pc) &&) true
+	$(call inst,644,$(DOC_FILES),$(DOCDIR))
+	$(call inst,644,$(wildcard docs/examples/*),$(DOCDIR)/examples)
+	$(call inst,644,$(wildcard models/*.ham),$(DOCDIR)/models)
 
 uninstall:
-	rm -f $(DESTDIR)$(BINDIR)/hbvmgen $(DESTDIR)$(LIBDIR)/libhbvmrt.a $(DESTDIR)$(INCLUDEDIR)/hbvmrt.h \
-	      $(DESTDIR)$(MANDIR)/man1/hbvmgen.1 $(DESTDIR)$(PCDIR)/hbvmrt.pc
+	rm -f $(call shq,$(DESTDIR)$(BINDIR)/hbvmgen) $(call shq,$(DESTDIR)$(INCLUDEDIR)/hbvmrt.h) \
+	  $(call shq,$(DESTDIR)$(MANDIR)/man1/hbvmgen.1) \
+	  $(foreach f,libhbvmrt.a libhbvmrt_omp.a libhbvmrt_mpi.a libhbvmrt.so libhbvmrt.so.$(SOMAJOR) \
+	    libhbvmrt.so.$(VERSION),$(call shq,$(DESTDIR)$(LIBDIR)/$(f))) \
+	  $(foreach f,hbvmrt hbvmrt_omp hbvmrt_mpi,$(call shq,$(DESTDIR)$(PCDIR)/$(f).pc))
+	rm -f $(foreach f,$(notdir $(DOC_FILES)) $(addprefix examples/,$(notdir $(wildcard docs/examples/*))) \
+	  $(addprefix models/,$(notdir $(wildcard models/*.ham))),$(call shq,$(DESTDIR)$(DOCDIR)/$(f)))
+	-rmdir $(call shq,$(DESTDIR)$(DOCDIR)/examples) $(call shq,$(DESTDIR)$(DOCDIR)/models) $(call shq,$(DESTDIR)$(DOCDIR)) 2>/dev/null || true
 
 FORCE:
 
