@@ -152,10 +152,10 @@ $(RUNNER): $(TEST_OBJ) $(GEN_OBJ) $(patsubst $(B)/%,$(SB)/%,$(SOLV_OBJ) $(TSOLV_
 # ---- make check, make check-long ----
 # One runner per suite of tests/suites.def, CHECK_JOBS of them at a time; the
 # test cases tagged "long" (tcase_set_tags) run in check-long only, those
-# tagged "numeric" (they exercise only the generated solvers' arithmetic) are
-# left out of check's sanitized run. What runs where:
+# tagged "sanlong" (the generated solvers' arithmetic, many solvers compiled,
+# builds as a user does) are left out of check's sanitized run. What runs where:
 #   make check       plain: every suite, no "long" case;
-#                    sanitized (runner-mix): every suite, no "long" or "numeric" case
+#                    sanitized (runner-mix): every suite, no "long" or "sanlong" case
 #   make check-long  plain: the "long" cases;
 #                    sanitized (runner, solvers instrumented too): every case
 #   make SANITIZE=1 check   the latter alone
