@@ -185,8 +185,9 @@ check-run-$1: $(CHECK_ORDER:%=$(CK)/$1/%.rc)
 endef
 $(eval $(call suite_rule,plain,build/tests/runner,CK_EXCLUDE_TAGS=long HBVM_SANITIZED=))
 $(eval $(call suite_rule,sanitized,build-san/tests/runner-mix,CK_EXCLUDE_TAGS='long sanlong' HBVM_SANITIZED=1))
-$(eval $(call suite_rule,long,build/tests/runner,CK_INCLUDE_TAGS=long HBVM_SANITIZED=))
-$(eval $(call suite_rule,sanitized-all,build-san/tests/runner,HBVM_SANITIZED=1))
+# check-long's runs share the cores with a sanitized build: Check's timeouts x4
+$(eval $(call suite_rule,long,build/tests/runner,CK_INCLUDE_TAGS=long HBVM_SANITIZED= CK_TIMEOUT_MULTIPLIER=4))
+$(eval $(call suite_rule,sanitized-all,build-san/tests/runner,HBVM_SANITIZED=1 CK_TIMEOUT_MULTIPLIER=4))
 
 # Build a sanitized runner quietly (its log in $(CK)/), for a run beside another.
 # $1: make's variables for it.
