@@ -226,6 +226,7 @@ END_TEST
 Suite *batch_suite(void) {
   Suite *s = suite_create("batch");
   TCase *tc = tcase_create("lanes");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, test_bconst_k2s2);
   tcase_add_test(tc, test_bpoly_k3s3);

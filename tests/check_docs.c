@@ -217,9 +217,10 @@ START_TEST(install_and_pkg_config)
            "-o %s/pendulum",
            env, d, d, d, sanitized() ? SAN_FLAGS : "", d, d, d, d);
   ck_assert_msg(sh(cmd) == 0, "building with pkg-config failed: %s", cmd);
-  snprintf(cmd, sizeof cmd, "%s/embed", d);
+  /* pkg-config links the shared runtime, which the loader finds in PREFIX/lib */
+  snprintf(cmd, sizeof cmd, "LD_LIBRARY_PATH=%s/lib %s/embed", d, d);
   check_example_output(cmd);
-  snprintf(cmd, sizeof cmd, "%s/pendulum -h 0.1 -N 2 --quiet --csv - 2>/dev/null", d);
+  snprintf(cmd, sizeof cmd, "LD_LIBRARY_PATH=%s/lib %s/pendulum -h 0.1 -N 2 --quiet --csv - 2>/dev/null", d, d);
   first_line(cmd, line, sizeof line);
   ck_assert_str_eq(line, "t,x,y,p_x,p_y,lambda_1,H,g_1,hc_1");
   /* DESTDIR stages the same files; the .pc keeps the real prefix */
@@ -424,6 +425,7 @@ Suite *docs_suite(void)
 {
   Suite *s = suite_create("docs");
   TCase *tc = tcase_create("docs");
+  tcase_set_tags(tc, "sanlong"); /* builds as a user does: sanitized in check-long */
   tcase_set_timeout(tc, 300);
   tcase_add_test(tc, embedding_examples_c_and_cpp);
   tcase_add_test(tc, embedding_doc_shows_the_examples);

@@ -287,10 +287,15 @@ static void teardown(void)
 Suite *ensemble_suite(void)
 {
   Suite *s = suite_create("ensemble");
+  TCase *widths = tcase_create("batch widths");
+  tcase_set_tags(widths, "sanlong"); /* four batch solvers compiled: sanitized in check-long */
+  tcase_add_checked_fixture(widths, setup, teardown);
+  tcase_set_timeout(widths, 300);
+  tcase_add_test(widths, test_independent_of_w_and_threads);
+  suite_add_tcase(s, widths);
   TCase *tc = tcase_create("ensemble");
   tcase_add_checked_fixture(tc, setup, teardown);
   tcase_set_timeout(tc, 300);
-  tcase_add_test(tc, test_independent_of_w_and_threads);
   tcase_add_test(tc, test_sweep_and_mpi);
   tcase_add_test(tc, test_span_and_tol);
   tcase_add_test(tc, test_errors);

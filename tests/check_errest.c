@@ -173,6 +173,7 @@ END_TEST
 Suite *errest_suite(void) {
   Suite *s = suite_create("errest");
   TCase *tc = tcase_create("errest");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_add_loop_test(tc, tracks_true_error, 0, (int)(sizeof cases / sizeof cases[0]));
   tcase_add_loop_test(tc, cold_estimate_not_below_truth, 0, (int)(sizeof cases / sizeof cases[0]));
   tcase_set_timeout(tc, 60);
@@ -379,6 +380,7 @@ END_TEST
 Suite *adaptive_suite(void) {
   Suite *s = suite_create("adaptive");
   TCase *tc = tcase_create("adaptive");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_add_loop_test(tc, adaptive_proportional, 0, (int)(sizeof adaptive_cases / sizeof adaptive_cases[0]));
   tcase_add_loop_test(tc, adaptive_const_proportional, 0, 2);
   tcase_add_test(tc, adaptive_rejected_unchanged);

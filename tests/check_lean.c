@@ -385,11 +385,10 @@ END_TEST
 Suite *lean_suite(void) {
   Suite *s = suite_create("lean");
   TCase *tc = tcase_create("structure");
-  tcase_set_timeout(tc, 180); /* the corpus compile takes ~20 s, more under the sanitizers */
+  tcase_set_timeout(tc, 180);
   tcase_add_test(tc, equal_mass_matrices_give_equal_code);
   tcase_add_test(tc, dense_mass_is_a_table);
   tcase_add_test(tc, no_event_code_without_events);
-  tcase_add_test(tc, corpus_models_compile);
   tcase_add_test(tc, unsafe_math_refused);
   tcase_add_test(tc, huge_c_refused);
   tcase_add_test(tc, limits_settable_with_D);
@@ -403,5 +402,10 @@ Suite *lean_suite(void) {
   tcase_add_test(tc, wide_step_holds_H_at_roundoff);
   tcase_add_test(tc, float_wide_step_holds_H);
   suite_add_tcase(s, tc);
+  TCase *corpus = tcase_create("corpus"); /* make check-long */
+  tcase_set_tags(corpus, "long");
+  tcase_set_timeout(corpus, 180); /* ~20 s, more under the sanitizers */
+  tcase_add_test(corpus, corpus_models_compile);
+  suite_add_tcase(s, corpus);
   return s;
 }

@@ -173,6 +173,7 @@ Suite *mass_suite(void)
 {
   Suite *s = suite_create("mass");
   TCase *tc = tcase_create("params in M");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_add_test(tc, test_diag_same_trajectory);
   tcase_add_test(tc, test_dense_same_trajectory);
   tcase_add_test(tc, test_table_same_trajectory);

@@ -383,6 +383,7 @@ END_TEST
 Suite *poly_suite(void) {
   Suite *s = suite_create("poly");
   TCase *tc = tcase_create("order 2s");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_set_timeout(tc, 300);
   tcase_add_loop_test(tc, order_2s_and_conservation, 0, (int)(sizeof orders / sizeof orders[0]));
   tcase_add_test(tc, const_family_stays_order_2);

@@ -419,6 +419,7 @@ Suite *ref_suite(void)
 {
   Suite *s = suite_create("ref");
   TCase *tc = tcase_create("reference");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_set_timeout(tc, 60);
   tcase_add_loop_test(tc, test_dims, 0, NPROB);
   tcase_add_test(tc, test_unknown);

@@ -114,6 +114,7 @@ Suite *rolled_suite(void)
 {
   Suite *s = suite_create("rolled");
   TCase *tc = tcase_create("stage loop");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, test_same_trajectory);
   tcase_add_test(tc, test_conservation);

@@ -520,6 +520,7 @@ END_TEST
 Suite *stress_suite(void) {
   Suite *s = suite_create("stress");
   TCase *tc = tcase_create("contract");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_set_timeout(tc, 60);
   tcase_add_test(tc, sweep_committed_solvers);
   tcase_add_test(tc, sweep_test_only_solvers);
@@ -531,7 +532,8 @@ Suite *stress_suite(void) {
   tcase_add_test(tc, singularity_fails_cleanly);
   tcase_add_test(tc, overflow_fails_cleanly);
   suite_add_tcase(s, tc);
-  TCase *arm = tcase_create("embedded");
+  TCase *arm = tcase_create("embedded"); /* make check-long */
+  tcase_set_tags(arm, "long");
   tcase_set_timeout(arm, 120);
   tcase_add_test(arm, embedded_build);
   tcase_add_test(arm, clang_build);

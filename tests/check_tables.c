@@ -128,6 +128,7 @@ END_TEST
 Suite *tables_suite(void) {
   Suite *s = suite_create("tables");
   TCase *tc = tcase_create("paper");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, tab0_pendulum);
   tcase_add_test(tc, tab1_conical);
