@@ -25,20 +25,30 @@
 
 int emit_is_newton(const Emitter *e) { return e->st->kern[K_NSOLVE].nout > 0; }
 
-// NAME_newton_factor: the kernel "newton_factor" at gam, its pivots checked.
+// NAME_newton_factor: the kernel "newton_factor" at gam, its pivots checked
+// (with constraints also those of the multiplier's Schur complement, and J
+// takes the multiplier lam).
 static void emit_factor_checked(Emitter *e) {
+  int nu = e->mod->nu;
   tmpl(e, "#ifndef $P_REFRESH\n#define $P_REFRESH 4  /* factorisations of the Newton matrix a step, at most */\n#endif\n"
-          "/* The Newton matrix I + h^2 A (x) M^-1 J at the polynomial gam, factored into nf.\n"
-          " * Returns $P_OK, $P_ENONFINITE, or $P_ENOCONV for a singular matrix (a pivot below\n"
-          " * $P_SINGTOL of its diagonal entry: h too long for a J with negative curvature). */\n"
-          "static int $P_newton_factor_checked(const $P_state *x, const $R *gam, $R h, const $P_params *prm, $R *nf)\n{\n"
-          "  int i;\n"
-          "  $(newton_factor q0=x->q gam=gam h=h out=nf);\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) {\n"
+          "/* The Newton matrix I + h^2 A (x) M^-1 J at the polynomial gam, factored into nf.\n");
+  if (nu) tmpl(e, " * J = Hess(U + lam' g), lam the multiplier (its first $P_NU entries are read).\n");
+  tmpl(e, " * Returns $P_OK, $P_ENONFINITE, or $P_ENOCONV for a singular matrix (a pivot below\n"
+          " * $P_SINGTOL of its diagonal entry: h too long for a J with negative curvature). */\n");
+  tmpl(e, nu ? "static int $P_newton_factor_checked(const $P_state *x, const $R *gam, const $R *lam, $R h, "
+               "const $P_params *prm, $R *nf)\n{\n  int i;\n  $(newton_factor q0=x->q gam=gam h=h lam=lam out=nf);\n"
+             : "static int $P_newton_factor_checked(const $P_state *x, const $R *gam, $R h, const $P_params *prm, $R *nf)\n"
+               "{\n  int i;\n  $(newton_factor q0=x->q gam=gam h=h out=nf);\n");
+  tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) {\n"
           "    $R piv = nf[$[newton_factor.pivot]i], dia = nf[$[newton_factor.adiag]i];\n"
           "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
-          "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ENOCONV;\n  }\n"
-          "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
+          "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ENOCONV;\n  }\n");
+  if (nu)
+    tmpl(e, "  for (i = 0; i < $P_NU; i++) {  /* the multiplier's Schur complement */\n"
+            "    $R piv = nf[$[newton_factor.spivot]i], dia = nf[$[newton_factor.sadiag]i];\n"
+            "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
+            "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ENOCONV;\n  }\n");
+  tmpl(e, "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
 }
 
 // What NAME_step_within needs before its body: the checked factorisation.
@@ -48,16 +58,24 @@ void emit_newton_helpers(Emitter *e) { emit_factor_checked(e); }
 // leaving sw the sweep at it (sw[gam] replaced by gam itself), it the
 // iterations, nfac the factorisations, d1 the first correction.
 void emit_newton_iteration(Emitter *e) {
+  int nu = e->mod->nu;
   tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
           "   * factored at the predicted polynomial, again where the iteration slows down */\n"
           "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M];\n"
-          "  int nfac = 1;\n"
-          "  rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n"
-          "  if (rc != $P_OK) return rc;\n"
+          "  int nfac = 1;\n");
+  tmpl(e, nu ? "  rc = $P_newton_factor_checked(x, gam, x->lambda, h, prm, nf);\n"
+             : "  rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
+  tmpl(e, "  if (rc != $P_OK) return rc;\n"
           "  rc = $P_ENOCONV;\n"
-          "  for (it = 1; it <= $P_MAXITER; it++) {\n"
-          "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n"
-          "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
+          "  for (it = 1; it <= $P_MAXITER; it++) {\n");
+  tmpl(e, nu ? "    $(sweep q0=x->q p0=x->p gam=gam h=h g0=g0 out=sw);\n" : "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n");
+  if (nu) /* as the fixed-point sweep: a zero pivot makes lambda 0/0 */
+    tmpl(e, "    for (i = 0; i < $P_NU; i++) {\n"
+            "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
+            "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
+            "    }\n"
+            "    if (rc == $P_ESINGULAR) break;\n");
+  tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
           "    if (rc == $P_ENONFINITE) break;\n"
           "    for (i = 0; i < $P_S * $P_M; i++) res[i] = sw[$[sweep.gam]i] - gam[i];\n"
           "    $(newton_solve gam=res lu=nf out=dg);\n"
@@ -82,9 +100,10 @@ void emit_newton_iteration(Emitter *e) {
           "    for (i = 0; i < $P_S * $P_M; i++) gam[i] += dg[i];\n"
           "    /* contracting by less than 2x (rho > 1/2) above round-off: J refreshed at the\n"
           "     * current polynomial */\n"
-          "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n"
-          "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n"
-          "      nfac++;\n"
+          "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n");
+  tmpl(e, nu ? "      int rf = $P_newton_factor_checked(x, gam, sw + $[sweep.lambda]0, h, prm, nf);  /* the last lambda */\n"
+             : "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
+  tmpl(e, "      nfac++;\n"
           "      if (rf != $P_OK) { rc = rf; break; }\n"
           "    }\n  }\n"
           "  /* the step is the one at the gamma the sweep was evaluated at */\n"

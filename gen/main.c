@@ -49,8 +49,9 @@ static const char usage[] =
     "  --iteration I fixed or newton: how the step's equations are solved. fixed\n"
     "                (default): fixed-point sweeps, which converge while h omega < ~3 (omega\n"
     "                the fastest frequency of the linearised model); newton: simplified\n"
-    "                Newton with the Hessian of U, for stiff models and long steps (no\n"
-    "                constraints yet; not with --batch or --wide-step; docs/method-newton.md)\n"
+    "                Newton with the Hessian of U (+ lambda' g), for stiff models and long\n"
+    "                steps; with constraints only with --multiplier const; not with --batch\n"
+    "                or --wide-step; docs/method-newton.md)\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k, and the\n"
     "                size of the code it would write (nothing is written)\n"
@@ -618,8 +619,9 @@ int main(int argc, char **argv) {
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
-  if (o.iteration == ITER_NEWTON && mod->nu) {
-    error_at(mod->g_loc[0], "--iteration newton does not handle constraints yet: pass --iteration fixed");
+  if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
+    error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
+                            "use --multiplier const (or --iteration fixed)");
     rc = 1;
   } else if (k > MAX_K) {
     report_degree(mod, o.s, k);

@@ -232,13 +232,23 @@ static double half_integral(const Method *me, int j) {
   return me->xi[j + 1] * pp - me->xi[j] * pm;
 }
 
-// The Hessian of U as dense m x m nodes at the point q.
+// The Hessian of the Lagrangian U + lambda' g as dense m x m nodes at the
+// point q, lambda the input lam (the first nu entries: the state's
+// multiplier; none without constraints, where it is Hess U).
 static int *hessian_at(Build *b, const int *q) {
   Dag *d = b->d;
+  const Model *mod = b->mod;
   int m = b->m, nnz = 0, z = dag_const(d, 0);
+  int *grad = step_nodes(m);
+  for (int i = 0; i < m; i++) grad[i] = mod->gradU[i];
+  for (int a = 0; a < b->nu; a++)
+    for (int e = 0; e < mod->jac[a].n; e++) {
+      int i = mod->jac[a].e[e].coord;
+      grad[i] = dag_add(d, grad[i], dag_mul(d, step_in(b, IN_LAM, a), mod->jac[a].e[e].node));
+    }
   SparseVec *rows = arena_alloc((size_t)m * sizeof *rows);
   for (int i = 0; i < m; i++) {
-    ad_gradient_sparse(d, b->mod->gradU[i], m, &rows[i]);
+    ad_gradient_sparse(d, grad[i], m, &rows[i]);
     nnz += rows[i].n;
   }
   int *roots = step_nodes(nnz), *img = step_nodes(nnz), *J = step_nodes(m * m);
@@ -277,72 +287,43 @@ static int *block_matrix(Build *b, const NewtonBlock *blk, const int *B, int hh,
   return N;
 }
 
-// The kernel "newton_factor": J = Hess U at q0 + h sum_j gamma_j int_0^{1/2} P_j
-// (the midpoint of the step's polynomial at the input gamma), B = M^-1 J, and
-// each block's LU factor (lu.c, minimum-degree order, no pivoting); results
-// lu (the factors' structural nonzeros), pivot and adiag (S*M each: the
-// blocks' sizes add up to s m). The factors' nonzeros become the input lu of
-// "newton_solve"; fac[q] receives block q's factor over those inputs.
-static LuFactor *build_factor(Build *b, const NewtonBasis *nb) {
-  Dag *d = b->d;
-  Step *st = b->st;
-  int m = b->m, s = b->s;
-  b->owners = 1u << K_NFACTOR;
-  step_section(b, "Newton matrix: Hess U at the midpoint of the step, B = M^-1 J, the blocks I + h^2 lambda B");
-  int *qm = step_nodes(m), *J, *B = step_nodes(m * m), *col = step_nodes(m), *bcol = step_nodes(m);
-  for (int i = 0; i < m; i++) {
-    int acc = dag_const(d, 0);
-    for (int j = 0; j < s; j++) acc = dag_add(d, acc, dag_mul(d, dag_const(d, half_integral(b->me, j)), step_in(b, IN_GAM, j * m + i)));
-    qm[i] = dag_add(d, step_in(b, IN_Q0, i), dag_mul(d, b->h, acc));
-  }
-  J = hessian_at(b, qm);
-  for (int c = 0; c < m; c++) {
-    for (int i = 0; i < m; i++) col[i] = J[i * m + c];
-    minv_apply(b->mod, d, col, bcol);
-    for (int i = 0; i < m; i++) B[i * m + c] = bcol[i];
-  }
-  int hh = dag_mul(d, b->h, b->h), nlu = 0, npiv = 0;
-  int *lu = step_nodes(4 * m * m * nb->nblocks), *pivot = step_nodes(s * m), *adiag = step_nodes(s * m);
-  LuFactor *in = arena_alloc((size_t)nb->nblocks * sizeof *in);
-  for (int q = 0; q < nb->nblocks; q++) {
-    int n, *N = block_matrix(b, &nb->blk[q], B, hh, &n);
-    step_section(b, nb->blk[q].pair ? "LU of a complex pair's block (its real form)" : "LU of a real eigenvalue's block");
-    LuFactor f;
-    lu_factor(d, N, n, &f, pivot + npiv, adiag + npiv);
-    npiv += n;
-    in[q] = (LuFactor){n, f.perm, step_nodes(n * n)};
-    for (int t = 0; t < n * n; t++) {
-      in[q].F[t] = f.F[t];
-      if (dag_is_zero(d, f.F[t])) continue;
-      lu[nlu] = f.F[t];
-      in[q].F[t] = dag_input(d, st->in[IN_LU].first + nlu);
-      nlu++;
-    }
-  }
-  st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
-  step_result(st, K_NFACTOR, "lu", SZ_ONE, nlu, nlu, lu);
-  step_result(st, K_NFACTOR, "pivot", SZ_SM, 1, s * m, pivot);
-  step_result(st, K_NFACTOR, "adiag", SZ_SM, 1, s * m, adiag);
-  st->kern[K_NFACTOR].what = "The Newton matrix I + h^2 A (x) M^-1 J, J = Hess U at the midpoint of the step's\n"
-                             " * polynomial gam, as the blocks of A's eigenbasis, factored: out = their LU factors,\n"
-                             " * pivots (S*M), diagonal (S*M).";
+// What newton_solve reads of newton_factor's results, as its input lu: the
+// blocks' factors; with constraints also W = N^-1 V (s m x nu, column a at
+// a s m), the rho_j of the factorisation (s x nu x the entries of jac[a])
+// and the factor of the Schur complement S (nu x nu).
+typedef struct {
+  LuFactor *blk;
+  int *W;
+  int ***rho;
+  LuFactor S;
+} NewtonFactor;
+
+// The input of newton_solve standing for the factor's node v: v itself
+// where it is a structural zero, else the next entry of lu.
+static int stash(Build *b, int v, int *lu, int *nlu) {
+  if (dag_is_zero(b->d, v)) return v;
+  lu[*nlu] = v;
+  return dag_input(b->d, b->st->in[IN_LU].first + (*nlu)++);
+}
+
+// The same for a factor: a copy of f over the inputs.
+static LuFactor stash_factor(Build *b, const LuFactor *f, int *lu, int *nlu) {
+  LuFactor in = {f->n, f->perm, step_nodes(f->n * f->n)};
+  for (int t = 0; t < f->n * f->n; t++) in.F[t] = stash(b, f->F[t], lu, nlu);
   return in;
 }
 
-// The kernel "newton_solve": dgam = (T (x) I) Lambda-blocks^-1 (T^-1 (x) I) r,
-// r the residual Phi(gamma) - gamma passed as the input gam.
-static void build_solve(Build *b, const NewtonBasis *nb, const LuFactor *fac) {
+// x = N^-1 r = (T (x) I) Lambda-blocks^-1 (T^-1 (x) I) r (s m nodes each)
+// with the blocks' factors fac: their own nodes (in newton_factor) or the
+// inputs standing for them (in newton_solve).
+static void newton_apply(Build *b, const NewtonBasis *nb, const LuFactor *fac, const int *r, int *dg) {
   Dag *d = b->d;
   int m = b->m, s = b->s;
-  b->owners = 1u << K_NSOLVE;
-  step_section(b, "Newton correction: w = (T^-1 (x) I) r, the blocks solved, dgam = (T (x) I) z");
-  int *w = step_nodes(s * m), *z = step_nodes(s * m), *dg = step_nodes(s * m);
-  int *rhs = step_nodes(2 * m), *x = step_nodes(2 * m);
+  int *w = step_nodes(s * m), *z = step_nodes(s * m), *rhs = step_nodes(2 * m), *x = step_nodes(2 * m);
   for (int j = 0; j < s; j++)
     for (int i = 0; i < m; i++) {
       int acc = dag_const(d, 0);
-      for (int r = 0; r < s; r++)
-        acc = dag_add(d, acc, dag_mul(d, dag_const(d, nb->Tinv[j * s + r]), step_in(b, IN_GAM, r * m + i)));
+      for (int c = 0; c < s; c++) acc = dag_add(d, acc, dag_mul(d, dag_const(d, nb->Tinv[j * s + c]), r[c * m + i]));
       w[j * m + i] = acc;
     }
   for (int q = 0; q < nb->nblocks; q++) {
@@ -369,19 +350,160 @@ static void build_solve(Build *b, const NewtonBasis *nb, const LuFactor *fac) {
   for (int j = 0; j < s; j++)
     for (int i = 0; i < m; i++) {
       int acc = dag_const(d, 0);
-      for (int r = 0; r < s; r++) acc = dag_add(d, acc, dag_mul(d, dag_const(d, nb->T[j * s + r]), z[r * m + i]));
+      for (int c = 0; c < s; c++) acc = dag_add(d, acc, dag_mul(d, dag_const(d, nb->T[j * s + c]), z[c * m + i]));
       dg[j * m + i] = acc;
     }
-  step_result(b->st, K_NSOLVE, "dgam", SZ_SM, 1, s * m, dg);
-  b->st->kern[K_NSOLVE].what = "The Newton correction for the residual r = (new gamma) - gamma given as gam, with the\n"
-                               " * factors lu of newton_factor: out = (I + h^2 A (x) M^-1 J)^-1 r (S*M).";
+}
+
+// sum_j rho_j[:, a]' v_j over the entries of jac[a] (rho: s x nu x entries).
+static int rho_dot(Build *b, int ***rho, int a, const int *v) {
+  Dag *d = b->d;
+  const SparseVec *col = &b->mod->jac[a];
+  int acc = dag_const(d, 0);
+  for (int j = 0; j < b->s; j++)
+    for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, rho[j][a][e], v[j * b->m + col->e[e].coord]));
+  return acc;
+}
+
+// The constant multiplier in the Newton correction. The sweep's lambda
+// makes C gamma_new = -g0 / h, C = [rho_0' .. rho_{s-1}'], so the Newton
+// system for the correction dg and an auxiliary mu (nu) is
+//     N dg + V mu = r,   C dg = C r,   V = (X (x) M^-1) rho,
+// rho and C frozen with J. Eliminating mu: W = N^-1 V (nu extra right-hand
+// sides of the blocks), S = C W (nu x nu), factored here; the solve is
+// z = N^-1 r, mu = S^-1 C (z - r), dg = z - W mu. Results: W, rho (for C)
+// and S's factor into lu, S's pivots and diagonal into spivot, sadiag (nu).
+static void build_schur(Build *b, const NewtonBasis *nb, const LuFactor *fac, int *lu, int *nlu, NewtonFactor *nf,
+                        int *spivot, int *sadiag) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s, nu = b->nu, sm = s * m;
+  step_section(b, "the multiplier's columns W = N^-1 (X (x) M^-1) rho_a and S = [rho_0' .. rho_{s-1}'] W, factored");
+  int *V = step_nodes(sm), *W = step_nodes(sm * nu), *S = step_nodes(nu * nu);
+  int **vr = arena_alloc((size_t)s * sizeof *vr);
+  for (int a = 0; a < nu; a++) {
+    for (int j = 0; j < s; j++) vr[j] = b->vrho[j][a];
+    for (int j = 0; j < s; j++)
+      for (int i = 0; i < m; i++) V[j * m + i] = step_apply_x(b, j, i, vr);
+    newton_apply(b, nb, fac, V, W + a * sm);
+  }
+  for (int a = 0; a < nu; a++)
+    for (int c = 0; c < nu; c++) S[a * nu + c] = rho_dot(b, b->rho, a, W + c * sm);
+  LuFactor sf;
+  lu_factor(d, S, nu, &sf, spivot, sadiag);
+  nf->W = step_nodes(sm * nu);
+  for (int t = 0; t < sm * nu; t++) nf->W[t] = stash(b, W[t], lu, nlu);
+  nf->rho = arena_alloc((size_t)s * sizeof *nf->rho);
+  for (int j = 0; j < s; j++) {
+    nf->rho[j] = arena_alloc((size_t)nu * sizeof *nf->rho[j]);
+    for (int a = 0; a < nu; a++) {
+      nf->rho[j][a] = step_nodes(b->mod->jac[a].n);
+      for (int e = 0; e < b->mod->jac[a].n; e++) nf->rho[j][a][e] = stash(b, b->rho[j][a][e], lu, nlu);
+    }
+  }
+  nf->S = stash_factor(b, &sf, lu, nlu);
+}
+
+// The kernel "newton_factor": J = Hess(U + lambda' g) at q0 + h sum_j
+// gamma_j int_0^{1/2} P_j (the midpoint of the step's polynomial at the
+// input gamma; lambda the input lam), B = M^-1 J, and each block's LU
+// factor (lu.c, minimum-degree order, no pivoting); with constraints the
+// Schur complement of the multiplier (build_schur). Results lu (what
+// newton_solve reads: the factors' structural nonzeros, and W, rho), pivot
+// and adiag (S*M each: the blocks' sizes add up to s m), and with
+// constraints spivot, sadiag (NU). nf receives the factor over the inputs
+// of newton_solve.
+static void build_factor(Build *b, const NewtonBasis *nb, NewtonFactor *nf) {
+  Dag *d = b->d;
+  Step *st = b->st;
+  int m = b->m, s = b->s, nu = b->nu;
+  b->owners = 1u << K_NFACTOR;
+  step_section(b, nu ? "Newton matrix: Hess(U + lambda' g) at the midpoint of the step, B = M^-1 J, the blocks I + h^2 lambda B"
+                     : "Newton matrix: Hess U at the midpoint of the step, B = M^-1 J, the blocks I + h^2 lambda B");
+  int *qm = step_nodes(m), *J, *B = step_nodes(m * m), *col = step_nodes(m), *bcol = step_nodes(m);
+  for (int i = 0; i < m; i++) {
+    int acc = dag_const(d, 0);
+    for (int j = 0; j < s; j++) acc = dag_add(d, acc, dag_mul(d, dag_const(d, half_integral(b->me, j)), step_in(b, IN_GAM, j * m + i)));
+    qm[i] = dag_add(d, step_in(b, IN_Q0, i), dag_mul(d, b->h, acc));
+  }
+  J = hessian_at(b, qm);
+  for (int c = 0; c < m; c++) {
+    for (int i = 0; i < m; i++) col[i] = J[i * m + c];
+    minv_apply(b->mod, d, col, bcol);
+    for (int i = 0; i < m; i++) B[i * m + c] = bcol[i];
+  }
+  int hh = dag_mul(d, b->h, b->h), nlu = 0, npiv = 0;
+  int nmax = 4 * m * m * nb->nblocks + nu * (s * m + nu);
+  for (int a = 0; a < nu; a++) nmax += s * b->mod->jac[a].n;
+  int *lu = step_nodes(nmax), *pivot = step_nodes(s * m), *adiag = step_nodes(s * m);
+  LuFactor *fac = arena_alloc((size_t)nb->nblocks * sizeof *fac);
+  nf->blk = arena_alloc((size_t)nb->nblocks * sizeof *nf->blk);
+  for (int q = 0; q < nb->nblocks; q++) {
+    int n, *N = block_matrix(b, &nb->blk[q], B, hh, &n);
+    step_section(b, nb->blk[q].pair ? "LU of a complex pair's block (its real form)" : "LU of a real eigenvalue's block");
+    lu_factor(d, N, n, &fac[q], pivot + npiv, adiag + npiv);
+    npiv += n;
+    nf->blk[q] = stash_factor(b, &fac[q], lu, &nlu);
+  }
+  int *spivot = step_nodes(nu), *sadiag = step_nodes(nu);
+  if (nu) build_schur(b, nb, fac, lu, &nlu, nf, spivot, sadiag);
+  st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
+  step_result(st, K_NFACTOR, "lu", SZ_ONE, nlu, nlu, lu);
+  step_result(st, K_NFACTOR, "pivot", SZ_SM, 1, s * m, pivot);
+  step_result(st, K_NFACTOR, "adiag", SZ_SM, 1, s * m, adiag);
+  if (nu) {
+    step_result(st, K_NFACTOR, "spivot", SZ_NU, 1, nu, spivot);
+    step_result(st, K_NFACTOR, "sadiag", SZ_NU, 1, nu, sadiag);
+  }
+  st->kern[K_NFACTOR].what =
+      nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam' g) at the midpoint of the step's\n"
+           " * polynomial gam, as the blocks of A's eigenbasis, factored, with the multiplier's columns\n"
+           " * W = N^-1 V and the Schur complement S = C W: out = the factors, W, C and S's factor (what\n"
+           " * newton_solve reads as lu), pivots (S*M), diagonal (S*M), S's pivots (NU), diagonal (NU)."
+         : "The Newton matrix I + h^2 A (x) M^-1 J, J = Hess U at the midpoint of the step's\n"
+           " * polynomial gam, as the blocks of A's eigenbasis, factored: out = their LU factors,\n"
+           " * pivots (S*M), diagonal (S*M).";
+}
+
+// The kernel "newton_solve": dgam = N^-1 r, r the residual Phi(gamma) -
+// gamma passed as the input gam; with constraints dgam = z - W mu, z = N^-1 r,
+// mu = S^-1 C (z - r) (build_schur).
+static void build_solve(Build *b, const NewtonBasis *nb, const NewtonFactor *nf) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s, nu = b->nu, sm = s * m;
+  b->owners = 1u << K_NSOLVE;
+  step_section(b, "Newton correction: w = (T^-1 (x) I) r, the blocks solved, dgam = (T (x) I) z");
+  int *r = step_nodes(sm), *dg = step_nodes(sm);
+  for (int i = 0; i < sm; i++) r[i] = step_in(b, IN_GAM, i);
+  newton_apply(b, nb, nf->blk, r, dg);
+  if (nu) {
+    step_section(b, "the multiplier eliminated: mu = S^-1 C (z - r), dgam = z - W mu");
+    int *zr = step_nodes(sm), *t = step_nodes(nu), *mu = step_nodes(nu);
+    for (int i = 0; i < sm; i++) zr[i] = dag_sub(d, dg[i], r[i]);
+    for (int a = 0; a < nu; a++) t[a] = rho_dot(b, nf->rho, a, zr);
+    lu_apply(d, &nf->S, t, mu);
+    for (int i = 0; i < sm; i++)
+      for (int a = 0; a < nu; a++) dg[i] = dag_sub(d, dg[i], dag_mul(d, nf->W[a * sm + i], mu[a]));
+  }
+  step_result(b->st, K_NSOLVE, "dgam", SZ_SM, 1, sm, dg);
+  b->st->kern[K_NSOLVE].what = nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+                                    " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M)."
+                                  : "The Newton correction for the residual r = (new gamma) - gamma given as gam, with the\n"
+                                    " * factors lu of newton_factor: out = (I + h^2 A (x) M^-1 J)^-1 r (S*M).";
 }
 
 // The kernels of --iteration newton (after the sweep: it reuses the sweep's
-// inputs, and its input lu is laid out last).
+// inputs, and its input lu is laid out last). With constraints (the
+// constant family only) the input lam (S*NU, of which the first NU are
+// read: the multiplier in J) is laid out before lu.
 void build_newton(Build *b) {
   NewtonBasis nb;
+  NewtonFactor nf;
+  ASSERT(!b->nu || b->me->family == MULT_CONST);
+  if (b->nu) {
+    b->st->in[IN_LAM].len = b->s * b->nu;
+    b->st->in[IN_LU].first = b->st->in[IN_LAM].first + b->st->in[IN_LAM].len;
+  }
   newton_basis(b->me, &nb);
-  LuFactor *fac = build_factor(b, &nb);
-  build_solve(b, &nb, fac);
+  build_factor(b, &nb, &nf);
+  build_solve(b, &nb, &nf);
 }
