@@ -388,7 +388,7 @@ static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "      if (rc >= 0) {\n        *h = hh * fac;\n        s->rejected = rejected;\n"
           "        return rc;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
-          "    if (fabs$f(hh) < $P_HMIN * (1 + tmax)) {\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + tmax) || rejected >= $P_MAXTRIES) {\n"
           "      s->h = 0;\n      s->rejected = rejected;\n"
           "      for (l = 0; l < $P_W; l++)\n"
           "        if (!x->idle[l] && (s->code[l] == $P_OK || s->code[l] == $P_EREJECT)) s->code[l] = $P_ENOCONV;\n"

@@ -275,7 +275,7 @@ void emit_step_factor(Emitter *e) {
     for (int i = 0; i < a + b; i++) out(e, ")");
     out(e, " : grow;  /* 0.9 err^(-1/%d) */\n", controller_order(e));
   }
-  tmpl(e, "      if (fac > grow) fac = grow;\n      if (fac < ($R)0.2) fac = ($R)0.2;\n");
+  tmpl(e, "      if (fac > grow) fac = grow;\n      if (!(fac >= ($R)0.2)) fac = ($R)0.2;  /* a NaN estimate too */\n");
 }
 
 // NAME_step_adaptive: NAME_step with its error estimate tested before the
@@ -294,8 +294,9 @@ void emit_step_factor(Emitter *e) {
 void emit_step_adaptive(Emitter *e) {
   tmpl(e, "\nint $P_step($P_state *x, $P_real h, const $P_params *prm, $P_stats *st)\n{\n"
           "  return $P_step_within(x, h, 0, 0, prm, st);\n}\n");
-  out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n\n",
+  out(e, "\n#ifndef %s_HMIN\n#define %s_HMIN %s  /* smallest adaptive step, relative to 1 + |t| */\n#endif\n",
       e->P, e->P, e->single ? "1e-5f" : "1e-12");
+  out(e, "#ifndef %s_MAXTRIES\n#define %s_MAXTRIES 100  /* tries of one adaptive step, at most */\n#endif\n\n", e->P, e->P);
   if (controller_order(e) == step_order(e))
     out(e, "/* The exponent of the controller: the step's order %d (error per unit step). */\n", step_order(e));
   else
@@ -304,9 +305,13 @@ void emit_step_adaptive(Emitter *e) {
         controller_order(e), e->P, step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
           "  $P_stats s;\n  $R hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */\n"
-          "  int rc, rejected = 0, misses = 0;\n"
+          "  int rc, rejected = 0, misses = 0, i;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
+          "  /* a non-finite t never reaches the floor $P_HMIN (1 + |t|): refused, with the state */\n"
+          "  if (!isfinite(x->t)) return $P_ENONFINITE;\n"
+          "  for (i = 0; i < $P_M; i++)\n"
+          "    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return $P_ENONFINITE;\n"
           "  tol *= $P_TOLC;\n"
           "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
           "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
@@ -316,7 +321,7 @@ void emit_step_adaptive(Emitter *e) {
           "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
           "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
           "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");
-  tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n        int i;\n"
+  tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n"
           "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
           "        err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n      }\n");
   emit_step_factor(e);
@@ -327,7 +332,7 @@ void emit_step_adaptive(Emitter *e) {
   tmpl(e, "        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
-          "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t))) {\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t)) || rejected >= $P_MAXTRIES) {\n"
           "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
           "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n");
   if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");

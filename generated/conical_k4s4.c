@@ -809,6 +809,9 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
 #ifndef conical_k4s4_HMIN
 #define conical_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef conical_k4s4_MAXTRIES
+#define conical_k4s4_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
  * (conical_k4s4_mult_err: q is of order 4, p of order 2 across the hidden constraint). */
@@ -816,9 +819,13 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
 {
   conical_k4s4_stats s;
   double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k4s4_EBADSTEP;
+  /* a non-finite t never reaches the floor conical_k4s4_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return conical_k4s4_ENONFINITE;
+  for (i = 0; i < conical_k4s4_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return conical_k4s4_ENONFINITE;
   tol *= conical_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
@@ -832,14 +839,13 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
       err = rc == conical_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == conical_k4s4_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < conical_k4s4_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
       fac = err > 0 ? (double)0.9 / cbrt(err) : grow;  /* 0.9 err^(-1/3) */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == conical_k4s4_OK) {
         *h = hh * fac;
         if (st) {
@@ -857,7 +863,7 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < conical_k4s4_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < conical_k4s4_HMIN * (1 + fabs(x->t)) || rejected >= conical_k4s4_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

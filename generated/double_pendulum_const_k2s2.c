@@ -836,6 +836,9 @@ int double_pendulum_const_k2s2_step(double_pendulum_const_k2s2_state *x, double_
 #ifndef double_pendulum_const_k2s2_HMIN
 #define double_pendulum_const_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef double_pendulum_const_k2s2_MAXTRIES
+#define double_pendulum_const_k2s2_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
  * (double_pendulum_const_k2s2_mult_err: q is of order 4, p of order 2 across the hidden constraint). */
@@ -843,9 +846,13 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
 {
   double_pendulum_const_k2s2_stats s;
   double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_const_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_const_k2s2_EBADSTEP;
+  /* a non-finite t never reaches the floor double_pendulum_const_k2s2_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return double_pendulum_const_k2s2_ENONFINITE;
+  for (i = 0; i < double_pendulum_const_k2s2_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return double_pendulum_const_k2s2_ENONFINITE;
   tol *= double_pendulum_const_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -859,14 +866,13 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
       err = rc == double_pendulum_const_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == double_pendulum_const_k2s2_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < double_pendulum_const_k2s2_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
       fac = err > 0 ? (double)0.9 / cbrt(err) : grow;  /* 0.9 err^(-1/3) */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == double_pendulum_const_k2s2_OK) {
         *h = hh * fac;
         if (st) {
@@ -884,7 +890,7 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < double_pendulum_const_k2s2_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < double_pendulum_const_k2s2_HMIN * (1 + fabs(x->t)) || rejected >= double_pendulum_const_k2s2_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

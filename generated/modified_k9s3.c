@@ -1092,6 +1092,9 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modif
 #ifndef modified_k9s3_HMIN
 #define modified_k9s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef modified_k9s3_MAXTRIES
+#define modified_k9s3_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
  * (modified_k9s3_mult_err: q is of order 4, p of order 2 across the hidden constraint). */
@@ -1099,9 +1102,13 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
 {
   modified_k9s3_stats s;
   double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return modified_k9s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k9s3_EBADSTEP;
+  /* a non-finite t never reaches the floor modified_k9s3_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return modified_k9s3_ENONFINITE;
+  for (i = 0; i < modified_k9s3_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return modified_k9s3_ENONFINITE;
   tol *= modified_k9s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1115,14 +1122,13 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
       err = rc == modified_k9s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == modified_k9s3_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < modified_k9s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
       fac = err > 0 ? (double)0.9 / cbrt(err) : grow;  /* 0.9 err^(-1/3) */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == modified_k9s3_OK) {
         *h = hh * fac;
         if (st) {
@@ -1140,7 +1146,7 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < modified_k9s3_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < modified_k9s3_HMIN * (1 + fabs(x->t)) || rejected >= modified_k9s3_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

@@ -482,15 +482,22 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
 #ifndef pendulum_angle_k6s3_HMIN
 #define pendulum_angle_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef pendulum_angle_k6s3_MAXTRIES
+#define pendulum_angle_k6s3_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */
 int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   pendulum_angle_k6s3_stats s;
   double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_angle_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_angle_k6s3_EBADSTEP;
+  /* a non-finite t never reaches the floor pendulum_angle_k6s3_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return pendulum_angle_k6s3_ENONFINITE;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return pendulum_angle_k6s3_ENONFINITE;
   tol *= pendulum_angle_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -504,14 +511,13 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
       err = rc == pendulum_angle_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == pendulum_angle_k6s3_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < pendulum_angle_k6s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
       fac = err > 0 ? (double)0.9 / cbrt(sqrt(err)) : grow;  /* 0.9 err^(-1/6) */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == pendulum_angle_k6s3_OK) {
         *h = hh * fac;
         if (st) {
@@ -529,7 +535,7 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < pendulum_angle_k6s3_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < pendulum_angle_k6s3_HMIN * (1 + fabs(x->t)) || rejected >= pendulum_angle_k6s3_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "ref.h"
 #include "solvers.h"
@@ -334,6 +335,32 @@ START_TEST(adaptive_rejected_unchanged)
 }
 END_TEST
 
+// A state the adaptive step cannot start from (t, q or p not finite) is
+// refused at once with NAME_ENONFINITE and left as it was (issue 30, item 6:
+// with t = NaN the floor NAME_HMIN (1 + |t|) was never reached, and the tries
+// went on forever, their counter overflowing). The alarm fails the test on
+// the old code, which never returns.
+START_TEST(adaptive_nonfinite_state)
+{
+  pendulum_poly_k3s3_state x, before;
+  pendulum_poly_k3s3_stats st;
+  const double bad[] = {NAN, INFINITY, -INFINITY};
+  alarm(20);
+  for (int k = 0; k < 9; k++) {
+    double h = 0.1;
+    pendulum_poly_k3s3_init(&x, NULL, NULL);
+    if (k < 3) x.t = bad[k];
+    else if (k < 6) x.q[1] = bad[k - 3];
+    else x.p[0] = bad[k - 6];
+    memcpy(&before, &x, sizeof x);
+    ck_assert_int_eq(pendulum_poly_k3s3_step_adaptive(&x, &h, 1e-8, NULL, &st), pendulum_poly_k3s3_ENONFINITE);
+    ck_assert_int_eq(memcmp(&before, &x, sizeof x), 0);
+    ck_assert(h == 0.1);
+  }
+  alarm(0);
+}
+END_TEST
+
 /* The sweeps of pendulum_poly_k3s3_step_adaptive over T = 10 at tol against
  * those of the fixed step at each accepted step's h from its state; the
  * largest |g| after a step in *gmax. */
@@ -382,6 +409,7 @@ Suite *adaptive_suite(void) {
   tcase_add_loop_test(tc, adaptive_proportional, 0, (int)(sizeof adaptive_cases / sizeof adaptive_cases[0]));
   tcase_add_loop_test(tc, adaptive_const_proportional, 0, 2);
   tcase_add_test(tc, adaptive_rejected_unchanged);
+  tcase_add_test(tc, adaptive_nonfinite_state);
   tcase_add_test(tc, adaptive_iteration_stops_at_tolerance);
   tcase_add_test(tc, adaptive_quadrature_defect);
   tcase_set_timeout(tc, 60);
