@@ -399,7 +399,7 @@ void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_pol
 {
   int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < conical_poly_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_poly_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : conical_poly_k2s2_p0[i];
@@ -1041,7 +1041,7 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h,
 int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s2_real *h, conical_poly_k2s2_real tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   conical_poly_k2s2_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_poly_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_poly_k2s2_EBADSTEP;
@@ -1066,11 +1066,16 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(sqrt(err)) : grow;  /* 0.9 err^(-1/4) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == conical_poly_k2s2_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(sqrt(err));  /* err^(1/4) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.656 / err)^(1/4) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == conical_poly_k2s2_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;

@@ -94,7 +94,7 @@ void henon_heiles_k3s2_init_params(henon_heiles_k3s2_state *x, const henon_heile
 {
   int i;
   henon_heiles_k3s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < henon_heiles_k3s2_M; i++) {
     x->q[i] = q0 ? q0[i] : henon_heiles_k3s2_q0[i];
     x->p[i] = p0 ? p0[i] : henon_heiles_k3s2_p0[i];
@@ -468,7 +468,7 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h,
 int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, henon_heiles_k3s2_real tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st)
 {
   henon_heiles_k3s2_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return henon_heiles_k3s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return henon_heiles_k3s2_EBADSTEP;
@@ -493,11 +493,16 @@ int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(sqrt(err)) : grow;  /* 0.9 err^(-1/4) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == henon_heiles_k3s2_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(sqrt(err));  /* err^(1/4) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.656 / err)^(1/4) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == henon_heiles_k3s2_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
