@@ -79,6 +79,7 @@ void emit_dense(Emitter *e);
 /* emit_estimate.c: the error estimates, NAME_step and NAME_step_adaptive */
 void emit_estimators(Emitter *e);
 void emit_step_factor(Emitter *e);
+void emit_root(Emitter *e, const char *dst, const char *err);
 void emit_step_adaptive(Emitter *e);
 
 /* emit_iterate.c: the step's fixed-point iteration (the block "iterate") */

@@ -42,7 +42,7 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  /* private: compensated-summation errors and the last two steps' polynomials */\n");
   int poly = e->st->kern[K_FACTOR].nout > 0;
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
-  out(e, "  %s_real gam2[%d], hprev2;\n", e->P, s * m);
+  out(e, "  %s_real gam2[%d], hprev2, errprev;\n", e->P, s * m);
   out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
   if (poly) {
     out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
@@ -201,7 +201,7 @@ static void emit_init(Emitter *e) {
   if (of_params) tmpl(e, "  $R v[$<initial>];\n");
   tmpl(e, "  $P_DEFAULT_PARAMS(prm)\n");
   if (of_params) tmpl(e, "  $(initial out=v);\n");
-  tmpl(e, "  x->t = x->tc = x->hprev = x->hprev2 = 0;\n"
+  tmpl(e, "  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;\n"
           "  for (i = 0; i < $P_M; i++) {\n");
   if (of_params)
     tmpl(e, "    x->q[i] = q0 ? q0[i] : v[$[initial.q0]i];\n"

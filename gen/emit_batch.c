@@ -22,7 +22,7 @@ void emit_batch_header(Emitter *e, int lanes) {
   out(e, "%d * %s_W];\n", nu1, e->P);
   tmpl(e, "  /* private, per lane as in $P_state */\n"
           "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n"
-          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W];\n"
+          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W], errprev[$P_W];\n"
           "  $P_real pinc[$P_S * $P_M * $P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
   /* idle last: every array before it starts at a multiple of W reals, so a
@@ -60,7 +60,7 @@ void emit_batch_header(Emitter *e, int lanes) {
 
 // NAME_batch_set and NAME_batch_get: one lane to and from a NAME_state.
 static void emit_set_get(Emitter *e) {
-  static const char *const scalar[] = {"t", "tc", "hprev", "hprev2", "H0"}, *const array[][2] = {
+  static const char *const scalar[] = {"t", "tc", "hprev", "hprev2", "errprev", "H0"}, *const array[][2] = {
       {"q", "$P_M"},   {"p", "$P_M"},   {"qc", "$P_M"}, {"pc", "$P_M"}, {"gam", "$P_S * $P_M"}, {"gam2", "$P_S * $P_M"},
       {"lambda", "$P_NU"}, {"pinc", "$P_S * $P_M"}, {"pcorr", "$P_M"}};
   int poly = e->st->kern[K_FACTOR].nout > 0;
@@ -68,7 +68,7 @@ static void emit_set_get(Emitter *e) {
   for (int get = 0; get < 2; get++) {
     tmpl(e, get ? "void $P_batch_get(const $P_batch *x, int l, $P_state *s)\n{\n  int i;\n"
                 : "void $P_batch_set($P_batch *x, int l, const $P_state *s)\n{\n  int i;\n");
-    for (int f = 0; f < (poly ? 5 : 4); f++)
+    for (int f = 0; f < (poly ? 6 : 5); f++)
       out(e, get ? "  s->%s = x->%s[l];\n" : "  x->%s[l] = s->%s;\n", scalar[f], scalar[f]);
     for (int f = 0; f < (poly ? 9 : 8); f++) {
       const char *n = array[f][0];

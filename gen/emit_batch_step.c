@@ -362,14 +362,14 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // any failure, the number of lanes that failed (never the -1, -2 of a try).
 static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l;\n"
+          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rp, pmax, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
           "  if (!(hh != 0 && isfinite(hh))) {  /* every active lane fails: say how many, as below */\n"
           "    $P_batch_within(x, hh, 0, 0, prm, s);\n"
           "    for (l = 0; l < $P_W; l++) nact += s->code[l] != $P_OK;\n"
           "    return nact;\n  }\n"
           "  tol *= $P_TOLC;\n"
-          "  for (l = 0; l < $P_W; l++)\n    if (!x->idle[l]) {\n      nact++;\n"
+          "  for (l = 0; l < $P_W; l++)\n    if (!x->idle[l]) {\n      if (!nact++) l0 = l;  /* the first active lane */\n"
           "      if (fabs$f(x->t[l]) > tmax) tmax = fabs$f(x->t[l]);\n"
           "      if (x->hprev[l] != 0) first = 0;\n    }\n"
           "  if (first) grow = 100;  /* every active lane's first step: from a guess, as $P_step_adaptive */\n"
@@ -378,17 +378,25 @@ static void emit_batch_adaptive(Emitter *e) {
           "    if (rc == -1) misses++;\n"
           "    if (rc != -2) {\n"
           "      /* the lanes' largest error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
-          "      err = 0;\n"
+          "      err = pmax = 0;\n"
           "      for (l = 0; l < $P_W; l++) {\n        $R sc = 0, el;\n"
           "        if (x->idle[l] || (rc >= 0 && s->code[l] != $P_OK)) continue;\n"
           "        for (i = 0; rc >= 0 && i < $P_M; i++)\n"
           "          if (fabs$f(x->q[i * $P_W + l]) > sc) sc = fabs$f(x->q[i * $P_W + l]);\n"
-          "        el = s->err_est[l] / (tol * fabs$f(hh) * (1 + sc));\n        if (el > err) err = el;\n      }\n");
+          "        el = s->err_est[l] / (tol * fabs$f(hh) * (1 + sc));\n        if (el > err) err = el;\n");
+  /* each lane keeps its own err^(1/p), bitwise NAME_step_adaptive's; the
+   * prediction from the largest, where every lane took the same last steps */
+  tmpl(e, "        if (rc < 0) continue;\n        ");
+  emit_root(e, "rp", "el");
+  tmpl(e, "        if (x->hprev2[l] != x->hprev2[l0] || x->hprev2[l] == 0) pmax = -1;\n"
+          "        if (pmax >= 0 && x->errprev[l] > pmax) pmax = x->errprev[l];\n"
+          "        x->errprev[l] = rp;\n      }\n"
+          "      pq = rc >= 0 && pmax > 0 ? pmax * (hh / x->hprev2[l0]) : 0;\n");
   emit_step_factor(e);
   tmpl(e, "      if (rc >= 0) {\n        *h = hh * fac;\n        s->rejected = rejected;\n"
           "        return rc;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
-          "    if (fabs$f(hh) < $P_HMIN * (1 + tmax)) {\n"
+          "    if (fabs$f(hh) < $P_HMIN * (1 + tmax) || rejected >= $P_MAXTRIES) {\n"
           "      s->h = 0;\n      s->rejected = rejected;\n"
           "      for (l = 0; l < $P_W; l++)\n"
           "        if (!x->idle[l] && (s->code[l] == $P_OK || s->code[l] == $P_EREJECT)) s->code[l] = $P_ENOCONV;\n"

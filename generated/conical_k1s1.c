@@ -205,7 +205,7 @@ void conical_k1s1_init_params(conical_k1s1_state *x, const conical_k1s1_real *q0
 {
   int i;
   conical_k1s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < conical_k1s1_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k1s1_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k1s1_p0[i];
@@ -521,15 +521,22 @@ int conical_k1s1_step(conical_k1s1_state *x, conical_k1s1_real h, const conical_
 #ifndef conical_k1s1_HMIN
 #define conical_k1s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef conical_k1s1_MAXTRIES
+#define conical_k1s1_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */
 int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, conical_k1s1_real tol, const conical_k1s1_params *prm, conical_k1s1_stats *st)
 {
   conical_k1s1_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k1s1_EBADSTEP;
+  /* a non-finite t never reaches the floor conical_k1s1_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return conical_k1s1_ENONFINITE;
+  for (i = 0; i < conical_k1s1_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return conical_k1s1_ENONFINITE;
   tol *= conical_k1s1_TOLC;
   for (;;) {
     s.iters = 0;
@@ -543,16 +550,20 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
       err = rc == conical_k1s1_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == conical_k1s1_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < conical_k1s1_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(err) : grow;  /* 0.9 err^(-1/2) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == conical_k1s1_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(err);  /* err^(1/2) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.81 / err)^(1/2) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == conical_k1s1_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -568,7 +579,7 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < conical_k1s1_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < conical_k1s1_HMIN * (1 + fabs(x->t)) || rejected >= conical_k1s1_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

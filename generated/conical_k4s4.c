@@ -208,7 +208,7 @@ void conical_k4s4_init_params(conical_k4s4_state *x, const conical_k4s4_real *q0
 {
   int i;
   conical_k4s4_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < conical_k4s4_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k4s4_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k4s4_p0[i];
@@ -811,16 +811,23 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
 #ifndef conical_k4s4_HMIN
 #define conical_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef conical_k4s4_MAXTRIES
+#define conical_k4s4_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
  * (conical_k4s4_mult_err: q is of order 4, p of order 2 across the hidden constraint). */
 int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, conical_k4s4_real tol, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   conical_k4s4_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k4s4_EBADSTEP;
+  /* a non-finite t never reaches the floor conical_k4s4_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return conical_k4s4_ENONFINITE;
+  for (i = 0; i < conical_k4s4_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return conical_k4s4_ENONFINITE;
   tol *= conical_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
@@ -834,16 +841,20 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
       err = rc == conical_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == conical_k4s4_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < conical_k4s4_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / cbrt(err) : grow;  /* 0.9 err^(-1/3) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == conical_k4s4_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = cbrt(err);  /* err^(1/3) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == conical_k4s4_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -859,7 +870,7 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < conical_k4s4_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < conical_k4s4_HMIN * (1 + fabs(x->t)) || rejected >= conical_k4s4_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

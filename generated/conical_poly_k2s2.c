@@ -401,7 +401,7 @@ void conical_poly_k2s2_init_params(conical_poly_k2s2_state *x, const conical_pol
 {
   int i;
   conical_poly_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < conical_poly_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_poly_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : conical_poly_k2s2_p0[i];
@@ -1035,15 +1035,22 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h,
 #ifndef conical_poly_k2s2_HMIN
 #define conical_poly_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef conical_poly_k2s2_MAXTRIES
+#define conical_poly_k2s2_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 4 (error per unit step). */
 int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s2_real *h, conical_poly_k2s2_real tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st)
 {
   conical_poly_k2s2_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_poly_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_poly_k2s2_EBADSTEP;
+  /* a non-finite t never reaches the floor conical_poly_k2s2_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return conical_poly_k2s2_ENONFINITE;
+  for (i = 0; i < conical_poly_k2s2_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return conical_poly_k2s2_ENONFINITE;
   tol *= conical_poly_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1057,16 +1064,20 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
       err = rc == conical_poly_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == conical_poly_k2s2_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < conical_poly_k2s2_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(sqrt(err)) : grow;  /* 0.9 err^(-1/4) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == conical_poly_k2s2_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(sqrt(err));  /* err^(1/4) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.656 / err)^(1/4) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == conical_poly_k2s2_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1082,7 +1093,7 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < conical_poly_k2s2_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < conical_poly_k2s2_HMIN * (1 + fabs(x->t)) || rejected >= conical_poly_k2s2_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

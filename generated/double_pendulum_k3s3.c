@@ -1381,7 +1381,7 @@ void double_pendulum_k3s3_init_params(double_pendulum_k3s3_state *x, const doubl
 {
   int i;
   double_pendulum_k3s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < double_pendulum_k3s3_M; i++) {
     x->q[i] = q0 ? q0[i] : double_pendulum_k3s3_q0[i];
     x->p[i] = p0 ? p0[i] : double_pendulum_k3s3_p0[i];
@@ -2511,15 +2511,22 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s
 #ifndef double_pendulum_k3s3_HMIN
 #define double_pendulum_k3s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef double_pendulum_k3s3_MAXTRIES
+#define double_pendulum_k3s3_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */
 int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, double_pendulum_k3s3_real tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   double_pendulum_k3s3_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k3s3_EBADSTEP;
+  /* a non-finite t never reaches the floor double_pendulum_k3s3_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return double_pendulum_k3s3_ENONFINITE;
+  for (i = 0; i < double_pendulum_k3s3_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return double_pendulum_k3s3_ENONFINITE;
   tol *= double_pendulum_k3s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -2533,16 +2540,20 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
       err = rc == double_pendulum_k3s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == double_pendulum_k3s3_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < double_pendulum_k3s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / cbrt(sqrt(err)) : grow;  /* 0.9 err^(-1/6) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == double_pendulum_k3s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = cbrt(sqrt(err));  /* err^(1/6) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.531 / err)^(1/6) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == double_pendulum_k3s3_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -2558,7 +2569,7 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < double_pendulum_k3s3_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < double_pendulum_k3s3_HMIN * (1 + fabs(x->t)) || rejected >= double_pendulum_k3s3_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

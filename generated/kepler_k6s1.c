@@ -95,7 +95,7 @@ void kepler_k6s1_init_params(kepler_k6s1_state *x, const kepler_k6s1_real *q0, c
 {
   int i;
   kepler_k6s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < kepler_k6s1_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k6s1_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k6s1_p0[i];
@@ -474,15 +474,22 @@ int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h, const kepler_k6s1
 #ifndef kepler_k6s1_HMIN
 #define kepler_k6s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef kepler_k6s1_MAXTRIES
+#define kepler_k6s1_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */
 int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_k6s1_real tol, const kepler_k6s1_params *prm, kepler_k6s1_stats *st)
 {
   kepler_k6s1_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s1_EBADSTEP;
+  /* a non-finite t never reaches the floor kepler_k6s1_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return kepler_k6s1_ENONFINITE;
+  for (i = 0; i < kepler_k6s1_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return kepler_k6s1_ENONFINITE;
   tol *= kepler_k6s1_TOLC;
   for (;;) {
     s.iters = 0;
@@ -496,16 +503,20 @@ int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_
       err = rc == kepler_k6s1_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == kepler_k6s1_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < kepler_k6s1_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(err) : grow;  /* 0.9 err^(-1/2) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == kepler_k6s1_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(err);  /* err^(1/2) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.81 / err)^(1/2) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == kepler_k6s1_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -521,7 +532,7 @@ int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < kepler_k6s1_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < kepler_k6s1_HMIN * (1 + fabs(x->t)) || rejected >= kepler_k6s1_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

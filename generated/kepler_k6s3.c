@@ -95,7 +95,7 @@ void kepler_k6s3_init_params(kepler_k6s3_state *x, const kepler_k6s3_real *q0, c
 {
   int i;
   kepler_k6s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < kepler_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k6s3_p0[i];
@@ -657,15 +657,22 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h, const kepler_k6s3
 #ifndef kepler_k6s3_HMIN
 #define kepler_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef kepler_k6s3_MAXTRIES
+#define kepler_k6s3_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */
 int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_k6s3_real tol, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   kepler_k6s3_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s3_EBADSTEP;
+  /* a non-finite t never reaches the floor kepler_k6s3_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return kepler_k6s3_ENONFINITE;
+  for (i = 0; i < kepler_k6s3_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return kepler_k6s3_ENONFINITE;
   tol *= kepler_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -679,16 +686,20 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
       err = rc == kepler_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == kepler_k6s3_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < kepler_k6s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / cbrt(sqrt(err)) : grow;  /* 0.9 err^(-1/6) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == kepler_k6s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = cbrt(sqrt(err));  /* err^(1/6) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.531 / err)^(1/6) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == kepler_k6s3_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -704,7 +715,7 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < kepler_k6s3_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < kepler_k6s3_HMIN * (1 + fabs(x->t)) || rejected >= kepler_k6s3_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

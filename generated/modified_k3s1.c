@@ -230,7 +230,7 @@ void modified_k3s1_init_params(modified_k3s1_state *x, const modified_k3s1_real 
 {
   int i;
   modified_k3s1_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < modified_k3s1_M; i++) {
     x->q[i] = q0 ? q0[i] : modified_k3s1_q0[i];
     x->p[i] = p0 ? p0[i] : modified_k3s1_p0[i];
@@ -594,15 +594,22 @@ int modified_k3s1_step(modified_k3s1_state *x, modified_k3s1_real h, const modif
 #ifndef modified_k3s1_HMIN
 #define modified_k3s1_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef modified_k3s1_MAXTRIES
+#define modified_k3s1_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 2 (error per unit step). */
 int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, modified_k3s1_real tol, const modified_k3s1_params *prm, modified_k3s1_stats *st)
 {
   modified_k3s1_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return modified_k3s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k3s1_EBADSTEP;
+  /* a non-finite t never reaches the floor modified_k3s1_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return modified_k3s1_ENONFINITE;
+  for (i = 0; i < modified_k3s1_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return modified_k3s1_ENONFINITE;
   tol *= modified_k3s1_TOLC;
   for (;;) {
     s.iters = 0;
@@ -616,16 +623,20 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
       err = rc == modified_k3s1_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == modified_k3s1_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < modified_k3s1_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(err) : grow;  /* 0.9 err^(-1/2) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == modified_k3s1_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(err);  /* err^(1/2) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.81 / err)^(1/2) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == modified_k3s1_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -641,7 +652,7 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < modified_k3s1_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < modified_k3s1_HMIN * (1 + fabs(x->t)) || rejected >= modified_k3s1_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

@@ -236,7 +236,7 @@ void modified_k9s3_init_params(modified_k9s3_state *x, const modified_k9s3_real 
 {
   int i;
   modified_k9s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < modified_k9s3_M; i++) {
     x->q[i] = q0 ? q0[i] : modified_k9s3_q0[i];
     x->p[i] = p0 ? p0[i] : modified_k9s3_p0[i];
@@ -1094,16 +1094,23 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modif
 #ifndef modified_k9s3_HMIN
 #define modified_k9s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef modified_k9s3_MAXTRIES
+#define modified_k9s3_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
  * (modified_k9s3_mult_err: q is of order 4, p of order 2 across the hidden constraint). */
 int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, modified_k9s3_real tol, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   modified_k9s3_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return modified_k9s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k9s3_EBADSTEP;
+  /* a non-finite t never reaches the floor modified_k9s3_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return modified_k9s3_ENONFINITE;
+  for (i = 0; i < modified_k9s3_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return modified_k9s3_ENONFINITE;
   tol *= modified_k9s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1117,16 +1124,20 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
       err = rc == modified_k9s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == modified_k9s3_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < modified_k9s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / cbrt(err) : grow;  /* 0.9 err^(-1/3) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == modified_k9s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = cbrt(err);  /* err^(1/3) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == modified_k9s3_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1142,7 +1153,7 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < modified_k9s3_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < modified_k9s3_HMIN * (1 + fabs(x->t)) || rejected >= modified_k9s3_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

@@ -88,7 +88,7 @@ void pendulum_angle_k6s3_init_params(pendulum_angle_k6s3_state *x, const pendulu
 {
   int i;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_angle_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_angle_k6s3_p0[i];
@@ -484,15 +484,22 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
 #ifndef pendulum_angle_k6s3_HMIN
 #define pendulum_angle_k6s3_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef pendulum_angle_k6s3_MAXTRIES
+#define pendulum_angle_k6s3_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 6 (error per unit step). */
 int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   pendulum_angle_k6s3_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_angle_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_angle_k6s3_EBADSTEP;
+  /* a non-finite t never reaches the floor pendulum_angle_k6s3_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return pendulum_angle_k6s3_ENONFINITE;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return pendulum_angle_k6s3_ENONFINITE;
   tol *= pendulum_angle_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -506,16 +513,20 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
       err = rc == pendulum_angle_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == pendulum_angle_k6s3_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < pendulum_angle_k6s3_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / cbrt(sqrt(err)) : grow;  /* 0.9 err^(-1/6) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == pendulum_angle_k6s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = cbrt(sqrt(err));  /* err^(1/6) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.531 / err)^(1/6) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == pendulum_angle_k6s3_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -531,7 +542,7 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < pendulum_angle_k6s3_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < pendulum_angle_k6s3_HMIN * (1 + fabs(x->t)) || rejected >= pendulum_angle_k6s3_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

@@ -181,7 +181,7 @@ void pendulum_k2s2_init_params(pendulum_k2s2_state *x, const pendulum_k2s2_real 
 {
   int i;
   pendulum_k2s2_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < pendulum_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_k2s2_p0[i];
@@ -579,16 +579,23 @@ int pendulum_k2s2_step(pendulum_k2s2_state *x, pendulum_k2s2_real h, const pendu
 #ifndef pendulum_k2s2_HMIN
 #define pendulum_k2s2_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef pendulum_k2s2_MAXTRIES
+#define pendulum_k2s2_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: 3, the order of the estimate in q per unit step
  * (pendulum_k2s2_mult_err: q is of order 4, p of order 2 across the hidden constraint). */
 int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, pendulum_k2s2_real tol, const pendulum_k2s2_params *prm, pendulum_k2s2_stats *st)
 {
   pendulum_k2s2_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k2s2_EBADSTEP;
+  /* a non-finite t never reaches the floor pendulum_k2s2_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return pendulum_k2s2_ENONFINITE;
+  for (i = 0; i < pendulum_k2s2_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return pendulum_k2s2_ENONFINITE;
   tol *= pendulum_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -602,16 +609,20 @@ int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, p
       err = rc == pendulum_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == pendulum_k2s2_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < pendulum_k2s2_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / cbrt(err) : grow;  /* 0.9 err^(-1/3) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == pendulum_k2s2_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = cbrt(err);  /* err^(1/3) */
+      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == pendulum_k2s2_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -627,7 +638,7 @@ int pendulum_k2s2_step_adaptive(pendulum_k2s2_state *x, pendulum_k2s2_real *h, p
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < pendulum_k2s2_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < pendulum_k2s2_HMIN * (1 + fabs(x->t)) || rejected >= pendulum_k2s2_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;

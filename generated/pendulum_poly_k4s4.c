@@ -787,7 +787,7 @@ void pendulum_poly_k4s4_init_params(pendulum_poly_k4s4_state *x, const pendulum_
 {
   int i;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
-  x->t = x->tc = x->hprev = x->hprev2 = 0;
+  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k4s4_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k4s4_p0[i];
@@ -1802,15 +1802,22 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
 #ifndef pendulum_poly_k4s4_HMIN
 #define pendulum_poly_k4s4_HMIN 1e-12  /* smallest adaptive step, relative to 1 + |t| */
 #endif
+#ifndef pendulum_poly_k4s4_MAXTRIES
+#define pendulum_poly_k4s4_MAXTRIES 100  /* tries of one adaptive step, at most */
+#endif
 
 /* The exponent of the controller: the step's order 8 (error per unit step). */
 int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, pendulum_poly_k4s4_real tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   pendulum_poly_k4s4_stats s;
-  double hh = *h, err, fac, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
-  int rc, rejected = 0, misses = 0;
+  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k4s4_EBADSTEP;
+  /* a non-finite t never reaches the floor pendulum_poly_k4s4_HMIN (1 + |t|): refused, with the state */
+  if (!isfinite(x->t)) return pendulum_poly_k4s4_ENONFINITE;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++)
+    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return pendulum_poly_k4s4_ENONFINITE;
   tol *= pendulum_poly_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1824,16 +1831,20 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
       err = rc == pendulum_poly_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
       if (rc == pendulum_poly_k4s4_OK) {
         double sc = 0;
-        int i;
         for (i = 0; i < pendulum_poly_k4s4_M; i++)
           if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
         err = s.err_est / (tol * fabs(hh) * (1 + sc));
       }
-      fac = err > 0 ? (double)0.9 / sqrt(sqrt(sqrt(err))) : grow;  /* 0.9 err^(-1/8) */
+      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
+      pq = rc == pendulum_poly_k4s4_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      r = sqrt(sqrt(sqrt(err)));  /* err^(1/8) */
+      fac = err > 0 ? 0.74989420933245587 / r : grow;  /* (0.1 / err)^(1/8) */
+      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
-      if (fac < (double)0.2) fac = (double)0.2;
+      if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == pendulum_poly_k4s4_OK) {
         *h = hh * fac;
+        x->errprev = r;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1849,7 +1860,7 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
     rejected++;
     grow = 1;
     hh *= fac;
-    if (fabs(hh) < pendulum_poly_k4s4_HMIN * (1 + fabs(x->t))) {
+    if (fabs(hh) < pendulum_poly_k4s4_HMIN * (1 + fabs(x->t)) || rejected >= pendulum_poly_k4s4_MAXTRIES) {
       if (st) {
         st->iters = s.iters;
         st->increment = s.increment;
