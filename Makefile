@@ -318,6 +318,7 @@ FORCE:
 fuzz:
 	@scripts/deps.sh fuzz
 	tests/fuzz/run.sh $(FUZZ_SECONDS)
+	tests/fuzz/run_runtime.sh $(FUZZ_SECONDS)
 
 clean:
 	rm -rf build build-san gen/hbvmgen runtime/libhbvmrt.a runtime/libhbvmrt_omp.a runtime/libhbvmrt_mpi.a demo

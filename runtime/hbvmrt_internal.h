@@ -32,7 +32,9 @@
 /* The most CSV rows --dt may ask for (span / DT), and the most trajectories
  * of --sweep or --ensemble (their results are kept until all are done). */
 #define HBVMRT_MAX_ROWS 1e9
+#ifndef HBVMRT_MAX_TRAJ   /* (smaller in the fuzz build: tests/fuzz/run_runtime.sh) */
 #define HBVMRT_MAX_TRAJ 10000000L
+#endif
 
 /* The driver options once parsed and checked. */
 typedef struct {
