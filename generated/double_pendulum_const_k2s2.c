@@ -723,6 +723,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_const_k2s2_EREJECT;
         }
@@ -800,6 +801,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_const_k2s2_OK) return rc;
   /* double_pendulum_const_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -875,6 +877,7 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_const_k2s2_OK;
       }
@@ -891,6 +894,7 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_const_k2s2_EREJECT ? rc : double_pendulum_const_k2s2_ENOCONV;
     }

@@ -2317,6 +2317,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_k3s3_EREJECT;
         }
@@ -2409,6 +2410,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_k3s3_OK) return rc;
   /* double_pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -2547,6 +2549,7 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_k3s3_OK;
       }
@@ -2563,6 +2566,7 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_k3s3_EREJECT ? rc : double_pendulum_k3s3_ENOCONV;
     }

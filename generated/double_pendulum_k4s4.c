@@ -4062,6 +4062,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_k4s4_EREJECT;
         }
@@ -4171,6 +4172,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_k4s4_OK) return rc;
   /* double_pendulum_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -4309,6 +4311,7 @@ int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pen
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_k4s4_OK;
       }
@@ -4325,6 +4328,7 @@ int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pen
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_k4s4_EREJECT ? rc : double_pendulum_k4s4_ENOCONV;
     }

@@ -1264,6 +1264,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return modified_poly_k6s2_EREJECT;
         }
@@ -1328,6 +1329,7 @@ static int modified_poly_k6s2_step_within(modified_poly_k6s2_state *x, modified_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != modified_poly_k6s2_OK) return rc;
   /* modified_poly_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1466,6 +1468,7 @@ int modified_poly_k6s2_step_adaptive(modified_poly_k6s2_state *x, modified_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return modified_poly_k6s2_OK;
       }
@@ -1482,6 +1485,7 @@ int modified_poly_k6s2_step_adaptive(modified_poly_k6s2_state *x, modified_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != modified_poly_k6s2_EREJECT ? rc : modified_poly_k6s2_ENOCONV;
     }

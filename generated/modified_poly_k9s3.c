@@ -2134,6 +2134,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return modified_poly_k9s3_EREJECT;
         }
@@ -2210,6 +2211,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != modified_poly_k9s3_OK) return rc;
   /* modified_poly_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -2348,6 +2350,7 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return modified_poly_k9s3_OK;
       }
@@ -2364,6 +2367,7 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != modified_poly_k9s3_EREJECT ? rc : modified_poly_k9s3_ENOCONV;
     }

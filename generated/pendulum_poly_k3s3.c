@@ -1082,6 +1082,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_poly_k3s3_EREJECT;
         }
@@ -1148,6 +1149,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_poly_k3s3_OK) return rc;
   /* pendulum_poly_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1286,6 +1288,7 @@ int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_poly_k3s3_OK;
       }
@@ -1302,6 +1305,7 @@ int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_poly_k3s3_EREJECT ? rc : pendulum_poly_k3s3_ENOCONV;
     }

@@ -23,6 +23,9 @@ typedef struct {
   double err_est;     /* the step's local error estimate */
   double h;           /* the step taken (step_adaptive) */
   int rejected;       /* tries rejected before it (step_adaptive) */
+  /* The step's relative energy defect, |H1 - H0| / (|K| + |U|) (0 from
+   * drivers generated before it, and where the step conserves H exactly). */
+  double defect;
 } hbvmrt_stats;
 
 /* One run-time parameter: its name and where it lives in the params block. */
