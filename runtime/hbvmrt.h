@@ -82,7 +82,8 @@ typedef struct {
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status
- * (0 success, 1 bad arguments, 2 a failed step). */
+ * (0 success, 1 bad arguments, 2 a failed step, 3 steps that did not
+ * conserve H). */
 int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
 
 /* The batch step of a solver generated with --batch W, for the ensemble

@@ -19,7 +19,11 @@
  *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
- * a failed step), 2 a failed step or an event that is not a number. */
+ * a failed step), 2 a failed step or an event that is not a number, 3 steps
+ * whose relative energy defect (hbvmrt_stats.defect) is above sqrt(eps):
+ * the run ended, but H was not conserved.  Every run that started ends with
+ * the summary line (summary), after warnings on the largest local error
+ * estimate and on those steps; per-step messages stop at HBVMRT_MAX_SAID. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
