@@ -317,7 +317,7 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "steps retried smaller, the smallest and largest |h| taken, the largest\n"
     "local error estimate of a step, H at t=0 and max_dH/|H0|, the largest\n"
     "relative energy defect of a step and the steps where it is above\n"
-    "sqrt(eps), the time reached and how the run ended (ok, output_error,\n"
+    "sqrt(eps) (or --tol if larger), the time reached and how the run ended (ok, output_error,\n"
     "step_failed, event_nan, energy_defect); a warning line before it when the\n"
     "error estimate is above 1e-3 (1 + max|q|) or steps were flagged.\n"
     "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"

@@ -109,6 +109,18 @@ static int osc_step_estimated(void *x, double h, const void *prm, hbvmrt_stats *
   return rc;
 }
 
+/* an adaptive step of osc (the step proposed kept), each with a relative
+ * energy defect of 1e-6 */
+static int osc_step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)
+{
+  int rc = osc_step(x, *h, prm, st);
+
+  (void)tol;
+  st->h = *h;
+  st->defect = 1e-6;
+  return rc;
+}
+
 static const char *osc_strerror(int code)
 {
   return code == 7 ? "did not converge" : "unknown";
@@ -840,6 +852,19 @@ START_TEST(summary_truth)
                                "3.000e-01"));
   ck_assert(summary_status(r.err, "energy_defect"));
   ck_assert_int_eq(count_lines(r.err), 3);
+  done(&r);
+  /* under --tol the defect is flagged above the tolerance only: the step's
+   * estimate holds it within tol */
+  est.step_adaptive = osc_step_adaptive;
+  r = run(&est, "--tol 1e-4 -h 0.1 -T 1");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(summary_field(r.err, "max_defect"), 1e-6);
+  ck_assert(summary_status(r.err, "ok"));
+  done(&r);
+  r = run(&est, "--tol 1e-8 -h 0.1 -T 1");
+  ck_assert_int_eq(r.status, 3);
+  ck_assert_double_eq(summary_field(r.err, "defect_steps"), 10);
+  ck_assert_ptr_nonnull(strstr(r.err, "take a smaller --tol (exit status 3)"));
   done(&r);
 }
 END_TEST
