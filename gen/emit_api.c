@@ -61,7 +61,11 @@ void emit_header(Emitter *e, const EmitOptions *o) {
           "  $P_real increment; /* last scaled increment of the iteration */\n"
           "  $P_real err_est;   /* estimate of the step's local error in q (max norm) */\n"
           "  $P_real h;         /* the step taken */\n"
-          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n");
+          "  int rejected;      /* $P_step_adaptive: tries rejected before it */\n"
+          "  $P_real defect;    /* |H(q1, p1) - H(q0, p0)| / (|K| + |U|) at q0, p0, the step's relative\n"
+          "                      * energy defect (0 where k nodes integrate H exactly, or the end of\n"
+          "                      * step restores it); far above round-off: the step is too long for\n"
+          "                      * its quadrature, and H is not conserved */\n");
   if (emit_is_newton(e)) emit_newton_stats(e);
   tmpl(e, "} $P_stats;\n\n"
           "/* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the\n"

@@ -282,7 +282,7 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
 
 // A lane's call of a scalar step function f(state, sw, h, prm) on the lane's
 // state and its sweep's results, with the arguments `more` after prm
-// (NAME_defect: none; NAME_mult_err: ", 1", as under the adaptive step).
+// (NAME_defect: ", 0", no relative defect; NAME_mult_err: ", 1", as under the adaptive step).
 static void emit_lane_call(Emitter *e, const char *f, const char *more) {
   out(e, "/* Lane l's %s_%s, on its state and its sweep's results. */\n", e->P, f);
   out(e, "static %s %s_batch_%s(const %s_batch *x, const %s *sw, int l, %s h, const %s_params *prm)\n{\n",
@@ -309,7 +309,7 @@ static void emit_lane_estimate(Emitter *e, int mult, int defect) {
           "    $R v = fabs$f(x->q[i * $P_W + l]) + fabs$f(h * g[i]);\n    if (v > sc) sc = v;\n  }\n"
           "  *scale = sc;\n  return $P_err_est(g, h, d1, cold);\n}\n\n");
   if (mult) emit_lane_call(e, "mult_err", ", 1");
-  if (defect) emit_lane_call(e, "defect", "");
+  if (defect) emit_lane_call(e, "defect", ", 0");
 }
 
 // NAME_batch_step_adaptive's tests inside NAME_batch_within, as

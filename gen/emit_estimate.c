@@ -226,18 +226,23 @@ static void emit_mult_err(Emitter *e) {
 // energy surface it takes, over the force |p1 - p0| / h; (q1, p1) from the
 // converged sweep, before the commit (no copy of the state: a step over the
 // tolerance with it is rejected as NAME_step_within rejects any, unwritten).
+// Also the defect relative to |K| + |U| (at q0, p0) into *rel (if not NULL),
+// for the stats.
 static void emit_defect(Emitter *e) {
   tmpl(e, "/* The quadrature's part of the local error (the $P_K nodes do not integrate H exactly\n"
           " * for this model), which $P_err_est does not see: the energy defect of the step from\n"
-          " * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */\n"
-          "static $R $P_defect(const $P_state *x, const $W *sw, $R h, const $P_params *prm)\n{\n"
-          "  $R q1[$P_M], p1[$P_M], z[$P_M], H0, U0, H1, dH, dp = 0;\n  int i;\n");
+          " * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h; *rel (if\n"
+          " * not NULL) the defect over |K| + |U| (the stats' defect). */\n"
+          "static $R $P_defect(const $P_state *x, const $W *sw, $R h, const $P_params *prm, $R *rel)\n{\n"
+          "  $R q1[$P_M], p1[$P_M], z[$P_M], H0, U0, H1, dH, sc, dp = 0;\n  int i;\n");
   emit_step_end_loop(e);
   tmpl(e, "    z[i] = 0;\n  }\n"
           "  $(energy_kernel q0=x->q p0=x->p out=&H0);\n"
           "  $(energy_kernel q0=x->q p0=z out=&U0);\n"
           "  $(energy_kernel q0=q1 p0=p1 out=&H1);\n"
-          "  dH = fabs$f(H1 - H0) - $P_NOISETOL * (fabs$f(H0 - U0) + fabs$f(U0));\n"
+          "  sc = fabs$f(H0 - U0) + fabs$f(U0);  /* |K| + |U| */\n"
+          "  if (rel) *rel = sc > 0 ? fabs$f(H1 - H0) / sc : fabs$f(H1 - H0);\n"
+          "  dH = fabs$f(H1 - H0) - $P_NOISETOL * sc;\n"
           "  return dH > 0 && dp > 0 ? dH * fabs$f(h) / dp : 0;\n}\n\n");
 }
 
@@ -355,14 +360,16 @@ void emit_step_adaptive(Emitter *e) {
   emit_step_factor(e);
   tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n        x->errprev = r;\n"
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
-          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n");
+          "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n"
+          "          st->defect = s.defect;\n");
   if (emit_is_newton(e)) tmpl(e, "          st->factors = s.factors;\n");
   tmpl(e, "        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
           "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t)) || rejected >= $P_MAXTRIES) {\n"
           "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
-          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n");
+          "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n"
+          "        st->defect = s.defect;\n");
   if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");
   tmpl(e, "      }\n"
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");

@@ -80,7 +80,8 @@ static void emit_first_sweep(Emitter *e) {
           "        est = $P_err_est(gam, h, d1, 0);\n"
           "        if (!(est <= tol * (1 + scale))) {\n"
           "          if (st) {\n            st->iters = 1;\n            st->increment = inc;\n"
-          "            st->err_est = est;\n            st->h = h;\n            st->rejected = 0;\n          }\n"
+          "            st->err_est = est;\n            st->h = h;\n            st->rejected = 0;\n"
+          "            st->defect = 0;\n          }\n"
           "          return $P_EREJECT;\n        }\n      }\n    }\n");
 }
 

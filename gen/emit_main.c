@@ -29,10 +29,10 @@ static void emit_adapters(FILE *f, const char *P) {
           P);
   fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n");
   fprintf(f, "  %s_stats s;\n  int rc = %s_step(x, h, prm, &s);\n", P, P);
-  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  return rc;\n}\n\n");
+  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n  return rc;\n}\n\n");
   fprintf(f, "static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)\n{\n");
   fprintf(f, "  %s_stats s;\n  int rc = %s_step_adaptive(x, h, tol, prm, &s);\n", P, P);
-  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n"
+  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n"
              "  st->h = s.h;\n  st->rejected = s.rejected;\n  return rc;\n}\n\n");
 }
 
@@ -93,12 +93,12 @@ static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
   fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n"
              "  %s_params r;\n  %s_stats s;\n  int rc;\n  to_real(prm, &r);\n"
              "  rc = %s_step(&((view *)x)->s, (%s_real)h, &r, &s);\n"
-             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  sync(x);\n"
+             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n  sync(x);\n"
              "  return rc;\n}\n\n", P, P, P, P);
   fprintf(f, "static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)\n{\n"
              "  %s_params r;\n  %s_stats s;\n  %s_real hr = (%s_real)*h;\n  int rc;\n  to_real(prm, &r);\n"
              "  rc = %s_step_adaptive(&((view *)x)->s, &hr, (%s_real)tol, &r, &s);\n  *h = hr;\n"
-             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n"
+             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n"
              "  st->h = s.h;\n  st->rejected = s.rejected;\n  sync(x);\n  return rc;\n}\n\n", P, P, P, P, P, P);
   fprintf(f, "static double energy(const void *x, const void *prm)\n{\n  %s_params r;\n  to_real(prm, &r);\n"
              "  return %s_energy(&((const view *)x)->s, &r);\n}\n\n", P, P);

@@ -35,7 +35,8 @@
  *             branch of emit_iterate, in a file of its own.
  *   estimate  emit_step_estimate: est from NAME_err_est (gam, d1, cold), and
  *             NAME_mult_err, NAME_defect (x, sw) where the solver has them;
- *             the stats (it, inc, est, h); returns rc when not NAME_OK,
+ *             the stats (it, inc, est, h, the relative energy defect, which
+ *             costs NAME_defect only when st is given); returns rc when not NAME_OK,
  *             NAME_EREJECT over the tolerance, NAME_ENONFINITE for a t or a
  *             Theta_j (sw[sweep.theta]) not finite.
  *   end       emit_step_end: the constant or polynomial family's end of the
@@ -110,10 +111,13 @@ static void emit_step_estimate(Emitter *e) {
     tmpl(e, "  if ((tol > 0 || st) && rc == $P_OK) {  /* the multiplier's part: for $P_step_adaptive and the stats */\n"
             "    $R em = $P_mult_err(x, sw, h, prm, tol > 0);\n    if (em > est) est = em;\n  }\n");
   if (energy_defect_wanted(e))
-    tmpl(e, "  if (tol > 0 && rc == $P_OK) est += $P_defect(x, sw, h, prm);  /* under $P_step_adaptive */\n");
+    tmpl(e, "  $R rel = 0;  /* the step's relative energy defect, for the stats */\n"
+            "  if ((tol > 0 || st) && rc == $P_OK) {  /* for $P_step_adaptive and the stats */\n"
+            "    $R ed = $P_defect(x, sw, h, prm, &rel);\n    if (tol > 0) est += ed;\n  }\n");
   tmpl(e, "  if (st) {\n    st->iters = it > $P_MAXITER ? $P_MAXITER : it;\n    st->increment = inc;\n"
-          "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n  }\n"
-          "  if (rc != $P_OK) return rc;\n"
+          "    st->err_est = est;\n    st->h = h;\n    st->rejected = 0;\n");
+  tmpl(e, energy_defect_wanted(e) ? "    st->defect = rel;\n  }\n" : "    st->defect = 0;\n  }\n");
+  tmpl(e, "  if (rc != $P_OK) return rc;\n"
           "  /* $P_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */\n"
           "  if (tol > 0 && !(est <= tol * (1 + scale))) return $P_EREJECT;\n"
           "  if (!isfinite(x->t + h) || !isfinite(x->tc)) return $P_ENONFINITE;\n"

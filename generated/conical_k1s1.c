@@ -435,6 +435,7 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return conical_k1s1_EREJECT;
         }
@@ -485,6 +486,7 @@ static int conical_k1s1_step_within(conical_k1s1_state *x, conical_k1s1_real h_,
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != conical_k1s1_OK) return rc;
   /* conical_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -570,6 +572,7 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return conical_k1s1_OK;
       }
@@ -586,6 +589,7 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != conical_k1s1_EREJECT ? rc : conical_k1s1_ENOCONV;
     }

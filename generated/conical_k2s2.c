@@ -549,6 +549,7 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return conical_k2s2_EREJECT;
         }
@@ -612,6 +613,7 @@ static int conical_k2s2_step_within(conical_k2s2_state *x, conical_k2s2_real h_,
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != conical_k2s2_OK) return rc;
   /* conical_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -698,6 +700,7 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return conical_k2s2_OK;
       }
@@ -714,6 +717,7 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != conical_k2s2_EREJECT ? rc : conical_k2s2_ENOCONV;
     }

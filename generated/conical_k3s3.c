@@ -614,6 +614,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return conical_k3s3_EREJECT;
         }
@@ -687,6 +688,7 @@ static int conical_k3s3_step_within(conical_k3s3_state *x, conical_k3s3_real h_,
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != conical_k3s3_OK) return rc;
   /* conical_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -773,6 +775,7 @@ int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, coni
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return conical_k3s3_OK;
       }
@@ -789,6 +792,7 @@ int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, coni
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != conical_k3s3_EREJECT ? rc : conical_k3s3_ENOCONV;
     }

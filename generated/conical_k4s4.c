@@ -693,6 +693,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return conical_k4s4_EREJECT;
         }
@@ -775,6 +776,7 @@ static int conical_k4s4_step_within(conical_k4s4_state *x, conical_k4s4_real h_,
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != conical_k4s4_OK) return rc;
   /* conical_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -861,6 +863,7 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return conical_k4s4_OK;
       }
@@ -877,6 +880,7 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != conical_k4s4_EREJECT ? rc : conical_k4s4_ENOCONV;
     }

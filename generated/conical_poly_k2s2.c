@@ -871,6 +871,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return conical_poly_k2s2_EREJECT;
         }
@@ -935,6 +936,7 @@ static int conical_poly_k2s2_step_within(conical_poly_k2s2_state *x, conical_pol
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != conical_poly_k2s2_OK) return rc;
   /* conical_poly_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1084,6 +1086,7 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return conical_poly_k2s2_OK;
       }
@@ -1100,6 +1103,7 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != conical_poly_k2s2_EREJECT ? rc : conical_poly_k2s2_ENOCONV;
     }

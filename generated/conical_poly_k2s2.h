@@ -44,6 +44,10 @@ typedef struct {
   conical_poly_k2s2_real err_est;   /* estimate of the step's local error in q (max norm) */
   conical_poly_k2s2_real h;         /* the step taken */
   int rejected;      /* conical_poly_k2s2_step_adaptive: tries rejected before it */
+  conical_poly_k2s2_real defect;    /* |H(q1, p1) - H(q0, p0)| / (|K| + |U|) at q0, p0, the step's relative
+                      * energy defect (0 where k nodes integrate H exactly, or the end of
+                      * step restores it); far above round-off: the step is too long for
+                      * its quadrature, and H is not conserved */
 } conical_poly_k2s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

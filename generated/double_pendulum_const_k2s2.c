@@ -725,6 +725,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_const_k2s2_EREJECT;
         }
@@ -802,6 +803,7 @@ static int double_pendulum_const_k2s2_step_within(double_pendulum_const_k2s2_sta
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_const_k2s2_OK) return rc;
   /* double_pendulum_const_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -888,6 +890,7 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_const_k2s2_OK;
       }
@@ -904,6 +907,7 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_const_k2s2_EREJECT ? rc : double_pendulum_const_k2s2_ENOCONV;
     }

@@ -931,6 +931,7 @@ static int double_pendulum_const_k4s4_step_within(double_pendulum_const_k4s4_sta
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_const_k4s4_EREJECT;
         }
@@ -1033,6 +1034,7 @@ static int double_pendulum_const_k4s4_step_within(double_pendulum_const_k4s4_sta
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_const_k4s4_OK) return rc;
   /* double_pendulum_const_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1119,6 +1121,7 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_const_k4s4_OK;
       }
@@ -1135,6 +1138,7 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_const_k4s4_EREJECT ? rc : double_pendulum_const_k4s4_ENOCONV;
     }

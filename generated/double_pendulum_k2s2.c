@@ -1328,6 +1328,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_k2s2_EREJECT;
         }
@@ -1403,6 +1404,7 @@ static int double_pendulum_k2s2_step_within(double_pendulum_k2s2_state *x, doubl
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_k2s2_OK) return rc;
   /* double_pendulum_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1552,6 +1554,7 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_k2s2_OK;
       }
@@ -1568,6 +1571,7 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_k2s2_EREJECT ? rc : double_pendulum_k2s2_ENOCONV;
     }

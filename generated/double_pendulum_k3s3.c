@@ -2319,6 +2319,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_k3s3_EREJECT;
         }
@@ -2411,6 +2412,7 @@ static int double_pendulum_k3s3_step_within(double_pendulum_k3s3_state *x, doubl
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_k3s3_OK) return rc;
   /* double_pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -2560,6 +2562,7 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_k3s3_OK;
       }
@@ -2576,6 +2579,7 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_k3s3_EREJECT ? rc : double_pendulum_k3s3_ENOCONV;
     }

@@ -4064,6 +4064,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return double_pendulum_k4s4_EREJECT;
         }
@@ -4173,6 +4174,7 @@ static int double_pendulum_k4s4_step_within(double_pendulum_k4s4_state *x, doubl
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != double_pendulum_k4s4_OK) return rc;
   /* double_pendulum_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -4322,6 +4324,7 @@ int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pen
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return double_pendulum_k4s4_OK;
       }
@@ -4338,6 +4341,7 @@ int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pen
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != double_pendulum_k4s4_EREJECT ? rc : double_pendulum_k4s4_ENOCONV;
     }

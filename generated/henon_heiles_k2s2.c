@@ -221,10 +221,11 @@ henon_heiles_k2s2_OUT_OF_LINE double henon_heiles_k2s2_err_est(const double *gam
 
 /* The quadrature's part of the local error (the henon_heiles_k2s2_K nodes do not integrate H exactly
  * for this model), which henon_heiles_k2s2_err_est does not see: the energy defect of the step from
- * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */
-static double henon_heiles_k2s2_defect(const henon_heiles_k2s2_state *x, const double *sw, double h, const henon_heiles_k2s2_params *prm)
+ * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h; *rel (if
+ * not NULL) the defect over |K| + |U| (the stats' defect). */
+static double henon_heiles_k2s2_defect(const henon_heiles_k2s2_state *x, const double *sw, double h, const henon_heiles_k2s2_params *prm, double *rel)
 {
-  double q1[henon_heiles_k2s2_M], p1[henon_heiles_k2s2_M], z[henon_heiles_k2s2_M], H0, U0, H1, dH, dp = 0;
+  double q1[henon_heiles_k2s2_M], p1[henon_heiles_k2s2_M], z[henon_heiles_k2s2_M], H0, U0, H1, dH, sc, dp = 0;
   int i;
   for (i = 0; i < henon_heiles_k2s2_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -235,7 +236,9 @@ static double henon_heiles_k2s2_defect(const henon_heiles_k2s2_state *x, const d
   henon_heiles_k2s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   henon_heiles_k2s2_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
   henon_heiles_k2s2_energy_kernel(q1, p1, 0, 0, 0, prm, &H1);
-  dH = fabs(H1 - H0) - henon_heiles_k2s2_NOISETOL * (fabs(H0 - U0) + fabs(U0));
+  sc = fabs(H0 - U0) + fabs(U0);  /* |K| + |U| */
+  if (rel) *rel = sc > 0 ? fabs(H1 - H0) / sc : fabs(H1 - H0);
+  dH = fabs(H1 - H0) - henon_heiles_k2s2_NOISETOL * sc;
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
 
@@ -372,6 +375,7 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return henon_heiles_k2s2_EREJECT;
         }
@@ -410,13 +414,18 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
   sw[6] = sw6;
   sw[7] = sw7;
   est = st || tol > 0 ? henon_heiles_k2s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
-  if (tol > 0 && rc == henon_heiles_k2s2_OK) est += henon_heiles_k2s2_defect(x, sw, h, prm);  /* under henon_heiles_k2s2_step_adaptive */
+  double rel = 0;  /* the step's relative energy defect, for the stats */
+  if ((tol > 0 || st) && rc == henon_heiles_k2s2_OK) {  /* for henon_heiles_k2s2_step_adaptive and the stats */
+    double ed = henon_heiles_k2s2_defect(x, sw, h, prm, &rel);
+    if (tol > 0) est += ed;
+  }
   if (st) {
     st->iters = it > henon_heiles_k2s2_MAXITER ? henon_heiles_k2s2_MAXITER : it;
     st->increment = inc;
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = rel;
   }
   if (rc != henon_heiles_k2s2_OK) return rc;
   /* henon_heiles_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -502,6 +511,7 @@ int henon_heiles_k2s2_step_adaptive(henon_heiles_k2s2_state *x, henon_heiles_k2s
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return henon_heiles_k2s2_OK;
       }
@@ -518,6 +528,7 @@ int henon_heiles_k2s2_step_adaptive(henon_heiles_k2s2_state *x, henon_heiles_k2s
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != henon_heiles_k2s2_EREJECT ? rc : henon_heiles_k2s2_ENOCONV;
     }

@@ -382,6 +382,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return henon_heiles_k3s2_EREJECT;
         }
@@ -426,6 +427,7 @@ static int henon_heiles_k3s2_step_within(henon_heiles_k3s2_state *x, henon_heile
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != henon_heiles_k3s2_OK) return rc;
   /* henon_heiles_k3s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -511,6 +513,7 @@ int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return henon_heiles_k3s2_OK;
       }
@@ -527,6 +530,7 @@ int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != henon_heiles_k3s2_EREJECT ? rc : henon_heiles_k3s2_ENOCONV;
     }

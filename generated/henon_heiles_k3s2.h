@@ -42,6 +42,10 @@ typedef struct {
   henon_heiles_k3s2_real err_est;   /* estimate of the step's local error in q (max norm) */
   henon_heiles_k3s2_real h;         /* the step taken */
   int rejected;      /* henon_heiles_k3s2_step_adaptive: tries rejected before it */
+  henon_heiles_k3s2_real defect;    /* |H(q1, p1) - H(q0, p0)| / (|K| + |U|) at q0, p0, the step's relative
+                      * energy defect (0 where k nodes integrate H exactly, or the end of
+                      * step restores it); far above round-off: the step is too long for
+                      * its quadrature, and H is not conserved */
 } henon_heiles_k3s2_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

@@ -231,10 +231,11 @@ kepler_k16s2_OUT_OF_LINE double kepler_k16s2_err_est(const double *gam, double h
 
 /* The quadrature's part of the local error (the kepler_k16s2_K nodes do not integrate H exactly
  * for this model), which kepler_k16s2_err_est does not see: the energy defect of the step from
- * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */
-static double kepler_k16s2_defect(const kepler_k16s2_state *x, const double *sw, double h, const kepler_k16s2_params *prm)
+ * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h; *rel (if
+ * not NULL) the defect over |K| + |U| (the stats' defect). */
+static double kepler_k16s2_defect(const kepler_k16s2_state *x, const double *sw, double h, const kepler_k16s2_params *prm, double *rel)
 {
-  double q1[kepler_k16s2_M], p1[kepler_k16s2_M], z[kepler_k16s2_M], H0, U0, H1, dH, dp = 0;
+  double q1[kepler_k16s2_M], p1[kepler_k16s2_M], z[kepler_k16s2_M], H0, U0, H1, dH, sc, dp = 0;
   int i;
   for (i = 0; i < kepler_k16s2_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -245,7 +246,9 @@ static double kepler_k16s2_defect(const kepler_k16s2_state *x, const double *sw,
   kepler_k16s2_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   kepler_k16s2_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
   kepler_k16s2_energy_kernel(q1, p1, 0, 0, 0, prm, &H1);
-  dH = fabs(H1 - H0) - kepler_k16s2_NOISETOL * (fabs(H0 - U0) + fabs(U0));
+  sc = fabs(H0 - U0) + fabs(U0);  /* |K| + |U| */
+  if (rel) *rel = sc > 0 ? fabs(H1 - H0) / sc : fabs(H1 - H0);
+  dH = fabs(H1 - H0) - kepler_k16s2_NOISETOL * sc;
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
 
@@ -768,6 +771,7 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return kepler_k16s2_EREJECT;
         }
@@ -806,13 +810,18 @@ static int kepler_k16s2_step_within(kepler_k16s2_state *x, kepler_k16s2_real h_,
   sw[6] = sw6;
   sw[7] = sw7;
   est = st || tol > 0 ? kepler_k16s2_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
-  if (tol > 0 && rc == kepler_k16s2_OK) est += kepler_k16s2_defect(x, sw, h, prm);  /* under kepler_k16s2_step_adaptive */
+  double rel = 0;  /* the step's relative energy defect, for the stats */
+  if ((tol > 0 || st) && rc == kepler_k16s2_OK) {  /* for kepler_k16s2_step_adaptive and the stats */
+    double ed = kepler_k16s2_defect(x, sw, h, prm, &rel);
+    if (tol > 0) est += ed;
+  }
   if (st) {
     st->iters = it > kepler_k16s2_MAXITER ? kepler_k16s2_MAXITER : it;
     st->increment = inc;
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = rel;
   }
   if (rc != kepler_k16s2_OK) return rc;
   /* kepler_k16s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -898,6 +907,7 @@ int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepl
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return kepler_k16s2_OK;
       }
@@ -914,6 +924,7 @@ int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepl
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != kepler_k16s2_EREJECT ? rc : kepler_k16s2_ENOCONV;
     }

@@ -197,10 +197,11 @@ kepler_k6s1_OUT_OF_LINE double kepler_k6s1_err_est(const double *gam, double h, 
 
 /* The quadrature's part of the local error (the kepler_k6s1_K nodes do not integrate H exactly
  * for this model), which kepler_k6s1_err_est does not see: the energy defect of the step from
- * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */
-static double kepler_k6s1_defect(const kepler_k6s1_state *x, const double *sw, double h, const kepler_k6s1_params *prm)
+ * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h; *rel (if
+ * not NULL) the defect over |K| + |U| (the stats' defect). */
+static double kepler_k6s1_defect(const kepler_k6s1_state *x, const double *sw, double h, const kepler_k6s1_params *prm, double *rel)
 {
-  double q1[kepler_k6s1_M], p1[kepler_k6s1_M], z[kepler_k6s1_M], H0, U0, H1, dH, dp = 0;
+  double q1[kepler_k6s1_M], p1[kepler_k6s1_M], z[kepler_k6s1_M], H0, U0, H1, dH, sc, dp = 0;
   int i;
   for (i = 0; i < kepler_k6s1_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -211,7 +212,9 @@ static double kepler_k6s1_defect(const kepler_k6s1_state *x, const double *sw, d
   kepler_k6s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   kepler_k6s1_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
   kepler_k6s1_energy_kernel(q1, p1, 0, 0, 0, prm, &H1);
-  dH = fabs(H1 - H0) - kepler_k6s1_NOISETOL * (fabs(H0 - U0) + fabs(U0));
+  sc = fabs(H0 - U0) + fabs(U0);  /* |K| + |U| */
+  if (rel) *rel = sc > 0 ? fabs(H1 - H0) / sc : fabs(H1 - H0);
+  dH = fabs(H1 - H0) - kepler_k6s1_NOISETOL * sc;
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
 
@@ -399,6 +402,7 @@ static int kepler_k6s1_step_within(kepler_k6s1_state *x, kepler_k6s1_real h_, do
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return kepler_k6s1_EREJECT;
         }
@@ -431,13 +435,18 @@ static int kepler_k6s1_step_within(kepler_k6s1_state *x, kepler_k6s1_real h_, do
   sw[2] = sw2;
   sw[3] = sw3;
   est = st || tol > 0 ? kepler_k6s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
-  if (tol > 0 && rc == kepler_k6s1_OK) est += kepler_k6s1_defect(x, sw, h, prm);  /* under kepler_k6s1_step_adaptive */
+  double rel = 0;  /* the step's relative energy defect, for the stats */
+  if ((tol > 0 || st) && rc == kepler_k6s1_OK) {  /* for kepler_k6s1_step_adaptive and the stats */
+    double ed = kepler_k6s1_defect(x, sw, h, prm, &rel);
+    if (tol > 0) est += ed;
+  }
   if (st) {
     st->iters = it > kepler_k6s1_MAXITER ? kepler_k6s1_MAXITER : it;
     st->increment = inc;
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = rel;
   }
   if (rc != kepler_k6s1_OK) return rc;
   /* kepler_k6s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -523,6 +532,7 @@ int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return kepler_k6s1_OK;
       }
@@ -539,6 +549,7 @@ int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != kepler_k6s1_EREJECT ? rc : kepler_k6s1_ENOCONV;
     }

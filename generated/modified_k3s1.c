@@ -508,6 +508,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return modified_k3s1_EREJECT;
         }
@@ -558,6 +559,7 @@ static int modified_k3s1_step_within(modified_k3s1_state *x, modified_k3s1_real 
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != modified_k3s1_OK) return rc;
   /* modified_k3s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -643,6 +645,7 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return modified_k3s1_OK;
       }
@@ -659,6 +662,7 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != modified_k3s1_EREJECT ? rc : modified_k3s1_ENOCONV;
     }

@@ -743,6 +743,7 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return modified_k6s2_EREJECT;
         }
@@ -806,6 +807,7 @@ static int modified_k6s2_step_within(modified_k6s2_state *x, modified_k6s2_real 
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != modified_k6s2_OK) return rc;
   /* modified_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -892,6 +894,7 @@ int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, m
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return modified_k6s2_OK;
       }
@@ -908,6 +911,7 @@ int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, m
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != modified_k6s2_EREJECT ? rc : modified_k6s2_ENOCONV;
     }

@@ -985,6 +985,7 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return modified_k9s3_EREJECT;
         }
@@ -1058,6 +1059,7 @@ static int modified_k9s3_step_within(modified_k9s3_state *x, modified_k9s3_real 
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != modified_k9s3_OK) return rc;
   /* modified_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1144,6 +1146,7 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return modified_k9s3_OK;
       }
@@ -1160,6 +1163,7 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != modified_k9s3_EREJECT ? rc : modified_k9s3_ENOCONV;
     }

@@ -2136,6 +2136,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return modified_poly_k9s3_EREJECT;
         }
@@ -2212,6 +2213,7 @@ static int modified_poly_k9s3_step_within(modified_poly_k9s3_state *x, modified_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != modified_poly_k9s3_OK) return rc;
   /* modified_poly_k9s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -2361,6 +2363,7 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return modified_poly_k9s3_OK;
       }
@@ -2377,6 +2380,7 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != modified_poly_k9s3_EREJECT ? rc : modified_poly_k9s3_ENOCONV;
     }

@@ -44,6 +44,10 @@ typedef struct {
   modified_poly_k9s3_real err_est;   /* estimate of the step's local error in q (max norm) */
   modified_poly_k9s3_real h;         /* the step taken */
   int rejected;      /* modified_poly_k9s3_step_adaptive: tries rejected before it */
+  modified_poly_k9s3_real defect;    /* |H(q1, p1) - H(q0, p0)| / (|K| + |U|) at q0, p0, the step's relative
+                      * energy defect (0 where k nodes integrate H exactly, or the end of
+                      * step restores it); far above round-off: the step is too long for
+                      * its quadrature, and H is not conserved */
 } modified_poly_k9s3_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

@@ -226,10 +226,11 @@ pendulum_angle_k6s3_OUT_OF_LINE double pendulum_angle_k6s3_err_est(const double 
 
 /* The quadrature's part of the local error (the pendulum_angle_k6s3_K nodes do not integrate H exactly
  * for this model), which pendulum_angle_k6s3_err_est does not see: the energy defect of the step from
- * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */
-static double pendulum_angle_k6s3_defect(const pendulum_angle_k6s3_state *x, const double *sw, double h, const pendulum_angle_k6s3_params *prm)
+ * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h; *rel (if
+ * not NULL) the defect over |K| + |U| (the stats' defect). */
+static double pendulum_angle_k6s3_defect(const pendulum_angle_k6s3_state *x, const double *sw, double h, const pendulum_angle_k6s3_params *prm, double *rel)
 {
-  double q1[pendulum_angle_k6s3_M], p1[pendulum_angle_k6s3_M], z[pendulum_angle_k6s3_M], H0, U0, H1, dH, dp = 0;
+  double q1[pendulum_angle_k6s3_M], p1[pendulum_angle_k6s3_M], z[pendulum_angle_k6s3_M], H0, U0, H1, dH, sc, dp = 0;
   int i;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -240,7 +241,9 @@ static double pendulum_angle_k6s3_defect(const pendulum_angle_k6s3_state *x, con
   pendulum_angle_k6s3_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   pendulum_angle_k6s3_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
   pendulum_angle_k6s3_energy_kernel(q1, p1, 0, 0, 0, prm, &H1);
-  dH = fabs(H1 - H0) - pendulum_angle_k6s3_NOISETOL * (fabs(H0 - U0) + fabs(U0));
+  sc = fabs(H0 - U0) + fabs(U0);  /* |K| + |U| */
+  if (rel) *rel = sc > 0 ? fabs(H1 - H0) / sc : fabs(H1 - H0);
+  dH = fabs(H1 - H0) - pendulum_angle_k6s3_NOISETOL * sc;
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
 
@@ -406,6 +409,7 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_angle_k6s3_EREJECT;
         }
@@ -441,13 +445,18 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   sw[4] = sw4;
   sw[5] = sw5;
   est = st || tol > 0 ? pendulum_angle_k6s3_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
-  if (tol > 0 && rc == pendulum_angle_k6s3_OK) est += pendulum_angle_k6s3_defect(x, sw, h, prm);  /* under pendulum_angle_k6s3_step_adaptive */
+  double rel = 0;  /* the step's relative energy defect, for the stats */
+  if ((tol > 0 || st) && rc == pendulum_angle_k6s3_OK) {  /* for pendulum_angle_k6s3_step_adaptive and the stats */
+    double ed = pendulum_angle_k6s3_defect(x, sw, h, prm, &rel);
+    if (tol > 0) est += ed;
+  }
   if (st) {
     st->iters = it > pendulum_angle_k6s3_MAXITER ? pendulum_angle_k6s3_MAXITER : it;
     st->increment = inc;
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = rel;
   }
   if (rc != pendulum_angle_k6s3_OK) return rc;
   /* pendulum_angle_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -533,6 +542,7 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_angle_k6s3_OK;
       }
@@ -549,6 +559,7 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_angle_k6s3_EREJECT ? rc : pendulum_angle_k6s3_ENOCONV;
     }

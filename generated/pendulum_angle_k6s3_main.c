@@ -25,6 +25,7 @@ static int step(void *x, double h, const void *prm, hbvmrt_stats *st)
   st->iters = s.iters;
   st->increment = s.increment;
   st->err_est = s.err_est;
+  st->defect = s.defect;
   return rc;
 }
 
@@ -35,6 +36,7 @@ static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt
   st->iters = s.iters;
   st->increment = s.increment;
   st->err_est = s.err_est;
+  st->defect = s.defect;
   st->h = s.h;
   st->rejected = s.rejected;
   return rc;

@@ -389,6 +389,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_k1s1_EREJECT;
         }
@@ -435,6 +436,7 @@ static int pendulum_k1s1_step_within(pendulum_k1s1_state *x, pendulum_k1s1_real 
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_k1s1_OK) return rc;
   /* pendulum_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -520,6 +522,7 @@ int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, p
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_k1s1_OK;
       }
@@ -536,6 +539,7 @@ int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, p
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_k1s1_EREJECT ? rc : pendulum_k1s1_ENOCONV;
     }

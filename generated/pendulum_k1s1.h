@@ -42,6 +42,10 @@ typedef struct {
   pendulum_k1s1_real err_est;   /* estimate of the step's local error in q (max norm) */
   pendulum_k1s1_real h;         /* the step taken */
   int rejected;      /* pendulum_k1s1_step_adaptive: tries rejected before it */
+  pendulum_k1s1_real defect;    /* |H(q1, p1) - H(q0, p0)| / (|K| + |U|) at q0, p0, the step's relative
+                      * energy defect (0 where k nodes integrate H exactly, or the end of
+                      * step restores it); far above round-off: the step is too long for
+                      * its quadrature, and H is not conserved */
 } pendulum_k1s1_stats;
 
 /* q0, p0 NULL: the model's initial values (at the parameters prm; NULL: the

@@ -533,6 +533,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_k3s3_EREJECT;
         }
@@ -596,6 +597,7 @@ static int pendulum_k3s3_step_within(pendulum_k3s3_state *x, pendulum_k3s3_real 
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_k3s3_OK) return rc;
   /* pendulum_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -682,6 +684,7 @@ int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, p
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_k3s3_OK;
       }
@@ -698,6 +701,7 @@ int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, p
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_k3s3_EREJECT ? rc : pendulum_k3s3_ENOCONV;
     }

@@ -579,6 +579,7 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_poly_k1s1_EREJECT;
         }
@@ -628,6 +629,7 @@ static int pendulum_poly_k1s1_step_within(pendulum_poly_k1s1_state *x, pendulum_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_poly_k1s1_OK) return rc;
   /* pendulum_poly_k1s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -777,6 +779,7 @@ int pendulum_poly_k1s1_step_adaptive(pendulum_poly_k1s1_state *x, pendulum_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_poly_k1s1_OK;
       }
@@ -793,6 +796,7 @@ int pendulum_poly_k1s1_step_adaptive(pendulum_poly_k1s1_state *x, pendulum_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_poly_k1s1_EREJECT ? rc : pendulum_poly_k1s1_ENOCONV;
     }

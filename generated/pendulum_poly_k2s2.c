@@ -747,6 +747,7 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_poly_k2s2_EREJECT;
         }
@@ -805,6 +806,7 @@ static int pendulum_poly_k2s2_step_within(pendulum_poly_k2s2_state *x, pendulum_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_poly_k2s2_OK) return rc;
   /* pendulum_poly_k2s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -954,6 +956,7 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_poly_k2s2_OK;
       }
@@ -970,6 +973,7 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_poly_k2s2_EREJECT ? rc : pendulum_poly_k2s2_ENOCONV;
     }

@@ -1084,6 +1084,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_poly_k3s3_EREJECT;
         }
@@ -1150,6 +1151,7 @@ static int pendulum_poly_k3s3_step_within(pendulum_poly_k3s3_state *x, pendulum_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_poly_k3s3_OK) return rc;
   /* pendulum_poly_k3s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1299,6 +1301,7 @@ int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_poly_k3s3_OK;
       }
@@ -1315,6 +1318,7 @@ int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_poly_k3s3_EREJECT ? rc : pendulum_poly_k3s3_ENOCONV;
     }

@@ -1627,6 +1627,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return pendulum_poly_k4s4_EREJECT;
         }
@@ -1702,6 +1703,7 @@ static int pendulum_poly_k4s4_step_within(pendulum_poly_k4s4_state *x, pendulum_
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != pendulum_poly_k4s4_OK) return rc;
   /* pendulum_poly_k4s4_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1851,6 +1853,7 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return pendulum_poly_k4s4_OK;
       }
@@ -1867,6 +1870,7 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != pendulum_poly_k4s4_EREJECT ? rc : pendulum_poly_k4s4_ENOCONV;
     }

@@ -814,10 +814,11 @@ satellites_k6s1_OUT_OF_LINE double satellites_k6s1_err_est(const double *gam, do
 
 /* The quadrature's part of the local error (the satellites_k6s1_K nodes do not integrate H exactly
  * for this model), which satellites_k6s1_err_est does not see: the energy defect of the step from
- * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h. */
-static double satellites_k6s1_defect(const satellites_k6s1_state *x, const double *sw, double h, const satellites_k6s1_params *prm)
+ * x to x + (h sw[gam], sw[dp]) beyond round-off, over the force |p1 - p0| / h; *rel (if
+ * not NULL) the defect over |K| + |U| (the stats' defect). */
+static double satellites_k6s1_defect(const satellites_k6s1_state *x, const double *sw, double h, const satellites_k6s1_params *prm, double *rel)
 {
-  double q1[satellites_k6s1_M], p1[satellites_k6s1_M], z[satellites_k6s1_M], H0, U0, H1, dH, dp = 0;
+  double q1[satellites_k6s1_M], p1[satellites_k6s1_M], z[satellites_k6s1_M], H0, U0, H1, dH, sc, dp = 0;
   int i;
   for (i = 0; i < satellites_k6s1_M; i++) {
     q1[i] = x->q[i] + h * (double)sw[i];
@@ -828,7 +829,9 @@ static double satellites_k6s1_defect(const satellites_k6s1_state *x, const doubl
   satellites_k6s1_energy_kernel(x->q, x->p, 0, 0, 0, prm, &H0);
   satellites_k6s1_energy_kernel(x->q, z, 0, 0, 0, prm, &U0);
   satellites_k6s1_energy_kernel(q1, p1, 0, 0, 0, prm, &H1);
-  dH = fabs(H1 - H0) - satellites_k6s1_NOISETOL * (fabs(H0 - U0) + fabs(U0));
+  sc = fabs(H0 - U0) + fabs(U0);  /* |K| + |U| */
+  if (rel) *rel = sc > 0 ? fabs(H1 - H0) / sc : fabs(H1 - H0);
+  dH = fabs(H1 - H0) - satellites_k6s1_NOISETOL * sc;
   return dH > 0 && dp > 0 ? dH * fabs(h) / dp : 0;
 }
 
@@ -1722,6 +1725,7 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return satellites_k6s1_EREJECT;
         }
@@ -1800,13 +1804,18 @@ static int satellites_k6s1_step_within(satellites_k6s1_state *x, satellites_k6s1
   sw[25] = sw25;
   sw[26] = sw26;
   est = st || tol > 0 ? satellites_k6s1_err_est(gam, h, d1, cold || x->hprev == 0) : 0;  /* for whom asks */
-  if (tol > 0 && rc == satellites_k6s1_OK) est += satellites_k6s1_defect(x, sw, h, prm);  /* under satellites_k6s1_step_adaptive */
+  double rel = 0;  /* the step's relative energy defect, for the stats */
+  if ((tol > 0 || st) && rc == satellites_k6s1_OK) {  /* for satellites_k6s1_step_adaptive and the stats */
+    double ed = satellites_k6s1_defect(x, sw, h, prm, &rel);
+    if (tol > 0) est += ed;
+  }
   if (st) {
     st->iters = it > satellites_k6s1_MAXITER ? satellites_k6s1_MAXITER : it;
     st->increment = inc;
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = rel;
   }
   if (rc != satellites_k6s1_OK) return rc;
   /* satellites_k6s1_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -1892,6 +1901,7 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return satellites_k6s1_OK;
       }
@@ -1908,6 +1918,7 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != satellites_k6s1_EREJECT ? rc : satellites_k6s1_ENOCONV;
     }

@@ -3994,6 +3994,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return satellites_poly_k6s2_EREJECT;
         }
@@ -4037,6 +4038,7 @@ static int satellites_poly_k6s2_step_within(satellites_poly_k6s2_state *x, satel
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != satellites_poly_k6s2_OK) return rc;
   /* satellites_poly_k6s2_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -4186,6 +4188,7 @@ int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return satellites_poly_k6s2_OK;
       }
@@ -4202,6 +4205,7 @@ int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != satellites_poly_k6s2_EREJECT ? rc : satellites_poly_k6s2_ENOCONV;
     }

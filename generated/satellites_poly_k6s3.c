@@ -7529,6 +7529,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
             st->err_est = est;
             st->h = h;
             st->rejected = 0;
+            st->defect = 0;
           }
           return satellites_poly_k6s3_EREJECT;
         }
@@ -7572,6 +7573,7 @@ static int satellites_poly_k6s3_step_within(satellites_poly_k6s3_state *x, satel
     st->err_est = est;
     st->h = h;
     st->rejected = 0;
+    st->defect = 0;
   }
   if (rc != satellites_poly_k6s3_OK) return rc;
   /* satellites_poly_k6s3_step_adaptive: over tol (1 + max|q0| + |h gamma_0|), nothing is written */
@@ -7721,6 +7723,7 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
           st->err_est = s.err_est;
           st->h = hh;
           st->rejected = rejected;
+          st->defect = s.defect;
         }
         return satellites_poly_k6s3_OK;
       }
@@ -7737,6 +7740,7 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
         st->err_est = s.err_est;
         st->h = 0;
         st->rejected = rejected;
+        st->defect = s.defect;
       }
       return rc != satellites_poly_k6s3_EREJECT ? rc : satellites_poly_k6s3_ENOCONV;
     }

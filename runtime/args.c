@@ -290,7 +290,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --quiet            no progress line on a terminal\n"
     "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
     "                     (coordinates, p_ and a coordinate, params) and a row\n"
-    "                     per trajectory; --csv gets a summary row for each\n"
+    "                     per trajectory; --csv gets a summary row for each,\n"
+    "                     ending with its input columns (x(0), p_x(0), params)\n"
     "  --sweep NAME=A:B:N N trajectories, NAME (a column as above) from A to B;\n"
     "                     at most 1e7 trajectories, with --ensemble too\n"
     "  --threads N        threads for --ensemble/--sweep (OpenMP runtime only)\n"
@@ -306,15 +307,22 @@ static int print_help(const hbvmrt_model *md, FILE *out)
       fprintf(out, "  %s = %.17g\n", md->params[i].name, v);
     }
   }
-  fputs("\nA step that fails is retried as two halves, down to h/256, on stderr.\n"
-    "At the end one line on stderr:\n"
+  fputs("\nA step that fails is retried as two halves, down to h/256, on stderr\n"
+    "(the first 10, then counted in one line).\n"
+    "At the end, after a failed step or a write error too, one line on stderr:\n"
     "  steps=N iters_mean=X iters_max=Y max_dH=E max_g=E max_hc=E seconds=S\n"
-    "  steps_rejected=R h_min=E h_max=E\n"
+    "  steps_rejected=R h_min=E h_max=E max_err_est=E H0=E max_dH_rel=E\n"
+    "  max_defect=E defect_steps=N t=T status=WORD\n"
     "with the maxima of |H-H0|, |g_i| and |hc_i| over every step, the failed\n"
-    "steps retried smaller and the smallest and largest |h| taken.\n"
+    "steps retried smaller, the smallest and largest |h| taken, the largest\n"
+    "local error estimate of a step, H at t=0 and max_dH/|H0|, the largest\n"
+    "relative energy defect of a step and the steps where it is above\n"
+    "sqrt(eps) (or --tol if larger), the time reached and how the run ended (ok, output_error,\n"
+    "step_failed, event_nan, energy_defect); a warning line before it when the\n"
+    "error estimate is above 1e-3 (1 + max|q|) or steps were flagged.\n"
     "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"
     "included) or an output error, 2 a failed step or projection, or an\n"
-    "event that is not a number.\n", out);
+    "event that is not a number, 3 steps that did not conserve H.\n", out);
   free(prm);
   if (fflush(out) != 0 || ferror(out)) {
     hbvmrt_error(md, "cannot write the help text");

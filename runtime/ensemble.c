@@ -593,6 +593,22 @@ static int worker(Ens *e)
 
 /* ---- output ---- */
 
+/* The summary's name of input column c: a param by its name, the initial
+ * value of a coordinate or momentum as x(0), p_x(0), apart from the final
+ * x, p_x of the same row. */
+static void input_name(const Ens *e, int c, FILE *f)
+{
+  const hbvmrt_model *md = e->md;
+
+  if (e->kind[c] == COL_PARAM)
+    fprintf(f, ",%s", md->params[e->index[c]].name);
+  else
+    fprintf(f, ",%s%s(0)", e->kind[c] == COL_P ? "p_" : "", md->names[e->index[c]]);
+}
+
+/* The summary CSV: a row per trajectory, its status, final state and
+ * maxima, then the values of the input's columns (--ensemble) or the swept
+ * one (--sweep), as given, so that a row says what it ran. */
 static int write_results(const Ens *e, FILE *f)
 {
   const hbvmrt_model *md = e->md;
@@ -606,12 +622,17 @@ static int write_results(const Ens *e, FILE *f)
     fprintf(f, ",p_%s", md->names[i]);
   for (i = 0; i < nu; i++)
     fprintf(f, ",lambda_%d", i + 1);
-  fputs(",H,max_dH,max_g,max_hc,iters_mean,iters_max\n", f);
+  fputs(",H,max_dH,max_g,max_hc,iters_mean,iters_max", f);
+  for (i = 0; i < e->ncol; i++)
+    input_name(e, i, f);
+  fputc('\n', f);
   for (t = 0; t < e->nrow; t++) {
     const double *r = result(e, t);
     fprintf(f, "%ld,%d,%ld", t + 1, (int)r[0], (long)r[1]);
     for (i = 2; i < at_H(md) + R_SUM; i++)
       fprintf(f, ",%.17g", r[i]);
+    for (i = 0; i < e->ncol; i++)
+      fprintf(f, ",%.17g", e->val[t * e->ncol + i]);
     fputc('\n', f);
   }
   return ferror(f) ? -1 : 0;

@@ -23,6 +23,9 @@ typedef struct {
   double err_est;     /* the step's local error estimate */
   double h;           /* the step taken (step_adaptive) */
   int rejected;       /* tries rejected before it (step_adaptive) */
+  /* The step's relative energy defect, |H1 - H0| / (|K| + |U|) (0 from
+   * drivers generated before it, and where the step conserves H exactly). */
+  double defect;
 } hbvmrt_stats;
 
 /* One run-time parameter: its name and where it lives in the params block. */
@@ -79,7 +82,8 @@ typedef struct {
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status
- * (0 success, 1 bad arguments, 2 a failed step). */
+ * (0 success, 1 bad arguments, 2 a failed step, 3 steps that did not
+ * conserve H). */
 int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
 
 /* The batch step of a solver generated with --batch W, for the ensemble

@@ -27,6 +27,16 @@
 /* A failed step of the fixed h is retried as two halves, each of which may
  * be halved again, this many times deep (h / 256) before the run stops. */
 #define HBVMRT_HALVINGS 8
+/* Per-step messages (a failed step retried as halves) written per run; the
+ * rest are counted in one line at the end. */
+#define HBVMRT_MAX_SAID 10
+/* A step whose relative energy defect (hbvmrt_stats.defect) is above the
+ * square root of the solver's precision (1.5e-8 in double, 3.5e-4 in float)
+ * lost half the digits of H in one step: flagged in the summary, exit
+ * status 3 (run.c). */
+/* A run whose largest local error estimate is above this times
+ * 1 + max|q| is warned about (run.c). */
+#define HBVMRT_ERR_EST_WARN 1e-3
 /* The most lanes of a batch (hbvmgen --batch W: W <= 64). */
 #define HBVMRT_MAX_LANES 64
 /* The most CSV rows --dt may ask for (span / DT), and the most trajectories

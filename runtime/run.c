@@ -19,11 +19,16 @@
  *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
- * a failed step), 2 a failed step or an event that is not a number. */
+ * a failed step), 2 a failed step or an event that is not a number, 3 steps
+ * whose relative energy defect (hbvmrt_stats.defect) is above sqrt(eps):
+ * the run ended, but H was not conserved.  Every run that started ends with
+ * the summary line (summary), after warnings on the largest local error
+ * estimate and on those steps; per-step messages stop at HBVMRT_MAX_SAID. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,9 +55,16 @@ typedef struct {
   int csv_errno;              /* errno of the first failed write, or 0 */
   void *x0, *y;               /* the state before the step, a dense state (--dt, events) */
   long grid_k;                /* --dt: the next row is at t = grid_k DT */
+  double grid_t;              /* ... and the last one was at t = grid_t */
   hbvmrt_events ev;           /* --events, --stop-at */
   int stopped;                /* the --stop-at event ended the run */
   int event_nan;              /* ... or an event that is not a number, reported */
+  double max_err_est;         /* the largest local error estimate of a step */
+  double max_q;               /* max |q| over the steps, the scale of max_err_est */
+  double max_defect;          /* the largest relative energy defect of a step */
+  long defect_steps;          /* steps whose defect is far above round-off */
+  long said;                  /* per-step messages written on stderr ... */
+  long unsaid;                /* ... and suppressed past HBVMRT_MAX_SAID */
 } Run;
 
 /* The progress line: drawn only on a terminal, after a second, at most ten
@@ -363,8 +375,21 @@ static void grid_rows(Run *r)
     }
     if (r->csv && r->csv_errno == 0 && hbvmrt_csv_row(r->csv, md, r->y, H, r->g, r->hc) != 0)
       r->csv_errno = errno ? errno : EIO;
+    r->grid_t = tk;
     r->grid_k++;
   }
+}
+
+/* The state of the --stop-at event as the last row: with --dt too (its
+ * grid ended at the row before the event), unless the grid's last row is
+ * the event's t within the grid's round-off. */
+static int stop_row(Run *r)
+{
+  double t = state_t(r);
+
+  if (r->o->dt > 0 && fabs(t - r->grid_t) <= 1e-12 * (fabs(t) + r->o->dt))
+    return 0;
+  return write_row(r);
 }
 
 /* Before a step: the state it starts from, when events or --dt need it. */
@@ -372,6 +397,45 @@ static void before_step(Run *r)
 {
   if (r->x0)
     memcpy(r->x0, r->x, r->md->state_size);
+}
+
+/* The relative energy defect (hbvmrt_stats.defect) above which a step is
+ * flagged: sqrt(eps) of the solver's real type, half the digits of H lost in
+ * one step, or under --tol the tolerance, if larger (the adaptive step's
+ * estimate holds the defect within it: Kepler at k = s = 2, --tol 1e-4,
+ * keeps 2e-7, well within what was asked).  A step that resolves H keeps it
+ * to a few ulps (Kepler, k = 16: 4e-16 up to h = 0.5; float: 2e-7); one
+ * whose quadrature does not loses far more (h = 1: 1e-7, h = 300: 0.3). */
+static double defect_limit(const Run *r)
+{
+  double lim = sqrt(r->md->eps > 0 ? r->md->eps : 2.220446049250313e-16);
+
+  return r->o->tol > lim ? r->o->tol : lim;
+}
+
+/* A per-step message on stderr (printf-like): the first HBVMRT_MAX_SAID of
+ * the run are written, the rest counted (said at the end, say_suppressed),
+ * so that a run of a million retried steps does not write a million lines. */
+static void say(Run *r, const char *fmt, ...) HBVMRT_PRINTF(2, 3);
+static void say(Run *r, const char *fmt, ...)
+{
+  va_list ap;
+
+  if (r->said >= HBVMRT_MAX_SAID) {
+    r->unsaid++;
+    return;
+  }
+  r->said++;
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+}
+
+static void say_suppressed(const Run *r)
+{
+  if (r->unsaid > 0)
+    fprintf(stderr, "%s: %ld more such messages not shown (at most %d are)\n", r->md->name, r->unsaid,
+            HBVMRT_MAX_SAID);
 }
 
 /* A step of size h was taken: its figures into the run's, its events (the
@@ -386,6 +450,11 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
     r->h_min = fabs(h);
   if (fabs(h) > r->h_max)
     r->h_max = fabs(h);
+  keep_max(&r->max_err_est, st->err_est);
+  keep_max(&r->max_q, max_abs(r->x, r->md->off_q, r->md->m));
+  keep_max(&r->max_defect, st->defect);
+  if (!(st->defect <= defect_limit(r)))
+    r->defect_steps++;
   if (r->ev.md) {
     int found = hbvmrt_events_step(&r->ev, r->x0, r->x, h);
     r->event_nan = found == 2;
@@ -418,9 +487,8 @@ static void on_failed(void *ctx, double h, int code, int depth)
 
   r->rejected++;
   if (depth == 0)
-    fprintf(stderr, "%s: step h=%.6g failed at t=%.15g (%s): retrying with "
-            "halved steps\n", r->md->name, h, state_t(r),
-            r->md->strerror ? r->md->strerror(code) : "failed");
+    say(r, "%s: step h=%.6g failed at t=%.15g (%s): retrying with halved steps\n", r->md->name, h, state_t(r),
+        r->md->strerror ? r->md->strerror(code) : "failed");
 }
 
 /* Advance the state by h (hbvmrt_advance: one step, or, when it fails, its
@@ -462,7 +530,10 @@ static void loop_adaptive(Run *r, Progress *pg)
     taken(r, &st, st.h);
     if (r->stopped || at_end) {   /* at the event, or on T */
       hbvmrt_span_land(r->md, r->o, r->x);
-      step_row(r);
+      if (r->stopped)
+        stop_row(r);
+      else
+        step_row(r);
       return;
     }
     if (n % K == 0 && step_row(r) != 0)
@@ -492,7 +563,7 @@ static void loop(Run *r, Progress *pg)
       return;
     }
     if (r->stopped) {          /* at the --stop-at event */
-      step_row(r);
+      stop_row(r);
       return;
     }
     if (n == N)
@@ -518,12 +589,38 @@ static void report_failure(const Run *r)
     fprintf(stderr, "code %d\n", r->fail_code);
 }
 
-/* The summary line (docs/api.md, "The standalone driver"); without
- * constraints max_g and max_hc are kept, as a plain 0, so every run's line
- * has the same fields. */
-static void summary(const Run *r, double seconds)
+/* The largest local error estimate against the state: above
+ * HBVMRT_ERR_EST_WARN (1 + max|q|), said in one line.  The steps are then too
+ * long for the motion, whatever H and g say: the method conserves them at any
+ * h (a four-bar at h = 0.2 ended 1.76 off with H and g at 1e-14). */
+static void warn_err_est(const Run *r)
+{
+  double limit = HBVMRT_ERR_EST_WARN * (1 + r->max_q);
+
+  if (r->max_err_est > limit)
+    fprintf(stderr, "%s: warning: the largest local error estimate of a step, %.3e, is above %g (1 + max|q|) = "
+            "%.3e: the steps are too long for the motion, and the result may be far off even where H and g are "
+            "kept; take a smaller -h, or --tol\n", r->md->name, r->max_err_est, HBVMRT_ERR_EST_WARN, limit);
+}
+
+/* Steps flagged for their energy defect (defect_limit), said in one line. */
+static void warn_defect(const Run *r)
+{
+  if (r->defect_steps > 0)
+    fprintf(stderr, "%s: warning: %ld step%s did not conserve H: relative energy defect up to %.3e, above %.1e "
+            "(the k = %d nodes do not resolve H at this h); take a smaller %s (exit status 3)\n",
+            r->md->name, r->defect_steps, r->defect_steps == 1 ? "" : "s", r->max_defect, defect_limit(r),
+            r->md->k, r->o->tol > 0 ? "--tol" : "-h");
+}
+
+/* The summary line (docs/api.md, "The standalone driver"); without constraints max_g
+ * and max_hc are kept, as a plain 0, so every run's line has the same
+ * fields.  max_dH_rel is max_dH / |H0| (0 when both are 0); status says how
+ * the run ended, t where. */
+static void summary(const Run *r, double seconds, const char *status)
 {
   double mean = r->steps > 0 ? r->iters_sum / (double)r->steps : 0.0;
+  double rel = r->max_dh == 0 ? 0 : r->max_dh / fabs(r->H0);
 
   fprintf(stderr, "steps=%ld iters_mean=%.3g iters_max=%d max_dH=%.3e ",
           r->steps, mean, r->iters_max, r->max_dh);
@@ -531,16 +628,23 @@ static void summary(const Run *r, double seconds)
     fprintf(stderr, "max_g=%.3e max_hc=%.3e", r->max_g, r->max_hc);
   else
     fputs("max_g=0 max_hc=0", stderr);
-  fprintf(stderr, " seconds=%.3g steps_rejected=%ld h_min=%.3e h_max=%.3e\n",
+  fprintf(stderr, " seconds=%.3g steps_rejected=%ld h_min=%.3e h_max=%.3e",
           seconds, r->rejected, r->h_min, r->h_max);
+  fprintf(stderr, " max_err_est=%.3e H0=%.17g max_dH_rel=%.3e max_defect=%.3e defect_steps=%ld t=%.15g status=%s\n",
+          r->max_err_est, r->H0, rel, r->max_defect, r->defect_steps, state_t(r), status);
 }
 
-/* The loop and everything reported after it; returns the exit status. */
+/* The loop and everything reported after it; returns the exit status:
+ * 1 an output error, 2 a failed step or an event not a number, 3 steps that
+ * did not conserve H, else 0.  Every run that started ends with the summary
+ * line, its status one of ok, output_error, step_failed, event_nan,
+ * energy_defect (the first that applies). */
 static int simulate(Run *r)
 {
   Progress pg;
   double seconds;
-  int out_failed;
+  int out_failed, status;
+  static const char *const word[] = {"ok", "output_error", "step_failed", "energy_defect"};
 
   progress_start(&pg, r);
   if (r->o->tol > 0)
@@ -549,13 +653,17 @@ static int simulate(Run *r)
     loop(r, &pg);
   seconds = now() - pg.start;
   progress_clear(&pg);
+  say_suppressed(r);
   if (r->fail_code != 0)
     report_failure(r);
   out_failed = close_csv(r) != 0;
   if (r->ev.md && hbvmrt_events_close(&r->ev) != 0)
     out_failed = 1;
-  summary(r, seconds);
-  return out_failed ? 1 : r->fail_code != 0 || r->event_nan ? 2 : 0;
+  warn_err_est(r);
+  warn_defect(r);
+  status = out_failed ? 1 : r->fail_code != 0 || r->event_nan ? 2 : r->defect_steps > 0 ? 3 : 0;
+  summary(r, seconds, status == 2 && r->fail_code == 0 ? "event_nan" : word[status]);
+  return status;
 }
 
 /* The standalone driver's one run (driver.c sends it every run that is not an

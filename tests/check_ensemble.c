@@ -60,6 +60,17 @@ static const char rows[] =
     "# a comment line\n"
     "0, -1, 1e7, 0\n0.7, -0.71414284285428498, 0, 0\n0, -1.5, 0, 0\n0.8, -0.6, 0, 0\n0, -1, 3000, 0\n";
 
+/* Whether trajectory traj's row of the summary text ends with tail (its
+ * input columns: issue 31 item 8). */
+static int row_ends_with(const char *text, int traj, const char *tail)
+{
+  char key[32];
+  snprintf(key, sizeof key, "\n%d,", traj);
+  const char *row = strstr(text, key), *end = row ? strchr(row + 1, '\n') : NULL;
+  size_t n = strlen(tail);
+  return end && (size_t)(end - row) > n && !strncmp(end - n, tail, n);
+}
+
 START_TEST(test_independent_of_w_and_threads)
 {
   static const char *const flags[] = {"-s 2", "-s 2 --batch 1", "-s 2 --batch 3", "-s 2 --batch 4"};
@@ -83,6 +94,10 @@ START_TEST(test_independent_of_w_and_threads)
         ck_assert_ptr_nonnull(strstr(ref, "\n11,0,25600,")); /* 100 steps of 0.1 in halves of halves */
         ck_assert_ptr_nonnull(strstr(ref, "\n9,-1,0,0,0,-1.5,0,0,")); /* off the constraint: not run */
         ck_assert_ptr_nonnull(strstr(ref, "\n10,0,100,"));
+        /* each row ends with the input's values, named apart from the final state */
+        ck_assert_ptr_nonnull(strstr(ref, ",iters_mean,iters_max,x(0),y(0),p_x(0),p_y(0)\n"));
+        ck_assert_msg(row_ends_with(ref, 7, ",0,-1,10000000,0"), "%s", ref);
+        ck_assert_msg(row_ends_with(ref, 9, ",0,-1.5,0,0"), "%s", ref);
         /* the summary line counts the trajectories whose steps were retried as
          * halves (7, which fails even so, and 11), as a single run says it */
         snprintf(path, sizeof path, "%s/err.txt", dir);
@@ -108,6 +123,9 @@ START_TEST(test_sweep_and_mpi)
   build("mpb", "models/mass_param.ham", "-s 2 --batch 4", 0);
   one = run("", "mp", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 1", "s1.csv", 0);
   ck_assert_ptr_nonnull(strstr(one, "\n11,0,200,10,"));
+  ck_assert_ptr_nonnull(strstr(one, ",iters_mean,iters_max,m1\n")); /* the swept param, by row */
+  ck_assert_msg(row_ends_with(one, 1, ",1") && row_ends_with(one, 2, ",1.2") && row_ends_with(one, 11, ",3"), "%s",
+                one);
   got = run("", "mpb", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 2", "s2.csv", 0);
   ck_assert_msg(!strcmp(got, one), "--sweep with --batch 4 on 2 threads differs");
   free(got);

@@ -320,6 +320,34 @@ START_TEST(stop_at_step_end)
 }
 END_TEST
 
+/* --stop-at with --dt: the event's state is the last row, after the grid's
+ * rows before it (the CSV ended at the grid row before the event), with fixed
+ * and adaptive steps; an event on a grid point (the ramp's up at t = 1, DT
+ * 0.5) is written once. */
+START_TEST(stop_at_with_dt)
+{
+  static const char *const runs[] = {"-h 0.1 -T 30 --dt 0.25 --stop-at cross:3",
+                                     "--tol 1e-10 -h 0.01 -T 30 --dt 0.25 --stop-at cross:3"};
+  static Row ev[MAXROWS];
+  static double rows[MAXROWS * 9];
+  int nev, nrows;
+  double P = half_period();
+  for (int r = 0; r < 2; r++) {
+    ck_assert_int_eq(run(&pendulum_events_k4s4_model, runs[r], ev, &nev, rows, 9, &nrows, MAXROWS), 0);
+    const double *last = rows + (nrows - 1) * 9;
+    ck_assert_int_eq(nrows, (int)floor(3 * P / 0.25) + 2); /* t = 0, .., k DT < 3P, and the event */
+    ck_assert_msg(last[0] == ev[nev - 1].t && last[1] == ev[nev - 1].q[0] && fabs(last[0] - 3 * P) <= 1e-10,
+                  "%s: the last row is at t = %.17g, the event at %.17g", runs[r], last[0], ev[nev - 1].t);
+    ck_assert_msg(last[-9] == (nrows - 2) * 0.25, "%s: the row before it at t = %.17g", runs[r], last[-9]);
+  }
+  hbvmrt_model md = ramp_model();
+  static double ramp_rows[64 * 6];
+  ck_assert_int_eq(run(&md, "-h 0.25 -T 3 --dt 0.5 --stop-at up", ev, &nev, ramp_rows, 6, &nrows, 64), 0);
+  ck_assert_int_eq(nrows, 3); /* t = 0, 0.5, 1 */
+  ck_assert_msg(ramp_rows[2 * 6] == 1 && ramp_rows[2 * 6 + 3] == 0, "the last row at t = %.17g", ramp_rows[12]);
+}
+END_TEST
+
 /* An event that is not a number after a step (hole at a = 0, for 0.6 < t <
  * 0.9: positive at t = 0.5, NaN at 0.75, positive again at 1, crossing 0 in
  * both steps) cannot be searched: the run fails there, naming it, rather
@@ -420,6 +448,7 @@ Suite *events_suite(void) {
   tcase_add_test(tc, bad_options);
   tcase_add_test(tc, zero_at_step_end);
   tcase_add_loop_test(tc, stop_at_step_end, 0, 4);
+  tcase_add_test(tc, stop_at_with_dt);
   tcase_add_test(tc, event_not_a_number);
   tcase_add_loop_test(tc, span_end_exact, 0, 5);
   tcase_add_test(tc, same_output_twice);

@@ -26,6 +26,7 @@
 
 #include "hbvmrt.h"
 #include "hbvmrt_internal.h"       /* hbvmrt_span_steps */
+#include "kepler_k16s2.h"          /* a generated solver, for the energy defect */
 
 #define HALVINGS 8              /* HBVMRT_HALVINGS of runtime/hbvmrt_internal.h */
 
@@ -95,6 +96,31 @@ static int osc_step_short(void *x, double h, const void *prm, hbvmrt_stats *st)
   return osc_step(x, h, prm, st);
 }
 
+/* as osc_step, reporting a local error estimate of 0.5 on the third step
+ * (1e-6 on the others) and a relative energy defect of 0.3 on the fifth
+ * (0 on the others) */
+static int osc_step_estimated(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  int rc = osc_step(x, h, prm, st);
+  long n = ((OscState *)x)->n;
+
+  st->err_est = n == 3 ? 0.5 : 1e-6;
+  st->defect = n == 5 ? 0.3 : 0;
+  return rc;
+}
+
+/* an adaptive step of osc (the step proposed kept), each with a relative
+ * energy defect of 1e-6 */
+static int osc_step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)
+{
+  int rc = osc_step(x, *h, prm, st);
+
+  (void)tol;
+  st->h = *h;
+  st->defect = 1e-6;
+  return rc;
+}
+
 static const char *osc_strerror(int code)
 {
   return code == 7 ? "did not converge" : "unknown";
@@ -121,6 +147,36 @@ static const hbvmrt_model osc = {
   NULL, NULL, 0,                /* as a driver of hbvmgen 0.1: no projection */
   NULL,                         /* nor error control */
   NULL, 0, NULL, NULL, NULL     /* nor dense output and events */
+};
+
+/* --- kepler_k16s2: the generated solver of models/kepler.ham (k = 16) ---- */
+
+static void kep_init(void *x, const double *q0, const double *p0) { kepler_k16s2_init(x, q0, p0); }
+static void kep_params_default(void *prm) { kepler_k16s2_params_default(prm); }
+static double kep_energy(const void *x, const void *prm) { return kepler_k16s2_energy(x, prm); }
+
+/* emit_main.c's adapter of NAME_step */
+static int kep_step(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  kepler_k16s2_stats s;
+  int rc = kepler_k16s2_step(x, h, prm, &s);
+
+  st->iters = s.iters;
+  st->increment = s.increment;
+  st->err_est = s.err_est;
+  st->defect = s.defect;
+  return rc;
+}
+
+static const hbvmrt_model kepler = {
+  "kepler", kepler_k16s2_M, 0, kepler_k16s2_K, kepler_k16s2_S,
+  sizeof(kepler_k16s2_state), sizeof(kepler_k16s2_params),
+  offsetof(kepler_k16s2_state, t), offsetof(kepler_k16s2_state, q), offsetof(kepler_k16s2_state, p),
+  offsetof(kepler_k16s2_state, lambda),
+  0, NULL, NULL, NULL,
+  kep_init, kep_params_default, kep_step, kepler_k16s2_strerror, kep_energy,
+  NULL, NULL, NULL, NULL, NULL, DBL_EPSILON,
+  NULL, NULL, 0, NULL, NULL, NULL
 };
 
 /* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
@@ -482,6 +538,31 @@ static Summary summary_of(const char *err)
   return s;
 }
 
+/* The summary line's field NAME= (after the fixed ones above) as a number. */
+static double summary_field(const char *err, const char *name)
+{
+  const char *p = strstr(err, "steps=");
+  char key[64], *end;
+  double v;
+
+  ck_assert_ptr_nonnull(p);
+  snprintf(key, sizeof key, " %s=", name);
+  p = strstr(p, key);
+  ck_assert_msg(p != NULL, "no %s in the summary: %s", name, err);
+  v = strtod(p + strlen(key), &end);
+  ck_assert_msg(end != p + strlen(key) && (*end == ' ' || *end == '\n'), "bad %s in: %s", name, err);
+  return v;
+}
+
+/* Whether the summary line says status=WORD. */
+static int summary_status(const char *err, const char *word)
+{
+  const char *p = strstr(err, " status=");
+  size_t n = strlen(word);
+
+  return p && strncmp(p + 8, word, n) == 0 && p[8 + n] == '\n';
+}
+
 /* --- tests ----------------------------------------------------------------- */
 
 START_TEST(header_nu0)
@@ -734,6 +815,103 @@ START_TEST(no_csv)
 }
 END_TEST
 
+/* The summary tells the truth (issue 31 item 4): the largest local error
+ * estimate, H0 and the relative energy error, where and how the run ended;
+ * an estimate above 1e-3 (1 + max|q|) is warned about; a step whose energy
+ * defect is far above round-off (0.3 > sqrt(eps)) is flagged, warned about,
+ * exit status 3. */
+START_TEST(summary_truth)
+{
+  hbvmrt_model est = osc;
+  Result r = run(&osc, "-h 0.1 -N 4");
+
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(summary_field(r.err, "max_err_est"), 0);
+  ck_assert_double_eq(summary_field(r.err, "H0"), 0.5);
+  ck_assert_double_eq_tol(summary_field(r.err, "max_dH_rel"), summary_of(r.err).max_dH / 0.5,
+                          1e-3 * summary_of(r.err).max_dH / 0.5);
+  ck_assert_double_eq(summary_field(r.err, "defect_steps"), 0);
+  ck_assert_double_eq_tol(summary_field(r.err, "t"), 0.4, 1e-15);
+  ck_assert(summary_status(r.err, "ok"));
+  ck_assert_int_eq(count_lines(r.err), 1);
+  done(&r);
+  est.step = osc_step_estimated;
+  r = run(&est, "-h 0.1 -N 4");   /* the estimate of step 3, no defect yet */
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(summary_field(r.err, "max_err_est"), 0.5);
+  ck_assert_ptr_nonnull(strstr(r.err, "osc: warning: the largest local error estimate of a step, 5.000e-01, is "
+                               "above 0.001 (1 + max|q|)"));
+  ck_assert(summary_status(r.err, "ok"));
+  ck_assert_int_eq(count_lines(r.err), 2);
+  done(&r);
+  r = run(&est, "-h 0.1 -N 6");   /* and the defect of step 5 */
+  ck_assert_int_eq(r.status, 3);
+  ck_assert_double_eq(summary_field(r.err, "max_defect"), 0.3);
+  ck_assert_double_eq(summary_field(r.err, "defect_steps"), 1);
+  ck_assert_ptr_nonnull(strstr(r.err, "osc: warning: 1 step did not conserve H: relative energy defect up to "
+                               "3.000e-01"));
+  ck_assert(summary_status(r.err, "energy_defect"));
+  ck_assert_int_eq(count_lines(r.err), 3);
+  done(&r);
+  /* under --tol the defect is flagged above the tolerance only: the step's
+   * estimate holds it within tol */
+  est.step_adaptive = osc_step_adaptive;
+  r = run(&est, "--tol 1e-4 -h 0.1 -T 1");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(summary_field(r.err, "max_defect"), 1e-6);
+  ck_assert(summary_status(r.err, "ok"));
+  done(&r);
+  r = run(&est, "--tol 1e-8 -h 0.1 -T 1");
+  ck_assert_int_eq(r.status, 3);
+  ck_assert_double_eq(summary_field(r.err, "defect_steps"), 10);
+  ck_assert_ptr_nonnull(strstr(r.err, "take a smaller --tol (exit status 3)"));
+  done(&r);
+}
+END_TEST
+
+/* Issue 30 item 5: Kepler (k = 16) at h = 300 converged to steps whose
+ * quadrature does not resolve H, |H - H0| = 1.456, and exited 0. Its steps'
+ * energy defect (NAME_stats.defect) now flags the run: exit status 3. At
+ * h = 0.1 every step keeps H to round-off (max_defect 4e-16 measured; at
+ * most 16 ulps allowed), exit 0. */
+START_TEST(kepler_energy_defect)
+{
+  Result r = run(&kepler, "-h 300 -T 3000");
+
+  ck_assert_int_eq(r.status, 3);
+  ck_assert(summary_status(r.err, "energy_defect"));
+  ck_assert_double_gt(summary_field(r.err, "max_dH_rel"), 1);
+  ck_assert_double_gt(summary_field(r.err, "max_defect"), 0.1);
+  ck_assert_double_eq(summary_field(r.err, "H0"), -0.5);
+  ck_assert_ptr_nonnull(strstr(r.err, "kepler: warning: 1 step did not conserve H"));
+  done(&r);
+  r = run(&kepler, "-h 0.1 -T 100");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert(summary_status(r.err, "ok"));
+  ck_assert_double_le(summary_field(r.err, "max_defect"), 16 * DBL_EPSILON);
+  ck_assert_double_le(summary_field(r.err, "max_err_est"), 1e-3);
+  ck_assert_int_eq(count_lines(r.err), 1);
+  done(&r);
+}
+END_TEST
+
+/* Per-step messages stop at 10, then one line counts the rest: every step
+ * of 0.1 fails and is retried (one line each: 100 before). */
+START_TEST(messages_rate_limited)
+{
+  hbvmrt_model shortish = osc;
+  Result r;
+
+  shortish.step = osc_step_short;
+  r = run(&shortish, "-h 0.1 -N 100");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_int_eq(summary_of(r.err).rejected, 100);
+  ck_assert_ptr_nonnull(strstr(r.err, "osc: 90 more such messages not shown (at most 10 are)\n"));
+  ck_assert_int_eq(count_lines(r.err), 10 + 1 + 1);
+  done(&r);
+}
+END_TEST
+
 START_TEST(step_failure)
 {
   const char *want =
@@ -752,6 +930,8 @@ START_TEST(step_failure)
   ck_assert_int_eq(summary_of(r.err).steps, 5);
   ck_assert_int_eq(summary_of(r.err).rejected, 1 + HALVINGS);
   ck_assert_int_eq(count_lines(r.err), 3);
+  ck_assert(summary_status(r.err, "step_failed"));
+  ck_assert_double_eq_tol(summary_field(r.err, "t"), 0.5, 1e-15);
   done(&r);
 }
 END_TEST
@@ -938,6 +1118,7 @@ START_TEST(disk_full)
   ck_assert_int_eq(r.status, 1);
   ck_assert_int_eq(count_lines(r.err), 2);
   ck_assert_int_lt(summary_of(r.err).steps, 100000);
+  ck_assert(summary_status(r.err, "output_error"));
   done(&r);
 }
 END_TEST
@@ -1155,6 +1336,9 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, summary_every_step);
   tcase_add_test(run_, ring_default_run);
   tcase_add_test(run_, inconsistent_start);
+  tcase_add_test(run_, summary_truth);
+  tcase_add_test(run_, kepler_energy_defect);
+  tcase_add_test(run_, messages_rate_limited);
   tcase_add_test(run_, step_failure);
   tcase_add_test(run_, step_failure_every);
   tcase_add_test(run_, step_retried);
