@@ -100,12 +100,23 @@ static void keep_max(double *max, double v)
 
 /* ---- the options of the ensemble, and its input ---- */
 
+/* Whether arg is the option name, alone or with an attached =VALUE. */
+static int is_option(const char *arg, const char *name)
+{
+  size_t n = strlen(name);
+
+  return !strncmp(arg, name, n) && (arg[n] == 0 || arg[n] == '=');
+}
+
+/* Whether argv asks for an ensemble: --ensemble or --sweep, as the option
+ * itself (a prefix such as --sweep1 is the driver's unknown option, not an
+ * ensemble without its input: found by tests/fuzz/fuzz_runtime.c). */
 int hbvmrt_ensemble_wanted(int argc, char **argv)
 {
   int i;
 
   for (i = 1; i < argc; i++)
-    if (!strncmp(argv[i], "--ensemble", 10) || !strncmp(argv[i], "--sweep", 7))
+    if (is_option(argv[i], "--ensemble") || is_option(argv[i], "--sweep"))
       return 1;
   return 0;
 }

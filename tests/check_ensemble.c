@@ -201,11 +201,16 @@ START_TEST(test_errors)
   build("pe", "../models/pendulum.ham", "-s 2 --batch 2", 0);
   static const char *const bad[] = {"--sweep z=0:1:3", "--sweep x=0:1", "--ensemble /nonexistent.csv",
                                     "--sweep x=0:1:3 --ensemble a.csv", "--sweep x=0:1:3 --threads 0",
-                                    "--sweep x=0:1:3 --dt 0.1", "--sweep x=0:1:3 --every 2"};
+                                    "--sweep x=0:1:3 --dt 0.1", "--sweep x=0:1:3 --every 2", "--sweep1"};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     snprintf(cmd, sizeof cmd, "%s/pe %s -N 1 2>/dev/null", dir, bad[i]);
     ck_assert_msg(sh(cmd) == 1, "%s: expected exit status 1", bad[i]);
   }
+  /* a value that starts like --sweep (a CSV file named --sweep1) is no ensemble:
+   * it was taken for one without its input, and the driver died of a NULL
+   * (tests/fuzz/fuzz_runtime.c) */
+  snprintf(cmd, sizeof cmd, "cd %s && ./pe -N 1 --csv --sweep1 2>/dev/null && test -s ./--sweep1", dir);
+  ck_assert_msg(sh(cmd) == 0, "%s: expected a run writing the CSV --sweep1", cmd);
   /* --sweep N allocated 8 N bytes at once, N up to 1e9: now at most 1e7 */
   snprintf(cmd, sizeof cmd, "%s/pe --sweep x=0:1:10000001 -N 1 2>%s/err.txt", dir, dir);
   ck_assert_int_eq(sh(cmd), 1);
