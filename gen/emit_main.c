@@ -59,6 +59,20 @@ static void emit_dense_adapters(FILE *f, const Model *mod, const char *P, int si
     fprintf(f, "  %s_events(x, prm, values);\n}\n\n", P);
 }
 
+// The adapters of the switching functions and of NAME_restart (only when
+// the model has switching functions).
+static void emit_switch_adapters(FILE *f, const Model *mod, const char *P, int single) {
+  if (!mod->nswitch) return;
+  fprintf(f, "static void switches(const void *x, const void *prm, double *values)\n{\n");
+  if (single)
+    fprintf(f, "  %s_params r;\n  %s_real v[%s_NSWITCH];\n  int i;\n  to_real(prm, &r);\n"
+               "  %s_switch(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_NSWITCH; i++) values[i] = v[i];\n}\n\n",
+            P, P, P, P, P);
+  else
+    fprintf(f, "  %s_switch(x, prm, values);\n}\n\n", P);
+  fprintf(f, "static void restart(void *x) { %s_restart(%s); }\n\n", P, single ? "&((view *)x)->s" : "x");
+}
+
 // The same for a float solver: the runtime works in double, so it is given
 // a view (the state's public fields in double beside the float state, and
 // the params in double), converted at every call.
@@ -147,6 +161,7 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   if (o->single) emit_float_adapters(f, mod, P);
   else emit_adapters(f, P);
   emit_dense_adapters(f, mod, P, o->single);
+  emit_switch_adapters(f, mod, P, o->single);
   if (o->batch) emit_batch_adapters(f, P, o->single);
   /* what the runtime sees: the solver's state and params, or their double view */
   size_t n = strlen(P) + 16;
@@ -171,9 +186,12 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
   fprintf(f, "    init_params, project, %s,\n    step_adaptive,\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
   if (mod->nevents)
-    fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n  };\n", P, P, P);
+    fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n", P, P, P);
   else
-    fprintf(f, "    dense, 0, NULL, NULL, NULL,\n  };\n");
+    fprintf(f, "    dense, 0, NULL, NULL, NULL,\n");
+  if (mod->nswitch)
+    fprintf(f, "    %s_NSWITCH, %s_switch_kinds, %s_switch_what, switches, restart,\n", P, P, P);
+  fprintf(f, "  };\n");
   if (o->batch) {
     fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
                "batch_step, batch_observe,\n  };\n", P, P);

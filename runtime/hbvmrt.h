@@ -79,6 +79,16 @@ typedef struct {
   const char *const *event_names;
   const int *event_dirs;
   void (*events)(const void *x, const void *prm, double *values);
+  /* Switching functions (0 and NULL for a smooth model, and in drivers
+   * generated before them): where U or g is not smooth, NAME_switch
+   * (docs/api.md, "Kinks and jumps"). switch_kinds: 0 a sign change of the
+   * value, 1 a crossing of an integer; switch_what: the function ("abs",
+   * "min/max", ...); restart: NAME_restart, the next step starts afresh. */
+  int nswitch;
+  const int *switch_kinds;
+  const char *const *switch_what;
+  void (*switches)(const void *x, const void *prm, double *values);
+  void (*restart)(void *x);
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status
