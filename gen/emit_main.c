@@ -189,12 +189,15 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
     fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n", P, P, P);
   else
     fprintf(f, "    dense, 0, NULL, NULL, NULL,\n");
-  if (mod->nswitch)
-    fprintf(f, "    %s_NSWITCH, %s_switch_kinds, %s_switch_what, switches, restart,\n", P, P, P);
   fprintf(f, "  };\n");
-  if (o->batch) {
+  if (o->batch)
     fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
                "batch_step, batch_observe,\n  };\n", P, P);
+  if (mod->nswitch) { /* (a block of its own: the drivers of smooth models stay as they were) */
+    fprintf(f, "  static const hbvmrt_switching switching = {\n    %s_NSWITCH, %s_switch_kinds, %s_switch_what, switches, "
+               "restart,\n  };\n", P, P, P);
+    fprintf(f, "  return hbvmrt_main_switching(&model, &switching, %s, argc, argv);\n}\n", o->batch ? "&batch" : "NULL");
+  } else if (o->batch) {
     fprintf(f, "  return hbvmrt_main_batch(&model, &batch, argc, argv);\n}\n");
   } else {
     fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");

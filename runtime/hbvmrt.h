@@ -79,22 +79,25 @@ typedef struct {
   const char *const *event_names;
   const int *event_dirs;
   void (*events)(const void *x, const void *prm, double *values);
-  /* Switching functions (0 and NULL for a smooth model, and in drivers
-   * generated before them): where U or g is not smooth, NAME_switch
-   * (docs/api.md, "Kinks and jumps"). switch_kinds: 0 a sign change of the
-   * value, 1 a crossing of an integer; switch_what: the function ("abs",
-   * "min/max", ...); restart: NAME_restart, the next step starts afresh. */
-  int nswitch;
-  const int *switch_kinds;
-  const char *const *switch_what;
-  void (*switches)(const void *x, const void *prm, double *values);
-  void (*restart)(void *x);
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status
  * (0 success, 1 bad arguments, 2 a failed step, 3 steps that did not
  * conserve H). */
 int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
+
+/* The switching functions of a model that is not smooth (NAME_switch,
+ * docs/api.md, "Kinks and jumps"): n of them, their kinds (0 a kink or jump
+ * where the value changes sign, 1 where it crosses an integer), the
+ * function each comes from ("abs", "min/max", ...), their values at the
+ * state x, and NAME_restart (the next step starts afresh). */
+typedef struct {
+  int n;
+  const int *kinds;
+  const char *const *what;
+  void (*values)(const void *x, const void *prm, double *v);
+  void (*restart)(void *x);
+} hbvmrt_switching;
 
 /* The batch step of a solver generated with --batch W, for the ensemble
  * runner (--ensemble, --sweep), which then steps W trajectories at a time.
@@ -114,6 +117,12 @@ typedef struct {
 
 /* hbvmrt_main for a driver with a batch step. */
 int hbvmrt_main_batch(const hbvmrt_model *model, const hbvmrt_batch *batch, int argc, char **argv);
+
+/* hbvmrt_main (batch NULL) or hbvmrt_main_batch for a model with switching
+ * functions: a run's steps end on the points where they change sign
+ * (--no-switch: not); an ensemble's do not. */
+int hbvmrt_main_switching(const hbvmrt_model *model, const hbvmrt_switching *sw, const hbvmrt_batch *batch,
+                          int argc, char **argv);
 
 #ifdef __cplusplus
 }

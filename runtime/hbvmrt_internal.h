@@ -137,6 +137,7 @@ int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0,
 
 typedef struct {
   const hbvmrt_model *md;   /* NULL: off (a smooth model, or --no-switch) */
+  const hbvmrt_switching *fn;
   const void *prm;
   double *v0, *v1;          /* values of the functions: scratch */
   double *side;             /* per function: the side it is on (-1, 1; 0 on the point), for floor its cell */
@@ -148,8 +149,8 @@ typedef struct {
 
 /* Set up at the initial state x (nothing when off): 0, or -1 after
  * reporting. */
-int hbvmrt_switch_open(hbvmrt_switch *sw, const hbvmrt_model *md, const hbvmrt_opts *o, const void *prm,
-                       const void *x);
+int hbvmrt_switch_open(hbvmrt_switch *sw, const hbvmrt_model *md, const hbvmrt_switching *fn,
+                       const hbvmrt_opts *o, const void *prm, const void *x);
 /* A step of at most h from x0 (x a copy of it) that ends on the first
  * switching point inside it: the step h when it crosses none (0: x that
  * step, st its figures), else a step to the point located to 1e-13 (1 + |t|)
@@ -213,7 +214,7 @@ int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int
 
 /* run.c: one run of the standalone driver (hbvmrt_main without an ensemble) */
 
-int hbvmrt_run(const hbvmrt_model *md, int argc, char **argv);
+int hbvmrt_run(const hbvmrt_model *md, const hbvmrt_switching *sw, int argc, char **argv);
 
 /* table.c: a CSV table of numbers (--ensemble FILE) */
 

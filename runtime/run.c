@@ -57,6 +57,7 @@ typedef struct {
   long grid_k;                /* --dt: the next row is at t = grid_k DT */
   double grid_t;              /* ... and the last one was at t = grid_t */
   hbvmrt_events ev;           /* --events, --stop-at */
+  const hbvmrt_switching *swfn; /* the model's switching functions, or NULL */
   hbvmrt_switch sw;           /* steps ended on the switching points (switch.c) */
   int stopped;                /* the --stop-at event ended the run */
   int event_nan;              /* ... or an event that is not a number, reported */
@@ -188,7 +189,7 @@ static int check_initial(Run *r)
  * NULL q0/p0 means the model defaults, at the run's params when the driver
  * can say so), checked against the constraints.  The exit status after
  * reporting, or 0. */
-static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
+static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_switching *sw, const hbvmrt_opts *o)
 {
   const double *q0 = o->q0, *p0 = o->p0;
   size_t nu = (size_t)(md->nu > 0 ? md->nu : 0);
@@ -197,12 +198,13 @@ static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
   memset(r, 0, sizeof *r);
   r->grid_k = 1;              /* the row at t = 0 is the first */
   r->md = md;
+  r->swfn = sw;
   r->o = o;
   r->x = calloc(1, md->state_size + 1);
   r->prm = calloc(1, md->params_size + 1);
   r->g = calloc(nu + 1, sizeof *r->g);
   r->hc = calloc(nu + 1, sizeof *r->hc);
-  if (o->dt > 0 || o->events || o->stop_event >= 0 || (md->nswitch > 0 && !o->no_switch)) {
+  if (o->dt > 0 || o->events || o->stop_event >= 0 || (sw && sw->n > 0 && !o->no_switch)) {
     r->x0 = calloc(1, md->state_size + 1);
     r->y = calloc(1, md->state_size + 1);
     if (!r->x0 || !r->y) {
@@ -655,7 +657,7 @@ static void summary(const Run *r, double seconds, const char *status)
           seconds, r->rejected, r->h_min, r->h_max);
   fprintf(stderr, " max_err_est=%.3e H0=%.17g max_dH_rel=%.3e max_defect=%.3e defect_steps=%ld",
           r->max_err_est, r->H0, rel, r->max_defect, r->defect_steps);
-  if (r->md->nswitch > 0)   /* a model that is not smooth: the switching points crossed */
+  if (r->swfn && r->swfn->n > 0)   /* a model that is not smooth: the switching points crossed */
     fprintf(stderr, " switches=%ld", r->sw.crossed);
   fprintf(stderr, " t=%.15g status=%s\n", state_t(r), status);
 }
@@ -694,7 +696,7 @@ static int simulate(Run *r)
 
 /* The standalone driver's one run (driver.c sends it every run that is not an
  * ensemble): see hbvmrt.h and the comment at the top. */
-int hbvmrt_run(const hbvmrt_model *model, int argc, char **argv)
+int hbvmrt_run(const hbvmrt_model *model, const hbvmrt_switching *sw, int argc, char **argv)
 {
   hbvmrt_opts o;
   Run r;
@@ -705,10 +707,10 @@ int hbvmrt_run(const hbvmrt_model *model, int argc, char **argv)
     hbvmrt_opts_free(&o);
     return status == HBVMRT_ARGS_DONE ? 0 : 1;
   }
-  status = setup(&r, model, &o);
+  status = setup(&r, model, sw, &o);
   if (status == 0)
     status = open_csv(&r) == 0 && hbvmrt_events_open(&r.ev, model, &o, r.prm, r.x) == 0 &&
-                     hbvmrt_switch_open(&r.sw, model, &o, r.prm, r.x) == 0
+                     hbvmrt_switch_open(&r.sw, model, sw, &o, r.prm, r.x) == 0
                  ? simulate(&r)
                  : 1;
   if (r.ev.md && status == 1)

@@ -36,15 +36,16 @@
 #define NEAR_FACTOR 1e-6           /* a point found where no step converges: some function this much nearer
                                     * its point than at the start, else the failure is not a kink's */
 
-int hbvmrt_switch_open(hbvmrt_switch *sw, const hbvmrt_model *md, const hbvmrt_opts *o, const void *prm,
-                       const void *x)
+int hbvmrt_switch_open(hbvmrt_switch *sw, const hbvmrt_model *md, const hbvmrt_switching *fn,
+                       const hbvmrt_opts *o, const void *prm, const void *x)
 {
-  int n = md->nswitch + 1, i;
+  int n = fn ? fn->n + 1 : 1, i;
 
   memset(sw, 0, sizeof *sw);
-  if (md->nswitch <= 0 || !md->switches || o->no_switch)
+  if (!fn || fn->n <= 0 || !fn->values || o->no_switch)
     return 0;
   sw->md = md;
+  sw->fn = fn;
   sw->prm = prm;
   sw->v0 = calloc(2 * (size_t)n, sizeof *sw->v0);   /* (and the sides kept by find_within) */
   sw->v1 = calloc((size_t)n, sizeof *sw->v1);
@@ -55,9 +56,9 @@ int hbvmrt_switch_open(hbvmrt_switch *sw, const hbvmrt_model *md, const hbvmrt_o
     hbvmrt_error(md, "out of memory");
     return -1;
   }
-  md->switches(x, prm, sw->v1);
-  for (i = 0; i < md->nswitch; i++)
-    sw->side[i] = md->switch_kinds[i] == 1 ? floor(sw->v1[i]) : sw->v1[i] > 0 ? 1 : sw->v1[i] < 0 ? -1 : 0;
+  sw->fn->values(x, prm, sw->v1);
+  for (i = 0; i < sw->fn->n; i++)
+    sw->side[i] = sw->fn->kinds[i] == 1 ? floor(sw->v1[i]) : sw->v1[i] > 0 ? 1 : sw->v1[i] < 0 ? -1 : 0;
   return 0;
 }
 
@@ -68,7 +69,7 @@ static double to_point(const hbvmrt_switch *sw, int i, double v)
 {
   double s = sw->side[i];
 
-  if (sw->md->switch_kinds[i] == 1)
+  if (sw->fn->kinds[i] == 1)
     return v - s < s + 1 - v ? v - s : s + 1 - v;
   return s == 0 ? fabs(v) : s * v;
 }
@@ -79,8 +80,8 @@ static int first_crossed(hbvmrt_switch *sw, const double *v)
 {
   int i;
 
-  for (i = 0; i < sw->md->nswitch; i++) {
-    if (sw->md->switch_kinds[i] != 1 && sw->side[i] == 0)
+  for (i = 0; i < sw->fn->n; i++) {
+    if (sw->fn->kinds[i] != 1 && sw->side[i] == 0)
       sw->side[i] = v[i] > 0 ? 1 : v[i] < 0 ? -1 : 0;
     if (to_point(sw, i, v[i]) < 0)
       return i;
@@ -95,7 +96,7 @@ static void crossing(const hbvmrt_switch *sw, int i, double v, double *level, do
 {
   double s = sw->side[i];
 
-  if (sw->md->switch_kinds[i] == 1) {
+  if (sw->fn->kinds[i] == 1) {
     *level = v >= s + 1 ? s + 1 : s;
     *dir = v >= s + 1 ? -1 : 1;
   } else {
@@ -114,7 +115,7 @@ static int probe(hbvmrt_switch *sw, const void *x0, double h, double theta, void
   memset(st, 0, sizeof *st);
   code = md->step(z, theta * h, sw->prm, st);
   if (code == 0)
-    md->switches(z, sw->prm, v);
+    sw->fn->values(z, sw->prm, v);
   return code;
 }
 
@@ -124,7 +125,7 @@ static int nearest(const hbvmrt_switch *sw, const double *v0, const double *v1)
 {
   int i, best = -1;
 
-  for (i = 0; i < sw->md->nswitch; i++)
+  for (i = 0; i < sw->fn->n; i++)
     if (fabs(to_point(sw, i, v1[i])) <= NEAR_FACTOR * fabs(to_point(sw, i, v0[i])) &&
         (best < 0 || fabs(to_point(sw, i, v1[i])) < fabs(to_point(sw, best, v1[best]))))
       best = i;
@@ -137,9 +138,9 @@ static void flip_crossed(hbvmrt_switch *sw, const double *v)
 {
   int i;
 
-  for (i = 0; i < sw->md->nswitch; i++)
+  for (i = 0; i < sw->fn->n; i++)
     if (to_point(sw, i, v[i]) < 0) {
-      sw->side[i] = sw->md->switch_kinds[i] == 1 ? floor(v[i]) : v[i] > 0 ? 1 : -1;
+      sw->side[i] = sw->fn->kinds[i] == 1 ? floor(v[i]) : v[i] > 0 ? 1 : -1;
       sw->crossed++;
     }
 }
@@ -189,7 +190,7 @@ int hbvmrt_switch_find(hbvmrt_switch *sw, const void *x0, void *x, double h, dou
         target = i;
         stuck = 0;
         crossing(sw, i, sw->v1[i], &level, &dir);
-        md->switches(zlo, sw->prm, sw->v0);
+        sw->fn->values(zlo, sw->prm, sw->v0);
         flo = dir * (sw->v0[i] - level);
       }
       hi = c;
@@ -213,19 +214,19 @@ int hbvmrt_switch_find(hbvmrt_switch *sw, const void *x0, void *x, double h, dou
     }
   }
   if (have_hi && lo > 0) {   /* the state just past the point, whose force is that of the far side */
-    md->switches(zhi, sw->prm, sw->v1);
+    sw->fn->values(zhi, sw->prm, sw->v1);
     flip_crossed(sw, sw->v1);
     return ended(sw, x, zhi, &shi, hi * h, st);
   }
   /* no step past the point converged: the state at lo, short of it by
    * less than tol, if some function is on its point there (at least
    * NEAR_FACTOR nearer than at x0) */
-  md->switches(zlo, sw->prm, sw->v1);
-  md->switches(x0, sw->prm, sw->v0);
+  sw->fn->values(zlo, sw->prm, sw->v1);
+  sw->fn->values(x0, sw->prm, sw->v0);
   target = lo > 0 ? nearest(sw, sw->v0, sw->v1) : -1;
   if (target < 0)
     return first_code != 0 ? first_code : -1;
-  if (md->switch_kinds[target] == 1)   /* to the cell beyond the nearer end */
+  if (sw->fn->kinds[target] == 1)   /* to the cell beyond the nearer end */
     sw->side[target] += sw->side[target] + 1 - sw->v1[target] < sw->v1[target] - sw->side[target] ? 1 : -1;
   else
     sw->side[target] = -sw->side[target];
@@ -245,8 +246,8 @@ int hbvmrt_switch_predicted(hbvmrt_switch *sw, const void *x, double h, double *
     return 0;
   for (k = 1; k <= 4; k++) {   /* the last step's polynomials carried on over the next */
     md->dense(x, 1 + 0.25 * k * h / hprev, sw->z[2]);
-    md->switches(sw->z[2], sw->prm, sw->v1);
-    for (int i = 0; i < md->nswitch; i++)
+    sw->fn->values(sw->z[2], sw->prm, sw->v1);
+    for (int i = 0; i < sw->fn->n; i++)
       if (to_point(sw, i, sw->v1[i]) < 0) {
         *guess = 0.25 * k;
         return 1;
@@ -278,11 +279,11 @@ static int find_within(hbvmrt_switch *sw, const void *x0, void *x, double h, dou
   long crossed = sw->crossed;
   int found;
 
-  memcpy(sw->v0 + md->nswitch + 1, sw->side, (size_t)md->nswitch * sizeof *sw->side);
+  memcpy(sw->v0 + sw->fn->n + 1, sw->side, (size_t)sw->fn->n * sizeof *sw->side);
   found = hbvmrt_switch_find(sw, x0, x, h, guess, st);
   if (found != 1 || st->err_est <= 0.01 * tol * fabs(st->h) * (1 + max_q(md, x)))
     return found;
-  memcpy(sw->side, sw->v0 + md->nswitch + 1, (size_t)md->nswitch * sizeof *sw->side);
+  memcpy(sw->side, sw->v0 + sw->fn->n + 1, (size_t)sw->fn->n * sizeof *sw->side);
   sw->crossed = crossed;
   sw->cut = sw->pending = 0;
   memcpy(x, x0, md->state_size);
@@ -304,7 +305,7 @@ int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h
     if (found == 0 || found < 0)
       memcpy(x, x0, md->state_size);   /* no point after all: the step with error control */
     if (found < 1 && (code = hbvmrt_adaptive_step(md, x, &hs, t_end, tol, sw->prm, st, at_end)) == 0) {
-      md->switches(x, sw->prm, sw->v1);
+      sw->fn->values(x, sw->prm, sw->v1);
       if (first_crossed(sw, sw->v1) < 0) {
         *h = hs;
         return 0;
@@ -313,7 +314,7 @@ int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h
       found = find_within(sw, x0, x, st->h, -1, tol, st);
       if (found < 0 || found == 0) {   /* (not located: the step across stands, the sides beyond it) */
         memcpy(x, sw->z[3], md->state_size);
-        md->switches(x, sw->prm, sw->v1);
+        sw->fn->values(x, sw->prm, sw->v1);
         flip_crossed(sw, sw->v1);
         *h = hs;
         return 0;
@@ -332,8 +333,8 @@ int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h
 
 void hbvmrt_switch_before(hbvmrt_switch *sw, void *x)
 {
-  if (sw->md && sw->pending && sw->md->restart)
-    sw->md->restart(x);
+  if (sw->md && sw->pending && sw->fn->restart)
+    sw->fn->restart(x);
   sw->pending = 0;
 }
 
