@@ -36,6 +36,18 @@ static void emit_adapters(FILE *f, const char *P) {
              "  st->h = s.h;\n  st->rejected = s.rejected;\n  return rc;\n}\n\n");
 }
 
+// The adapter `name` of a function of the state with n values (n the
+// macro NAME_count), NAME_fn: in float, converted to double.
+static void emit_values_adapter(FILE *f, const char *P, int single, const char *name, const char *fn, const char *count) {
+  fprintf(f, "static void %s(const void *x, const void *prm, double *values)\n{\n", name);
+  if (single)
+    fprintf(f, "  %s_params r;\n  %s_real v[%s_%s];\n  int i;\n  to_real(prm, &r);\n"
+               "  %s_%s(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_%s; i++) values[i] = v[i];\n}\n\n",
+            P, P, P, count, P, fn, P, count);
+  else
+    fprintf(f, "  %s_%s(x, prm, values);\n}\n\n", P, fn);
+}
+
 // The adapters of dense output and events (events only when the model has
 // some): dense gives a state block y, x at theta inside its last step, for
 // the runtime's functions of a state (double solver: its own state; float:
@@ -50,26 +62,14 @@ static void emit_dense_adapters(FILE *f, const Model *mod, const char *P, int si
     fprintf(f, "  const %s_state *a = x;\n  %s_state *b = y;\n  *b = *a;\n  %s_dense(a, theta, b->q, b->p);\n"
                "  b->t = a->t - a->hprev * (1 - theta);\n}\n\n", P, P, P);
   if (!mod->nevents) return;
-  fprintf(f, "static void events(const void *x, const void *prm, double *values)\n{\n");
-  if (single)
-    fprintf(f, "  %s_params r;\n  %s_real v[%s_NEVENTS];\n  int i;\n  to_real(prm, &r);\n"
-               "  %s_events(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_NEVENTS; i++) values[i] = v[i];\n}\n\n",
-            P, P, P, P, P);
-  else
-    fprintf(f, "  %s_events(x, prm, values);\n}\n\n", P);
+  emit_values_adapter(f, P, single, "events", "events", "NEVENTS");
 }
 
 // The adapters of the switching functions and of NAME_restart (only when
 // the model has switching functions).
 static void emit_switch_adapters(FILE *f, const Model *mod, const char *P, int single) {
   if (!mod->nswitch) return;
-  fprintf(f, "static void switches(const void *x, const void *prm, double *values)\n{\n");
-  if (single)
-    fprintf(f, "  %s_params r;\n  %s_real v[%s_NSWITCH];\n  int i;\n  to_real(prm, &r);\n"
-               "  %s_switch(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_NSWITCH; i++) values[i] = v[i];\n}\n\n",
-            P, P, P, P, P);
-  else
-    fprintf(f, "  %s_switch(x, prm, values);\n}\n\n", P);
+  emit_values_adapter(f, P, single, "switches", "switch", "NSWITCH");
   fprintf(f, "static void restart(void *x) { %s_restart(%s); }\n\n", P, single ? "&((view *)x)->s" : "x");
 }
 
