@@ -300,7 +300,8 @@ static void print_switches(const Model *mod, const char *name) {
          mod->switch_in_U ? "U" : "g");
   for (int i = 0; i < mod->nswitch; i++)
     printf("switch %d: %s, %s, %.6g at q0\n", i + 1, mod->switch_what[i],
-           mod->switch_kinds[i] == SWITCH_INTEGER ? "jumps where it crosses an integer" : "kink or jump at 0", v[i]);
+           mod->switch_kinds[i] == SWITCH_INTEGER ? "jumps where it crosses an integer" : "kink or jump at 0",
+           v[i] == 0 ? 0.0 : v[i]); /* (no -0) */
   free(prm);
   free(v);
 }
