@@ -97,7 +97,8 @@ void switch_warn(const Model *mod) {
     len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", len ? ", " : "", mod->switch_what[i]);
   }
   Loc at = mod->switch_in_U || !mod->nu ? mod->U_loc : mod->g_loc[0];
-  warning_at(at, "%s not smooth (%s): %d switching function%s; the driver ends a step at each of their sign "
-             "changes and restarts there (--no-switch: off; docs/language.md, \"Kinks and jumps\")",
+  warning_at(at, "%s not smooth (%s): %d switching function%s; the driver ends a step on each point where one "
+             "changes sign (crosses an integer, for floor) and restarts there (--no-switch: off; docs/language.md, "
+             "\"Kinks and jumps\")",
              mod->switch_in_U ? "U is" : "g is", list, mod->nswitch, mod->nswitch == 1 ? "" : "s");
 }

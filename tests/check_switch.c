@@ -15,6 +15,9 @@
  *            Fixed steps with the switching are of order 4 = 2s again
  *            (error ratio 16 per halving of h, measured 15.9 and 16.0;
  *            without it 1.6 and 1.7);
+ *   wells    floor (in mod): the closed form of tests/models/wells.ham; at
+ *            --tol 1e-6, 1e-8, 1e-10 within TOL T, 7 switches; --no-switch
+ *            fails at the first cusp;
  *   --multiplier const (the same bounce: no constraints) no longer aborts,
  *            and the summary says switches=N only for a model that has
  *            switching functions. */
@@ -29,6 +32,7 @@
 #include <unistd.h>
 
 #include "bounce_k16s2.h"
+#include "wells_k16s2.h"
 #include "hbvmrt.h"
 #include "polymer_wall4_k4s4.h"
 #include "polymer_wall_k2s2.h"
@@ -77,6 +81,7 @@ Suite *switch_suite(void);
                                                  P##_restart_};
 
 SW_MODEL(bounce_k16s2)
+SW_MODEL(wells_k16s2)
 SW_MODEL(polymer_wall_k2s2)
 SW_MODEL(polymer_wall4_k4s4)
 
@@ -180,6 +185,31 @@ START_TEST(bounce_without_switching)
 }
 END_TEST
 
+/* A row of wells (tests/models/wells.ham) at t. */
+static void wells_exact(double t, double *q, double *p) {
+  double tau = 2 * asin(2.0 / 3), k = floor(t / tau + 0.5);
+  q[0] = 1 + 2 * k + 1.5 * sin(t - k * tau);
+  p[0] = 1.5 * cos(t - k * tau);
+}
+
+static const double wells_tols[] = {1e-6, 1e-8, 1e-10};
+
+START_TEST(wells_adaptive)
+{
+  double row[MAXCOL], ref[MAXCOL], T = 10, tol = wells_tols[_i];
+  char args[128];
+  snprintf(args, sizeof args, "-T %g --tol %g", T, tol);
+  ck_assert_msg(run(&wells_k16s2_model, &wells_k16s2_switching, args, row, 4) == 0, "%s: %s", args, run_err);
+  wells_exact(T, ref + 1, ref + 2);
+  double err = row_error(row, ref, 1);
+  if (getenv("HBVM_SWITCH_TABLE")) printf("wells --tol %g: error %.3e, switches %ld\n", tol, err, switches());
+  ck_assert_int_eq(switches(), 7);
+  ck_assert_msg(err <= tol * T, "%s: error %.3e above TOL T", args, err);
+  snprintf(args, sizeof args, "-T %g --tol %g --no-switch", T, tol);
+  ck_assert_int_eq(run(&wells_k16s2_model, &wells_k16s2_switching, args, row, 4), 2);
+}
+END_TEST
+
 /* The reference of the polymer at T = 5: s = 4, fixed steps with the switching. */
 static const double *polymer_reference(void) {
   static double ref[MAXCOL];
@@ -235,6 +265,7 @@ Suite *switch_suite(void) {
   tcase_set_timeout(tc, 300);
   tcase_add_loop_test(tc, bounce_adaptive, 0, 5);
   tcase_add_test(tc, bounce_without_switching);
+  tcase_add_loop_test(tc, wells_adaptive, 0, 3);
   tcase_add_loop_test(tc, polymer_adaptive, 0, 5);
   tcase_add_test(tc, polymer_fixed_order);
   suite_add_tcase(s, tc);
