@@ -18,9 +18,11 @@
  *   wells    floor (in mod): the closed form of tests/models/wells.ham; at
  *            --tol 1e-6, 1e-8, 1e-10 within TOL T, 7 switches; --no-switch
  *            fails at the first cusp;
- *   --multiplier const (the same bounce: no constraints) no longer aborts,
- *            and the summary says switches=N only for a model that has
- *            switching functions. */
+ *   hard     the polymer on a hard wall (the force jumps, polymer_hard.ham)
+ *            with --multiplier const: --no-switch stops at the first contact
+ *            (t = 1.34), as issue 31 saw; with the switching it runs to T,
+ *            within 10 TOL T of the reference (s = 4, h = 2.5e-4) at --tol
+ *            1e-6 and 1e-7. */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
 #include <float.h>
@@ -32,8 +34,11 @@
 #include <unistd.h>
 
 #include "bounce_k16s2.h"
+#include "driver_adapters.h"
 #include "wells_k16s2.h"
 #include "hbvmrt.h"
+#include "polymer_hard4_k4s4.h"
+#include "polymer_hard_c_k2s2.h"
 #include "polymer_wall4_k4s4.h"
 #include "polymer_wall_k2s2.h"
 
@@ -42,34 +47,7 @@ Suite *switch_suite(void);
 /* The driver's adapters and model description of solver P with switching
  * functions (as emit_main.c writes them for a double solver). */
 #define SW_MODEL(P)                                                                                                 \
-  static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); }                        \
-  static void P##_pd_(void *prm) { P##_params_default(prm); }                                                       \
-  static int P##_step_(void *x, double h, const void *prm, hbvmrt_stats *st) {                                      \
-    P##_stats s;                                                                                                    \
-    int rc = P##_step(x, h, prm, &s);                                                                               \
-    st->iters = s.iters;                                                                                            \
-    st->err_est = s.err_est;                                                                                        \
-    return rc;                                                                                                      \
-  }                                                                                                                 \
-  static int P##_adapt_(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st) {                        \
-    P##_stats s;                                                                                                    \
-    int rc = P##_step_adaptive(x, h, tol, prm, &s);                                                                 \
-    st->iters = s.iters;                                                                                            \
-    st->err_est = s.err_est;                                                                                        \
-    st->h = s.h;                                                                                                    \
-    st->rejected = s.rejected;                                                                                      \
-    return rc;                                                                                                      \
-  }                                                                                                                 \
-  static double P##_energy_(const void *x, const void *prm) { return P##_energy(x, prm); }                          \
-  static void P##_g_(const void *x, const void *prm, double *g) { P##_constraints(x, prm, g); }                     \
-  static void P##_hc_(const void *x, const void *prm, double *g) { P##_hidden(x, prm, g); }                         \
-  static void P##_dense_(const void *x, double theta, void *y) {                                                    \
-    const P##_state *a = x;                                                                                         \
-    P##_state *b = y;                                                                                               \
-    *b = *a;                                                                                                        \
-    P##_dense(a, theta, b->q, b->p);                                                                                \
-    b->t = a->t - a->hprev * (1 - theta);                                                                           \
-  }                                                                                                                 \
+  DRIVER_ADAPTERS(P)                                                                                                \
   static void P##_switch_(const void *x, const void *prm, double *v) { P##_switch(x, prm, v); }                     \
   static void P##_restart_(void *x) { P##_restart(x); }                                                             \
   static const hbvmrt_model P##_model = {                                                                           \
@@ -84,6 +62,8 @@ SW_MODEL(bounce_k16s2)
 SW_MODEL(wells_k16s2)
 SW_MODEL(polymer_wall_k2s2)
 SW_MODEL(polymer_wall4_k4s4)
+SW_MODEL(polymer_hard_c_k2s2)
+SW_MODEL(polymer_hard4_k4s4)
 
 #define MAXCOL 32
 
@@ -242,6 +222,27 @@ START_TEST(polymer_adaptive)
 }
 END_TEST
 
+START_TEST(hard_wall_const)
+{
+  static const double tol[] = {1e-6, 1e-7};
+  static double ref[MAXCOL];
+  double row[MAXCOL], T = 5;
+  char args[128];
+  ck_assert_int_eq(run(&polymer_hard4_k4s4_model, &polymer_hard4_k4s4_switching, "-T 5 -h 0.00025", ref, 17), 0);
+  ck_assert_int_eq(switches(), 17);
+  snprintf(args, sizeof args, "-T %g --tol %g", T, tol[_i]);
+  ck_assert_msg(run(&polymer_hard_c_k2s2_model, &polymer_hard_c_k2s2_switching, args, row, 17) == 0, "%s: %s", args,
+                run_err);
+  double err = row_error(row, ref, 8);
+  if (getenv("HBVM_SWITCH_TABLE")) printf("hard wall, const, --tol %g: error %.3e, switches %ld\n", tol[_i], err, switches());
+  ck_assert_int_eq(switches(), 17);
+  ck_assert_msg(err <= 10 * tol[_i] * T, "%s: error %.3e above 10 TOL T", args, err);
+  snprintf(args, sizeof args, "-T %g --tol %g --no-switch", T, tol[_i]);
+  ck_assert_int_eq(run(&polymer_hard_c_k2s2_model, &polymer_hard_c_k2s2_switching, args, row, 17), 2);
+  ck_assert_msg(strstr(run_err, "did not converge") && row[0] < 1.5, "t = %g: %s", row[0], run_err);
+}
+END_TEST
+
 /* Fixed steps cut on the points are of order 2s = 4 again. */
 START_TEST(polymer_fixed_order)
 {
@@ -268,6 +269,7 @@ Suite *switch_suite(void) {
   tcase_add_loop_test(tc, wells_adaptive, 0, 3);
   tcase_add_loop_test(tc, polymer_adaptive, 0, 5);
   tcase_add_test(tc, polymer_fixed_order);
+  tcase_add_loop_test(tc, hard_wall_const, 0, 2);
   suite_add_tcase(s, tc);
   return s;
 }
