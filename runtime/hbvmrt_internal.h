@@ -37,6 +37,9 @@
 /* A run whose largest local error estimate is above this times
  * 1 + max|q| is warned about (run.c). */
 #define HBVMRT_ERR_EST_WARN 1e-3
+/* A fixed step cut on more switching points than this (a chattering
+ * contact) takes the rest of its h across them (run.c). */
+#define HBVMRT_MAX_CUTS 1000
 /* The most lanes of a batch (hbvmgen --batch W: W <= 64). */
 #define HBVMRT_MAX_LANES 64
 /* The most CSV rows --dt may ask for (span / DT), and the most trajectories

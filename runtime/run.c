@@ -498,28 +498,29 @@ static void on_failed(void *ctx, double h, int code, int depth)
 
 /* Advance the state by h (hbvmrt_advance: one step, or, when it fails, its
  * halves; a step cut on a switching point is followed by the rest of h, so
- * that the run keeps its grid).  Returns 0, or the code of the last failed
+ * that the run keeps its grid; after HBVMRT_MAX_CUTS cuts in one step, a
+ * chattering contact, the rest goes across them).  Returns 0, or the code of the last failed
  * step. */
 static int advance(Run *r, double h)
 {
   hbvmrt_steps cb = {on_before, on_taken, on_failed, NULL};
   double target = state_t(r) + h;
-  int stopped;
+  int stopped, cuts = 0;
 
   cb.ctx = r;
-  while (r->sw.md) {   /* steps that end on the switching points (switch.c) */
+  while (r->sw.md && cuts++ < HBVMRT_MAX_CUTS) {   /* steps that end on the switching points (switch.c) */
     hbvmrt_stats st;
     double rest = target - state_t(r);
     int found;
     before_step(r);
     found = hbvmrt_switch_find(&r->sw, r->x0, r->x, rest, -1, &st);
-    if (found != 0 && found != 1) {   /* a failure not at a point: halves, as without */
-      h = rest;
+    h = rest;
+    if (found != 0 && found != 1)   /* a failure not at a point: halves, as without */
       break;
-    }
     taken(r, &st, st.h);
     if (found == 0 || r->stopped)
       return 0;
+    h = target - state_t(r);
   }
   return hbvmrt_advance(r->md, r->x, r->prm, h, 0, &cb, &stopped);
 }
