@@ -2,28 +2,32 @@
  * (docs/api.md, "Kinks and jumps"; off with --no-switch).
  *
  * Where U or g is not smooth (abs, sign, min, max, floor, mod: hbvmgen
- * emits the arguments as NAME_switch), a step that crosses the kink
+ * emits the arguments as NAME_switch), a step that crosses the point
  * integrates a function that is not smooth over the step: its error is of
- * low order whatever s is, and the local error estimate, which assumes
- * smoothness, does not see it (issue 31: the polymer on a wall ended 1e4 to
- * 1e6 times above --tol). So every step is checked: a switching function
- * whose value at the step's end is on the other side of its switching point
- * (a sign change, or a crossing of an integer for floor) has crossed it
- * inside the step. The step is then cut to end exactly on the first such
- * point t*: a step of the method from the step's start x0 to t*, which
- * sees only one side of the kink, is the new state; the next step starts
- * afresh there (NAME_restart: no warm start from the far side, and the
- * controller's history forgotten), and the rest of a fixed step follows it.
+ * low order whatever s is, the local error estimate, which assumes
+ * smoothness, does not see it (issue 31: a polymer on a wall ended 1e4 to
+ * 1e6 times above --tol), and where the force jumps the iteration of a step
+ * across it may not converge at any h (a hard wall with the constant
+ * multiplier stopped at its first contact). So each step ends on the first
+ * such point inside it, and the next step starts afresh there
+ * (NAME_restart: no warm start from the far side, the controller's history
+ * forgotten); the rest of a fixed step follows.
  *
- * The point is located in two stages, as events are (events.c): on the
- * dense output of the step, which straddles the kink and is only a guess
- * there; then with real steps of theta h from x0, by the Illinois variant of
- * regula falsi started from that guess, until the bracket is below
- * HBVMRT_SWITCH_TOL relative in t. Each function keeps the side it is on
- * (for floor, the integer cell), flipped when it is crossed, so that a value
- * within round-off of the point at the cut is not a second crossing; a
- * crossing found within HBVMRT_SWITCH_NEAR of the step's start is that of a
- * step that began on the point, which needs no cut. Two crossings of one
+ * Each function keeps the side of its point it is on (for floor, its
+ * integer cell): a value beyond it at a step's end is a crossing inside the
+ * step. hbvmrt_switch_find searches the step [0, h] from its start x0 with
+ * steps of the method of theta h: one that converges and crosses no point
+ * is short of it (lower end), one that crosses a point or does not converge
+ * is past it (upper end); Illinois regula falsi on the function crossed once
+ * the upper end has values, halving before, until the bracket is below
+ * HBVMRT_SWITCH_TOL (1 + |t|) in t. The state is then that of the upper end
+ * (all its stages on the near side: a step of a smooth problem, whose force
+ * at the end is the far side's, so that the next step's estimate is right),
+ * and every function beyond its point there flips side. Adaptive steps
+ * (hbvmrt_switch_adaptive) search before the step where the last step's
+ * polynomials carried on predict a point inside it, and after a step that
+ * crossed one or failed; a step to the point whose error estimate is above
+ * the tolerance is undone for a step half as long. Two crossings of one
  * function inside one step cancel and are not seen. */
 #include <math.h>
 #include <stdlib.h>
