@@ -69,6 +69,7 @@ void emit_kernels(Emitter *e);
 void emit_set_lambda(Emitter *e);
 void emit_public(Emitter *e);
 void emit_events(Emitter *e);
+void emit_switches(Emitter *e);
 
 /* emit_predict.c: NAME_predict (the warm start, with NAME_add) and NAME_dense */
 double same_size_coefficient(const Emitter *e, int t);

@@ -103,6 +103,20 @@ void emit_header(Emitter *e, const EmitOptions *o) {
             "extern const char *const $P_event_names[$P_NEVENTS];\n"
             "extern const int $P_event_dirs[$P_NEVENTS];\n"
             "void $P_events(const $P_state *x, const $P_params *prm, $P_real *values);\n\n");
+  if (mod->nswitch) {
+    tmpl(e, "/* The model's switching functions (docs/api.md, \"Kinks and jumps\"): U or g is not\n"
+            " * smooth where one changes sign (kind 0: abs, sign, min, max) or crosses an integer\n"
+            " * (kind 1: floor, mod). Their kinds, the function each comes from, their values at\n"
+            " * x->q. A step across such a point is of low order: end the step on it. */\n");
+    out(e, "#define %s_NSWITCH %d\n", e->P, mod->nswitch);
+    tmpl(e, "extern const int $P_switch_kinds[$P_NSWITCH];\n"
+            "extern const char *const $P_switch_what[$P_NSWITCH];\n"
+            "void $P_switch(const $P_state *x, const $P_params *prm, $P_real *values);\n"
+            "/* Forget the steps' history (warm start, step size controller): the next step\n"
+            " * starts afresh, as after $P_init. For the step after a switching point, whose\n"
+            " * far side the history does not describe. */\n"
+            "void $P_restart($P_state *x);\n\n");
+  }
 }
 
 // The end of NAME.h (after the batch declarations, emit_batch_header).
@@ -267,4 +281,19 @@ void emit_events(Emitter *e) {
   for (int i = 0; i < mod->nevents; i++) out(e, "%s%d", i ? ", " : "", mod->event_dirs[i]);
   tmpl(e, "};\n\nvoid $P_events(const $P_state *x, const $P_params *prm, $P_real *values)\n{\n"
           "  $P_DEFAULT_PARAMS(prm)\n  $(events_kernel q0=x->q p0=x->p out=values);\n}\n");
+}
+
+// The switching functions of the model (none: nothing is emitted): their
+// kinds and functions as tables, their values through the kernel
+// "switch_kernel", and NAME_restart.
+void emit_switches(Emitter *e) {
+  const Model *mod = e->mod;
+  if (!mod->nswitch) return;
+  tmpl(e, "\nconst int $P_switch_kinds[$P_NSWITCH] = {");
+  for (int i = 0; i < mod->nswitch; i++) out(e, "%s%d", i ? ", " : "", mod->switch_kinds[i]);
+  tmpl(e, "};\nconst char *const $P_switch_what[$P_NSWITCH] = {");
+  for (int i = 0; i < mod->nswitch; i++) out(e, "%s\"%s\"", i ? ", " : "", mod->switch_what[i]);
+  tmpl(e, "};\n\nvoid $P_switch(const $P_state *x, const $P_params *prm, $P_real *values)\n{\n"
+          "  $P_DEFAULT_PARAMS(prm)\n  $(switch_kernel q0=x->q p0=x->p out=values);\n}\n\n"
+          "void $P_restart($P_state *x)\n{\n  x->hprev = 0;  /* as after init: no warm start, a first step */\n}\n");
 }

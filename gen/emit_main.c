@@ -36,6 +36,18 @@ static void emit_adapters(FILE *f, const char *P) {
              "  st->h = s.h;\n  st->rejected = s.rejected;\n  return rc;\n}\n\n");
 }
 
+// The adapter `name` of a function of the state with n values (n the
+// macro NAME_count), NAME_fn: in float, converted to double.
+static void emit_values_adapter(FILE *f, const char *P, int single, const char *name, const char *fn, const char *count) {
+  fprintf(f, "static void %s(const void *x, const void *prm, double *values)\n{\n", name);
+  if (single)
+    fprintf(f, "  %s_params r;\n  %s_real v[%s_%s];\n  int i;\n  to_real(prm, &r);\n"
+               "  %s_%s(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_%s; i++) values[i] = v[i];\n}\n\n",
+            P, P, P, count, P, fn, P, count);
+  else
+    fprintf(f, "  %s_%s(x, prm, values);\n}\n\n", P, fn);
+}
+
 // The adapters of dense output and events (events only when the model has
 // some): dense gives a state block y, x at theta inside its last step, for
 // the runtime's functions of a state (double solver: its own state; float:
@@ -50,13 +62,15 @@ static void emit_dense_adapters(FILE *f, const Model *mod, const char *P, int si
     fprintf(f, "  const %s_state *a = x;\n  %s_state *b = y;\n  *b = *a;\n  %s_dense(a, theta, b->q, b->p);\n"
                "  b->t = a->t - a->hprev * (1 - theta);\n}\n\n", P, P, P);
   if (!mod->nevents) return;
-  fprintf(f, "static void events(const void *x, const void *prm, double *values)\n{\n");
-  if (single)
-    fprintf(f, "  %s_params r;\n  %s_real v[%s_NEVENTS];\n  int i;\n  to_real(prm, &r);\n"
-               "  %s_events(&((const view *)x)->s, &r, v);\n  for (i = 0; i < %s_NEVENTS; i++) values[i] = v[i];\n}\n\n",
-            P, P, P, P, P);
-  else
-    fprintf(f, "  %s_events(x, prm, values);\n}\n\n", P);
+  emit_values_adapter(f, P, single, "events", "events", "NEVENTS");
+}
+
+// The adapters of the switching functions and of NAME_restart (only when
+// the model has switching functions).
+static void emit_switch_adapters(FILE *f, const Model *mod, const char *P, int single) {
+  if (!mod->nswitch) return;
+  emit_values_adapter(f, P, single, "switches", "switch", "NSWITCH");
+  fprintf(f, "static void restart(void *x) { %s_restart(%s); }\n\n", P, single ? "&((view *)x)->s" : "x");
 }
 
 // The same for a float solver: the runtime works in double, so it is given
@@ -147,6 +161,7 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   if (o->single) emit_float_adapters(f, mod, P);
   else emit_adapters(f, P);
   emit_dense_adapters(f, mod, P, o->single);
+  emit_switch_adapters(f, mod, P, o->single);
   if (o->batch) emit_batch_adapters(f, P, o->single);
   /* what the runtime sees: the solver's state and params, or their double view */
   size_t n = strlen(P) + 16;
@@ -171,12 +186,18 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
   fprintf(f, "    init_params, project, %s,\n    step_adaptive,\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
   if (mod->nevents)
-    fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n  };\n", P, P, P);
+    fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n", P, P, P);
   else
-    fprintf(f, "    dense, 0, NULL, NULL, NULL,\n  };\n");
-  if (o->batch) {
+    fprintf(f, "    dense, 0, NULL, NULL, NULL,\n");
+  fprintf(f, "  };\n");
+  if (o->batch)
     fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
                "batch_step, batch_observe,\n  };\n", P, P);
+  if (mod->nswitch) { /* (a block of its own: the drivers of smooth models stay as they were) */
+    fprintf(f, "  static const hbvmrt_switching switching = {\n    %s_NSWITCH, %s_switch_kinds, %s_switch_what, switches, "
+               "restart,\n  };\n", P, P, P);
+    fprintf(f, "  return hbvmrt_main_switching(&model, &switching, %s, argc, argv);\n}\n", o->batch ? "&batch" : "NULL");
+  } else if (o->batch) {
     fprintf(f, "  return hbvmrt_main_batch(&model, &batch, argc, argv);\n}\n");
   } else {
     fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");

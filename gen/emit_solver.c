@@ -62,6 +62,7 @@ int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const St
   emit_kernels(&e);
   emit_public(&e);
   emit_events(&e);
+  emit_switches(&e);
   emit_step(&e);
   emit_step_adaptive(&e);
   emit_project(&e);

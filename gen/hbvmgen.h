@@ -7,6 +7,7 @@
  *   ad.c                reverse-mode gradients and Jacobians on the DAG
  *   mass.c              the mass matrix: SPD check and structure of M^-1 (in the DAG with params)
  *   model.c             gradient of U, Jacobian of g, checks of q0 and p0
+ *   switch.c            the switching functions: where U or g is not smooth
  *   method.c            HBVM(k,s) constants and the choice of k
  *   step.c              the step of the method, built as one more DAG (step.h):
  *     step_const.c      the multiplier family of the paper (constant over a step)
@@ -348,7 +349,20 @@ typedef struct {
   int nevents;
   const char **event_names;
   int *event_nodes, *event_dirs;
+  /* switching functions (switch.c): nodes of q and params where U or g is
+   * not smooth, their kinds (SWITCH_*), the function that has each ("abs",
+   * "min/max", ...), and whether U has one (else only g) */
+  int nswitch;
+  int *switch_nodes, *switch_kinds;
+  const char **switch_what;
+  int switch_in_U;
 } Model;
+
+/* The kinds of switching functions: a kink or jump where the value changes
+ * sign (abs, sign, min, max), or where it crosses an integer (floor, mod). */
+enum { SWITCH_SIGN = 0, SWITCH_INTEGER = 1 };
+void model_switches(Model *mod);      /* switch.c: after model_differentiate */
+void switch_warn(const Model *mod);   /* the generation-time warning (none when smooth) */
 
 /* The default of Model.mass_loop, from the measurements in docs/embedding.md. */
 #define MASS_LOOP_DEFAULT 512
@@ -425,6 +439,7 @@ typedef enum {
   K_CONSISTENT, /* NAME_project: a Newton step onto g = 0, p projected onto the hidden constraint */
   K_INITIAL,    /* the model's q0, p0 as functions of the params (when they use any) */
   K_EVENTS,     /* the model's event functions at (q0, p0) (when it has events) */
+  K_SWITCH,     /* the model's switching functions at q0 (when it has some) */
   K_NFACTOR,    /* --iteration newton: the Newton matrix, factored (step_newton.c) */
   K_NSOLVE,     /* --iteration newton: the correction for a residual */
   K_COUNT

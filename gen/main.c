@@ -288,6 +288,24 @@ static const char *mass_str(MassKind k) {
   return "?";
 }
 
+// --check's lines on the switching functions (none for a smooth model):
+// their number, then each one's function, kind and value at q0 (default params).
+static void print_switches(const Model *mod, const char *name) {
+  if (!mod->nswitch) return;
+  double *prm = xmalloc((size_t)(mod->nparams + 1) * sizeof *prm), *v = xmalloc((size_t)mod->nswitch * sizeof *v);
+  for (int i = 0; i < mod->nparams; i++) prm[i] = mod->params[i].value;
+  dag_eval_many(mod->dag, mod->switch_nodes, mod->nswitch, mod->q0, prm, v);
+  printf("switching functions: %d (%s_switch): %s not smooth where they change sign; the driver ends a step on "
+         "each such point and restarts there (--no-switch: off)\n", mod->nswitch, name,
+         mod->switch_in_U ? "U" : "g");
+  for (int i = 0; i < mod->nswitch; i++)
+    printf("switch %d: %s, %s, %.6g at q0\n", i + 1, mod->switch_what[i],
+           mod->switch_kinds[i] == SWITCH_INTEGER ? "jumps where it crosses an integer" : "kink or jump at 0",
+           v[i] == 0 ? 0.0 : v[i]); /* (no -0) */
+  free(prm);
+  free(v);
+}
+
 static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam) {
   char a[16], b[16];
   printf("model %s: m=%d nu=%d deg(U)=%s deg(g)=%s k=%d s=%d\n", o->name, mod->m, mod->nu, deg_str(mod->degU, a),
@@ -318,6 +336,7 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   for (int i = 0; i < mod->m; i++) ngrad += !dag_is_zero(mod->dag, mod->gradU[i]);
   printf("grad U: %d nonzero entries of %d\n", ngrad, mod->m);
   for (int i = 0; i < mod->nparams; i++) printf("param %s = %.17g\n", mod->params[i].name, mod->params[i].value);
+  print_switches(mod, o->name);
   method_advise(stdout, mod, o->s, k, fam);
 }
 
@@ -614,7 +633,9 @@ int main(int argc, char **argv) {
   if (o.mass_loop) mod->mass_loop = o.mass_loop;
   if (o.stage_loop) mod->stage_loop = o.stage_loop;
   model_differentiate(mod);
+  model_switches(mod);
   model_check_initial(mod);
+  switch_warn(mod);
   const char *why = "given with -k";
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;

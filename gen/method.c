@@ -286,9 +286,9 @@ void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam) {
   const char *kink = nonsmooth_function(mod);
   int smooth_poly = mod->degU != DEG_NONPOLY && mod->degg != DEG_NONPOLY;
   if (kink) {
-    fprintf(f, "advice: U or g uses %s, which has a kink or a jump: each crossing costs accuracy whatever s is, "
-               "so a high s buys little; s = 2 and a step small near the kinks (docs/choosing.md, \"Kinks and "
-               "jumps\")\n", kink);
+    fprintf(f, "advice: U or g uses %s, which has a kink or a jump: the driver ends its steps on them (the "
+               "switching functions above), which keeps the order of the smooth method; choose s and k as for a "
+               "smooth model (docs/choosing.md, \"Kinks and jumps\")\n", kink);
   } else if (!mod->nu) {
     int chosen = s == 6 && (smooth_poly ? method_quadrature_exact(k, s, mod->degU, 0) : k == 11);
     fprintf(f, "advice: unconstrained and smooth: -s 6 %s(order 12)%s; on the outer solar system 24x (error "

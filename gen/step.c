@@ -479,6 +479,13 @@ static void build_diagnostics(Build *b) {
     dag_subst(d, mod->event_nodes, mod->nevents, qp, 2 * m, ev);
     step_result(b->st, K_EVENTS, "values", SZ_ONE, mod->nevents, mod->nevents, ev);
   }
+  if (mod->nswitch) {
+    int *sw = step_nodes(mod->nswitch);
+    b->owners = 1u << K_SWITCH;
+    step_section(b, "switching functions");
+    dag_subst(d, mod->switch_nodes, mod->nswitch, q, m, sw);
+    step_result(b->st, K_SWITCH, "values", SZ_ONE, mod->nswitch, mod->nswitch, sw);
+  }
   step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);
   step_result(b->st, K_ENERGY, "H", SZ_ONE, 1, 1, &H);
   build_initial_values(b);
@@ -561,6 +568,7 @@ static const struct {
                       0},
     [K_INITIAL] = {"initial", "out = the model's q0 (M) and p0 (M) at the parameters prm", 0},
     [K_EVENTS] = {"events_kernel", "out = the model's event functions at (q0, p0), in the order written", 0},
+    [K_SWITCH] = {"switch_kernel", "out = the model's switching functions at q0 (where U or g is not smooth)", 0},
     [K_NFACTOR] = {"newton_factor", NULL, 0},
     [K_NSOLVE] = {"newton_solve", NULL, 0},
 };

@@ -2,7 +2,7 @@
  *
  *   NAME [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..] [--p0 a,b,..]
  *        [--param name=value] [--project] [--csv FILE] [--tol TOL] [--dt DT]
- *        [--events FILE] [--stop-at NAME[:COUNT]] [--quiet] [--help]
+ *        [--events FILE] [--stop-at NAME[:COUNT]] [--no-switch] [--quiet] [--help]
  *
  * Options are read left to right; a repeated option overrides the earlier one
  * (--param per name).  A value is the next argument, so `-h -0.01` works; it
@@ -26,7 +26,7 @@
 typedef enum {
   OPT_STEP, OPT_TIME, OPT_STEPS, OPT_EVERY, OPT_Q0, OPT_P0, OPT_PARAM,
   OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT, OPT_TOL, OPT_DT, OPT_EVENTS,
-  OPT_STOP_AT
+  OPT_STOP_AT, OPT_NO_SWITCH
 } OptId;
 
 typedef struct {
@@ -41,7 +41,7 @@ static const Option options[] = {
   {"--param", OPT_PARAM, 1}, {"--csv", OPT_CSV, 1},  {"--quiet", OPT_QUIET, 0},
   {"--help", OPT_HELP, 0},   {"--project", OPT_PROJECT, 0},
   {"--tol", OPT_TOL, 1},      {"--dt", OPT_DT, 1},    {"--events", OPT_EVENTS, 1},
-  {"--stop-at", OPT_STOP_AT, 1},
+  {"--stop-at", OPT_STOP_AT, 1}, {"--no-switch", OPT_NO_SWITCH, 0},
 };
 
 /* What was seen on the way, for the checks that need all options. */
@@ -244,7 +244,7 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "usage: %s [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..]\n"
     "       %*s [--p0 a,b,..] [--param name=value] [--project] [--csv FILE]\n"
     "       %*s [--tol TOL] [--dt DT] [--events FILE] [--stop-at NAME[:COUNT]]\n"
-    "       %*s [--quiet]\n"
+    "       %*s [--no-switch] [--quiet]\n"
     "\n"
     "Integrates the model %s (m=%d coordinates, nu=%d constraints) with the\n"
     "HBVM(k=%d,s=%d) line integral method, N steps of the constant step h.\n"
@@ -287,6 +287,11 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --stop-at NAME[:COUNT]  end the run at the COUNT-th (default 1st)\n"
     "                     occurrence of the event NAME, its state the last\n"
     "                     state of the run\n"
+    "  --no-switch        do not end steps where U or g is not smooth (a model\n"
+    "                     with abs, sign, min, max, floor or mod: by default each\n"
+    "                     step that crosses such a point is cut to end on it,\n"
+    "                     located to 1e-12 relative in t, and the next starts\n"
+    "                     afresh there; the summary counts them, switches=N)\n"
     "  --quiet            no progress line on a terminal\n"
     "  --ensemble FILE    many trajectories: FILE.csv has a header of columns\n"
     "                     (coordinates, p_ and a coordinate, params) and a row\n"
@@ -412,6 +417,9 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
     return 0;
   case OPT_QUIET:
     o->quiet = 1;
+    return 0;
+  case OPT_NO_SWITCH:
+    o->no_switch = 1;
     return 0;
   case OPT_PROJECT:
     o->project = 1;

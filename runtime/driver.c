@@ -10,7 +10,17 @@ int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv)
 {
   if (hbvmrt_ensemble_wanted(argc, argv))
     return hbvmrt_ensemble_main(model, NULL, argc, argv);   /* ensemble.c */
-  return hbvmrt_run(model, argc, argv);                      /* run.c */
+  return hbvmrt_run(model, NULL, argc, argv);                /* run.c */
+}
+
+/* A model with switching functions: a run ends its steps on their points
+ * (run.c, switch.c); an ensemble runs as without them. */
+int hbvmrt_main_switching(const hbvmrt_model *model, const hbvmrt_switching *sw, const hbvmrt_batch *batch,
+                          int argc, char **argv)
+{
+  if (hbvmrt_ensemble_wanted(argc, argv))
+    return hbvmrt_ensemble_main(model, batch, argc, argv);
+  return hbvmrt_run(model, sw, argc, argv);
 }
 
 int hbvmrt_main_batch(const hbvmrt_model *model, const hbvmrt_batch *batch, int argc, char **argv)

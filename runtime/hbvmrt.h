@@ -86,6 +86,19 @@ typedef struct {
  * conserve H). */
 int hbvmrt_main(const hbvmrt_model *model, int argc, char **argv);
 
+/* The switching functions of a model that is not smooth (NAME_switch,
+ * docs/api.md, "Kinks and jumps"): n of them, their kinds (0 a kink or jump
+ * where the value changes sign, 1 where it crosses an integer), the
+ * function each comes from ("abs", "min/max", ...), their values at the
+ * state x, and NAME_restart (the next step starts afresh). */
+typedef struct {
+  int n;
+  const int *kinds;
+  const char *const *what;
+  void (*values)(const void *x, const void *prm, double *v);
+  void (*restart)(void *x);
+} hbvmrt_switching;
+
 /* The batch step of a solver generated with --batch W, for the ensemble
  * runner (--ensemble, --sweep), which then steps W trajectories at a time.
  * The batch block is size bytes; lanes are moved in and out as state blocks;
@@ -104,6 +117,12 @@ typedef struct {
 
 /* hbvmrt_main for a driver with a batch step. */
 int hbvmrt_main_batch(const hbvmrt_model *model, const hbvmrt_batch *batch, int argc, char **argv);
+
+/* hbvmrt_main (batch NULL) or hbvmrt_main_batch for a model with switching
+ * functions: a run's steps end on the points where they change sign
+ * (--no-switch: not); an ensemble's do not. */
+int hbvmrt_main_switching(const hbvmrt_model *model, const hbvmrt_switching *sw, const hbvmrt_batch *batch,
+                          int argc, char **argv);
 
 #ifdef __cplusplus
 }

@@ -37,6 +37,9 @@
 /* A run whose largest local error estimate is above this times
  * 1 + max|q| is warned about (run.c). */
 #define HBVMRT_ERR_EST_WARN 1e-3
+/* A fixed step cut on more switching points than this (a chattering
+ * contact) takes the rest of its h across them (run.c). */
+#define HBVMRT_MAX_CUTS 1000
 /* The most lanes of a batch (hbvmgen --batch W: W <= 64). */
 #define HBVMRT_MAX_LANES 64
 /* The most CSV rows --dt may ask for (span / DT), and the most trajectories
@@ -64,6 +67,7 @@ typedef struct {
   const char *events;  /* --events FILE: the events CSV ("-": stdout), or NULL */
   int stop_event;      /* --stop-at: the event that ends the run, or -1 */
   long stop_count;     /* ... at its stop_count-th occurrence */
+  int no_switch;       /* --no-switch: steps not ended on the switching points */
 } hbvmrt_opts;
 
 /* What hbvmrt_parse_args tells the caller to do next. */
@@ -131,6 +135,49 @@ int hbvmrt_events_close(hbvmrt_events *ev);
 int hbvmrt_state_within(const hbvmrt_model *md, const void *prm, const void *x0, const void *x, double theta,
                         double hsub, void *z);
 
+/* switch.c: steps ended on the points where U or g is not smooth (the
+ * model's switching functions; --no-switch turns it off) */
+
+typedef struct {
+  const hbvmrt_model *md;   /* NULL: off (a smooth model, or --no-switch) */
+  const hbvmrt_switching *fn;
+  const void *prm;
+  double *v0, *v1;          /* values of the functions: scratch */
+  double *side;             /* per function: the side it is on (-1, 1; 0 on the point), for floor its cell */
+  void *z[4];               /* scratch states of the search */
+  long crossed;             /* switching points crossed */
+  int cut;                  /* the last step searched ended on a point */
+  int pending;              /* the next step restarts (NAME_restart) */
+} hbvmrt_switch;
+
+/* Set up at the initial state x (nothing when off): 0, or -1 after
+ * reporting. */
+int hbvmrt_switch_open(hbvmrt_switch *sw, const hbvmrt_model *md, const hbvmrt_switching *fn,
+                       const hbvmrt_opts *o, const void *prm, const void *x);
+/* A step of at most h from x0 (x a copy of it) that ends on the first
+ * switching point inside it: the step h when it crosses none (0: x that
+ * step, st its figures), else a step to the point located to 1e-13 (1 + |t|)
+ * by steps of the method from x0, the first of them at guess h when guess
+ * is in (0, 1) (1: x that step, st its figures, sw->cut set, the point's
+ * side flipped, and the next step restarts). A step that does not converge
+ * counts as one past a point; when the steps fail but not at a point, the
+ * first step's code, x unchanged (-1: a point that could not be located). */
+int hbvmrt_switch_find(hbvmrt_switch *sw, const void *x0, void *x, double h, double guess, hbvmrt_stats *st);
+/* Whether a switching point is predicted within the step h from x by the
+ * last step's polynomials (dense output) carried on; *guess where, as a
+ * fraction of h. */
+int hbvmrt_switch_predicted(hbvmrt_switch *sw, const void *x, double h, double *guess);
+/* hbvmrt_adaptive_step from x0 (x a copy of it) ended on the first
+ * switching point inside the step: found by the last step's polynomials
+ * carried on before it is tried, or after it crossed one or failed
+ * (hbvmrt_switch_find, from the step tried). The step's code; *h stays the
+ * proposal after a step cut on a point. */
+int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h, double t_end, double tol,
+                           hbvmrt_stats *st, int *at_end);
+/* Before a step from x: after a cut, the step's history is forgotten. */
+void hbvmrt_switch_before(hbvmrt_switch *sw, void *x);
+void hbvmrt_switch_close(hbvmrt_switch *sw);
+
 /* span.c: stepping to the end of the span, hit exactly, and halving a failed
  * fixed step (run.c, ensemble.c) */
 
@@ -170,7 +217,7 @@ int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int
 
 /* run.c: one run of the standalone driver (hbvmrt_main without an ensemble) */
 
-int hbvmrt_run(const hbvmrt_model *md, int argc, char **argv);
+int hbvmrt_run(const hbvmrt_model *md, const hbvmrt_switching *sw, int argc, char **argv);
 
 /* table.c: a CSV table of numbers (--ensemble FILE) */
 

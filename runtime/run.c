@@ -57,6 +57,8 @@ typedef struct {
   long grid_k;                /* --dt: the next row is at t = grid_k DT */
   double grid_t;              /* ... and the last one was at t = grid_t */
   hbvmrt_events ev;           /* --events, --stop-at */
+  const hbvmrt_switching *swfn; /* the model's switching functions, or NULL */
+  hbvmrt_switch sw;           /* steps ended on the switching points (switch.c) */
   int stopped;                /* the --stop-at event ended the run */
   int event_nan;              /* ... or an event that is not a number, reported */
   double max_err_est;         /* the largest local error estimate of a step */
@@ -187,7 +189,7 @@ static int check_initial(Run *r)
  * NULL q0/p0 means the model defaults, at the run's params when the driver
  * can say so), checked against the constraints.  The exit status after
  * reporting, or 0. */
-static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
+static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_switching *sw, const hbvmrt_opts *o)
 {
   const double *q0 = o->q0, *p0 = o->p0;
   size_t nu = (size_t)(md->nu > 0 ? md->nu : 0);
@@ -196,12 +198,13 @@ static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_opts *o)
   memset(r, 0, sizeof *r);
   r->grid_k = 1;              /* the row at t = 0 is the first */
   r->md = md;
+  r->swfn = sw;
   r->o = o;
   r->x = calloc(1, md->state_size + 1);
   r->prm = calloc(1, md->params_size + 1);
   r->g = calloc(nu + 1, sizeof *r->g);
   r->hc = calloc(nu + 1, sizeof *r->hc);
-  if (o->dt > 0 || o->events || o->stop_event >= 0) {
+  if (o->dt > 0 || o->events || o->stop_event >= 0 || (sw && sw->n > 0 && !o->no_switch)) {
     r->x0 = calloc(1, md->state_size + 1);
     r->y = calloc(1, md->state_size + 1);
     if (!r->x0 || !r->y) {
@@ -392,9 +395,11 @@ static int stop_row(Run *r)
   return write_row(r);
 }
 
-/* Before a step: the state it starts from, when events or --dt need it. */
+/* Before a step: a fresh start after a switching point (switch.c), and the
+ * state it starts from, when events, --dt or the switching need it. */
 static void before_step(Run *r)
 {
+  hbvmrt_switch_before(&r->sw, r->x);
   if (r->x0)
     memcpy(r->x0, r->x, r->md->state_size);
 }
@@ -492,13 +497,31 @@ static void on_failed(void *ctx, double h, int code, int depth)
 }
 
 /* Advance the state by h (hbvmrt_advance: one step, or, when it fails, its
- * halves).  Returns 0, or the code of the last failed step. */
+ * halves; a step cut on a switching point is followed by the rest of h, so
+ * that the run keeps its grid; after HBVMRT_MAX_CUTS cuts in one step, a
+ * chattering contact, the rest goes across them).  Returns 0, or the code of the last failed
+ * step. */
 static int advance(Run *r, double h)
 {
   hbvmrt_steps cb = {on_before, on_taken, on_failed, NULL};
-  int stopped;
+  double target = state_t(r) + h;
+  int stopped, cuts = 0;
 
   cb.ctx = r;
+  while (r->sw.md && cuts++ < HBVMRT_MAX_CUTS) {   /* steps that end on the switching points (switch.c) */
+    hbvmrt_stats st;
+    double rest = target - state_t(r);
+    int found;
+    before_step(r);
+    found = hbvmrt_switch_find(&r->sw, r->x0, r->x, rest, -1, &st);
+    h = rest;
+    if (found != 0 && found != 1)   /* a failure not at a point: halves, as without */
+      break;
+    taken(r, &st, st.h);
+    if (found == 0 || r->stopped)
+      return 0;
+    h = target - state_t(r);
+  }
   return hbvmrt_advance(r->md, r->x, r->prm, h, 0, &cb, &stopped);
 }
 
@@ -518,7 +541,10 @@ static void loop_adaptive(Run *r, Progress *pg)
     int at_end, code;
 
     before_step(r);
-    code = hbvmrt_adaptive_step(r->md, r->x, &h, t_end, r->o->tol, r->prm, &st, &at_end);
+    if (r->sw.md)   /* steps that end on the switching points (switch.c) */
+      code = hbvmrt_switch_adaptive(&r->sw, r->x0, r->x, &h, t_end, r->o->tol, &st, &at_end);
+    else
+      code = hbvmrt_adaptive_step(r->md, r->x, &h, t_end, r->o->tol, r->prm, &st, &at_end);
     r->rejected += st.rejected;
     if (code != 0) {
       r->fail_code = code;
@@ -630,8 +656,11 @@ static void summary(const Run *r, double seconds, const char *status)
     fputs("max_g=0 max_hc=0", stderr);
   fprintf(stderr, " seconds=%.3g steps_rejected=%ld h_min=%.3e h_max=%.3e",
           seconds, r->rejected, r->h_min, r->h_max);
-  fprintf(stderr, " max_err_est=%.3e H0=%.17g max_dH_rel=%.3e max_defect=%.3e defect_steps=%ld t=%.15g status=%s\n",
-          r->max_err_est, r->H0, rel, r->max_defect, r->defect_steps, state_t(r), status);
+  fprintf(stderr, " max_err_est=%.3e H0=%.17g max_dH_rel=%.3e max_defect=%.3e defect_steps=%ld",
+          r->max_err_est, r->H0, rel, r->max_defect, r->defect_steps);
+  if (r->swfn && r->swfn->n > 0)   /* a model that is not smooth: the switching points crossed */
+    fprintf(stderr, " switches=%ld", r->sw.crossed);
+  fprintf(stderr, " t=%.15g status=%s\n", state_t(r), status);
 }
 
 /* The loop and everything reported after it; returns the exit status:
@@ -668,7 +697,7 @@ static int simulate(Run *r)
 
 /* The standalone driver's one run (driver.c sends it every run that is not an
  * ensemble): see hbvmrt.h and the comment at the top. */
-int hbvmrt_run(const hbvmrt_model *model, int argc, char **argv)
+int hbvmrt_run(const hbvmrt_model *model, const hbvmrt_switching *sw, int argc, char **argv)
 {
   hbvmrt_opts o;
   Run r;
@@ -679,11 +708,15 @@ int hbvmrt_run(const hbvmrt_model *model, int argc, char **argv)
     hbvmrt_opts_free(&o);
     return status == HBVMRT_ARGS_DONE ? 0 : 1;
   }
-  status = setup(&r, model, &o);
+  status = setup(&r, model, sw, &o);
   if (status == 0)
-    status = open_csv(&r) == 0 && hbvmrt_events_open(&r.ev, model, &o, r.prm, r.x) == 0 ? simulate(&r) : 1;
+    status = open_csv(&r) == 0 && hbvmrt_events_open(&r.ev, model, &o, r.prm, r.x) == 0 &&
+                     hbvmrt_switch_open(&r.sw, model, sw, &o, r.prm, r.x) == 0
+                 ? simulate(&r)
+                 : 1;
   if (r.ev.md && status == 1)
     hbvmrt_events_close(&r.ev);
+  hbvmrt_switch_close(&r.sw);
   teardown(&r);
   hbvmrt_opts_free(&o);
   return status;

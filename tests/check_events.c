@@ -27,6 +27,7 @@
 #include <fcntl.h>
 #include <float.h>
 
+#include "driver_adapters.h"
 #include "errest.h"
 #include "hbvmrt.h"
 #include "kepler_events_k4s4.h"
@@ -40,32 +41,7 @@ Suite *events_suite(void);
 /* The driver's adapters and model description of solver P (as emit_main.c
  * writes them for a double solver without parameters). */
 #define EV_MODEL(P)                                                                                                 \
-  static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); }                        \
-  static void P##_pd_(void *prm) { P##_params_default(prm); }                                                       \
-  static int P##_step_(void *x, double h, const void *prm, hbvmrt_stats *st) {                                      \
-    P##_stats s;                                                                                                    \
-    int rc = P##_step(x, h, prm, &s);                                                                               \
-    st->iters = s.iters;                                                                                            \
-    return rc;                                                                                                      \
-  }                                                                                                                 \
-  static int P##_adapt_(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st) {                        \
-    P##_stats s;                                                                                                    \
-    int rc = P##_step_adaptive(x, h, tol, prm, &s);                                                                 \
-    st->iters = s.iters;                                                                                            \
-    st->h = s.h;                                                                                                    \
-    st->rejected = s.rejected;                                                                                      \
-    return rc;                                                                                                      \
-  }                                                                                                                 \
-  static double P##_energy_(const void *x, const void *prm) { return P##_energy(x, prm); }                          \
-  static void P##_g_(const void *x, const void *prm, double *g) { P##_constraints(x, prm, g); }                     \
-  static void P##_hc_(const void *x, const void *prm, double *g) { P##_hidden(x, prm, g); }                         \
-  static void P##_dense_(const void *x, double theta, void *y) {                                                    \
-    const P##_state *a = x;                                                                                         \
-    P##_state *b = y;                                                                                               \
-    *b = *a;                                                                                                        \
-    P##_dense(a, theta, b->q, b->p);                                                                                \
-    b->t = a->t - a->hprev * (1 - theta);                                                                           \
-  }                                                                                                                 \
+  DRIVER_ADAPTERS(P)                                                                                                \
   static void P##_events_(const void *x, const void *prm, double *v) { P##_events(x, prm, v); }                     \
   static const hbvmrt_model P##_model = {                                                                           \
       #P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), sizeof(P##_params), offsetof(P##_state, t),               \

@@ -911,7 +911,13 @@ START_TEST(test_check_advice)
   fclose(f);
   snprintf(args, sizeof args, "--check %s/kink.ham", dir);
   ck_assert_int_eq(run_cli(args, 0, out, sizeof out), 0);
-  ck_assert_msg(strstr(out, "\nadvice: U or g uses max, which has a kink or a jump: ") && !strstr(out, "smooth"),
+  ck_assert_msg(strstr(out, "\nadvice: U or g uses max, which has a kink or a jump: ") &&
+                    !strstr(out, "advice: unconstrained and smooth") && !strstr(out, "advice: constrained and smooth"),
+                "%s", out);
+  /* the switching functions: max(y, 0) at y, and mod(x, 1) at floor(x)'s integer crossings */
+  ck_assert_msg(strstr(out, "\nswitching functions: 2 (kink_switch): U not smooth") &&
+                    strstr(out, "\nswitch 1: min/max, kink or jump at 0, ") &&
+                    strstr(out, "\nswitch 2: floor, jumps where it crosses an integer, "),
                 "%s", out);
   snprintf(args, sizeof args, "rm -r %s", dir);
   ck_assert_int_eq(system(args), 0);
