@@ -305,7 +305,8 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
   if (o->iteration == ITER_NEWTON)
     printf("iteration: newton (simplified Newton, the Newton matrix factored once a step, docs/method-newton.md)\n");
-  if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
+  if (mod->mass_q) mass_q_report(stdout, mod);
+  else if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
   else
     printf("M: with params: %s, computed from them in every kernel call\n",
            mod->mass_L ? "dense, M^-1 v by its L D L' factors" : "diagonal, M^-1 = 1/M_ii");
@@ -619,7 +620,9 @@ int main(int argc, char **argv) {
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
-  if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
+  if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
+    rc = 1;
+  } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
                             "use --multiplier const (or --iteration fixed)");
     rc = 1;
