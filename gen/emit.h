@@ -93,6 +93,7 @@ void emit_end_const(Emitter *e);
 void emit_mq_predict(Emitter *e);
 void emit_mq_start(Emitter *e);
 void emit_mq_carry(Emitter *e);
+void emit_mq_rescale(Emitter *e);
 
 /* emit_step.c: NAME_step_within as named blocks */
 void emit_step(Emitter *e);

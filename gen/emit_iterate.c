@@ -187,7 +187,7 @@ static void emit_fused_checks(Emitter *e) {
 
 // The end of an iteration: failure, convergence or a stall.
 static void emit_convergence(Emitter *e) {
-  int poly = e->st->kern[K_FACTOR].nout > 0;
+  int poly = e->st->kern[K_FACTOR].nout > 0 || e->mod->mass_q; /* (M(q): its end rescales p to H0 too) */
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
   if (poly) { /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"

@@ -6,7 +6,10 @@
  * the fixed-point iteration (emit_iterate.c) calls: NAME_predict_theta, the
  * warm start of Theta (emit_mq_predict, beside NAME_predict); the local pth
  * and its start (emit_mq_start); and after each sweep Theta's increment,
- * which joins gamma's in the convergence test, and the carry (emit_mq_carry). */
+ * which joins gamma's in the convergence test, and the carry (emit_mq_carry).
+ * The end of the step (emit_end.c) calls emit_mq_rescale: p1 rescaled to the
+ * run's energy, so that the iteration may stop at 2 ulps (the poly family's
+ * contraction test, emit_iterate.c) and k = s nodes suffice for H. */
 #include <stdio.h>
 
 #include "emit.h"
@@ -42,6 +45,7 @@ void emit_mq_predict(Emitter *e) {
 // The iteration's Theta, pth, and its warm start.
 void emit_mq_start(Emitter *e) {
   tmpl(e, "  $R pth[$P_S * $P_M];  /* M(q): Theta, p's polynomial, carried from sweep to sweep */\n"
+          "  $R inc_old2 = HUGE_VAL, rho;  /* the contraction test ($P_contraction) */\n"
           "  $P_predict_theta(x, h, cold, pth);\n");
 }
 
@@ -57,4 +61,27 @@ void emit_mq_carry(Emitter *e) {
           "        $R v = fabs$f(h * (sw[$[sweep.th0]i] - pth[i]));\n"
           "        if (v > pi) pi = v;\n        pth[i] = sw[$[sweep.th0]i];\n      }\n"
           "      if (ps > 0) pi /= ps;\n      if (pi > inc) inc = pi;\n    }\n");
+}
+
+// After the commit (compensated sums): p1 rescaled, p1 = beta p1, so that
+// H(q1, p1) = H0, as the poly family's end of step does (T is quadratic in
+// p for any M(q)). H0 is taken anew on the first step, or where H(q0, p0)
+// (Hn, before the commit) differs from it by more than round-off: the state
+// or the params were changed between steps. No rescale at rest (K = 0) or
+// where H0 < U(q1), nor near rest, where beta is not within 1e-6 of 1 and
+// H(q1, p1) - H0 is round-off.
+void emit_mq_rescale(Emitter *e) {
+  tmpl(e, "  {  /* M(q): p1 rescaled to the run's energy H0 */\n"
+          "    $R z[$P_M], U1, K, H0, beta = 1;\n"
+          "    for (i = 0; i < $P_M; i++) z[i] = 0;\n"
+          "    $(energy_kernel q0=x->q p0=z out=&U1);\n"
+          "    K = $P_energy(x, prm) - U1;\n"
+          "    H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0 : Hn;\n"
+          "    if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
+          "    /* near rest a round-off in H is a large change of p (it is that over |v|): a\n"
+          "     * discrepancy at round-off is corrected only where the correction is small (s = 2,\n"
+          "     * tol 1e-10 from rest: 1000x the error without this test) */\n"
+          "    if (!(fabs$f(beta - 1) <= 1e-6) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n"
+          "    for (i = 0; i < $P_M; i++) $P_add(&x->p[i], &x->pc[i], (beta - 1) * (x->p[i] - x->pc[i]));\n"
+          "    x->H0 = H0;\n  }\n");
 }

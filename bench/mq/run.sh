@@ -8,7 +8,7 @@ trap 'rm -rf "$dir"' EXIT
 G=gen/hbvmgen
 $G models/double_pendulum_angles.ham -s 3 -n dpa3 -o "$dir" >/dev/null
 $G models/double_pendulum_angles.ham -s 4 -n dpa4 -o "$dir" >/dev/null
-$G models/double_pendulum_angles.ham -s 4 -k 6 -n dpa4s -o "$dir" >/dev/null
+$G models/double_pendulum_angles.ham -s 4 -k 20 -n dpa4s -o "$dir" >/dev/null
 $G models/double_pendulum.ham -s 4 -k 4 -n cart_k4s4 -o "$dir" >/dev/null
 CFLAGS="-std=c99 -O2 -Wall -Wextra -pedantic"
 cc $CFLAGS -I"$dir" -o "$dir/bench" bench/mq/dpa_bench.c "$dir"/dpa3.c "$dir"/dpa4.c \
