@@ -874,17 +874,11 @@ static void add_constraints(Ctx *cx, const Stmt *st) {
 }
 
 // Flatten a list of entries of M (diag(...) or a row) into want nodes,
-// constants or expressions of params; a value that depends on a coordinate
-// is an error there, a wrong count an error at at, naming the list what.
+// expressions of constants, params and coordinates; a wrong count is an
+// error at at, naming the list what.
 static int *mass_list(Ctx *cx, const Ast *e, Loc at, const char *what, int want) {
   List l = {{0}, {0}, {0}};
   if (flatten(cx, e, &l) < 0) return NULL;
-  for (int i = 0; i < l.nodes.n; i++)
-    if (cx->d->nodes[l.nodes.v[i]].flags & DEP_INPUT) {
-      Loc loc = {l.lines.v[i], l.cols.v[i]};
-      error_at(loc, "M cannot depend on a coordinate (only on constants and params), but this value does");
-      return NULL;
-    }
   if (l.nodes.n != want) {
     error_at(at, "%s has %d value%s, expected %d (one per coordinate)", what, l.nodes.n, l.nodes.n == 1 ? "" : "s",
              want);
@@ -906,8 +900,13 @@ static double *param_values(const Ctx *cx) {
 // mass_setup or mass_setup_diag.
 static void mass_from_nodes(Ctx *cx, const int *nodes, int dense, Loc loc) {
   Model *mod = cx->mod;
-  int n = dense ? mod->m * mod->m : mod->m, params = 0;
+  int n = dense ? mod->m * mod->m : mod->m, params = 0, coords = 0;
   for (int i = 0; i < n; i++) params |= cx->d->nodes[nodes[i]].op != OP_CONST;
+  for (int i = 0; i < n; i++) coords |= cx->d->nodes[nodes[i]].flags & DEP_INPUT;
+  if (coords) { /* M(q): checked at q0 once q0 is known (mass_q_check) */
+    mass_q_setup(mod, nodes, dense, loc);
+    return;
+  }
   if (params && mass_setup_params(mod, nodes, dense, loc) < 0) return;
   double *prm = param_values(cx), *v = xmalloc((size_t)n * sizeof *v);
   dag_eval_many(cx->d, nodes, n, NULL, prm, v);
@@ -965,8 +964,10 @@ static void lower_mass(Ctx *cx) {
   int n = lower(cx, e);
   if (n < 0) return;
   const Node *nd = &cx->d->nodes[n];
-  if (nd->flags & DEP_INPUT) {
-    error_at(e->loc, "M cannot depend on a coordinate (only on constants and params), but it does");
+  int *dg = arena_alloc((size_t)m * sizeof *dg);
+  for (int i = 0; i < m; i++) dg[i] = n;
+  if (nd->flags & DEP_INPUT) { /* c(q) times the identity */
+    mass_from_nodes(cx, dg, 0, e->loc);
     return;
   }
   double *prm = param_values(cx);
@@ -977,8 +978,6 @@ static void lower_mass(Ctx *cx) {
              c);
     return;
   }
-  int *dg = arena_alloc((size_t)m * sizeof *dg);
-  for (int i = 0; i < m; i++) dg[i] = n;
   mass_from_nodes(cx, dg, 0, e->loc);
 }
 
@@ -1151,6 +1150,11 @@ Model *analyse(const char *file, Stmt *prog) {
     lower_mass(cx);
     mod->q0 = initial_values(cx, cx->q0, cx->q0_stmt, "q0", &mod->q0_loc, &mod->q0n);
     mod->p0 = initial_values(cx, cx->p0, cx->p0_stmt, "p0", &mod->p0_loc, &mod->p0n);
+    if (mod->mass_q && mod->q0) {
+      double *prm = param_values(cx);
+      mass_q_check(mod, prm);
+      free(prm);
+    }
     lower_events(cx);
   }
   mod->nu = cx->g.n;
@@ -1165,6 +1169,7 @@ Model *analyse(const char *file, Stmt *prog) {
   mod->params = cx->params;
   mod->nparams = cx->nparams;
   mod->degU = cx->d->nodes[mod->U].deg;
+  if (mod->mass_q) mod->degU = DEG_NONPOLY; /* H's degree for the quadrature: T = p' M(q)^-1 p / 2 is rational in q */
   mod->degg = 0;
   for (int a = 0; a < mod->nu; a++) {
     int dg = cx->d->nodes[mod->g[a]].deg;

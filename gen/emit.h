@@ -90,6 +90,12 @@ void emit_fixed_point(Emitter *e);
 void emit_end_poly(Emitter *e);
 void emit_end_const(Emitter *e);
 
+/* emit_mq.c: what the iteration adds for M(q) (the sweep's carried Theta) */
+void emit_mq_predict(Emitter *e);
+void emit_mq_start(Emitter *e);
+void emit_mq_carry(Emitter *e);
+void emit_mq_rescale(Emitter *e);
+
 /* emit_step.c: NAME_step_within as named blocks */
 void emit_step(Emitter *e);
 

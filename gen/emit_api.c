@@ -44,10 +44,8 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
   out(e, "  %s_real gam2[%d], hprev2, errprev;\n", e->P, s * m);
   out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
-  if (poly) {
-    out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
-    out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
-  }
+  if (poly || mod->mass_q) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+  if (poly) out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
     char v[40];
@@ -232,6 +230,8 @@ static void emit_init(Emitter *e) {
           "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;\n");
   if (e->st->kern[K_FACTOR].nout)
     tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
+  else if (e->mod->mass_q)
+    tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"
           "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0)\n{\n"

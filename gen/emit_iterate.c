@@ -136,8 +136,9 @@ static void emit_fused_sweep(Emitter *e) {
 static void emit_sweep_checks(Emitter *e) {
   int wide = e->wide_step, poly = e->st->kern[K_FACTOR].nout > 0;
   char call[128];
-  snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s%s out=sw);\n", wide ? "q0w" : "x->q",
-           wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "", poly ? " lam=lam lu=fa" : "");
+  snprintf(call, sizeof call, "    $(sweep q0=%s p0=%s gam=gam h=h%s%s%s out=sw);\n", wide ? "q0w" : "x->q",
+           wide ? "p0w" : "x->p", e->mod->nu ? " g0=g0" : "", poly ? " lam=lam lu=fa" : "",
+           e->mod->mass_q ? " pth=pth" : "");
   tmpl(e, call);
   tmpl(e, "    /* increment: max |h (gamma_new - gamma)| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
@@ -150,6 +151,7 @@ static void emit_sweep_checks(Emitter *e) {
           "      gam[i] = sw[$[sweep.gam]i];\n    }\n");
   emit_first_sweep(e);
   tmpl(e, "    if (scale > 0) inc /= scale;\n");
+  if (e->mod->mass_q) emit_mq_carry(e); /* emit_mq.c */
   if (poly)
     tmpl(e, "    for (i = 0; i < $P_S * $P_NU; i++) lam[i] = sw[$[sweep.lam]i];\n"
             "    for (i = 0; i < $<sweep.theta>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
@@ -185,7 +187,7 @@ static void emit_fused_checks(Emitter *e) {
 
 // The end of an iteration: failure, convergence or a stall.
 static void emit_convergence(Emitter *e) {
-  int poly = e->st->kern[K_FACTOR].nout > 0;
+  int poly = e->st->kern[K_FACTOR].nout > 0 || e->mod->mass_q; /* (M(q): its end rescales p to H0 too) */
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
   if (poly) { /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
@@ -234,6 +236,7 @@ void emit_fixed_point(Emitter *e) {
     emit_factor(e, "  ");
   }
   if (e->fused) emit_fused_locals(e);
+  if (e->mod->mass_q) emit_mq_start(e); /* emit_mq.c */
   tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
   if (poly) {
     tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"

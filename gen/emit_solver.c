@@ -52,7 +52,7 @@ int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {.f = hf, .mod = mod, .me = me, .st = st, .P = o->name, .single = o->single,
                .compensated = o->compensated, .wide_step = o->wide_step, .kid = K_SWEEP};
-  e.fused = !o->wide_step && !emit_is_newton(&e) && kernel_inlinable(&e, K_SWEEP);
+  e.fused = !o->wide_step && !emit_is_newton(&e) && !mod->mass_q && kernel_inlinable(&e, K_SWEEP);
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);
   if (o->batch) emit_batch_header(&e, o->batch);

@@ -134,6 +134,7 @@ static void emit_step_end(Emitter *e) {
 // The step's helpers, then NAME_step_within block by block (above).
 void emit_step(Emitter *e) {
   emit_predict(e);
+  if (e->mod->mass_q) emit_mq_predict(e); /* emit_mq.c */
   emit_estimators(e);
   if (emit_is_newton(e)) emit_newton_helpers(e);
   emit_step_head(e);

@@ -336,6 +336,16 @@ typedef struct {
    * diagonal. minv, minv_diag and mass then hold M at the default params. */
   int *minv_node;
   SparseVec *mass_L;
+  /* M(q), a mass matrix that depends on the coordinates (mass_q.c): its
+   * m*m row-major entries as nodes of q (inputs 0..m-1) and params, NULL
+   * when M does not depend on q (minv, minv_diag then hold M at q0); for the
+   * step, in the model's space of q (inputs 0..m-1) and p (inputs m..2m-1):
+   * v = M(q)^-1 p (m nodes) and the force grad_q T + grad U (m nodes), T =
+   * p' v / 2, by closed form (mass_q_closed) or reverse-mode AD */
+  int *mass_q;
+  Loc mass_loc;
+  int mass_q_closed;
+  int *mq_v, *mq_force;
   double *q0, *p0;            /* m each, at the default params */
   int *q0n, *p0n;             /* m nodes each: q0, p0 as functions of the params */
   Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
@@ -375,6 +385,15 @@ int mass_setup_diag(Model *mod, const double *diag, Loc loc); /* M = diag(diag[0
  * M^-1 in the DAG; call before mass_setup* with M at the default params. */
 int mass_setup_params(Model *mod, const int *entries, int dense, Loc loc);
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out); /* out = M^-1 v, nodes */
+long mass_ldl(Dag *d, const int *a, int m, SparseVec *L, int *dinv, Loc loc, const char *what);
+void mass_ldl_solve(Dag *d, const SparseVec *L, const int *dinv, int m, const int *v, int *out);
+/* mass_q.c: M(q) */
+void mass_q_setup(Model *mod, const int *entries, int dense, Loc loc);
+int mass_q_check(Model *mod, const double *prm);   /* M(q0) SPD: 0, or -1 after a located error */
+void mass_q_kinetic(Model *mod);                   /* mod->mq_v, mod->mq_force */
+void minv_apply_at(const Model *mod, Dag *d, const int *q, const int *v, int *out); /* M(q)^-1 v */
+int mass_q_refuse(const Model *mod, int newton, int batch, int wide); /* 1 after an error */
+void mass_q_report(FILE *f, const Model *mod);    /* --check: M's dependence and cost */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);
 

@@ -323,9 +323,10 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
   if (o->iteration == ITER_NEWTON)
     printf("iteration: newton (simplified Newton, the Newton matrix factored once a step, docs/method-newton.md)\n");
-  if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
+  if (mod->mass_q) mass_q_report(stdout, mod);
+  else if (!mod->minv_node) printf("M: constant, %s\n", mass_str(mod->mass));
   else
-    printf("M: with params: %s, computed from them in every kernel call\n",
+    printf("M: with params (constant in q): %s, computed from them in every kernel call\n",
            mod->mass_L ? "dense, M^-1 v by its L D L' factors" : "diagonal, M^-1 = 1/M_ii");
   long nnz = 0;
   for (int a2 = 0; a2 < mod->nu; a2++) nnz += mod->jac[a2].n;
@@ -639,8 +640,11 @@ int main(int argc, char **argv) {
   const char *why = "given with -k";
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
-  int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
-  if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
+  int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, mod->mass_q ? MULT_POLY : fam, &why);
+  if (mod->mass_q && !o.k) why = "M depends on q: k = s, the end of the step rescales p to keep H (docs/method-mq.md)";
+  if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
+    rc = 1;
+  } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
                             "use --multiplier const (or --iteration fixed)");
     rc = 1;

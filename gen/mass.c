@@ -31,7 +31,9 @@
 #define MAX_MASS_FACTOR 20000
 
 // Why M fails its checks: at its value, or at the default params.
-static const char *at_defaults(const Model *mod) { return mod->minv_node ? " at the default params" : ""; }
+static const char *at_defaults(const Model *mod) {
+  return mod->mass_q ? " at q0" : mod->minv_node ? " at the default params" : "";
+}
 
 // Record a diagonal M given by its m diagonal entries: each must be
 // positive; M is then the identity, a scalar multiple of it, or diagonal.
@@ -122,43 +124,54 @@ static int guarded_inverse(Dag *d, int x) {
 // positive definite M are positive): for i < j
 //   W_ji = M_ji - sum_{k<i} W_jk L_ik    (= L_ji d_i),   L_ji = W_ji / d_i,
 //   d_j  = M_jj - sum_{k<j} W_jk L_jk.
-// Zeros stay structural (folding), so a banded M keeps its band. Returns 0,
-// or -1 after an error when the factorisation is too large.
-static int factor_params(Model *mod, const int *a, Loc loc) {
-  Dag *d = mod->dag;
-  int m = mod->m, start = d->n;
+// a: m*m row-major nodes; L: m rows below the diagonal (arena), dinv: the m
+// guarded 1/d_j. Zeros stay structural (folding), so a banded M keeps its
+// band. Returns the entries of L, or -1 after an error at loc when the
+// factorisation takes more than MAX_MASS_FACTOR operations (what: why it
+// is redone, for the message).
+long mass_ldl(Dag *d, const int *a, int m, SparseVec *L, int *dinv, Loc loc, const char *what) {
+  int start = d->n;
   int *w = xmalloc((size_t)m * sizeof *w);
-  mod->mass_L = arena_alloc((size_t)m * sizeof *mod->mass_L);
   long total = 0;
   for (int j = 0; j < m; j++) {
     int nnz = 0;
     for (int i = 0; i < j; i++) {
       int x = a[(size_t)j * m + i];
-      const SparseVec *row = &mod->mass_L[i];
+      const SparseVec *row = &L[i];
       for (int e = 0; e < row->n; e++)
         if (!dag_is_zero(d, w[row->e[e].coord])) x = dag_sub(d, x, dag_mul(d, w[row->e[e].coord], row->e[e].node));
       w[i] = x;
       nnz += !dag_is_zero(d, x);
     }
-    SparseVec *lj = &mod->mass_L[j];
+    SparseVec *lj = &L[j];
     lj->e = arena_alloc((size_t)(nnz + 1) * sizeof *lj->e);
+    lj->n = 0;
     int dj = a[(size_t)j * m + j];
     for (int i = 0; i < j; i++) {
       if (dag_is_zero(d, w[i])) continue;
-      int l = dag_mul(d, w[i], mod->minv_node[i]);
+      int l = dag_mul(d, w[i], dinv[i]);
       lj->e[lj->n++] = (Entry){i, l};
       dj = dag_sub(d, dj, dag_mul(d, w[i], l));
     }
-    mod->minv_node[j] = guarded_inverse(d, dj);
+    dinv[j] = guarded_inverse(d, dj);
     total += lj->n;
     if (d->n - start > MAX_MASS_FACTOR) {
       free(w);
-      error_at(loc, "M has params, so it is factored in every kernel call: here that needs more than %d operations "
-               "(at row %d of %d); make M constant, diagonal or sparser", MAX_MASS_FACTOR, j + 1, m);
+      error_at(loc, "M %s, so it is factored in every kernel call: here that needs more than %d operations "
+               "(at row %d of %d); make M constant, diagonal or sparser", what, MAX_MASS_FACTOR, j + 1, m);
       return -1;
     }
   }
   free(w);
+  return total;
+}
+
+// M with params: its L D L' factors in mod (mass_L NULL when diagonal
+// after all). Returns 0, or -1 after an error.
+static int factor_params(Model *mod, const int *a, Loc loc) {
+  mod->mass_L = arena_alloc((size_t)mod->m * sizeof *mod->mass_L);
+  long total = mass_ldl(mod->dag, a, mod->m, mod->mass_L, mod->minv_node, loc, "has params");
+  if (total < 0) return -1;
   if (!total) mod->mass_L = NULL; /* diagonal after all */
   return 0;
 }
@@ -189,18 +202,17 @@ int mass_setup_params(Model *mod, const int *entries, int dense, Loc loc) {
   return factor_params(mod, entries, loc);
 }
 
-// out = M^-1 v from the factors of an M with params: L y = v, z = D^-1 y,
-// L' out = z (the last solve column by column, from the rows of L).
-static void minv_apply_params(const Model *mod, Dag *d, const int *v, int *out) {
-  int m = mod->m;
-  const SparseVec *L = mod->mass_L;
+// out = M^-1 v from factors M = L D L' (L NULL: diagonal; dinv: D^-1):
+// L y = v, z = D^-1 y, L' out = z (the last solve column by column, from
+// the rows of L). out may not alias v.
+void mass_ldl_solve(Dag *d, const SparseVec *L, const int *dinv, int m, const int *v, int *out) {
   memcpy(out, v, (size_t)m * sizeof *out);
   for (int i = 0; L && i < m; i++)
     for (int e = 0; e < L[i].n; e++)
       if (!dag_is_zero(d, out[L[i].e[e].coord]))
         out[i] = dag_sub(d, out[i], dag_mul(d, L[i].e[e].node, out[L[i].e[e].coord]));
   for (int i = 0; i < m; i++)
-    if (!dag_is_zero(d, out[i])) out[i] = dag_mul(d, mod->minv_node[i], out[i]);
+    if (!dag_is_zero(d, out[i])) out[i] = dag_mul(d, dinv[i], out[i]);
   for (int i = m - 1; L && i >= 0; i--)
     for (int e = 0; e < L[i].n && !dag_is_zero(d, out[i]); e++)
       out[L[i].e[e].coord] = dag_sub(d, out[L[i].e[e].coord], dag_mul(d, L[i].e[e].node, out[i]));
@@ -220,7 +232,7 @@ static int minv_table(const Model *mod, Dag *d) {
 // prints as loops: m^2 operations would be m^2 lines of C.
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out) {
   if (mod->minv_node) {
-    minv_apply_params(mod, d, v, out);
+    mass_ldl_solve(d, mod->mass_L, mod->minv_node, mod->m, v, out);
     return;
   }
   int m = mod->m, zero = dag_const(d, 0);

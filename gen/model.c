@@ -24,6 +24,7 @@ void model_differentiate(Model *mod) {
     d->where = mod->g_loc[a];
     ad_gradient_sparse(d, mod->g[a], m, &mod->jac[a]);
   }
+  if (mod->mass_q) mass_q_kinetic(mod);
 }
 
 static double *param_defaults(const Model *mod) {

@@ -453,7 +453,7 @@ static void build_diagnostics(Build *b) {
   dag_subst(d, mod->g, nu, q, m, g);
   b->owners = 1u << K_MINV_P | 1u << K_ENERGY | 1u << K_HIDDEN | 1u << K_LAMBDA0;
   step_section(b, "M^-1 p0");
-  minv_apply(mod, d, p, v);
+  minv_apply_at(mod, d, q, p, v);
   b->owners = 1u << K_ENERGY;
   step_section(b, "energy");
   int kin = dag_const(d, 0);
@@ -598,6 +598,14 @@ Step *step_build(Model *mod, const Method *me) {
   b.h = step_in(&b, IN_H, 0);
   int poly = me->family == MULT_POLY && nu;
   if (poly) layout_inputs(st, m, nu, s, s * nu, 0); /* the factor's length is known once it is built */
+  if (mod->mass_q) { /* M(q): the general-H sweep carries Theta in the input pth */
+    layout_inputs(st, m, nu, s, s * m, 0);
+    st->in[IN_LAM].name = "pth";
+    st->in[IN_LAM].sym = SZ_SM;
+    build_mq_sweep(&b);
+    build_diagnostics(&b);
+    return st;
+  }
   build_stages(&b);
   if (poly) {
     build_poly_multiplier(&b);

@@ -43,6 +43,7 @@ void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, 
 
 void build_const_multiplier(Build *b);
 void build_poly_multiplier(Build *b);
+void build_mq_sweep(Build *b); /* step_mq.c: M(q), no constraints */
 
 /* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
  * A[j][r] = sum_i X[j][i] sum_l b_l P_i(c_l) Ihat[l][r] in a real eigenbasis:

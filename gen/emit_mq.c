@@ -1,0 +1,87 @@
+/* emit_mq.c - what the step's iteration adds for a mass matrix M(q).
+ *
+ * The sweep with M(q) (step_mq.c) reads Theta, the coefficients of p's
+ * polynomial, from its input pth, and the iteration carries the sweep's new
+ * Theta (sw[th0..]) to the next sweep. This file prints the three pieces
+ * the fixed-point iteration (emit_iterate.c) calls: NAME_predict_theta, the
+ * warm start of Theta (emit_mq_predict, beside NAME_predict); the local pth
+ * and its start (emit_mq_start); and after each sweep Theta's increment,
+ * which joins gamma's in the convergence test, and the carry (emit_mq_carry).
+ * The end of the step (emit_end.c) calls emit_mq_rescale: p1 rescaled to the
+ * run's energy, so that the iteration may stop at 2 ulps (the poly family's
+ * contraction test, emit_iterate.c) and k = s nodes suffice for H. */
+#include <stdio.h>
+
+#include "emit.h"
+
+// NAME_predict_theta: the last step's Theta (x->pinc holds p1 - p0 =
+// -h Theta_0, then Theta_1..) extrapolated to a step of size h with the
+// warm start's E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, as gamma is; 0 on the
+// first step or when cold (p constant over the step).
+void emit_mq_predict(Emitter *e) {
+  int s = e->me->s, n = s * s * s;
+  tmpl(e, "\n/* Theta for a step of size h (M(q): p's polynomial is iterated with gamma): the last\n"
+          " * step's, from x->pinc, extrapolated like gamma; 0 on the first step or when cold. */\n"
+          "$P_OUT_OF_LINE void $P_predict_theta(const $P_state *x, $R h, int cold, $R *pth)\n{\n"
+          "  static const $R E[");
+  out(e, "%d] = {", n);
+  for (int t = 0; t < n; t++) {
+    char lit[40];
+    format_real(e, lit, sizeof lit, e->me->E[t]);
+    out(e, "%s%s", t ? (t % 4 ? ", " : ",\n    ") : "", lit);
+  }
+  tmpl(e, "};\n  $R prev[$P_S * $P_M], r, c;\n  int i, j, l, d;\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) pth[i] = 0;\n"
+          "  if (cold || x->hprev == 0) return;\n"
+          "  for (i = 0; i < $P_M; i++) prev[i] = -x->pinc[i] / x->hprev;\n"
+          "  for (i = $P_M; i < $P_S * $P_M; i++) prev[i] = x->pinc[i];\n"
+          "  r = h / x->hprev;\n"
+          "  for (j = 0; j < $P_S; j++)\n    for (i = 0; i < $P_S; i++) {\n"
+          "      for (c = 0, d = $P_S - 1; d >= 0; d--) c = c * r + E[(j * $P_S + i) * $P_S + d];\n"
+          "      if (c != 0)\n        for (l = 0; l < $P_M; l++) pth[j * $P_M + l] += c * prev[i * $P_M + l];\n"
+          "    }\n}\n");
+}
+
+// The iteration's Theta, pth, and its warm start.
+void emit_mq_start(Emitter *e) {
+  tmpl(e, "  $R pth[$P_S * $P_M];  /* M(q): Theta, p's polynomial, carried from sweep to sweep */\n"
+          "  $R inc_old2 = HUGE_VAL, rho;  /* the contraction test ($P_contraction) */\n"
+          "  $P_predict_theta(x, h, cold, pth);\n");
+}
+
+// After a sweep (inc already scaled): Theta's increment |h (Theta_new -
+// Theta)| over max |p0| + |h Theta_0| joins inc, and the new Theta becomes pth.
+void emit_mq_carry(Emitter *e) {
+  tmpl(e, "    {  /* M(q): Theta's scaled increment joins gamma's; the new Theta is carried */\n"
+          "      $R pi = 0, ps = 0;\n"
+          "      for (i = 0; i < $P_M; i++) {\n"
+          "        $R v = fabs$f(x->p[i]) + fabs$f(h * sw[$[sweep.th0]i]);\n"
+          "        if (v > ps) ps = v;\n      }\n"
+          "      for (i = 0; i < $P_S * $P_M; i++) {\n"
+          "        $R v = fabs$f(h * (sw[$[sweep.th0]i] - pth[i]));\n"
+          "        if (v > pi) pi = v;\n        pth[i] = sw[$[sweep.th0]i];\n      }\n"
+          "      if (ps > 0) pi /= ps;\n      if (pi > inc) inc = pi;\n    }\n");
+}
+
+// After the commit (compensated sums): p1 rescaled, p1 = beta p1, so that
+// H(q1, p1) = H0, as the poly family's end of step does (T is quadratic in
+// p for any M(q)). H0 is taken anew on the first step, or where H(q0, p0)
+// (Hn, before the commit) differs from it by more than round-off: the state
+// or the params were changed between steps. No rescale at rest (K = 0) or
+// where H0 < U(q1), nor near rest, where beta is not within 1e-6 of 1 and
+// H(q1, p1) - H0 is round-off.
+void emit_mq_rescale(Emitter *e) {
+  tmpl(e, "  {  /* M(q): p1 rescaled to the run's energy H0 */\n"
+          "    $R z[$P_M], U1, K, H0, beta = 1;\n"
+          "    for (i = 0; i < $P_M; i++) z[i] = 0;\n"
+          "    $(energy_kernel q0=x->q p0=z out=&U1);\n"
+          "    K = $P_energy(x, prm) - U1;\n"
+          "    H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0 : Hn;\n"
+          "    if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
+          "    /* near rest a round-off in H is a large change of p (it is that over |v|): a\n"
+          "     * discrepancy at round-off is corrected only where the correction is small (s = 2,\n"
+          "     * tol 1e-10 from rest: 1000x the error without this test) */\n"
+          "    if (!(fabs$f(beta - 1) <= 1e-6) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n"
+          "    for (i = 0; i < $P_M; i++) $P_add(&x->p[i], &x->pc[i], (beta - 1) * (x->p[i] - x->pc[i]));\n"
+          "    x->H0 = H0;\n  }\n");
+}
