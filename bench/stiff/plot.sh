@@ -31,14 +31,14 @@ for p in $(awk -F, 'NR > 1 { print $1 }' "$R/stiff_work_precision.csv" | uniq); 
     plots="$plots${plots:+, }'$f' using 1:2 with linespoints $style lc rgb '$c' title '$t'"
   done
   gnuplot <<GP
-set terminal $term noenhanced
+set terminal $term
 set output '$R/stiff_wp_$p.png'
 set logscale xy
 set format x '10^{%L}'
 set format y '10^{%L}'
 set xlabel 'slow-motion error at T = 10 (max norm)'
 set ylabel 'CPU seconds (median of timed repeats)'
-set title '$p: work against the slow motion error (bench/stiff/run.sh)'
+set title '$p: work against the slow motion error (bench/stiff/run.sh)' noenhanced
 set key outside right
 set grid
 plot $plots
