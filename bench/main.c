@@ -168,12 +168,15 @@ static int cmd_sweep(int argc, char **argv)
   if (sscanf(argv[6], "%lf:%lf:%lf", &sw.from, &sw.to, &sw.factor) != 3 || !(sw.factor > 1) || !(sw.to > 0))
     usage();
   for (i = 7; i < argc; i++) {
+    if (strcmp(argv[i], "--keep-going") == 0) { /* the one option without a value */
+      sw.keep_going = 1;
+      continue;
+    }
     if (i + 1 >= argc) usage();
     if (strcmp(argv[i], "-k") == 0) sw.k = atoi(argv[++i]);
     else if (strcmp(argv[i], "-s") == 0) sw.s = atoi(argv[++i]);
     else if (strcmp(argv[i], "--cap") == 0) sw.cap = atof(argv[++i]);
     else if (strcmp(argv[i], "--floor") == 0) sw.floor = atof(argv[++i]);
-    else if (strcmp(argv[i], "--keep-going") == 0) sw.keep_going = 1;
     else if (strcmp(argv[i], "--repeats") == 0) sw.repeats = atoi(argv[++i]);
     else if (strcmp(argv[i], "--min") == 0) sw.min_seconds = atof(argv[++i]);
     else usage();

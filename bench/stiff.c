@@ -6,6 +6,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "dihedral.h"
+
 static const double unit_minv[BENCH_MAXM] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
 
 /* --------------------------------------------------------------- FPU chain
@@ -199,20 +201,10 @@ static void but_init(double *q0, double *p0) {
   memset(p0, 0, 12 * sizeof *p0);
 }
 
-/* The dihedral angle of r1..r4: atan2 of the planes' normals. */
+/* The dihedral angle (tests/dihedral.h). */
 static int but_slow(const double *q, const double *p, double *out) {
-  double b[3][3], n1[3], n2[3], m1[3];
   (void)p;
-  for (int j = 0; j < 3; j++)
-    for (int c = 0; c < 3; c++) b[j][c] = q[3 * (j + 1) + c] - q[3 * j + c];
-#define CROSS(o, u, v) \
-  (o[0] = u[1] * v[2] - u[2] * v[1], o[1] = u[2] * v[0] - u[0] * v[2], o[2] = u[0] * v[1] - u[1] * v[0])
-  CROSS(n1, b[0], b[1]);
-  CROSS(n2, b[1], b[2]);
-  CROSS(m1, n1, b[1]);
-#undef CROSS
-  double len = sqrt(b[1][0] * b[1][0] + b[1][1] * b[1][1] + b[1][2] * b[1][2]);
-  out[0] = atan2((m1[0] * n2[0] + m1[1] * n2[1] + m1[2] * n2[2]) / len, n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2]);
+  out[0] = dihedral(q);
   return 1;
 }
 

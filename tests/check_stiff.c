@@ -32,6 +32,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dihedral.h"
 #include "butane_fixed_k4s2.h"
 #include "butane_newton_k4s2.h"
 #include "fpu_fixed_k4s2.h"
@@ -216,23 +217,6 @@ START_TEST(test_bob_longest) {
 END_TEST
 
 /* ---- the molecule ---- */
-
-/* The dihedral angle of r1..r4 (q = r1, r2, r3, r4 in R^3): atan2 of the
- * normals of the planes (r1, r2, r3) and (r2, r3, r4). */
-static double dihedral(const double *q) {
-  double b[3][3], n1[3], n2[3], m1[3];
-  for (int j = 0; j < 3; j++)
-    for (int c = 0; c < 3; c++) b[j][c] = q[3 * (j + 1) + c] - q[3 * j + c];
-#define CROSS(o, u, v) \
-  (o[0] = u[1] * v[2] - u[2] * v[1], o[1] = u[2] * v[0] - u[0] * v[2], o[2] = u[0] * v[1] - u[1] * v[0])
-  CROSS(n1, b[0], b[1]);
-  CROSS(n2, b[1], b[2]);
-  CROSS(m1, n1, b[1]);
-#undef CROSS
-  double len = sqrt(b[1][0] * b[1][0] + b[1][1] * b[1][1] + b[1][2] * b[1][2]);
-  double x = n1[0] * n2[0] + n1[1] * n2[1] + n1[2] * n2[2], y = (m1[0] * n2[0] + m1[1] * n2[1] + m1[2] * n2[2]) / len;
-  return atan2(y, x);
-}
 
 /* omega = 1.751 sqrt(ka) (models/butane.ham). */
 static double butane_omega(double ka) { return 1.751 * sqrt(ka); }
