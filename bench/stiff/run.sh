@@ -17,6 +17,7 @@
 #      and the points of equal error compared timed again in alternation
 #   5. bench/results/stiff_work_precision.csv, stiff_iterations.csv,
 #      stiff_scan.csv, stiff_scan_iterations.csv, stiff_ab.csv,
+#      stiff_instructions.csv (callgrind, bench/stiff/count.sh),
 #      stiff_wp_P.png, stiff_summary.txt, stiff_machine.txt
 # The error is the slow motion's (max norm at T = 10, bench/stiff.h): the
 # fast phase is not resolved at h omega >> 1 by any long-step method.
@@ -158,6 +159,7 @@ cp "$B/res/iterations.csv" "$R/stiff_iterations.csv"
 cp "$B/scan/iterations.csv" "$R/stiff_scan_iterations.csv"
 cp "$B/scan/work_precision.csv" "$R/stiff_scan.csv"
 { echo "E,problem,point,rounds,median_seconds,ratio_to_newton"; cat "$B/res/ab.csv"; } >"$R/stiff_ab.csv"
+bench/stiff/count.sh "$B" "$R"
 cat "$B/res/failures.txt" "$B/scan/failures.txt" >"$R/stiff_failures.txt"
 {
   echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'), $(elapsed) s; $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)"

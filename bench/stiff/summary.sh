@@ -114,3 +114,13 @@ awk -F, 'NR > 1 {
     row[k] = row[k] sprintf("; %s %.3g s = %.1fx", $3, $5, $6)
   }
   END { for (i = 1; i <= n; i++) print row[keys[i]] }' "$R/stiff_ab.csv"
+echo
+
+echo "6. The fixed-step points of section 5 under callgrind: instructions of all the run's steps"
+echo "   (bench/stiff/count.sh, stiff_instructions.csv), and their ratio to newton's"
+[ -f "$R/stiff_instructions.csv" ] && awk -F, 'NR > 1 {
+    k = $2 " " $1
+    if (!(k in row)) { keys[++n] = k; row[k] = sprintf("%-10s E %-5s newton %s %.3g M", $2, $1, $3, $5 / 1e6); next }
+    row[k] = row[k] sprintf("; %s %.3g M = %.2fx", $3, $5 / 1e6, $6)
+  }
+  END { for (i = 1; i <= n; i++) print row[keys[i]] }' "$R/stiff_instructions.csv"
