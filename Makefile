@@ -6,6 +6,7 @@
 #   make demo       generate, build and run the pendulum with HBVM(2,2)
 #   make generated  regenerate the committed solvers in generated/
 #   make tables     the paper's tables beside ours (docs/tables.md)
+#   make bench-stiff  the stiff benchmark alone (bench/stiff/run.sh; make bench runs it too)
 #   make install    hbvmgen, the runtimes (libhbvmrt.a, .so, _omp.a, _mpi.a with MPI=1),
 #                   hbvmrt.h, hbvmgen.1, the .pc files, the docs under
 #                   $(DESTDIR)$(PREFIX) (PREFIX=/usr/local); make uninstall
@@ -50,7 +51,7 @@ LIBRT_MPI:= $(B)/libhbvmrt_mpi.a
 LIBRT_SO := $(B)/libhbvmrt.so
 MPICC    ?= mpicc
 
-.PHONY: all deps check check-long check-build check-san-build check-san-all-build demo generated tables figures bench fuzz clean install uninstall
+.PHONY: all deps check check-long check-build check-san-build check-san-all-build demo generated tables figures bench bench-stiff fuzz clean install uninstall
 BINS     := $(HBVMGEN) $(LIBRT) $(LIBRT_OMP) $(LIBRT_SO) $(if $(MPI),$(LIBRT_MPI))
 all: $(BINS)
 	@cmp -s $(HBVMGEN) gen/hbvmgen || cp $(HBVMGEN) gen/hbvmgen
@@ -245,6 +246,12 @@ bench: deps
 	@scripts/deps.sh bench
 	@$(MAKE) --no-print-directory all
 	bench/run.sh
+
+# the stiff benchmark alone (issue 27; also part of make bench)
+bench-stiff: deps
+	@scripts/deps.sh bench
+	@$(MAKE) --no-print-directory all
+	bench/stiff/run.sh
 
 # Installation. The pkg-config files (hbvmrt, hbvmrt_omp, and with MPI=1
 # hbvmrt_mpi) are made from runtime/hbvmrt.pc.in with the prefix and

@@ -59,9 +59,13 @@ int method_run(const MethodDef *md, const Setting *set, Observer *ob, Outcome *o
 /* Take set->nsteps steps of size set->h (fixedstep.c). */
 int fixedstep_run(const Stepper *sp, const Setting *set, Observer *ob, Outcome *out);
 
+/* `bench ab` (abrun.c). */
+int cmd_ab(int argc, char **argv);
+
 /* The methods (one file each). */
 int hbvm_open(const Setting *set, Stepper *sp);      /* --multiplier const */
 int hbvm_poly_open(const Setting *set, Stepper *sp); /* --multiplier poly */
+int hbvm_newton_open(const Setting *set, Stepper *sp); /* --iteration newton --multiplier const */
 void hbvm_close(Stepper *sp);
 int generic_open(const Setting *set, Stepper *sp);
 void generic_close(Stepper *sp);
@@ -70,6 +74,8 @@ void rattle_close(Stepper *sp);
 int ida_integrate(const Setting *set, Observer *ob, Outcome *out);
 int gsl_rk8pd_integrate(const Setting *set, Observer *ob, Outcome *out);
 int gsl_rk4imp_integrate(const Setting *set, Observer *ob, Outcome *out);
+int gsl_msbdf_integrate(const Setting *set, Observer *ob, Outcome *out); /* stiff problems without constraints */
+int gsl_bsimp_integrate(const Setting *set, Observer *ob, Outcome *out);
 int hbvm_adaptive_integrate(const Setting *set, Observer *ob, Outcome *out);      /* const */
 int hbvm_poly_adaptive_integrate(const Setting *set, Observer *ob, Outcome *out); /* poly */
 

@@ -9,7 +9,7 @@ LIBS    := $(shell pkg-config --libs gsl) -lsundials_ida -lsundials_sunlinsolden
            -lsundials_nvecserial -lm
 
 SRC     := main.c methods.c fixedstep.c problems.c linalg.c timing.c sweep.c count.c reference.c \
-           hbvm.c hbvm_adaptive.c hbvm_generic.c rattle.c ida.c gslpeers.c
+           hbvm.c hbvm_adaptive.c hbvm_generic.c rattle.c ida.c gslpeers.c stiff.c abrun.c
 OBJ     := $(addprefix $(B)/obj/,$(SRC:.c=.o)) $(B)/obj/ref.o
 GENOBJ  := $(foreach s,$(SOLVERS),$(B)/gen/$(s).o $(B)/gen/$(s)_bench.o) $(B)/gen/registry.o
 

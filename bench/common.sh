@@ -1,4 +1,5 @@
-# bench/common.sh - sourced by bench/run.sh and bench/adaptive/run.sh: the
+# bench/common.sh - sourced by bench/run.sh, bench/adaptive/run.sh,
+# bench/stiff/run.sh and the plot scripts: the
 # range of fixed steps of each problem, the error where a line stops, and the
 # registry of the generated solvers of a build.
 # Step sizes FROM:TO:FACTOR (h = T/N, N from ceil(T/FROM) doubling) and the
@@ -19,6 +20,16 @@ floor() {
   kepler* | conical) echo 1e-13 ;;
   *) echo 3e-13 ;;
   esac
+}
+
+# The gnuplot terminal of the figures, $1 pixels ("1100,750"): pngcairo where
+# gnuplot has it.
+png_terminal() {
+  if echo 'set terminal' | gnuplot 2>&1 | grep -q pngcairo; then
+    echo "pngcairo size $1 font ',11'"
+  else
+    echo "png size $1"
+  fi
 }
 
 # Write DIR/registry.c, the table gen_solvers[] of the solvers named in the

@@ -1,7 +1,11 @@
-/* gslpeers.c - the methods "gsl-rk8pd" and "gsl-rk4imp": GSL odeiv2's
- * adaptive explicit Runge-Kutta-Prince-Dormand (8,9) and implicit Gauss
- * (2 stages, order 4, modified Newton with the exact Jacobian) on the
- * minimal-coordinate formulation of the problems that have one:
+/* gslpeers.c - the methods "gsl-rk8pd", "gsl-rk4imp", "gsl-msbdf" and
+ * "gsl-bsimp": GSL odeiv2's adaptive explicit Runge-Kutta-Prince-Dormand
+ * (8,9), implicit Gauss (2 stages, order 4, modified Newton with the exact
+ * Jacobian), variable-order BDF (1-5, Nordsieck form) and the implicit
+ * Bulirsch-Stoer of Bader and Deuflhard, on the minimal-coordinate
+ * formulation of the problems that have one, and on the stiff problems
+ * without constraints (stiff.h: the FPU chain) as they are, y = (q, p),
+ * with the Jacobian from their Hessian:
  *
  *   pendulum  theta'' = -sin theta;  q = (sin th, -cos th)
  *   conical   spherical angles (theta from the downward vertical, phi):
@@ -24,6 +28,7 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include "bench.h"
+#include "stiff.h"
 
 typedef struct {
   const char *problem;
@@ -243,7 +248,50 @@ static void dpend_to_qp(const double *y, double *q, double *p)
   p[3] = s1 * y[2] + s2 * y[3];
 }
 
+/* ------------------------- stiff problems without constraints, y = (q, p)
+ * f = (M^-1 p, -grad U(q)), J = [[0, M^-1], [-Hess U, 0]]; params: the Stiff. */
+
+static int sep_f(double t, const double y[], double f[], void *params)
+{
+  const Problem *pb = ((const Stiff *)params)->pb;
+  int m = pb->m, i;
+  (void)t;
+  pb->grad(y, f + m);
+  for (i = 0; i < m; i++) {
+    f[i] = pb->minv[i] * y[m + i];
+    f[m + i] = -f[m + i];
+  }
+  return GSL_SUCCESS;
+}
+
+static int sep_jac(double t, const double y[], double *J, double dfdt[], void *params)
+{
+  const Stiff *st = params;
+  int m = st->pb->m, n = 2 * m, i, j;
+  double H[BENCH_MAXM * BENCH_MAXM];
+  (void)t;
+  st->hess(y, H);
+  for (i = 0; i < n * n; i++) J[i] = 0;
+  for (i = 0; i < m; i++) {
+    J[i * n + m + i] = st->pb->minv[i];
+    for (j = 0; j < m; j++) J[(m + i) * n + j] = -H[i * m + j];
+  }
+  for (i = 0; i < n; i++) dfdt[i] = 0;
+  return GSL_SUCCESS;
+}
+
 /* -------------------------------------------------------------- the runs */
+
+/* (q, p) from y: the minimal form's map, or y itself (mf NULL). */
+static void y_to_qp(const MinimalForm *mf, int m, const double *y, double *q, double *p)
+{
+  if (mf) {
+    mf->to_qp(y, q, p);
+    return;
+  }
+  memcpy(q, y, (size_t)m * sizeof *q);
+  memcpy(p, y + m, (size_t)m * sizeof *p);
+}
 
 static const MinimalForm forms[] = {
     {"pendulum", 2, pend_f, pend_jac, pend_init, pend_to_qp},
@@ -261,23 +309,34 @@ static const MinimalForm forms[] = {
 static int integrate(const gsl_odeiv2_step_type *type, const Setting *set, Observer *ob, Outcome *out)
 {
   const MinimalForm *mf = NULL;
+  const Stiff *st = stiff_find(set->pb);
   gsl_odeiv2_system sys;
   gsl_odeiv2_driver *d;
-  double y[4], t = 0, h = 1e-3 * set->T;
+  double y[2 * BENCH_MAXM], t = 0, h = 1e-3 * set->T;
   size_t i;
-  int rc = 0;
+  int rc = 0, m = set->pb->m;
   for (i = 0; i < sizeof forms / sizeof forms[0]; i++)
     if (strcmp(forms[i].problem, set->pb->name) == 0) mf = &forms[i];
-  if (!mf) return -1;
-  sys.function = mf->f;
-  sys.jacobian = mf->jac;
-  sys.dimension = mf->dim;
-  sys.params = NULL;
+  if (mf) {
+    sys.function = mf->f;
+    sys.jacobian = mf->jac;
+    sys.dimension = mf->dim;
+    sys.params = NULL;
+  } else if (st && st->hess && set->pb->nu == 0) {
+    sys.function = sep_f;
+    sys.jacobian = sep_jac;
+    sys.dimension = (size_t)(2 * m);
+    sys.params = (void *)st;
+  } else
+    return -1;
   d = gsl_odeiv2_driver_alloc_y_new(&sys, type, h, set->tol, set->tol);
   if (!d) return -2;
-  mf->init(y);
+  if (mf)
+    mf->init(y);
+  else
+    set->pb->init(y, y + m);
   if (ob) {
-    mf->to_qp(y, out->q, out->p);
+    y_to_qp(mf, m, y, out->q, out->p);
     observer_start(ob, set->pb, out->q, out->p);
   }
   while (t < set->T) {
@@ -286,11 +345,11 @@ static int integrate(const gsl_odeiv2_step_type *type, const Setting *set, Obser
       break;
     }
     if (ob) {
-      mf->to_qp(y, out->q, out->p);
+      y_to_qp(mf, m, y, out->q, out->p);
       observer_point(ob, out->q, out->p);
     }
   }
-  mf->to_qp(y, out->q, out->p);
+  y_to_qp(mf, m, y, out->q, out->p);
   out->steps = (long)(d->e->count - d->e->failed_steps);
   out->iters = 0;
   out->itmax = 0;
@@ -306,4 +365,14 @@ int gsl_rk8pd_integrate(const Setting *set, Observer *ob, Outcome *out)
 int gsl_rk4imp_integrate(const Setting *set, Observer *ob, Outcome *out)
 {
   return integrate(gsl_odeiv2_step_rk4imp, set, ob, out);
+}
+
+int gsl_msbdf_integrate(const Setting *set, Observer *ob, Outcome *out)
+{
+  return integrate(gsl_odeiv2_step_msbdf, set, ob, out);
+}
+
+int gsl_bsimp_integrate(const Setting *set, Observer *ob, Outcome *out)
+{
+  return integrate(gsl_odeiv2_step_bsimp, set, ob, out);
 }

@@ -1,7 +1,8 @@
 /* hbvm.c - the methods "hbvm" and "hbvm-poly": a generated solver, found by
  * problem, (k, s) and multiplier family among those bench/run.sh built
  * (NAME_kKsS: --multiplier const, the paper's method; NAME_kKsSpoly:
- * --multiplier poly, order 2s). */
+ * --multiplier poly, order 2s; NAME_kKsSnewton: --iteration newton
+ * --multiplier const, the method "hbvm-newton" of the stiff benchmark). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,7 +14,7 @@ const GenSolver *gen_solver_find(const char *problem, int k, int s, GenFamily fa
 {
   char name[128];
   int i;
-  snprintf(name, sizeof name, "%s_k%ds%d%s", problem, k, s, family == GEN_POLY ? "poly" : "");
+  snprintf(name, sizeof name, "%s_k%ds%d%s", problem, k, s, family == GEN_POLY ? "poly" : family == GEN_NEWTON ? "newton" : "");
   for (i = 0; gen_solvers[i]; i++)
     if (strcmp(gen_solvers[i]->name, name) == 0) return gen_solvers[i];
   return NULL;
@@ -60,6 +61,8 @@ static int open_family(const Setting *set, Stepper *sp, GenFamily family)
 int hbvm_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_CONST); }
 
 int hbvm_poly_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_POLY); }
+
+int hbvm_newton_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_NEWTON); }
 
 void hbvm_close(Stepper *sp)
 {

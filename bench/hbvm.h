@@ -25,8 +25,9 @@ typedef struct {
  * by bench/run.sh). */
 extern const GenSolver *const gen_solvers[];
 
-/* The multiplier family a solver was generated with (hbvmgen --multiplier). */
-typedef enum { GEN_CONST, GEN_POLY } GenFamily;
+/* The multiplier family a solver was generated with (hbvmgen --multiplier),
+ * or GEN_NEWTON: --iteration newton --multiplier const (NAME_kKsSnewton). */
+typedef enum { GEN_CONST, GEN_POLY, GEN_NEWTON } GenFamily;
 
 /* The generated solver for problem at (k, s) of that family, or NULL. */
 const GenSolver *gen_solver_find(const char *problem, int k, int s, GenFamily family);

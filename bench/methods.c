@@ -6,11 +6,14 @@
 static const MethodDef methods[] = {
     {"hbvm", hbvm_open, hbvm_close, NULL},
     {"hbvm-poly", hbvm_poly_open, hbvm_close, NULL},
+    {"hbvm-newton", hbvm_newton_open, hbvm_close, NULL},
     {"hbvm-generic", generic_open, generic_close, NULL},
     {"rattle", rattle_open, rattle_close, NULL},
     {"ida", NULL, NULL, ida_integrate},
     {"gsl-rk8pd", NULL, NULL, gsl_rk8pd_integrate},
     {"gsl-rk4imp", NULL, NULL, gsl_rk4imp_integrate},
+    {"gsl-msbdf", NULL, NULL, gsl_msbdf_integrate},
+    {"gsl-bsimp", NULL, NULL, gsl_bsimp_integrate},
     {"hbvm-adaptive", NULL, NULL, hbvm_adaptive_integrate},
     {"hbvm-poly-adaptive", NULL, NULL, hbvm_poly_adaptive_integrate},
 };

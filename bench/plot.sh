@@ -17,11 +17,8 @@ W=$2
 mkdir -p "$W"
 rm -f "$W"/*.dat
 
-if echo 'set terminal' | gnuplot 2>&1 | grep -q pngcairo; then
-  term="pngcairo size 1100,750 font ',11'"
-else
-  term="png size 1100,750"
-fi
+. "$(dirname "$0")/common.sh"
+term=$(png_terminal 1100,750)
 KS_COLORS="#1f77b4 #ff7f0e #2ca02c #d62728 #17becf #e377c2 #8c564b #bcbd22 #aec7e8"
 POLY_COLORS="#000080 #b22222 #006400 #ff00ff #8b4513"
 

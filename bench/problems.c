@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "linalg.h"
+#include "stiff.h"
 
 static const double unit_minv[BENCH_MAXM] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
 
@@ -386,7 +387,20 @@ const Problem *problem_find(const char *name)
   size_t i;
   for (i = 0; name && i < sizeof problems / sizeof problems[0]; i++)
     if (strcmp(problems[i].name, name) == 0) return &problems[i];
-  return NULL;
+  return name ? stiff_problem_find(name) : NULL;
+}
+
+double problem_error(const Problem *pb, const double *q, const double *p, const double *qref, const double *pref)
+{
+  const Stiff *st = stiff_find(pb);
+  double a[STIFF_MAXSLOW], b[STIFF_MAXSLOW];
+  int n;
+  if (!st) return fmax(maxdiff(pb->m, q, qref), maxdiff(pb->m, p, pref));
+  n = st->slow(q, p, a);
+  st->slow(qref, pref, b);
+  for (int i = 0; i < n; i++)
+    if (!isfinite(a[i])) return NAN; /* fmax in maxdiff would drop it: a run that blew up */
+  return maxdiff(n, a, b);
 }
 
 double problem_energy(const Problem *pb, const double *q, const double *p)

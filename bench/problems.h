@@ -32,6 +32,10 @@ typedef struct {
 /* The problem called name, or NULL. */
 const Problem *problem_find(const char *name);
 
+/* The error of (q, p) against the reference (qref, pref): max norm of
+ * (q, p), or of the slow quantities on the stiff problems (stiff.h). */
+double problem_error(const Problem *pb, const double *q, const double *p, const double *qref, const double *pref);
+
 /* H(q, p). */
 double problem_energy(const Problem *pb, const double *q, const double *p);
 

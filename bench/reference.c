@@ -24,6 +24,7 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include "ref.h"
+#include "stiff.h"
 
 /* q' = M^-1 p, p' = -grad U - G lambda(q, p), y = (q, p); params: Problem. */
 static int index1_rhs(double t, const double y[], double f[], void *params)
@@ -85,7 +86,7 @@ int reference_final(const Problem *pb, double T, double tol, double *q, double *
     snprintf(how, (size_t)n, "exact: (q0, p0) after %.0f whole periods", periods);
     return 0;
   }
-  if (strcmp(pb->name, "chain8") == 0) {
+  if (strcmp(pb->name, "chain8") == 0 || stiff_find(pb)) {
     double dg, dH;
     int rc = reference_index1(pb, T, tol, q, p, &dg, &dH);
     snprintf(how, (size_t)n, "index-1 formulation, GSL rk8pd, tol %g (bench/reference.c): max|g| %.2e, max|H-H0| %.2e",

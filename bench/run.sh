@@ -205,6 +205,8 @@ bench/batch/run.sh || echo "bench: the batch/ensemble benchmark failed"
 echo "== the scalar step against its bound, compilers and flags ($(elapsed) s)"
 bench/step/run.sh || echo "bench: the step benchmark failed"
 bench/lean/kauto.sh
+echo "== the stiff models: Newton against the fixed-point step, IDA, RATTLE, GSL ($(elapsed) s)"
+bench/stiff/run.sh || echo "bench: the stiff benchmark failed"
 
 echo "load after (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg)" >>"$R/machine.txt"
 echo "bench/run.sh: $(elapsed) s" | tee -a "$R/machine.txt"

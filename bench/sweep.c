@@ -89,7 +89,7 @@ int sweep_run(const Sweep *sw)
     int rc = method_run(sw->md, &set, &ob, &tr.out);
     t1 = cpu_seconds() - t0;
     if (rc == -1) return -1;
-    err = fmax(maxdiff(sw->pb->m, tr.out.q, sw->qref), maxdiff(sw->pb->m, tr.out.p, sw->pref));
+    err = problem_error(sw->pb, tr.out.q, tr.out.p, sw->qref, sw->pref);
     if (rc != 0 || !isfinite(err)) {
       fprintf(stderr, "bench: %s %s k=%d s=%d h=%g tol=%g: run failed, point skipped\n", sw->pb->name, sw->md->name,
               sw->k, sw->s, set.h, set.tol);
@@ -103,7 +103,7 @@ int sweep_run(const Sweep *sw)
     done++;
     best = fmin(best, err);
     /* at the reference's accuracy, past the round-off floor, or too slow */
-    if (err < sw->floor || (best < 1e-7 && err > 4 * best) || seconds > sw->cap) break;
+    if (err < sw->floor || (!sw->keep_going && best < 1e-7 && err > 4 * best) || seconds > sw->cap) break;
   }
   return done ? 0 : -2;
 }

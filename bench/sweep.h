@@ -16,6 +16,7 @@ typedef struct {
   double from, to, factor; /* h (or tol) from `from` down to `to`, divided by factor */
   double cap;              /* stop refining once one run takes longer (CPU seconds) */
   double floor;            /* stop refining once err_q is below */
+  int keep_going;          /* no stop at an error grown 4x (the stiff lines: not round-off there) */
   double min_seconds;      /* of one timed repeat */
   int repeats;             /* timed repeats; the median is reported */
   FILE *wp, *iters, *overhead; /* work_precision.csv, iterations.csv, overhead.csv */
