@@ -276,7 +276,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "                     0.01 TOL |h| (1 + max|q|), so that the error at T is\n"
     "                     about TOL T (1 + max|q|); -h is the first step, -T is\n"
     "                     hit exactly; --every K counts the steps taken;\n"
-    "                     TOL >= eps^2 (4.9e-32 in double, 1.4e-14 in float)\n"
+    "                     TOL >= 8 eps (1.8e-15 in double, 9.5e-7 in float:\n"
+    "                     below it round-off outweighs the tolerance)\n"
     "  --dt DT            CSV rows at t = 0, DT, 2 DT, .. (DT > 0) whatever the\n"
     "                     steps are, each a step of the method from the start\n"
     "                     of the step containing it (as accurate as the steps),\n"
@@ -364,14 +365,18 @@ static int parse_stop_at(const hbvmrt_model *md, const char *val, hbvmrt_opts *o
   return -1;
 }
 
-/* The smallest --tol: eps^2 of the solver's real type (4.9e-32 in double,
- * 1.4e-14 in float). Far below what its round-off lets a step meet, and
- * where the controller's tol |h| stays a normal number: a subnormal tol
- * (1e-310) made NAME_step_adaptive loop forever. */
+/* The smallest --tol: 8 ulps of the solver's real type (1.8e-15 in double,
+ * 9.5e-7 in float). Each step leaves a few ulps of round-off that no
+ * estimate sees; below 8 ulps a tighter tol only takes more steps, each
+ * adding its round-off, and the error at T grows (a float top: 2.4e-6 at
+ * 1e-6, 5.7e-6 at 1e-7; a float four-bar and a double top alike, issue 31,
+ * item 2). It also keeps the controller's tol |h| a normal number: a
+ * subnormal tol (1e-310) made NAME_step_adaptive loop forever. */
+#define HBVMRT_TOL_ULPS 8
 static double min_tol(const hbvmrt_model *md)
 {
   double eps = md->eps > 0 ? md->eps : DBL_EPSILON;
-  return eps * eps;
+  return HBVMRT_TOL_ULPS * eps;
 }
 
 /* Store one option's value in o (or seen); -1 after reporting an error. */
@@ -424,8 +429,9 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
       return -1;
     }
     if (o->tol < min_tol(md)) {
-      hbvmrt_error(md, "--tol must be >= %.2g, the square of the solver's precision: no step meets a smaller one "
-                   "(got %s)", min_tol(md), val);
+      hbvmrt_error(md, "--tol must be >= %.2g, 8 ulps of the solver's %s: below it the round-off of the steps "
+                   "outweighs the tolerance, and a tighter one gives a larger error (got %s)", min_tol(md),
+                   md->eps > 2 * DBL_EPSILON ? "float" : "double", val);
       return -1;
     }
     if (!md->step_adaptive) {

@@ -432,9 +432,19 @@ START_TEST(bad_options)
                                         "-T 1 --dt 1e-300", "-N 10 --dt 1e-12", "-T 1e10 --dt 1"};
   for (size_t i = 0; i < sizeof endless / sizeof endless[0]; i++) {
     ck_assert_msg(run(&pendulum_events_k4s4_model, endless[i], ev, &nev, rows, 9, &nrows, 8) == 1, "%s", endless[i]);
-    ck_assert_msg(strstr(run_err, strstr(endless[i], "--tol") ? "--tol must be >= 4.9e-32" : "rows over the span"),
+    ck_assert_msg(strstr(run_err, strstr(endless[i], "--tol") ? "--tol must be >= 1.8e-15" : "rows over the span"),
                   "%s: %s", endless[i], run_err);
   }
+  /* below 8 ulps round-off outweighs the tolerance (issue 31, item 2): refused with the
+   * bound, in double and in float (a float solver's eps: tol 1e-6 runs, 1e-7 does not) */
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-T 1 --tol 1e-15", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_msg(strstr(run_err, "--tol must be >= 1.8e-15, 8 ulps of the solver's double"), "%s", run_err);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-T 1 --tol 2e-15", ev, &nev, rows, 9, &nrows, 8), 0);
+  hbvmrt_model flt = pendulum_events_k4s4_model;
+  flt.eps = FLT_EPSILON;
+  ck_assert_int_eq(run(&flt, "-T 1 --tol 1e-7", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_msg(strstr(run_err, "--tol must be >= 9.5e-07, 8 ulps of the solver's float"), "%s", run_err);
+  ck_assert_int_eq(run(&flt, "-T 1 --tol 1e-6", ev, &nev, rows, 9, &nrows, 8), 0);
 }
 END_TEST
 
