@@ -314,6 +314,25 @@ void emit_step_factor(Emitter *e) {
           "      if (fac > grow) fac = grow;\n      if (!(fac >= ($R)0.2)) fac = ($R)0.2;  /* a NaN estimate too */\n");
 }
 
+// NAME_step_controlled: NAME_step_adaptive under absolute and relative
+// tolerances and a largest step (NAME_controls; the driver's --atol, --rtol,
+// --hmax): the tol (atol + rtol max|q|) / (1 + max|q|) at the step's start,
+// so that the test tol (1 + max|q|) is atol + rtol max|q| there; *h clamped
+// to hmax before the step and after it. A bad control (NULL, not finite,
+// negative, atol and rtol both 0) is NAME_EBADSTEP, x unchanged.
+static void emit_step_controlled(Emitter *e) {
+  tmpl(e, "\nint $P_step_controlled($P_state *x, $P_real *h, const $P_controls *c, const $P_params *prm,\n"
+          "                       $P_stats *st)\n{\n"
+          "  $R sc = 0;\n  int i, rc;\n"
+          "  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||\n"
+          "      !isfinite(c->atol + c->rtol + c->hmax))\n    return $P_EBADSTEP;\n"
+          "  for (i = 0; i < $P_M; i++)\n    if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "  if (c->hmax > 0 && fabs$f(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;\n"
+          "  rc = $P_step_adaptive(x, h, ($P_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);\n"
+          "  if (c->hmax > 0 && fabs$f(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;\n"
+          "  return rc;\n}\n");
+}
+
 // NAME_step_adaptive: NAME_step with its error estimate tested before the
 // commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
 // and relative at once, so that the errors of the steps up to T add up to
@@ -382,4 +401,5 @@ void emit_step_adaptive(Emitter *e) {
   if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");
   tmpl(e, "      }\n"
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
+  emit_step_controlled(e);
 }

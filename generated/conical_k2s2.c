@@ -722,6 +722,22 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
   }
 }
 
+int conical_k2s2_step_controlled(conical_k2s2_state *x, conical_k2s2_real *h, const conical_k2s2_controls *c, const conical_k2s2_params *prm,
+                       conical_k2s2_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return conical_k2s2_EBADSTEP;
+  for (i = 0; i < conical_k2s2_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = conical_k2s2_step_adaptive(x, h, (conical_k2s2_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (conical_k2s2_TOL) or stops decreasing at round-off, at most conical_k2s2_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

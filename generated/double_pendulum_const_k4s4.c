@@ -1143,6 +1143,22 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
   }
 }
 
+int double_pendulum_const_k4s4_step_controlled(double_pendulum_const_k4s4_state *x, double_pendulum_const_k4s4_real *h, const double_pendulum_const_k4s4_controls *c, const double_pendulum_const_k4s4_params *prm,
+                       double_pendulum_const_k4s4_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return double_pendulum_const_k4s4_EBADSTEP;
+  for (i = 0; i < double_pendulum_const_k4s4_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = double_pendulum_const_k4s4_step_adaptive(x, h, (double_pendulum_const_k4s4_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (double_pendulum_const_k4s4_TOL) or stops decreasing at round-off, at most double_pendulum_const_k4s4_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -447,6 +447,22 @@ int kepler_k1s1_step_adaptive(kepler_k1s1_state *x, kepler_k1s1_real *h, kepler_
   }
 }
 
+int kepler_k1s1_step_controlled(kepler_k1s1_state *x, kepler_k1s1_real *h, const kepler_k1s1_controls *c, const kepler_k1s1_params *prm,
+                       kepler_k1s1_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return kepler_k1s1_EBADSTEP;
+  for (i = 0; i < kepler_k1s1_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = kepler_k1s1_step_adaptive(x, h, (kepler_k1s1_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (kepler_k1s1_TOL) or stops decreasing at round-off, at most kepler_k1s1_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -737,6 +737,22 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
   }
 }
 
+int kepler_k6s3_step_controlled(kepler_k6s3_state *x, kepler_k6s3_real *h, const kepler_k6s3_controls *c, const kepler_k6s3_params *prm,
+                       kepler_k6s3_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return kepler_k6s3_EBADSTEP;
+  for (i = 0; i < kepler_k6s3_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = kepler_k6s3_step_adaptive(x, h, (kepler_k6s3_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (kepler_k6s3_TOL) or stops decreasing at round-off, at most kepler_k6s3_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -667,6 +667,22 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
   }
 }
 
+int modified_k3s1_step_controlled(modified_k3s1_state *x, modified_k3s1_real *h, const modified_k3s1_controls *c, const modified_k3s1_params *prm,
+                       modified_k3s1_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return modified_k3s1_EBADSTEP;
+  for (i = 0; i < modified_k3s1_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = modified_k3s1_step_adaptive(x, h, (modified_k3s1_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (modified_k3s1_TOL) or stops decreasing at round-off, at most modified_k3s1_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

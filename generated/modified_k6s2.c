@@ -916,6 +916,22 @@ int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, m
   }
 }
 
+int modified_k6s2_step_controlled(modified_k6s2_state *x, modified_k6s2_real *h, const modified_k6s2_controls *c, const modified_k6s2_params *prm,
+                       modified_k6s2_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return modified_k6s2_EBADSTEP;
+  for (i = 0; i < modified_k6s2_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = modified_k6s2_step_adaptive(x, h, (modified_k6s2_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (modified_k6s2_TOL) or stops decreasing at round-off, at most modified_k6s2_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -2385,6 +2385,22 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
   }
 }
 
+int modified_poly_k9s3_step_controlled(modified_poly_k9s3_state *x, modified_poly_k9s3_real *h, const modified_poly_k9s3_controls *c, const modified_poly_k9s3_params *prm,
+                       modified_poly_k9s3_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return modified_poly_k9s3_EBADSTEP;
+  for (i = 0; i < modified_poly_k9s3_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = modified_poly_k9s3_step_adaptive(x, h, (modified_poly_k9s3_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (modified_poly_k9s3_TOL) or stops decreasing at round-off, at most modified_poly_k9s3_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -544,6 +544,22 @@ int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, p
   }
 }
 
+int pendulum_k1s1_step_controlled(pendulum_k1s1_state *x, pendulum_k1s1_real *h, const pendulum_k1s1_controls *c, const pendulum_k1s1_params *prm,
+                       pendulum_k1s1_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return pendulum_k1s1_EBADSTEP;
+  for (i = 0; i < pendulum_k1s1_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = pendulum_k1s1_step_adaptive(x, h, (pendulum_k1s1_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (pendulum_k1s1_TOL) or stops decreasing at round-off, at most pendulum_k1s1_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -978,6 +978,22 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
   }
 }
 
+int pendulum_poly_k2s2_step_controlled(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real *h, const pendulum_poly_k2s2_controls *c, const pendulum_poly_k2s2_params *prm,
+                       pendulum_poly_k2s2_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return pendulum_poly_k2s2_EBADSTEP;
+  for (i = 0; i < pendulum_poly_k2s2_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = pendulum_poly_k2s2_step_adaptive(x, h, (pendulum_poly_k2s2_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (pendulum_poly_k2s2_TOL) or stops decreasing at round-off, at most pendulum_poly_k2s2_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

@@ -1875,6 +1875,22 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
   }
 }
 
+int pendulum_poly_k4s4_step_controlled(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, const pendulum_poly_k4s4_controls *c, const pendulum_poly_k4s4_params *prm,
+                       pendulum_poly_k4s4_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return pendulum_poly_k4s4_EBADSTEP;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = pendulum_poly_k4s4_step_adaptive(x, h, (pendulum_poly_k4s4_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (pendulum_poly_k4s4_TOL) or stops decreasing at round-off, at most pendulum_poly_k4s4_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */

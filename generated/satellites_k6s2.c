@@ -2364,6 +2364,22 @@ int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real
   }
 }
 
+int satellites_k6s2_step_controlled(satellites_k6s2_state *x, satellites_k6s2_real *h, const satellites_k6s2_controls *c, const satellites_k6s2_params *prm,
+                       satellites_k6s2_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return satellites_k6s2_EBADSTEP;
+  for (i = 0; i < satellites_k6s2_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = satellites_k6s2_step_adaptive(x, h, (satellites_k6s2_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
+}
+
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q
  * (satellites_k6s2_TOL) or stops decreasing at round-off, at most satellites_k6s2_MAXITER times; then p
  * projected onto the hidden constraint at that q. x is written only on success. */
