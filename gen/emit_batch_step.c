@@ -362,7 +362,7 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // any failure, the number of lanes that failed (never the -1, -2 of a try).
 static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rp, pmax, grow = 5, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
+          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rp, pmax, grow = 2, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
           "  if (!(hh != 0 && isfinite(hh))) {  /* every active lane fails: say how many, as below */\n"
           "    $P_batch_within(x, hh, 0, 0, prm, s);\n"
@@ -377,11 +377,11 @@ static void emit_batch_adaptive(Emitter *e) {
           "    rc = $P_batch_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, s);\n"
           "    if (rc == -1) misses++;\n"
           "    if (rc != -2) {\n"
-          "      /* the lanes' largest error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
+          "      /* the lanes' largest error over its tolerance tol |h| (1 + max|q|), as $P_step_adaptive */\n"
           "      err = pmax = 0;\n"
           "      for (l = 0; l < $P_W; l++) {\n        $R sc = 0, el;\n"
           "        if (x->idle[l] || (rc >= 0 && s->code[l] != $P_OK)) continue;\n"
-          "        for (i = 0; rc >= 0 && i < $P_M; i++)\n"
+          "        for (i = 0; i < $P_M; i++)\n"
           "          if (fabs$f(x->q[i * $P_W + l]) > sc) sc = fabs$f(x->q[i * $P_W + l]);\n"
           "        el = s->err_est[l] / (tol * fabs$f(hh) * (1 + sc));\n        if (el > err) err = el;\n");
   /* each lane keeps its own err^(1/p), bitwise NAME_step_adaptive's; the

@@ -260,13 +260,18 @@ void emit_estimators(Emitter *e) {
 
 // The error the controller aims at, over the tolerance: the step from
 // (rho / err)^(1/p). The estimate scatters from step to step (Kepler (11,6):
-// 3-20x at about the same h), and with the standard 0.9^p (0.28 at p = 12,
-// 0.43 at p = 8) as the aim a fifth of the tries were rejected; 0.1 cut that
-// to 0-12% (docs/api.md). At p <= 6 the standard aim kept rejections at 1-8%
-// (pendulum, s = 3) and 0.1 only shrank the error below tol / 30.
+// 3-20x at about the same h, and up to 40x from one step to the next on the
+// way to the perihelion), so the higher p, the smaller the aim that keeps
+// such a jump under the tolerance: with the standard 0.9^p (0.28 at p = 12,
+// 0.43 at p = 8, 0.53 at p = 6) 4-25% of the tries were rejected (Kepler,
+// the double pendulum, the four-bar, the solar system); with 0.3 at p = 4, 6,
+// 0.05 at p = 8 and 0.02 above, 0-10%, at the same work for the same error
+// (the error falls as the steps grow, as h^p: docs/api.md, "Adaptive
+// steps"). The constant multiplier's p = 3 keeps 0.9^3: its error, p's, is
+// bounded per step and does not scatter so.
 static double control_rho(const Emitter *e) {
   int p = controller_order(e);
-  return p <= 6 ? pow(0.9, p) : 0.1;
+  return p <= 3 ? pow(0.9, p) : p <= 6 ? 0.3 : p <= 8 ? 0.05 : 0.02;
 }
 
 // Print "      DST = err^(1/p);" for the controller's order p: a chain of
@@ -309,14 +314,37 @@ void emit_step_factor(Emitter *e) {
           "      if (fac > grow) fac = grow;\n      if (!(fac >= ($R)0.2)) fac = ($R)0.2;  /* a NaN estimate too */\n");
 }
 
+// NAME_step_controlled: NAME_step_adaptive under absolute and relative
+// tolerances and a largest step (NAME_controls; the driver's --atol, --rtol,
+// --hmax): the tol (atol + rtol max|q|) / (1 + max|q|) at the step's start,
+// so that the test tol (1 + max|q|) is atol + rtol max|q| there; *h clamped
+// to hmax before the step and after it. A bad control (NULL, not finite,
+// negative, atol and rtol both 0) is NAME_EBADSTEP, x unchanged.
+static void emit_step_controlled(Emitter *e) {
+  tmpl(e, "\nint $P_step_controlled($P_state *x, $P_real *h, const $P_controls *c, const $P_params *prm,\n"
+          "                       $P_stats *st)\n{\n"
+          "  $R sc = 0;\n  int i, rc;\n"
+          "  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||\n"
+          "      !isfinite(c->atol + c->rtol + c->hmax))\n    return $P_EBADSTEP;\n"
+          "  for (i = 0; i < $P_M; i++)\n    if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "  if (c->hmax > 0 && fabs$f(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;\n"
+          "  rc = $P_step_adaptive(x, h, ($P_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);\n"
+          "  if (c->hmax > 0 && fabs$f(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;\n"
+          "  return rc;\n}\n");
+}
+
 // NAME_step_adaptive: NAME_step with its error estimate tested before the
 // commit: accepted within tol |h| (1 + max|q|) (error per unit step, absolute
 // and relative at once, so that the errors of the steps up to T add up to
 // about tol T, whatever their number), else retried from the unchanged state
 // with a smaller step. The next step from the standard controller of
 // Hairer, Norsett and Wanner (I.II.4) for an error of order h^p per unit
-// step: h (0.9 / err)^(1/p) within [h/5, 5h], not growing right after a
-// rejection; after the first step (hprev 0: from the caller's guess) within
+// step: h (rho / err)^(1/p) (control_rho) within [h/5, 2h], not growing
+// right after a rejection (5h let a step outgrow the estimate's asymptotic
+// range, and the next was rejected); err over tol |h| (1 + max|q|) whether
+// accepted or not (without 1 + max|q| a rejected try of the solar system,
+// |q| ~ 30, shrank 2.4x too much, and a quarter of the tries cycled through
+// a rejection, issue 31, item 3); after the first step (hprev 0: from the caller's guess) within
 // [h/5, 100h], as CVODE lets its first step grow 1e4x: the ramp from a small
 // guess took three steps of the satellites' 9 to 33 (2026-11-26,
 // bench/README.md). A failed step is retried with half the step. After three
@@ -335,7 +363,7 @@ void emit_step_adaptive(Emitter *e) {
            " * (%s_mult_err: q is of order 4, p of order %d across the hidden constraint). */\n",
         controller_order(e), e->P, step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
-          "  $P_stats s;\n  $R hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */\n"
+          "  $P_stats s;\n  $R hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */\n"
           "  int rc, rejected = 0, misses = 0, i;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
@@ -350,11 +378,11 @@ void emit_step_adaptive(Emitter *e) {
           "    rc = $P_step_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, &s);\n"
           "    if (rc == $P_EREJECT) misses++;\n"
           "    if (rc == $P_OK || rc == $P_EREJECT) {\n"
-          "      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */\n"
-          "      err = rc == $P_OK ? 1 : s.err_est / (tol * fabs$f(hh));\n");
-  tmpl(e, "      if (rc == $P_OK) {\n        $R sc = 0;\n"
-          "        for (i = 0; i < $P_M; i++)\n          if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
-          "        err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n      }\n"
+          "      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when\n"
+          "       * not, as the test in $P_step_within */\n"
+          "      sc = 0;\n"
+          "      for (i = 0; i < $P_M; i++)\n        if (fabs$f(x->q[i]) > sc) sc = fabs$f(x->q[i]);\n"
+          "      err = s.err_est / (tol * fabs$f(hh) * (1 + sc));\n"
           "      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */\n"
           "      pq = rc == $P_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;\n");
   emit_step_factor(e);
@@ -373,4 +401,5 @@ void emit_step_adaptive(Emitter *e) {
   if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");
   tmpl(e, "      }\n"
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
+  emit_step_controlled(e);
 }

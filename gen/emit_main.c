@@ -96,6 +96,9 @@ static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
   fprintf(f, "static void sync(view *v)\n{\n  int i;\n  v->t = v->s.t;\n"
              "  for (i = 0; i < %s_M; i++) {\n    v->q[i] = v->s.q[i];\n    v->p[i] = v->s.p[i];\n  }\n"
              "  for (i = 0; i < %d; i++) v->lambda[i] = v->s.lambda[i];\n}\n\n", P, nu1);
+  fprintf(f, "/* --t0: the float state's time (its compensation cleared) */\n"
+             "static void set_time(void *x, double t)\n{\n  view *v = x;\n"
+             "  v->s.t = (%s_real)t;\n  v->s.tc = 0;\n  v->t = v->s.t;\n}\n\n", P);
   fprintf(f, "static void init_params(void *x, const double *q0, const double *p0, const void *prm)\n{\n"
              "  %s_real q[%s_M], p[%s_M];\n  %s_params r;\n  int i;\n"
              "  for (i = 0; i < %s_M; i++) {\n    q[i] = q0 ? (%s_real)q0[i] : 0;\n"
@@ -185,11 +188,12 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, "    %d, params, q0, p0,\n", mod->nparams);
   fprintf(f, "    init, params_default, step, %s_strerror, energy, constraints, hidden, names,\n", P);
   fprintf(f, "    init_params, project, %s,\n    step_adaptive,\n", o->single ? "FLT_EPSILON" : "DBL_EPSILON");
+  /* the float view sets its solver's t (--t0); a double state's t the runtime writes itself */
   if (mod->nevents)
     fprintf(f, "    dense, %s_NEVENTS, %s_event_names, %s_event_dirs, events,\n", P, P, P);
   else
     fprintf(f, "    dense, 0, NULL, NULL, NULL,\n");
-  fprintf(f, "  };\n");
+  fprintf(f, "    %s,\n  };\n", o->single ? "set_time" : "NULL");
   if (o->batch)
     fprintf(f, "  static const hbvmrt_batch batch = {\n    %s_W, sizeof(%s_batch), batch_set, batch_get, batch_idle, "
                "batch_step, batch_observe,\n  };\n", P, P);

@@ -67,6 +67,16 @@ int conical_k3s3_step(conical_k3s3_state *x, conical_k3s3_real h, const conical_
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * conical_k3s3_HMIN (1 + |t|). */
 int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, conical_k3s3_real tol, const conical_k3s3_params *prm, conical_k3s3_stats *st);
+/* The controls of conical_k3s3_step_controlled: each step's error estimate within
+ * conical_k3s3_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * conical_k3s3_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  conical_k3s3_real atol, rtol, hmax;
+} conical_k3s3_controls;
+/* conical_k3s3_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int conical_k3s3_step_controlled(conical_k3s3_state *x, conical_k3s3_real *h, const conical_k3s3_controls *c, const conical_k3s3_params *prm,
+                       conical_k3s3_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

@@ -822,7 +822,7 @@ int conical_k4s4_step(conical_k4s4_state *x, conical_k4s4_real h, const conical_
 int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, conical_k4s4_real tol, const conical_k4s4_params *prm, conical_k4s4_stats *st)
 {
   conical_k4s4_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k4s4_EBADSTEP;
@@ -839,14 +839,12 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
     rc = conical_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == conical_k4s4_EREJECT) misses++;
     if (rc == conical_k4s4_OK || rc == conical_k4s4_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == conical_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == conical_k4s4_OK) {
-        double sc = 0;
-        for (i = 0; i < conical_k4s4_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in conical_k4s4_step_within */
+      sc = 0;
+      for (i = 0; i < conical_k4s4_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == conical_k4s4_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = cbrt(err);  /* err^(1/3) */
@@ -885,6 +883,22 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
       return rc != conical_k4s4_EREJECT ? rc : conical_k4s4_ENOCONV;
     }
   }
+}
+
+int conical_k4s4_step_controlled(conical_k4s4_state *x, conical_k4s4_real *h, const conical_k4s4_controls *c, const conical_k4s4_params *prm,
+                       conical_k4s4_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return conical_k4s4_EBADSTEP;
+  for (i = 0; i < conical_k4s4_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = conical_k4s4_step_adaptive(x, h, (conical_k4s4_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -69,6 +69,16 @@ int conical_poly_k2s2_step(conical_poly_k2s2_state *x, conical_poly_k2s2_real h,
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * conical_poly_k2s2_HMIN (1 + |t|). */
 int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s2_real *h, conical_poly_k2s2_real tol, const conical_poly_k2s2_params *prm, conical_poly_k2s2_stats *st);
+/* The controls of conical_poly_k2s2_step_controlled: each step's error estimate within
+ * conical_poly_k2s2_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * conical_poly_k2s2_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  conical_poly_k2s2_real atol, rtol, hmax;
+} conical_poly_k2s2_controls;
+/* conical_poly_k2s2_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int conical_poly_k2s2_step_controlled(conical_poly_k2s2_state *x, conical_poly_k2s2_real *h, const conical_poly_k2s2_controls *c, const conical_poly_k2s2_params *prm,
+                       conical_poly_k2s2_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

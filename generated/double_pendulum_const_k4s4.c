@@ -1080,7 +1080,7 @@ int double_pendulum_const_k4s4_step(double_pendulum_const_k4s4_state *x, double_
 int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x, double_pendulum_const_k4s4_real *h, double_pendulum_const_k4s4_real tol, const double_pendulum_const_k4s4_params *prm, double_pendulum_const_k4s4_stats *st)
 {
   double_pendulum_const_k4s4_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_const_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_const_k4s4_EBADSTEP;
@@ -1097,14 +1097,12 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
     rc = double_pendulum_const_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == double_pendulum_const_k4s4_EREJECT) misses++;
     if (rc == double_pendulum_const_k4s4_OK || rc == double_pendulum_const_k4s4_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == double_pendulum_const_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == double_pendulum_const_k4s4_OK) {
-        double sc = 0;
-        for (i = 0; i < double_pendulum_const_k4s4_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in double_pendulum_const_k4s4_step_within */
+      sc = 0;
+      for (i = 0; i < double_pendulum_const_k4s4_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == double_pendulum_const_k4s4_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = cbrt(err);  /* err^(1/3) */
@@ -1143,6 +1141,22 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
       return rc != double_pendulum_const_k4s4_EREJECT ? rc : double_pendulum_const_k4s4_ENOCONV;
     }
   }
+}
+
+int double_pendulum_const_k4s4_step_controlled(double_pendulum_const_k4s4_state *x, double_pendulum_const_k4s4_real *h, const double_pendulum_const_k4s4_controls *c, const double_pendulum_const_k4s4_params *prm,
+                       double_pendulum_const_k4s4_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return double_pendulum_const_k4s4_EBADSTEP;
+  for (i = 0; i < double_pendulum_const_k4s4_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = double_pendulum_const_k4s4_step_adaptive(x, h, (double_pendulum_const_k4s4_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -1513,7 +1513,7 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
 int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real *h, double_pendulum_k2s2_real tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   double_pendulum_k2s2_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k2s2_EBADSTEP;
@@ -1530,18 +1530,16 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
     rc = double_pendulum_k2s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == double_pendulum_k2s2_EREJECT) misses++;
     if (rc == double_pendulum_k2s2_OK || rc == double_pendulum_k2s2_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == double_pendulum_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == double_pendulum_k2s2_OK) {
-        double sc = 0;
-        for (i = 0; i < double_pendulum_k2s2_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in double_pendulum_k2s2_step_within */
+      sc = 0;
+      for (i = 0; i < double_pendulum_k2s2_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == double_pendulum_k2s2_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = sqrt(sqrt(err));  /* err^(1/4) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.656 / err)^(1/4) */
+      fac = err > 0 ? 0.74008280449228525 / r : grow;  /* (0.3 / err)^(1/4) */
       if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
@@ -1576,6 +1574,22 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
       return rc != double_pendulum_k2s2_EREJECT ? rc : double_pendulum_k2s2_ENOCONV;
     }
   }
+}
+
+int double_pendulum_k2s2_step_controlled(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real *h, const double_pendulum_k2s2_controls *c, const double_pendulum_k2s2_params *prm,
+                       double_pendulum_k2s2_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return double_pendulum_k2s2_EBADSTEP;
+  for (i = 0; i < double_pendulum_k2s2_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = double_pendulum_k2s2_step_adaptive(x, h, (double_pendulum_k2s2_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

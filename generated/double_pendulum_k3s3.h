@@ -69,6 +69,16 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * double_pendulum_k3s3_HMIN (1 + |t|). */
 int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, double_pendulum_k3s3_real tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st);
+/* The controls of double_pendulum_k3s3_step_controlled: each step's error estimate within
+ * double_pendulum_k3s3_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * double_pendulum_k3s3_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  double_pendulum_k3s3_real atol, rtol, hmax;
+} double_pendulum_k3s3_controls;
+/* double_pendulum_k3s3_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int double_pendulum_k3s3_step_controlled(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, const double_pendulum_k3s3_controls *c, const double_pendulum_k3s3_params *prm,
+                       double_pendulum_k3s3_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

@@ -67,6 +67,16 @@ int henon_heiles_k3s2_step(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real h,
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * henon_heiles_k3s2_HMIN (1 + |t|). */
 int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, henon_heiles_k3s2_real tol, const henon_heiles_k3s2_params *prm, henon_heiles_k3s2_stats *st);
+/* The controls of henon_heiles_k3s2_step_controlled: each step's error estimate within
+ * henon_heiles_k3s2_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * henon_heiles_k3s2_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  henon_heiles_k3s2_real atol, rtol, hmax;
+} henon_heiles_k3s2_controls;
+/* henon_heiles_k3s2_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int henon_heiles_k3s2_step_controlled(henon_heiles_k3s2_state *x, henon_heiles_k3s2_real *h, const henon_heiles_k3s2_controls *c, const henon_heiles_k3s2_params *prm,
+                       henon_heiles_k3s2_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

@@ -67,6 +67,16 @@ int kepler_k6s1_step(kepler_k6s1_state *x, kepler_k6s1_real h, const kepler_k6s1
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * kepler_k6s1_HMIN (1 + |t|). */
 int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_k6s1_real tol, const kepler_k6s1_params *prm, kepler_k6s1_stats *st);
+/* The controls of kepler_k6s1_step_controlled: each step's error estimate within
+ * kepler_k6s1_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * kepler_k6s1_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  kepler_k6s1_real atol, rtol, hmax;
+} kepler_k6s1_controls;
+/* kepler_k6s1_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int kepler_k6s1_step_controlled(kepler_k6s1_state *x, kepler_k6s1_real *h, const kepler_k6s1_controls *c, const kepler_k6s1_params *prm,
+                       kepler_k6s1_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

@@ -674,7 +674,7 @@ int kepler_k6s3_step(kepler_k6s3_state *x, kepler_k6s3_real h, const kepler_k6s3
 int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_k6s3_real tol, const kepler_k6s3_params *prm, kepler_k6s3_stats *st)
 {
   kepler_k6s3_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return kepler_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k6s3_EBADSTEP;
@@ -691,18 +691,16 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
     rc = kepler_k6s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == kepler_k6s3_EREJECT) misses++;
     if (rc == kepler_k6s3_OK || rc == kepler_k6s3_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == kepler_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == kepler_k6s3_OK) {
-        double sc = 0;
-        for (i = 0; i < kepler_k6s3_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in kepler_k6s3_step_within */
+      sc = 0;
+      for (i = 0; i < kepler_k6s3_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == kepler_k6s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = cbrt(sqrt(err));  /* err^(1/6) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.531 / err)^(1/6) */
+      fac = err > 0 ? 0.81818882300002704 / r : grow;  /* (0.3 / err)^(1/6) */
       if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
@@ -737,6 +735,22 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
       return rc != kepler_k6s3_EREJECT ? rc : kepler_k6s3_ENOCONV;
     }
   }
+}
+
+int kepler_k6s3_step_controlled(kepler_k6s3_state *x, kepler_k6s3_real *h, const kepler_k6s3_controls *c, const kepler_k6s3_params *prm,
+                       kepler_k6s3_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return kepler_k6s3_EBADSTEP;
+  for (i = 0; i < kepler_k6s3_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = kepler_k6s3_step_adaptive(x, h, (kepler_k6s3_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

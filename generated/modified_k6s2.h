@@ -67,6 +67,16 @@ int modified_k6s2_step(modified_k6s2_state *x, modified_k6s2_real h, const modif
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * modified_k6s2_HMIN (1 + |t|). */
 int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, modified_k6s2_real tol, const modified_k6s2_params *prm, modified_k6s2_stats *st);
+/* The controls of modified_k6s2_step_controlled: each step's error estimate within
+ * modified_k6s2_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * modified_k6s2_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  modified_k6s2_real atol, rtol, hmax;
+} modified_k6s2_controls;
+/* modified_k6s2_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int modified_k6s2_step_controlled(modified_k6s2_state *x, modified_k6s2_real *h, const modified_k6s2_controls *c, const modified_k6s2_params *prm,
+                       modified_k6s2_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

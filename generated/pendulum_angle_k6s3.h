@@ -67,6 +67,16 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
  * proposed, st->h the step taken. Fails (x unchanged) only below a step of
  * pendulum_angle_k6s3_HMIN (1 + |t|). */
 int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st);
+/* The controls of pendulum_angle_k6s3_step_controlled: each step's error estimate within
+ * pendulum_angle_k6s3_TOLC (atol + rtol max|q|) |h| (per unit time; atol = rtol = tol is
+ * pendulum_angle_k6s3_step_adaptive's), and |h| at most hmax (0: no bound). */
+typedef struct {
+  pendulum_angle_k6s3_real atol, rtol, hmax;
+} pendulum_angle_k6s3_controls;
+/* pendulum_angle_k6s3_step_adaptive under c: *h (the step tried, and the next proposed) within
+ * hmax, and tol (atol + rtol max|q|) / (1 + max|q|) at the step's start. */
+int pendulum_angle_k6s3_step_controlled(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, const pendulum_angle_k6s3_controls *c, const pendulum_angle_k6s3_params *prm,
+                       pendulum_angle_k6s3_stats *st);
 /* q and p at t - h (1 - theta), 0 <= theta <= 1, inside the last step h taken, from
  * the step's own polynomials (no model evaluation): of order S+1 in q and p, equal
  * to the state at theta = 1 and to the state before the step at theta = 0. Before

@@ -69,6 +69,7 @@ int main(int argc, char **argv)
     init_params, project, DBL_EPSILON,
     step_adaptive,
     dense, 0, NULL, NULL, NULL,
+    NULL,
   };
   return hbvmrt_main(&model, argc, argv);
 }

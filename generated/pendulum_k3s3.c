@@ -643,7 +643,7 @@ int pendulum_k3s3_step(pendulum_k3s3_state *x, pendulum_k3s3_real h, const pendu
 int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, pendulum_k3s3_real tol, const pendulum_k3s3_params *prm, pendulum_k3s3_stats *st)
 {
   pendulum_k3s3_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_k3s3_EBADSTEP;
@@ -660,14 +660,12 @@ int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, p
     rc = pendulum_k3s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == pendulum_k3s3_EREJECT) misses++;
     if (rc == pendulum_k3s3_OK || rc == pendulum_k3s3_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == pendulum_k3s3_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == pendulum_k3s3_OK) {
-        double sc = 0;
-        for (i = 0; i < pendulum_k3s3_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in pendulum_k3s3_step_within */
+      sc = 0;
+      for (i = 0; i < pendulum_k3s3_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == pendulum_k3s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = cbrt(err);  /* err^(1/3) */
@@ -706,6 +704,22 @@ int pendulum_k3s3_step_adaptive(pendulum_k3s3_state *x, pendulum_k3s3_real *h, p
       return rc != pendulum_k3s3_EREJECT ? rc : pendulum_k3s3_ENOCONV;
     }
   }
+}
+
+int pendulum_k3s3_step_controlled(pendulum_k3s3_state *x, pendulum_k3s3_real *h, const pendulum_k3s3_controls *c, const pendulum_k3s3_params *prm,
+                       pendulum_k3s3_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return pendulum_k3s3_EBADSTEP;
+  for (i = 0; i < pendulum_k3s3_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = pendulum_k3s3_step_adaptive(x, h, (pendulum_k3s3_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

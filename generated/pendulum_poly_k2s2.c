@@ -915,7 +915,7 @@ int pendulum_poly_k2s2_step(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real
 int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real *h, pendulum_poly_k2s2_real tol, const pendulum_poly_k2s2_params *prm, pendulum_poly_k2s2_stats *st)
 {
   pendulum_poly_k2s2_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k2s2_EBADSTEP;
@@ -932,18 +932,16 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
     rc = pendulum_poly_k2s2_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == pendulum_poly_k2s2_EREJECT) misses++;
     if (rc == pendulum_poly_k2s2_OK || rc == pendulum_poly_k2s2_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == pendulum_poly_k2s2_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == pendulum_poly_k2s2_OK) {
-        double sc = 0;
-        for (i = 0; i < pendulum_poly_k2s2_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in pendulum_poly_k2s2_step_within */
+      sc = 0;
+      for (i = 0; i < pendulum_poly_k2s2_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == pendulum_poly_k2s2_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = sqrt(sqrt(err));  /* err^(1/4) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.656 / err)^(1/4) */
+      fac = err > 0 ? 0.74008280449228525 / r : grow;  /* (0.3 / err)^(1/4) */
       if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
@@ -978,6 +976,22 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
       return rc != pendulum_poly_k2s2_EREJECT ? rc : pendulum_poly_k2s2_ENOCONV;
     }
   }
+}
+
+int pendulum_poly_k2s2_step_controlled(pendulum_poly_k2s2_state *x, pendulum_poly_k2s2_real *h, const pendulum_poly_k2s2_controls *c, const pendulum_poly_k2s2_params *prm,
+                       pendulum_poly_k2s2_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return pendulum_poly_k2s2_EBADSTEP;
+  for (i = 0; i < pendulum_poly_k2s2_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = pendulum_poly_k2s2_step_adaptive(x, h, (pendulum_poly_k2s2_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -1812,7 +1812,7 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
 int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, pendulum_poly_k4s4_real tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   pendulum_poly_k4s4_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k4s4_EBADSTEP;
@@ -1829,18 +1829,16 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
     rc = pendulum_poly_k4s4_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == pendulum_poly_k4s4_EREJECT) misses++;
     if (rc == pendulum_poly_k4s4_OK || rc == pendulum_poly_k4s4_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == pendulum_poly_k4s4_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == pendulum_poly_k4s4_OK) {
-        double sc = 0;
-        for (i = 0; i < pendulum_poly_k4s4_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in pendulum_poly_k4s4_step_within */
+      sc = 0;
+      for (i = 0; i < pendulum_poly_k4s4_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == pendulum_poly_k4s4_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = sqrt(sqrt(sqrt(err)));  /* err^(1/8) */
-      fac = err > 0 ? 0.74989420933245587 / r : grow;  /* (0.1 / err)^(1/8) */
+      fac = err > 0 ? 0.68765602193363207 / r : grow;  /* (0.05 / err)^(1/8) */
       if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
@@ -1875,6 +1873,22 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
       return rc != pendulum_poly_k4s4_EREJECT ? rc : pendulum_poly_k4s4_ENOCONV;
     }
   }
+}
+
+int pendulum_poly_k4s4_step_controlled(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, const pendulum_poly_k4s4_controls *c, const pendulum_poly_k4s4_params *prm,
+                       pendulum_poly_k4s4_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return pendulum_poly_k4s4_EBADSTEP;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = pendulum_poly_k4s4_step_adaptive(x, h, (pendulum_poly_k4s4_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

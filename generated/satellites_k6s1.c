@@ -1860,7 +1860,7 @@ int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h, const
 int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real *h, satellites_k6s1_real tol, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   satellites_k6s1_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s1_EBADSTEP;
@@ -1877,14 +1877,12 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
     rc = satellites_k6s1_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == satellites_k6s1_EREJECT) misses++;
     if (rc == satellites_k6s1_OK || rc == satellites_k6s1_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == satellites_k6s1_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == satellites_k6s1_OK) {
-        double sc = 0;
-        for (i = 0; i < satellites_k6s1_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in satellites_k6s1_step_within */
+      sc = 0;
+      for (i = 0; i < satellites_k6s1_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == satellites_k6s1_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = sqrt(err);  /* err^(1/2) */
@@ -1923,6 +1921,22 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
       return rc != satellites_k6s1_EREJECT ? rc : satellites_k6s1_ENOCONV;
     }
   }
+}
+
+int satellites_k6s1_step_controlled(satellites_k6s1_state *x, satellites_k6s1_real *h, const satellites_k6s1_controls *c, const satellites_k6s1_params *prm,
+                       satellites_k6s1_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return satellites_k6s1_EBADSTEP;
+  for (i = 0; i < satellites_k6s1_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = satellites_k6s1_step_adaptive(x, h, (satellites_k6s1_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

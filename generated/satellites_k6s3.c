@@ -2790,7 +2790,7 @@ int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h, const
 int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real *h, satellites_k6s3_real tol, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   satellites_k6s3_stats s;
-  double hh = *h, err, fac, r, pq, grow = x->hprev == 0 ? 100 : 5;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s3_EBADSTEP;
@@ -2807,14 +2807,12 @@ int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real
     rc = satellites_k6s3_step_within(x, hh, tol * fabs(hh), misses >= 3, prm, &s);
     if (rc == satellites_k6s3_EREJECT) misses++;
     if (rc == satellites_k6s3_OK || rc == satellites_k6s3_EREJECT) {
-      /* the step's error over its tolerance; over tol |h| (1 + max|q|) when accepted */
-      err = rc == satellites_k6s3_OK ? 1 : s.err_est / (tol * fabs(hh));
-      if (rc == satellites_k6s3_OK) {
-        double sc = 0;
-        for (i = 0; i < satellites_k6s3_M; i++)
-          if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
-        err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      }
+      /* the step's error over its tolerance tol |h| (1 + max|q|): q1 when accepted, q0 when
+       * not, as the test in satellites_k6s3_step_within */
+      sc = 0;
+      for (i = 0; i < satellites_k6s3_M; i++)
+        if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+      err = s.err_est / (tol * fabs(hh) * (1 + sc));
       /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
       pq = rc == satellites_k6s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
       r = cbrt(err);  /* err^(1/3) */
@@ -2853,6 +2851,22 @@ int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real
       return rc != satellites_k6s3_EREJECT ? rc : satellites_k6s3_ENOCONV;
     }
   }
+}
+
+int satellites_k6s3_step_controlled(satellites_k6s3_state *x, satellites_k6s3_real *h, const satellites_k6s3_controls *c, const satellites_k6s3_params *prm,
+                       satellites_k6s3_stats *st)
+{
+  double sc = 0;
+  int i, rc;
+  if (!c || !(c->atol >= 0 && c->rtol >= 0 && c->hmax >= 0 && c->atol + c->rtol > 0) ||
+      !isfinite(c->atol + c->rtol + c->hmax))
+    return satellites_k6s3_EBADSTEP;
+  for (i = 0; i < satellites_k6s3_M; i++)
+    if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  rc = satellites_k6s3_step_adaptive(x, h, (satellites_k6s3_real)((c->atol + c->rtol * sc) / (1 + sc)), prm, st);
+  if (c->hmax > 0 && fabs(*h) > c->hmax) *h = *h < 0 ? -c->hmax : c->hmax;
+  return rc;
 }
 
 /* Newton's iteration onto g(q) = 0 until the correction is within 2 ulps of q

@@ -2,7 +2,9 @@
  *
  *   NAME [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..] [--p0 a,b,..]
  *        [--param name=value] [--project] [--csv FILE] [--tol TOL] [--dt DT]
- *        [--events FILE] [--stop-at NAME[:COUNT]] [--no-switch] [--quiet] [--help]
+ *        [--events FILE] [--stop-at NAME[:COUNT]] [--atol A] [--rtol R]
+ *        [--tol-per time|run] [--hmax H] [--max-steps N] [--t0 T0]
+ *        [--restart FILE[:ROW]] [--no-switch] [--quiet] [--help]
  *
  * Options are read left to right; a repeated option overrides the earlier one
  * (--param per name).  A value is the next argument, so `-h -0.01` works; it
@@ -26,7 +28,8 @@
 typedef enum {
   OPT_STEP, OPT_TIME, OPT_STEPS, OPT_EVERY, OPT_Q0, OPT_P0, OPT_PARAM,
   OPT_CSV, OPT_QUIET, OPT_HELP, OPT_PROJECT, OPT_TOL, OPT_DT, OPT_EVENTS,
-  OPT_STOP_AT, OPT_NO_SWITCH
+  OPT_STOP_AT, OPT_NO_SWITCH, OPT_HMAX, OPT_MAX_STEPS, OPT_ATOL, OPT_RTOL, OPT_TOL_PER,
+  OPT_T0, OPT_RESTART
 } OptId;
 
 typedef struct {
@@ -42,12 +45,16 @@ static const Option options[] = {
   {"--help", OPT_HELP, 0},   {"--project", OPT_PROJECT, 0},
   {"--tol", OPT_TOL, 1},      {"--dt", OPT_DT, 1},    {"--events", OPT_EVENTS, 1},
   {"--stop-at", OPT_STOP_AT, 1}, {"--no-switch", OPT_NO_SWITCH, 0},
+  {"--hmax", OPT_HMAX, 1},    {"--max-steps", OPT_MAX_STEPS, 1},
+  {"--atol", OPT_ATOL, 1},    {"--rtol", OPT_RTOL, 1}, {"--tol-per", OPT_TOL_PER, 1},
+  {"--t0", OPT_T0, 1},        {"--restart", OPT_RESTART, 1},
 };
 
 /* What was seen on the way, for the checks that need all options. */
 typedef struct {
   int have_T, have_N;
   double T;
+  int have_atol, have_rtol;
 } Seen;
 
 void hbvmrt_error(const hbvmrt_model *md, const char *fmt, ...)
@@ -244,6 +251,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "usage: %s [-h STEP] [-T TIME | -N STEPS] [--every K] [--q0 a,b,..]\n"
     "       %*s [--p0 a,b,..] [--param name=value] [--project] [--csv FILE]\n"
     "       %*s [--tol TOL] [--dt DT] [--events FILE] [--stop-at NAME[:COUNT]]\n"
+    "       %*s [--atol A] [--rtol R] [--tol-per time|run] [--hmax H]\n"
+    "       %*s [--max-steps N] [--t0 T0] [--restart FILE[:ROW]]\n"
     "       %*s [--no-switch] [--quiet]\n"
     "\n"
     "Integrates the model %s (m=%d coordinates, nu=%d constraints) with the\n"
@@ -257,7 +266,8 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "  --every K          a CSV row every K steps, K >= 1; t=0 and the last\n"
     "                     step are always written (default 1)\n"
     "  --q0 a,b,..        initial positions, %d values (default ",
-    md->name, (int)strlen(md->name), "", (int)strlen(md->name), "", (int)strlen(md->name), "", md->name, md->m,
+    md->name, (int)strlen(md->name), "", (int)strlen(md->name), "", (int)strlen(md->name), "",
+    (int)strlen(md->name), "", (int)strlen(md->name), "", md->name, md->m,
     md->nu, md->k,
     md->s, HBVMRT_DEFAULT_H, HBVMRT_DEFAULT_T, md->m);
   print_vector(out, md->q0, md->m);
@@ -276,7 +286,24 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "                     0.01 TOL |h| (1 + max|q|), so that the error at T is\n"
     "                     about TOL T (1 + max|q|); -h is the first step, -T is\n"
     "                     hit exactly; --every K counts the steps taken;\n"
-    "                     TOL >= eps^2 (4.9e-32 in double, 1.4e-14 in float)\n"
+    "                     TOL >= 8 eps (1.8e-15 in double, 9.5e-7 in float:\n"
+    "                     below it round-off outweighs the tolerance)\n"
+    "  --atol A --rtol R  adaptive steps within 0.01 (A + R max|q|) |h| instead:\n"
+    "                     absolute and relative (--tol TOL is --atol TOL\n"
+    "                     --rtol TOL; --rtol alone sets A = R, --atol alone R = 0)\n"
+    "  --tol-per time|run what the tolerance bounds: time (default), the error\n"
+    "                     per unit time, so that the error at T is about\n"
+    "                     TOL T (1 + max|q|); run, the error at T, about\n"
+    "                     TOL (1 + max|q|) whatever T and its unit (TOL / T\n"
+    "                     per unit time)\n"
+    "  --hmax H           adaptive steps of at most H > 0 (no bound by default;\n"
+    "                     a fixed -h above it is refused)\n"
+    "  --max-steps N      stop after N steps (N >= 1) short of T: status 2\n"
+    "  --t0 T0            the time of the initial state (default 0); the run\n"
+    "                     goes to T0 + TIME\n"
+    "  --restart FILE[:ROW]  start from row ROW (1 = t0's, default the last)\n"
+    "                     of a CSV this driver wrote (--csv): its t, q and p\n"
+    "                     (params as given; a later --t0, --q0, --p0 wins)\n"
     "  --dt DT            CSV rows at t = 0, DT, 2 DT, .. (DT > 0) whatever the\n"
     "                     steps are, each a step of the method from the start\n"
     "                     of the step containing it (as accurate as the steps),\n"
@@ -323,11 +350,13 @@ static int print_help(const hbvmrt_model *md, FILE *out)
     "local error estimate of a step, H at t=0 and max_dH/|H0|, the largest\n"
     "relative energy defect of a step and the steps where it is above\n"
     "sqrt(eps) (or --tol if larger), the time reached and how the run ended (ok, output_error,\n"
-    "step_failed, event_nan, energy_defect); a warning line before it when the\n"
+    "step_failed, event_nan, energy_defect, max_steps); a warning line before it when the\n"
     "error estimate is above 1e-3 (1 + max|q|) or steps were flagged.\n"
     "Exit status: 0 success, 1 bad arguments (inconsistent initial values\n"
     "included) or an output error, 2 a failed step or projection, or an\n"
-    "event that is not a number, 3 steps that did not conserve H.\n", out);
+    "event that is not a number, or --max-steps reached, 3 steps that did not\n"
+    "conserve H. On a terminal a progress line: the share of the span done,\n"
+    "steps per second, |H-H0| and the time left (ETA).\n", out);
   free(prm);
   if (fflush(out) != 0 || ferror(out)) {
     hbvmrt_error(md, "cannot write the help text");
@@ -369,14 +398,18 @@ static int parse_stop_at(const hbvmrt_model *md, const char *val, hbvmrt_opts *o
   return -1;
 }
 
-/* The smallest --tol: eps^2 of the solver's real type (4.9e-32 in double,
- * 1.4e-14 in float). Far below what its round-off lets a step meet, and
- * where the controller's tol |h| stays a normal number: a subnormal tol
- * (1e-310) made NAME_step_adaptive loop forever. */
+/* The smallest --tol: 8 ulps of the solver's real type (1.8e-15 in double,
+ * 9.5e-7 in float). Each step leaves a few ulps of round-off that no
+ * estimate sees; below 8 ulps a tighter tol only takes more steps, each
+ * adding its round-off, and the error at T grows (a float top: 2.4e-6 at
+ * 1e-6, 5.7e-6 at 1e-7; a float four-bar and a double top alike, issue 31,
+ * item 2). It also keeps the controller's tol |h| a normal number: a
+ * subnormal tol (1e-310) made NAME_step_adaptive loop forever. */
+#define HBVMRT_TOL_ULPS 8
 static double min_tol(const hbvmrt_model *md)
 {
   double eps = md->eps > 0 ? md->eps : DBL_EPSILON;
-  return eps * eps;
+  return HBVMRT_TOL_ULPS * eps;
 }
 
 /* Store one option's value in o (or seen); -1 after reporting an error. */
@@ -432,8 +465,9 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
       return -1;
     }
     if (o->tol < min_tol(md)) {
-      hbvmrt_error(md, "--tol must be >= %.2g, the square of the solver's precision: no step meets a smaller one "
-                   "(got %s)", min_tol(md), val);
+      hbvmrt_error(md, "--tol must be >= %.2g, 8 ulps of the solver's %s: below it the round-off of the steps "
+                   "outweighs the tolerance, and a tighter one gives a larger error (got %s)", min_tol(md),
+                   md->eps > 2 * DBL_EPSILON ? "float" : "double", val);
       return -1;
     }
     if (!md->step_adaptive) {
@@ -455,13 +489,84 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
     return needs(md, op->name, md->nevents > 0, "events ('event NAME = ...' in the model)");
   case OPT_STOP_AT:
     return parse_stop_at(md, val, o);
+  case OPT_HMAX:
+    if (parse_number(md, op->name, val, &o->hmax) != 0)
+      return -1;
+    if (!(o->hmax > 0)) {
+      hbvmrt_error(md, "--hmax must be > 0 (got %s)", val);
+      return -1;
+    }
+    return 0;
+  case OPT_MAX_STEPS:
+    return parse_count(md, op->name, val, 1, &o->max_steps);
+  case OPT_ATOL:
+  case OPT_RTOL:
+    if (parse_number(md, op->name, val, op->id == OPT_ATOL ? &o->atol : &o->rtol) != 0)
+      return -1;
+    if (!((op->id == OPT_ATOL ? o->atol : o->rtol) > 0)) {
+      hbvmrt_error(md, "%s must be > 0 (got %s)", op->name, val);
+      return -1;
+    }
+    if ((op->id == OPT_ATOL ? o->atol : o->rtol) < min_tol(md)) {
+      hbvmrt_error(md, "%s must be >= %.2g, 8 ulps of the solver's %s (got %s)", op->name, min_tol(md),
+                   md->eps > 2 * DBL_EPSILON ? "float" : "double", val);
+      return -1;
+    }
+    *(op->id == OPT_ATOL ? &seen->have_atol : &seen->have_rtol) = 1;
+    return needs(md, op->name, md->step_adaptive != NULL, "error control (hbvmgen 0.1.0 or later, --main)");
+  case OPT_TOL_PER:
+    if (strcmp(val, "time") != 0 && strcmp(val, "run") != 0) {
+      hbvmrt_error(md, "--tol-per must be 'time' (the default: the tolerance per unit time) or 'run' (on the "
+                   "error at T) (got '%s')", val);
+      return -1;
+    }
+    o->tol_per_run = strcmp(val, "run") == 0;
+    return 0;
+  case OPT_T0:
+    return parse_number(md, op->name, val, &o->t0);
+  case OPT_RESTART:
+    return hbvmrt_restart(md, val, o);
   case OPT_HELP:
     break;
   }
   return 0;
 }
 
-/* The checks that need every option: -T against -N, and N from the span. */
+/* The tolerances once every option is read: --atol/--rtol against --tol
+ * (--rtol alone: atol = rtol, as --tol; --atol alone: rtol = 0), divided by
+ * the span under --tol-per run, each per unit time at least min_tol; -1
+ * after reporting. */
+static int finish_tol(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
+{
+  double span = o->T;
+
+  if ((seen->have_atol || seen->have_rtol) && o->tol > 0) {
+    hbvmrt_error(md, "--tol or --atol/--rtol, not both (--tol TOL is --atol TOL --rtol TOL)");
+    return -1;
+  }
+  if (seen->have_rtol && !seen->have_atol)
+    o->atol = o->rtol;
+  if (seen->have_atol || seen->have_rtol)
+    o->tol = o->atol > o->rtol ? o->atol : o->rtol;  /* the nominal tol: adaptive steps */
+  if (!o->tol_per_run || !(o->tol > 0))
+    return 0;
+  if (!(span > 0)) {
+    hbvmrt_error(md, "--tol-per run needs a span -T > 0");
+    return -1;
+  }
+  o->tol /= span;
+  o->atol /= span;
+  o->rtol /= span;
+  if (o->tol < min_tol(md)) {
+    hbvmrt_error(md, "--tol-per run: the tolerance over the span T = %g is %.2g per unit time, below %.2g, 8 ulps "
+                 "of the solver's precision", span, o->tol, min_tol(md));
+    return -1;
+  }
+  return 0;
+}
+
+/* The checks that need every option: -T against -N, N from the span, the
+ * tolerances, --hmax against a fixed -h. */
 static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
 {
   double T;
@@ -470,8 +575,12 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
     hbvmrt_error(md, "-T and -N cannot be used together");
     return -1;
   }
-  if (seen->have_N && o->tol > 0) {
+  if (seen->have_N && (o->tol > 0 || seen->have_atol || seen->have_rtol)) {
     hbvmrt_error(md, "--tol takes the span from -T, not -N");
+    return -1;
+  }
+  if (o->hmax > 0 && !(o->tol > 0 || seen->have_atol || seen->have_rtol) && fabs(o->h) > o->hmax) {
+    hbvmrt_error(md, "-h %g is above --hmax %g: a fixed step is -h (--hmax bounds adaptive steps)", o->h, o->hmax);
     return -1;
   }
   if (seen->have_N)
@@ -485,7 +594,7 @@ static int finish(const hbvmrt_model *md, hbvmrt_opts *o, const Seen *seen)
     hbvmrt_error(md, "too many steps: T/|h| = %g (at most 2^53)", T / fabs(o->h));
     return -1;
   }
-  return 0;
+  return finish_tol(md, o, seen);
 }
 
 /* Path resolved as far as it exists: its directory's real path, then its
@@ -561,7 +670,7 @@ static int check_grid(const hbvmrt_model *md, const hbvmrt_opts *o)
 int hbvmrt_parse_args(const hbvmrt_model *md, int argc, char **argv,
                       hbvmrt_opts *o)
 {
-  Seen seen = {0, 0, 0.0};
+  Seen seen = {0, 0, 0.0, 0, 0};
   size_t np = (size_t)(md->nparams > 0 ? md->nparams : 0) + 1;
   int i;
 

@@ -428,15 +428,15 @@ static void steps_scalar(Traj *tr, long from, double fail_h, int fail_code)
   const hbvmrt_model *md = e->md;
   void *x = tr->w->x;
   hbvmrt_steps cb = {NULL, traj_taken, traj_failed, NULL};
-  double h = e->o.h, t_end = hbvmrt_span_end(&e->o);
-  int code = 0, stopped, at_end = hbvmrt_state_time(md, x) == t_end;
+  double h = e->o.h;
+  int code = 0, stopped, at_end = hbvmrt_state_time(md, x) == hbvmrt_span_end(&e->o);
   long k;
 
   cb.ctx = tr;
   if (e->o.tol > 0)
     while (code == 0 && !at_end) {
       hbvmrt_stats st;
-      if ((code = hbvmrt_adaptive_step(md, x, &h, t_end, e->o.tol, tr->prm, &st, &at_end)) == 0)
+      if ((code = hbvmrt_adaptive_step(md, &e->o, x, &h, tr->prm, &st, &at_end)) == 0)
         traj_taken(tr, &st, st.h);
     }
   else {
@@ -707,6 +707,11 @@ static int prepare(Ens *e, int argc, char **argv, char **rest)
   if (e->o.dt > 0 || e->o.events || e->o.stop_event >= 0 || e->o.every != 1) {
     hbvmrt_error(md, "--%s writes rows along one run: not with --ensemble or --sweep, which write a summary row "
                  "per trajectory", e->o.dt > 0 ? "dt" : e->o.events ? "events" : e->o.stop_event >= 0 ? "stop-at" : "every");
+    return 1;
+  }
+  if (e->o.t0 != 0 || e->o.max_steps > 0) {
+    hbvmrt_error(md, "--%s is for one run: not with --ensemble or --sweep, whose trajectories start at t = 0",
+                 e->o.t0 != 0 ? "t0 (or --restart)" : "max-steps");
     return 1;
   }
   if (!md->init_params || !md->names || md->m > 1024) {

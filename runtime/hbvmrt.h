@@ -79,6 +79,10 @@ typedef struct {
   const char *const *event_names;
   const int *event_dirs;
   void (*events)(const void *x, const void *prm, double *values);
+  /* Set the time of the state x to t (--t0, --restart); NULL: a double
+   * state's t is written at off_t (drivers generated before it, and double
+   * solvers), and a float driver before it refuses --t0. */
+  void (*set_time)(void *x, double t);
 } hbvmrt_model;
 
 /* Run the standalone driver: returns the process exit status

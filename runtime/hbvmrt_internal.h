@@ -68,6 +68,13 @@ typedef struct {
   int stop_event;      /* --stop-at: the event that ends the run, or -1 */
   long stop_count;     /* ... at its stop_count-th occurrence */
   int no_switch;       /* --no-switch: steps not ended on the switching points */
+  double t0;           /* --t0 (or --restart's row): the time of the initial state */
+  double hmax;         /* --hmax: the largest adaptive step (0: none) */
+  long max_steps;      /* --max-steps: the run stops with status 2 after that many (0: none) */
+  /* --atol/--rtol: each step within atol + rtol max|q| (per unit time); 0, 0: tol (1 + max|q|).
+   * Under --tol-per run these and tol are divided by the span T once parsed. */
+  double atol, rtol;
+  int tol_per_run;     /* --tol-per run: the tolerance is on the error at T, not per unit time */
 } hbvmrt_opts;
 
 /* What hbvmrt_parse_args tells the caller to do next. */
@@ -172,7 +179,7 @@ int hbvmrt_switch_predicted(hbvmrt_switch *sw, const void *x, double h, double *
  * carried on before it is tried, or after it crossed one or failed
  * (hbvmrt_switch_find, from the step tried). The step's code; *h stays the
  * proposal after a step cut on a point. */
-int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h, double t_end, double tol,
+int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const hbvmrt_opts *o, const void *x0, void *x, double *h,
                            hbvmrt_stats *st, int *at_end);
 /* Before a step from x: after a cut, the step's history is forgotten. */
 void hbvmrt_switch_before(hbvmrt_switch *sw, void *x);
@@ -193,10 +200,16 @@ long hbvmrt_span_steps(double T, double h);
 void hbvmrt_span_land(const hbvmrt_model *md, const hbvmrt_opts *o, void *x);
 /* Step n of N of a fixed-step run from x: h, the last shortened to end on T. */
 double hbvmrt_fixed_step(const hbvmrt_model *md, const hbvmrt_opts *o, long n, const void *x);
-/* One adaptive step toward t_end from x, of at most *h (the last shortened
- * to end on t_end); the step's code, the next h in *h, *at_end when on it. */
-int hbvmrt_adaptive_step(const hbvmrt_model *md, void *x, double *h, double t_end, double tol, const void *prm,
+/* The tolerance per unit time of the next adaptive step from x: o->tol, or
+ * (atol + rtol max|q|) / (1 + max|q|) under --atol/--rtol. */
+double hbvmrt_step_tol(const hbvmrt_model *md, const hbvmrt_opts *o, const void *x);
+/* One adaptive step toward the span's end from x, of at most *h and --hmax
+ * (the last shortened to end on it); the step's code, the next h in *h,
+ * *at_end when on it. */
+int hbvmrt_adaptive_step(const hbvmrt_model *md, const hbvmrt_opts *o, void *x, double *h, const void *prm,
                          hbvmrt_stats *st, int *at_end);
+/* Set the time of the state x to t (--t0): 0, or -1 when the driver cannot. */
+int hbvmrt_set_time(const hbvmrt_model *md, void *x, double t);
 
 /* What the caller of hbvmrt_advance hears: before each try (may be NULL),
  * after each step taken (its stats and size; nonzero: stop there), after
@@ -217,6 +230,10 @@ int hbvmrt_halve(const hbvmrt_model *md, void *x, const void *prm, double h, int
 
 /* run.c: one run of the standalone driver (hbvmrt_main without an ensemble) */
 
+/* The progress line's estimate of the time left, "ETA 1m05s", into buf:
+ * from the seconds elapsed and the share done (0 < done <= 1); "" before. */
+void hbvmrt_eta(double elapsed, double done, char *buf, size_t n);
+
 int hbvmrt_run(const hbvmrt_model *md, const hbvmrt_switching *sw, int argc, char **argv);
 
 /* table.c: a CSV table of numbers (--ensemble FILE) */
@@ -236,6 +253,12 @@ typedef struct {
  * rows, and at least one. */
 int hbvmrt_table_read(const hbvmrt_model *md, const char *path, long max_rows, hbvmrt_table *tb);
 void hbvmrt_table_free(hbvmrt_table *tb);
+
+/* restart.c: --restart FILE[:ROW], the initial state from a row of the driver's CSV */
+
+/* Set o->t0, o->q0, o->p0 from row ROW (1-based, default the last) of the
+ * CSV named by val: 0, or -1 after reporting. */
+int hbvmrt_restart(const hbvmrt_model *md, const char *val, hbvmrt_opts *o);
 
 /* ensemble.c: --ensemble FILE / --sweep NAME=A:B:N, many trajectories */
 

@@ -19,7 +19,8 @@
  *
  * Exit status: 0 success, 1 bad arguments or an output error (the CSV could
  * not be opened or written: an incomplete file is never silent; this wins over
- * a failed step), 2 a failed step or an event that is not a number, 3 steps
+ * a failed step), 2 a failed step, an event that is not a number or
+ * --max-steps reached short of T, 3 steps
  * whose relative energy defect (hbvmrt_stats.defect) is above sqrt(eps):
  * the run ended, but H was not conserved.  Every run that started ends with
  * the summary line (summary), after warnings on the largest local error
@@ -65,6 +66,7 @@ typedef struct {
   double max_q;               /* max |q| over the steps, the scale of max_err_est */
   double max_defect;          /* the largest relative energy defect of a step */
   long defect_steps;          /* steps whose defect is far above round-off */
+  int max_steps_hit;          /* --max-steps ended the run short of T */
   long said;                  /* per-step messages written on stderr ... */
   long unsaid;                /* ... and suppressed past HBVMRT_MAX_SAID */
 } Run;
@@ -228,6 +230,11 @@ static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_switching *sw, con
     }
     md->init(r->x, q0, p0);
   }
+  if (o->t0 != 0 && hbvmrt_set_time(md, r->x, o->t0) != 0) {
+    hbvmrt_error(md, "--t0: this float driver cannot set the time of its state (generated before --t0): "
+                 "generate it again");
+    return 1;
+  }
   status = check_initial(r);
   r->H0 = md->energy(r->x, r->prm);
   return status;
@@ -310,7 +317,7 @@ static void progress_tick(Progress *pg, const Run *r, long n)
 {
   double t = now(), since = t - pg->last_check;
   double done = (double)n / (double)r->o->nsteps;
-  char line[160];
+  char line[192], eta[32];
   int len;
 
   if (since < 0.01 && pg->stride < (1L << 20))
@@ -323,15 +330,33 @@ static void progress_tick(Progress *pg, const Run *r, long n)
     return;
   pg->last_draw = t;
   if (r->o->tol > 0 && r->o->T > 0)   /* adaptive: the share of the span */
-    done = fabs(state_t(r)) / r->o->T;
-  len = snprintf(line, sizeof line, "%s: %5.1f%%  %.0f steps/s  |H-H0|=%.2e",
+    done = fabs(state_t(r) - r->o->t0) / r->o->T;
+  hbvmrt_eta(t - pg->start, done, eta, sizeof eta);
+  len = snprintf(line, sizeof line, "%s: %5.1f%%  %.0f steps/s  |H-H0|=%.2e  %s",
                  r->md->name, 100.0 * done,
-                 (double)n / (t - pg->start), fabs(r->H - r->H0));
+                 (double)n / (t - pg->start), fabs(r->H - r->H0), eta);
   if (len > (int)sizeof line - 1)
     len = (int)sizeof line - 1;
   fprintf(stderr, "\r%-*s", pg->width, line);
   if (len > pg->width)
     pg->width = len;
+}
+
+void hbvmrt_eta(double elapsed, double done, char *buf, size_t n)
+{
+  double left = elapsed * (1 - done) / done;
+
+  if (!(done > 0 && done <= 1 && left < 1e8)) {
+    if (n)
+      buf[0] = '\0';
+    return;
+  }
+  if (left < 60)
+    snprintf(buf, n, "ETA %.0fs", left);
+  else if (left < 3600)
+    snprintf(buf, n, "ETA %.0fm%02.0fs", floor(left / 60), floor(fmod(left, 60)));
+  else
+    snprintf(buf, n, "ETA %.0fh%02.0fm", floor(left / 3600), floor(fmod(left, 3600) / 60));
 }
 
 static void progress_clear(Progress *pg)
@@ -360,7 +385,7 @@ static void grid_rows(Run *r)
   int i;
 
   for (;;) {
-    double dir = t1 < t0 ? -1 : 1, tk = dir * (double)r->grid_k * dt, theta, H;
+    double dir = t1 < t0 ? -1 : 1, tk = r->o->t0 + dir * (double)r->grid_k * dt, theta, H;
     if ((tk - t1) * dir > 1e-12 * (fabs(t1) + dt) || t1 == t0)
       return;
     theta = (tk - t0) / (t1 - t0);
@@ -525,6 +550,19 @@ static int advance(Run *r, double h)
   return hbvmrt_advance(r->md, r->x, r->prm, h, 0, &cb, &stopped);
 }
 
+/* --max-steps: n steps taken and the span not done: the run stops there
+ * (status 2, max_steps), its state written as the last row (unless the
+ * --every K of the loop just wrote it). */
+static int max_steps_reached(Run *r, long n, long K)
+{
+  if (!(r->o->max_steps > 0 && n >= r->o->max_steps))
+    return 0;
+  r->max_steps_hit = 1;
+  if (n % K != 0)
+    step_row(r);
+  return 1;
+}
+
 /* --tol: adaptive steps from h until -T, hit exactly (hbvmrt_adaptive_step).
  * Rows at t=0, every K steps taken and at T; stops at the first failed step
  * (its code in r->fail_code). */
@@ -540,11 +578,13 @@ static void loop_adaptive(Run *r, Progress *pg)
     hbvmrt_stats st;
     int at_end, code;
 
+    if (max_steps_reached(r, n, K))
+      return;
     before_step(r);
     if (r->sw.md)   /* steps that end on the switching points (switch.c) */
-      code = hbvmrt_switch_adaptive(&r->sw, r->x0, r->x, &h, t_end, r->o->tol, &st, &at_end);
+      code = hbvmrt_switch_adaptive(&r->sw, r->o, r->x0, r->x, &h, &st, &at_end);
     else
-      code = hbvmrt_adaptive_step(r->md, r->x, &h, t_end, r->o->tol, r->prm, &st, &at_end);
+      code = hbvmrt_adaptive_step(r->md, r->o, r->x, &h, r->prm, &st, &at_end);
     r->rejected += st.rejected;
     if (code != 0) {
       r->fail_code = code;
@@ -581,7 +621,10 @@ static void loop(Run *r, Progress *pg)
   if (write_row(r) != 0)
     return;
   for (n = 1; n <= N; n++) {
-    int code = advance(r, hbvmrt_fixed_step(r->md, r->o, n, r->x));
+    int code;
+    if (max_steps_reached(r, n - 1, K))
+      return;
+    code = advance(r, hbvmrt_fixed_step(r->md, r->o, n, r->x));
     if (code != 0) {
       r->fail_code = code;
       if ((n - 1) % K != 0)
@@ -667,7 +710,7 @@ static void summary(const Run *r, double seconds, const char *status)
  * 1 an output error, 2 a failed step or an event not a number, 3 steps that
  * did not conserve H, else 0.  Every run that started ends with the summary
  * line, its status one of ok, output_error, step_failed, event_nan,
- * energy_defect (the first that applies). */
+ * max_steps, energy_defect (the first that applies). */
 static int simulate(Run *r)
 {
   Progress pg;
@@ -685,13 +728,16 @@ static int simulate(Run *r)
   say_suppressed(r);
   if (r->fail_code != 0)
     report_failure(r);
+  if (r->max_steps_hit)
+    fprintf(stderr, "%s: error: --max-steps %ld reached at t=%.15g, short of the span's end %.15g\n", r->md->name,
+            r->o->max_steps, state_t(r), hbvmrt_span_end(r->o));
   out_failed = close_csv(r) != 0;
   if (r->ev.md && hbvmrt_events_close(&r->ev) != 0)
     out_failed = 1;
   warn_err_est(r);
   warn_defect(r);
-  status = out_failed ? 1 : r->fail_code != 0 || r->event_nan ? 2 : r->defect_steps > 0 ? 3 : 0;
-  summary(r, seconds, status == 2 && r->fail_code == 0 ? "event_nan" : word[status]);
+  status = out_failed ? 1 : r->fail_code != 0 || r->event_nan || r->max_steps_hit ? 2 : r->defect_steps > 0 ? 3 : 0;
+  summary(r, seconds, status == 2 && r->fail_code == 0 ? (r->max_steps_hit ? "max_steps" : "event_nan") : word[status]);
   return status;
 }
 

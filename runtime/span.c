@@ -18,7 +18,33 @@ double hbvmrt_state_time(const hbvmrt_model *md, const void *x)
 
 double hbvmrt_span_end(const hbvmrt_opts *o)
 {
-  return o->h < 0 ? -o->T : o->T;
+  return o->t0 + (o->h < 0 ? -o->T : o->T);
+}
+
+int hbvmrt_set_time(const hbvmrt_model *md, void *x, double t)
+{
+  if (md->set_time)
+    md->set_time(x, t);
+  else if (md->eps == DBL_EPSILON)  /* a double state: t is the double at off_t */
+    memcpy((char *)x + md->off_t, &t, sizeof t);
+  else
+    return -1;
+  return 0;
+}
+
+double hbvmrt_step_tol(const hbvmrt_model *md, const hbvmrt_opts *o, const void *x)
+{
+  double sc = 0, q;
+  int i;
+
+  if (!(o->atol > 0 || o->rtol > 0))
+    return o->tol;
+  for (i = 0; i < md->m; i++) {
+    memcpy(&q, (const char *)x + md->off_q + (size_t)i * sizeof q, sizeof q);
+    if (fabs(q) > sc)
+      sc = fabs(q);
+  }
+  return (o->atol + o->rtol * sc) / (1 + sc);
 }
 
 /* The number N of steps of |h| over the span T: the least N with N |h| >= T
@@ -68,22 +94,26 @@ double hbvmrt_fixed_step(const hbvmrt_model *md, const hbvmrt_opts *o, long n, c
   return n == o->nsteps && o->to_T ? hbvmrt_span_end(o) - hbvmrt_state_time(md, x) : o->h;
 }
 
-/* One adaptive step (NAME_step_adaptive at tol) toward t_end from x, of at
- * most *h: a step that would pass t_end is shortened to end on it, and so is
- * one within 1e-12 of it, so that no sliver of a step is left. Returns the
- * step's code; on success *h is the next step the controller proposes (kept
- * as it was after the last step, whose size says nothing) and *at_end is 1
- * when x is now on t_end. */
-int hbvmrt_adaptive_step(const hbvmrt_model *md, void *x, double *h, double t_end, double tol, const void *prm,
+/* One adaptive step (NAME_step_adaptive at hbvmrt_step_tol) toward the
+ * span's end t_end from x, of at most *h and --hmax: a step that would pass
+ * t_end is shortened to end on it, and so is one within 1e-12 of it, so that
+ * no sliver of a step is left. Returns the step's code; on success *h is the
+ * next step the controller proposes (kept as it was after the last step,
+ * whose size says nothing) and *at_end is 1 when x is now on t_end. */
+int hbvmrt_adaptive_step(const hbvmrt_model *md, const hbvmrt_opts *o, void *x, double *h, const void *prm,
                          hbvmrt_stats *st, int *at_end)
 {
-  double rest = t_end - hbvmrt_state_time(md, x), hn = *h;
-  int last = fabs(hn) >= fabs(rest) * (1 - 1e-12), code;
+  double t_end = hbvmrt_span_end(o), rest = t_end - hbvmrt_state_time(md, x), hn;
+  int last, code;
 
+  if (o->hmax > 0 && fabs(*h) > o->hmax)
+    *h = *h < 0 ? -o->hmax : o->hmax;
+  hn = *h;
+  last = fabs(hn) >= fabs(rest) * (1 - 1e-12);
   memset(st, 0, sizeof *st);
   if (last)
     hn = rest;
-  code = md->step_adaptive(x, &hn, tol, prm, st);
+  code = md->step_adaptive(x, &hn, hbvmrt_step_tol(md, o, x), prm, st);
   *at_end = code == 0 && last && st->h == rest;
   if (code == 0 && !*at_end)
     *h = hn;

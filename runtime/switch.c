@@ -294,11 +294,12 @@ static int find_within(hbvmrt_switch *sw, const void *x0, void *x, double h, dou
   return 2;
 }
 
-int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h, double t_end, double tol,
+int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const hbvmrt_opts *o, const void *x0, void *x, double *h,
                            hbvmrt_stats *st, int *at_end)
 {
   const hbvmrt_model *md = sw->md;
-  double rest = t_end - hbvmrt_state_time(md, x0), hmax = 0, guess;
+  double rest = hbvmrt_span_end(o) - hbvmrt_state_time(md, x0), tol = hbvmrt_step_tol(md, o, x0), guess;
+  double hmax = o->hmax > 0 ? copysign(o->hmax, *h) : 0;   /* --hmax, then halves of a step too long */
   int code = 0, found, attempt;
 
   for (attempt = 0; attempt < 8; attempt++) {
@@ -308,7 +309,7 @@ int hbvmrt_switch_adaptive(hbvmrt_switch *sw, const void *x0, void *x, double *h
     found = hbvmrt_switch_predicted(sw, x0, H, &guess) ? find_within(sw, x0, x, H, guess, tol, st) : -1;
     if (found == 0 || found < 0)
       memcpy(x, x0, md->state_size);   /* no point after all: the step with error control */
-    if (found < 1 && (code = hbvmrt_adaptive_step(md, x, &hs, t_end, tol, sw->prm, st, at_end)) == 0) {
+    if (found < 1 && (code = hbvmrt_adaptive_step(md, o, x, &hs, sw->prm, st, at_end)) == 0) {
       sw->fn->values(x, sw->prm, sw->v1);
       if (first_crossed(sw, sw->v1) < 0) {
         *h = hs;

@@ -31,6 +31,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "hbvmrt.h"
+
 Suite *docs_suite(void);
 
 #define SAN_FLAGS "-fsanitize=address,undefined -fno-omit-frame-pointer"
@@ -312,6 +314,65 @@ START_TEST(help_covers_man_page)
 }
 END_TEST
 
+/* The standalone driver's options (the words starting with '-' before the
+ * text on the lines of its --help that start with "  -", of a bare model of one
+ * coordinate) are each in the man page's STANDALONE DRIVER section, spelt
+ * as roff spells them, and in docs/api.md in backquotes: --hmax, --atol,
+ * --t0, --restart (issue 31, item 5) and the rest. */
+START_TEST(driver_options_documented)
+{
+  static const double zero[1] = {0};
+  hbvmrt_model md;
+  char *argv[] = {"m", "--help", NULL}, *help, line[512];
+  char *page = slurp("../docs/hbvmgen.1"), *api = slurp("../docs/api.md");
+  const char *sec = strstr(page, "\n.SH STANDALONE DRIVER\n"), *end = sec ? strstr(sec + 1, "\n.SH ") : NULL;
+  FILE *f = tmpfile();
+  int out = dup(1), n = 0;
+  memset(&md, 0, sizeof md);
+  md.name = "m";
+  md.m = 1;
+  md.state_size = md.params_size = 8;
+  md.q0 = md.p0 = zero;
+  ck_assert(f && out >= 0 && sec && end);
+  fflush(stdout);
+  dup2(fileno(f), 1);
+  int rc = hbvmrt_main(&md, 2, argv);
+  fflush(stdout);
+  dup2(out, 1);
+  close(out);
+  ck_assert_int_eq(rc, 0);
+  rewind(f);
+  while (fgets(line, sizeof line, f)) {
+    char *gap;
+    if (strncmp(line, "  -", 3))
+      continue;
+    if ((gap = strstr(line + 2, "  ")))  /* the options end where the text after them starts */
+      *gap = '\0';
+    for (char *w = strtok(line, " ,|\n"); w; w = strtok(NULL, " ,|\n")) {
+      char roff[64], quoted[40];
+      size_t k = 0;
+      if (w[0] != '-')
+        continue;
+      for (const char *c = w; *c && k + 3 < sizeof roff; c++) {
+        if (*c == '-')
+          roff[k++] = '\\';
+        roff[k++] = *c;
+      }
+      roff[k] = '\0';
+      help = strstr(sec, roff);
+      ck_assert_msg(help && help < end, "docs/hbvmgen.1 (STANDALONE DRIVER) does not document the driver's %s", w);
+      snprintf(quoted, sizeof quoted, "`%s", w);
+      ck_assert_msg(strstr(api, quoted), "docs/api.md does not document the driver's %s", w);
+      n++;
+    }
+  }
+  ck_assert_int_ge(n, 20);
+  fclose(f);
+  free(page);
+  free(api);
+}
+END_TEST
+
 /* Source comments point at docs/, not at the retired SPEC (its "section
  * N"), and what --check prints names no source file of the generator
  * (gen/NAME.c) where a user would look for an explanation. */
@@ -432,6 +493,7 @@ Suite *docs_suite(void)
   tcase_add_test(tc, install_and_pkg_config);
   tcase_add_test(tc, man_page_and_api_cover_help);
   tcase_add_test(tc, help_covers_man_page);
+  tcase_add_test(tc, driver_options_documented);
   tcase_add_test(tc, no_pointers_to_sources);
   tcase_add_test(tc, relative_links_resolve);
   tcase_add_test(tc, stack_bound_holds);

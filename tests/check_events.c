@@ -30,6 +30,7 @@
 #include "driver_adapters.h"
 #include "errest.h"
 #include "hbvmrt.h"
+#include "hbvmrt_internal.h" /* hbvmrt_eta */
 #include "kepler_events_k4s4.h"
 #include "pendulum_events_k4s4.h"
 #include "ramp_events_k2s2.h"
@@ -47,7 +48,7 @@ Suite *events_suite(void);
       #P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), sizeof(P##_params), offsetof(P##_state, t),               \
       offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda), 0, NULL, NULL, NULL, P##_init_,   \
       P##_pd_, P##_step_, P##_strerror, P##_energy_, P##_g_, P##_hc_, names_xy, NULL, NULL, DBL_EPSILON, P##_adapt_,      \
-      P##_dense_, P##_NEVENTS, P##_event_names, P##_event_dirs, P##_events_};
+      P##_dense_, P##_NEVENTS, P##_event_names, P##_event_dirs, P##_events_, NULL};
 
 static const char *const names_xy[] = {"x", "y"};
 
@@ -408,9 +409,173 @@ START_TEST(bad_options)
                                         "-T 1 --dt 1e-300", "-N 10 --dt 1e-12", "-T 1e10 --dt 1"};
   for (size_t i = 0; i < sizeof endless / sizeof endless[0]; i++) {
     ck_assert_msg(run(&pendulum_events_k4s4_model, endless[i], ev, &nev, rows, 9, &nrows, 8) == 1, "%s", endless[i]);
-    ck_assert_msg(strstr(run_err, strstr(endless[i], "--tol") ? "--tol must be >= 4.9e-32" : "rows over the span"),
+    ck_assert_msg(strstr(run_err, strstr(endless[i], "--tol") ? "--tol must be >= 1.8e-15" : "rows over the span"),
                   "%s: %s", endless[i], run_err);
   }
+  /* below 8 ulps round-off outweighs the tolerance (issue 31, item 2): refused with the
+   * bound, in double and in float (a float solver's eps: tol 1e-6 runs, 1e-7 does not) */
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-T 1 --tol 1e-15", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_msg(strstr(run_err, "--tol must be >= 1.8e-15, 8 ulps of the solver's double"), "%s", run_err);
+  ck_assert_int_eq(run(&pendulum_events_k4s4_model, "-T 1 --tol 2e-15", ev, &nev, rows, 9, &nrows, 8), 0);
+  hbvmrt_model flt = pendulum_events_k4s4_model;
+  flt.eps = FLT_EPSILON;
+  ck_assert_int_eq(run(&flt, "-T 1 --tol 1e-7", ev, &nev, rows, 9, &nrows, 8), 1);
+  ck_assert_msg(strstr(run_err, "--tol must be >= 9.5e-07, 8 ulps of the solver's float"), "%s", run_err);
+  ck_assert_int_eq(run(&flt, "-T 1 --tol 1e-6", ev, &nev, rows, 9, &nrows, 8), 0);
+}
+END_TEST
+
+/* ---- the driver's options of issue 31, item 5 (docs/api.md, "The standalone driver"), on Kepler ---- */
+
+static Row opt_ev[MAXROWS];
+static double opt_a[MAXROWS * 6], opt_b[MAXROWS * 6];
+
+/* Run Kepler's driver with args into rows (6 columns: t, x, y, p_x, p_y, H): the status, the rows in *n. */
+static int kep(const char *args, double *rows, int *n) {
+  int nev;
+  return run(&kepler_events_k4s4_model, args, opt_ev, &nev, rows, 6, n, MAXROWS);
+}
+
+/* --hmax bounds every adaptive step (without it the steps reach 0.4), and a fixed -h above it is refused. */
+START_TEST(option_hmax) {
+  int n, k;
+  double hbig = 0;
+  ck_assert_int_eq(kep("--tol 1e-8 -h 0.01 -T 10", opt_a, &n), 0);
+  for (k = 1; k < n; k++) hbig = fmax(hbig, opt_a[k * 6] - opt_a[(k - 1) * 6]);
+  ck_assert_msg(hbig > 0.2, "largest step %g without --hmax", hbig);
+  ck_assert_int_eq(kep("--tol 1e-8 -h 0.01 -T 10 --hmax 0.05", opt_a, &n), 0);
+  for (k = 1; k < n; k++) ck_assert_double_le(opt_a[k * 6] - opt_a[(k - 1) * 6], 0.05 * (1 + 1e-12));
+  ck_assert_double_eq(opt_a[(n - 1) * 6], 10);
+  ck_assert_int_eq(kep("-h 0.1 -T 1 --hmax 0.05", opt_a, &n), 1);
+  ck_assert_msg(strstr(run_err, "-h 0.1 is above --hmax 0.05"), "%s", run_err);
+  ck_assert_int_eq(kep("--tol 1e-8 -T 1 --hmax 0", opt_a, &n), 1);
+}
+END_TEST
+
+/* --max-steps stops a run short of T: status 2, said, status=max_steps; fixed and adaptive. */
+START_TEST(option_max_steps) {
+  int n;
+  ck_assert_int_eq(kep("-h 0.1 -T 10 --max-steps 25", opt_a, &n), 2);
+  ck_assert_msg(strstr(run_err, "--max-steps 25 reached at t=2.5,") && strstr(run_err, "steps=25 ") &&
+                    strstr(run_err, "status=max_steps"), "%s", run_err);
+  ck_assert_int_eq(kep("--tol 1e-8 -T 10 --max-steps 30", opt_a, &n), 2);
+  ck_assert_msg(strstr(run_err, "steps=30 ") && strstr(run_err, "status=max_steps"), "%s", run_err);
+  ck_assert_int_eq(kep("-h 0.1 -T 1 --max-steps 25", opt_a, &n), 0);  /* 10 steps: done before */
+  ck_assert_int_eq(kep("-h 0.1 -T 1 --max-steps 0", opt_a, &n), 1);
+}
+END_TEST
+
+/* The largest difference in q, p of the last rows of two runs. */
+static double last_diff(const double *a, int na, const double *b, int nb) {
+  double d = 0;
+  for (int c = 1; c < 5; c++) d = fmax(d, fabs(a[(na - 1) * 6 + c] - b[(nb - 1) * 6 + c]));
+  return d;
+}
+
+/* --atol A --rtol R: --rtol alone is --atol R --rtol R, which takes the steps of --tol R (to the
+ * rounding of (R + R s) / (1 + s)); A = 1e-6, R = 1e-10 takes more steps than --tol 1e-6 (its tol
+ * is A / (1 + max|q|) and less) and fewer than --tol 1e-10; --tol with them is refused. */
+START_TEST(option_atol_rtol) {
+  int na, nb, n6, n10;
+  ck_assert_int_eq(kep("--rtol 1e-8 -T 10", opt_a, &na), 0);
+  ck_assert_int_eq(kep("--atol 1e-8 --rtol 1e-8 -T 10", opt_b, &nb), 0);
+  ck_assert_int_eq(na, nb);
+  ck_assert_double_eq(last_diff(opt_a, na, opt_b, nb), 0);
+  ck_assert_int_eq(kep("--tol 1e-8 -T 10", opt_b, &nb), 0);
+  ck_assert_msg(abs(na - nb) <= 2 && last_diff(opt_a, na, opt_b, nb) <= 1e-9, "%d and %d steps, %.2e apart", na, nb,
+                last_diff(opt_a, na, opt_b, nb));
+  ck_assert_int_eq(kep("--tol 1e-6 -T 10", opt_b, &n6), 0);
+  ck_assert_int_eq(kep("--tol 1e-10 -T 10", opt_b, &n10), 0);
+  ck_assert_int_eq(kep("--atol 1e-6 --rtol 1e-10 -T 10", opt_a, &na), 0);
+  ck_assert_msg(n6 < na && na < n10, "steps: --tol 1e-6 %d, --atol 1e-6 --rtol 1e-10 %d, --tol 1e-10 %d", n6, na, n10);
+  ck_assert_int_eq(kep("--tol 1e-8 --atol 1e-8 -T 1", opt_a, &na), 1);
+  ck_assert_msg(strstr(run_err, "--tol or --atol/--rtol, not both"), "%s", run_err);
+  ck_assert_int_eq(kep("--rtol 1e-16 -T 1", opt_a, &na), 1);
+}
+END_TEST
+
+/* --tol-per run: TOL / T per unit time, so the steps of --tol 1e-8 over T = 20 at 2e-7; the
+ * error at T of ten periods within 30x TOL (1 + max|q|) (1.6), as the tolerance per unit time
+ * holds TOL T (docs/api.md, "Tolerance proportionality"); refused below the bound. */
+START_TEST(option_tol_per_run) {
+  int na, nb;
+  double q[2], p[2], e = 0;
+  ck_assert_int_eq(kep("--tol 2e-7 --tol-per run -T 20", opt_a, &na), 0);
+  ck_assert_int_eq(kep("--tol 1e-8 -T 20", opt_b, &nb), 0);
+  ck_assert_msg(na == nb && last_diff(opt_a, na, opt_b, nb) <= 1e-10, "%d and %d steps, %.2e apart", na, nb,
+                last_diff(opt_a, na, opt_b, nb));
+  ck_assert_int_eq(kep("--tol 1e-6 --tol-per run -T 62.831853071795862", opt_a, &na), 0);
+  kepler_exact(opt_a[(na - 1) * 6], q, p);
+  for (int c = 0; c < 2; c++) e = fmax(e, fmax(fabs(opt_a[(na - 1) * 6 + 1 + c] - q[c]), fabs(opt_a[(na - 1) * 6 + 3 + c] - p[c])));
+  ck_assert_msg(e <= 30 * 1e-6 * 2.6, "error at T %.2e under --tol-per run 1e-6", e);
+  ck_assert_int_eq(kep("--tol 1e-14 --tol-per run -T 100", opt_a, &na), 1);
+  ck_assert_int_eq(kep("--tol 1e-8 --tol-per span -T 1", opt_a, &na), 1);
+}
+END_TEST
+
+/* --t0: the rows' t from T0, the states those of the run from 0 (Kepler does not depend on t). */
+START_TEST(option_t0) {
+  int na, nb;
+  ck_assert_int_eq(kep("-h 0.1 -N 20 --t0 5", opt_a, &na), 0);
+  ck_assert_int_eq(kep("-h 0.1 -N 20", opt_b, &nb), 0);
+  ck_assert_int_eq(na, nb);
+  for (int k = 0; k < na; k++) {
+    ck_assert_double_eq_tol(opt_a[k * 6], 5 + opt_b[k * 6], 1e-13);
+    for (int c = 1; c < 5; c++) ck_assert_double_eq_tol(opt_a[k * 6 + c], opt_b[k * 6 + c], 1e-15);
+  }
+  ck_assert_int_eq(kep("--tol 1e-8 -T 2 --t0 -3", opt_a, &na), 0);
+  ck_assert_double_eq(opt_a[0], -3);
+  ck_assert_double_eq(opt_a[(na - 1) * 6], -1);
+}
+END_TEST
+
+/* --restart FILE[:ROW]: from the last row of 20 steps, 20 more end within round-off (1e-13) of
+ * 40 steps at once; ROW picks a row; a row past the end and a missing column are refused. */
+START_TEST(option_restart) {
+  char path[] = "/tmp/hbvm-restart-XXXXXX", args[128];
+  int na, nb, fd = mkstemp(path);
+  ck_assert(fd >= 0);
+  close(fd);
+  ck_assert_int_eq(kep("-h 0.1 -N 20", opt_a, &na), 0);
+  FILE *f = fopen(path, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs("t,x,y,p_x,p_y,H\n", f);
+  for (int k = 0; k < na; k++)
+    for (int c = 0; c < 6; c++) fprintf(f, "%.17g%s", opt_a[k * 6 + c], c < 5 ? "," : "\n");
+  fclose(f);
+  snprintf(args, sizeof args, "-h 0.1 -N 20 --restart %s", path);
+  ck_assert_int_eq(kep(args, opt_b, &nb), 0);
+  ck_assert_double_eq(opt_b[0], 2);
+  ck_assert_int_eq(kep("-h 0.1 -N 40", opt_a, &na), 0);
+  ck_assert_double_eq_tol(opt_b[(nb - 1) * 6], 4, 1e-13);
+  ck_assert_msg(last_diff(opt_a, na, opt_b, nb) <= 1e-13, "restarted: %.2e off", last_diff(opt_a, na, opt_b, nb));
+  snprintf(args, sizeof args, "-h 0.1 -N 1 --restart %s:11", path);
+  ck_assert_int_eq(kep(args, opt_b, &nb), 0);
+  ck_assert_double_eq_tol(opt_b[0], 1, 1e-15);
+  snprintf(args, sizeof args, "-h 0.1 -N 1 --restart %s:99", path);
+  ck_assert_int_eq(kep(args, opt_b, &nb), 1);
+  ck_assert_msg(strstr(run_err, "has 21 rows, not 99"), "%s", run_err);
+  f = fopen(path, "w");
+  fputs("t,x,y\n0,1,0\n", f);
+  fclose(f);
+  snprintf(args, sizeof args, "-h 0.1 -N 1 --restart %s", path);
+  ck_assert_int_eq(kep(args, opt_b, &nb), 1);
+  ck_assert_msg(strstr(run_err, "has no column 'p_x'"), "%s", run_err);
+  unlink(path);
+}
+END_TEST
+
+/* The progress line's time left: elapsed (1 - done) / done, in s, m and s, or h and m. */
+START_TEST(option_eta) {
+  char b[32];
+  hbvmrt_eta(10, 0.5, b, sizeof b);
+  ck_assert_str_eq(b, "ETA 10s");
+  hbvmrt_eta(30, 0.25, b, sizeof b);
+  ck_assert_str_eq(b, "ETA 1m30s");
+  hbvmrt_eta(3600, 0.5, b, sizeof b);
+  ck_assert_str_eq(b, "ETA 1h00m");
+  hbvmrt_eta(1, 0, b, sizeof b);
+  ck_assert_str_eq(b, "");
 }
 END_TEST
 
@@ -429,6 +594,13 @@ Suite *events_suite(void) {
   tcase_add_loop_test(tc, span_end_exact, 0, 5);
   tcase_add_test(tc, same_output_twice);
   tcase_add_loop_test(tc, dt_grid, 0, sizeof dt_runs / sizeof dt_runs[0]);
+  tcase_add_test(tc, option_hmax);
+  tcase_add_test(tc, option_max_steps);
+  tcase_add_test(tc, option_atol_rtol);
+  tcase_add_test(tc, option_tol_per_run);
+  tcase_add_test(tc, option_t0);
+  tcase_add_test(tc, option_restart);
+  tcase_add_test(tc, option_eta);
   suite_add_tcase(s, tc);
   return s;
 }

@@ -146,7 +146,8 @@ static const hbvmrt_model osc = {
   NULL,                         /* no names: the numbered CSV header */
   NULL, NULL, 0,                /* as a driver of hbvmgen 0.1: no projection */
   NULL,                         /* nor error control */
-  NULL, 0, NULL, NULL, NULL     /* nor dense output and events */
+  NULL, 0, NULL, NULL, NULL,    /* nor dense output and events */
+  NULL                          /* nor a time of its own (--t0: written at off_t) */
 };
 
 /* --- kepler_k16s2: the generated solver of models/kepler.ham (k = 16) ---- */
@@ -176,7 +177,7 @@ static const hbvmrt_model kepler = {
   0, NULL, NULL, NULL,
   kep_init, kep_params_default, kep_step, kepler_k16s2_strerror, kep_energy,
   NULL, NULL, NULL, NULL, NULL, DBL_EPSILON,
-  NULL, NULL, 0, NULL, NULL, NULL
+  NULL, NULL, 0, NULL, NULL, NULL, NULL
 };
 
 /* --- ring: m=2, nu=1, parameter k ---------------------------------------- */
@@ -276,7 +277,7 @@ static const hbvmrt_model ring = {
   NULL,
   NULL, NULL, 0,
   NULL,
-  NULL, 0, NULL, NULL, NULL
+  NULL, 0, NULL, NULL, NULL, NULL
 };
 
 /* ring with the fields of hbvmgen 0.2 drivers: init at the run's params

@@ -140,7 +140,8 @@ static const hbvmrt_model fz = {
   fz_names,
   fz_init_params, fz_project, DBL_EPSILON,
   fz_step_adaptive,
-  fz_dense, 2, fz_event_names, fz_event_dirs, fz_events
+  fz_dense, 2, fz_event_names, fz_event_dirs, fz_events,
+  NULL
 };
 
 /* as a driver of hbvmgen 0.1, which ends at the field names */
@@ -155,7 +156,8 @@ static const hbvmrt_model old = {
   NULL,
   NULL, NULL, 0,
   NULL,
-  NULL, 0, NULL, NULL, NULL
+  NULL, 0, NULL, NULL, NULL,
+  NULL
 };
 
 /* ---- the input ---- */
