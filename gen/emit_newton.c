@@ -51,18 +51,21 @@ static void emit_factor_checked(Emitter *e) {
   tmpl(e, "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
 }
 
-// What NAME_step_within needs before its body: the checked factorisation.
-void emit_newton_helpers(Emitter *e) { emit_factor_checked(e); }
+// What NAME_step_within needs before its body: the checked factorisation
+// (and under --iteration auto the limit of the sweeps, NAME_SWITCH).
+void emit_newton_helpers(Emitter *e) {
+  if (emit_is_auto(e))
+    tmpl(e, "#ifndef $P_SWITCH\n#define $P_SWITCH 12  /* sweeps foreseen above which Newton takes over (auto) */\n#endif\n");
+  emit_factor_checked(e);
+}
 
-// The loop of NAME_step_within: from the predicted gam to the converged one,
+// The Newton loop of NAME_step_within: from gam to the converged gamma,
 // leaving sw the sweep at it (sw[gam] replaced by gam itself), it the
-// iterations, nfac the factorisations, d1 the first correction.
-void emit_newton_iteration(Emitter *e) {
+// iterations, nfac the factorisations, d1 the first correction. Assumes
+// nf, res, dg and nfac declared (emit_newton_locals), rc NAME_ENOCONV and
+// inc, inc_min, stall as the step's head sets them.
+static void emit_newton_loop(Emitter *e) {
   int nu = e->mod->nu;
-  tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
-          "   * factored at the predicted polynomial, again where the iteration slows down */\n"
-          "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M];\n"
-          "  int nfac = 1;\n");
   tmpl(e, nu ? "  rc = $P_newton_factor_checked(x, gam, x->lambda, h, prm, nf);\n"
              : "  rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
   tmpl(e, "  if (rc != $P_OK) return rc;\n"
@@ -107,11 +110,88 @@ void emit_newton_iteration(Emitter *e) {
           "      if (rf != $P_OK) { rc = rf; break; }\n"
           "    }\n  }\n"
           "  /* the step is the one at the gamma the sweep was evaluated at */\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n"
-          "  if (st) st->factors = nfac;\n");
+          "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n");
 }
 
-// The field of NAME_stats the Newton iteration adds.
+// The Newton iteration's locals, and its counts in the stats zeroed (a
+// step may return before it writes them).
+static void emit_newton_locals(Emitter *e, int nfac) {
+  tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M];\n");
+  out(e, "  int nfac = %d;\n", nfac);
+  tmpl(e, "  if (st) st->newton = st->factors = st->jacobians = 0;\n");
+}
+
+// The counts of the Newton iteration into the stats: nit iterations, nfac
+// factorisations, each with its own J.
+static void emit_newton_counts(Emitter *e, const char *nit) {
+  out(e, "  if (st) {\n    st->newton = %s;\n    st->factors = st->jacobians = nfac;\n  }\n", nit);
+}
+
+// --iteration newton: the loop of NAME_step_within, simplified Newton from
+// the predicted gam (emit_newton_loop).
+void emit_newton_iteration(Emitter *e) {
+  tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
+          "   * factored at the predicted polynomial, again where the iteration slows down */\n");
+  emit_newton_locals(e, 1);
+  emit_newton_loop(e);
+  emit_newton_counts(e, "it");
+}
+
+int emit_is_auto(const Emitter *e) { return e->me->iteration == ITER_AUTO; }
+
+// What NAME_ENOCONV says did not converge.
+const char *emit_iteration_name(const Emitter *e) {
+  return emit_is_auto(e) ? "fixed-point and Newton iterations" : emit_is_newton(e) ? "Newton iteration"
+                                                                                     : "fixed-point iteration";
+}
+
+// --iteration auto on a stiff model: the fixed-point sweeps of emit_iterate.c
+// from the predicted gamma; where they are slow (emit_auto_slow) or fail,
+// simplified Newton from the same start. Newton directly when |h| is at
+// least x->hnewton, the shortest step whose sweeps were slow (kept in the
+// state at the end of the step, emit_newton_commit). it: the sweeps plus
+// the Newton iterations.
+void emit_auto_iteration(Emitter *e) {
+  tmpl(e, "  /* --iteration auto: fixed-point sweeps first; simplified Newton where they are slow\n"
+          "   * or fail (from the same predicted gamma), or directly from a step as long as one\n"
+          "   * whose sweeps were slow (x->hnewton) */\n"
+          "  $R gpred[$P_S * $P_M], inc_pp = HUGE_VAL, hnewton = x->hnewton;\n"
+          "  int sweeps = 0;\n");
+  emit_newton_locals(e, 0);
+  tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) gpred[i] = gam[i];\n"
+          "  if (!(hnewton > 0 && fabs$f(h) >= hnewton)) {\n");
+  emit_fixed_point(e);
+  tmpl(e, "  sweeps = it > $P_MAXITER ? $P_MAXITER : it;\n"
+          "  if (rc != $P_OK && (!(hnewton > 0) || fabs$f(h) < hnewton)) hnewton = fabs$f(h);\n"
+          "  }\n"
+          "  if (rc != $P_OK) {  /* simplified Newton from the predicted gamma */\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = gpred[i];\n"
+          "  inc = inc_min = HUGE_VAL;\n  stall = 0;\n  nfac = 1;\n");
+  emit_newton_loop(e);
+  emit_newton_counts(e, "it");
+  tmpl(e, "  it += sweeps;\n  }\n");
+}
+
+// In the fixed-point loop of --iteration auto, after the tests for
+// convergence: the sweeps are slow where the increment, falling by
+// rho2 = inc / inc_pp over two sweeps, would take more than NAME_SWITCH
+// sweeps in all to reach NAME_TOL / 256, or does not fall (it >= 3). The loop
+// then ends with rc not NAME_OK, and Newton takes over.
+void emit_auto_slow(Emitter *e) {
+  tmpl(e, "    /* slow: more than $P_SWITCH sweeps foreseen at the contraction of the last two */\n"
+          "    if (it >= 3 && !(inc < inc_pp && it + 2 * log(inc * 256 / $P_TOL) / log(inc_pp / inc) <= $P_SWITCH)) {\n"
+          "      rc = $P_ENOCONV;\n      break;\n    }\n"
+          "    inc_pp = inc_old;\n");
+}
+
+// The end of a step of --iteration auto: the shortest slow h into the state.
+void emit_newton_commit(Emitter *e) {
+  if (emit_is_auto(e)) tmpl(e, "  x->hnewton = hnewton;\n");
+}
+
+// The fields of NAME_stats the Newton iteration adds.
 void emit_newton_stats(Emitter *e) {
-  tmpl(e, "  int factors;       /* factorisations of the Newton matrix (--iteration newton) */\n");
+  tmpl(e, "  int newton;        /* iterations of simplified Newton (iters counts them too) */\n"
+          "  int factors;       /* factorisations of the Newton matrix */\n"
+          "  int jacobians;     /* evaluations of its J = Hess(U + lambda' g) (one a factorisation) */\n");
 }

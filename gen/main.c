@@ -154,8 +154,9 @@ static int parse_args(int argc, char **argv, Options *o) {
     } else if (!strcmp(a, "--iteration")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
-      if (strcmp(v, "fixed") && strcmp(v, "newton")) return fail("--iteration needs 'fixed' or 'newton', got '%s'", v);
-      o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : ITER_FIXED;
+      if (strcmp(v, "fixed") && strcmp(v, "newton") && strcmp(v, "auto"))
+        return fail("--iteration needs 'auto', 'fixed' or 'newton', got '%s'", v);
+      o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : !strcmp(v, "auto") ? ITER_AUTO : ITER_FIXED;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -288,7 +289,8 @@ static const char *mass_str(MassKind k) {
   return "?";
 }
 
-static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam) {
+static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam,
+                        const char *iter_why) {
   char a[16], b[16];
   printf("model %s: m=%d nu=%d deg(U)=%s deg(g)=%s k=%d s=%d\n", o->name, mod->m, mod->nu, deg_str(mod->degU, a),
          deg_str(mod->degg, b), k, o->s);
@@ -305,6 +307,8 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
   if (o->iteration == ITER_NEWTON)
     printf("iteration: newton (simplified Newton, the Newton matrix factored once a step, docs/method-newton.md)\n");
+  else
+    printf("iteration: %s\n", iter_why);
   if (!mod->minv_node) printf("M: %s\n", mass_str(mod->mass));
   else
     printf("M: with params: %s, computed from them in every kernel call\n",
@@ -503,9 +507,9 @@ static EmitOptions emit_options(const Options *o) {
 // whether the k stages are straight-line code or one loop (--stage-loop).
 // Returns 1 when the step cannot be emitted (the reason reported), else 0;
 // without a temporary file the line says so and the status stays 0.
-static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam) {
+static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam, IterKind iter) {
   Method *me = method_new(k, o->s, fam);
-  me->iteration = (IterKind)o->iteration;
+  me->iteration = iter;
   Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
   if (!st || emit_check(mod, st, &eo)) return 1;
@@ -589,8 +593,48 @@ static void report_degree(const Model *mod, int s, int k) {
            best < 0 ? "U" : "this constraint", best < 0 ? mod->degU : mod->degg, k, MAX_K);
 }
 
+/* --iteration auto: a model is stiff where omega_fast / omega_slow of its
+ * linearisation at q0 (stiffness.c) is at least this. The fixed-point sweep
+ * converges while h omega_fast < ~3; a step that follows the slow motion
+ * accurately has h omega_slow of about 0.04 (HBVM(k,2): a relative error of
+ * order 1e-7 a period), so above 3 / 0.04 = 75 the sweep, not accuracy,
+ * sets h. The paper's models are at most 56 (satellites), the stiff bob at
+ * k = 1e4 is 107, the FPU chain 47 at omega = 50 and 945 at omega = 1000. */
+#define STIFF_RATIO 75
+
+// What --iteration resolves to: fixed and newton as given; auto (the
+// default) ITER_AUTO (sweeps first, Newton where they are slow) for a stiff
+// model where Newton can be emitted, else ITER_FIXED, today's code. why
+// receives --check's line (after "iteration: ").
+static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily fam, char *why, size_t n) {
+  if (o->iteration == ITER_FIXED) {
+    snprintf(why, n, "fixed (fixed-point sweeps, given with --iteration fixed)");
+    return ITER_FIXED;
+  }
+  if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
+  double wf, ws, r = model_stiffness(mod, &wf, &ws);
+  const char *no = mod->nu && fam == MULT_POLY ? "Newton needs --multiplier const with constraints"
+                   : o->batch                  ? "Newton is not emitted with --batch"
+                   : o->wide_step              ? "Newton is not emitted with --wide-step"
+                   : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
+                                               : NULL;
+  if (r == 0)
+    snprintf(why, n, "auto: fixed (fixed-point sweeps; stiffness not estimated: %s)",
+             mod->minv_node ? "M has params" : mod->m > 200 ? "m > 200" : "no nonzero frequency at q0");
+  else if (r < STIFF_RATIO)
+    snprintf(why, n, "auto: fixed (fixed-point sweeps; not stiff: omega_fast / omega_slow = %.3g / %.3g = %.3g < %d "
+             "at q0)", wf, ws, r, STIFF_RATIO);
+  else if (no)
+    snprintf(why, n, "auto: fixed (fixed-point sweeps, converging while h < ~3 / %.3g; stiff, omega_fast / omega_slow "
+             "= %.3g >= %d at q0, but %s)", wf, r, STIFF_RATIO, no);
+  else
+    snprintf(why, n, "auto: sweeps, then newton where they contract slowly (stiff: omega_fast / omega_slow = %.3g / "
+             "%.3g = %.3g >= %d at q0; docs/method-newton.md)", wf, ws, r, STIFF_RATIO);
+  return r >= STIFF_RATIO && !no ? ITER_AUTO : ITER_FIXED;
+}
+
 int main(int argc, char **argv) {
-  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_AUTO};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) {
@@ -619,6 +663,8 @@ int main(int argc, char **argv) {
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, fam, &why);
+  char iter_why[512];
+  IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
   if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
                             "use --multiplier const (or --iteration fixed)");
@@ -634,11 +680,11 @@ int main(int argc, char **argv) {
              FLOAT_POLY_MAX_S, o.s);
     rc = 1;
   } else if (o.check_only) {
-    print_check(mod, &o, k, why, fam);
-    rc = print_check_code(&o, mod, k, fam);
+    print_check(mod, &o, k, why, fam, iter_why);
+    rc = print_check_code(&o, mod, k, fam, iter);
   } else {
     Method *me = method_new(k, o.s, fam);
-    me->iteration = (IterKind)o.iteration;
+    me->iteration = iter;
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }
