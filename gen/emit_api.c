@@ -49,8 +49,7 @@ void emit_header(Emitter *e, const EmitOptions *o) {
     out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
     out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
   }
-  if (emit_is_auto(e))
-    out(e, "  %s_real hnewton;  /* the shortest |h| whose sweeps were slow: Newton from it on (0: none) */\n", e->P);
+  if (emit_is_newton(e)) emit_newton_state(e);
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
     char v[40];
@@ -221,7 +220,7 @@ static void emit_init(Emitter *e) {
           "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;\n");
   if (e->st->kern[K_FACTOR].nout)
     tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
-  if (emit_is_auto(e)) tmpl(e, "  x->hnewton = 0;\n");
+  if (emit_is_newton(e)) emit_newton_init(e);
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"
           "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0)\n{\n"

@@ -51,9 +51,10 @@ static void emit_factor_checked(Emitter *e) {
   tmpl(e, "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
 }
 
-// What NAME_step_within needs before its body: the checked factorisation
-// (and under --iteration auto the limit of the sweeps, NAME_SWITCH).
+// What NAME_step_within needs before its body: the checked factorisation,
+// NAME_REUSE (and under --iteration auto the limit of the sweeps, NAME_SWITCH).
 void emit_newton_helpers(Emitter *e) {
+  tmpl(e, "#ifndef $P_REUSE\n#define $P_REUSE 1e-3  /* a factor kept across steps while it contracts below this */\n#endif\n");
   if (emit_is_auto(e))
     tmpl(e, "#ifndef $P_SWITCH\n#define $P_SWITCH 12  /* sweeps foreseen above which Newton takes over (auto) */\n#endif\n");
   emit_factor_checked(e);
@@ -61,14 +62,24 @@ void emit_newton_helpers(Emitter *e) {
 
 // The Newton loop of NAME_step_within: from gam to the converged gamma,
 // leaving sw the sweep at it (sw[gam] replaced by gam itself), it the
-// iterations, nfac the factorisations, d1 the first correction. Assumes
-// nf, res, dg and nfac declared (emit_newton_locals), rc NAME_ENOCONV and
-// inc, inc_min, stall as the step's head sets them.
+// iterations, nfac the factorisations, rate the contraction, d1 the first
+// correction. The factor is the state's, x->nf, where it was taken at this
+// h and the last step that used it contracted by less than NAME_REUSE (the
+// rule of Radau5 and IDA across steps), else a fresh one into nf; fac
+// points at the one in use. Assumes nf, res, dg, nfac, rate and fac
+// declared (emit_newton_locals), rc NAME_ENOCONV and inc, inc_min, stall as
+// the step's head sets them.
 static void emit_newton_loop(Emitter *e) {
   int nu = e->mod->nu;
-  tmpl(e, nu ? "  rc = $P_newton_factor_checked(x, gam, x->lambda, h, prm, nf);\n"
-             : "  rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
-  tmpl(e, "  if (rc != $P_OK) return rc;\n"
+  tmpl(e, "  rate = 0;\n"
+          "  if (x->nfh == h && x->nfrate < $P_REUSE) {\n"
+          "    fac = x->nf;  /* the last step's factor, at this h, contracted fast: kept */\n"
+          "  } else {\n");
+  tmpl(e, nu ? "    rc = $P_newton_factor_checked(x, gam, x->lambda, h, prm, nf);\n"
+             : "    rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
+  tmpl(e, "    nfac++;\n"
+          "    if (rc != $P_OK) return rc;\n"
+          "  }\n"
           "  rc = $P_ENOCONV;\n"
           "  for (it = 1; it <= $P_MAXITER; it++) {\n");
   tmpl(e, nu ? "    $(sweep q0=x->q p0=x->p gam=gam h=h g0=g0 out=sw);\n" : "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n");
@@ -81,7 +92,7 @@ static void emit_newton_loop(Emitter *e) {
   tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
           "    if (rc == $P_ENONFINITE) break;\n"
           "    for (i = 0; i < $P_S * $P_M; i++) res[i] = sw[$[sweep.gam]i] - gam[i];\n"
-          "    $(newton_solve gam=res lu=nf out=dg);\n"
+          "    $(newton_solve gam=res lu=fac out=dg);\n"
           "    /* increment: max |h dgamma| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
           "    for (i = 0; i < $P_M; i++) {\n"
@@ -92,6 +103,7 @@ static void emit_newton_loop(Emitter *e) {
           "    if (it == 1) d1 = inc;  /* the predictor's error, for $P_err_est */\n"
           "    if (scale > 0) inc /= scale;\n"
           "    if (!isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
+          "    if (it > 1 && inc > $P_NOISETOL && inc > rate * inc_old) rate = inc / inc_old;  /* above round-off */\n"
           "    /* converged at the gamma of this sweep (whose error is this increment): the\n"
           "     * increment far below an ulp, or within 2 ulps and no longer falling 4x (noise) */\n"
           "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) {\n"
@@ -106,7 +118,7 @@ static void emit_newton_loop(Emitter *e) {
           "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n");
   tmpl(e, nu ? "      int rf = $P_newton_factor_checked(x, gam, sw + $[sweep.lambda]0, h, prm, nf);  /* the last lambda */\n"
              : "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
-  tmpl(e, "      nfac++;\n"
+  tmpl(e, "      fac = nf;\n      nfac++;\n"
           "      if (rf != $P_OK) { rc = rf; break; }\n"
           "    }\n  }\n"
           "  /* the step is the one at the gamma the sweep was evaluated at */\n"
@@ -114,11 +126,12 @@ static void emit_newton_loop(Emitter *e) {
 }
 
 // The Newton iteration's locals, and its counts in the stats zeroed (a
-// step may return before it writes them).
-static void emit_newton_locals(Emitter *e, int nfac) {
-  tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M];\n");
-  out(e, "  int nfac = %d;\n", nfac);
-  tmpl(e, "  if (st) st->newton = st->factors = st->jacobians = 0;\n");
+// step may return before it writes them). rate < 0: Newton did not run.
+static void emit_newton_locals(Emitter *e) {
+  tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
+          "  const $R *fac = nf;  /* the factor in use: nf, or the state's */\n"
+          "  int nfac = 0;\n"
+          "  if (st) st->newton = st->factors = st->jacobians = 0;\n");
 }
 
 // The counts of the Newton iteration into the stats: nit iterations, nfac
@@ -132,7 +145,7 @@ static void emit_newton_counts(Emitter *e, const char *nit) {
 void emit_newton_iteration(Emitter *e) {
   tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
           "   * factored at the predicted polynomial, again where the iteration slows down */\n");
-  emit_newton_locals(e, 1);
+  emit_newton_locals(e);
   emit_newton_loop(e);
   emit_newton_counts(e, "it");
 }
@@ -157,7 +170,7 @@ void emit_auto_iteration(Emitter *e) {
           "   * whose sweeps were slow (x->hnewton) */\n"
           "  $R gpred[$P_S * $P_M], inc_pp = HUGE_VAL, hnewton = x->hnewton;\n"
           "  int sweeps = 0;\n");
-  emit_newton_locals(e, 0);
+  emit_newton_locals(e);
   tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) gpred[i] = gam[i];\n"
           "  if (!(hnewton > 0 && fabs$f(h) >= hnewton)) {\n");
   emit_fixed_point(e);
@@ -166,7 +179,7 @@ void emit_auto_iteration(Emitter *e) {
           "  }\n"
           "  if (rc != $P_OK) {  /* simplified Newton from the predicted gamma */\n"
           "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = gpred[i];\n"
-          "  inc = inc_min = HUGE_VAL;\n  stall = 0;\n  nfac = 1;\n");
+          "  inc = inc_min = HUGE_VAL;\n  stall = 0;\n");
   emit_newton_loop(e);
   emit_newton_counts(e, "it");
   tmpl(e, "  it += sweeps;\n  }\n");
@@ -184,9 +197,29 @@ void emit_auto_slow(Emitter *e) {
           "    inc_pp = inc_old;\n");
 }
 
-// The end of a step of --iteration auto: the shortest slow h into the state.
+// The end of a step with Newton: a fresh factor into the state with its h,
+// the contraction of the step that used it, and under --iteration auto the
+// shortest slow h.
 void emit_newton_commit(Emitter *e) {
+  if (!emit_is_newton(e)) return;
+  tmpl(e, "  if (nfac) {  /* a fresh factor: kept for the next steps at this h */\n"
+          "    for (i = 0; i < $<newton_factor>; i++) x->nf[i] = nf[i];\n"
+          "    x->nfh = h;\n  }\n"
+          "  if (rate >= 0) x->nfrate = rate;\n");
   if (emit_is_auto(e)) tmpl(e, "  x->hnewton = hnewton;\n");
+}
+
+// The state's fields of the Newton iteration: its factor kept across steps.
+void emit_newton_state(Emitter *e) {
+  tmpl(e, "  $R nf[$<newton_factor> + 1];  /* the Newton matrix's factor kept across steps ... */\n"
+          "  $R nfh, nfrate;  /* ... taken at h = nfh (0: none); the last contraction with it */\n");
+  if (emit_is_auto(e)) tmpl(e, "  $R hnewton;  /* the shortest |h| whose sweeps were slow: Newton from it on (0: none) */\n");
+}
+
+// Their values after NAME_init: no factor.
+void emit_newton_init(Emitter *e) {
+  tmpl(e, "  x->nfh = x->nfrate = 0;\n  for (i = 0; i <= $<newton_factor>; i++) x->nf[i] = 0;\n");
+  if (emit_is_auto(e)) tmpl(e, "  x->hnewton = 0;\n");
 }
 
 // The fields of NAME_stats the Newton iteration adds.
