@@ -46,12 +46,15 @@ static const char usage[] =
     "                (2s where the true multiplier is constant); poly: a polynomial of\n"
     "                degree s-1, then p projected onto the hidden constraint and rescaled\n"
     "                to the energy: order 2s. Default: poly for s >= 2 with constraints\n"
-    "  --iteration I fixed or newton: how the step's equations are solved. fixed\n"
-    "                (default): fixed-point sweeps, which converge while h omega < ~3 (omega\n"
-    "                the fastest frequency of the linearised model); newton: simplified\n"
-    "                Newton with the Hessian of U (+ lambda' g), for stiff models and long\n"
-    "                steps; with constraints only with --multiplier const; not with --batch\n"
-    "                or --wide-step; docs/method-newton.md)\n"
+    "  --iteration I auto, fixed or newton: how the step's equations are solved. fixed:\n"
+    "                fixed-point sweeps, which converge while h omega < ~3 (omega the\n"
+    "                fastest frequency of the linearised model); newton: simplified Newton\n"
+    "                with the Hessian of U (+ lambda' g), for stiff models and long steps;\n"
+    "                auto (default): fixed's code for a model that is not stiff at q0\n"
+    "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
+    "                where they are slow (--check says which). Newton: with constraints\n"
+    "                only with --multiplier const; not with --batch or --wide-step\n"
+    "                (docs/method-newton.md)\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k, and the\n"
     "                size of the code it would write (nothing is written)\n"
@@ -667,7 +670,8 @@ int main(int argc, char **argv) {
   IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
   if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
-                            "use --multiplier const (or --iteration fixed)");
+                            "use --multiplier const (the constant multiplier, order 2 in p with constraints), "
+                            "or --iteration fixed or auto (fixed-point sweeps in the poly family)");
     rc = 1;
   } else if (k > MAX_K) {
     report_degree(mod, o.s, k);
