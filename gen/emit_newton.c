@@ -1,4 +1,5 @@
-/* emit_newton.c - C text of the step's iteration under --iteration newton.
+/* emit_newton.c - C text of the step's iteration under --iteration newton,
+ * and under --iteration auto on a stiff model.
  *
  * In place of the fixed-point loop of emit_step.c: simplified Newton on
  * F(gamma) = Phi(gamma) - gamma, Phi the sweep kernel (its result gam is
@@ -6,8 +7,11 @@
  * the kernel "newton_factor" at the predicted polynomial, and again at the
  * current one where the increments fall by less than half (the rule of
  * Radau5 and IDA, within the step); "newton_solve" gives the correction.
- * The factor is not kept across steps (first version: one or more
- * factorisations every step).
+ * Across steps the factor is kept in the state while h is the same and the
+ * last step contracted below NAME_REUSE (Radau5's rule across steps).
+ * Under auto (emit_auto_iteration) the step first runs the fixed-point
+ * loop of emit_iterate.c, which ends early where it is slow
+ * (emit_auto_slow), and Newton restarts from the predicted gamma.
  *
  * Stopping: as the fixed-point step of the constant family, on the scaled
  * increment |h dgamma| / (max |q| + |h gamma_0|): far below an ulp
