@@ -604,6 +604,11 @@ static void report_degree(const Model *mod, int s, int k) {
  * sets h. The paper's models are at most 56 (satellites), the stiff bob at
  * k = 1e4 is 107, the FPU chain 47 at omega = 50 and 945 at omega = 1000. */
 #define STIFF_RATIO 75
+/* ... and auto emits Newton only up to this m: its factorisation is unrolled
+ * (m^3 operations for a dense Hessian; the loop form is not done), and a
+ * long chain's frequencies alone spread like m (tests/check_lean.c's dense
+ * chain of m = 160 would have taken more than 4 MB of C). */
+#define AUTO_NEWTON_MAX_M 32
 
 // What --iteration resolves to: fixed and newton as given; auto (the
 // default) ITER_AUTO (sweeps first, Newton where they are slow) for a stiff
@@ -620,6 +625,8 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily
                    : o->batch                  ? "Newton is not emitted with --batch"
                    : o->wide_step              ? "Newton is not emitted with --wide-step"
                    : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
+                   : mod->m > AUTO_NEWTON_MAX_M ? "auto emits Newton up to m = " STR(AUTO_NEWTON_MAX_M)
+                                                  " (its factorisation is unrolled: --iteration newton)"
                                                : NULL;
   if (r == 0)
     snprintf(why, n, "auto: fixed (fixed-point sweeps; stiffness not estimated: %s)",

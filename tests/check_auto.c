@@ -5,8 +5,9 @@
  *   decision  a model that is not stiff by the rule (omega_fast / omega_slow
  *             below 75 at q0: the paper's four models, Kepler, the FPU chain
  *             at its default omega = 50) and a stiff one Newton cannot take
- *             (the stiff bob in the default poly family) get the code of
- *             --iteration fixed, byte for byte; --check says which ran.
+ *             (the stiff bob in the default poly family; a stiff chain of
+ *             m = 40 > 32) get the code of --iteration fixed, byte for byte;
+ *             --check says which ran.
  *   fpu       the FPU chain at omega = 1000 (tests/models/fpu_stiff.ham),
  *             HBVM(4,2): at h omega = 0.1 the sweeps converge fast, Newton
  *             never runs and the trajectory is the fixed-point solver's bit
@@ -55,6 +56,22 @@ START_TEST(test_not_stiff_is_fixed) {
     free(b);
     free(text);
   }
+}
+END_TEST
+
+/* A stiff model above m = 32 (a chain of 40 stiff springs, omega_fast /
+ * omega_slow about 2000) gets the fixed-point code too: Newton's unrolled
+ * factorisation would grow like m^3. Fails without the cap. */
+START_TEST(test_large_stiff_is_fixed) {
+  static const char text[] = "N = 40\nvariables q[N]\n"
+                             "U = 1e6 * sum(i in 2..N, (q[i] - q[i-1])^2) / 2 + sum(i in 1..N, q[i]^2) / 2\n"
+                             "q0 = [0.01 * i for i in 1..N]\np0 = [0 for i in 1..N]\n";
+  char *a = generate_source(text, "-s 2"), *b = generate_source(text, "-s 2 --iteration fixed");
+  ck_assert_ptr_nonnull(a);
+  ck_assert_ptr_nonnull(b);
+  ck_assert_msg(!strcmp(a, b), "m = 40: auto's code is not --iteration fixed's");
+  free(a);
+  free(b);
 }
 END_TEST
 
@@ -223,6 +240,7 @@ Suite *auto_suite(void) {
   TCase *tc = tcase_create("decision");
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, test_not_stiff_is_fixed);
+  tcase_add_test(tc, test_large_stiff_is_fixed);
   tcase_add_test(tc, test_check_says);
   suite_add_tcase(s, tc);
   TCase *fpu = tcase_create("fpu");
