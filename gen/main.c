@@ -327,7 +327,8 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   else
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
   if (o->iteration == ITER_NEWTON)
-    printf("iteration: newton (simplified Newton, the Newton matrix factored once a step, docs/method-newton.md)\n");
+    printf("iteration: newton (simplified Newton, the Newton matrix factored and kept across steps while it contracts "
+           "fast, docs/method-newton.md)\n");
   else
     printf("iteration: %s\n", iter_why);
   if (mod->mass_q) mass_q_report(stdout, mod);
