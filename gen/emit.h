@@ -108,6 +108,13 @@ int emit_is_newton(const Emitter *e);
 void emit_newton_helpers(Emitter *e);
 void emit_newton_iteration(Emitter *e);
 void emit_newton_stats(Emitter *e);
+int emit_is_auto(const Emitter *e);
+const char *emit_iteration_name(const Emitter *e);
+void emit_auto_iteration(Emitter *e);
+void emit_auto_slow(Emitter *e);
+void emit_newton_commit(Emitter *e);
+void emit_newton_state(Emitter *e);
+void emit_newton_init(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */
 void emit_batch_header(Emitter *e, int lanes);

@@ -32,8 +32,9 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "#define %s_NPARAMS %d\n", e->P, mod->nparams);
   out(e, "#define %s_NEVENTS %d  /* event functions (docs/language.md) */\n\n", e->P, mod->nevents);
   tmpl(e, "/* Return codes of $P_step; on any nonzero code the state is unchanged. */\n"
-          "#define $P_OK 0\n"
-          "#define $P_ENOCONV 1     /* the fixed-point iteration did not converge: reduce h */\n"
+          "#define $P_OK 0\n");
+  out(e, "#define %s_ENOCONV 1     /* the %s did not converge: reduce h */\n", e->P, emit_iteration_name(e));
+  tmpl(e, ""
           "#define $P_ENONFINITE 2  /* a non-finite value (outside a function's domain?) */\n"
           "#define $P_ESINGULAR 3   /* the multiplier system is singular (dependent constraints?) */\n"
           "#define $P_EBADSTEP 4    /* h is zero or not finite */\n\n"
@@ -46,6 +47,7 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
   if (poly || mod->mass_q) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
   if (poly) out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
+  if (emit_is_newton(e)) emit_newton_state(e);
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
   for (int i = 0; i < mod->nparams; i++) {
     char v[40];
@@ -245,6 +247,7 @@ static void emit_init(Emitter *e) {
     tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
   else if (e->mod->mass_q)
     tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
+  if (emit_is_newton(e)) emit_newton_init(e);
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"
           "void $P_init($P_state *x, const $P_real *q0, const $P_real *p0)\n{\n"
@@ -263,8 +266,9 @@ void emit_public(Emitter *e) {
           "#define $P_DEFAULT_PARAMS(prm) $P_params dflt_; if (!prm) { $P_params_default(&dflt_); prm = &dflt_; }\n\n");
   emit_init(e);
   tmpl(e, "const char *$P_strerror(int code)\n{\n  switch (code) {\n"
-          "  case $P_OK: return \"ok\";\n"
-          "  case $P_ENOCONV: return \"fixed-point iteration did not converge\";\n"
+          "  case $P_OK: return \"ok\";\n");
+  out(e, "  case %s_ENOCONV: return \"%s did not converge\";\n", e->P, emit_iteration_name(e));
+  tmpl(e, ""
           "  case $P_ENONFINITE: return \"non-finite value\";\n"
           "  case $P_ESINGULAR: return \"singular multiplier system\";\n"
           "  case $P_EBADSTEP: return \"step size zero or not finite\";\n"

@@ -117,6 +117,7 @@ void emit_end_poly(Emitter *e) {
           "  for (i = 0; i < $P_NU; i++) {\n"
           "    $W lam = beta * beta * pr[$[project_p1.lamv]i] - pr[$[project_p1.lamu]i];\n"
           "    x->lambda[i] = isfinite(lam) ? ($R)lam : 0;\n  }\n");
+  emit_newton_commit(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }
 
@@ -146,5 +147,6 @@ void emit_end_const(Emitter *e) {
   }
   emit_commit_gamma(e);
   emit_commit_pinc(e);
+  emit_newton_commit(e);
   tmpl(e, "  $P_add(&x->t, &x->tc, h);\n  x->hprev2 = x->hprev;\n  x->hprev = h;\n  return $P_OK;\n}\n");
 }

@@ -390,7 +390,8 @@ void emit_step_adaptive(Emitter *e) {
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
           "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n"
           "          st->defect = s.defect;\n");
-  if (emit_is_newton(e)) tmpl(e, "          st->factors = s.factors;\n");
+  if (emit_is_newton(e))
+    tmpl(e, "          st->newton = s.newton;\n          st->factors = s.factors;\n          st->jacobians = s.jacobians;\n");
   tmpl(e, "        }\n"
           "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
@@ -398,7 +399,8 @@ void emit_step_adaptive(Emitter *e) {
           "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"
           "        st->err_est = s.err_est;\n        st->h = 0;\n        st->rejected = rejected;\n"
           "        st->defect = s.defect;\n");
-  if (emit_is_newton(e)) tmpl(e, "        st->factors = s.factors;\n");
+  if (emit_is_newton(e))
+    tmpl(e, "        st->newton = s.newton;\n        st->factors = s.factors;\n        st->jacobians = s.jacobians;\n");
   tmpl(e, "      }\n"
           "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
   emit_step_controlled(e);

@@ -219,7 +219,9 @@ static void emit_convergence(Emitter *e) {
           "     * no failure. $P_STALL sweeps without one are a stall: converged if it is at\n"
           "     * round-off ($P_NOISETOL), else a failure: never a step that has not converged. */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
-          "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n  }\n");
+          "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n");
+  if (emit_is_auto(e)) emit_auto_slow(e); /* emit_newton.c */
+  out(e, "  }\n");
 }
 
 // The fixed-point iteration of the step: gamma swept until the increment

@@ -17,7 +17,13 @@ static void emit_values(FILE *f, const char *name, const double *v, int n) {
 
 // Adapters from the runtime's opaque pointers to the double solver's
 // typed functions: the runtime reads and writes its state directly.
-static void emit_adapters(FILE *f, const char *P) {
+// The Newton iteration's counts copied from s to the runtime's st, where
+// the solver has them (--iteration newton, or auto on a stiff model).
+static const char *newton_copy(const Method *me) {
+  return me->iteration == ITER_FIXED ? "" : "  st->newton = s.newton;\n  st->factors = s.factors;\n  st->jacobians = s.jacobians;\n";
+}
+
+static void emit_adapters(FILE *f, const char *P, const Method *me) {
   fprintf(f, "static void init(void *x, const double *q0, const double *p0) { %s_init(x, q0, p0); }\n", P);
   fprintf(f, "static void init_params(void *x, const double *q0, const double *p0, const void *prm)\n"
              "{\n  %s_init_params(x, q0, p0, prm);\n}\n", P);
@@ -29,11 +35,12 @@ static void emit_adapters(FILE *f, const char *P) {
           P);
   fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n");
   fprintf(f, "  %s_stats s;\n  int rc = %s_step(x, h, prm, &s);\n", P, P);
-  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n  return rc;\n}\n\n");
+  fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n%s"
+             "  return rc;\n}\n\n", newton_copy(me));
   fprintf(f, "static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)\n{\n");
   fprintf(f, "  %s_stats s;\n  int rc = %s_step_adaptive(x, h, tol, prm, &s);\n", P, P);
   fprintf(f, "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n"
-             "  st->h = s.h;\n  st->rejected = s.rejected;\n  return rc;\n}\n\n");
+             "  st->h = s.h;\n  st->rejected = s.rejected;\n%s  return rc;\n}\n\n", newton_copy(me));
 }
 
 // The adapter `name` of a function of the state with n values (n the
@@ -76,7 +83,7 @@ static void emit_switch_adapters(FILE *f, const Model *mod, const char *P, int s
 // The same for a float solver: the runtime works in double, so it is given
 // a view (the state's public fields in double beside the float state, and
 // the params in double), converted at every call.
-static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
+static void emit_float_adapters(FILE *f, const Model *mod, const char *P, const Method *me) {
   int nu1 = mod->nu ? mod->nu : 1;
   fprintf(f, "/* The runtime reads and writes doubles: it sees this view of the float state and\n"
              " * params, converted at every call. */\n");
@@ -110,13 +117,14 @@ static void emit_float_adapters(FILE *f, const Model *mod, const char *P) {
   fprintf(f, "static int step(void *x, double h, const void *prm, hbvmrt_stats *st)\n{\n"
              "  %s_params r;\n  %s_stats s;\n  int rc;\n  to_real(prm, &r);\n"
              "  rc = %s_step(&((view *)x)->s, (%s_real)h, &r, &s);\n"
-             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n  sync(x);\n"
-             "  return rc;\n}\n\n", P, P, P, P);
+             "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n%s"
+             "  sync(x);\n  return rc;\n}\n\n", P, P, P, P, newton_copy(me));
   fprintf(f, "static int step_adaptive(void *x, double *h, double tol, const void *prm, hbvmrt_stats *st)\n{\n"
              "  %s_params r;\n  %s_stats s;\n  %s_real hr = (%s_real)*h;\n  int rc;\n  to_real(prm, &r);\n"
              "  rc = %s_step_adaptive(&((view *)x)->s, &hr, (%s_real)tol, &r, &s);\n  *h = hr;\n"
              "  st->iters = s.iters;\n  st->increment = s.increment;\n  st->err_est = s.err_est;\n  st->defect = s.defect;\n"
-             "  st->h = s.h;\n  st->rejected = s.rejected;\n  sync(x);\n  return rc;\n}\n\n", P, P, P, P, P, P);
+             "  st->h = s.h;\n  st->rejected = s.rejected;\n%s  sync(x);\n  return rc;\n}\n\n", P, P, P, P, P, P,
+          newton_copy(me));
   fprintf(f, "static double energy(const void *x, const void *prm)\n{\n  %s_params r;\n  to_real(prm, &r);\n"
              "  return %s_energy(&((const view *)x)->s, &r);\n}\n\n", P, P);
   static const char *const fun[2] = {"constraints", "hidden"};
@@ -161,8 +169,8 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   fprintf(f, " * Standalone driver: cc -O2 -std=c99 -Iruntime -Igenerated generated/%s.c generated/%s_main.c\n", P, P);
   fprintf(f, " *   runtime/libhbvmrt.a -lm; run ./%s --help for its options. */\n", P);
   fprintf(f, "#include <float.h>\n#include <stddef.h>\n\n#include \"hbvmrt.h\"\n#include \"%s.h\"\n\n", P);
-  if (o->single) emit_float_adapters(f, mod, P);
-  else emit_adapters(f, P);
+  if (o->single) emit_float_adapters(f, mod, P, me);
+  else emit_adapters(f, P, me);
   emit_dense_adapters(f, mod, P, o->single);
   emit_switch_adapters(f, mod, P, o->single);
   if (o->batch) emit_batch_adapters(f, P, o->single);
@@ -206,6 +214,5 @@ int emit_driver(FILE *f, const Model *mod, const Method *me, const EmitOptions *
   } else {
     fprintf(f, "  return hbvmrt_main(&model, argc, argv);\n}\n");
   }
-  (void)me;
   return ferror(f) ? -1 : 0;
 }

@@ -1,4 +1,5 @@
-/* emit_newton.c - C text of the step's iteration under --iteration newton.
+/* emit_newton.c - C text of the step's iteration under --iteration newton,
+ * and under --iteration auto on a stiff model.
  *
  * In place of the fixed-point loop of emit_step.c: simplified Newton on
  * F(gamma) = Phi(gamma) - gamma, Phi the sweep kernel (its result gam is
@@ -6,8 +7,11 @@
  * the kernel "newton_factor" at the predicted polynomial, and again at the
  * current one where the increments fall by less than half (the rule of
  * Radau5 and IDA, within the step); "newton_solve" gives the correction.
- * The factor is not kept across steps (first version: one or more
- * factorisations every step).
+ * Across steps the factor is kept in the state while h is the same and the
+ * last step contracted below NAME_REUSE (Radau5's rule across steps).
+ * Under auto (emit_auto_iteration) the step first runs the fixed-point
+ * loop of emit_iterate.c, which ends early where it is slow
+ * (emit_auto_slow), and Newton restarts from the predicted gamma.
  *
  * Stopping: as the fixed-point step of the constant family, on the scaled
  * increment |h dgamma| / (max |q| + |h gamma_0|): far below an ulp
@@ -51,21 +55,35 @@ static void emit_factor_checked(Emitter *e) {
   tmpl(e, "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
 }
 
-// What NAME_step_within needs before its body: the checked factorisation.
-void emit_newton_helpers(Emitter *e) { emit_factor_checked(e); }
+// What NAME_step_within needs before its body: the checked factorisation,
+// NAME_REUSE (and under --iteration auto the limit of the sweeps, NAME_SWITCH).
+void emit_newton_helpers(Emitter *e) {
+  tmpl(e, "#ifndef $P_REUSE\n#define $P_REUSE 1e-3  /* a factor kept across steps while it contracts below this */\n#endif\n");
+  if (emit_is_auto(e))
+    tmpl(e, "#ifndef $P_SWITCH\n#define $P_SWITCH 12  /* sweeps foreseen above which Newton takes over (auto) */\n#endif\n");
+  emit_factor_checked(e);
+}
 
-// The loop of NAME_step_within: from the predicted gam to the converged one,
+// The Newton loop of NAME_step_within: from gam to the converged gamma,
 // leaving sw the sweep at it (sw[gam] replaced by gam itself), it the
-// iterations, nfac the factorisations, d1 the first correction.
-void emit_newton_iteration(Emitter *e) {
+// iterations, nfac the factorisations, rate the contraction, d1 the first
+// correction. The factor is the state's, x->nf, where it was taken at this
+// h and the last step that used it contracted by less than NAME_REUSE (the
+// rule of Radau5 and IDA across steps), else a fresh one into nf; fac
+// points at the one in use. Assumes nf, res, dg, nfac, rate and fac
+// declared (emit_newton_locals), rc NAME_ENOCONV and inc, inc_min, stall as
+// the step's head sets them.
+static void emit_newton_loop(Emitter *e) {
   int nu = e->mod->nu;
-  tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
-          "   * factored at the predicted polynomial, again where the iteration slows down */\n"
-          "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M];\n"
-          "  int nfac = 1;\n");
-  tmpl(e, nu ? "  rc = $P_newton_factor_checked(x, gam, x->lambda, h, prm, nf);\n"
-             : "  rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
-  tmpl(e, "  if (rc != $P_OK) return rc;\n"
+  tmpl(e, "  rate = 0;\n"
+          "  if (x->nfh == h && x->nfrate < $P_REUSE) {\n"
+          "    fac = x->nf;  /* the last step's factor, at this h, contracted fast: kept */\n"
+          "  } else {\n");
+  tmpl(e, nu ? "    rc = $P_newton_factor_checked(x, gam, x->lambda, h, prm, nf);\n"
+             : "    rc = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
+  tmpl(e, "    nfac++;\n"
+          "    if (rc != $P_OK) return rc;\n"
+          "  }\n"
           "  rc = $P_ENOCONV;\n"
           "  for (it = 1; it <= $P_MAXITER; it++) {\n");
   tmpl(e, nu ? "    $(sweep q0=x->q p0=x->p gam=gam h=h g0=g0 out=sw);\n" : "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n");
@@ -78,7 +96,7 @@ void emit_newton_iteration(Emitter *e) {
   tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
           "    if (rc == $P_ENONFINITE) break;\n"
           "    for (i = 0; i < $P_S * $P_M; i++) res[i] = sw[$[sweep.gam]i] - gam[i];\n"
-          "    $(newton_solve gam=res lu=nf out=dg);\n"
+          "    $(newton_solve gam=res lu=fac out=dg);\n"
           "    /* increment: max |h dgamma| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
           "    for (i = 0; i < $P_M; i++) {\n"
@@ -89,6 +107,7 @@ void emit_newton_iteration(Emitter *e) {
           "    if (it == 1) d1 = inc;  /* the predictor's error, for $P_err_est */\n"
           "    if (scale > 0) inc /= scale;\n"
           "    if (!isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
+          "    if (it > 1 && inc > $P_NOISETOL && inc > rate * inc_old) rate = inc / inc_old;  /* above round-off */\n"
           "    /* converged at the gamma of this sweep (whose error is this increment): the\n"
           "     * increment far below an ulp, or within 2 ulps and no longer falling 4x (noise) */\n"
           "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) {\n"
@@ -103,15 +122,113 @@ void emit_newton_iteration(Emitter *e) {
           "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n");
   tmpl(e, nu ? "      int rf = $P_newton_factor_checked(x, gam, sw + $[sweep.lambda]0, h, prm, nf);  /* the last lambda */\n"
              : "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
-  tmpl(e, "      nfac++;\n"
+  tmpl(e, "      fac = nf;\n      nfac++;\n"
           "      if (rf != $P_OK) { rc = rf; break; }\n"
           "    }\n  }\n"
           "  /* the step is the one at the gamma the sweep was evaluated at */\n"
-          "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n"
-          "  if (st) st->factors = nfac;\n");
+          "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n");
 }
 
-// The field of NAME_stats the Newton iteration adds.
+// The Newton iteration's locals, and its counts in the stats zeroed (a
+// step may return before it writes them). rate < 0: Newton did not run.
+static void emit_newton_locals(Emitter *e) {
+  tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
+          "  const $R *fac = nf;  /* the factor in use: nf, or the state's */\n"
+          "  int nfac = 0;\n"
+          "  if (st) st->newton = st->factors = st->jacobians = 0;\n");
+}
+
+// The counts of the Newton iteration into the stats: nit iterations, nfac
+// factorisations, each with its own J.
+static void emit_newton_counts(Emitter *e, const char *nit) {
+  out(e, "  if (st) {\n    st->newton = %s;\n    st->factors = st->jacobians = nfac;\n  }\n", nit);
+}
+
+// --iteration newton: the loop of NAME_step_within, simplified Newton from
+// the predicted gam (emit_newton_loop).
+void emit_newton_iteration(Emitter *e) {
+  tmpl(e, "  /* simplified Newton on Phi(gamma) - gamma = 0 (Phi: the sweep), the Newton matrix\n"
+          "   * factored at the predicted polynomial, again where the iteration slows down */\n");
+  emit_newton_locals(e);
+  emit_newton_loop(e);
+  emit_newton_counts(e, "it");
+}
+
+int emit_is_auto(const Emitter *e) { return e->me->iteration == ITER_AUTO; }
+
+// What NAME_ENOCONV says did not converge.
+const char *emit_iteration_name(const Emitter *e) {
+  return emit_is_auto(e) ? "fixed-point and Newton iterations" : emit_is_newton(e) ? "Newton iteration"
+                                                                                     : "fixed-point iteration";
+}
+
+// --iteration auto on a stiff model: the fixed-point sweeps of emit_iterate.c
+// from the predicted gamma; where they are slow (emit_auto_slow) or fail,
+// simplified Newton from the same start. Newton directly when |h| is at
+// least x->hnewton, the shortest step whose sweeps were slow (kept in the
+// state at the end of the step, emit_newton_commit). it: the sweeps plus
+// the Newton iterations.
+void emit_auto_iteration(Emitter *e) {
+  tmpl(e, "  /* --iteration auto: fixed-point sweeps first; simplified Newton where they are slow\n"
+          "   * or fail (from the same predicted gamma), or directly from a step as long as one\n"
+          "   * whose sweeps were slow (x->hnewton) */\n"
+          "  $R gpred[$P_S * $P_M], inc_pp = HUGE_VAL, hnewton = x->hnewton;\n"
+          "  int sweeps = 0;\n");
+  emit_newton_locals(e);
+  tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) gpred[i] = gam[i];\n"
+          "  if (!(hnewton > 0 && fabs$f(h) >= hnewton)) {\n");
+  emit_fixed_point(e);
+  tmpl(e, "  sweeps = it > $P_MAXITER ? $P_MAXITER : it;\n"
+          "  if (rc != $P_OK && (!(hnewton > 0) || fabs$f(h) < hnewton)) hnewton = fabs$f(h);\n"
+          "  }\n"
+          "  if (rc != $P_OK) {  /* simplified Newton from the predicted gamma */\n"
+          "  for (i = 0; i < $P_S * $P_M; i++) gam[i] = gpred[i];\n"
+          "  inc = inc_min = HUGE_VAL;\n  stall = 0;\n");
+  emit_newton_loop(e);
+  emit_newton_counts(e, "it");
+  tmpl(e, "  it += sweeps;\n  }\n");
+}
+
+// In the fixed-point loop of --iteration auto, after the tests for
+// convergence: the sweeps are slow where the increment, falling by
+// rho2 = inc / inc_pp over two sweeps, would take more than NAME_SWITCH
+// sweeps in all to reach NAME_TOL / 256, or does not fall (it >= 3). The loop
+// then ends with rc not NAME_OK, and Newton takes over.
+void emit_auto_slow(Emitter *e) {
+  tmpl(e, "    /* slow: more than $P_SWITCH sweeps foreseen at the contraction of the last two */\n"
+          "    if (it >= 3 && !(inc < inc_pp && it + 2 * log(inc * 256 / $P_TOL) / log(inc_pp / inc) <= $P_SWITCH)) {\n"
+          "      rc = $P_ENOCONV;\n      break;\n    }\n"
+          "    inc_pp = inc_old;\n");
+}
+
+// The end of a step with Newton: a fresh factor into the state with its h,
+// the contraction of the step that used it, and under --iteration auto the
+// shortest slow h.
+void emit_newton_commit(Emitter *e) {
+  if (!emit_is_newton(e)) return;
+  tmpl(e, "  if (nfac) {  /* a fresh factor: kept for the next steps at this h */\n"
+          "    for (i = 0; i < $<newton_factor>; i++) x->nf[i] = nf[i];\n"
+          "    x->nfh = h;\n  }\n"
+          "  if (rate >= 0) x->nfrate = rate;\n");
+  if (emit_is_auto(e)) tmpl(e, "  x->hnewton = hnewton;\n");
+}
+
+// The state's fields of the Newton iteration: its factor kept across steps.
+void emit_newton_state(Emitter *e) {
+  tmpl(e, "  $R nf[$<newton_factor> + 1];  /* the Newton matrix's factor kept across steps ... */\n"
+          "  $R nfh, nfrate;  /* ... taken at h = nfh (0: none); the last contraction with it */\n");
+  if (emit_is_auto(e)) tmpl(e, "  $R hnewton;  /* the shortest |h| whose sweeps were slow: Newton from it on (0: none) */\n");
+}
+
+// Their values after NAME_init: no factor.
+void emit_newton_init(Emitter *e) {
+  tmpl(e, "  x->nfh = x->nfrate = 0;\n  for (i = 0; i <= $<newton_factor>; i++) x->nf[i] = 0;\n");
+  if (emit_is_auto(e)) tmpl(e, "  x->hnewton = 0;\n");
+}
+
+// The fields of NAME_stats the Newton iteration adds.
 void emit_newton_stats(Emitter *e) {
-  tmpl(e, "  int factors;       /* factorisations of the Newton matrix (--iteration newton) */\n");
+  tmpl(e, "  int newton;        /* iterations of simplified Newton (iters counts them too) */\n"
+          "  int factors;       /* factorisations of the Newton matrix */\n"
+          "  int jacobians;     /* evaluations of its J = Hess(U + lambda' g) (one a factorisation) */\n");
 }

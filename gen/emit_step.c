@@ -97,9 +97,11 @@ static void emit_step_predict(Emitter *e) {
 
 // iterate: the step's equations solved for gamma (the contract above). The
 // one place that chooses the iteration: the fixed-point sweep loop, or
-// simplified Newton (--iteration newton, emit_newton.c).
+// simplified Newton (--iteration newton, emit_newton.c), or the sweeps
+// switching to Newton where they are slow (--iteration auto on a stiff model).
 static void emit_iterate(Emitter *e) {
-  if (emit_is_newton(e)) emit_newton_iteration(e); /* emit_newton.c */
+  if (emit_is_auto(e)) emit_auto_iteration(e); /* emit_newton.c */
+  else if (emit_is_newton(e)) emit_newton_iteration(e);
   else emit_fixed_point(e);
 }
 

@@ -396,6 +396,8 @@ int mass_q_refuse(const Model *mod, int newton, int batch, int wide); /* 1 after
 void mass_q_report(FILE *f, const Model *mod);    /* --check: M's dependence and cost */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);
+/* stiffness.c: omega_fast / omega_slow of the linearisation at q0 (0: not estimated) */
+double model_stiffness(const Model *mod, double *wfast, double *wslow);
 
 /* ---- method.c: HBVM(k,s) constants and the choice of k ---- */
 
@@ -408,7 +410,8 @@ typedef enum {
 /* How the step's equations are solved (--iteration). */
 typedef enum {
   ITER_FIXED, /* fixed-point sweeps: converge while h omega < ~3 */
-  ITER_NEWTON /* simplified Newton on gamma (step_newton.c, emit_newton.c) */
+  ITER_NEWTON, /* simplified Newton on gamma (step_newton.c, emit_newton.c) */
+  ITER_AUTO    /* fixed-point sweeps, Newton where they converge slowly (emit_newton.c) */
 } IterKind;
 #define NEWTON_MAX_S 8 /* the largest s of --iteration newton (its eigenbasis is checked up to it) */
 

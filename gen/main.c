@@ -46,12 +46,15 @@ static const char usage[] =
     "                (2s where the true multiplier is constant); poly: a polynomial of\n"
     "                degree s-1, then p projected onto the hidden constraint and rescaled\n"
     "                to the energy: order 2s. Default: poly for s >= 2 with constraints\n"
-    "  --iteration I fixed or newton: how the step's equations are solved. fixed\n"
-    "                (default): fixed-point sweeps, which converge while h omega < ~3 (omega\n"
-    "                the fastest frequency of the linearised model); newton: simplified\n"
-    "                Newton with the Hessian of U (+ lambda' g), for stiff models and long\n"
-    "                steps; with constraints only with --multiplier const; not with --batch\n"
-    "                or --wide-step; docs/method-newton.md)\n"
+    "  --iteration I auto, fixed or newton: how the step's equations are solved. fixed:\n"
+    "                fixed-point sweeps, which converge while h omega < ~3 (omega the\n"
+    "                fastest frequency of the linearised model); newton: simplified Newton\n"
+    "                with the Hessian of U (+ lambda' g), for stiff models and long steps;\n"
+    "                auto (default): fixed's code for a model that is not stiff at q0\n"
+    "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
+    "                where they are slow (--check says which). Newton: with constraints\n"
+    "                only with --multiplier const; not with --batch or --wide-step\n"
+    "                (docs/method-newton.md)\n"
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k, and the\n"
     "                size of the code it would write (nothing is written)\n"
@@ -154,8 +157,9 @@ static int parse_args(int argc, char **argv, Options *o) {
     } else if (!strcmp(a, "--iteration")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
-      if (strcmp(v, "fixed") && strcmp(v, "newton")) return fail("--iteration needs 'fixed' or 'newton', got '%s'", v);
-      o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : ITER_FIXED;
+      if (strcmp(v, "fixed") && strcmp(v, "newton") && strcmp(v, "auto"))
+        return fail("--iteration needs 'auto', 'fixed' or 'newton', got '%s'", v);
+      o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : !strcmp(v, "auto") ? ITER_AUTO : ITER_FIXED;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -306,7 +310,8 @@ static void print_switches(const Model *mod, const char *name) {
   free(v);
 }
 
-static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam) {
+static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam,
+                        const char *iter_why) {
   char a[16], b[16];
   printf("model %s: m=%d nu=%d deg(U)=%s deg(g)=%s k=%d s=%d\n", o->name, mod->m, mod->nu, deg_str(mod->degU, a),
          deg_str(mod->degg, b), k, o->s);
@@ -322,7 +327,10 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   else
     printf("multiplier: const (the paper's method): order 2 in q and p, 1 in lambda\n");
   if (o->iteration == ITER_NEWTON)
-    printf("iteration: newton (simplified Newton, the Newton matrix factored once a step, docs/method-newton.md)\n");
+    printf("iteration: newton (simplified Newton, the Newton matrix factored and kept across steps while it contracts "
+           "fast, docs/method-newton.md)\n");
+  else
+    printf("iteration: %s\n", iter_why);
   if (mod->mass_q) mass_q_report(stdout, mod);
   else if (!mod->minv_node) printf("M: constant, %s\n", mass_str(mod->mass));
   else
@@ -523,9 +531,9 @@ static EmitOptions emit_options(const Options *o) {
 // whether the k stages are straight-line code or one loop (--stage-loop).
 // Returns 1 when the step cannot be emitted (the reason reported), else 0;
 // without a temporary file the line says so and the status stays 0.
-static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam) {
+static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam, IterKind iter) {
   Method *me = method_new(k, o->s, fam);
-  me->iteration = (IterKind)o->iteration;
+  me->iteration = iter;
   Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
   if (!st || emit_check(mod, st, &eo)) return 1;
@@ -609,8 +617,57 @@ static void report_degree(const Model *mod, int s, int k) {
            best < 0 ? "U" : "this constraint", best < 0 ? mod->degU : mod->degg, k, MAX_K);
 }
 
+/* --iteration auto: a model is stiff where omega_fast / omega_slow of its
+ * linearisation at q0 (stiffness.c) is at least this. The fixed-point sweep
+ * converges while h omega_fast < ~3; a step that follows the slow motion
+ * accurately has h omega_slow of about 0.04 (HBVM(k,2): a relative error of
+ * order 1e-7 a period), so above 3 / 0.04 = 75 the sweep, not accuracy,
+ * sets h. The paper's models are at most 56 (satellites), the stiff bob at
+ * k = 1e4 is 107, the FPU chain 47 at omega = 50 and 945 at omega = 1000. */
+#define STIFF_RATIO 75
+/* ... and auto emits Newton only up to this m: its factorisation is unrolled
+ * (m^3 operations for a dense Hessian; the loop form is not done), and a
+ * long chain's frequencies alone spread like m (tests/check_lean.c's dense
+ * chain of m = 160 would have taken more than 4 MB of C). */
+#define AUTO_NEWTON_MAX_M 32
+
+// What --iteration resolves to: fixed and newton as given; auto (the
+// default) ITER_AUTO (sweeps first, Newton where they are slow) for a stiff
+// model where Newton can be emitted, else ITER_FIXED, today's code. why
+// receives --check's line (after "iteration: ").
+static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily fam, char *why, size_t n) {
+  if (o->iteration == ITER_FIXED) {
+    snprintf(why, n, "fixed (fixed-point sweeps, given with --iteration fixed)");
+    return ITER_FIXED;
+  }
+  if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
+  double wf, ws, r = model_stiffness(mod, &wf, &ws);
+  const char *no = mod->mass_q                ? "Newton does not handle an M that depends on q"
+                   : mod->nu && fam == MULT_POLY ? "Newton needs --multiplier const with constraints"
+                   : o->batch                  ? "Newton is not emitted with --batch"
+                   : o->wide_step              ? "Newton is not emitted with --wide-step"
+                   : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
+                   : mod->m > AUTO_NEWTON_MAX_M ? "auto emits Newton up to m = " STR(AUTO_NEWTON_MAX_M)
+                                                  " (its factorisation is unrolled: --iteration newton)"
+                                               : NULL;
+  if (r == 0)
+    snprintf(why, n, "auto: fixed (fixed-point sweeps; stiffness not estimated: %s)",
+             mod->mass_q ? "M depends on q" : mod->minv_node ? "M has params" : mod->m > 200 ? "m > 200"
+                                                                                : "no nonzero frequency at q0");
+  else if (r < STIFF_RATIO)
+    snprintf(why, n, "auto: fixed (fixed-point sweeps; not stiff: omega_fast / omega_slow = %.3g / %.3g = %.3g < %d "
+             "at q0)", wf, ws, r, STIFF_RATIO);
+  else if (no)
+    snprintf(why, n, "auto: fixed (fixed-point sweeps, converging while h < ~3 / %.3g; stiff, omega_fast / omega_slow "
+             "= %.3g >= %d at q0, but %s)", wf, r, STIFF_RATIO, no);
+  else
+    snprintf(why, n, "auto: sweeps, then newton where they contract slowly (stiff: omega_fast / omega_slow = %.3g / "
+             "%.3g = %.3g >= %d at q0; docs/method-newton.md)", wf, ws, r, STIFF_RATIO);
+  return r >= STIFF_RATIO && !no ? ITER_AUTO : ITER_FIXED;
+}
+
 int main(int argc, char **argv) {
-  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_AUTO};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) {
@@ -642,11 +699,14 @@ int main(int argc, char **argv) {
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
   int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, mod->mass_q ? MULT_POLY : fam, &why);
   if (mod->mass_q && !o.k) why = "M depends on q: k = s, the end of the step rescales p to keep H (docs/method-mq.md)";
+  char iter_why[512];
+  IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
   if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
     rc = 1;
   } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
-                            "use --multiplier const (or --iteration fixed)");
+                            "use --multiplier const (the constant multiplier, order 2 in p with constraints), "
+                            "or --iteration fixed or auto (fixed-point sweeps in the poly family)");
     rc = 1;
   } else if (k > MAX_K) {
     report_degree(mod, o.s, k);
@@ -659,11 +719,11 @@ int main(int argc, char **argv) {
              FLOAT_POLY_MAX_S, o.s);
     rc = 1;
   } else if (o.check_only) {
-    print_check(mod, &o, k, why, fam);
-    rc = print_check_code(&o, mod, k, fam);
+    print_check(mod, &o, k, why, fam, iter_why);
+    rc = print_check_code(&o, mod, k, fam, iter);
   } else {
     Method *me = method_new(k, o.s, fam);
-    me->iteration = (IterKind)o.iteration;
+    me->iteration = iter;
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }

@@ -614,6 +614,6 @@ Step *step_build(Model *mod, const Method *me) {
     build_const_multiplier(&b);
   }
   build_diagnostics(&b);
-  if (me->iteration == ITER_NEWTON) build_newton(&b);
+  if (me->iteration != ITER_FIXED) build_newton(&b);
   return st;
 }

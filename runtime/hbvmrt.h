@@ -26,6 +26,10 @@ typedef struct {
   /* The step's relative energy defect, |H1 - H0| / (|K| + |U|) (0 from
    * drivers generated before it, and where the step conserves H exactly). */
   double defect;
+  /* The step's simplified Newton iterations, factorisations of the Newton
+   * matrix and evaluations of its J (0 from drivers of solvers without
+   * Newton: the runtime zeroes the stats before each step). */
+  int newton, factors, jacobians;
 } hbvmrt_stats;
 
 /* One run-time parameter: its name and where it lives in the params block. */

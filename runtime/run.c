@@ -67,6 +67,8 @@ typedef struct {
   double max_defect;          /* the largest relative energy defect of a step */
   long defect_steps;          /* steps whose defect is far above round-off */
   int max_steps_hit;          /* --max-steps ended the run short of T */
+  long newton_steps;          /* steps that took simplified Newton ... */
+  long newton, factors, jacobians; /* ... its iterations, factorisations, J evaluations */
   long said;                  /* per-step messages written on stderr ... */
   long unsaid;                /* ... and suppressed past HBVMRT_MAX_SAID */
 } Run;
@@ -474,6 +476,10 @@ static void taken(Run *r, const hbvmrt_stats *st, double h)
 {
   r->steps++;
   r->iters_sum += st->iters;
+  r->newton_steps += st->newton > 0;
+  r->newton += st->newton;
+  r->factors += st->factors;
+  r->jacobians += st->jacobians;
   if (st->iters > r->iters_max)
     r->iters_max = st->iters;
   if (r->steps == 1 || fabs(h) < r->h_min)
@@ -682,10 +688,20 @@ static void warn_defect(const Run *r)
             r->md->k, r->o->tol > 0 ? "--tol" : "-h");
 }
 
+/* Which solver ran, for the summary: fixed (no step took Newton), newton
+ * (every step did), fixed+newton (under --iteration auto, some steps did). */
+static const char *solver_ran(const Run *r)
+{
+  if (r->newton_steps == 0)
+    return "fixed";
+  return r->newton_steps == r->steps ? "newton" : "fixed+newton";
+}
+
 /* The summary line (docs/api.md, "The standalone driver"); without constraints max_g
  * and max_hc are kept, as a plain 0, so every run's line has the same
- * fields.  max_dH_rel is max_dH / |H0| (0 when both are 0); status says how
- * the run ended, t where. */
+ * fields.  max_dH_rel is max_dH / |H0| (0 when both are 0); solver says
+ * which iteration ran, and where Newton did, its counts follow; status says
+ * how the run ended, t where. */
 static void summary(const Run *r, double seconds, const char *status)
 {
   double mean = r->steps > 0 ? r->iters_sum / (double)r->steps : 0.0;
@@ -703,6 +719,10 @@ static void summary(const Run *r, double seconds, const char *status)
           r->max_err_est, r->H0, rel, r->max_defect, r->defect_steps);
   if (r->swfn && r->swfn->n > 0)   /* a model that is not smooth: the switching points crossed */
     fprintf(stderr, " switches=%ld", r->sw.crossed);
+  fprintf(stderr, " solver=%s", solver_ran(r));
+  if (r->newton_steps > 0)
+    fprintf(stderr, " newton_steps=%ld newton_iters=%ld factors=%ld jacobians=%ld", r->newton_steps, r->newton,
+            r->factors, r->jacobians);
   fprintf(stderr, " t=%.15g status=%s\n", state_t(r), status);
 }
 

@@ -34,6 +34,7 @@
 #include "fpu_newton_k4s2.h"
 #include "stiff_bob_fixed_k16s2.h"
 #include "stiff_bob_newton_k16s2.h"
+#include "generate.h"
 #include "hbvmgen.h"
 #include "step.h"
 
@@ -336,17 +337,6 @@ START_TEST(test_bob_failed_step_rolls_back) {
 }
 END_TEST
 
-/* The generator's output (stdout and stderr) for args, and its exit status. */
-static int generator(const char *args, char *out, size_t size) {
-  char cmd[512];
-  snprintf(cmd, sizeof cmd, "../gen/hbvmgen %s 2>&1", args);
-  FILE *f = popen(cmd, "r");
-  ck_assert_ptr_nonnull(f);
-  size_t n = fread(out, 1, size - 1, f);
-  out[n] = 0;
-  return pclose(f);
-}
-
 START_TEST(test_refused) {
   static const struct {
     const char *args, *says;
@@ -357,16 +347,16 @@ START_TEST(test_refused) {
       {"--iteration newton --batch 2 --check ../models/fpu.ham", "error: --iteration newton cannot be used with --batch"},
       {"--iteration newton --wide-step --check ../models/fpu.ham", "error: --iteration newton cannot be used with --wide-step"},
       {"--iteration newton -s 9 --check ../models/fpu.ham", "error: --iteration newton needs a smaller -s (s=9 > 8)"},
-      {"--iteration newtn --check ../models/fpu.ham", "error: --iteration needs 'fixed' or 'newton', got 'newtn'"},
+      {"--iteration newtn --check ../models/fpu.ham", "error: --iteration needs 'auto', 'fixed' or 'newton', got 'newtn'"},
   };
   char out[4096];
   for (int c = 0; c < 5; c++) {
-    ck_assert_msg(generator(cases[c].args, out, sizeof out) != 0, "%s: accepted", cases[c].args);
+    ck_assert_msg(generator_output(cases[c].args, out, sizeof out) != 0, "%s: accepted", cases[c].args);
     ck_assert_msg(strstr(out, cases[c].says) != NULL, "%s said:\n%s", cases[c].args, out);
   }
-  ck_assert_int_eq(generator("--iteration newton --check ../models/fpu.ham", out, sizeof out), 0);
+  ck_assert_int_eq(generator_output("--iteration newton --check ../models/fpu.ham", out, sizeof out), 0);
   ck_assert_msg(strstr(out, "iteration: newton") != NULL, "--check said:\n%s", out);
-  ck_assert_int_eq(generator("--iteration newton --multiplier const --check ../models/pendulum.ham", out, sizeof out), 0);
+  ck_assert_int_eq(generator_output("--iteration newton --multiplier const --check ../models/pendulum.ham", out, sizeof out), 0);
 }
 END_TEST
 

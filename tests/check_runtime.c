@@ -816,6 +816,39 @@ START_TEST(no_csv)
 }
 END_TEST
 
+/* as osc_step, a solver of --iteration auto: Newton (4 iterations, one
+ * factorisation) in the steps after the second */
+static int osc_step_newton(void *x, double h, const void *prm, hbvmrt_stats *st)
+{
+  int rc = osc_step(x, h, prm, st);
+
+  if (st && ((OscState *)x)->n > 2) {
+    st->newton = 4;
+    st->factors = st->jacobians = 1;
+  }
+  return rc;
+}
+
+/* The summary says which solver ran (issue 27): fixed where no step took
+ * Newton, with no counts; fixed+newton when some did (--iteration auto),
+ * with the counts summed. */
+START_TEST(summary_solver)
+{
+  hbvmrt_model aut = osc;
+  Result r = run(&osc, "-h 0.1 -N 4");
+
+  ck_assert_ptr_nonnull(strstr(r.err, " solver=fixed t="));
+  done(&r);
+  aut.step = osc_step_newton;
+  r = run(&aut, "-h 0.1 -N 2");
+  ck_assert_ptr_nonnull(strstr(r.err, " solver=fixed t="));
+  done(&r);
+  r = run(&aut, "-h 0.1 -N 5");
+  ck_assert_ptr_nonnull(strstr(r.err, " solver=fixed+newton newton_steps=3 newton_iters=12 factors=3 jacobians=3 t="));
+  done(&r);
+}
+END_TEST
+
 /* The summary tells the truth (issue 31 item 4): the largest local error
  * estimate, H0 and the relative energy error, where and how the run ended;
  * an estimate above 1e-3 (1 + max|q|) is warned about; a step whose energy
@@ -1338,6 +1371,7 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, ring_default_run);
   tcase_add_test(run_, inconsistent_start);
   tcase_add_test(run_, summary_truth);
+  tcase_add_test(run_, summary_solver);
   tcase_add_test(run_, kepler_energy_defect);
   tcase_add_test(run_, messages_rate_limited);
   tcase_add_test(run_, step_failure);

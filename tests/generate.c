@@ -47,3 +47,13 @@ int kernel_temporaries(const char *src, const char *head) {
   while (p && (p = strstr(p + 1, "const double t")) && p < end) n++;
   return n;
 }
+
+int generator_output(const char *args, char *out, size_t size) {
+  char cmd[1024];
+  snprintf(cmd, sizeof cmd, "../gen/hbvmgen %s 2>&1", args);
+  FILE *f = popen(cmd, "r");
+  if (!f) return -1;
+  size_t n = fread(out, 1, size - 1, f);
+  out[n] = 0;
+  return pclose(f);
+}

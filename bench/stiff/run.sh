@@ -72,7 +72,7 @@ GSL_TOLS=1e-3:1e-11:10
 mkdir -p "$B/gen" "$B/models" "$B/res" "$B/scan" "$R"
 rm -f "$B"/res/*.csv "$B"/res/failures.txt "$B"/scan/*.csv "$B"/scan/failures.txt
 
-# ---- 1. generate: s = 2, 3 at -k auto, fixed point and Newton
+# ---- 1. generate: s = 2, 3 at -k auto, fixed point (forced: auto would pick Newton on these) and Newton
 echo "== bench/stiff: generating ($(elapsed) s)"
 : >"$B/configs.txt"
 solvers=""
@@ -80,7 +80,7 @@ for p in $PROBLEMS; do
   model "$p"
   for s in 2 3; do
     k=$("$GEN" --check --multiplier const -s "$s" "$B/models/$p.ham" | sed -n '1s/.* k=\([0-9]*\) s=.*/\1/p')
-    "$GEN" --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}" -o "$B/gen" "$B/models/$p.ham"
+    "$GEN" --iteration fixed --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}" -o "$B/gen" "$B/models/$p.ham"
     "$GEN" --iteration newton --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}newton" -o "$B/gen" \
       "$B/models/$p.ham"
     solvers="$solvers ${p}_k${k}s${s} ${p}_k${k}s${s}newton"
