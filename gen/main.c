@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "hbvmgen.h"
+#include "roll.h"
 
 #define MAX_MODEL_BYTES (64L << 20)
 #define MAX_S 20
@@ -75,6 +76,11 @@ static const char usage[] =
     "  --stage-loop N  print the k stages of the step as one loop over the stages (the\n"
     "                model's derivatives once, inside it) when their straight-line code\n"
     "                would take N or more operations (default " STR(STAGE_LOOP_DEFAULT) ", docs/embedding.md)\n"
+    "  --rolled auto|on|off  print the model's index as loops (the rolled form,\n"
+    "                docs/rolled.md): one loop body per run of uniform terms of U, g\n"
+    "                and their derivatives, and the banded multiplier system as a loop;\n"
+    "                auto (default) rolls a large model the form covers, on insists\n"
+    "                (an error says what it does not cover yet), off never rolls\n"
     "  -h, --help    this text\n"
     "  --version     the version\n";
 
@@ -88,6 +94,7 @@ typedef struct {
   long mass_loop; /* --mass-loop N, 0 for the default */
   long stage_loop; /* --stage-loop N, 0 for the default */
   int iteration;   /* --iteration: an IterKind */
+  int rolled;      /* --rolled: ROLL_AUTO, ROLL_ON or ROLL_OFF */
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -156,6 +163,11 @@ static int parse_args(int argc, char **argv, Options *o) {
       const char *v = argv[++i];
       if (strcmp(v, "fixed") && strcmp(v, "newton")) return fail("--iteration needs 'fixed' or 'newton', got '%s'", v);
       o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : ITER_FIXED;
+    } else if (!strcmp(a, "--rolled")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      const char *v = argv[++i];
+      if (strcmp(v, "auto") && strcmp(v, "on") && strcmp(v, "off")) return fail("--rolled needs 'auto', 'on' or 'off', got '%s'", v);
+      o->rolled = !strcmp(v, "on") ? ROLL_ON : !strcmp(v, "off") ? ROLL_OFF : ROLL_AUTO;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -494,7 +506,7 @@ static void note_large_output(const char *path) {
 // What the emitter takes of the options.
 static EmitOptions emit_options(const Options *o) {
   EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
-                    !o->plain_sum, o->wide_step, o->batch};
+                    !o->plain_sum, o->wide_step, o->batch, o->rolled, NULL};
   return eo;
 }
 
@@ -508,7 +520,7 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam)
   me->iteration = (IterKind)o->iteration;
   Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
-  if (!st || emit_check(mod, st, &eo)) return 1;
+  if (!st || roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo)) return 1;
   FILE *h = tmpfile(), *c = tmpfile();
   if (!h || !c || emit_solver(h, c, mod, me, st, &eo) != 0) /* the analysis stands; only the size is missing */
     printf("code: not measured (no temporary file: %s)\n", strerror(errno));
@@ -521,13 +533,13 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam)
 }
 
 // Emit the solver files; all or nothing.
-static int write_outputs(const Options *o, const Model *mod, const Method *me, const Step *st) {
+static int write_outputs(const Options *o, Model *mod, const Method *me, const Step *st) {
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
   char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
   int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   EmitOptions eo = emit_options(o);
-  if (!rc && emit_check(mod, st, &eo)) return 1; /* nothing is written yet */
+  if (!rc && (roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo))) return 1; /* nothing is written yet */
   atexit(remove_temporaries);
   mode_t mask = umask(0);
   umask(mask);
@@ -590,7 +602,7 @@ static void report_degree(const Model *mod, int s, int k) {
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_FIXED, ROLL_AUTO};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) {
