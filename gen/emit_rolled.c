@@ -84,28 +84,60 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
     out(e, "    const double r%d = %s;\n", k, rhs);
   }
   body_name(e, r, r->body[r->nbody - 1], a, sizeof a);
-  if (os) out(e, "    out[%d * u + %d] = %s;\n  }\n", os, oo, a);
+  if (os) out(e, "    out[%d * u + %d] %s= %s;\n  }\n", os < 0 ? -os : os, oo, os < 0 ? "+" : "", a);
   else out(e, "    acc += %s;\n  }\n", a);
 }
 
 // A family as the function $P_roll_NAME(q, v, prm, out): out[i] for its
-// items, or with sum out[0] = the sum of them in order.
-static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int sum) {
+// items; with mode 1 out[0] = the sum of them in order, with mode -1 out[i]
+// += item i.
+static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int mode) {
   rtmpl(e, "\n/* %s */\nstatic void $P_roll_%s(const double *q, const double *v, const $P_params *prm, double *out)\n{\n"
-           "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, sum ? "  double acc = 0;\n" : "");
-  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], !sum, 0);
-  out(e, sum ? "  out[0] = acc;\n}\n" : "}\n");
+           "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  double acc = 0;\n" : "");
+  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0);
+  out(e, mode == 1 ? "  out[0] = acc;\n}\n" : "}\n");
 }
 
-// The Jacobian's entries: out[T i + t] = d g_tcon[i,t] / dq_i, a family per t.
-static void emit_jacobian(Emitter *e) {
-  const Roll *r = e->roll;
-  tmpl(e, "\n/* the Jacobian's entries: out[$P_RT * i + t] = d g_a / dq_i, a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
-          "static void $P_roll_jac(const double *q, const double *v, const $P_params *prm, double *out)\n{\n"
-          "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n");
-  for (int t = 0; t < r->T; t++)
-    for (int i = 0; i < r->jac[t].nruns; i++) emit_run(e, &r->jac[t].runs[i], r->T, t);
+// A family per t of the Jacobian's entries (fams[t]) as the function
+// $P_roll_NAME: out[T i + t] = item i of family t.
+static void emit_tfamily(Emitter *e, const char *name, const char *what, const RollFamily *const *fams, int add) {
+  rtmpl(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
+           "static void $P_roll_%s(const double *q, const double *v, const $P_params *prm, double *out)\n{\n"
+           "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what, name);
+  for (int t = 0; t < e->roll->T; t++)
+    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -e->roll->T : e->roll->T, t);
   out(e, "}\n");
+}
+
+// Which part of a split family: the whole, or its affine, linear or curved items.
+enum { PART_ALL, PART_AFFINE, PART_LIN, PART_CURVED };
+
+static const RollFamily *jac_part(const Roll *r, int t, int part) {
+  return part == PART_ALL ? &r->jac[t] : part == PART_AFFINE ? &r->jac_s[t].affine : part == PART_LIN ? &r->jac_s[t].lin
+                                                                                                      : &r->jac_s[t].curved;
+}
+
+// Whether part of the Jacobian has a nonzero item.
+static int jac_used(const Roll *r, int part) {
+  int used = 0;
+  for (int t = 0; t < r->T; t++) used |= !jac_part(r, t, part)->zero;
+  return used;
+}
+
+// The Jacobian's families: the whole, and the parts the sweep uses.
+static void emit_jacobians(Emitter *e) {
+  static const char *const name[] = {"jac", "jac_affine", "jac_lin", "jac_curved"};
+  static const char *const what[] = {"the Jacobian's entries d g_a / dq_i", "its affine entries (else 0)",
+                                     "out += the linear part sum_k d^2 g_a / dq_i dq_k v_k of its affine entries",
+                                     "its curved entries (else 0)"};
+  const Roll *r = e->roll;
+  const RollFamily **f = xmalloc((size_t)(r->T + 1) * sizeof *f);
+  for (int part = PART_ALL; part <= PART_CURVED; part++) {
+    if (part != PART_ALL && !jac_used(r, part)) continue;
+    for (int t = 0; t < r->T; t++) f[t] = jac_part(r, t, part);
+    emit_tfamily(e, name[part], what[part], f, part == PART_LIN);
+  }
+  free(f);
 }
 
 // A table of n reals (or ints) as a static const array, sixteen a line.
@@ -120,43 +152,59 @@ static void emit_array(Emitter *e, const char *type, const char *name, const dou
   out(e, n > 0 ? "\n};\n" : "0};\n");
 }
 
+// B = G' M^-1 G in band storage from the Jacobian's entries, one loop over
+// the coordinates with the T constraints on each unrolled.
+static void emit_gram(Emitter *e) {
+  const Roll *r = e->roll;
+  int T = r->T, W = 2 * r->bw + 1;
+  tmpl(e, "/* B = G' M^-1 G in band storage, G the Jacobian's entries J ($P_roll_jac). */\n"
+          "static void $P_roll_gram(const double *J, double *B)\n{\n"
+          "  int i;\n"
+          "  for (i = 0; i < $P_NU * $P_RW; i++) B[i] = 0;\n");
+  out(e, "  for (i = 0; i < %d; i++) {\n", r->m);
+  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d];\n", t, e->P, T, t);
+  for (int t = 0; t < T; t++)
+    for (int u = 0; u < T; u++)
+      out(e, "    if (a%d >= 0 && a%d >= 0) B[a%d * %d + a%d - a%d + %d] += J[%d * i + %d] * (%s%sJ[%d * i + %d]);\n", t, u, t, W,
+          u, t, r->bw, T, t, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", T, u);
+  out(e, "  }\n}\n");
+}
+
 // The band LU of the multiplier system and of G' M^-1 G: factor in place
 // (multipliers below the diagonal), pivots and the diagonal it started from;
 // solve in place.
 static void emit_band(Emitter *e) {
+  int bw = e->roll->bw;
   tmpl(e, "\n/* A (NU x NU, band storage A[a * $P_RW + c - a + $P_RBW]) = L U without pivoting, in place:\n"
-          " * pivot[k] the k-th pivot, adiag[k] the diagonal entry it started from. */\n"
+          " * pivot[k] the k-th pivot, adiag[k] the diagonal entry it started from. The band's\n"
+          " * offsets are unrolled. */\n"
           "static void $P_band_factor(double *A, double *pivot, double *adiag)\n{\n"
-          "  int k, i, c;\n"
+          "  int k;\n"
           "  for (k = 0; k < $P_NU; k++) adiag[k] = A[k * $P_RW + $P_RBW];\n"
           "  for (k = 0; k < $P_NU; k++) {\n"
-          "    pivot[k] = A[k * $P_RW + $P_RBW];\n"
-          "    for (i = k + 1; i <= k + $P_RBW && i < $P_NU; i++) {\n"
-          "      const double f = A[i * $P_RW + k - i + $P_RBW] / A[k * $P_RW + $P_RBW];\n"
-          "      A[i * $P_RW + k - i + $P_RBW] = f;\n"
-          "      for (c = k + 1; c <= k + $P_RBW && c < $P_NU; c++) A[i * $P_RW + c - i + $P_RBW] -= f * A[k * $P_RW + c - k + $P_RBW];\n"
-          "    }\n  }\n}\n\n"
+          "    const double *Ak = A + k * $P_RW + $P_RBW;  /* Ak[c - k] = A[k][c] */\n"
+          "    pivot[k] = Ak[0];\n");
+  for (int d = 1; d <= bw; d++) {
+    rtmpl(e, "    if (k + %d < $P_NU) {\n"
+             "      double *Ai = A + (k + %d) * $P_RW + $P_RBW - %d;  /* Ai[c - k] = A[k + %d][c] */\n"
+             "      const double f = Ai[0] / Ak[0];\n"
+             "      Ai[0] = f;\n", d, d, d, d);
+    for (int c = 1; c <= bw; c++) rtmpl(e, "      if (k + %d < $P_NU) Ai[%d] -= f * Ak[%d];\n", c, c, c);
+    out(e, "    }\n");
+  }
+  tmpl(e, "  }\n}\n\n"
           "/* x = A^-1 x for A factored by $P_band_factor. */\n"
           "static void $P_band_solve(const double *A, double *x)\n{\n"
-          "  int k, i, c;\n"
-          "  for (k = 0; k < $P_NU; k++)\n"
-          "    for (i = k + 1; i <= k + $P_RBW && i < $P_NU; i++) x[i] -= A[i * $P_RW + k - i + $P_RBW] * x[k];\n"
+          "  int k;\n"
+          "  for (k = 0; k < $P_NU; k++) {\n"
+          "    const double xk = x[k];\n");
+  for (int d = 1; d <= bw; d++) rtmpl(e, "    if (k + %d < $P_NU) x[k + %d] -= A[(k + %d) * $P_RW + $P_RBW - %d] * xk;\n", d, d, d, d);
+  tmpl(e, "  }\n"
           "  for (k = $P_NU - 1; k >= 0; k--) {\n"
-          "    double acc = x[k];\n"
-          "    for (c = k + 1; c <= k + $P_RBW && c < $P_NU; c++) acc -= A[k * $P_RW + c - k + $P_RBW] * x[c];\n"
-          "    x[k] = acc / A[k * $P_RW + $P_RBW];\n  }\n}\n\n"
-          "/* B = G' M^-1 G in band storage, G the Jacobian's entries J ($P_roll_jac). */\n"
-          "static void $P_roll_gram(const double *J, double *B)\n{\n"
-          "  int i, t, s;\n"
-          "  for (i = 0; i < $P_NU * $P_RW; i++) B[i] = 0;\n"
-          "  for (i = 0; i < $P_M; i++)\n"
-          "    for (t = 0; t < $P_RT; t++) {\n"
-          "      const int a = $P_tcon[i * $P_RT + t];\n"
-          "      if (a < 0) continue;\n"
-          "      for (s = 0; s < $P_RT; s++) {\n"
-          "        const int c = $P_tcon[i * $P_RT + s];\n"
-          "        if (c >= 0) B[a * $P_RW + c - a + $P_RBW] += J[i * $P_RT + t] * ($P_MINV(i) J[i * $P_RT + s]);\n"
-          "      }\n    }\n}\n");
+          "    double acc = x[k];\n");
+  for (int c = 1; c <= bw; c++) rtmpl(e, "    if (k + %d < $P_NU) acc -= A[k * $P_RW + $P_RBW + %d] * x[k + %d];\n", c, c, c);
+  tmpl(e, "    x[k] = acc / A[k * $P_RW + $P_RBW];\n  }\n}\n\n");
+  emit_gram(e);
 }
 
 // Everything the rolled kernels share, printed before the first of them:
@@ -175,92 +223,163 @@ static void emit_helpers(Emitter *e) {
     tmpl(e, "#define $P_MINV(i) $P_rminv[i] *\n");
   }
   if (r->T) emit_array(e, "int", "tcon", NULL, r->tcon, m * r->T);
-  double *xi = xmalloc((size_t)(s + 1) * sizeof(double));
-  memcpy(xi, me->xi, (size_t)(s + 1) * sizeof(double));
-  emit_array(e, "double", "rIhat", me->Ihat, NULL, k * s);
-  emit_array(e, "double", "rW", me->W, NULL, k * s);
-  emit_array(e, "double", "rxi", xi, NULL, s + 1);
-  free(xi);
+  if (r->curved) {
+    emit_array(e, "double", "rIhat", me->Ihat, NULL, k * s);
+    emit_array(e, "double", "rW", me->W, NULL, k * s);
+  }
   emit_family(e, "gradU", "out[i] = dU/dq_i", &r->gradU, 0);
+  if (!r->gradU_s.affine.zero) emit_family(e, "gradU_affine", "out[i] = dU/dq_i where it is affine in q, else 0", &r->gradU_s.affine, 0);
+  if (!r->gradU_s.lin.zero) emit_family(e, "gradU_lin", "out[i] += sum_k d^2U/dq_i dq_k v_k where dU/dq_i is affine", &r->gradU_s.lin, -1);
+  if (!r->gradU_s.curved.zero) emit_family(e, "gradU_curved", "out[i] = dU/dq_i where it is not affine in q, else 0", &r->gradU_s.curved, 0);
   emit_family(e, "U", "out[0] = U(q), its terms in the order of its sums", &r->U, 1);
   if (r->nu) {
     emit_family(e, "g", "out[a] = g_a(q)", &r->g, 0);
     emit_family(e, "hvv", "out[a] = v' Hess(g_a)(q) v", &r->hvv, 0);
-    emit_jacobian(e);
+    emit_jacobians(e);
     emit_band(e);
   }
   e->roll_helpers = 1;
 }
 
-// The sweep: stages, projections, multiplier system, new gamma.
-static void emit_sweep(Emitter *e) {
-  int nu = e->mod->nu, m = e->mod->m, s = e->me->s, T = e->roll->T, mt = m * T;
-  rtmpl(e, "  double Q[%d], F[%d], psi[%d], th[%d];\n  int i, j, l, t = 0;\n  (void)t;\n", m, m, s * m, s * m);
-  if (nu) rtmpl(e, "  double J[%d], R[%d], A[%d], r[%d];\n", mt, s * mt, nu * (2 * e->roll->bw + 1), nu);
-  tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) psi[i] = 0;\n");
-  if (nu) tmpl(e, "  for (i = 0; i < $P_S * $P_M * $P_RT; i++) R[i] = 0;\n");
-  tmpl(e, "  /* the k stages: Q = q0 + h sum_j Ihat[l][j] gamma_j; grad U(Q) and grad g(Q), summed with b_l P_j(c_l) */\n"
-          "  for (l = 0; l < $P_K; l++) {\n"
-          "    for (i = 0; i < $P_M; i++) {\n"
-          "      double acc = 0;\n"
-          "      for (j = 0; j < $P_S; j++) acc += $P_rIhat[l * $P_S + j] * gam[j * $P_M + i];\n"
-          "      Q[i] = q0[i] + h * acc;\n    }\n"
-          "    $P_roll_gradU(Q, 0, prm, F);\n");
-  if (nu) tmpl(e, "    $P_roll_jac(Q, 0, prm, J);\n");
-  tmpl(e, "    for (j = 0; j < $P_S; j++) {\n"
-          "      const double w = $P_rW[l * $P_S + j];\n"
-          "      for (i = 0; i < $P_M; i++) psi[j * $P_M + i] += w * F[i];\n");
-  if (nu) tmpl(e, "      for (i = 0; i < $P_M * $P_RT; i++) R[j * $P_M * $P_RT + i] += w * J[i];\n");
-  tmpl(e, "    }\n  }\n");
-  if (nu) {
-    tmpl(e, "  /* the multiplier system A lambda = r (band): A = h [xi_0 rho_0' M^-1 rho_0 + sum_j xi_j (rho_j' M^-1 rho_j-1\n"
-            "   * - rho_j-1' M^-1 rho_j)], r = rho_0' M^-1 (p0 - h xi_0 psi_0) - h sum_j xi_j (...) + g0, a sum over i */\n"
-            "  for (i = 0; i < $P_NU * $P_RW; i++) A[i] = 0;\n"
-            "  for (i = 0; i < $P_NU; i++) r[i] = 0;\n"
-            "  for (i = 0; i < $P_M; i++)\n"
-            "    for (t = 0; t < $P_RT; t++) {\n"
-            "      const int a = $P_tcon[i * $P_RT + t], it = i * $P_RT + t;\n"
-            "      const double *Ra = R + it;\n"
-            "      double sk;\n"
-            "      int u;\n"
-            "      if (a < 0) continue;\n"
-            "      sk = $P_rxi[0] * (Ra[0] * ($P_MINV(i) psi[i]));\n"
-            "      for (j = 1; j < $P_S; j++)\n"
-            "        sk += $P_rxi[j] * (Ra[j * $P_M * $P_RT] * ($P_MINV(i) psi[(j - 1) * $P_M + i])\n"
-            "                       - Ra[(j - 1) * $P_M * $P_RT] * ($P_MINV(i) psi[j * $P_M + i]));\n"
-            "      r[a] += Ra[0] * ($P_MINV(i) p0[i]) - h * sk;\n"
-            "      for (u = 0; u < $P_RT; u++) {\n"
-            "        const int c = $P_tcon[i * $P_RT + u];\n"
-            "        const double *Rc = R + i * $P_RT + u;\n"
-            "        if (c < 0) continue;\n"
-            "        sk = $P_rxi[0] * (Ra[0] * ($P_MINV(i) Rc[0]));\n"
-            "        for (j = 1; j < $P_S; j++)\n"
-            "          sk += $P_rxi[j] * (Ra[j * $P_M * $P_RT] * ($P_MINV(i) Rc[(j - 1) * $P_M * $P_RT])\n"
-            "                         - Ra[(j - 1) * $P_M * $P_RT] * ($P_MINV(i) Rc[j * $P_M * $P_RT]));\n"
-            "        A[a * $P_RW + c - a + $P_RBW] += h * sk;\n"
-            "      }\n    }\n"
-            "  for (i = 0; i < $P_NU; i++) r[i] += g0[i];  /* g(q0) / h, or 0 */\n"
-            "  $P_band_factor(A, out + $<sweep.pivot>, out + $<sweep.adiag>);\n"
-            "  $P_band_solve(A, r);\n"
-            "  for (i = 0; i < $P_NU; i++) out[$[sweep.lambda]i] = r[i];\n");
+// A real literal of the method's constants.
+static const char *lit(Emitter *e, double v) {
+  static char buf[8][48];
+  static int next;
+  char *b = buf[next++ % 8];
+  format_real(e, b, 48, v);
+  return b;
+}
+
+// Print "DST = SRC-combination" of X row j (METHOD.md): xi_j v_{j-1} -
+// xi_{j+1} v_{j+1} (v_0 for j = 0, the second term absent for j = s-1),
+// v_r read as fmt with r * stride (an offset) and name.
+static void x_row(Emitter *e, int j, const char *name, int stride, char *buf, size_t size) {
+  const double *xi = e->me->xi;
+  int n = snprintf(buf, size, "%s * %s[%d + i]", lit(e, xi[j]), name, (j ? j - 1 : 0) * stride);
+  if (j + 1 < e->me->s) snprintf(buf + n, size - (size_t)n, " - %s * %s[%d + i]", lit(e, xi[j + 1]), name, (j + 1) * stride);
+}
+
+// The projections psi_j = sum_l b_l P_j(c_l) grad U(Q_l) and rho_j (R[j M T
+// + i T + t], the Jacobian's entries) of the sweep: the affine entries in
+// closed form, the curved ones summed over the k stages (unrolled: k and s
+// are small; the loops are over the coordinates).
+static void emit_projections(Emitter *e) {
+  const Roll *r = e->roll;
+  const Method *me = e->me;
+  int nu = e->mod->nu, m = e->mod->m, s = me->s, mt = m * r->T;
+  char x[512];
+  out(e, "  /* entries affine in q, projected in closed form: delta_j0 f(q0) + f_lin(h (X gamma)_j) */\n");
+  if (!r->gradU_s.affine.zero) tmpl(e, "  $P_roll_gradU_affine(q0, 0, prm, psi);\n");
+  rtmpl(e, "  for (i = %d; i < %d; i++) psi[i] = 0;\n", r->gradU_s.affine.zero ? 0 : m, s * m);
+  if (nu && jac_used(r, PART_AFFINE)) tmpl(e, "  $P_roll_jac_affine(q0, 0, prm, R);\n");
+  if (nu) rtmpl(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
+  if (r->lin) {
+    out(e, "  for (i = 0; i < %d; i++) {\n", m);
+    for (int j = 0; j < s; j++) {
+      x_row(e, j, "gam", m, x, sizeof x);
+      out(e, "    hX[%d + i] = h * (%s);\n", j * m, x);
+    }
+    out(e, "  }\n  for (j = 0; j < %d; j++) {\n", s);
+    if (!r->gradU_s.lin.zero)
+      rtmpl(e, "    $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", m, m);
+    if (nu && jac_used(r, PART_LIN))
+      rtmpl(e, "    $P_roll_jac_lin(0, hX + j * %d, prm, R + j * %d);\n", m, mt);
+    out(e, "  }\n");
   }
-  tmpl(e, "  /* Theta_j = psi_j + rho_j lambda */\n"
-          "  for (j = 0; j < $P_S; j++)\n"
-          "    for (i = 0; i < $P_M; i++) {\n"
-          "      double acc = psi[j * $P_M + i];\n");
-  if (nu)
-    tmpl(e, "      for (t = 0; t < $P_RT; t++)\n"
-            "        if ($P_tcon[i * $P_RT + t] >= 0) acc += R[j * $P_M * $P_RT + i * $P_RT + t] * r[$P_tcon[i * $P_RT + t]];\n");
-  tmpl(e, "      th[j * $P_M + i] = acc;\n    }\n"
-          "  /* new gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i], p1 - p0 = -h Theta_0 */\n"
-          "  for (j = 0; j < $P_S; j++)\n"
-          "    for (i = 0; i < $P_M; i++) {\n"
-          "      double x = $P_rxi[j] * th[(j ? j - 1 : 0) * $P_M + i];\n"
-          "      if (j + 1 < $P_S) x -= $P_rxi[j + 1] * th[(j + 1) * $P_M + i];\n"
-          "      x = h * x;\n"
-          "      out[$[sweep.gam]j * $P_M + i] = $P_MINV(i) (j == 0 ? p0[i] - x : -x);\n    }\n"
-          "  for (i = 0; i < $P_M; i++) out[$[sweep.dp]i] = -(h * th[i]);\n"
-          "  for (i = 0; i < ($P_S - 1) * $P_M; i++) out[$[sweep.theta]i] = th[$P_M + i];\n");
+  if (!r->curved) return;
+  out(e, "  /* the other entries at the k stages: Q = q0 + h sum_j Ihat[l][j] gamma_j, summed with b_l P_j(c_l) */\n");
+  for (int l = 0; l < me->k; l++) {
+    out(e, "  /* stage %d of %d */\n  for (i = 0; i < %d; i++) Q[i] = q0[i] + h * (", l + 1, me->k, m);
+    for (int j = 0; j < s; j++) out(e, "%s%s * gam[%d + i]", j ? " + " : "", lit(e, me->Ihat[l * s + j]), j * m);
+    out(e, ");\n");
+    if (!r->gradU_s.curved.zero) {
+      tmpl(e, "  $P_roll_gradU_curved(Q, 0, prm, F);\n");
+      out(e, "  for (i = 0; i < %d; i++) {\n", m);
+      for (int j = 0; j < s; j++) out(e, "    psi[%d + i] += %s * F[i];\n", j * m, lit(e, me->W[l * s + j]));
+      out(e, "  }\n");
+    }
+    if (nu && jac_used(r, PART_CURVED)) {
+      tmpl(e, "  $P_roll_jac_curved(Q, 0, prm, J);\n");
+      out(e, "  for (i = 0; i < %d; i++) {\n", mt);
+      for (int j = 0; j < s; j++) out(e, "    R[%d + i] += %s * J[i];\n", j * mt, lit(e, me->W[l * s + j]));
+      out(e, "  }\n");
+    }
+  }
+}
+
+// The multiplier system, assembled by one loop over the coordinates: for
+// each constraint a on coordinate i (t unrolled), Y_k = M^-1 times the
+// coefficient of y_k in xi_0 x_0'y_0 + sum_j xi_j (x_j'y_j-1 - x_j-1'y_j), x
+// = rho[i, a], then r[a] += rho_0 M^-1 p0 - h Y'psi, A[a][c] += h Y'rho[i, c].
+static void emit_system(Emitter *e) {
+  const Roll *r = e->roll;
+  const double *xi = e->me->xi;
+  int m = e->mod->m, s = e->me->s, T = r->T, mt = m * T, W = 2 * r->bw + 1;
+  int psi_const = r->gradU_s.lin.zero && r->gradU_s.curved.zero; /* psi_j = 0 for j >= 1 */
+  tmpl(e, "  /* the multiplier system A lambda = r (band): A = h [xi_0 rho_0' M^-1 rho_0 + sum_j xi_j (rho_j' M^-1 rho_j-1\n"
+          "   * - rho_j-1' M^-1 rho_j)], r = rho_0' M^-1 (p0 - h xi_0 psi_0) - h sum_j xi_j (...) + g0, a sum over i */\n"
+          "  for (i = 0; i < $P_NU * $P_RW; i++) A[i] = 0;\n"
+          "  for (i = 0; i < $P_NU; i++) r[i] = 0;\n");
+  out(e, "  for (i = 0; i < %d; i++) {\n", m);
+  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d];\n", t, e->P, T, t);
+  for (int t = 0; t < T; t++) {
+    out(e, "    if (a%d >= 0) {\n", t);
+    for (int k = 0; k < s; k++) {
+      char y[256];
+      int n = 0;
+      if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", lit(e, xi[k + 1]), (k + 1) * mt + t, T);
+      if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", lit(e, xi[0]), t, T);
+      else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", lit(e, xi[k]), (k - 1) * mt + t, T);
+      out(e, "      const double Y%d = %s%s(%s);\n", k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
+    }
+    out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
+    for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
+    out(e, ");\n");
+    for (int u = 0; u < T; u++) {
+      out(e, "      if (a%d >= 0) A[a%d * %d + a%d - a%d + %d] += h * (", u, t, W, u, t, r->bw);
+      for (int k = 0; k < s; k++) out(e, "%sY%d * R[%d + %d * i]", k ? " + " : "", k, k * mt + u, T);
+      out(e, ");\n");
+    }
+    out(e, "    }\n");
+  }
+  out(e, "  }\n");
+  tmpl(e, "  for (i = 0; i < $P_NU; i++) r[i] += g0[i];  /* g(q0) / h, or 0 */\n"
+          "  $P_band_factor(A, out + $<sweep.pivot>, out + $<sweep.adiag>);\n"
+          "  $P_band_solve(A, r);\n"
+          "  r[$P_NU] = 0;  /* read where a coordinate has fewer than T constraints */\n"
+          "  for (i = 0; i < $P_NU; i++) out[$[sweep.lambda]i] = r[i];\n");
+}
+
+// The sweep: projections, multiplier system, then per coordinate Theta_j =
+// psi_j + rho_j lambda, gamma_j = M^-1 [delta_j0 p0 - h sum_i X[j][i] Theta_i]
+// and p1 - p0 = -h Theta_0.
+static void emit_sweep(Emitter *e) {
+  const Roll *r = e->roll;
+  int nu = e->mod->nu, m = e->mod->m, s = e->me->s, T = r->T, mt = m * T;
+  char x[512];
+  rtmpl(e, "  double Q[%d], F[%d], hX[%d], psi[%d];\n  int i, j = 0;\n  (void)Q; (void)F; (void)hX; (void)j;\n", m, m,
+        s * m, s * m);
+  if (nu) rtmpl(e, "  double J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
+  emit_projections(e);
+  if (nu) emit_system(e);
+  out(e, "  for (i = 0; i < %d; i++) {\n", m);
+  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d] < 0 ? %d : %s_tcon[%d * i + %d];\n", t, e->P, T, t, nu, e->P, T, t);
+  out(e, "    double th[%d];\n", s);
+  for (int j = 0; j < s; j++) {
+    out(e, "    th[%d] = psi[%d + i]", j, j * m);
+    for (int t = 0; t < T; t++) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
+    out(e, ";\n");
+  }
+  for (int j = 0; j < s; j++) {
+    x_row(e, j, "th", 1, x, sizeof x);
+    /* th is a local array here: th[r + i] would be wrong, so name its entries */
+    char *p;
+    while ((p = strstr(x, " + i]"))) memmove(p, p + 4, strlen(p + 4) + 1);
+    rtmpl(e, "    out[$[sweep.gam]%d + i] = $P_MINV(i) (%s(h * (%s)));\n", j * m, j ? "-" : "p0[i] - ", x);
+  }
+  tmpl(e, "    out[$[sweep.dp]i] = -(h * th[0]);\n");
+  for (int j = 1; j < s; j++) rtmpl(e, "    out[$[sweep.theta]%d + i] = th[%d];\n", (j - 1) * m, j);
+  out(e, "  }\n");
 }
 
 // The consistent multiplier: (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U.

@@ -37,7 +37,7 @@ typedef struct {
   Dag *d;
   int m;
   int *stamp, *local; /* per node id: the walk that saw it, its place in the post-order */
-  int epoch;
+  int room, epoch;    /* ids stamp and local have room for */
   IntVec order, stack;
   Code *code[2];      /* the item being encoded and the one before */
   int ncode[2], cap[2];
@@ -113,11 +113,21 @@ static int same_code(const Walk *w) {
   return 1;
 }
 
+// Room in w for every node of the DAG, which grows as families are built.
+static void walk_fit(Walk *w) {
+  if (w->room >= w->d->n) return;
+  w->stamp = xrealloc(w->stamp, (size_t)w->d->n * sizeof(int));
+  w->local = xrealloc(w->local, (size_t)w->d->n * sizeof(int));
+  memset(w->stamp + w->room, 0, (size_t)(w->d->n - w->room) * sizeof(int));
+  w->room = w->d->n;
+}
+
 // Split the n items nodes[] into runs (base[u] their base indices, or NULL:
 // the lowest coordinate each reads). Returns 0, or -1 when an item cannot
 // be printed or there are more than ROLL_MAX_RUNS runs.
 static int family(Walk *w, RollFamily *f, const int *nodes, const int *base, int n) {
   int cap = 0, prev_base = 0;
+  walk_fit(w);
   f->nitems = n;
   f->nruns = 0;
   f->runs = NULL;
@@ -140,7 +150,36 @@ static int family(Walk *w, RollFamily *f, const int *nodes, const int *base, int
     }
     prev_base = b;
   }
+  f->zero = 1;
+  for (int i = 0; i < f->nruns; i++) {
+    const RollRun *r = &f->runs[i];
+    f->zero &= r->nbody == 1 && dag_is_zero(w->d, r->body[0]);
+  }
   return 0;
+}
+
+// The family of the n items nodes[] split into affine, linear part and
+// curved (RollSplit), the items one per coordinate (base[u] = u). Returns 0
+// or -1 as family does.
+static int split_family(Walk *w, RollSplit *sp, const int *nodes, const int *base, int n) {
+  Dag *d = w->d;
+  int m = w->m, zero = dag_const(d, 0);
+  int *aff = step_nodes(n), *lin = step_nodes(n), *cur = step_nodes(n);
+  for (int u = 0; u < n; u++) {
+    int deg = d->nodes[nodes[u]].deg;
+    aff[u] = lin[u] = cur[u] = zero;
+    if (deg != 0 && deg != 1) {
+      cur[u] = nodes[u];
+      continue;
+    }
+    SparseVec gr; /* constants or params: the item is affine */
+    ad_gradient_sparse(d, nodes[u], m, &gr);
+    aff[u] = nodes[u];
+    for (int e = 0; e < gr.n; e++) lin[u] = dag_add(d, lin[u], dag_mul(d, gr.e[e].node, dag_input(d, m + gr.e[e].coord)));
+  }
+  return family(w, &sp->affine, aff, base, n) || family(w, &sp->lin, lin, base, n) || family(w, &sp->curved, cur, base, n)
+             ? -1
+             : 0;
 }
 
 // The terms of U in the order its sums add them: U's tree of additions,
@@ -215,7 +254,7 @@ static Roll *analyse_roll(Model *mod, const char **why) {
   int *jnode = coupling(mod, r), *coord = step_nodes(m), *items = step_nodes(m + 1), *hvv = step_nodes(nu + 1);
   for (int i = 0; i < m; i++) coord[i] = i;
   curvatures(mod, hvv);
-  Walk w = {d, m, xcalloc((size_t)d->n, sizeof(int)), xcalloc((size_t)d->n, sizeof(int)), 0, {0}, {0}, {0}, {0}, {0}};
+  Walk w = {d, m, NULL, NULL, 0, 0, {0}, {0}, {0}, {0}, {0}};
   int nterms, *terms = potential_terms(d, mod->U, &nterms), bad = 0;
   const char *what = NULL;
   if (family(&w, &r->gradU, mod->gradU, coord, m)) bad = 1, what = "the gradient of U";
@@ -223,6 +262,18 @@ static Roll *analyse_roll(Model *mod, const char **why) {
   for (int t = 0; t < r->T && !bad; t++) {
     for (int i = 0; i < m; i++) items[i] = jnode[i * r->T + t];
     if (family(&w, &r->jac[t], items, coord, m)) bad = 1, what = "the Jacobian of g";
+  }
+  if (!bad && split_family(&w, &r->gradU_s, mod->gradU, coord, m)) bad = 1, what = "the gradient of U";
+  r->jac_s = arena_alloc((size_t)(r->T + 1) * sizeof(RollSplit));
+  for (int t = 0; t < r->T && !bad; t++) {
+    for (int i = 0; i < m; i++) items[i] = jnode[i * r->T + t];
+    if (split_family(&w, &r->jac_s[t], items, coord, m)) bad = 1, what = "the Jacobian of g";
+  }
+  r->curved = !bad && !r->gradU_s.curved.zero;
+  r->lin = !bad && !r->gradU_s.lin.zero;
+  for (int t = 0; t < r->T && !bad; t++) {
+    r->curved |= !r->jac_s[t].curved.zero;
+    r->lin |= !r->jac_s[t].lin.zero;
   }
   if (!bad && family(&w, &r->g, mod->g, NULL, nu)) bad = 1, what = "g";
   if (!bad && family(&w, &r->U, terms, NULL, nterms)) bad = 1, what = "U";

@@ -33,7 +33,19 @@ typedef struct {
   int nitems;
   RollRun *runs;
   int nruns;
+  int zero;           /* every item is the constant 0 */
 } RollFamily;
+
+/* A family of derivative entries split for the step's Legendre projections:
+ * the items affine in q are projected in closed form, as step.c does,
+ * sum_l b_l P_j(c_l) f(Q_l) = delta_j0 f(q0) + f_lin(h (X gamma)_j), and only
+ * the others (curved) are evaluated at the k stages. Each family has all the
+ * items, 0 where an item belongs to another. */
+typedef struct {
+  RollFamily affine;  /* f, affine items */
+  RollFamily lin;     /* f_lin(v) = sum_i df/dq_i v_i, v the second array, affine items */
+  RollFamily curved;  /* f, the other items */
+} RollSplit;
 
 /* The analysis emit_rolled.c prints from. Inputs of the families' nodes:
  * slots 0..m-1 are q (the array q), m..2m-1 are the second array (v). */
@@ -46,6 +58,10 @@ typedef struct Roll {
   RollFamily g;       /* items a: g_a */
   RollFamily U;       /* items: the terms of U, summed in order */
   RollFamily hvv;     /* items a: v' Hess(g_a)(q) v */
+  RollSplit gradU_s;  /* gradU, split for the projections */
+  RollSplit *jac_s;   /* T of them: jac, split */
+  int curved;         /* some entry is curved: the stages are evaluated */
+  int lin;            /* some affine entry is not constant: h (X gamma)_j is needed */
 } Roll;
 
 /* Decide the form from eo->rolled and set eo->roll (NULL: straight-line).
