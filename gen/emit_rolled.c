@@ -212,8 +212,7 @@ static void emit_band(Emitter *e) {
 // family functions.
 static void emit_helpers(Emitter *e) {
   const Roll *r = e->roll;
-  const Method *me = e->me;
-  int m = e->mod->m, k = me->k, s = me->s;
+  int m = e->mod->m;
   rtmpl(e, "\n/* The rolled form (docs/rolled.md): the model's index kept as loops. T = most constraints\n"
            " * on one coordinate, BW = the half band of the multiplier system. */\n"
            "#define $P_RT %d\n#define $P_RBW %d\n#define $P_RW (2 * $P_RBW + 1)\n", r->T, r->bw);
@@ -223,16 +222,12 @@ static void emit_helpers(Emitter *e) {
     tmpl(e, "#define $P_MINV(i) $P_rminv[i] *\n");
   }
   if (r->T) emit_array(e, "int", "tcon", NULL, r->tcon, m * r->T);
-  if (r->curved) {
-    emit_array(e, "double", "rIhat", me->Ihat, NULL, k * s);
-    emit_array(e, "double", "rW", me->W, NULL, k * s);
-  }
-  emit_family(e, "gradU", "out[i] = dU/dq_i", &r->gradU, 0);
   if (!r->gradU_s.affine.zero) emit_family(e, "gradU_affine", "out[i] = dU/dq_i where it is affine in q, else 0", &r->gradU_s.affine, 0);
   if (!r->gradU_s.lin.zero) emit_family(e, "gradU_lin", "out[i] += sum_k d^2U/dq_i dq_k v_k where dU/dq_i is affine", &r->gradU_s.lin, -1);
   if (!r->gradU_s.curved.zero) emit_family(e, "gradU_curved", "out[i] = dU/dq_i where it is not affine in q, else 0", &r->gradU_s.curved, 0);
   emit_family(e, "U", "out[0] = U(q), its terms in the order of its sums", &r->U, 1);
   if (r->nu) {
+    emit_family(e, "gradU", "out[i] = dU/dq_i", &r->gradU, 0);
     emit_family(e, "g", "out[a] = g_a(q)", &r->g, 0);
     emit_family(e, "hvv", "out[a] = v' Hess(g_a)(q) v", &r->hvv, 0);
     emit_jacobians(e);

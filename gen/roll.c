@@ -308,6 +308,17 @@ static long sweep_ops(const Model *mod, const Step *st) {
   return dag_count_ops(mod->dag, outs, kernel_size(k));
 }
 
+// Items per run of the derivatives' families: how many times the rolled
+// form shortens them.
+static double compression(const Roll *r) {
+  long items = r->gradU.nitems + r->g.nitems, runs = r->gradU.nruns + r->g.nruns;
+  for (int t = 0; t < r->T; t++) {
+    items += r->jac[t].nitems;
+    runs += r->jac[t].nruns;
+  }
+  return runs ? (double)items / (double)runs : 0;
+}
+
 int roll_choose(Model *mod, const Method *me, const Step *st, EmitOptions *eo) {
   eo->roll = NULL;
   if (eo->rolled == ROLL_OFF) return 0;
@@ -315,6 +326,7 @@ int roll_choose(Model *mod, const Method *me, const Step *st, EmitOptions *eo) {
   const char *why = not_covered(mod, me, eo);
   if (!on && (why || sweep_ops(mod, st) < ROLL_AUTO_OPS)) return 0;
   Roll *r = why ? NULL : analyse_roll(mod, &why);
+  if (r && !on && compression(r) < ROLL_AUTO_COMPRESSION) return 0; /* little repetition: straight-line is as short */
   if (!r && on) {
     error_at(mod->nu ? mod->g_loc[0] : mod->U_loc, "--rolled on: the rolled form cannot print this model: %s", why);
     return 1;

@@ -17,7 +17,9 @@ enum { ROLL_OFF, ROLL_ON, ROLL_AUTO };
 #define ROLL_MAX_RUNS 64
 /* --rolled auto rolls a model whose straight-line sweep has at least this many
  * operations (docs/rolled.md, "Crossover": measured on the chain). */
-#define ROLL_AUTO_OPS 6000
+#define ROLL_AUTO_OPS 4000
+/* ... and whose derivatives it shortens this many times at least (items per run). */
+#define ROLL_AUTO_COMPRESSION 8
 
 /* One maximal run of items that are the same expression up to a shift of
  * the index: item u (u0 <= u < u0 + n) has the base index b0 + stride (u -
