@@ -205,6 +205,8 @@ bench/batch/run.sh || echo "bench: the batch/ensemble benchmark failed"
 echo "== the scalar step against its bound, compilers and flags ($(elapsed) s)"
 bench/step/run.sh || echo "bench: the step benchmark failed"
 bench/lean/kauto.sh
+echo "== the rolled form on chains of N pendula ($(elapsed) s)"
+bench/rolled/run.sh || echo "bench: the rolled-form benchmark failed"
 
 echo "load after (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg)" >>"$R/machine.txt"
 echo "bench/run.sh: $(elapsed) s" | tee -a "$R/machine.txt"
