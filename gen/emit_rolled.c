@@ -81,7 +81,7 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
     body_name(e, r, n->a, a, sizeof a);
     if (n->b >= 0) body_name(e, r, n->b, b, sizeof b);
     op_rhs(e, n, a, b, rhs, sizeof rhs);
-    out(e, "    const double r%d = %s;\n", k, rhs);
+    out(e, "    const %s r%d = %s;\n", real_type(e, 0), k, rhs);
   }
   body_name(e, r, r->body[r->nbody - 1], a, sizeof a);
   if (os) out(e, "    out[%d * u + %d] %s= %s;\n  }\n", os < 0 ? -os : os, oo, os < 0 ? "+" : "", a);
@@ -92,8 +92,8 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
 // items; with mode 1 out[0] = the sum of them in order, with mode -1 out[i]
 // += item i.
 static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int mode) {
-  rtmpl(e, "\n/* %s */\nstatic void $P_roll_%s(const double *q, const double *v, const $P_params *prm, double *out)\n{\n"
-           "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  double acc = 0;\n" : "");
+  rtmpl(e, "\n/* %s */\nstatic void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
+           "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  $R acc = 0;\n" : "");
   for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0);
   out(e, mode == 1 ? "  out[0] = acc;\n}\n" : "}\n");
 }
@@ -102,7 +102,7 @@ static void emit_family(Emitter *e, const char *name, const char *what, const Ro
 // $P_roll_NAME: out[T i + t] = item i of family t.
 static void emit_tfamily(Emitter *e, const char *name, const char *what, const RollFamily *const *fams, int add) {
   rtmpl(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
-           "static void $P_roll_%s(const double *q, const double *v, const $P_params *prm, double *out)\n{\n"
+           "static void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what, name);
   for (int t = 0; t < e->roll->T; t++)
     for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -e->roll->T : e->roll->T, t);
@@ -158,7 +158,7 @@ static void emit_gram(Emitter *e) {
   const Roll *r = e->roll;
   int T = r->T, W = 2 * r->bw + 1;
   tmpl(e, "/* B = G' M^-1 G in band storage, G the Jacobian's entries J ($P_roll_jac). */\n"
-          "static void $P_roll_gram(const double *J, double *B)\n{\n"
+          "static void $P_roll_gram(const $R *J, $R *B)\n{\n"
           "  int i;\n"
           "  for (i = 0; i < $P_NU * $P_RW; i++) B[i] = 0;\n");
   out(e, "  for (i = 0; i < %d; i++) {\n", r->m);
@@ -178,30 +178,29 @@ static void emit_band(Emitter *e) {
   tmpl(e, "\n/* A (NU x NU, band storage A[a * $P_RW + c - a + $P_RBW]) = L U without pivoting, in place:\n"
           " * pivot[k] the k-th pivot, adiag[k] the diagonal entry it started from. The band's\n"
           " * offsets are unrolled. */\n"
-          "static void $P_band_factor(double *A, double *pivot, double *adiag)\n{\n"
+          "static void $P_band_factor($R *A, $R *pivot, $R *adiag)\n{\n"
           "  int k;\n"
           "  for (k = 0; k < $P_NU; k++) adiag[k] = A[k * $P_RW + $P_RBW];\n"
           "  for (k = 0; k < $P_NU; k++) {\n"
-          "    const double *Ak = A + k * $P_RW + $P_RBW;  /* Ak[c - k] = A[k][c] */\n"
+          "    const $R *Ak = A + k * $P_RW + $P_RBW;  /* Ak[c - k] = A[k][c] */\n"
           "    pivot[k] = Ak[0];\n");
   for (int d = 1; d <= bw; d++) {
     rtmpl(e, "    if (k + %d < $P_NU) {\n"
-             "      double *Ai = A + (k + %d) * $P_RW + $P_RBW - %d;  /* Ai[c - k] = A[k + %d][c] */\n"
-             "      const double f = Ai[0] / Ak[0];\n"
+             "      $R *Ai = A + (k + %d) * $P_RW + $P_RBW - %d;  /* Ai[c - k] = A[k + %d][c] */\n"
+             "      const $R f = Ai[0] / Ak[0];\n"
              "      Ai[0] = f;\n", d, d, d, d);
     for (int c = 1; c <= bw; c++) rtmpl(e, "      if (k + %d < $P_NU) Ai[%d] -= f * Ak[%d];\n", c, c, c);
     out(e, "    }\n");
   }
   tmpl(e, "  }\n}\n\n"
           "/* x = A^-1 x for A factored by $P_band_factor. */\n"
-          "static void $P_band_solve(const double *A, double *x)\n{\n"
-          "  int k;\n"
-          "  for (k = 0; k < $P_NU; k++) {\n"
-          "    const double xk = x[k];\n");
+          "static void $P_band_solve(const $R *A, $R *x)\n{\n"
+          "  int k;\n");
+  if (bw) tmpl(e, "  for (k = 0; k < $P_NU; k++) {\n    const $R xk = x[k];\n");
   for (int d = 1; d <= bw; d++) rtmpl(e, "    if (k + %d < $P_NU) x[k + %d] -= A[(k + %d) * $P_RW + $P_RBW - %d] * xk;\n", d, d, d, d);
-  tmpl(e, "  }\n"
-          "  for (k = $P_NU - 1; k >= 0; k--) {\n"
-          "    double acc = x[k];\n");
+  if (bw) tmpl(e, "  }\n");
+  tmpl(e, "  for (k = $P_NU - 1; k >= 0; k--) {\n"
+          "    $R acc = x[k];\n");
   for (int c = 1; c <= bw; c++) rtmpl(e, "    if (k + %d < $P_NU) acc -= A[k * $P_RW + $P_RBW + %d] * x[k + %d];\n", c, c, c);
   tmpl(e, "    x[k] = acc / A[k * $P_RW + $P_RBW];\n  }\n}\n\n");
   emit_gram(e);
@@ -218,7 +217,7 @@ static void emit_helpers(Emitter *e) {
            "#define $P_RT %d\n#define $P_RBW %d\n#define $P_RW (2 * $P_RBW + 1)\n", r->T, r->bw);
   if (r->identity) tmpl(e, "#define $P_MINV(i) /* M = I */\n");
   else {
-    emit_array(e, "double", "rminv", e->mod->minv_diag, NULL, m);
+    emit_array(e, real_type(e, 0), "rminv", e->mod->minv_diag, NULL, m);
     tmpl(e, "#define $P_MINV(i) $P_rminv[i] *\n");
   }
   if (r->T) emit_array(e, "int", "tcon", NULL, r->tcon, m * r->T);
@@ -325,7 +324,7 @@ static void emit_system(Emitter *e) {
       if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", lit(e, xi[k + 1]), (k + 1) * mt + t, T);
       if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", lit(e, xi[0]), t, T);
       else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", lit(e, xi[k]), (k - 1) * mt + t, T);
-      out(e, "      const double Y%d = %s%s(%s);\n", k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
+      out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
     }
     out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
     for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
@@ -352,14 +351,14 @@ static void emit_sweep(Emitter *e) {
   const Roll *r = e->roll;
   int nu = e->mod->nu, m = e->mod->m, s = e->me->s, T = r->T, mt = m * T;
   char x[512];
-  rtmpl(e, "  double Q[%d], F[%d], hX[%d], psi[%d];\n  int i, j = 0;\n  (void)Q; (void)F; (void)hX; (void)j;\n", m, m,
+  rtmpl(e, "  $R Q[%d], F[%d], hX[%d], psi[%d];\n  int i, j = 0;\n  (void)Q; (void)F; (void)hX; (void)j;\n", m, m,
         s * m, s * m);
-  if (nu) rtmpl(e, "  double J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
+  if (nu) rtmpl(e, "  $R J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
   emit_projections(e);
   if (nu) emit_system(e);
   out(e, "  for (i = 0; i < %d; i++) {\n", m);
   for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d] < 0 ? %d : %s_tcon[%d * i + %d];\n", t, e->P, T, t, nu, e->P, T, t);
-  out(e, "    double th[%d];\n", s);
+  out(e, "    %s th[%d];\n", real_type(e, 0), s);
   for (int j = 0; j < s; j++) {
     out(e, "    th[%d] = psi[%d + i]", j, j * m);
     for (int t = 0; t < T; t++) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
@@ -380,7 +379,7 @@ static void emit_sweep(Emitter *e) {
 // The consistent multiplier: (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U.
 static void emit_lambda0(Emitter *e) {
   int nu = e->mod->nu, m = e->mod->m, mt = m * e->roll->T;
-  rtmpl(e, "  double J[%d], B[%d], gu[%d], v[%d], hv[%d], rr[%d], piv[%d], dia[%d];\n  int i, t;\n", mt,
+  rtmpl(e, "  $R J[%d], B[%d], gu[%d], v[%d], hv[%d], rr[%d], piv[%d], dia[%d];\n  int i, t;\n", mt,
         nu * (2 * e->roll->bw + 1), m, m, nu, nu, nu, nu);
   tmpl(e, "  $P_roll_jac(q0, 0, prm, J);\n  $P_roll_gram(J, B);\n  $P_roll_gradU(q0, 0, prm, gu);\n"
           "  for (i = 0; i < $P_M; i++) v[i] = $P_MINV(i) p0[i];\n"
@@ -397,13 +396,13 @@ static void emit_lambda0(Emitter *e) {
 // NAME_project's Newton step onto g = 0 and projection of p.
 static void emit_consistent(Emitter *e) {
   int nu = e->mod->nu, m = e->mod->m, mt = m * e->roll->T;
-  rtmpl(e, "  double J[%d], B[%d], y[%d], mu[%d];\n  int i, t;\n", mt, nu * (2 * e->roll->bw + 1), nu, nu);
+  rtmpl(e, "  $R J[%d], B[%d], y[%d], mu[%d];\n  int i, t;\n", mt, nu * (2 * e->roll->bw + 1), nu, nu);
   tmpl(e, "  $P_roll_jac(q0, 0, prm, J);\n  $P_roll_gram(J, B);\n"
           "  $P_band_factor(B, out + $<consistent.pivot>, out + $<consistent.adiag>);\n"
           "  $P_roll_g(q0, 0, prm, y);\n  $P_band_solve(B, y);\n"
           "  for (i = 0; i < $P_NU; i++) mu[i] = 0;\n"
           "  for (i = 0; i < $P_M; i++) {\n"
-          "    double acc = 0;\n"
+          "    $R acc = 0;\n"
           "    for (t = 0; t < $P_RT; t++)\n"
           "      if ($P_tcon[i * $P_RT + t] >= 0) {\n"
           "        acc += J[i * $P_RT + t] * y[$P_tcon[i * $P_RT + t]];\n"
@@ -412,7 +411,7 @@ static void emit_consistent(Emitter *e) {
           "    out[$[consistent.dq]i] = -($P_MINV(i) acc);\n  }\n"
           "  $P_band_solve(B, mu);\n"
           "  for (i = 0; i < $P_M; i++) {\n"
-          "    double acc = 0;\n"
+          "    $R acc = 0;\n"
           "    for (t = 0; t < $P_RT; t++)\n"
           "      if ($P_tcon[i * $P_RT + t] >= 0) acc -= J[i * $P_RT + t] * mu[$P_tcon[i * $P_RT + t]];\n"
           "    out[$[consistent.dp]i] = acc;\n  }\n");
@@ -424,12 +423,12 @@ static void emit_state_kernel(Emitter *e, KernelId id) {
   switch (id) {
   case K_MINV_P: tmpl(e, "  int i;\n  for (i = 0; i < $P_M; i++) out[i] = $P_MINV(i) p0[i];\n"); break;
   case K_ENERGY:
-    tmpl(e, "  double kin = 0, u;\n  int i;\n  for (i = 0; i < $P_M; i++) kin += p0[i] * ($P_MINV(i) p0[i]);\n"
-            "  $P_roll_U(q0, 0, prm, &u);\n  out[0] = 0.5 * kin + u;\n");
+    rtmpl(e, "  $R kin = 0, u;\n  int i;\n  for (i = 0; i < $P_M; i++) kin += p0[i] * ($P_MINV(i) p0[i]);\n"
+             "  $P_roll_U(q0, 0, prm, &u);\n  out[0] = %s * kin + u;\n", lit(e, 0.5));
     break;
   case K_G: tmpl(e, "  $P_roll_g(q0, 0, prm, out);\n"); break;
   case K_HIDDEN:
-    rtmpl(e, "  double J[%d];\n  int i, t;\n", mt);
+    rtmpl(e, "  $R J[%d];\n  int i, t;\n", mt);
     tmpl(e, "  $P_roll_jac(q0, 0, prm, J);\n  for (i = 0; i < $P_NU; i++) out[i] = 0;\n"
             "  for (i = 0; i < $P_M; i++)\n    for (t = 0; t < $P_RT; t++)\n"
             "      if ($P_tcon[i * $P_RT + t] >= 0) out[$P_tcon[i * $P_RT + t]] += J[i * $P_RT + t] * ($P_MINV(i) p0[i]);\n");

@@ -499,7 +499,8 @@ static void note_large_output(const char *path) {
   fprintf(stderr,
           "hbvmgen: note: '%s' is %.1f MB of C: compilers take minutes and gigabytes on a file this size "
           "(gcc -O2: 30 s and 0.4 GB at 3.8 MB, 200 s and 3.2 GB at 19.7 MB; --stage-loop and --mass-loop "
-          "shrink what they can, docs/embedding.md, \"Large models\")\n",
+          "shrink what they can, docs/embedding.md, \"Large models\"; a model uniform in its index is a few "
+          "loops with --multiplier const, docs/rolled.md)\n",
           path, (double)sb.st_size / 1e6);
 }
 
@@ -561,7 +562,8 @@ static int write_outputs(const Options *o, Model *mod, const Method *me, const S
     fprintf(stderr,
             "hbvmgen: error: '%s' would be %.1f MB of C, above the %.0f MB no compiler handles in reasonable time "
             "(gcc -O2: 200 s and 3.2 GB at 19.7 MB); --stage-loop N and --mass-loop N roll the stages and M^-1 "
-            "into loops where they can (docs/embedding.md, \"Large models\")\n",
+            "into loops where they can (docs/embedding.md, \"Large models\"), --rolled the model's index "
+            "(docs/rolled.md)\n",
             final[C], (double)csize / 1e6, MAX_C_BYTES / 1e6);
     rc = 2; /* reported: no second message */
   }

@@ -8,6 +8,9 @@
  *             up to the reordering of sums (docs/rolled.md, "Same results"),
  *             and at the start the same H, g, hidden constraint and
  *             consistent multiplier to round-off;
+ *   float     --real float rolled against straight-line, to float's bound;
+ *   adaptive  NAME_step_adaptive, NAME_dense and NAME_project on the rolled
+ *             kernels follow the straight-line ones to the reordering bound;
  *   conserve  H and g of the rolled chains stay at round-off;
  *   size      the C of the rolled chain (s = 4, const) as a function of N:
  *             the loops are the same at N = 250 and 1000, only the data grows
@@ -16,7 +19,8 @@
  *   choose    --rolled auto keeps a small chain straight-line and rolls a
  *             large one; --rolled on refuses what the form does not cover
  *             (the poly family, a model not uniform in its index), auto
- *             falls back to straight-line there.
+ *             falls back to straight-line there; variables x[30000], refused
+ *             as 37.6 MB of straight-line C, is rolled by default.
  * The suite is reroll_suite(); the project's runner adds it. */
 #include <check.h>
 #include <math.h>
@@ -26,6 +30,8 @@
 
 #include "chain32_rolled_k2s2.h"
 #include "chain32_straight_k2s2.h"
+#include "chain32f_rolled_k2s2.h"
+#include "chain32f_straight_k2s2.h"
 #include "chain_rolled_k4s4.h"
 #include "chain_straight_k4s4.h"
 #include "fpu_rolled_k2s2.h"
@@ -49,6 +55,63 @@ START_TEST(test_same_trajectory)
   SAME_TRAJECTORY(chain32_rolled_k2s2, chain32_straight_k2s2, 0.01, REORDER_TOL, "chain 32, s = 2, rolled vs straight-line");
   SAME_TRAJECTORY(spring_rolled_k2s2, spring_straight_k2s2, 0.01, REORDER_TOL, "chain with springs, rolled vs straight-line");
   SAME_TRAJECTORY(fpu_rolled_k2s2, fpu_straight_k2s2, 0.002, REORDER_TOL, "FPU, rolled vs straight-line");
+}
+END_TEST
+
+/* Adaptive steps, dense output and NAME_project work on the kernels, so the
+ * rolled chain with springs follows the straight-line one under
+ * NAME_step_adaptive too: the error estimates agree to round-off, so do the
+ * steps chosen (a relative 1e-16 of h), and the trajectories to the
+ * reordering bound. */
+START_TEST(test_adaptive_dense)
+{
+  spring_rolled_k2s2_state a;
+  spring_straight_k2s2_state b;
+  double ha = 0.05, hb = 0.05, qa[spring_rolled_k2s2_M], pa[spring_rolled_k2s2_M], qb[spring_rolled_k2s2_M],
+         pb[spring_rolled_k2s2_M], worst = 0;
+  spring_rolled_k2s2_init(&a, NULL, NULL);
+  spring_straight_k2s2_init(&b, NULL, NULL);
+  for (int n = 0; n < 100; n++) {
+    ck_assert_int_eq(spring_rolled_k2s2_step_adaptive(&a, &ha, 1e-8, NULL, NULL), 0);
+    ck_assert_int_eq(spring_straight_k2s2_step_adaptive(&b, &hb, 1e-8, NULL, NULL), 0);
+    spring_rolled_k2s2_dense(&a, 0.5, qa, pa);
+    spring_straight_k2s2_dense(&b, 0.5, qb, pb);
+    worst = fmax(worst, fabs(a.t - b.t));
+    worst = max_diff(max_diff(worst, qa, qb, spring_rolled_k2s2_M), pa, pb, spring_rolled_k2s2_M);
+    worst = max_diff(max_diff(worst, a.q, b.q, spring_rolled_k2s2_M), a.p, b.p, spring_rolled_k2s2_M);
+  }
+  ck_assert_int_eq(spring_rolled_k2s2_project(&a, NULL, NULL, NULL), 0);
+  ck_assert_int_eq(spring_straight_k2s2_project(&b, NULL, NULL, NULL), 0);
+  worst = max_diff(max_diff(worst, a.q, b.q, spring_rolled_k2s2_M), a.p, b.p, spring_rolled_k2s2_M);
+  printf("reroll: chain with springs, adaptive steps to t = %.3f, dense output, project: rolled vs straight-line %.3g\n",
+         a.t, worst);
+  ck_assert_msg(worst <= REORDER_TOL, "adaptive: the trajectories differ by %.3g", worst);
+}
+END_TEST
+
+/* --real float: the reordering bound in float's precision, a few ulps
+ * (6e-8) of values up to 50 a step, spread at most 300-fold: 1e-3
+ * (measured 1.1e-5); H and g of the rolled solver within what the
+ * straight-line float solver keeps (1.1e-4 and 3.8e-6 measured). */
+START_TEST(test_float)
+{
+  chain32f_rolled_k2s2_state a;
+  chain32f_straight_k2s2_state b;
+  chain32f_rolled_k2s2_init(&a, NULL, NULL);
+  chain32f_straight_k2s2_init(&b, NULL, NULL);
+  float H0 = chain32f_rolled_k2s2_energy(&a, NULL), g[chain32f_rolled_k2s2_NU];
+  double worst = 0, dH = 0, dg = 0;
+  for (int n = 0; n < NSTEPS; n++) {
+    ck_assert_int_eq(chain32f_rolled_k2s2_step(&a, 0.01f, NULL, NULL), 0);
+    ck_assert_int_eq(chain32f_straight_k2s2_step(&b, 0.01f, NULL, NULL), 0);
+    for (int i = 0; i < chain32f_rolled_k2s2_M; i++) worst = fmax(worst, fmax(fabs(a.q[i] - b.q[i]), fabs(a.p[i] - b.p[i])));
+    dH = fmax(dH, fabs(chain32f_rolled_k2s2_energy(&a, NULL) - H0));
+    chain32f_rolled_k2s2_constraints(&a, NULL, g);
+    for (int i = 0; i < chain32f_rolled_k2s2_NU; i++) dg = fmax(dg, fabs(g[i]));
+  }
+  printf("reroll: float chain 32, rolled vs straight-line: %.3g; |H - H0| %.3g, |g| %.3g\n", worst, dH, dg);
+  ck_assert_msg(worst <= 1e-3, "float: the trajectories differ by %.3g", worst);
+  ck_assert_msg(dH <= 1e-3 && dg <= 4e-5, "float: H or g drift %.3g %.3g", dH, dg);
 }
 END_TEST
 
@@ -157,6 +220,21 @@ START_TEST(test_size)
 }
 END_TEST
 
+/* variables x[30000] with a sum of squares: 37.6 MB of straight-line C,
+ * refused (tests/check_lean.c); rolled by default, a third of a megabyte,
+ * most of it q0 and p0. */
+START_TEST(test_many_coordinates)
+{
+  const char *text = "variables x[30000]\nM = identity\nU = sum(i in 1..30000, x[i]^2)\n"
+                     "q0 = [1 for i in 1..30000]\np0 = [0 for i in 1..30000]\n";
+  char *src = generate_source(text, "-s 2");
+  ck_assert_msg(src != NULL, "x[30000] was not generated");
+  printf("reroll: variables x[30000], sum of squares: %zu bytes of C\n", strlen(src));
+  ck_assert_msg(strstr(src, "(rolled)") && strlen(src) <= 400000, "x[30000]: %zu bytes of C", strlen(src));
+  free(src);
+}
+END_TEST
+
 START_TEST(test_choose)
 {
   char *small = chain_model(8), *large = chain_model(64);
@@ -191,8 +269,11 @@ Suite *reroll_suite(void)
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, test_same_trajectory);
   tcase_add_test(tc, test_same_state_functions);
+  tcase_add_test(tc, test_float);
+  tcase_add_test(tc, test_adaptive_dense);
   tcase_add_test(tc, test_conservation);
   tcase_add_test(tc, test_size);
+  tcase_add_test(tc, test_many_coordinates);
   tcase_add_test(tc, test_choose);
   suite_add_tcase(s, tc);
   return s;
