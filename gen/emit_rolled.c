@@ -18,8 +18,8 @@
  *     lu.c prints unrolled: its symmetric part is positive definite).
  * The sums are those of the straight-line kernels, but some are taken in
  * another order (docs/rolled.md says which): results agree to round-off.
- * Work arrays are locals of the kernels: about (3 + 2T) S M + NU (2 BW + 4)
- * doubles of stack in the sweep. */
+ * Work arrays are locals of the kernels: 2 (S + 1) M + (S + 1) T M + NU (2 BW
+ * + 2) reals of stack in the sweep. */
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
