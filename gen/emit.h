@@ -41,6 +41,8 @@ typedef struct {
   unsigned local;  /* 1 << input slot */
   const char *res; /* non-NULL: results go to locals res0, res1, ..., not out[] */
   int fused;       /* the step's iteration has the sweep inlined, gamma in locals */
+  const struct Roll *roll; /* non-NULL: the rolled form (roll.h, emit_rolled.c) */
+  int roll_helpers; /* its helpers are printed */
 } Emitter;
 
 /* emit_kernel.c: printing, and the kernels */
@@ -50,10 +52,15 @@ const char *math_suffix(const Emitter *e, int wide);
 void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
 void emit_kernel(Emitter *e, KernelId k);
+void kernel_signature(Emitter *e, const Kernel *k, int part);
+void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, size_t size);
 void emit_tables(Emitter *e);
 int kernel_inlinable(const Emitter *e, KernelId k);
 int sweep_reduces(const Emitter *e);
 int emit_kernel_inline(Emitter *e, KernelId k);
+
+/* emit_rolled.c: kernel k in the rolled form (e->roll), 1; 0 when it has none */
+int emit_rolled_kernel(Emitter *e, KernelId k);
 
 /* emit_choice.c: what the model, method and options choose for the step */
 int step_order(const Emitter *e);

@@ -418,26 +418,33 @@ static void emit_node(Emitter *e, int id) {
   }
   ref(e, n->a, a, sizeof a);
   if (n->b >= 0) ref(e, n->b, b, sizeof b);
-  switch ((Op)n->op) {
-  case OP_ADD: snprintf(rhs, sizeof rhs, "%s + %s", a, b); break;
-  case OP_SUB: snprintf(rhs, sizeof rhs, "%s - %s", a, b); break;
-  case OP_MUL: snprintf(rhs, sizeof rhs, "%s * %s", a, b); break;
-  case OP_DIV: snprintf(rhs, sizeof rhs, "%s / %s", a, b); break;
-  case OP_NEG: snprintf(rhs, sizeof rhs, "-%s", a); break;
-  case OP_SIGN: snprintf(rhs, sizeof rhs, "(%s > 0) - (%s < 0)", a, a); break;
-  case OP_POW: {
-    const Node *ex = &e->mod->dag->nodes[n->b];
-    if (ex->op == OP_CONST && power_expr(rhs, sizeof rhs, a, ex->val)) break;
-    snprintf(rhs, sizeof rhs, "pow%s(%s, %s)", math_suffix(e, e->wide), a, b);
-    break;
-  }
-  default:
-    if (n->b >= 0) snprintf(rhs, sizeof rhs, "%s%s(%s, %s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a, b);
-    else snprintf(rhs, sizeof rhs, "%s%s(%s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a);
-  }
+  op_rhs(e, n, a, b, rhs, sizeof rhs);
   char lhs[32];
   snprintf(lhs, sizeof lhs, e->body ? "b%d" : "t%d", e->body ? id : e->temp[id]);
   out(e, "%s%s  const %s %s = %s;\n", body_indent(e), e->body ? "    " : "", real_type(e, e->wide), lhs, rhs);
+}
+
+// The C expression of operation n on its operands' names a and b (b unused
+// for a unary one) into rhs: an operator, x^n for a small integer n as
+// products, or the math function in the kernel's precision.
+void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, size_t size) {
+  switch ((Op)n->op) {
+  case OP_ADD: snprintf(rhs, size, "%s + %s", a, b); break;
+  case OP_SUB: snprintf(rhs, size, "%s - %s", a, b); break;
+  case OP_MUL: snprintf(rhs, size, "%s * %s", a, b); break;
+  case OP_DIV: snprintf(rhs, size, "%s / %s", a, b); break;
+  case OP_NEG: snprintf(rhs, size, "-%s", a); break;
+  case OP_SIGN: snprintf(rhs, size, "(%s > 0) - (%s < 0)", a, a); break;
+  case OP_POW: {
+    const Node *ex = &e->mod->dag->nodes[n->b];
+    if (ex->op == OP_CONST && power_expr(rhs, size, a, ex->val)) break;
+    snprintf(rhs, size, "pow%s(%s, %s)", math_suffix(e, e->wide), a, b);
+    break;
+  }
+  default:
+    if (n->b >= 0) snprintf(rhs, size, "%s%s(%s, %s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a, b);
+    else snprintf(rhs, size, "%s%s(%s)", op_cfun((Op)n->op), math_suffix(e, e->wide), a);
+  }
 }
 
 // Whether the batch kernel k is inlined where it is called: those that each
@@ -453,7 +460,7 @@ static int lane_inlined(const Emitter *e, const Kernel *k) {
 
 // The signature of kernel k (of its part-th part when part >= 0): one
 // argument per input block of the Step, then the parameters and out[].
-static void kernel_signature(Emitter *e, const Kernel *k, int part) {
+void kernel_signature(Emitter *e, const Kernel *k, int part) {
   const Step *st = e->st;
   const char *t = real_type(e, e->wide); /* the sweep of --wide-step: state, gamma, results wider */
   const char *rs = e->lanes ? "*restrict " : "*"; /* lanes: the compiler may assume no overlap */
@@ -681,6 +688,7 @@ static void emit_lane_reductions(Emitter *e, const Kernel *k, const int *outs, i
 // code from the DAG, in several parts when it is large. Kernels marked wide
 // compute one precision wider under --wide-step.
 void emit_kernel(Emitter *e, KernelId id) {
+  if (e->roll && emit_rolled_kernel(e, id)) return; /* the rolled form's loops instead (emit_rolled.c) */
   const Kernel *k = &e->st->kern[id];
   int *ops, nops = kernel_ops(e, id, &ops), nouts = kernel_size(k), top = -1;
   int *outs = kernel_outs(k);
@@ -714,6 +722,7 @@ void emit_kernel(Emitter *e, KernelId id) {
 // Whether kernel k is small enough, and free of tables and stage loops, to
 // be printed as one block of the fused step (emit_kernel_inline, INLINE_NODES).
 int kernel_inlinable(const Emitter *e, KernelId id) {
+  if (e->roll) return 0; /* the rolled kernels are loops */
   int *ops, nops = kernel_ops(e, id, &ops), plain = nops <= INLINE_NODES;
   for (int i = 0; plain && i < nops; i++) /* tables and stage loops only in functions of their own */
     plain = e->mod->dag->nodes[ops[i]].op != OP_TROW && e->mod->dag->nodes[ops[i]].op != OP_SSUM;

@@ -51,7 +51,7 @@ int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
 // Write NAME.h to hf and NAME.c to cf. Returns 0, or -1 on a write error.
 int emit_solver(FILE *hf, FILE *cf, const Model *mod, const Method *me, const Step *st, const EmitOptions *o) {
   Emitter e = {.f = hf, .mod = mod, .me = me, .st = st, .P = o->name, .single = o->single,
-               .compensated = o->compensated, .wide_step = o->wide_step, .kid = K_SWEEP};
+               .compensated = o->compensated, .wide_step = o->wide_step, .kid = K_SWEEP, .roll = o->roll};
   e.fused = !o->wide_step && !emit_is_newton(&e) && !mod->mass_q && kernel_inlinable(&e, K_SWEEP);
   e.temp = xmalloc((size_t)mod->dag->n * sizeof(int));
   emit_header(&e, o);

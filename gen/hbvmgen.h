@@ -500,6 +500,8 @@ typedef struct {
   int compensated;      /* Kahan summation (off with --plain-sum) */
   int wide_step;        /* --wide-step: iterate and update one precision wider */
   int batch;            /* --batch W: also NAME_batch_step over W lanes (0: none) */
+  int rolled;           /* --rolled: ROLL_OFF, ROLL_ON or ROLL_AUTO (roll.h) */
+  const struct Roll *roll; /* the rolled form roll_choose chose, or NULL */
 } EmitOptions;
 
 int emit_check(const Model *mod, const Step *st, const EmitOptions *o); /* 1 after errors */

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "hbvmgen.h"
+#include "roll.h"
 
 #define MAX_MODEL_BYTES (64L << 20)
 #define MAX_S 20
@@ -78,6 +79,11 @@ static const char usage[] =
     "  --stage-loop N  print the k stages of the step as one loop over the stages (the\n"
     "                model's derivatives once, inside it) when their straight-line code\n"
     "                would take N or more operations (default " STR(STAGE_LOOP_DEFAULT) ", docs/embedding.md)\n"
+    "  --rolled auto|on|off  print the model's index as loops (the rolled form,\n"
+    "                docs/rolled.md): one loop body per run of uniform terms of U, g\n"
+    "                and their derivatives, and the banded multiplier system as a loop;\n"
+    "                auto (default) rolls a large model the form covers, on insists\n"
+    "                (an error says what it does not cover yet), off never rolls\n"
     "  -h, --help    this text\n"
     "  --version     the version\n";
 
@@ -91,6 +97,7 @@ typedef struct {
   long mass_loop; /* --mass-loop N, 0 for the default */
   long stage_loop; /* --stage-loop N, 0 for the default */
   int iteration;   /* --iteration: an IterKind */
+  int rolled;      /* --rolled: ROLL_AUTO, ROLL_ON or ROLL_OFF */
 } Options;
 
 static int fail(const char *fmt, const char *arg) {
@@ -160,6 +167,11 @@ static int parse_args(int argc, char **argv, Options *o) {
       if (strcmp(v, "fixed") && strcmp(v, "newton") && strcmp(v, "auto"))
         return fail("--iteration needs 'auto', 'fixed' or 'newton', got '%s'", v);
       o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : !strcmp(v, "auto") ? ITER_AUTO : ITER_FIXED;
+    } else if (!strcmp(a, "--rolled")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      const char *v = argv[++i];
+      if (strcmp(v, "auto") && strcmp(v, "on") && strcmp(v, "off")) return fail("--rolled needs 'auto', 'on' or 'off', got '%s'", v);
+      o->rolled = !strcmp(v, "on") ? ROLL_ON : !strcmp(v, "off") ? ROLL_OFF : ROLL_AUTO;
     } else if (!strcmp(a, "--real")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -515,14 +527,15 @@ static void note_large_output(const char *path) {
   fprintf(stderr,
           "hbvmgen: note: '%s' is %.1f MB of C: compilers take minutes and gigabytes on a file this size "
           "(gcc -O2: 30 s and 0.4 GB at 3.8 MB, 200 s and 3.2 GB at 19.7 MB; --stage-loop and --mass-loop "
-          "shrink what they can, docs/embedding.md, \"Large models\")\n",
+          "shrink what they can, docs/embedding.md, \"Large models\"; a model uniform in its index is a few "
+          "loops with --multiplier const, docs/rolled.md)\n",
           path, (double)sb.st_size / 1e6);
 }
 
 // What the emitter takes of the options.
 static EmitOptions emit_options(const Options *o) {
   EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
-                    !o->plain_sum, o->wide_step, o->batch};
+                    !o->plain_sum, o->wide_step, o->batch, o->rolled, NULL};
   return eo;
 }
 
@@ -536,7 +549,7 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam,
   me->iteration = iter;
   Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
-  if (!st || emit_check(mod, st, &eo)) return 1;
+  if (!st || roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo)) return 1;
   FILE *h = tmpfile(), *c = tmpfile();
   if (!h || !c || emit_solver(h, c, mod, me, st, &eo) != 0) /* the analysis stands; only the size is missing */
     printf("code: not measured (no temporary file: %s)\n", strerror(errno));
@@ -549,13 +562,13 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam,
 }
 
 // Emit the solver files; all or nothing.
-static int write_outputs(const Options *o, const Model *mod, const Method *me, const Step *st) {
+static int write_outputs(const Options *o, Model *mod, const Method *me, const Step *st) {
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
   char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
   int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   EmitOptions eo = emit_options(o);
-  if (!rc && emit_check(mod, st, &eo)) return 1; /* nothing is written yet */
+  if (!rc && (roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo))) return 1; /* nothing is written yet */
   atexit(remove_temporaries);
   mode_t mask = umask(0);
   umask(mask);
@@ -577,7 +590,8 @@ static int write_outputs(const Options *o, const Model *mod, const Method *me, c
     fprintf(stderr,
             "hbvmgen: error: '%s' would be %.1f MB of C, above the %.0f MB no compiler handles in reasonable time "
             "(gcc -O2: 200 s and 3.2 GB at 19.7 MB); --stage-loop N and --mass-loop N roll the stages and M^-1 "
-            "into loops where they can (docs/embedding.md, \"Large models\")\n",
+            "into loops where they can (docs/embedding.md, \"Large models\"), --rolled the model's index "
+            "(docs/rolled.md)\n",
             final[C], (double)csize / 1e6, MAX_C_BYTES / 1e6);
     rc = 2; /* reported: no second message */
   }
@@ -667,7 +681,7 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily
 }
 
 int main(int argc, char **argv) {
-  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_AUTO};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_AUTO, ROLL_AUTO};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) {

@@ -1,0 +1,73 @@
+/* roll.h - the rolled form of a large model (roll.c, emit_rolled.c).
+ *
+ * roll.c finds the repetition a model's index makes (variables x[N], sums
+ * and comprehensions over i) in its derivatives: runs of items that are the
+ * same expression up to a shift of the index. emit_rolled.c prints each run
+ * once, as a loop over arrays, and the step's kernels around them as loops
+ * (the banded multiplier system included). docs/rolled.md is the design. */
+#ifndef ROLL_H
+#define ROLL_H
+
+#include "hbvmgen.h"
+
+/* --rolled: EmitOptions.rolled */
+enum { ROLL_OFF, ROLL_ON, ROLL_AUTO };
+
+/* A family with more runs than this is not uniform in its index: not rolled. */
+#define ROLL_MAX_RUNS 64
+/* --rolled auto rolls a model whose straight-line sweep has at least this many
+ * operations (docs/rolled.md, "Crossover": measured on the chain). */
+#define ROLL_AUTO_OPS 4000
+/* ... and whose derivatives it shortens this many times at least (items per run). */
+#define ROLL_AUTO_COMPRESSION 8
+
+/* One maximal run of items that are the same expression up to a shift of
+ * the index: item u (u0 <= u < u0 + n) has the base index b0 + stride (u -
+ * u0), and its expression is body[] (in post-order, the root last) with
+ * each input at its offset from the base. */
+typedef struct {
+  int u0, n;
+  int b0, stride;
+  int *body, nbody;
+} RollRun;
+
+typedef struct {
+  int nitems;
+  RollRun *runs;
+  int nruns;
+  int zero;           /* every item is the constant 0 */
+} RollFamily;
+
+/* A family of derivative entries split for the step's Legendre projections:
+ * the items affine in q are projected in closed form, as step.c does,
+ * sum_l b_l P_j(c_l) f(Q_l) = delta_j0 f(q0) + f_lin(h (X gamma)_j), and only
+ * the others (curved) are evaluated at the k stages. Each family has all the
+ * items, 0 where an item belongs to another. */
+typedef struct {
+  RollFamily affine;  /* f, affine items */
+  RollFamily lin;     /* f_lin(v) = sum_i df/dq_i v_i, v the second array, affine items */
+  RollFamily curved;  /* f, the other items */
+} RollSplit;
+
+/* The analysis emit_rolled.c prints from. Inputs of the families' nodes:
+ * slots 0..m-1 are q (the array q), m..2m-1 are the second array (v). */
+typedef struct Roll {
+  int m, nu, T, bw;   /* T: most constraints on one coordinate; bw: the half band of G' M^-1 G */
+  int *tcon;          /* m*T: the t-th constraint on coordinate i (increasing), -1 */
+  int identity;       /* M = I */
+  RollFamily gradU;   /* items i: dU/dq_i */
+  RollFamily *jac;    /* T families, items i: d g_tcon[i,t] / dq_i, 0 where tcon is -1 */
+  RollFamily g;       /* items a: g_a */
+  RollFamily U;       /* items: the terms of U, summed in order */
+  RollFamily hvv;     /* items a: v' Hess(g_a)(q) v */
+  RollSplit gradU_s;  /* gradU, split for the projections */
+  RollSplit *jac_s;   /* T of them: jac, split */
+  int curved;         /* some entry is curved: the stages are evaluated */
+  int lin;            /* some affine entry is not constant: h (X gamma)_j is needed */
+} Roll;
+
+/* Decide the form from eo->rolled and set eo->roll (NULL: straight-line).
+ * Returns 1 after an error (--rolled on for a model or options the rolled
+ * form does not cover), else 0. */
+int roll_choose(Model *mod, const Method *me, const Step *st, EmitOptions *eo);
+#endif

@@ -1,0 +1,280 @@
+/* check_reroll.c - Check suite for the rolled form (--rolled, gen/roll.c,
+ * gen/emit_rolled.c, docs/rolled.md): the model's index kept as loops.
+ *
+ *   same      the chain of 8 pendula (s = 4), of 32 (s = 2), the chain with
+ *             masses and a second-neighbour spring whose force is not affine
+ *             (the stage loop, M^-1 a table) and the unconstrained FPU chain
+ *             (params), rolled against straight-line: the same trajectories
+ *             up to the reordering of sums (docs/rolled.md, "Same results"),
+ *             and at the start the same H, g, hidden constraint and
+ *             consistent multiplier to round-off;
+ *   float     --real float rolled against straight-line, to float's bound;
+ *   adaptive  NAME_step_adaptive, NAME_dense and NAME_project on the rolled
+ *             kernels follow the straight-line ones to the reordering bound;
+ *   conserve  H and g of the rolled chains stay at round-off;
+ *   size      the C of the rolled chain (s = 4, const) as a function of N:
+ *             the loops are the same at N = 250 and 1000, only the data grows
+ *             (bytes per coordinate bounded), N = 1000 is under 300 KB; bytes,
+ *             no timing (bench/rolled/run.sh measures time);
+ *   choose    --rolled auto keeps a small chain straight-line and rolls a
+ *             large one; --rolled on refuses what the form does not cover
+ *             (the poly family, a model not uniform in its index), auto
+ *             falls back to straight-line there; variables x[30000], refused
+ *             as 37.6 MB of straight-line C, is rolled by default.
+ * The suite is reroll_suite(); the project's runner adds it. */
+#include <check.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "chain32_rolled_k2s2.h"
+#include "chain32_straight_k2s2.h"
+#include "chain32f_rolled_k2s2.h"
+#include "chain32f_straight_k2s2.h"
+#include "chain_rolled_k4s4.h"
+#include "chain_straight_k4s4.h"
+#include "fpu_rolled_k2s2.h"
+#include "fpu_straight_k2s2.h"
+#include "generate.h"
+#include "side_by_side.h"
+#include "spring_rolled_k2s2.h"
+#include "spring_straight_k2s2.h"
+
+Suite *reroll_suite(void);
+
+/* The reordering bound of docs/rolled.md: the two forms round the same sums
+ * in another order, a few ulps of the step's largest terms a step (about
+ * 1e-15 of values up to 50), and the chain's motion spreads a difference by
+ * at most a factor 10^3 over the NSTEPS steps (measured 1e-11 at most). */
+#define REORDER_TOL 1e-9
+
+START_TEST(test_same_trajectory)
+{
+  SAME_TRAJECTORY(chain_rolled_k4s4, chain_straight_k4s4, 0.01, REORDER_TOL, "chain 8, s = 4, rolled vs straight-line");
+  SAME_TRAJECTORY(chain32_rolled_k2s2, chain32_straight_k2s2, 0.01, REORDER_TOL, "chain 32, s = 2, rolled vs straight-line");
+  SAME_TRAJECTORY(spring_rolled_k2s2, spring_straight_k2s2, 0.01, REORDER_TOL, "chain with springs, rolled vs straight-line");
+  SAME_TRAJECTORY(fpu_rolled_k2s2, fpu_straight_k2s2, 0.002, REORDER_TOL, "FPU, rolled vs straight-line");
+}
+END_TEST
+
+/* Adaptive steps, dense output and NAME_project work on the kernels, so the
+ * rolled chain with springs follows the straight-line one under
+ * NAME_step_adaptive too: the error estimates agree to round-off, so do the
+ * steps chosen (a relative 1e-16 of h), and the trajectories to the
+ * reordering bound. */
+START_TEST(test_adaptive_dense)
+{
+  spring_rolled_k2s2_state a;
+  spring_straight_k2s2_state b;
+  double ha = 0.05, hb = 0.05, qa[spring_rolled_k2s2_M], pa[spring_rolled_k2s2_M], qb[spring_rolled_k2s2_M],
+         pb[spring_rolled_k2s2_M], worst = 0;
+  spring_rolled_k2s2_init(&a, NULL, NULL);
+  spring_straight_k2s2_init(&b, NULL, NULL);
+  for (int n = 0; n < 100; n++) {
+    ck_assert_int_eq(spring_rolled_k2s2_step_adaptive(&a, &ha, 1e-8, NULL, NULL), 0);
+    ck_assert_int_eq(spring_straight_k2s2_step_adaptive(&b, &hb, 1e-8, NULL, NULL), 0);
+    spring_rolled_k2s2_dense(&a, 0.5, qa, pa);
+    spring_straight_k2s2_dense(&b, 0.5, qb, pb);
+    worst = fmax(worst, fabs(a.t - b.t));
+    worst = max_diff(max_diff(worst, qa, qb, spring_rolled_k2s2_M), pa, pb, spring_rolled_k2s2_M);
+    worst = max_diff(max_diff(worst, a.q, b.q, spring_rolled_k2s2_M), a.p, b.p, spring_rolled_k2s2_M);
+  }
+  ck_assert_int_eq(spring_rolled_k2s2_project(&a, NULL, NULL, NULL), 0);
+  ck_assert_int_eq(spring_straight_k2s2_project(&b, NULL, NULL, NULL), 0);
+  worst = max_diff(max_diff(worst, a.q, b.q, spring_rolled_k2s2_M), a.p, b.p, spring_rolled_k2s2_M);
+  printf("reroll: chain with springs, adaptive steps to t = %.3f, dense output, project: rolled vs straight-line %.3g\n",
+         a.t, worst);
+  ck_assert_msg(worst <= REORDER_TOL, "adaptive: the trajectories differ by %.3g", worst);
+}
+END_TEST
+
+/* --real float: the reordering bound in float's precision, a few ulps
+ * (6e-8) of values up to 50 a step, spread at most 300-fold: 1e-3
+ * (measured 1.1e-5); H and g of the rolled solver within what the
+ * straight-line float solver keeps (1.1e-4 and 3.8e-6 measured). */
+START_TEST(test_float)
+{
+  chain32f_rolled_k2s2_state a;
+  chain32f_straight_k2s2_state b;
+  chain32f_rolled_k2s2_init(&a, NULL, NULL);
+  chain32f_straight_k2s2_init(&b, NULL, NULL);
+  float H0 = chain32f_rolled_k2s2_energy(&a, NULL), g[chain32f_rolled_k2s2_NU];
+  double worst = 0, dH = 0, dg = 0;
+  for (int n = 0; n < NSTEPS; n++) {
+    ck_assert_int_eq(chain32f_rolled_k2s2_step(&a, 0.01f, NULL, NULL), 0);
+    ck_assert_int_eq(chain32f_straight_k2s2_step(&b, 0.01f, NULL, NULL), 0);
+    for (int i = 0; i < chain32f_rolled_k2s2_M; i++) worst = fmax(worst, fmax(fabs(a.q[i] - b.q[i]), fabs(a.p[i] - b.p[i])));
+    dH = fmax(dH, fabs(chain32f_rolled_k2s2_energy(&a, NULL) - H0));
+    chain32f_rolled_k2s2_constraints(&a, NULL, g);
+    for (int i = 0; i < chain32f_rolled_k2s2_NU; i++) dg = fmax(dg, fabs(g[i]));
+  }
+  printf("reroll: float chain 32, rolled vs straight-line: %.3g; |H - H0| %.3g, |g| %.3g\n", worst, dH, dg);
+  ck_assert_msg(worst <= 1e-3, "float: the trajectories differ by %.3g", worst);
+  ck_assert_msg(dH <= 1e-3 && dg <= 4e-5, "float: H or g drift %.3g %.3g", dH, dg);
+}
+END_TEST
+
+/* The functions of the state outside the step (NAME_energy, the kernels g
+ * and hidden, the consistent multiplier of NAME_init) at a moving state of
+ * the chain with springs: equal to round-off in both forms. */
+START_TEST(test_same_state_functions)
+{
+  spring_rolled_k2s2_state a;
+  spring_straight_k2s2_state b;
+  spring_rolled_k2s2_init(&a, NULL, NULL);
+  spring_straight_k2s2_init(&b, NULL, NULL);
+  for (int n = 0; n < 50; n++) {
+    ck_assert_int_eq(spring_rolled_k2s2_step(&a, 0.01, NULL, NULL), 0);
+    ck_assert_int_eq(spring_straight_k2s2_step(&b, 0.01, NULL, NULL), 0);
+  }
+  memcpy(b.q, a.q, sizeof a.q); /* the same state in both */
+  memcpy(b.p, a.p, sizeof a.p);
+  spring_rolled_k2s2_init(&a, a.q, a.p);
+  spring_straight_k2s2_init(&b, b.q, b.p);
+  double ga[spring_rolled_k2s2_NU], gb[spring_rolled_k2s2_NU], ha[spring_rolled_k2s2_NU], hb[spring_rolled_k2s2_NU];
+  spring_rolled_k2s2_constraints(&a, NULL, ga);
+  spring_straight_k2s2_constraints(&b, NULL, gb);
+  spring_rolled_k2s2_hidden(&a, NULL, ha);
+  spring_straight_k2s2_hidden(&b, NULL, hb);
+  double dH = fabs(spring_rolled_k2s2_energy(&a, NULL) - spring_straight_k2s2_energy(&b, NULL));
+  double dg = max_diff(0, ga, gb, spring_rolled_k2s2_NU), dh = max_diff(0, ha, hb, spring_rolled_k2s2_NU);
+  double dl = max_diff(0, a.lambda, b.lambda, spring_rolled_k2s2_NU), lmax = 0;
+  for (int i = 0; i < spring_rolled_k2s2_NU; i++) lmax = fmax(lmax, fabs(b.lambda[i]));
+  printf("reroll: state functions, rolled vs straight-line: H %.3g, g %.3g, hidden %.3g, lambda %.3g of %.3g\n", dH, dg, dh,
+         dl, lmax);
+  ck_assert_msg(dH <= 1e-13 && dg <= 1e-14 && dh <= 1e-13, "H, g or hidden differ: %.3g %.3g %.3g", dH, dg, dh);
+  ck_assert_msg(dl <= 1e-12 * fmax(1, lmax), "the consistent multiplier differs by %.3g", dl);
+}
+END_TEST
+
+/* |H - H0| and max |g| of a rolled solver over NSTEPS steps of h. */
+#define DRIFT(P, h, dH, dg)                                                \
+  do {                                                                     \
+    P##_state x;                                                           \
+    double g_[P##_NU];                                                     \
+    P##_init(&x, NULL, NULL);                                              \
+    double H0 = P##_energy(&x, NULL);                                      \
+    for (int n = 0; n < NSTEPS; n++) {                                     \
+      ck_assert_int_eq(P##_step(&x, (h), NULL, NULL), 0);                  \
+      P##_constraints(&x, NULL, g_);                                       \
+      (dH) = fmax((dH), fabs(P##_energy(&x, NULL) - H0));                  \
+      for (int i = 0; i < P##_NU; i++) (dg) = fmax((dg), fabs(g_[i]));     \
+    }                                                                      \
+  } while (0)
+
+/* H is linear in y plus the kinetic energy and g quadratic, so k = s
+ * nodes conserve both exactly (METHOD.md): what is left is round-off, a
+ * few ulps of U's terms (|y| <= N) a step. */
+START_TEST(test_conservation)
+{
+  double dH = 0, dg = 0, dH32 = 0, dg32 = 0;
+  DRIFT(chain_rolled_k4s4, 0.01, dH, dg);
+  DRIFT(chain32_rolled_k2s2, 0.01, dH32, dg32);
+  printf("reroll: rolled chains: |H - H0| %.3g (8), %.3g (32); |g| %.3g, %.3g\n", dH, dH32, dg, dg32);
+  ck_assert_msg(dH <= 1e-13 && dH32 <= 1e-12, "H off round-off: %.3g %.3g", dH, dH32);
+  ck_assert_msg(dg <= 1e-14 && dg32 <= 1e-14, "g off round-off: %.3g %.3g", dg, dg32);
+}
+END_TEST
+
+/* The text of the chain of n pendula (models/chain8.ham). malloc'd. */
+static char *chain_model(int n)
+{
+  char *text = malloc(512);
+  ck_assert_ptr_nonnull(text);
+  snprintf(text, 512, "N = %d\nvariables x[N], y[N]\nU = sum(i in 1..N, y[i])\n"
+                      "g = [x[1]^2 + y[1]^2 - 1, [(x[i] - x[i-1])^2 + (y[i] - y[i-1])^2 - 1 for i in 2..N]]\n"
+                      "q0 = [[i for i in 1..N], [0 for i in 1..N]]\np0 = [0 for i in 1..2*N]\n", n);
+  return text;
+}
+
+/* How many times needle occurs in s. */
+static int count(const char *s, const char *needle)
+{
+  int n = 0;
+  for (const char *p = strstr(s, needle); p; p = strstr(p + 1, needle)) n++;
+  return n;
+}
+
+START_TEST(test_size)
+{
+  static const int ns[] = {250, 1000};
+  char *src[2];
+  for (int i = 0; i < 2; i++) {
+    char *text = chain_model(ns[i]);
+    src[i] = generate_source(text, "--multiplier const -s 4 --rolled on");
+    free(text);
+    ck_assert_msg(src[i] != NULL, "generation failed at N = %d", ns[i]);
+  }
+  size_t a = strlen(src[0]), b = strlen(src[1]);
+  double per_coordinate = (double)(b - a) / (2.0 * (ns[1] - ns[0]));
+  int loops0 = count(src[0], "for ("), loops1 = count(src[1], "for (");
+  printf("reroll: rolled chain, s = 4: %zu bytes at N = 250, %zu at N = 1000 (%.1f bytes per coordinate); %d loops\n", a, b,
+         per_coordinate, loops1);
+  ck_assert_msg(b <= 300000, "the rolled chain of 1000 is %zu bytes of C, above 300 KB", b);
+  ck_assert_msg(loops0 == loops1, "the rolled chain has %d loops at N = 250 and %d at N = 1000", loops0, loops1);
+  /* what grows is data: q0, p0 (two literals a coordinate) and tcon (two ints) */
+  ck_assert_msg(per_coordinate <= 32, "the rolled chain grows by %.1f bytes a coordinate", per_coordinate);
+  free(src[0]);
+  free(src[1]);
+}
+END_TEST
+
+/* variables x[30000] with a sum of squares: 37.6 MB of straight-line C,
+ * refused (tests/check_lean.c); rolled by default, a third of a megabyte,
+ * most of it q0 and p0. */
+START_TEST(test_many_coordinates)
+{
+  const char *text = "variables x[30000]\nM = identity\nU = sum(i in 1..30000, x[i]^2)\n"
+                     "q0 = [1 for i in 1..30000]\np0 = [0 for i in 1..30000]\n";
+  char *src = generate_source(text, "-s 2");
+  ck_assert_msg(src != NULL, "x[30000] was not generated");
+  printf("reroll: variables x[30000], sum of squares: %zu bytes of C\n", strlen(src));
+  ck_assert_msg(strstr(src, "(rolled)") && strlen(src) <= 400000, "x[30000]: %zu bytes of C", strlen(src));
+  free(src);
+}
+END_TEST
+
+START_TEST(test_choose)
+{
+  char *small = chain_model(8), *large = chain_model(64);
+  char *a = generate_source(small, "--multiplier const -s 4");
+  char *b = generate_source(large, "--multiplier const -s 4");
+  char *c = generate_source(large, "-s 4"); /* the poly family: not covered */
+  ck_assert_msg(a && b && c, "generation failed");
+  ck_assert_msg(!strstr(a, "(rolled)"), "--rolled auto rolled the chain of 8");
+  ck_assert_msg(strstr(b, "(rolled)"), "--rolled auto did not roll the chain of 64");
+  ck_assert_msg(!strstr(c, "(rolled)"), "--rolled auto rolled the poly family");
+  ck_assert_ptr_null(generate_source(large, "-s 4 --rolled on"));
+  /* x[i]^i: a different expression at each i, not uniform in the index */
+  const char *odd = "N = 80\nvariables x[N]\nU = sum(i in 1..N, x[i]^i)\nq0 = [0.5 for i in 1..N]\n"
+                    "p0 = [0 for i in 1..N]\n";
+  ck_assert_ptr_null(generate_source(odd, "-s 2 --rolled on"));
+  char *d = generate_source(odd, "-s 2");
+  ck_assert_msg(d && !strstr(d, "(rolled)"), "a model not uniform in its index was rolled");
+  free(a);
+  free(b);
+  free(c);
+  free(d);
+  free(small);
+  free(large);
+}
+END_TEST
+
+Suite *reroll_suite(void)
+{
+  Suite *s = suite_create("reroll");
+  TCase *tc = tcase_create("rolled form");
+  tcase_set_tags(tc, "sanlong"); /* the generated arithmetic: sanitized in check-long */
+  tcase_set_timeout(tc, 120);
+  tcase_add_test(tc, test_same_trajectory);
+  tcase_add_test(tc, test_same_state_functions);
+  tcase_add_test(tc, test_float);
+  tcase_add_test(tc, test_adaptive_dense);
+  tcase_add_test(tc, test_conservation);
+  tcase_add_test(tc, test_size);
+  tcase_add_test(tc, test_many_coordinates);
+  tcase_add_test(tc, test_choose);
+  suite_add_tcase(s, tc);
+  return s;
+}
