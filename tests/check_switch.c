@@ -54,7 +54,7 @@ Suite *switch_suite(void);
       #P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), sizeof(P##_params), offsetof(P##_state, t),               \
       offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda), 0, NULL, NULL, NULL, P##_init_,   \
       P##_pd_, P##_step_, P##_strerror, P##_energy_, P##_g_, P##_hc_, NULL, NULL, NULL, DBL_EPSILON, P##_adapt_,    \
-      P##_dense_, 0, NULL, NULL, NULL};                                                                             \
+      P##_dense_, 0, NULL, NULL, NULL, NULL};                                                                       \
   static const hbvmrt_switching P##_switching = {P##_NSWITCH, P##_switch_kinds, P##_switch_what, P##_switch_,        \
                                                  P##_restart_};
 
