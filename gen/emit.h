@@ -70,6 +70,7 @@ int energy_defect_wanted(const Emitter *e);
 
 /* emit_api.c: NAME.h, and NAME.c's prelude, kernels and public functions */
 void emit_header(Emitter *e, const EmitOptions *o);
+void emit_gtol_scaled(Emitter *e); /* float: NAME_gtol(q, stride), g's round-off at q */
 void emit_header_end(Emitter *e);
 void emit_prelude(Emitter *e, const EmitOptions *o);
 void emit_kernels(Emitter *e);

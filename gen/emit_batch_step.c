@@ -175,9 +175,10 @@ static void emit_lane_newton(Emitter *e) {
           "      for (n = 0; n < $P_NEWTON && any; n++) {\n"
           "        $(g q0=q1 prm=par out=g1);\n"
           "        for (l = 0; l < $P_W; l++) off[l] = 0;\n"
-          "        for (i = 0; i < $P_NU; i++)\n"
-          "          for (l = 0; l < $P_W; l++) off[l] |= !(fabs$f(g1[i * $P_W + l]) <= $P_GTOL);\n"
-          "        any = 0;\n        for (l = 0; l < $P_W; l++) any |= ea[l] &= off[l];\n"
+          "        for (i = 0; i < $P_NU; i++)\n");
+  tmpl(e, e->single ? "          for (l = 0; l < $P_W; l++) off[l] |= !(fabs$f(g1[i * $P_W + l]) <= $P_gtol(q1 + l, $P_W));\n"
+                    : "          for (l = 0; l < $P_W; l++) off[l] |= !(fabs$f(g1[i * $P_W + l]) <= $P_GTOL);\n");
+  tmpl(e, "        any = 0;\n        for (l = 0; l < $P_W; l++) any |= ea[l] &= off[l];\n"
           "        if (!any) break;\n"
           "        $(consistent q0=q1 p0=p1 prm=par out=cs);\n"
           "        for (i = 0; i < $P_NU; i++)\n          for (l = 0; l < $P_W; l++) {\n"
@@ -450,9 +451,14 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, in, 0, 0);\n"
           : poly    ? "  $P_batch_predict(x, h, cold, par, in, ref, two);\n"
                     : "  $P_batch_predict(x, h, cold, par, in, 0, two);\n");
-  if (nu)
-    tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n"
-            "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+  if (nu) {
+    tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n");
+    tmpl(e, e->single ? "  for (l = 0; l < $P_W; l++) {  /* (float: the threshold grows with g's round-off) */\n"
+                        "    $R gt = $P_gtol(x->q + l, $P_W);\n"
+                        "    for (i = 0; i < $P_NU; i++)\n"
+                        "      g0[i * $P_W + l] = fabs$f(g0[i * $P_W + l]) <= gt ? 0 : g0[i * $P_W + l] / h;\n  }\n"
+                      : "  for (i = 0; i < $P_NU * $P_W; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+  }
   if (poly)
     tmpl(e, "  $R fa[($<factor> + 1) * $P_W];\n"
             "  $(factor q0=x->q gam=in h=h prm=par out=fa);\n"

@@ -54,16 +54,17 @@ void emit_end_poly(Emitter *e) {
             "    q1[i] = x->q[i];\n    qc1[i] = x->qc[i];\n    p1[i] = x->p[i];\n    pc1[i] = x->pc[i];\n"
             "    $P_add(&q1[i], &qc1[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&p1[i], &pc1[i], sw[$[sweep.dp]i]);\n  }\n");
-  if (itol_wanted(e))
+  if (itol_wanted(e)) {
     tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol), above round-off:\n"
             "   * while g(q1) is not round-off ($P_GTOL), q1 onto g = 0 by Newton steps ($P_NEWTON at\n"
             "   * most: one, or two from $P_ITOLMAX), and gamma_0 with it, so that $P_dense still\n"
             "   * starts the step at q0 */\n"
             "  if (attol) {\n    $R g1[$P_NU], cs[$<consistent>];\n    int n, off;\n"
             "    for (n = 0; n < $P_NEWTON; n++) {\n"
-            "      $(g q0=q1 out=g1);\n"
-            "      for (off = 0, i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_GTOL);\n"
-            "      if (!off) break;\n"
+            "      $(g q0=q1 out=g1);\n");
+    tmpl(e, e->single ? "      for (off = 0, i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_gtol(q1, 1));\n"
+                      : "      for (off = 0, i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_GTOL);\n");
+    tmpl(e, "      if (!off) break;\n"
             "      $(consistent q0=q1 p0=p1 out=cs);\n"
             "      for (i = 0; i < $P_NU; i++) {\n"
             "        $R piv = cs[$[consistent.pivot]i], dia = cs[$[consistent.adiag]i];\n"
@@ -74,6 +75,7 @@ void emit_end_poly(Emitter *e) {
             "        if (!isfinite(d)) return $P_ENONFINITE;\n"
             "        $P_add(&q1[i], &qc1[i], d);\n"
             "        gam[i] += d / h;\n      }\n    }\n  }\n");
+  }
   tmpl(e, "  $W phat[$P_M];  /* p1 before the projection, the end of p's polynomial */\n"
           "  for (i = 0; i < $P_M; i++) phat[i] = p1[i];\n");
   /* the finiteness test stops before the multiplier's lamv and lamu, the last

@@ -87,12 +87,15 @@ static void emit_step_predict(Emitter *e) {
   } else
     tmpl(e, poly ? "  two = $P_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */\n"
                  : "  $P_predict(x, h, cold, prm, gam);\n");
-  if (e->mod->nu)
-    tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
-            "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
-            "   * cannot drift; below $P_GTOL, g(q0) is round-off, and kicking the momenta by it\n"
-            "   * (eps / h a step) would only add noise, so it is left out. */\n"
-            "  for (i = 0; i < $P_NU; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
+  if (!e->mod->nu) return;
+  tmpl(e, "  $R g0[$P_NU];\n  $(g q0=x->q p0=x->p out=g0);\n"
+          "  /* g(q0) / h in the multiplier equation makes g(q1) = 0 rather than g(q0), so g\n"
+          "   * cannot drift; below $P_GTOL, g(q0) is round-off, and kicking the momenta by it\n"
+          "   * (eps / h a step) would only add noise, so it is left out. */\n");
+  tmpl(e, e->single ? "  {  /* (in float the threshold grows with g's round-off: $P_gtol) */\n"
+                      "    $R gt = $P_gtol(x->q, 1);\n"
+                      "    for (i = 0; i < $P_NU; i++) g0[i] = fabs$f(g0[i]) <= gt ? 0 : g0[i] / h;\n  }\n"
+                    : "  for (i = 0; i < $P_NU; i++) g0[i] = fabs$f(g0[i]) <= $P_GTOL ? 0 : g0[i] / h;\n");
 }
 
 // iterate: the step's equations solved for gamma (the contract above). The
