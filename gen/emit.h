@@ -51,6 +51,7 @@ const char *real_type(const Emitter *e, int wide);
 const char *math_suffix(const Emitter *e, int wide);
 void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
+void tmplf(Emitter *e, const char *fmt, ...); /* tmpl of a printf format's result */
 void emit_kernel(Emitter *e, KernelId k);
 void kernel_signature(Emitter *e, const Kernel *k, int part);
 void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, size_t size);

@@ -12,7 +12,6 @@
  * convergence or a stall (emit_convergence). The polynomial family
  * refactors when the increments fall slowly. The fused locals are written
  * back to gam[] and sw[] at the end, for the rest of the step. */
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -37,16 +36,6 @@ static void emit_factor(Emitter *e, const char *indent) {
 // Where result block name of the sweep starts in its out[].
 static int sweep_at(const Emitter *e, const char *name) {
   return step_block(e->st, K_SWEEP, name)->first;
-}
-
-// tmpl of a printf format's result.
-static void tmplf(Emitter *e, const char *fmt, ...) {
-  char text[1024];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(text, sizeof text, fmt, ap);
-  va_end(ap);
-  tmpl(e, text);
 }
 
 // "if (!isfinite(sw0) || ... || !isfinite(sw{n-1})) rc = CODE;", the finiteness

@@ -183,6 +183,16 @@ void tmpl(Emitter *e, const char *text) {
     p = close ? close : p + 1;
   }
 }
+
+// tmpl of a printf format's result (at most 4095 characters).
+void tmplf(Emitter *e, const char *fmt, ...) {
+  char text[4096];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(text, sizeof text, fmt, ap);
+  va_end(ap);
+  tmpl(e, text);
+}
 // A literal that reads back exactly in the real type and is a C floating
 // constant: 17 significant digits for double, 9 and an f suffix for float.
 void format_real(const Emitter *e, char *buf, size_t size, double v) {

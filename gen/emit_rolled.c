@@ -20,7 +20,6 @@
  * another order (docs/rolled.md says which): results agree to round-off.
  * Work arrays are locals of the kernels: 2 (S + 1) M + (S + 1) T M + NU (2 BW
  * + 2) reals of stack in the sweep. */
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -28,16 +27,6 @@
 #include "roll.h"
 
 #define NAME_SIZE 256
-
-// tmpl of a printf format.
-static void rtmpl(Emitter *e, const char *fmt, ...) {
-  char buf[4096];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  tmpl(e, buf);
-}
 
 // The C name of node id inside a run's body: a literal, a parameter, an
 // input at its offset from the base b, or the temporary rK of its place k.
@@ -92,7 +81,7 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
 // items; with mode 1 out[0] = the sum of them in order, with mode -1 out[i]
 // += item i.
 static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int mode) {
-  rtmpl(e, "\n/* %s */\nstatic void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
+  tmplf(e, "\n/* %s */\nstatic void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  $R acc = 0;\n" : "");
   for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0);
   out(e, mode == 1 ? "  out[0] = acc;\n}\n" : "}\n");
@@ -101,7 +90,7 @@ static void emit_family(Emitter *e, const char *name, const char *what, const Ro
 // A family per t of the Jacobian's entries (fams[t]) as the function
 // $P_roll_NAME: out[T i + t] = item i of family t.
 static void emit_tfamily(Emitter *e, const char *name, const char *what, const RollFamily *const *fams, int add) {
-  rtmpl(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
+  tmplf(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
            "static void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what, name);
   for (int t = 0; t < e->roll->T; t++)
@@ -143,7 +132,7 @@ static void emit_jacobians(Emitter *e) {
 // A table of n reals (or ints) as a static const array, sixteen a line.
 static void emit_array(Emitter *e, const char *type, const char *name, const double *v, const int *iv, int n) {
   char lit[64];
-  rtmpl(e, "static const %s $P_%s[%d] = {", type, name, n > 0 ? n : 1);
+  tmplf(e, "static const %s $P_%s[%d] = {", type, name, n > 0 ? n : 1);
   for (int i = 0; i < n; i++) {
     if (iv) snprintf(lit, sizeof lit, "%d", iv[i]);
     else format_real(e, lit, sizeof lit, v[i]);
@@ -185,11 +174,11 @@ static void emit_band(Emitter *e) {
           "    const $R *Ak = A + k * $P_RW + $P_RBW;  /* Ak[c - k] = A[k][c] */\n"
           "    pivot[k] = Ak[0];\n");
   for (int d = 1; d <= bw; d++) {
-    rtmpl(e, "    if (k + %d < $P_NU) {\n"
+    tmplf(e, "    if (k + %d < $P_NU) {\n"
              "      $R *Ai = A + (k + %d) * $P_RW + $P_RBW - %d;  /* Ai[c - k] = A[k + %d][c] */\n"
              "      const $R f = Ai[0] / Ak[0];\n"
              "      Ai[0] = f;\n", d, d, d, d);
-    for (int c = 1; c <= bw; c++) rtmpl(e, "      if (k + %d < $P_NU) Ai[%d] -= f * Ak[%d];\n", c, c, c);
+    for (int c = 1; c <= bw; c++) tmplf(e, "      if (k + %d < $P_NU) Ai[%d] -= f * Ak[%d];\n", c, c, c);
     out(e, "    }\n");
   }
   tmpl(e, "  }\n}\n\n"
@@ -197,11 +186,11 @@ static void emit_band(Emitter *e) {
           "static void $P_band_solve(const $R *A, $R *x)\n{\n"
           "  int k;\n");
   if (bw) tmpl(e, "  for (k = 0; k < $P_NU; k++) {\n    const $R xk = x[k];\n");
-  for (int d = 1; d <= bw; d++) rtmpl(e, "    if (k + %d < $P_NU) x[k + %d] -= A[(k + %d) * $P_RW + $P_RBW - %d] * xk;\n", d, d, d, d);
+  for (int d = 1; d <= bw; d++) tmplf(e, "    if (k + %d < $P_NU) x[k + %d] -= A[(k + %d) * $P_RW + $P_RBW - %d] * xk;\n", d, d, d, d);
   if (bw) tmpl(e, "  }\n");
   tmpl(e, "  for (k = $P_NU - 1; k >= 0; k--) {\n"
           "    $R acc = x[k];\n");
-  for (int c = 1; c <= bw; c++) rtmpl(e, "    if (k + %d < $P_NU) acc -= A[k * $P_RW + $P_RBW + %d] * x[k + %d];\n", c, c, c);
+  for (int c = 1; c <= bw; c++) tmplf(e, "    if (k + %d < $P_NU) acc -= A[k * $P_RW + $P_RBW + %d] * x[k + %d];\n", c, c, c);
   tmpl(e, "    x[k] = acc / A[k * $P_RW + $P_RBW];\n  }\n}\n\n");
   emit_gram(e);
 }
@@ -212,7 +201,7 @@ static void emit_band(Emitter *e) {
 static void emit_helpers(Emitter *e) {
   const Roll *r = e->roll;
   int m = e->mod->m;
-  rtmpl(e, "\n/* The rolled form (docs/rolled.md): the model's index kept as loops. T = most constraints\n"
+  tmplf(e, "\n/* The rolled form (docs/rolled.md): the model's index kept as loops. T = most constraints\n"
            " * on one coordinate, BW = the half band of the multiplier system. */\n"
            "#define $P_RT %d\n#define $P_RBW %d\n#define $P_RW (2 * $P_RBW + 1)\n", r->T, r->bw);
   if (r->identity) tmpl(e, "#define $P_MINV(i) /* M = I */\n");
@@ -264,9 +253,9 @@ static void emit_projections(Emitter *e) {
   char x[512];
   out(e, "  /* entries affine in q, projected in closed form: delta_j0 f(q0) + f_lin(h (X gamma)_j) */\n");
   if (!r->gradU_s.affine.zero) tmpl(e, "  $P_roll_gradU_affine(q0, 0, prm, psi);\n");
-  rtmpl(e, "  for (i = %d; i < %d; i++) psi[i] = 0;\n", r->gradU_s.affine.zero ? 0 : m, s * m);
+  tmplf(e, "  for (i = %d; i < %d; i++) psi[i] = 0;\n", r->gradU_s.affine.zero ? 0 : m, s * m);
   if (nu && jac_used(r, PART_AFFINE)) tmpl(e, "  $P_roll_jac_affine(q0, 0, prm, R);\n");
-  if (nu) rtmpl(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
+  if (nu) tmplf(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
   if (r->lin) {
     out(e, "  for (i = 0; i < %d; i++) {\n", m);
     for (int j = 0; j < s; j++) {
@@ -275,9 +264,9 @@ static void emit_projections(Emitter *e) {
     }
     out(e, "  }\n  for (j = 0; j < %d; j++) {\n", s);
     if (!r->gradU_s.lin.zero)
-      rtmpl(e, "    $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", m, m);
+      tmplf(e, "    $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", m, m);
     if (nu && jac_used(r, PART_LIN))
-      rtmpl(e, "    $P_roll_jac_lin(0, hX + j * %d, prm, R + j * %d);\n", m, mt);
+      tmplf(e, "    $P_roll_jac_lin(0, hX + j * %d, prm, R + j * %d);\n", m, mt);
     out(e, "  }\n");
   }
   if (!r->curved) return;
@@ -351,9 +340,9 @@ static void emit_sweep(Emitter *e) {
   const Roll *r = e->roll;
   int nu = e->mod->nu, m = e->mod->m, s = e->me->s, T = r->T, mt = m * T;
   char x[512];
-  rtmpl(e, "  $R Q[%d], F[%d], hX[%d], psi[%d];\n  int i, j = 0;\n  (void)Q; (void)F; (void)hX; (void)j;\n", m, m,
+  tmplf(e, "  $R Q[%d], F[%d], hX[%d], psi[%d];\n  int i, j = 0;\n  (void)Q; (void)F; (void)hX; (void)j;\n", m, m,
         s * m, s * m);
-  if (nu) rtmpl(e, "  $R J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
+  if (nu) tmplf(e, "  $R J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
   emit_projections(e);
   if (nu) emit_system(e);
   out(e, "  for (i = 0; i < %d; i++) {\n", m);
@@ -369,17 +358,17 @@ static void emit_sweep(Emitter *e) {
     /* th is a local array here: th[r + i] would be wrong, so name its entries */
     char *p;
     while ((p = strstr(x, " + i]"))) memmove(p, p + 4, strlen(p + 4) + 1);
-    rtmpl(e, "    out[$[sweep.gam]%d + i] = $P_MINV(i) (%s(h * (%s)));\n", j * m, j ? "-" : "p0[i] - ", x);
+    tmplf(e, "    out[$[sweep.gam]%d + i] = $P_MINV(i) (%s(h * (%s)));\n", j * m, j ? "-" : "p0[i] - ", x);
   }
   tmpl(e, "    out[$[sweep.dp]i] = -(h * th[0]);\n");
-  for (int j = 1; j < s; j++) rtmpl(e, "    out[$[sweep.theta]%d + i] = th[%d];\n", (j - 1) * m, j);
+  for (int j = 1; j < s; j++) tmplf(e, "    out[$[sweep.theta]%d + i] = th[%d];\n", (j - 1) * m, j);
   out(e, "  }\n");
 }
 
 // The consistent multiplier: (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U.
 static void emit_lambda0(Emitter *e) {
   int nu = e->mod->nu, m = e->mod->m, mt = m * e->roll->T;
-  rtmpl(e, "  $R J[%d], B[%d], gu[%d], v[%d], hv[%d], rr[%d], piv[%d], dia[%d];\n  int i, t;\n", mt,
+  tmplf(e, "  $R J[%d], B[%d], gu[%d], v[%d], hv[%d], rr[%d], piv[%d], dia[%d];\n  int i, t;\n", mt,
         nu * (2 * e->roll->bw + 1), m, m, nu, nu, nu, nu);
   tmpl(e, "  $P_roll_jac(q0, 0, prm, J);\n  $P_roll_gram(J, B);\n  $P_roll_gradU(q0, 0, prm, gu);\n"
           "  for (i = 0; i < $P_M; i++) v[i] = $P_MINV(i) p0[i];\n"
@@ -396,7 +385,7 @@ static void emit_lambda0(Emitter *e) {
 // NAME_project's Newton step onto g = 0 and projection of p.
 static void emit_consistent(Emitter *e) {
   int nu = e->mod->nu, m = e->mod->m, mt = m * e->roll->T;
-  rtmpl(e, "  $R J[%d], B[%d], y[%d], mu[%d];\n  int i, t;\n", mt, nu * (2 * e->roll->bw + 1), nu, nu);
+  tmplf(e, "  $R J[%d], B[%d], y[%d], mu[%d];\n  int i, t;\n", mt, nu * (2 * e->roll->bw + 1), nu, nu);
   tmpl(e, "  $P_roll_jac(q0, 0, prm, J);\n  $P_roll_gram(J, B);\n"
           "  $P_band_factor(B, out + $<consistent.pivot>, out + $<consistent.adiag>);\n"
           "  $P_roll_g(q0, 0, prm, y);\n  $P_band_solve(B, y);\n"
@@ -423,12 +412,12 @@ static void emit_state_kernel(Emitter *e, KernelId id) {
   switch (id) {
   case K_MINV_P: tmpl(e, "  int i;\n  for (i = 0; i < $P_M; i++) out[i] = $P_MINV(i) p0[i];\n"); break;
   case K_ENERGY:
-    rtmpl(e, "  $R kin = 0, u;\n  int i;\n  for (i = 0; i < $P_M; i++) kin += p0[i] * ($P_MINV(i) p0[i]);\n"
+    tmplf(e, "  $R kin = 0, u;\n  int i;\n  for (i = 0; i < $P_M; i++) kin += p0[i] * ($P_MINV(i) p0[i]);\n"
              "  $P_roll_U(q0, 0, prm, &u);\n  out[0] = %s * kin + u;\n", lit(e, 0.5));
     break;
   case K_G: tmpl(e, "  $P_roll_g(q0, 0, prm, out);\n"); break;
   case K_HIDDEN:
-    rtmpl(e, "  $R J[%d];\n  int i, t;\n", mt);
+    tmplf(e, "  $R J[%d];\n  int i, t;\n", mt);
     tmpl(e, "  $P_roll_jac(q0, 0, prm, J);\n  for (i = 0; i < $P_NU; i++) out[i] = 0;\n"
             "  for (i = 0; i < $P_M; i++)\n    for (t = 0; t < $P_RT; t++)\n"
             "      if ($P_tcon[i * $P_RT + t] >= 0) out[$P_tcon[i * $P_RT + t]] += J[i * $P_RT + t] * ($P_MINV(i) p0[i]);\n");
