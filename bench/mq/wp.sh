@@ -6,7 +6,8 @@
 # s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, each built by
 # gcc -O2 and by clang -O3 -march=native -fno-math-errno -ffp-contract=off
 # (docs/api.md, "Flags that are safe"). Writes bench/results/mq_wp.csv and
-# bench/results/mq_ratios.txt (bench/mq/ratios.awk). Run from the repository's
+# bench/results/mq_ratios.txt (bench/mq/ratios.awk), and with gnuplot the
+# figures bench/results/mq_wp_*.png (bench/mq/plot.sh). Run from the repository's
 # root after `make all`: sh bench/mq/wp.sh
 set -e
 dir=$(mktemp -d)
@@ -44,3 +45,4 @@ out=bench/results/mq_wp.csv
 "$dir/wp_clang" | tail -n +2 >>"$out"
 awk -F, -f bench/mq/ratios.awk "$out" >bench/results/mq_ratios.txt
 cat bench/results/mq_ratios.txt
+if command -v gnuplot >/dev/null; then sh bench/mq/plot.sh; fi
