@@ -20,6 +20,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
+#include "dpa_ode.h"
+
 #include "solvers.h"
 
 #define T_END 10.0
@@ -44,20 +46,6 @@ static int pa_rhs(double t, const double *y, double *dy, void *par)
   (void)par;
   dy[0] = y[1];
   dy[1] = -sin(y[0]);
-  return GSL_SUCCESS;
-}
-
-/* H = p' M(q)^-1 p / 2 - 2 cos th1 - cos th2, M = [[2, c], [c, 1]], c = cos(th1 - th2). */
-static int dpa_rhs(double t, const double *y, double *dy, void *par)
-{
-  double d = y[0] - y[1], c = cos(d), s = sin(d), det = 2 - c * c;
-  double v1 = (y[2] - c * y[3]) / det, v2 = (2 * y[3] - c * y[2]) / det;
-  (void)t;
-  (void)par;
-  dy[0] = v1;
-  dy[1] = v2;
-  dy[2] = -s * v1 * v2 - 2 * sin(y[0]);
-  dy[3] = s * v1 * v2 - sin(y[1]);
   return GSL_SUCCESS;
 }
 
