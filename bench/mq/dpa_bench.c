@@ -14,6 +14,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_odeiv2.h>
 
+#include "dpa_ode.h"
+
 #include "cart_k4s4.h"
 #include "dpa3.h"
 #include "dpa4.h"
@@ -21,18 +23,6 @@
 
 #define T_END 10.0
 #define R 7
-
-static int rhs(double t, const double *y, double *dy, void *par) {
-  double d = y[0] - y[1], c = cos(d), s = sin(d), det = 2 - c * c;
-  double v1 = (y[2] - c * y[3]) / det, v2 = (2 * y[3] - c * y[2]) / det;
-  (void)t;
-  (void)par;
-  dy[0] = v1;
-  dy[1] = v2;
-  dy[2] = -s * v1 * v2 - 2 * sin(y[0]);
-  dy[3] = s * v1 * v2 - sin(y[1]);
-  return GSL_SUCCESS;
-}
 
 static double now(void) {
   struct timespec ts;
@@ -55,7 +45,7 @@ typedef struct {
 } Method;
 
 static void run_rk8pd(double tol, double *x, long *steps) {
-  gsl_odeiv2_system sys = {rhs, NULL, 4, NULL};
+  gsl_odeiv2_system sys = {dpa_rhs, NULL, 4, NULL};
   gsl_odeiv2_driver *dr = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-3, tol, tol);
   double y[4] = {0.5, -0.3, 0, 0}, t = 0;
   gsl_odeiv2_driver_apply(dr, &t, T_END, y);

@@ -1,0 +1,235 @@
+/* wp.c - work-precision lines in minimal coordinates against GSL's rk8pd on
+ * the same ODE: the pendulum in its angle (models/pendulum_angle.ham, constant
+ * M) and the double pendulum in angles (models/double_pendulum_angles.ham,
+ * M(q)). Each generated solver is run fixed (h = T/N) and adaptive
+ * (NAME_step_adaptive at tol, the last step shortened to end on T, as
+ * bench/hbvm_adaptive.c does); rk8pd adaptive at tol (epsabs = epsrel = tol,
+ * as bench/gslpeers.c). The error is the max-norm error of (q, p) at T against
+ * rk8pd at 1e-15; the time of a point is the median of ROUNDS CPU times taken
+ * in turns (every timed point once a round), each at least MIN_SEC long.
+ * Only the points whose error lies in [ERR_LO, ERR_HI] are timed (they bracket
+ * 1e-10 and 1e-12). bench/mq/run.sh generates the solvers and writes
+ * solvers.def (S(name, problem, k, s, variant)) and solvers.h (their headers),
+ * then bench/mq/ratios.awk interpolates the CSV this prints. */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_odeiv2.h>
+
+#include "dpa_ode.h"
+
+#include "solvers.h"
+
+#define T_END 10.0
+#define ROUNDS 7
+#define MIN_SEC 0.004
+#define ERR_LO 2e-14
+#define ERR_HI 3e-9
+#define MAXPTS 4096
+#ifndef BUILD
+#define BUILD "cc"
+#endif
+
+enum { PA, DPA };
+static const char *const problem_name[] = {"pendulum_angle", "double_pendulum_angles"};
+static const int problem_m[] = {1, 2};
+
+/* -------------------------------------------------------- the two ODEs */
+
+static int pa_rhs(double t, const double *y, double *dy, void *par)
+{
+  (void)t;
+  (void)par;
+  dy[0] = y[1];
+  dy[1] = -sin(y[0]);
+  return GSL_SUCCESS;
+}
+
+static double energy(int pb, const double *y)
+{
+  if (pb == PA) return 0.5 * y[1] * y[1] - cos(y[0]);
+  double c = cos(y[0] - y[1]), det = 2 - c * c;
+  double v1 = (y[2] - c * y[3]) / det, v2 = (2 * y[3] - c * y[2]) / det;
+  return 0.5 * (y[2] * v1 + y[3] * v2) - 2 * cos(y[0]) - cos(y[1]);
+}
+
+static void initial(int pb, double *y)
+{
+  if (pb == PA) {
+    y[0] = 0;
+    y[1] = 1;
+  } else {
+    y[0] = 0.5;
+    y[1] = -0.3;
+    y[2] = y[3] = 0;
+  }
+}
+
+/* ------------------------------------------------------------ methods */
+
+typedef void (*RunFn)(int pb, double par, double *y, long *steps); /* (q, p) at T_END */
+
+static void run_rk8pd(int pb, double tol, double *y, long *steps)
+{
+  gsl_odeiv2_system sys = {pb == PA ? pa_rhs : dpa_rhs, NULL, (size_t)(2 * problem_m[pb]), NULL};
+  gsl_odeiv2_driver *dr = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-3 * T_END, tol, tol);
+  double t = 0;
+  initial(pb, y);
+  if (gsl_odeiv2_driver_apply(dr, &t, T_END, y) != GSL_SUCCESS) abort();
+  *steps = (long)dr->n;
+  gsl_odeiv2_driver_free(dr);
+}
+
+/* run_P_fixed and run_P_adaptive for the generated solver P (m coordinates). */
+#define HBVM_RUNS(P)                                                              \
+  static void run_##P##_fixed(int pb, double n_steps, double *y, long *steps)    \
+  {                                                                               \
+    P##_state x;                                                                  \
+    long n = lround(n_steps), m = problem_m[pb];                                  \
+    double h = T_END / (double)n;                                                 \
+    P##_init(&x, 0, 0);                                                           \
+    for (long i = 0; i < n; i++)                                                  \
+      if (P##_step(&x, h, 0, 0)) abort();                                         \
+    *steps = n;                                                                   \
+    for (long c = 0; c < m; c++) y[c] = x.q[c], y[m + c] = x.p[c];                \
+  }                                                                               \
+  static void run_##P##_adaptive(int pb, double tol, double *y, long *steps)     \
+  {                                                                               \
+    P##_state x;                                                                  \
+    double h = 1e-3 * T_END;                                                      \
+    long n = 0, m = problem_m[pb];                                                \
+    P##_init(&x, 0, 0);                                                           \
+    while (x.t < T_END * (1 - 1e-14)) {                                           \
+      double rest = T_END - x.t, hh = h >= rest * (1 - 1e-12) ? rest : h;         \
+      int last = hh == rest;                                                      \
+      if (P##_step_adaptive(&x, &hh, tol, 0, 0)) abort();                         \
+      if (!last || x.t < T_END * (1 - 1e-14)) h = hh;                             \
+      n++;                                                                        \
+    }                                                                             \
+    *steps = n;                                                                   \
+    for (long c = 0; c < m; c++) y[c] = x.q[c], y[m + c] = x.p[c];                \
+  }
+#define S(P, PB, K, SS, VAR) HBVM_RUNS(P)
+#include "solvers.def"
+#undef S
+
+typedef struct {
+  const char *name, *variant;
+  int pb, k, s;
+  RunFn fixed, adaptive;
+} Solver;
+
+static const Solver solvers[] = {
+#define S(P, PB, K, SS, VAR) {#P, VAR, PB, K, SS, run_##P##_fixed, run_##P##_adaptive},
+#include "solvers.def"
+#undef S
+};
+enum { NSOLVERS = sizeof solvers / sizeof solvers[0] };
+
+/* ------------------------------------------------------------- points */
+
+typedef struct {
+  int pb, k, s;
+  const char *method, *variant, *mode;
+  RunFn run;
+  double par, err, dH, sec[ROUNDS];
+  long steps;
+} Point;
+
+static Point pts[MAXPTS];
+static int npts;
+
+static double cpu_now(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Run point p once untimed: its error at T against ref and |H(T) - H0|. */
+static void measure_error(Point *p, const double *ref)
+{
+  double y[4], y0[4];
+  int d = 2 * problem_m[p->pb];
+  p->run(p->pb, p->par, y, &p->steps);
+  p->err = 0;
+  for (int c = 0; c < d; c++) p->err = fmax(p->err, fabs(y[c] - ref[c]));
+  initial(p->pb, y0);
+  p->dH = fabs(energy(p->pb, y) - energy(p->pb, y0));
+}
+
+static Point *add(int pb, const char *method, const char *variant, const char *mode, int k, int s, RunFn run,
+                  double par)
+{
+  Point *p = &pts[npts++];
+  if (npts > MAXPTS) abort();
+  *p = (Point){pb, k, s, method, variant, mode, run, par, 0, 0, {0}, 0};
+  return p;
+}
+
+/* Add a line: tolerances 10^-4 .. 10^-14.5, a factor 10^(1/4) apart
+ * (adaptive), or N = 10 .. 2560 steps a factor 10^(1/8) apart (fixed: its
+ * error falls as N^-2s), kept while the error is above ERR_LO/10. */
+static void add_line(int pb, const char *method, const char *variant, const char *mode, int k, int s, RunFn run,
+                     const double *ref)
+{
+  int fixed = mode[0] == 'f';
+  for (int i = 0; i <= 42; i++) {
+    double par = fixed ? round(10 * pow(10, i / 8.0)) : pow(10, -4 - i / 4.0);
+    if (fixed && par > 2560) break;
+    Point *p = add(pb, method, variant, mode, k, s, run, par);
+    measure_error(p, ref);
+    if (p->err < ERR_LO / 10) break;
+  }
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static int timed(const Point *p) { return p->err >= ERR_LO && p->err <= ERR_HI; }
+
+int main(void)
+{
+  double ref[2][4];
+  long n;
+  for (int pb = PA; pb <= DPA; pb++) {
+    run_rk8pd(pb, 1e-15, ref[pb], &n);
+    add_line(pb, "gsl-rk8pd", "", "adaptive", 0, 0, run_rk8pd, ref[pb]);
+  }
+  for (int i = 0; i < NSOLVERS; i++) {
+    const Solver *v = &solvers[i];
+    add_line(v->pb, v->name, v->variant, "adaptive", v->k, v->s, v->adaptive, ref[v->pb]);
+    add_line(v->pb, v->name, v->variant, "fixed", v->k, v->s, v->fixed, ref[v->pb]);
+  }
+  for (int r = 0; r < ROUNDS; r++) /* in turns: every timed point once a round */
+    for (int i = 0; i < npts; i++) {
+      double y[4], t0, t1;
+      long steps, reps = 0;
+      if (!timed(&pts[i])) continue;
+      t0 = cpu_now();
+      do {
+        pts[i].run(pts[i].pb, pts[i].par, y, &steps);
+        reps++;
+      } while ((t1 = cpu_now()) - t0 < MIN_SEC);
+      pts[i].sec[r] = (t1 - t0) / (double)reps;
+    }
+  printf("build,problem,method,variant,mode,k,s,param,steps,err,dH,seconds\n");
+  for (int i = 0; i < npts; i++) {
+    Point *p = &pts[i];
+    double med = 0;
+    if (timed(p)) {
+      qsort(p->sec, ROUNDS, sizeof p->sec[0], cmp_double);
+      med = p->sec[ROUNDS / 2];
+    }
+    printf("%s,%s,%s,%s,%s,%d,%d,%.6g,%ld,%.3e,%.2e,%.4e\n", BUILD, problem_name[p->pb], p->method, p->variant, p->mode,
+           p->k, p->s, p->par, p->steps, p->err, p->dH, med);
+  }
+  return 0;
+}

@@ -1,0 +1,48 @@
+#!/bin/sh
+# bench/mq/wp.sh - work-precision of hbvmgen in minimal coordinates against
+# GSL's rk8pd on the same ODE (bench/mq/wp.c): the pendulum in its angle and
+# the double pendulum in angles, s = 2..6 at k = s and at the generator's k
+# (-k auto; 2s+12 for the pendulum, s for M(q)), the double pendulum also at
+# s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, each built by
+# gcc -O2 and by clang -O3 -march=native -fno-math-errno -ffp-contract=off
+# (docs/api.md, "Flags that are safe"). Writes bench/results/mq_wp.csv and
+# bench/results/mq_ratios.txt (bench/mq/ratios.awk), and with gnuplot the
+# figures bench/results/mq_wp_*.png (bench/mq/plot.sh). Run from the repository's
+# root after `make all`: sh bench/mq/wp.sh
+set -e
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+G=gen/hbvmgen
+: >"$dir/solvers.def"
+: >"$dir/solvers.h"
+# gen MODEL PROBLEM(0 pendulum angle, 1 double pendulum angles) NAME K S VARIANT [options]
+gen() {
+  model=$1 pb=$2 name=$3 k=$4 s=$5 var=$6
+  shift 6
+  $G "models/$model.ham" -k "$k" -s "$s" -n "$name" -o "$dir" "$@" >/dev/null
+  [ "$k" = auto ] && k=$(sed -n 's/.*_K \([0-9]*\).*/\1/p' "$dir/$name.h" | head -n 1)
+  echo "S($name, $pb, ${k:-0}, $s, \"$var\")" >>"$dir/solvers.def"
+  echo "#include \"$name.h\"" >>"$dir/solvers.h"
+}
+for s in 2 3 4 5 6; do
+  gen pendulum_angle 0 pa_ks_s$s "$s" "$s" ""
+  gen pendulum_angle 0 pa_kauto_s$s auto "$s" ""
+done
+for s in 3 4 5 6 7 8; do
+  gen double_pendulum_angles 1 dpa_ks_s$s "$s" "$s" ""
+done
+gen double_pendulum_angles 1 dpa_kauto_s4 auto 4 ""
+gen double_pendulum_angles 1 dpa_kauto_s6 auto 6 ""
+gen double_pendulum_angles 1 dpa_k11_s6 11 6 ""
+gen double_pendulum_angles 1 dpa_ks_s4_loop 4 4 "stage-loop" --stage-loop 1
+W="-std=c99 -Wall -Wextra -pedantic"
+srcs=$(sed -n 's/^S(\([a-z0-9_]*\),.*/\1.c/p' "$dir/solvers.def" | sed "s|^|$dir/|")
+nice -n 5 gcc $W -O2 -DBUILD='"gcc-O2"' -I"$dir" -o "$dir/wp_gcc" bench/mq/wp.c $srcs $(pkg-config --libs gsl) -lm
+nice -n 5 clang $W -O3 -march=native -fno-math-errno -ffp-contract=off -DBUILD='"clang-O3-native"' -I"$dir" \
+  -o "$dir/wp_clang" bench/mq/wp.c $srcs $(pkg-config --libs gsl) -lm
+out=bench/results/mq_wp.csv
+"$dir/wp_gcc" >"$out"
+"$dir/wp_clang" | tail -n +2 >>"$out"
+awk -F, -f bench/mq/ratios.awk "$out" >bench/results/mq_ratios.txt
+cat bench/results/mq_ratios.txt
+if command -v gnuplot >/dev/null; then sh bench/mq/plot.sh; fi
