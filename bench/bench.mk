@@ -6,10 +6,11 @@ B       ?= build/bench
 CFLAGS  := -O2 -g -std=c99 -Wall -Wextra -pedantic
 GSL     := $(shell pkg-config --cflags gsl)
 LIBS    := $(shell pkg-config --libs gsl) -lsundials_ida -lsundials_sunlinsoldense -lsundials_sunmatrixdense \
+           -lsundials_sunlinsolband -lsundials_sunmatrixband \
            -lsundials_nvecserial -lm
 
 SRC     := main.c methods.c fixedstep.c problems.c linalg.c timing.c sweep.c count.c reference.c \
-           hbvm.c hbvm_adaptive.c hbvm_generic.c rattle.c ida.c gslpeers.c stiff.c abrun.c
+           hbvm.c hbvm_adaptive.c hbvm_generic.c rattle.c ida.c ida_run.c gslpeers.c stiff.c abrun.c
 OBJ     := $(addprefix $(B)/obj/,$(SRC:.c=.o)) $(B)/obj/ref.o
 GENOBJ  := $(foreach s,$(SOLVERS),$(B)/gen/$(s).o $(B)/gen/$(s)_bench.o) $(B)/gen/registry.o
 

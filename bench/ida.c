@@ -12,17 +12,14 @@
  * multiplier, mu = 0, so (y, y') is consistent. Without constraints (Kepler) this is the plain
  * ODE written as an implicit DAE of index 0. The run's setup (IDA memory,
  * vectors, matrix, solver) is part of what is timed, as for the other
- * methods; only the SUNDIALS context is made once. */
+ * methods (ida_run.c). */
 #include <math.h>
 #include <stdio.h>
 
-#include <ida/ida.h>
 #include <nvector/nvector_serial.h>
-#include <sundials/sundials_context.h>
-#include <sunlinsol/sunlinsol_dense.h>
-#include <sunmatrix/sunmatrix_dense.h>
 
 #include "bench.h"
+#include "ida_run.h"
 
 #define MAXSTEPS 1000000 /* a run that needs more has failed */
 /* Absolute tolerance of lambda and mu. They are outside the error test;
@@ -30,7 +27,8 @@
  * problem's own tolerance (index 2: their Newton corrections are amplified
  * by 1/h) failed on the first step for tol <= 1e-9 (IDA_CONV_FAIL on
  * conical, modified, satellites) and made no progress on chain8 with 1e-6;
- * 1e-3 passes at every tolerance on every problem. */
+ * 1e-3 passes at every tolerance on every problem. bench/rolled/ida_chain.c
+ * uses the same. */
 #define ALG_ATOL 1e-3
 
 /* F(t, y, y') of the GGL system; user_data is the Problem. */
@@ -61,16 +59,6 @@ static int residual(realtype t, N_Vector yy, N_Vector yp, N_Vector rr, void *use
   return isfinite(r[0]) ? 0 : 1;
 }
 
-/* IDA's messages are not wanted: failures are reported by the caller. */
-static void quiet(int error_code, const char *module, const char *function, char *msg, void *data)
-{
-  (void)error_code;
-  (void)module;
-  (void)function;
-  (void)msg;
-  (void)data;
-}
-
 /* Consistent y, y' at t = 0: the problem's q0, p0, the index-1 lambda, mu = 0. */
 static int initial_values(const Problem *pb, double *y, double *yd, double *id)
 {
@@ -91,56 +79,28 @@ static int initial_values(const Problem *pb, double *y, double *yd, double *id)
   return 0;
 }
 
+/* The observer's step: y = (q, p, ...). */
+static void observe(void *ob, const double *y)
+{
+  observer_point(ob, y, y + ((Observer *)ob)->pb->m);
+}
+
 int ida_integrate(const Setting *set, Observer *ob, Outcome *out)
 {
-  static SUNContext ctx;
   const Problem *pb = set->pb;
-  int m = pb->m, n = 2 * m + 2 * pb->nu, rc = -2, flag = 0, i;
-  void *mem;
-  N_Vector yy, yp, id, atol;
-  SUNMatrix A;
-  SUNLinearSolver LS;
-  realtype t = 0;
-  long nst = 0;
-  if (!ctx && SUNContext_Create(NULL, &ctx) != 0) return -2;
-  yy = N_VNew_Serial(n, ctx);
-  yp = N_VNew_Serial(n, ctx);
-  id = N_VNew_Serial(n, ctx);
-  atol = N_VNew_Serial(n, ctx);
-  A = SUNDenseMatrix(n, n, ctx);
-  LS = SUNLinSol_Dense(yy, A, ctx);
-  mem = IDACreate(ctx);
-  if (!yy || !yp || !id || !atol || !A || !LS || !mem) goto done;
-  if (initial_values(pb, N_VGetArrayPointer(yy), N_VGetArrayPointer(yp), N_VGetArrayPointer(id)) != 0) goto done;
-  for (i = 0; i < n; i++) NV_Ith_S(atol, i) = i < 2 * m ? set->tol : ALG_ATOL;
-  if (IDAInit(mem, residual, 0, yy, yp) != IDA_SUCCESS || IDASVtolerances(mem, set->tol, atol) != IDA_SUCCESS ||
-      IDASetUserData(mem, (void *)pb) != IDA_SUCCESS || IDASetLinearSolver(mem, LS, A) != IDA_SUCCESS ||
-      IDASetId(mem, id) != IDA_SUCCESS || IDASetSuppressAlg(mem, SUNTRUE) != IDA_SUCCESS ||
-      IDASetStopTime(mem, set->T) != IDA_SUCCESS || IDASetMaxNumSteps(mem, 10000000) != IDA_SUCCESS ||
-      IDASetErrHandlerFn(mem, quiet, NULL) != IDA_SUCCESS)
-    goto done;
-  if (ob) observer_start(ob, pb, N_VGetArrayPointer(yy), N_VGetArrayPointer(yy) + m);
-  while (flag != IDA_TSTOP_RETURN) {
-    flag = IDASolve(mem, set->T, &t, yy, yp, IDA_ONE_STEP);
-    if (flag < 0 || ++nst > MAXSTEPS) goto done;
-    if (ob) observer_point(ob, N_VGetArrayPointer(yy), N_VGetArrayPointer(yy) + m);
-  }
-  IDAGetNumSteps(mem, &nst);
+  int m = pb->m, n = 2 * m + 2 * pb->nu, i;
+  double y[2 * BENCH_MAXM + 2 * BENCH_MAXNU], yd[2 * BENCH_MAXM + 2 * BENCH_MAXNU];
+  double id[2 * BENCH_MAXM + 2 * BENCH_MAXNU], atol[2 * BENCH_MAXM + 2 * BENCH_MAXNU];
+  IdaSystem sys = {n, 0, residual, (void *)pb, set->tol, atol, id, ob ? observe : NULL, ob};
+  if (initial_values(pb, y, yd, id) != 0) return -2;
+  for (i = 0; i < n; i++) atol[i] = i < 2 * m ? set->tol : ALG_ATOL;
+  if (ob) observer_start(ob, pb, y, y + m);
+  if (ida_run(&sys, y, yd, set->T, MAXSTEPS, &out->steps) != 0) return -2;
   for (i = 0; i < m; i++) {
-    out->q[i] = NV_Ith_S(yy, i);
-    out->p[i] = NV_Ith_S(yy, m + i);
+    out->q[i] = y[i];
+    out->p[i] = y[m + i];
   }
-  out->steps = nst;
   out->iters = 0;
   out->itmax = 0;
-  rc = 0;
-done:
-  IDAFree(&mem);
-  SUNLinSolFree(LS);
-  SUNMatDestroy(A);
-  N_VDestroy(yy);
-  N_VDestroy(yp);
-  N_VDestroy(id);
-  N_VDestroy(atol);
-  return rc;
+  return 0;
 }
