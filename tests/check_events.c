@@ -84,21 +84,7 @@ static int run(const hbvmrt_model *md, const char *args, Row *ev, int *nev, doub
   close(fe);
   close(fc);
   snprintf(buf, sizeof buf, "%s --quiet --events %s --csv %s %s", md->name, evpath, csvpath, args);
-  char *argv[32];
-  int argc = 0;
-  for (char *tok = strtok(buf, " "); tok && argc < 31; tok = strtok(NULL, " ")) argv[argc++] = tok;
-  argv[argc] = NULL;
-  FILE *saved = tmpfile();
-  ck_assert(saved != NULL);
-  int err = dup(2);
-  dup2(fileno(saved), 2); /* the summary line, the errors */
-  int status = hbvmrt_main(md, argc, argv);
-  fflush(stderr);
-  dup2(err, 2);
-  close(err);
-  rewind(saved);
-  run_err[fread(run_err, 1, sizeof run_err - 1, saved)] = 0;
-  fclose(saved);
+  int status = driver_run_captured(md, NULL, buf, run_err, sizeof run_err);
   FILE *f = fopen(evpath, "r");
   ck_assert(f != NULL);
   *nev = *nrows = 0;

@@ -72,24 +72,12 @@ static char run_err[4096]; /* the stderr of the last run() */
 /* Run the driver of md with the options in args (spaces between); the last
  * CSV row (ncol values) into last. Returns the exit status. */
 static int run(const hbvmrt_model *md, const hbvmrt_switching *sw, const char *args, double *last, int ncol) {
-  char csvpath[] = "/tmp/hbvm-switch-XXXXXX", line[4096], buf[512], *argv[32];
-  int fc = mkstemp(csvpath), argc = 0;
+  char csvpath[] = "/tmp/hbvm-switch-XXXXXX", line[4096], buf[512];
+  int fc = mkstemp(csvpath);
   ck_assert(fc >= 0);
   close(fc);
   snprintf(buf, sizeof buf, "%s --quiet --csv %s %s", md->name, csvpath, args);
-  for (char *tok = strtok(buf, " "); tok && argc < 31; tok = strtok(NULL, " ")) argv[argc++] = tok;
-  argv[argc] = NULL;
-  FILE *saved = tmpfile();
-  ck_assert(saved != NULL);
-  int err = dup(2);
-  dup2(fileno(saved), 2); /* the summary line, the errors */
-  int status = hbvmrt_main_switching(md, sw, NULL, argc, argv);
-  fflush(stderr);
-  dup2(err, 2);
-  close(err);
-  rewind(saved);
-  run_err[fread(run_err, 1, sizeof run_err - 1, saved)] = 0;
-  fclose(saved);
+  int status = driver_run_captured(md, sw, buf, run_err, sizeof run_err);
   FILE *f = fopen(csvpath, "r");
   ck_assert(f != NULL);
   while (fgets(line, sizeof line, f)) {

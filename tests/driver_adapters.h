@@ -6,6 +6,13 @@
 #ifndef HBVM_TESTS_DRIVER_ADAPTERS_H
 #define HBVM_TESTS_DRIVER_ADAPTERS_H
 
+#include <check.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "hbvmrt.h"
+
 #define DRIVER_ADAPTERS(P)                                                                                          \
   static void P##_init_(void *x, const double *q0, const double *p0) { P##_init(x, q0, p0); }                        \
   static void P##_pd_(void *prm) { P##_params_default(prm); }                                                       \
@@ -35,5 +42,28 @@
     P##_dense(a, theta, b->q, b->p);                                                                                \
     b->t = a->t - a->hprev * (1 - theta);                                                                           \
   }
+
+/* Run the driver of md (hbvmrt_main, or hbvmrt_main_switching where sw is
+ * not NULL) on the command line cmd (words between single spaces, the
+ * first the program's name), its stderr (the summary line, the errors) into
+ * err (n bytes, NUL-terminated). Returns the exit status. */
+static int driver_run_captured(const hbvmrt_model *md, const hbvmrt_switching *sw, char *cmd, char *err, size_t n) {
+  char *argv[32];
+  int argc = 0;
+  for (char *tok = strtok(cmd, " "); tok && argc < 31; tok = strtok(NULL, " ")) argv[argc++] = tok;
+  argv[argc] = NULL;
+  FILE *saved = tmpfile();
+  ck_assert(saved != NULL);
+  int fd = dup(2);
+  dup2(fileno(saved), 2);
+  int status = sw ? hbvmrt_main_switching(md, sw, NULL, argc, argv) : hbvmrt_main(md, argc, argv);
+  fflush(stderr);
+  dup2(fd, 2);
+  close(fd);
+  rewind(saved);
+  err[fread(err, 1, n - 1, saved)] = 0;
+  fclose(saved);
+  return status;
+}
 
 #endif
