@@ -122,6 +122,18 @@ static int parse_number(const hbvmrt_model *md, const char *opt, const char *s,
   return -1;
 }
 
+/* A finite number > 0 for opt (--tol, --dt, --hmax, --atol, --rtol). */
+static int parse_positive(const hbvmrt_model *md, const char *opt, const char *s, double *v)
+{
+  if (parse_number(md, opt, s, v) != 0)
+    return -1;
+  if (!(*v > 0)) {
+    hbvmrt_error(md, "%s must be > 0 (got %s)", opt, s);
+    return -1;
+  }
+  return 0;
+}
+
 /* --q0/--p0: exactly m comma-separated finite numbers into *out (allocated
  * on first use, overwritten when the option is repeated). */
 static int parse_vector(const hbvmrt_model *md, const char *opt, const char *s,
@@ -458,12 +470,8 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
     o->project = 1;
     return 0;
   case OPT_TOL:
-    if (parse_number(md, op->name, val, &o->tol) != 0)
+    if (parse_positive(md, op->name, val, &o->tol) != 0)
       return -1;
-    if (!(o->tol > 0)) {
-      hbvmrt_error(md, "--tol must be > 0 (got %s)", val);
-      return -1;
-    }
     if (o->tol < min_tol(md)) {
       hbvmrt_error(md, "--tol must be >= %.2g, 8 ulps of the solver's %s: below it the round-off of the steps "
                    "outweighs the tolerance, and a tighter one gives a larger error (got %s)", min_tol(md),
@@ -477,12 +485,8 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
     }
     return 0;
   case OPT_DT:
-    if (parse_number(md, op->name, val, &o->dt) != 0)
+    if (parse_positive(md, op->name, val, &o->dt) != 0)
       return -1;
-    if (!(o->dt > 0)) {
-      hbvmrt_error(md, "--dt must be > 0 (got %s)", val);
-      return -1;
-    }
     return needs(md, op->name, md->dense != NULL, "dense output");
   case OPT_EVENTS:
     o->events = val;
@@ -490,23 +494,13 @@ static int apply(const hbvmrt_model *md, const Option *op, const char *val,
   case OPT_STOP_AT:
     return parse_stop_at(md, val, o);
   case OPT_HMAX:
-    if (parse_number(md, op->name, val, &o->hmax) != 0)
-      return -1;
-    if (!(o->hmax > 0)) {
-      hbvmrt_error(md, "--hmax must be > 0 (got %s)", val);
-      return -1;
-    }
-    return 0;
+    return parse_positive(md, op->name, val, &o->hmax);
   case OPT_MAX_STEPS:
     return parse_count(md, op->name, val, 1, &o->max_steps);
   case OPT_ATOL:
   case OPT_RTOL:
-    if (parse_number(md, op->name, val, op->id == OPT_ATOL ? &o->atol : &o->rtol) != 0)
+    if (parse_positive(md, op->name, val, op->id == OPT_ATOL ? &o->atol : &o->rtol) != 0)
       return -1;
-    if (!((op->id == OPT_ATOL ? o->atol : o->rtol) > 0)) {
-      hbvmrt_error(md, "%s must be > 0 (got %s)", op->name, val);
-      return -1;
-    }
     if ((op->id == OPT_ATOL ? o->atol : o->rtol) < min_tol(md)) {
       hbvmrt_error(md, "%s must be >= %.2g, 8 ulps of the solver's %s (got %s)", op->name, min_tol(md),
                    md->eps > 2 * DBL_EPSILON ? "float" : "double", val);
