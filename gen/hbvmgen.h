@@ -419,6 +419,7 @@ typedef struct {
   int k, s;
   MultFamily family;
   IterKind iteration;
+  int energy_rescale; /* p1 rescaled to H0 at the end of a step (--energy rescale, emit_end.c) */
   double *c, *b;      /* k nodes and weights on [0,1] */
   double *Ihat;       /* k x s: integral_0^{c_l} P_j */
   double *W;          /* k x s: b_l P_j(c_l) */
