@@ -432,7 +432,7 @@ typedef struct {
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why);
 int method_quadrature_exact(int k, int s, int degU, int degg);
 Method *method_new(int k, int s, MultFamily family);
-void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam); /* --check's advice */
+void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam, int rescale); /* --check's advice */
 
 /* ---- step.c, step_const.c, step_poly.c, lu.c: the step as a DAG ---- */
 

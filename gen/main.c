@@ -347,7 +347,7 @@ static void print_switches(const Model *mod, const char *name) {
 }
 
 static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam,
-                        const char *iter_why) {
+                        const char *iter_why, int rescale) {
   char a[16], b[16];
   printf("model %s: m=%d nu=%d deg(U)=%s deg(g)=%s k=%d s=%d\n", o->name, mod->m, mod->nu, deg_str(mod->degU, a),
          deg_str(mod->degg, b), k, o->s);
@@ -382,7 +382,7 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   printf("grad U: %d nonzero entries of %d\n", ngrad, mod->m);
   for (int i = 0; i < mod->nparams; i++) printf("param %s = %.17g\n", mod->params[i].name, mod->params[i].value);
   print_switches(mod, o->name);
-  method_advise(stdout, mod, o->s, k, fam);
+  method_advise(stdout, mod, o->s, k, fam, rescale);
 }
 
 /* ---- writing the output ----
@@ -789,7 +789,7 @@ int main(int argc, char **argv) {
              FLOAT_POLY_MAX_S, o.s);
     rc = 1;
   } else if (o.check_only) {
-    print_check(mod, &o, k, why, fam, iter_why);
+    print_check(mod, &o, k, why, fam, iter_why, rescale);
     rc = print_check_code(&o, mod, k, fam, iter, rescale);
   } else {
     Method *me = method_new(k, o.s, fam);
