@@ -1,7 +1,7 @@
 /* check_energy.c - Check suite for the energy rescale of a model without
  * constraints and with a constant M (--energy rescale, the default at -k auto
- * for a U that is not a polynomial: docs/method-const.md, "Energy: the
- * rescale"), on models/pendulum_angle.ham and models/kepler.ham at k = s,
+ * for a U that is not a polynomial: docs/method-const.md, "Energy without
+ * constraints"), on models/pendulum_angle.ham and models/kepler.ham at k = s,
  * s = 1..4 (tests/models/LIST: pa_res, kep_res):
  *   energy    max |H - H0| at round-off over 10^5 steps, where k = s without
  *             the rescale (generated/kepler_kSsS, pa_plain) is far from it.
