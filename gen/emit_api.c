@@ -45,7 +45,8 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
   out(e, "  %s_real gam2[%d], hprev2, errprev;\n", e->P, s * m);
   out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
-  if (poly || mod->mass_q) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+  if (poly || energy_rescale_wanted(e)) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
+  if (energy_rescale_wanted(e) && !mod->mass_q) out(e, "  %s_real Hend;  /* H where the last step ended */\n", e->P);
   if (poly) out(e, "  %s_real pcorr[%d];  /* p1 minus p's polynomial at the end: the projection and rescale */\n", e->P, m);
   if (emit_is_newton(e)) emit_newton_state(e);
   out(e, "} %s_state;\n\ntypedef struct {\n", e->P);
@@ -266,8 +267,9 @@ static void emit_init(Emitter *e) {
           "  for (i = 0; i < $P_S * $P_M; i++) x->gam[i] = x->gam2[i] = x->pinc[i] = 0;\n");
   if (e->st->kern[K_FACTOR].nout)
     tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n  for (i = 0; i < $P_M; i++) x->pcorr[i] = 0;\n");
-  else if (e->mod->mass_q)
-    tmpl(e, "  x->H0 = 0;  /* taken at the first step */\n");
+  else if (energy_rescale_wanted(e))
+    tmpl(e, e->mod->mass_q ? "  x->H0 = 0;  /* taken at the first step */\n"
+                           : "  x->H0 = x->Hend = 0;  /* taken at the first step */\n");
   if (emit_is_newton(e)) emit_newton_init(e);
   if (e->mod->nu) emit_set_lambda(e);
   tmpl(e, "}\n\n"

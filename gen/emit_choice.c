@@ -27,6 +27,13 @@ int mult_err_wanted(const Emitter *e) { return step_order(e) < 2 * e->me->s; }
 // --wide-step, whose iteration is in the wider type.
 int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e->wide_step; }
 
+// Whether the constant family's end of the step rescales p1 to the run's
+// energy H0 (emit_mq_rescale): always with M(q), whose H no k integrates
+// exactly, and with --energy rescale (the default for an unconstrained
+// model whose U is not a polynomial, at -k auto: docs/method-const.md). The
+// iteration may then stop at 2 ulps (the contraction test, emit_iterate.c).
+int energy_rescale_wanted(const Emitter *e) { return e->mod->mass_q || e->me->energy_rescale; }
+
 // Whether the step's error estimate must take the quadrature's part from
 // the energy defect: k nodes do not integrate H exactly for this model (U or
 // g not polynomial, or k below -k auto), and no rescale restores H (the

@@ -4,8 +4,8 @@
  * (emit_step.c), the step ends by family. The constant family (emit_end_const)
  * checks the new state is finite and commits it: q1 = q0 + h gamma_0 and
  * p1 = p0 + (p1 - p0) as compensated sums (or the wide sums rounded once
- * with --wide-step), lambda the step's constant multiplier; with M(q) p1 is
- * then rescaled to the run's energy (emit_mq.c). The polynomial
+ * with --wide-step), lambda the step's constant multiplier; with M(q) or
+ * --energy rescale p1 is then rescaled to the run's energy (emit_mq.c). The polynomial
  * family (emit_end_poly) first forms q1 and p1 aside, puts q1 back on g = 0
  * by Newton steps where the adaptive iteration stopped above round-off,
  * projects p1 onto the hidden constraint and rescales it to the run's energy
@@ -127,7 +127,7 @@ void emit_end_poly(Emitter *e) {
 // commit (compensated sums, or the wide sums rounded once with --wide-step).
 void emit_end_const(Emitter *e) {
   int wide = e->wide_step;
-  if (e->mod->mass_q) tmpl(e, "  $R Hn = $P_energy(x, prm);  /* H(q0, p0), for the rescale */\n");
+  if (energy_rescale_wanted(e)) tmpl(e, "  $R Hn = $P_energy(x, prm);  /* H(q0, p0), for the rescale */\n");
   tmpl(e, "  for (i = 0; i < $P_M; i++) /* the new state must be finite too, compensations included */\n"
           "    if (!isfinite(x->q[i] + h * sw[$[sweep.gam]i]) || !isfinite(x->p[i] + sw[$[sweep.dp]i]) ||\n"
           "        !isfinite(x->qc[i]) || !isfinite(x->pc[i]))\n      return $P_ENONFINITE;\n");
@@ -136,7 +136,7 @@ void emit_end_const(Emitter *e) {
             "    $P_add(&x->q[i], &x->qc[i], h * sw[$[sweep.gam]i]);\n"
             "    $P_add(&x->p[i], &x->pc[i], sw[$[sweep.dp]i]);\n  }\n"
             "  for (i = 0; i < $P_NU; i++) x->lambda[i] = sw[$[sweep.lambda]i];\n");
-  if (!wide && e->mod->mass_q) emit_mq_rescale(e); /* emit_mq.c */
+  if (energy_rescale_wanted(e)) emit_mq_rescale(e); /* emit_mq.c (never with --wide-step) */
   if (wide) {
     tmpl(e, "  /* q1 = (q - qc) + h gamma_0 and p1 = (p - pc) + (p1 - p0) in $W, rounded once into\n"
             "   * q, p; what the rounding lost is the new qc, pc */\n"

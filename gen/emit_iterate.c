@@ -176,7 +176,7 @@ static void emit_fused_checks(Emitter *e) {
 
 // The end of an iteration: failure, convergence or a stall.
 static void emit_convergence(Emitter *e) {
-  int poly = e->st->kern[K_FACTOR].nout > 0 || e->mod->mass_q; /* (M(q): its end rescales p to H0 too) */
+  int poly = e->st->kern[K_FACTOR].nout > 0 || energy_rescale_wanted(e); /* (its end rescales p to H0 too) */
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
   if (poly) { /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
@@ -228,6 +228,7 @@ void emit_fixed_point(Emitter *e) {
   }
   if (e->fused) emit_fused_locals(e);
   if (e->mod->mass_q) emit_mq_start(e); /* emit_mq.c */
+  else if (energy_rescale_wanted(e) && !poly) tmpl(e, "  $R inc_old2 = HUGE_VAL, rho;  /* the contraction test ($P_contraction) */\n");
   tmpl(e, "  for (it = 1; it <= $P_MAXITER; it++) {\n");
   if (poly) {
     tmpl(e, "    /* the frozen factor converges as fast as a fresh one every sweep while h is\n"

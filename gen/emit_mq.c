@@ -69,19 +69,27 @@ void emit_mq_carry(Emitter *e) {
 // (Hn, before the commit) differs from it by more than round-off: the state
 // or the params were changed between steps. No rescale at rest (K = 0) or
 // where H0 < U(q1), nor near rest, where beta is not within 1e-6 of 1 and
-// H(q1, p1) - H0 is round-off.
+// H(q1, p1) - H0 is round-off. With a constant M (--energy rescale, the
+// caller emit_end.c) H0 is kept while H(q0, p0) is the energy the last step
+// ended with (x->Hend), exactly.
 void emit_mq_rescale(Emitter *e) {
-  tmpl(e, "  {  /* M(q): p1 rescaled to the run's energy H0 */\n"
-          "    $R z[$P_M], U1, K, H0, beta = 1;\n"
+  tmpl(e, e->mod->mass_q ? "  {  /* M(q): p1 rescaled to the run's energy H0 */\n"
+                          : "  {  /* p1 rescaled to the run's energy H0 (--energy rescale) */\n");
+  tmpl(e, "    $R z[$P_M], U1, K, H0, beta = 1;\n"
           "    for (i = 0; i < $P_M; i++) z[i] = 0;\n"
           "    $(energy_kernel q0=x->q p0=z out=&U1);\n"
-          "    K = $P_energy(x, prm) - U1;\n"
-          "    H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0 : Hn;\n"
-          "    if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
+          "    K = $P_energy(x, prm) - U1;\n");
+  tmpl(e, e->mod->mass_q ? "    H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$f(U1)) ? x->H0 : Hn;\n"
+                         /* --energy rescale: a rescale skipped (near rest, or H0 < U(q1) at a turning
+                          * point) is made up by the next step's, not taken for a change of the state */
+                         : "    H0 = x->hprev != 0 && Hn == x->Hend ? x->H0 : Hn;  /* the state unchanged since */\n");
+  tmpl(e, "    if (K > 0 && H0 - U1 > 0) beta = sqrt$f((H0 - U1) / K);\n"
           "    /* near rest a round-off in H is a large change of p (it is that over |v|): a\n"
           "     * discrepancy at round-off is corrected only where the correction is small (s = 2,\n"
           "     * tol 1e-10 from rest: 1000x the error without this test) */\n"
           "    if (!(fabs$f(beta - 1) <= 1e-6) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n"
           "    for (i = 0; i < $P_M; i++) $P_add(&x->p[i], &x->pc[i], (beta - 1) * (x->p[i] - x->pc[i]));\n"
-          "    x->H0 = H0;\n  }\n");
+          "    x->H0 = H0;\n");
+  if (!e->mod->mass_q) tmpl(e, "    x->Hend = $P_energy(x, prm);\n");
+  tmpl(e, "  }\n");
 }

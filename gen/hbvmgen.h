@@ -419,6 +419,7 @@ typedef struct {
   int k, s;
   MultFamily family;
   IterKind iteration;
+  int energy_rescale; /* p1 rescaled to H0 at the end of a step (--energy rescale, emit_end.c) */
   double *c, *b;      /* k nodes and weights on [0,1] */
   double *Ihat;       /* k x s: integral_0^{c_l} P_j */
   double *W;          /* k x s: b_l P_j(c_l) */
@@ -431,7 +432,7 @@ typedef struct {
 int method_auto_k(int s, int degU, int degg, MultFamily fam, const char **why);
 int method_quadrature_exact(int k, int s, int degU, int degg);
 Method *method_new(int k, int s, MultFamily family);
-void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam); /* --check's advice */
+void method_advise(FILE *f, const Model *mod, int s, int k, MultFamily fam, int rescale); /* --check's advice */
 
 /* ---- step.c, step_const.c, step_poly.c, lu.c: the step as a DAG ---- */
 

@@ -39,7 +39,14 @@ static const char usage[] =
     "options:\n"
     "  -s S          degree of the polynomial approximation, 1 <= S <= 20 (default 2)\n"
     "  -k K|auto     Gauss-Legendre nodes, S <= K <= 200 (default auto: the smallest k that\n"
-    "                conserves H and g exactly for polynomial models; 2s+12 otherwise)\n"
+    "                conserves H and g exactly for polynomial models; s where the step\n"
+    "                rescales p (--energy rescale, poly family); 2s+12 otherwise)\n"
+    "  --energy E    auto, rescale or quadrature: how a model without constraints keeps\n"
+    "                H at round-off. rescale: the end of each step rescales p to the\n"
+    "                run's energy (k = s suffices); quadrature: k exact for H, or 2s+12\n"
+    "                nodes where U is not a polynomial. auto (default): rescale where M\n"
+    "                depends on q, or where U is not a polynomial and neither -k, --batch\n"
+    "                nor --wide-step is given; quadrature otherwise (docs/method-const.md)\n"
     "  -o DIR        where NAME.c and NAME.h are written (default .: the current directory)\n"
     "  -n NAME       C prefix of every emitted symbol (default: the model file's base name)\n"
     "  --multiplier F  const or poly: how the Lagrange multiplier varies over a step.\n"
@@ -55,7 +62,10 @@ static const char usage[] =
     "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
     "                where they are slow (--check says which). Newton: with constraints\n"
     "                only with --multiplier const; not with --batch or --wide-step\n"
-    "                (docs/method-newton.md)\n"
+    "                (docs/method-newton.md)\n";
+
+/* (the rest of the usage, apart: a C99 compiler need not take a string over 4095 bytes) */
+static const char usage_more[] =
     "  --main        also emit NAME_main.c, a standalone driver (link runtime/libhbvmrt.a)\n"
     "  --check       parse and analyse only; print m, nu, degrees and the chosen k, and the\n"
     "                size of the code it would write (nothing is written)\n"
@@ -98,7 +108,11 @@ typedef struct {
   long stage_loop; /* --stage-loop N, 0 for the default */
   int iteration;   /* --iteration: an IterKind */
   int rolled;      /* --rolled: ROLL_AUTO, ROLL_ON or ROLL_OFF */
+  int energy;      /* --energy: an EnergyKind */
 } Options;
+
+/* --energy: how a model without constraints keeps H (resolve_energy) */
+typedef enum { ENERGY_AUTO, ENERGY_RESCALE, ENERGY_QUADRATURE } EnergyKind;
 
 static int fail(const char *fmt, const char *arg) {
   fprintf(stderr, "hbvmgen: error: ");
@@ -144,6 +158,7 @@ static int parse_args(int argc, char **argv, Options *o) {
     int has_value = i + 1 < argc;
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
       fputs(usage, stdout);
+      fputs(usage_more, stdout);
       return -1;
     } else if (!strcmp(a, "--version")) {
       printf("hbvmgen %s\n", HBVMGEN_VERSION);
@@ -167,6 +182,12 @@ static int parse_args(int argc, char **argv, Options *o) {
       if (strcmp(v, "fixed") && strcmp(v, "newton") && strcmp(v, "auto"))
         return fail("--iteration needs 'auto', 'fixed' or 'newton', got '%s'", v);
       o->iteration = !strcmp(v, "newton") ? ITER_NEWTON : !strcmp(v, "auto") ? ITER_AUTO : ITER_FIXED;
+    } else if (!strcmp(a, "--energy")) {
+      if (!has_value) return fail("option %s needs a value", a);
+      const char *v = argv[++i];
+      if (strcmp(v, "auto") && strcmp(v, "rescale") && strcmp(v, "quadrature"))
+        return fail("--energy needs 'auto', 'rescale' or 'quadrature', got '%s'", v);
+      o->energy = !strcmp(v, "rescale") ? ENERGY_RESCALE : !strcmp(v, "quadrature") ? ENERGY_QUADRATURE : ENERGY_AUTO;
     } else if (!strcmp(a, "--rolled")) {
       if (!has_value) return fail("option %s needs a value", a);
       const char *v = argv[++i];
@@ -212,6 +233,9 @@ static int parse_args(int argc, char **argv, Options *o) {
     return fail("-k must be at least -s (%s)", buf);
   }
   if (o->batch && o->wide_step) return fail("%s", "--batch cannot be used with --wide-step (long double does not vectorise)");
+  if (o->energy == ENERGY_RESCALE && (o->batch || o->wide_step))
+    return fail("--energy rescale cannot be used with %s (not yet: its step has no rescale)",
+                o->batch ? "--batch" : "--wide-step");
   if (o->iteration == ITER_NEWTON && (o->batch || o->wide_step))
     return fail("--iteration newton cannot be used with %s (not yet)", o->batch ? "--batch" : "--wide-step");
   if (o->iteration == ITER_NEWTON && o->s > NEWTON_MAX_S) {
@@ -323,7 +347,7 @@ static void print_switches(const Model *mod, const char *name) {
 }
 
 static void print_check(const Model *mod, const Options *o, int k, const char *why, MultFamily fam,
-                        const char *iter_why) {
+                        const char *iter_why, int rescale) {
   char a[16], b[16];
   printf("model %s: m=%d nu=%d deg(U)=%s deg(g)=%s k=%d s=%d\n", o->name, mod->m, mod->nu, deg_str(mod->degU, a),
          deg_str(mod->degg, b), k, o->s);
@@ -358,7 +382,7 @@ static void print_check(const Model *mod, const Options *o, int k, const char *w
   printf("grad U: %d nonzero entries of %d\n", ngrad, mod->m);
   for (int i = 0; i < mod->nparams; i++) printf("param %s = %.17g\n", mod->params[i].name, mod->params[i].value);
   print_switches(mod, o->name);
-  method_advise(stdout, mod, o->s, k, fam);
+  method_advise(stdout, mod, o->s, k, fam, rescale);
 }
 
 /* ---- writing the output ----
@@ -544,9 +568,10 @@ static EmitOptions emit_options(const Options *o) {
 // whether the k stages are straight-line code or one loop (--stage-loop).
 // Returns 1 when the step cannot be emitted (the reason reported), else 0;
 // without a temporary file the line says so and the status stays 0.
-static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam, IterKind iter) {
+static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam, IterKind iter, int rescale) {
   Method *me = method_new(k, o->s, fam);
   me->iteration = iter;
+  me->energy_rescale = rescale;
   Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
   if (!st || roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo)) return 1;
@@ -680,8 +705,32 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily
   return r >= STIFF_RATIO && !no ? ITER_AUTO : ITER_FIXED;
 }
 
+// Whether the end of the step rescales p1 to the run's energy (--energy;
+// Method.energy_rescale, emit_mq_rescale). Only without constraints (with
+// them the poly family rescales and projects, the const family keeps the
+// quadrature) and never with --batch or --wide-step. auto rescales where U
+// is not a polynomial and -k is not given: k = s then keeps H at round-off
+// at 1/3 of the 2s+12 nodes' cost (docs/method-const.md), while a given -k
+// keeps the quadrature of its nodes, byte for byte as before --energy. M(q)
+// always rescales (no k integrates its H). Returns 1 to rescale, 0 not, -1
+// after an error.
+static int resolve_energy(const Options *o, const Model *mod) {
+  if (o->energy != ENERGY_AUTO && mod->nu) {
+    fail("%s", "--energy applies to a model without constraints (with constraints the poly family rescales "
+               "p, the const family keeps the quadrature)");
+    return -1;
+  }
+  if (mod->mass_q && o->energy == ENERGY_QUADRATURE) {
+    fail("%s", "--energy quadrature: M depends on q, and no k integrates its H exactly (the step rescales p)");
+    return -1;
+  }
+  if (mod->nu || mod->mass_q || o->energy == ENERGY_QUADRATURE) return 0;
+  if (o->energy == ENERGY_RESCALE) return 1;
+  return mod->degU == DEG_NONPOLY && !o->k && !o->batch && !o->wide_step;
+}
+
 int main(int argc, char **argv) {
-  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_AUTO, ROLL_AUTO};
+  Options o = {NULL, ".", NULL, 2, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, ITER_AUTO, ROLL_AUTO, ENERGY_AUTO};
   int rc = parse_args(argc, argv, &o);
   if (rc) return rc < 0 ? 0 : rc;
   if (!o.name) {
@@ -711,11 +760,18 @@ int main(int argc, char **argv) {
   const char *why = "given with -k";
   /* the family changes nothing without constraints */
   MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
-  int k = o.k ? o.k : method_auto_k(o.s, mod->degU, mod->degg, mod->mass_q ? MULT_POLY : fam, &why);
+  int rescale = resolve_energy(&o, mod);
+  int k = o.k ? o.k : rescale > 0 ? o.s : method_auto_k(o.s, mod->degU, mod->degg, mod->mass_q ? MULT_POLY : fam, &why);
   if (mod->mass_q && !o.k) why = "M depends on q: k = s, the end of the step rescales p to keep H (docs/method-mq.md)";
+  if (rescale > 0 && !o.k)
+    why = o.energy == ENERGY_RESCALE ? "k = s, the end of the step rescales p to keep H (given with --energy rescale)"
+                                     : "U is not a polynomial: k = s, the end of the step rescales p to keep H "
+                                       "(--energy auto; --energy quadrature for k = 2s+12 without it, docs/method-const.md)";
   char iter_why[512];
   IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
-  if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
+  if (rescale < 0) {
+    rc = 1;
+  } else if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
     rc = 1;
   } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
@@ -733,11 +789,12 @@ int main(int argc, char **argv) {
              FLOAT_POLY_MAX_S, o.s);
     rc = 1;
   } else if (o.check_only) {
-    print_check(mod, &o, k, why, fam, iter_why);
-    rc = print_check_code(&o, mod, k, fam, iter);
+    print_check(mod, &o, k, why, fam, iter_why, rescale);
+    rc = print_check_code(&o, mod, k, fam, iter, rescale);
   } else {
     Method *me = method_new(k, o.s, fam);
     me->iteration = iter;
+    me->energy_rescale = rescale;
     Step *st = step_build(mod, me);
     rc = st ? write_outputs(&o, mod, me, st) : 1;
   }

@@ -31,6 +31,6 @@ plot $cmd
 GP
 }
 plot pendulum_angle gsl-rk8pd:adaptive pa_ks_s6:adaptive pa_ks_s6:fixed pa_ks_s4:adaptive \
-  pa_kauto_s6:adaptive pa_kauto_s4:adaptive
+  pa_kauto_s6:adaptive pa_kauto_s4:adaptive pa_quad_s6:adaptive pa_quad_s4:adaptive
 plot double_pendulum_angles gsl-rk8pd:adaptive dpa_ks_s6:fixed dpa_ks_s6:adaptive dpa_ks_s7:fixed \
   dpa_ks_s4:fixed dpa_ks_s4:adaptive

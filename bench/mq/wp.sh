@@ -2,7 +2,9 @@
 # bench/mq/wp.sh - work-precision of hbvmgen in minimal coordinates against
 # GSL's rk8pd on the same ODE (bench/mq/wp.c): the pendulum in its angle and
 # the double pendulum in angles, s = 2..6 at k = s and at the generator's k
-# (-k auto; 2s+12 for the pendulum, s for M(q)), the double pendulum also at
+# (-k auto: s for both, the end of the step rescaling p to keep H), the
+# pendulum also at its old default (--energy quadrature: k = 2s+12, no
+# rescale; with -k s the step keeps the plain quadrature), the double pendulum also at
 # s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, each built by
 # gcc -O2 and by clang -O3 -march=native -fno-math-errno -ffp-contract=off
 # (docs/api.md, "Flags that are safe"). Writes bench/results/mq_wp.csv and
@@ -27,6 +29,7 @@ gen() {
 for s in 2 3 4 5 6; do
   gen pendulum_angle 0 pa_ks_s$s "$s" "$s" ""
   gen pendulum_angle 0 pa_kauto_s$s auto "$s" ""
+  gen pendulum_angle 0 pa_quad_s$s auto "$s" "" --energy quadrature
 done
 for s in 3 4 5 6 7 8; do
   gen double_pendulum_angles 1 dpa_ks_s$s "$s" "$s" ""
