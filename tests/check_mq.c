@@ -40,6 +40,7 @@
 #include "sph_k16s2.h"
 
 Suite *mq_suite(void);
+void mq_fourbar_tests(Suite *s); /* check_mq_fourbar.c: M(q) with constraints */
 
 #define MAXM 3
 
@@ -474,5 +475,6 @@ Suite *mq_suite(void) {
   tcase_add_loop_test(tc, dense_inside_step, 0, 3);
   tcase_add_test(tc, check_reports_dependence);
   suite_add_tcase(s, tc);
+  mq_fourbar_tests(s);
   return s;
 }
