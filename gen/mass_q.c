@@ -82,21 +82,29 @@ void minv_apply_at(const Model *mod, Dag *d, const int *q, const int *v, int *ou
   solve_with((Model *)mod, d, a, v, out);
 }
 
+// The sparse gradient dx (in the model's q) of entry (a, b) of M(q) and
+// the weight of the pair in a quadratic form v' X v of a symmetric X,
+// v_a v_b (twice off the diagonal); 0 where the entry does not depend on q.
+static int entry_gradient(const Model *mod, Dag *d, int a, int b, const int *v, SparseVec *dx, int *w) {
+  int x = mod->mass_q[(size_t)a * mod->m + b];
+  if (!(d->nodes[x].flags & DEP_INPUT)) return 0;
+  ad_gradient_sparse(d, x, mod->m, dx);
+  *w = dag_mul(d, v[a], v[b]);
+  if (a != b) *w = dag_add(d, *w, *w);
+  return 1;
+}
+
 // grad_q T = -1/2 v' (dM/dq_i) v in closed form, g[i], for v the m nodes
 // of M^-1 p: sum over the entries of M that depend on q, the symmetric
 // pairs once with the factor 2.
 static void kinetic_closed(Model *mod, const int *v, int *g) {
   Dag *d = mod->dag;
-  int m = mod->m;
+  int m = mod->m, w;
   for (int i = 0; i < m; i++) g[i] = dag_const(d, 0);
   for (int a = 0; a < m; a++)
     for (int b = a; b < m; b++) {
-      int x = mod->mass_q[(size_t)a * m + b];
-      if (!(d->nodes[x].flags & DEP_INPUT)) continue;
       SparseVec dx;
-      ad_gradient_sparse(d, x, m, &dx);
-      int w = dag_mul(d, v[a], v[b]);
-      if (a != b) w = dag_add(d, w, w);
+      if (!entry_gradient(mod, d, a, b, v, &dx, &w)) continue;
       for (int e = 0; e < dx.n; e++) g[dx.e[e].coord] = dag_sub(d, g[dx.e[e].coord], dag_mul(d, dx.e[e].node, w));
     }
   for (int i = 0; i < m; i++) g[i] = dag_mul(d, dag_const(d, 0.5), g[i]);
@@ -107,16 +115,13 @@ static void kinetic_closed(Model *mod, const int *v, int *g) {
 // quadratic in v that d/dt (G' M(q)^-1 p) adds to a constant M's (the
 // multiplier consistent with (q, p), step_curvature).
 void mass_q_inertial(const Model *mod, Dag *d, const int *q, const int *v, int *out) {
-  int m = mod->m;
+  int m = mod->m, w;
   for (int i = 0; i < m; i++) out[i] = dag_const(d, 0);
   for (int a = 0; a < m; a++)
     for (int b = a; b < m; b++) {
-      int x = mod->mass_q[(size_t)a * m + b];
-      if (!(d->nodes[x].flags & DEP_INPUT)) continue;
       SparseVec dx;
-      ad_gradient_sparse(d, x, m, &dx);
-      int w = dag_mul(d, v[a], v[b]), along = dag_const(d, 0); /* dM_ab/dt = sum_c dM_ab/dq_c v_c */
-      if (a != b) w = dag_add(d, w, w);
+      if (!entry_gradient(mod, d, a, b, v, &dx, &w)) continue;
+      int along = dag_const(d, 0); /* dM_ab/dt = sum_c dM_ab/dq_c v_c */
       for (int e = 0; e < dx.n; e++) {
         int at;
         dag_subst(d, &dx.e[e].node, 1, q, m, &at);
