@@ -609,8 +609,9 @@ Step *step_build(Model *mod, const Method *me) {
   if (mod->mass_q) { /* M(q): the general-H sweep carries Theta in the input pth */
     if (poly) { /* with constraints: the poly family's multiplier and end of step */
       layout_inputs(st, m, nu, s, s * nu, 0, s * m);
-      mod->mass_at = step_nodes(m);
-      for (int i = 0; i < m; i++) ((int *)mod->mass_at)[i] = step_in(&b, IN_Q0, i);
+      int *at = step_nodes(m); /* minv_apply: M at each kernel's q0 */
+      for (int i = 0; i < m; i++) at[i] = step_in(&b, IN_Q0, i);
+      mod->mass_at = at;
       build_mq_constrained(&b);
     } else {
       layout_inputs(st, m, nu, s, 0, 0, s * m);

@@ -13,7 +13,12 @@
  * Theta, then from gamma and the new Theta the new gamma. Its
  * results are those of the constant family without constraints (gam, dp,
  * theta: the dense output and the estimate read them as they are) and
- * th0, Theta_0, which with theta after it is the whole new Theta. */
+ * th0, Theta_0, which with theta after it is the whole new Theta.
+ *
+ * With constraints (build_mq_constrained) the multiplier is the poly
+ * family's, a polynomial of degree s-1 in the force, with its frozen matrix
+ * (the kernel "factor", with M(q0)) and its end of step, in the M(q1) norm
+ * (the kernel "project_p1"); the sweep adds lam to the results. */
 #include <string.h>
 
 #include "step.h"
