@@ -105,6 +105,7 @@ void emit_mq_predict(Emitter *e);
 void emit_mq_start(Emitter *e);
 void emit_mq_carry(Emitter *e);
 void emit_mq_rescale(Emitter *e);
+void emit_mq_near_rest(Emitter *e); /* with constraints, in emit_end_poly */
 
 /* emit_step.c: NAME_step_within as named blocks */
 void emit_step(Emitter *e);

@@ -58,8 +58,13 @@ void emit_end_poly(Emitter *e) {
     tmpl(e, "  /* the iteration stopped at $P_step_adaptive's tolerance ($P_itol), above round-off:\n"
             "   * while g(q1) is not round-off ($P_GTOL), q1 onto g = 0 by Newton steps ($P_NEWTON at\n"
             "   * most: one, or two from $P_ITOLMAX), and gamma_0 with it, so that $P_dense still\n"
-            "   * starts the step at q0 */\n"
-            "  if (attol) {\n    $R g1[$P_NU], cs[$<consistent>];\n    int n, off;\n"
+            "   * starts the step at q0 */\n");
+    /* M(q): every step, as k = s leaves g(q1) = O(h^(2s+1)) for a g that is not a
+     * polynomial (the four-bar's loop closure; docs/method-mq.md) */
+    tmpl(e, e->mod->mass_q ? "  {  /* M(q): every step, also where k = s leaves g(q1) above round-off */\n"
+                             "    (void)attol;\n"
+                           : "  if (attol) {\n");
+    tmpl(e, "    $R g1[$P_NU], cs[$<consistent>];\n    int n, off;\n"
             "    for (n = 0; n < $P_NEWTON; n++) {\n"
             "      $(g q0=q1 out=g1);\n");
     tmpl(e, e->single ? "      for (off = 0, i = 0; i < $P_NU; i++) off |= !(fabs$f(g1[i]) <= $P_gtol(q1, 1));\n"
@@ -93,6 +98,7 @@ void emit_end_poly(Emitter *e) {
           "  K = pr[$[project_p1.kin]0];\n  U1 = pr[$[project_p1.U]0];\n"
           "  H0 = x->hprev != 0 && fabs$f(Hn - x->H0) <= 64 * $P_TOL * (K + fabs$g(U1)) ? x->H0 : Hn;\n"
           "  if (K > 0 && H0 - U1 > 0) beta = sqrt$g((H0 - U1) / K);\n");
+  if (e->mod->mass_q) emit_mq_near_rest(e); /* emit_mq.c */
   if (wide)
     tmpl(e, "  for (i = 0; i < $P_M; i++) {\n"
             "    p1[i] = beta * (p1[i] + pr[$[project_p1.dp]i]);\n"

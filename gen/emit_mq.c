@@ -42,11 +42,12 @@ void emit_mq_predict(Emitter *e) {
           "    }\n}\n");
 }
 
-// The iteration's Theta, pth, and its warm start.
+// The iteration's Theta, pth, and its warm start (with constraints the
+// poly family's step has declared the contraction test's locals).
 void emit_mq_start(Emitter *e) {
-  tmpl(e, "  $R pth[$P_S * $P_M];  /* M(q): Theta, p's polynomial, carried from sweep to sweep */\n"
-          "  $R inc_old2 = HUGE_VAL, rho;  /* the contraction test ($P_contraction) */\n"
-          "  $P_predict_theta(x, h, cold, pth);\n");
+  tmpl(e, "  $R pth[$P_S * $P_M];  /* M(q): Theta, p's polynomial, carried from sweep to sweep */\n");
+  if (!e->st->kern[K_FACTOR].nout) tmpl(e, "  $R inc_old2 = HUGE_VAL, rho;  /* the contraction test ($P_contraction) */\n");
+  tmpl(e, "  $P_predict_theta(x, h, cold, pth);\n");
 }
 
 // After a sweep (inc already scaled): Theta's increment |h (Theta_new -
@@ -92,4 +93,13 @@ void emit_mq_rescale(Emitter *e) {
           "    x->H0 = H0;\n");
   if (!e->mod->mass_q) tmpl(e, "    x->Hend = $P_energy(x, prm);\n");
   tmpl(e, "  }\n");
+}
+
+// With constraints, after the poly family's beta (emit_end_poly): no rescale
+// near rest, where beta is not within 1e-6 of 1 and H(q1, p1) - H0 is
+// round-off, as emit_mq_rescale does (from rest, s = 2, tol 1e-9: 17 tol of
+// global error without it, 0.3 tol with it; tests/check_mq_fourbar.c).
+void emit_mq_near_rest(Emitter *e) {
+  tmpl(e, "  /* M(q): near rest a round-off in H is a large change of p: corrected only where small */\n"
+          "  if (!(fabs$f(beta - 1) <= 1e-6) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n");
 }

@@ -346,6 +346,9 @@ typedef struct {
   Loc mass_loc;
   int mass_q_closed;
   int *mq_v, *mq_force;
+  /* with constraints, the point (m nodes: a kernel's q0 input) at which
+   * minv_apply takes M(q)^-1 outside the stages; NULL otherwise */
+  const int *mass_at;
   double *q0, *p0;            /* m each, at the default params */
   int *q0n, *p0n;             /* m nodes each: q0, p0 as functions of the params */
   Loc q0_loc, p0_loc, U_loc;  /* U_loc: the U statement, or line 0 */
@@ -391,8 +394,9 @@ void mass_ldl_solve(Dag *d, const SparseVec *L, const int *dinv, int m, const in
 void mass_q_setup(Model *mod, const int *entries, int dense, Loc loc);
 int mass_q_check(Model *mod, const double *prm);   /* M(q0) SPD: 0, or -1 after a located error */
 void mass_q_kinetic(Model *mod);                   /* mod->mq_v, mod->mq_force */
+void mass_q_inertial(const Model *mod, Dag *d, const int *q, const int *v, int *out); /* grad_q T + Mdot v */
 void minv_apply_at(const Model *mod, Dag *d, const int *q, const int *v, int *out); /* M(q)^-1 v */
-int mass_q_refuse(const Model *mod, int newton, int batch, int wide); /* 1 after an error */
+int mass_q_refuse(const Model *mod, int newton, int batch, int wide, int const_mult); /* 1 after an error */
 void mass_q_report(FILE *f, const Model *mod);    /* --check: M's dependence and cost */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);
@@ -454,7 +458,7 @@ typedef struct {
 } Slots;
 
 /* The inputs every kernel takes, in signature order. */
-enum { IN_Q0, IN_P0, IN_GAM, IN_H, IN_G0, IN_LAM, IN_LU, IN_COUNT };
+enum { IN_Q0, IN_P0, IN_GAM, IN_H, IN_G0, IN_LAM, IN_PTH, IN_LU, IN_COUNT };
 
 /* The kernels of a solver, in the order they are printed. */
 typedef enum {

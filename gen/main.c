@@ -759,7 +759,7 @@ int main(int argc, char **argv) {
   switch_warn(mod);
   const char *why = "given with -k";
   /* the family changes nothing without constraints */
-  MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 ? MULT_POLY : MULT_CONST;
+  MultFamily fam = !mod->nu ? MULT_CONST : o.multiplier >= 0 ? (MultFamily)o.multiplier : o.s >= 2 || mod->mass_q ? MULT_POLY : MULT_CONST;
   int rescale = resolve_energy(&o, mod);
   int k = o.k ? o.k : rescale > 0 ? o.s : method_auto_k(o.s, mod->degU, mod->degg, mod->mass_q ? MULT_POLY : fam, &why);
   if (mod->mass_q && !o.k) why = "M depends on q: k = s, the end of the step rescales p to keep H (docs/method-mq.md)";
@@ -771,7 +771,7 @@ int main(int argc, char **argv) {
   IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
   if (rescale < 0) {
     rc = 1;
-  } else if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
+  } else if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step, fam == MULT_CONST)) {
     rc = 1;
   } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "

@@ -229,8 +229,14 @@ static int minv_table(const Model *mod, Dag *d) {
 // v cost no lookup: the columns of a sparse Jacobian are mostly zeros. A
 // dense constant M whose product has mod->mass_loop multiplications or
 // more (nonzeros of M^-1 against those of v) is applied as rows of its table (dag_table_row), which the emitter
-// prints as loops: m^2 operations would be m^2 lines of C.
+// prints as loops: m^2 operations would be m^2 lines of C. An M(q) with
+// constraints is taken at mod->mass_at, the q0 input of the kernel being
+// built (step_build sets it): M(q1) in the projection, M(q0) in the factor.
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out) {
+  if (mod->mass_q && mod->mass_at) { /* M(q) with constraints: M at the kernel's point */
+    minv_apply_at(mod, d, mod->mass_at, v, out);
+    return;
+  }
   if (mod->minv_node) {
     mass_ldl_solve(d, mod->mass_L, mod->minv_node, mod->m, v, out);
     return;

@@ -82,24 +82,55 @@ void minv_apply_at(const Model *mod, Dag *d, const int *q, const int *v, int *ou
   solve_with((Model *)mod, d, a, v, out);
 }
 
+// The sparse gradient dx (in the model's q) of entry (a, b) of M(q) and
+// the weight of the pair in a quadratic form v' X v of a symmetric X,
+// v_a v_b (twice off the diagonal); 0 where the entry does not depend on q.
+static int entry_gradient(const Model *mod, Dag *d, int a, int b, const int *v, SparseVec *dx, int *w) {
+  int x = mod->mass_q[(size_t)a * mod->m + b];
+  if (!(d->nodes[x].flags & DEP_INPUT)) return 0;
+  ad_gradient_sparse(d, x, mod->m, dx);
+  *w = dag_mul(d, v[a], v[b]);
+  if (a != b) *w = dag_add(d, *w, *w);
+  return 1;
+}
+
 // grad_q T = -1/2 v' (dM/dq_i) v in closed form, g[i], for v the m nodes
 // of M^-1 p: sum over the entries of M that depend on q, the symmetric
 // pairs once with the factor 2.
 static void kinetic_closed(Model *mod, const int *v, int *g) {
   Dag *d = mod->dag;
-  int m = mod->m;
+  int m = mod->m, w;
   for (int i = 0; i < m; i++) g[i] = dag_const(d, 0);
   for (int a = 0; a < m; a++)
     for (int b = a; b < m; b++) {
-      int x = mod->mass_q[(size_t)a * m + b];
-      if (!(d->nodes[x].flags & DEP_INPUT)) continue;
       SparseVec dx;
-      ad_gradient_sparse(d, x, m, &dx);
-      int w = dag_mul(d, v[a], v[b]);
-      if (a != b) w = dag_add(d, w, w);
+      if (!entry_gradient(mod, d, a, b, v, &dx, &w)) continue;
       for (int e = 0; e < dx.n; e++) g[dx.e[e].coord] = dag_sub(d, g[dx.e[e].coord], dag_mul(d, dx.e[e].node, w));
     }
   for (int i = 0; i < m; i++) g[i] = dag_mul(d, dag_const(d, 0.5), g[i]);
+}
+
+// out = grad_q T + Mdot v at the point q for the velocity v (m nodes each,
+// a kernel's): -1/2 v' (dM/dq_i) v plus (sum_c dM/dq_c v_c) v, the terms
+// quadratic in v that d/dt (G' M(q)^-1 p) adds to a constant M's (the
+// multiplier consistent with (q, p), step_curvature).
+void mass_q_inertial(const Model *mod, Dag *d, const int *q, const int *v, int *out) {
+  int m = mod->m, w;
+  for (int i = 0; i < m; i++) out[i] = dag_const(d, 0);
+  for (int a = 0; a < m; a++)
+    for (int b = a; b < m; b++) {
+      SparseVec dx;
+      if (!entry_gradient(mod, d, a, b, v, &dx, &w)) continue;
+      int along = dag_const(d, 0); /* dM_ab/dt = sum_c dM_ab/dq_c v_c */
+      for (int e = 0; e < dx.n; e++) {
+        int at;
+        dag_subst(d, &dx.e[e].node, 1, q, m, &at);
+        out[dx.e[e].coord] = dag_sub(d, out[dx.e[e].coord], dag_mul(d, dag_const(d, 0.5), dag_mul(d, at, w)));
+        along = dag_add(d, along, dag_mul(d, at, v[dx.e[e].coord]));
+      }
+      out[a] = dag_add(d, out[a], dag_mul(d, along, v[b]));
+      if (a != b) out[b] = dag_add(d, out[b], dag_mul(d, along, v[a]));
+    }
 }
 
 // Build mod->mq_v = M(q)^-1 p and mod->mq_force = grad_q T + grad U in the
@@ -125,16 +156,17 @@ void mass_q_kinetic(Model *mod) {
   for (int i = 0; i < m; i++) mod->mq_force[i] = dag_add(d, gt[i], mod->gradU[i]);
 }
 
-// What a step with M(q) does not support yet: constraints, --iteration
-// newton, --batch and --wide-step. Reports each at M's statement; returns 1
-// after an error.
-int mass_q_refuse(const Model *mod, int newton, int batch, int wide) {
+// What a step with M(q) does not support yet: --iteration newton, --batch,
+// --wide-step, and with constraints the constant multiplier (--multiplier
+// const: the step is the poly family's). Reports each at M's statement;
+// returns 1 after an error.
+int mass_q_refuse(const Model *mod, int newton, int batch, int wide, int const_mult) {
   if (!mod->mass_q) return 0;
-  const char *what = mod->nu ? "constraints (g)" : newton ? "--iteration newton" : batch ? "--batch" : wide ? "--wide-step" : NULL;
+  const char *what = newton ? "--iteration newton" : batch ? "--batch" : wide ? "--wide-step"
+                     : mod->nu && const_mult ? "--multiplier const (constraints take the poly family's multiplier)" : NULL;
   if (!what) return 0;
-  error_at(mod->mass_loc, "M depends on the coordinates: %s with such an M %s not supported yet "
-           "(docs/method-mq.md); write M constant, in other coordinates, or drop %s",
-           what, mod->nu ? "are" : "is", mod->nu ? "the constraints" : "the option");
+  error_at(mod->mass_loc, "M depends on the coordinates: %s with such an M is not supported yet "
+           "(docs/method-mq.md); write M constant, in other coordinates, or drop the option", what);
   return 1;
 }
 

@@ -373,7 +373,8 @@ static void build_initial_values(Build *b) {
 // The curvature terms hvv[a] = v' Hess(g_a)(q) v for the velocity v (any
 // nodes, v may depend on q): the derivative of w_a(q) = grad g_a(q)' u along
 // u, with u the momentum inputs held constant while differentiating, then
-// u := v.
+// u := v. With M(q) less grad g_a' M(q)^-1 (grad_q T + Mdot v), the rest of
+// what is quadratic in v in d/dt (G' M(q)^-1 p) (mass_q_inertial).
 void step_curvature(Build *b, const int *q, const int *v, int *hvv) {
   Dag *d = b->d;
   Model *mod = b->mod;
@@ -398,6 +399,12 @@ void step_curvature(Build *b, const int *q, const int *v, int *hvv) {
   for (int k = 0; k < first; k++) map[k] = dag_input(d, k);
   memcpy(map + first, v, (size_t)m * sizeof(int));
   dag_subst(d, at_u, nu, map, first + m, hvv);
+  if (!mod->mass_q) return;
+  int *f = step_nodes(m), *mf = step_nodes(m), **G = step_jacobian_at(b, q);
+  mass_q_inertial(mod, d, q, v, f);
+  minv_apply(mod, d, f, mf);
+  for (int a = 0; a < nu; a++)
+    for (int i = 0; i < m; i++) hvv[a] = dag_sub(d, hvv[a], dag_mul(d, G[a][i], mf[i]));
 }
 
 // gmu[a] = grad g_a(q)' M^-1 grad U(q), G the dense columns of grad g at q.
@@ -520,7 +527,7 @@ int kernel_size(const Kernel *k) { return k->nout ? k->out[k->nout - 1].first + 
 
 // Lay out the input blocks: DAG inputs 0..m-1 are the model's coordinates,
 // the kernels' inputs follow in signature order.
-static void layout_inputs(Step *st, int m, int nu, int s, int nlam, int nlu) {
+static void layout_inputs(Step *st, int m, int nu, int s, int nlam, int nlu, int npth) {
   static const struct {
     const char *name;
     SizeSym sym;
@@ -528,9 +535,10 @@ static void layout_inputs(Step *st, int m, int nu, int s, int nlam, int nlu) {
   } spec[IN_COUNT] = {
       [IN_Q0] = {"q0", SZ_M, 0, 0, 0},  [IN_P0] = {"p0", SZ_M, 0, 0, 0},  [IN_GAM] = {"gam", SZ_SM, 0, 0, 0},
       [IN_H] = {"h", SZ_ONE, 1, 1, 1},  [IN_G0] = {"g0", SZ_NU, 0, 1, 0}, [IN_LAM] = {"lam", SZ_SNU, 0, 0, 0},
-      [IN_LU] = {"lu", SZ_ONE, 0, 0, 0},
+      [IN_LU] = {"lu", SZ_ONE, 0, 0, 0},      [IN_PTH] = {"pth", SZ_SM, 0, 0, 0},
   };
-  int len[IN_COUNT] = {[IN_Q0] = m, [IN_P0] = m, [IN_GAM] = s * m, [IN_H] = 1, [IN_G0] = nu, [IN_LAM] = nlam, [IN_LU] = nlu};
+  int len[IN_COUNT] = {[IN_Q0] = m, [IN_P0] = m, [IN_GAM] = s * m, [IN_H] = 1, [IN_G0] = nu, [IN_LAM] = nlam, [IN_LU] = nlu,
+                       [IN_PTH] = npth};
   for (int i = 0, first = m; i < IN_COUNT; i++) {
     Slots *bl = &st->in[i];
     bl->name = spec[i].name;
@@ -593,16 +601,22 @@ Step *step_build(Model *mod, const Method *me) {
     st->kern[k].what = kernel_spec[k].what;
     st->kern[k].wide = kernel_spec[k].wide;
   }
-  layout_inputs(st, m, nu, s, 0, 0);
+  layout_inputs(st, m, nu, s, 0, 0, 0);
   Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL, NULL};
   b.h = step_in(&b, IN_H, 0);
   int poly = me->family == MULT_POLY && nu;
-  if (poly) layout_inputs(st, m, nu, s, s * nu, 0); /* the factor's length is known once it is built */
+  if (poly) layout_inputs(st, m, nu, s, s * nu, 0, 0); /* the factor's length is known once it is built */
   if (mod->mass_q) { /* M(q): the general-H sweep carries Theta in the input pth */
-    layout_inputs(st, m, nu, s, s * m, 0);
-    st->in[IN_LAM].name = "pth";
-    st->in[IN_LAM].sym = SZ_SM;
-    build_mq_sweep(&b);
+    if (poly) { /* with constraints: the poly family's multiplier and end of step */
+      layout_inputs(st, m, nu, s, s * nu, 0, s * m);
+      int *at = step_nodes(m); /* minv_apply: M at each kernel's q0 */
+      for (int i = 0; i < m; i++) at[i] = step_in(&b, IN_Q0, i);
+      mod->mass_at = at;
+      build_mq_constrained(&b);
+    } else {
+      layout_inputs(st, m, nu, s, 0, 0, s * m);
+      build_mq_sweep(&b);
+    }
     build_diagnostics(&b);
     return st;
   }

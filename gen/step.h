@@ -43,7 +43,14 @@ void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, 
 
 void build_const_multiplier(Build *b);
 void build_poly_multiplier(Build *b);
-void build_mq_sweep(Build *b); /* step_mq.c: M(q), no constraints */
+void build_mq_sweep(Build *b);       /* step_mq.c: M(q), no constraints */
+void build_mq_constrained(Build *b); /* step_mq.c: M(q) with constraints */
+/* step_poly.c, shared with build_mq_constrained */
+typedef struct LuFactor LuFactor;
+int ***build_poly_factor(Build *b, LuFactor *in, int *****Rout); /* the kernel "factor", G at the stages */
+int **force_coefficients(Build *b, int ***G, int ****R, const int *lam); /* Theta_j(lambda) */
+int *conditions(Build *b, int ***G, int ****R, const int *gam);         /* C_i at gamma */
+void build_projection(Build *b);                                        /* the kernel "project_p1" */
 
 /* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
  * A[j][r] = sum_i X[j][i] sum_l b_l P_i(c_l) Ihat[l][r] in a real eigenbasis:
@@ -67,11 +74,11 @@ void build_newton(Build *b);
 /* lu.c: linear systems of DAG nodes, solved at generation time in structure */
 void lu_solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag);
 
-typedef struct {
+struct LuFactor {
   int n;
   int *perm;  /* the elimination order */
   int *F;     /* n x n: L's multipliers below the diagonal, U above, 1 / U's pivots on it */
-} LuFactor;
+};
 
 void lu_factor(Dag *d, const int *A, int n, LuFactor *f, int *pivot, int *diag);
 void lu_apply(Dag *d, const LuFactor *f, const int *r, int *x);

@@ -190,7 +190,7 @@ static int *multiplier_matrix(Build *b, int ****R) {
 // lam[r*nu + a] of the multiplier, Lambda_l = sum_r P_r(c_l) lambda_r: from
 // the stage Jacobians G (R NULL), or from their moments R as
 // psi_j + sum_r R_jr lambda_r.
-static int **force_coefficients(Build *b, int ***G, int ****R, const int *lam) {
+int **force_coefficients(Build *b, int ***G, int ****R, const int *lam) {
   Dag *d = b->d;
   const Method *me = b->me;
   int m = b->m, nu = b->nu, s = b->s, z = dag_const(d, 0);
@@ -233,7 +233,7 @@ static int **force_coefficients(Build *b, int ***G, int ****R, const int *lam) {
 // P_j(c_l) gamma_j: from the stage Jacobians G (R NULL), or from their
 // moments as sum_j R_ij[:, a]' gamma_j, which leaves the G_l dead once the
 // moments hold them.
-static int *conditions(Build *b, int ***G, int ****R, const int *gam) {
+int *conditions(Build *b, int ***G, int ****R, const int *gam) {
   Dag *d = b->d;
   const Method *me = b->me;
   int m = b->m, nu = b->nu, s = b->s, z = dag_const(d, 0);
@@ -284,7 +284,7 @@ static long sweep_ops(Build *b, int **theta, const int *lam1) {
 // The kernel "project_p1": at (q, p) = inputs (q0, p0), which the step sets to
 // (q1, p1), the correction dp = -G1 mu onto grad g(q1)' M^-1 p = 0, the
 // kinetic energy after it, U(q1), and the pivots of G1' M^-1 G1.
-static void build_projection(Build *b) {
+void build_projection(Build *b) {
   Dag *d = b->d;
   Model *mod = b->mod;
   int m = b->m, nu = b->nu, z = dag_const(d, 0);
@@ -340,10 +340,11 @@ static void build_projection(Build *b) {
                              " * round-off scale sum_i |dg/dq_i q_i| (NU).";
 }
 
-// The kernels of the polynomial family: "factor" (the frozen multiplier
-// matrix, once per step), "sweep" (with the factor's entries as the input
-// lu) and "project_p1".
-void build_poly_multiplier(Build *b) {
+// The kernel "factor": the multiplier matrix A from grad g at the stages
+// (returned, G[l][a][e]) and their moments (*Rout), factored; its
+// structural nonzeros are the factor's results and the sweep's input lu,
+// in the factor *in. Also for M(q) (step_mq.c), there with M(q0).
+int ***build_poly_factor(Build *b, LuFactor *in, int *****Rout) {
   Dag *d = b->d;
   Step *st = b->st;
   int nu = b->nu, s = b->s, n = s * nu;
@@ -364,12 +365,12 @@ void build_poly_multiplier(Build *b) {
   lu_factor(d, A, n, &f, pivot, adiag);
   /* the factor's structural nonzeros are its results, and the sweep's input lu */
   int nlu = 0, *lu = step_nodes(n * n);
-  LuFactor in = {n, f.perm, step_nodes(n * n)};
+  *in = (LuFactor){n, f.perm, step_nodes(n * n)};
   for (int t = 0; t < n * n; t++) {
-    in.F[t] = f.F[t];
+    in->F[t] = f.F[t];
     if (dag_is_zero(d, f.F[t])) continue;
     lu[nlu] = f.F[t];
-    in.F[t] = dag_input(d, st->in[IN_LU].first + nlu);
+    in->F[t] = dag_input(d, st->in[IN_LU].first + nlu);
     nlu++;
   }
   st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
@@ -378,6 +379,18 @@ void build_poly_multiplier(Build *b) {
   step_result(st, K_FACTOR, "adiag", SZ_SNU, 1, n, adiag);
   st->kern[K_FACTOR].what = "The multiplier matrix A at the predicted stages, factored once per step: out = its\n"
                             " * LU factors (L, U, 1 / pivots), pivots (S*NU), diagonal (S*NU).";
+  *Rout = R;
+  return G;
+}
+
+// The kernels of the polynomial family: "factor" (the frozen multiplier
+// matrix, once per step), "sweep" (with the factor's entries as the input
+// lu) and "project_p1".
+void build_poly_multiplier(Build *b) {
+  Step *st = b->st;
+  int n = b->s * b->nu;
+  LuFactor in;
+  int ****R, ***G = build_poly_factor(b, &in, &R);
   b->owners = 1u << K_SWEEP;
   int *lam = step_nodes(n), *lam1 = step_nodes(n);
   for (int t = 0; t < n; t++) lam[t] = step_in(b, IN_LAM, t);

@@ -40,6 +40,7 @@
 #include "sph_k16s2.h"
 
 Suite *mq_suite(void);
+void mq_fourbar_tests(Suite *s); /* check_mq_fourbar.c: M(q) with constraints */
 
 #define MAXM 3
 
@@ -447,6 +448,8 @@ START_TEST(check_reports_dependence) {
   } c[] = {{"../models/double_pendulum_angles.ham", "M: depends on q (th1, th2)"},
            {"../models/spherical_pendulum.ham", "M: depends on q (th)"},
            {"../models/arm3.ham", "M: depends on q (q2, q3)"},
+           {"../models/fourbar_angles.ham", "M: depends on q (th1, th2)"},
+           {"../models/fourbar_angles.ham", "multiplier: poly (degree 1, projection and energy rescale)"},
            {"../models/pendulum.ham", "M: constant, identity"},
            {"../tests/models/mass_param.ham", "M: with params (constant in q)"}};
   for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
@@ -474,5 +477,6 @@ Suite *mq_suite(void) {
   tcase_add_loop_test(tc, dense_inside_step, 0, 3);
   tcase_add_test(tc, check_reports_dependence);
   suite_add_tcase(s, tc);
+  mq_fourbar_tests(s);
   return s;
 }
