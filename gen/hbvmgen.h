@@ -392,7 +392,7 @@ void mass_q_setup(Model *mod, const int *entries, int dense, Loc loc);
 int mass_q_check(Model *mod, const double *prm);   /* M(q0) SPD: 0, or -1 after a located error */
 void mass_q_kinetic(Model *mod);                   /* mod->mq_v, mod->mq_force */
 void minv_apply_at(const Model *mod, Dag *d, const int *q, const int *v, int *out); /* M(q)^-1 v */
-int mass_q_refuse(const Model *mod, int newton, int batch, int wide); /* 1 after an error */
+int mass_q_refuse(const Model *mod, int newton, int wide); /* 1 after an error */
 void mass_q_report(FILE *f, const Model *mod);    /* --check: M's dependence and cost */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);

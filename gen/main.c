@@ -715,7 +715,7 @@ int main(int argc, char **argv) {
   if (mod->mass_q && !o.k) why = "M depends on q: k = s, the end of the step rescales p to keep H (docs/method-mq.md)";
   char iter_why[512];
   IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
-  if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step)) {
+  if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.wide_step)) {
     rc = 1;
   } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
     error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "

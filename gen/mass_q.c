@@ -126,11 +126,11 @@ void mass_q_kinetic(Model *mod) {
 }
 
 // What a step with M(q) does not support yet: constraints, --iteration
-// newton, --batch and --wide-step. Reports each at M's statement; returns 1
-// after an error.
-int mass_q_refuse(const Model *mod, int newton, int batch, int wide) {
+// newton and --wide-step. Reports each at M's statement; returns 1 after an
+// error.
+int mass_q_refuse(const Model *mod, int newton, int wide) {
   if (!mod->mass_q) return 0;
-  const char *what = mod->nu ? "constraints (g)" : newton ? "--iteration newton" : batch ? "--batch" : wide ? "--wide-step" : NULL;
+  const char *what = mod->nu ? "constraints (g)" : newton ? "--iteration newton" : wide ? "--wide-step" : NULL;
   if (!what) return 0;
   error_at(mod->mass_loc, "M depends on the coordinates: %s with such an M %s not supported yet "
            "(docs/method-mq.md); write M constant, in other coordinates, or drop %s",
