@@ -36,7 +36,7 @@ void emit_batch_mq_predict(Emitter *e) {
           "        for (l = 0; l < $P_W; l++) c[l] = c[l] * r[l] + $P_E[(j * $P_S + i) * $P_S + d];\n"
           "      for (m = 0; m < $P_M; m++)\n        for (l = 0; l < $P_W; l++) {\n"
           "          $R a = pth[(j * $P_M + m) * $P_W + l], t = a + c[l] * prev[(i * $P_M + m) * $P_W + l];\n"
-          "          pth[(j * $P_M + m) * $P_W + l] = (c[l] != 0) & (cold[l] == 0) ? t : a;\n        }\n"
+          "          pth[(j * $P_M + m) * $P_W + l] = ((c[l] != 0) & (cold[l] == 0)) ? t : a;\n        }\n"
           "    }\n}\n\n");
 }
 
@@ -80,7 +80,7 @@ void emit_batch_mq_rescale(Emitter *e) {
           "        $M up = (K > 0) & (H0 - u > 0);\n"
           "        $R b = sqrt$f(up ? (H0 - u) / (K > 0 ? K : 1) : 1);\n"
           "        b = up ? b : 1;\n"
-          "        b = ((fabs$f(b - 1) <= 1e-6) == 0) & (fabs$f(H0 - u - K) <= tl) ? 1 : b;  /* near rest */\n"
+          "        b = (((fabs$f(b - 1) <= 1e-6) == 0) & (fabs$f(H0 - u - K) <= tl)) ? 1 : b;  /* near rest */\n"
           "        beta[l] = b;\n"
           "        x->H0[l] = cm[l] ? H0 : x->H0[l];\n      }\n"
           "      for (i = 0; i < $P_M; i++)\n        for (l = 0; l < $P_W; l++) {\n"
