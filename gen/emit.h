@@ -7,7 +7,7 @@
  *   emit_solver.c (entry points: emit_check, emit_solver)
  *   emit_step.c, emit_project.c, emit_batch.c
  *   emit_api.c, emit_iterate.c, emit_newton.c, emit_end.c, emit_batch_step.c
- *   emit_estimate.c, emit_predict.c
+ *   emit_estimate.c, emit_predict.c, emit_mq.c, emit_batch_mq.c
  *   emit_choice.c
  *   emit_kernel.c
  * (emit_main.c, the driver, stands apart.) */
@@ -132,5 +132,10 @@ void emit_batch_header(Emitter *e, int lanes);
 void emit_batch_source(Emitter *e, int lanes);
 /* emit_batch_step.c: NAME_batch_step, its lane control as masked loops */
 void emit_batch_step(Emitter *e);
+/* emit_batch_mq.c: what the batch adds for M(q) (Theta in the lanes, the rescale) */
+void emit_batch_mq_predict(Emitter *e);
+void emit_batch_mq_increment(Emitter *e);
+void emit_batch_mq_keep(Emitter *e);
+void emit_batch_mq_rescale(Emitter *e);
 
 #endif

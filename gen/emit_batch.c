@@ -25,6 +25,7 @@ void emit_batch_header(Emitter *e, int lanes) {
           "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W], errprev[$P_W];\n"
           "  $P_real pinc[$P_S * $P_M * $P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
+  else if (e->mod->mass_q) tmpl(e, "  $P_real H0[$P_W];  /* M(q): the energy the step keeps */\n");
   /* idle last: every array before it starts at a multiple of W reals, so a
    * vector of one value's lanes never straddles two cache lines more than
    * the struct's own alignment makes it */
@@ -68,7 +69,7 @@ static void emit_set_get(Emitter *e) {
   for (int get = 0; get < 2; get++) {
     tmpl(e, get ? "void $P_batch_get(const $P_batch *x, int l, $P_state *s)\n{\n  int i;\n"
                 : "void $P_batch_set($P_batch *x, int l, const $P_state *s)\n{\n  int i;\n");
-    for (int f = 0; f < (poly ? 6 : 5); f++)
+    for (int f = 0; f < (poly || e->mod->mass_q ? 6 : 5); f++) /* H0 last */
       out(e, get ? "  s->%s = x->%s[l];\n" : "  x->%s[l] = s->%s;\n", scalar[f], scalar[f]);
     for (int f = 0; f < (poly ? 9 : 8); f++) {
       const char *n = array[f][0];
@@ -211,6 +212,7 @@ void emit_batch_source(Emitter *e, int lanes) {
   emit_set_get(e);
   emit_params_observers(e);
   emit_batch_predict(e);
+  if (e->mod->mass_q) emit_batch_mq_predict(e); /* emit_batch_mq.c */
   emit_batch_step(e);
   e->lanes = 0;
 }

@@ -52,6 +52,7 @@ static void emit_pivots(Emitter *e) {
 // l iterates on with increments that fell by less than 8x, so its factor is
 // refreshed before the next sweep, as in $P_step.
 static void emit_lane_test(Emitter *e, int poly) {
+  int mq = e->mod->mass_q != NULL; /* M(q): Theta in lam, the contraction test (emit_batch_mq.c) */
   tmpl(e, "/* After a sweep: the increment and tests of $P_step in every lane that iterates (act);\n"
           " * a lane that stops gets rc, iters = it and keeps its gamma, so the next sweeps repeat\n"
           " * its last one. Returns the number of lanes that iterate on. */\n"
@@ -60,7 +61,7 @@ static void emit_lane_test(Emitter *e, int poly) {
           "    $R *restrict inc_min, $M *restrict stall, $M *restrict rc, $M *restrict iters");
   tmpl(e, poly ? ",\n    $R *restrict rho, $M *restrict fresh, int *restrict nfresh, int ngo" : ", int ngo");
   tmpl(e, itol_wanted(e) ? ", $R tol, $R *restrict itl)\n{\n" : ")\n{\n");
-  if (!poly) tmpl(e, "  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
+  if (!poly && !mq) tmpl(e, "  (void)incp;  /* for the refresh of a factor, which this family has not */\n");
   tmpl(e, "  $R scale[$P_W], incn[$P_W], nan[$P_W];\n"
           "  $M bad[$P_W], sing[$P_W], ok[$P_W], better[$P_W], noise[$P_W], run[$P_W], nr = 0;  /* nr: a wide sum */\n"
           "  int i, l, nrun;\n  (void)lam;\n"
@@ -87,24 +88,27 @@ static void emit_lane_test(Emitter *e, int poly) {
     tmpl(e, "  for (i = 0; i < $P_NU; i++)\n    for (l = 0; l < $P_W; l++) {\n"
             "      $R piv = sw[($[sweep.pivot]i) * $P_W + l], dia = sw[($[sweep.adiag]i) * $P_W + l];\n"
             "      sing[l] |= isfinite(piv) & isfinite(dia) & ((fabs$f(piv) > $P_SINGTOL * fabs$f(dia)) == 0);\n    }\n");
+  if (mq) emit_batch_mq_increment(e); /* emit_batch_mq.c */
   if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
     tmpl(e, "  if (itl && it == 1)  /* once a step, at the first sweep's scale (a loop of its own: a division) */\n"
             "    for (l = 0; l < $P_W; l++) itl[l] = $P_itol(tol, scale[l]);\n");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
-          "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n"
-          "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
+          "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n");
+  if (mq) tmpl(e, "    in = thi[l] > in ? thi[l] : in;  /* M(q): Theta's increment joins gamma's */\n");
+  tmpl(e, "    bad[l] |= (nan[l] != 0) | !isfinite(in);\n");
   if (itol_wanted(e))
     tmpl(e, "    $R ti = itl ? itl[l] : $P_TOL;  /* the fixed step passes none: its test is $P_TOL's */\n"
             "    $R rh = $P_contraction(in, old, incp[l], it);\n"
             "    ok[l] = (in <= ti) | ((rh < 1) & (in * rh <= ti * (1 - rh)));  /* $P_converged, as masks */\n");
   else
-    tmpl(e, poly ? "    $R rh = $P_contraction(in, old, incp[l], it);\n"
+    tmpl(e, poly || mq ? "    $R rh = $P_contraction(in, old, incp[l], it);\n"
                    "    ok[l] = (in <= $P_TOL) | ((rh < 1) & (in * rh <= $P_TOL * (1 - rh)));\n"
                  : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n");
   if (poly)
     tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* for the factor's refresh (fresh) */\n"
             "    rho[l] = act[l] ? rh : rho[l];  /* for the test of the lanes' Newton steps */\n");
+  else if (mq) tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* the increment before the last ($P_contraction) */\n");
   tmpl(e, "    inc[l] = act[l] ? in : old;\n"
           "    inc_min[l] = (act[l] & better[l]) ? in : inc_min[l];\n  }\n"
           "  for (l = 0; l < $P_W; l++) {\n"
@@ -130,6 +134,7 @@ static void emit_lane_test(Emitter *e, int poly) {
     tmpl(e, "      for (i = 0; i < $P_S * $P_NU; i++)\n        for (l = 0; l < $P_W; l++) {\n"
             "          $R s = sw[($[sweep.lam]i) * $P_W + l], g = lam[i * $P_W + l];\n"
             "          sw[($[sweep.lam]i) * $P_W + l] = keep[l] ? g : s;\n        }\n");
+  if (mq) emit_batch_mq_keep(e); /* emit_batch_mq.c */
   tmpl(e, "    }\n  }\n  return nrun;\n}\n\n");
 }
 
@@ -204,7 +209,9 @@ static void emit_lane_newton(Emitter *e) {
 // over the lanes; every lane computes, only the lanes in cm[] are written.
 static void emit_commit(Emitter *e, int poly, int adaptive) {
   if (!poly) {
-    tmpl(e, "  {\n    $M nf[$P_W], cm[$P_W];\n"
+    tmpl(e, "  {\n    $M nf[$P_W], cm[$P_W];\n");
+    if (e->mod->mass_q) tmpl(e, "    $R Hn[$P_W];  /* H(q0, p0), for the rescale */\n    $(energy_kernel q0=x->q p0=x->p prm=par out=Hn);\n");
+    tmpl(e, ""
             "    for (l = 0; l < $P_W; l++) nf[l] = 0;\n"
             "    for (i = 0; i < $P_M; i++)\n      for (l = 0; l < $P_W; l++)\n"
             "        nf[l] |= !isfinite(x->q[i * $P_W + l] + h * sw[($[sweep.gam]i) * $P_W + l]) |\n"
@@ -220,6 +227,7 @@ static void emit_commit(Emitter *e, int poly, int adaptive) {
             "        x->p[i * $P_W + l] = cm[l] ? p : x->p[i * $P_W + l];\n        x->pc[i * $P_W + l] = cm[l] ? pc : x->pc[i * $P_W + l];\n      }\n"
             "    for (i = 0; i < $P_NU; i++)\n      for (l = 0; l < $P_W; l++)\n"
             "        x->lambda[i * $P_W + l] = cm[l] ? sw[($[sweep.lambda]i) * $P_W + l] : x->lambda[i * $P_W + l];\n");
+    if (e->mod->mass_q) emit_batch_mq_rescale(e); /* emit_batch_mq.c */
     emit_commit_common(e);
     return;
   }
@@ -412,7 +420,7 @@ static void emit_batch_adaptive(Emitter *e) {
 // -1 when a lane is over its tolerance, -2 when one failed. The fixed step
 // is printed without them, so that nothing of them costs it a cycle.
 static void emit_step_body(Emitter *e, int adaptive) {
-  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu;
+  int poly = e->st->kern[K_FACTOR].nout > 0, nu = e->mod->nu, mq = e->mod->mass_q != NULL;
   if (adaptive)
     tmpl(e, "/* One try of $P_batch_step_adaptive: $P_batch_step with the tests of $P_step_within at tol\n"
             " * > 0; -1 (a lane over tol) or -2 (a lane failed) with no lane written. cold: every lane\n"
@@ -430,6 +438,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
           "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
+  if (mq) tmpl(e, "  $R *pin = in + ($[sweep.th0]0) * $P_W;  /* M(q): the Theta the sweep reads (emit_batch_mq.c) */\n");
   if (poly)
     tmpl(e, "  $R *lin = in + ($[sweep.lam]0) * $P_W;  /* the multiplier the sweep reads */\n"
             "  $R rho[$P_W];  /* each lane's contraction at its last test ($P_contraction) */\n"
@@ -451,6 +460,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
   tmpl(e, !adaptive ? "  $P_batch_predict(x, h, 0, par, in, 0, 0);\n"
           : poly    ? "  $P_batch_predict(x, h, cold, par, in, ref, two);\n"
                     : "  $P_batch_predict(x, h, cold, par, in, 0, two);\n");
+  if (mq) tmpl(e, adaptive ? "  $P_batch_predict_theta(x, h, cold, pin);\n" : "  $P_batch_predict_theta(x, h, 0, pin);\n");
   if (nu) {
     tmpl(e, "  $R g0[$P_NU * $P_W];\n  $(g q0=x->q p0=x->p prm=par out=g0);\n");
     tmpl(e, e->single ? "  for (l = 0; l < $P_W; l++) {  /* (float: the threshold grows with g's round-off) */\n"
@@ -466,7 +476,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
             "  $P_batch_pivots(fa, go, rc);\n");
   char call[160];
   snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=in h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
-           poly ? " lam=lin lu=fa" : "");
+           poly ? " lam=lin lu=fa" : mq ? " pth=pin" : "");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n"
           "    act[l] = go[l];\n    nrun += (int)go[l];\n");
   tmpl(e, adaptive ? "    early |= (rc[l] != $P_OK) & !go[l];\n  }\n"
@@ -493,10 +503,12 @@ static void emit_step_body(Emitter *e, int adaptive) {
     tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, in, ref, two, go, cl, d1, est, rc)) {\n"
             "      tried = -1;\n      goto out;\n    }\n");
   tmpl(e, poly ? "    nrun = $P_batch_test(x, h, it, sw, in, lin, go, act, inc, incp, inc_min, stall, rc, iters, rho, fresh, &nfresh, ngo"
-               : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo");
+               : mq ? "    nrun = $P_batch_test(x, h, it, sw, in, pin, go, act, inc, incp, inc_min, stall, rc, iters, ngo"
+                    : "    nrun = $P_batch_test(x, h, it, sw, in, 0, go, act, inc, incp, inc_min, stall, rc, iters, ngo");
   tmpl(e, !itol_wanted(e) ? ");\n" : adaptive ? ", tol, itl);\n" : ", 0, 0);\n");
   tmpl(e, "    {  /* this sweep's results are the next one's input */\n      $R *t = in;\n      in = sw;\n      sw = t;\n    }\n");
   if (poly) tmpl(e, "    lin = in + ($[sweep.lam]0) * $P_W;\n");
+  if (mq) tmpl(e, "    pin = in + ($[sweep.th0]0) * $P_W;\n");
   tmpl(e, "  }\n  sw = in;  /* the last sweep's results */\n"
           "  $R nan[$P_W];  /* the rest of p's polynomial finite, as in $P_step (see $P_batch_test) */\n"
           "  for (l = 0; l < $P_W; l++) nan[l] = 0;\n"

@@ -1,5 +1,6 @@
 /* check_batch.c - hbvmgen --batch W: every lane of NAME_batch_step is bitwise
- * NAME_step from the same state, for both multiplier families, float and
+ * NAME_step from the same state, for both multiplier families and a mass
+ * matrix M(q) (its Theta carried in the lanes, p1 rescaled), float and
  * double, with params per lane, lanes that fail (left byte-identical while
  * the others advance) and idle lanes (tests/models/LIST, the b* solvers);
  * every lane of an accepted NAME_batch_step_adaptive is NAME_step_adaptive's
@@ -13,6 +14,10 @@
 #include "bconst_k2s2.h"
 #include "bfloat_k2s2.h"
 #include "bfloatpoly_k2s2.h"
+#include "barm_k3s3.h"
+#include "barmk_k18s3.h"
+#include "bdpa_k2s2.h"
+#include "bdpafloat_k2s2.h"
 #include "bkepler_k16s2.h"
 #include "bmass_k2s2.h"
 #include "bdense_k2s2.h"
@@ -25,12 +30,14 @@
 
 /* Lane l starts from the model's initial values after l scalar steps of
  * h (1 + l / 8), so the lanes differ in state and in the previous step (lane
- * 0 has none); the last lane's momenta are then made 1e4 times larger
- * (without constraints: q 1e6 times smaller), a step that cannot converge, and lane 1 is idle for the first steps. NSTEP
- * batch steps of h, then NSTEP of 1.5 h, each compared lane by lane with
- * NAME_step: the code, the iterations and the state's bytes. With params,
- * each lane's first param is scaled by 1 + l / 4. */
-#define BATCH_TEST(P, HSTEP, NSTEP)                                                                      \
+ * 0 has none); the last lane's momenta are then made 1e4 times larger (with
+ * LARGE_P; else q 1e6 times smaller), a step that cannot converge, and lane
+ * 1 is idle for the first steps. NSTEP batch steps of h, then NSTEP of 1.5 h,
+ * each compared lane by lane with NAME_step: the code, the iterations and the
+ * state's bytes. With params, each lane's first param is scaled by 1 + l / 4.
+ * BATCH_TEST: LARGE_P with constraints (Kepler's small q: near the singularity). */
+#define BATCH_TEST(P, HSTEP, NSTEP) BATCH_TEST_FAIL(P, HSTEP, NSTEP, P##_NU)
+#define BATCH_TEST_FAIL(P, HSTEP, NSTEP, LARGE_P)                                                        \
   START_TEST(test_##P) {                                                                             \
     P##_batch b;                                                                                     \
     P##_state s[P##_W], y;                                                                           \
@@ -48,7 +55,7 @@
       for (n = 0; n < l; n++) ck_assert_int_eq(P##_step(&s[l], (P##_real)((HSTEP) * (1 + l / 8.0)), &prm[l], NULL), 0); \
       if (l == P##_W - 1 && l > 0)                                                                   \
         for (i = 0; i < P##_M; i++) {                                                                \
-          if (P##_NU) s[l].p[i] = s[l].p[i] * 1e4f + 1e3f;                                           \
+          if (LARGE_P) s[l].p[i] = s[l].p[i] * 1e4f + 1e3f;                                         \
           else s[l].q[i] *= 1e-6f; /* Kepler: near the singularity */                              \
         }                                                                                            \
       P##_batch_set(&b, l, &s[l]);                                                                   \
@@ -102,6 +109,11 @@ BATCH_TEST(bdense_k2s2, 0.005, 8)
 BATCH_TEST(bloop_k16s2, 0.03, 12)
 BATCH_TEST(bswing_k6s2, 0.02, 12)
 BATCH_TEST(bplain_k3s3, 0.1, 12)
+/* M(q): from rest, the failing lane with momenta of 1e3 */
+BATCH_TEST_FAIL(bdpa_k2s2, 0.05, 12, 1)
+BATCH_TEST_FAIL(bdpafloat_k2s2, 0.05, 12, 1)
+BATCH_TEST_FAIL(barm_k3s3, 0.05, 12, 1)
+BATCH_TEST_FAIL(barmk_k18s3, 0.05, 8, 1) /* the sweep in parts: the lane test's own reductions */
 
 /* NAME_batch_step_adaptive, lanes sharing h: from the model's initial values
  * with lane l's momenta scaled by 1 + l / 16 (lane 1 idle), NSTEP steps at
@@ -111,8 +123,10 @@ BATCH_TEST(bplain_k3s3, 0.1, 12)
  * (when the batch's try was not a cold one, after three rejections); the
  * idle lane is untouched; H stays at round-off where the family restores it.
  * Then a lane that cannot step (q NaN): every active lane fails, none is
- * written. */
-#define ADAPTIVE_TEST(P, H0, TOL, NSTEP)                                                                   \
+ * written. ADAPTIVE_TEST_MQ, for M(q) from rest: lane l's coordinates are
+ * scaled by 1 + l / 16 too, and H stays at round-off (the rescale). */
+#define ADAPTIVE_TEST(P, H0, TOL, NSTEP) ADAPTIVE_TEST_MQ(P, H0, TOL, NSTEP, 0)
+#define ADAPTIVE_TEST_MQ(P, H0, TOL, NSTEP, MQ)                                                          \
   START_TEST(test_adaptive_##P) {                                                                      \
     P##_batch b, c;                                                                                    \
     P##_state s[P##_W], y, z;                                                                          \
@@ -126,7 +140,7 @@ BATCH_TEST(bplain_k3s3, 0.1, 12)
       P##_params_default(&prm[l]);                                                                     \
       P##_init_params(&s[l], NULL, NULL, &prm[l]);                                                     \
       for (i = 0; i < P##_M; i++) {                                                                    \
-        q[i] = s[l].q[i];                                                                              \
+        q[i] = s[l].q[i] * (P##_real)(MQ ? 1 + l / 16.0 : 1);                                          \
         p[i] = s[l].p[i] * (P##_real)(1 + l / 16.0);                                                   \
       }                                                                                                \
       P##_init_params(&s[l], q, p, &prm[l]);                                                           \
@@ -160,7 +174,7 @@ BATCH_TEST(bplain_k3s3, 0.1, 12)
     }                                                                                                  \
     ck_assert_msg(rejected > 0 && hmin < hmax && compared > (NSTEP), #P ": rejected %d, h %g..%g, compared %d", \
                   rejected, (double)hmin, (double)hmax, compared);                                      \
-    if (P##_NU && sizeof(P##_real) == sizeof(double))                                                  \
+    if ((P##_NU || MQ) && sizeof(P##_real) == sizeof(double))                                          \
       for (l = 0; l < P##_W; l++) {                                                                    \
         P##_batch_get(&b, l, &y);                                                                      \
         ck_assert_msg(fabs(P##_energy(&y, &prm[l]) - H[l]) <= 1e-13, #P " lane %d: H moved", l);       \
@@ -180,6 +194,9 @@ ADAPTIVE_TEST(bchain_k2s2, 0.05, 1e-6, 20)
 ADAPTIVE_TEST(bsat_k6s2, 0.5, 1e-6, 20)
 ADAPTIVE_TEST(bsatpoly_k6s2, 0.5, 1e-6, 20)
 ADAPTIVE_TEST(bfloatpoly_k2s2, 0.5, 1e-4, 20)
+ADAPTIVE_TEST_MQ(bdpa_k2s2, 0.5, 1e-8, 30, 1)
+ADAPTIVE_TEST_MQ(barm_k3s3, 0.5, 1e-8, 30, 1)
+ADAPTIVE_TEST_MQ(bdpafloat_k2s2, 0.5, 1e-4, 20, 1)
 
 /* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
 START_TEST(test_defaults_and_idle) {
@@ -249,6 +266,13 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_adaptive_bsat_k6s2);
   tcase_add_test(tc, test_adaptive_bsatpoly_k6s2);
   tcase_add_test(tc, test_adaptive_bfloatpoly_k2s2);
+  tcase_add_test(tc, test_bdpa_k2s2);
+  tcase_add_test(tc, test_bdpafloat_k2s2);
+  tcase_add_test(tc, test_barm_k3s3);
+  tcase_add_test(tc, test_barmk_k18s3);
+  tcase_add_test(tc, test_adaptive_bdpa_k2s2);
+  tcase_add_test(tc, test_adaptive_barm_k3s3);
+  tcase_add_test(tc, test_adaptive_bdpafloat_k2s2);
   suite_add_tcase(s, tc);
   return s;
 }

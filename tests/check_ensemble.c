@@ -1,7 +1,8 @@
 /* check_ensemble.c - the ensemble runner (runtime/ensemble.c): the summary
  * file of --ensemble and --sweep is byte for byte the same for the scalar
- * step and --batch W (W = 1, 3, 4), on 1 and 2 OpenMP threads, and on 1 and
- * 2 MPI ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI);
+ * step and --batch W (W = 1, 3, 4), on 1 and 2 OpenMP threads (also with a
+ * mass matrix M(q): models/double_pendulum_angles.ham), and on 1 and 2 MPI
+ * ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI);
  * a trajectory ends where a single run ends (-T hit exactly, --tol). */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
@@ -195,6 +196,39 @@ START_TEST(test_span_and_tol)
 }
 END_TEST
 
+/* M(q) (models/double_pendulum_angles.ham, k = s = 2): --ensemble with fixed
+ * steps, where one trajectory's steps are retried as halves (a lane that
+ * leaves the batch for the scalar path) and one fails, and --sweep with
+ * adaptive steps: the summary of --batch 4 is the scalar step's, byte for
+ * byte. */
+START_TEST(test_mass_q)
+{
+  static const char mq_rows[] = "th1, th2, p_th1, p_th2\n0.5, -0.3, 0, 0\n1, 0.5, 0.2, 0\n2, -1, 0, 0.5\n"
+                                "0.5, -0.3, 0, 100\n0.5, -0.3, 0, 1e7\n0.1, 0.1, 0, 0\n";
+  static const char *const how[] = {"--ensemble %s -h 0.05 -N 200 --threads 2",
+                                    "--sweep p_th2=0:3:7 --tol 1e-9 -T 5 --threads 2"};
+  char path[256], args[512];
+  snprintf(path, sizeof path, "%s/mq.csv", dir);
+  FILE *f = fopen(path, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs(mq_rows, f);
+  fclose(f);
+  build("dps", "../models/double_pendulum_angles.ham", "-s 2", 0);
+  build("dpb", "../models/double_pendulum_angles.ham", "-s 2 --batch 4", 0);
+  for (int i = 0; i < 2; i++) {
+    snprintf(args, sizeof args, how[i], path);
+    char *one = run("", "dps", args, "m1.csv", i ? 0 : 2), *bat = run("", "dpb", args, "m2.csv", i ? 0 : 2);
+    if (!i) {
+      ck_assert_ptr_nonnull(strstr(one, "\n4,0,")); /* from p_th2 = 100: in halves */
+      ck_assert_ptr_nonnull(strstr(one, "\n5,2,0,")); /* ENONFINITE at the first step */
+      ck_assert_ptr_nonnull(strstr(one, "\n6,0,200,10,"));
+    }
+    ck_assert_msg(!strcmp(one, bat), "%s: --batch 4 differs from the scalar step", args);
+    free(one), free(bat);
+  }
+}
+END_TEST
+
 START_TEST(test_errors)
 {
   char cmd[512];
@@ -321,6 +355,7 @@ Suite *ensemble_suite(void)
   tcase_set_timeout(tc, 300);
   tcase_add_test(tc, test_sweep_and_mpi);
   tcase_add_test(tc, test_span_and_tol);
+  tcase_add_test(tc, test_mass_q);
   tcase_add_test(tc, test_errors);
   tcase_add_test(tc, test_input_file);
   suite_add_tcase(s, tc);

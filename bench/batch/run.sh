@@ -27,9 +27,10 @@ CC=${CC:-gcc}
 FLAGS=${FLAGS:--O2 -march=native -fno-math-errno}
 mkdir -p "$B" "$R"
 
-# model, -k -s, h (the issue's table), steps per trajectory and repetition
+# model, -k -s, h (the issue's table; the double pendulum in angles, M(q): issue 28),
+# steps per trajectory and repetition
 problems="pendulum:2:2:0.025:4000 conical:2:2:0.0444:3000 kepler:16:2:0.031415926535897934:1500
-satellites:6:2:0.05:400 chain8:2:2:0.005:400"
+satellites:6:2:0.05:400 chain8:2:2:0.005:400 double_pendulum_angles:2:2:0.05:2000"
 
 [ "${1:-}" = ensemble ] && problems= # bench/batch/run.sh ensemble: the second part only
 [ -n "$problems" ] && echo "model,k,s,W,compiler,flags,scalar_ns,batch_ns,ratio" > "$R/batch.csv"
