@@ -17,10 +17,10 @@ TOLS=${TOLS:-"1e-6 1e-8 1e-10 1e-12"}
 mkdir -p "$B"
 # name model k s T
 while read -r n m k s T; do
-  [ -x "$B/$n" ] && [ "$B/$n" -nt "$GEN" ] || {
+  if [ -z "$(find "$B/$n" -newer "$GEN" 2>/dev/null)" ]; then # built by an older generator, or not at all
     "$GEN" --main -o "$B" -n "$n" -k "$k" -s "$s" "$m" 2>/dev/null
     cc -O2 -std=c99 -Iruntime -I"$B" "$B/$n.c" "$B/${n}_main.c" runtime/libhbvmrt.a -lm -o "$B/$n"
-  }
+  fi
   for tol in $TOLS; do
     "$B/$n" -h 0.01 -T "$T" --tol "$tol" --every 100000000 --quiet 2>&1 >/dev/null |
       sed -n 's/.*steps=\([0-9]*\) .*steps_rejected=\([0-9]*\).*/\1 \2/p' |
