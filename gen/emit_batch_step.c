@@ -371,7 +371,7 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // any failure, the number of lanes that failed (never the -1, -2 of a try).
 static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rp, pmax, grow = 2, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
+          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rq, rp, pmax, grow = 2, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
           "  if (!(hh != 0 && isfinite(hh))) {  /* every active lane fails: say how many, as below */\n"
           "    $P_batch_within(x, hh, 0, 0, prm, s);\n"
@@ -400,7 +400,7 @@ static void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "        if (x->hprev2[l] != x->hprev2[l0] || x->hprev2[l] == 0) pmax = -1;\n"
           "        if (pmax >= 0 && x->errprev[l] > pmax) pmax = x->errprev[l];\n"
           "        x->errprev[l] = rp;\n      }\n"
-          "      pq = rc >= 0 && pmax > 0 ? pmax * (hh / x->hprev2[l0]) : 0;\n");
+          "      rq = rc >= 0 && pmax > 0 ? pmax : 0;\n      pq = rq > 0 ? rq * (hh / x->hprev2[l0]) : 0;\n");
   emit_step_factor(e);
   tmpl(e, "      if (rc >= 0) {\n        *h = hh * fac;\n        s->rejected = rejected;\n"
           "        return rc;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"

@@ -1080,7 +1080,7 @@ int double_pendulum_const_k4s4_step(double_pendulum_const_k4s4_state *x, double_
 int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x, double_pendulum_const_k4s4_real *h, double_pendulum_const_k4s4_real tol, const double_pendulum_const_k4s4_params *prm, double_pendulum_const_k4s4_stats *st)
 {
   double_pendulum_const_k4s4_stats s;
-  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_const_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_const_k4s4_EBADSTEP;
@@ -1103,11 +1103,14 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
       for (i = 0; i < double_pendulum_const_k4s4_M; i++)
         if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
       err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
-      pq = rc == double_pendulum_const_k4s4_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      /* after two steps: the last one's err^(1/p), and that times hprev (this one) over hprev2 */
+      rq = rc == double_pendulum_const_k4s4_OK && x->hprev2 != 0 ? x->errprev : 0;
+      pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(err);  /* err^(1/3) */
       fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
-      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
+      if (rq < pq && pq <= 2 * rq) pq = rq;
+      if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == double_pendulum_const_k4s4_OK) {

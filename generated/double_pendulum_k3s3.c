@@ -2521,7 +2521,7 @@ int double_pendulum_k3s3_step(double_pendulum_k3s3_state *x, double_pendulum_k3s
 int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pendulum_k3s3_real *h, double_pendulum_k3s3_real tol, const double_pendulum_k3s3_params *prm, double_pendulum_k3s3_stats *st)
 {
   double_pendulum_k3s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k3s3_EBADSTEP;
@@ -2544,11 +2544,14 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
       for (i = 0; i < double_pendulum_k3s3_M; i++)
         if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
       err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
-      pq = rc == double_pendulum_k3s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      /* after two steps: the last one's err^(1/p), and that times hprev (this one) over hprev2 */
+      rq = rc == double_pendulum_k3s3_OK && x->hprev2 != 0 ? x->errprev : 0;
+      pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(sqrt(err));  /* err^(1/6) */
       fac = err > 0 ? 0.81818882300002704 / r : grow;  /* (0.3 / err)^(1/6) */
-      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
+      if (rq < pq && pq <= 2 * rq) pq = rq;
+      if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == double_pendulum_k3s3_OK) {

@@ -384,7 +384,7 @@ int kepler_k1s1_step(kepler_k1s1_state *x, kepler_k1s1_real h, const kepler_k1s1
 int kepler_k1s1_step_adaptive(kepler_k1s1_state *x, kepler_k1s1_real *h, kepler_k1s1_real tol, const kepler_k1s1_params *prm, kepler_k1s1_stats *st)
 {
   kepler_k1s1_stats s;
-  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return kepler_k1s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k1s1_EBADSTEP;
@@ -407,11 +407,14 @@ int kepler_k1s1_step_adaptive(kepler_k1s1_state *x, kepler_k1s1_real *h, kepler_
       for (i = 0; i < kepler_k1s1_M; i++)
         if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
       err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
-      pq = rc == kepler_k1s1_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      /* after two steps: the last one's err^(1/p), and that times hprev (this one) over hprev2 */
+      rq = rc == kepler_k1s1_OK && x->hprev2 != 0 ? x->errprev : 0;
+      pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = sqrt(err);  /* err^(1/2) */
       fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.81 / err)^(1/2) */
-      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
+      if (rq < pq && pq <= 2 * rq) pq = rq;
+      if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == kepler_k1s1_OK) {

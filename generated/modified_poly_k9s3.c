@@ -2322,7 +2322,7 @@ int modified_poly_k9s3_step(modified_poly_k9s3_state *x, modified_poly_k9s3_real
 int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_k9s3_real *h, modified_poly_k9s3_real tol, const modified_poly_k9s3_params *prm, modified_poly_k9s3_stats *st)
 {
   modified_poly_k9s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return modified_poly_k9s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_poly_k9s3_EBADSTEP;
@@ -2345,11 +2345,14 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
       for (i = 0; i < modified_poly_k9s3_M; i++)
         if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
       err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
-      pq = rc == modified_poly_k9s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      /* after two steps: the last one's err^(1/p), and that times hprev (this one) over hprev2 */
+      rq = rc == modified_poly_k9s3_OK && x->hprev2 != 0 ? x->errprev : 0;
+      pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(sqrt(err));  /* err^(1/6) */
       fac = err > 0 ? 0.81818882300002704 / r : grow;  /* (0.3 / err)^(1/6) */
-      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
+      if (rq < pq && pq <= 2 * rq) pq = rq;
+      if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == modified_poly_k9s3_OK) {

@@ -2790,7 +2790,7 @@ int satellites_k6s3_step(satellites_k6s3_state *x, satellites_k6s3_real h, const
 int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real *h, satellites_k6s3_real tol, const satellites_k6s3_params *prm, satellites_k6s3_stats *st)
 {
   satellites_k6s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s3_EBADSTEP;
@@ -2813,11 +2813,14 @@ int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real
       for (i = 0; i < satellites_k6s3_M; i++)
         if (fabs(x->q[i]) > sc) sc = fabs(x->q[i]);
       err = s.err_est / (tol * fabs(hh) * (1 + sc));
-      /* after two steps: hprev (this one) over hprev2, times the last one's err^(1/p) */
-      pq = rc == satellites_k6s3_OK && x->hprev2 != 0 ? x->errprev * (x->hprev / x->hprev2) : 0;
+      /* after two steps: the last one's err^(1/p), and that times hprev (this one) over hprev2 */
+      rq = rc == satellites_k6s3_OK && x->hprev2 != 0 ? x->errprev : 0;
+      pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(err);  /* err^(1/3) */
       fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
-      if (pq > 0 && pq < r) fac *= pq / r;  /* Gustafsson's prediction, where smaller */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
+      if (rq < pq && pq <= 2 * rq) pq = rq;
+      if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == satellites_k6s3_OK) {

@@ -189,6 +189,8 @@ Suite *errest_suite(void) {
 #include "solar_k16s2.h"
 #include "kepler_k3s3.h"
 #include "kepler_k4s4.h"
+#include "kepler_k11s6.h"
+#include "kepler_k18s3.h"
 #include "pendulum_k3s3.h"
 #include "pendulum_poly_k3s3.h"
 #include "satellites_poly_k6s3.h"
@@ -382,15 +384,30 @@ END_TEST
   }
 REJECTION_RUN(double_pendulum_k4s4)
 REJECTION_RUN(solar_k16s2)
+REJECTION_RUN(kepler_k4s4)
+REJECTION_RUN(kepler_k11s6)
+REJECTION_RUN(kepler_k18s3)
 
 // At most 5% of the tries rejected (issue 31, item 3): the solar system
 // (s = 2, |q| up to 40 AU, 20000 days) had 25% at every tol, a rejected try
 // shrinking 2.4x too much (its error read over tol |h| without 1 + max|q|)
 // and the steps growing back into the next rejection; the double pendulum
 // poly (4,4) 9.4% and 6.8% under the standard aim (measured: 0%, 3.8%, 1.1%).
+// Kepler e = 0.6 over ten periods, once an orbit a try rejected on the way to
+// the perihelion, where the error at the same h grows 10-200x in a step, at
+// (11,6) and (18,3) at tol 1e-6 and (4,4) at 1e-10: 5.3%, 8.5%, 5.5% with
+// Gustafsson's prediction alone, 4.1%, 0%, 4.5% with the error's trend
+// (emit_step_factor; measured with this loop).
 START_TEST(adaptive_rejections_under_5_percent)
 {
+  const double T = 20 * 3.141592653589793;
   long rej, n;
+  n = kepler_k11s6_tries(T, 1e-6, &rej);
+  ck_assert_msg(rej * 20 <= n, "kepler (11,6), tol 1e-6: %ld of %ld tries rejected", rej, n);
+  n = kepler_k18s3_tries(T, 1e-6, &rej);
+  ck_assert_msg(rej * 20 <= n, "kepler (18,3), tol 1e-6: %ld of %ld tries rejected", rej, n);
+  n = kepler_k4s4_tries(T, 1e-10, &rej);
+  ck_assert_msg(rej * 20 <= n, "kepler (4,4), tol 1e-10: %ld of %ld tries rejected", rej, n);
   n = solar_k16s2_tries(20000, 1e-10, &rej);
   ck_assert_msg(rej * 20 <= n, "solar (16,2), tol 1e-10: %ld of %ld tries rejected", rej, n);
   for (double tol = 1e-6; tol > 1e-8 / 2; tol /= 100) {
@@ -401,8 +418,12 @@ START_TEST(adaptive_rejections_under_5_percent)
 END_TEST
 
 // NAME_step_controlled: atol = rtol = tol takes NAME_step_adaptive's steps
-// (to the rounding of (tol + tol s) / (1 + s), which the controller carries
-// to 3.5e-6 of t over 76 steps of Kepler); hmax bounds the step tried
+// (to the rounding of (tol + tol s) / (1 + s), which the controller carried
+// to 3.5e-6 of t over 76 steps of Kepler; since the error's trend, a rounding
+// flips which prediction is smaller at step 42 (8e-5 of h), and the trend,
+// which feeds err_{n-1} / err_n back, carries it on: the two grids part by a
+// tenth of a step, 1.3e-2 at t = 10 after 83 steps);
+// hmax bounds the step tried
 // and the one proposed; a bad control is NAME_EBADSTEP with x unchanged.
 START_TEST(adaptive_controls)
 {
@@ -415,7 +436,7 @@ START_TEST(adaptive_controls)
   kepler_k4s4_init(&b, NULL, NULL);
   for (; a.t < T; na++) ck_assert_int_eq(kepler_k4s4_step_adaptive(&a, &ha, 1e-8, NULL, &st), 0);
   for (; b.t < T; nb++) ck_assert_int_eq(kepler_k4s4_step_controlled(&b, &hb, &c, NULL, &st), 0);
-  ck_assert_msg(labs(na - nb) <= 2 && fabs(a.t - b.t) <= 1e-4 * T, "%ld and %ld steps, to t = %.17g and %.17g", na,
+  ck_assert_msg(labs(na - nb) <= 2 && fabs(a.t - b.t) <= 0.2 * st.h, "%ld and %ld steps, to t = %.17g and %.17g", na,
                 nb, a.t, b.t);
   c.hmax = 0.05;
   kepler_k4s4_init(&b, NULL, NULL);
