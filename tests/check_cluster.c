@@ -7,13 +7,15 @@
  *             family and the paper's (const) one;
  *   order     the default family's order 2s = 4 against a tiny-step
  *             reference (the same solver at h / 16);
- *   rolled    --rolled on (each family of the derivatives as runs of one
- *             item: no pair loop yet) against straight-line: the same
- *             trajectory up to the reordering of sums (docs/rolled.md);
- *   choose    what --rolled makes of the pair model as N grows: auto keeps
- *             it straight-line (the rolled C is not shorter), and at N = 16
- *             --rolled on refuses it (the gradient at atom i has a number
- *             of terms that depends on i: docs/rolled.md, "Pair sums").
+ *   rolled    --rolled on (U's pair sum as one double loop over the pairs,
+ *             grad U scattered from it: gen/roll_pair.c) against
+ *             straight-line: the same trajectory up to the reordering of
+ *             sums (docs/rolled.md);
+ *   size      the rolled cluster's C as N grows: the same loops at N = 16
+ *             and 64, only the data grows (bytes, no timing:
+ *             bench/rolled/cluster.sh measures time);
+ *   choose    --rolled auto keeps the cluster of 8 straight-line (below the
+ *             crossover) and rolls the cluster of 32.
  * The suite is cluster_suite(); the project's runner adds it. */
 #include <check.h>
 #include <math.h>
@@ -28,6 +30,7 @@
 #include "side_by_side.h"
 
 Suite *cluster_suite(void);
+static char *cluster_model(int n, int side);
 
 #define CLUSTER_STEPS 4000
 
@@ -97,6 +100,10 @@ END_TEST
  * of the step's largest terms a step, spread by the motion. */
 START_TEST(test_rolled)
 {
+  char *text = cluster_model(4, 2), *src = generate_source(text, "--multiplier const --rolled on");
+  ck_assert_msg(src && strstr(src, "for (c = b + 1; c <= 3; c += 1)"), "the cluster of 4 has no loop over its pairs");
+  free(src);
+  free(text);
   SAME_TRAJECTORY(cluster_rolled_k4s2, cluster_straight_k4s2, 0.02, 1e-9, "cluster 4, rolled vs straight-line");
 }
 END_TEST
@@ -104,27 +111,67 @@ END_TEST
 /* tests/models/cluster4.ham with N molecules on a grid of side L (malloc'd). */
 static char *cluster_model(int n, int side)
 {
+  static const char *const sizes = "\nN  = 4\nL  = 2\n";
   char *text = read_text("models/cluster4.ham"), *at;
   ck_assert_ptr_nonnull(text);
-  at = strstr(text, "\nN  = 4\nL  = 2\n");
+  at = strstr(text, sizes);
   ck_assert_ptr_nonnull(at);
   char *out = malloc(strlen(text) + 32);
   ck_assert_ptr_nonnull(out);
   *at = 0;
-  sprintf(out, "%s\nN  = %d\nL  = %d\n%s", text, n, side, at + strlen("\nN  = 4\nL  = 2\n"));
+  sprintf(out, "%s\nN  = %d\nL  = %d\n%s", text, n, side, at + strlen(sizes));
   free(text);
   return out;
 }
 
+/* The rolled C of the cluster of n molecules (malloc'd). */
+static char *rolled_cluster(int n, int side)
+{
+  char *text = cluster_model(n, side), *src = generate_source(text, "--multiplier const --rolled on");
+  ck_assert_msg(src != NULL, "the cluster of %d was not rolled", n);
+  free(text);
+  return src;
+}
+
+/* How many times needle occurs in s. */
+static int count(const char *s, const char *needle)
+{
+  int n = 0;
+  for (const char *p = strstr(s, needle); p; p = strstr(p + 1, needle)) n++;
+  return n;
+}
+
+/* The pair sum is one run whatever N (measured 46 KB at N = 4, 50 KB at
+ * 16, 82 KB at 128, against 1.5 MB of straight-line C at 16): the loops are
+ * the same at N = 16 and 64, and what grows is q0, p0 and the table tcon:
+ * two %.17g literals (up to 25 bytes each with the separator) and one int a
+ * coordinate, 64 bytes at most (measured 48). */
+START_TEST(test_size)
+{
+  char *a = rolled_cluster(16, 3), *b = rolled_cluster(64, 4);
+  size_t na = strlen(a), nb = strlen(b);
+  double per_coordinate = (double)(nb - na) / (6.0 * (64 - 16));
+  int loops_a = count(a, "for ("), loops_b = count(b, "for (");
+  printf("cluster: rolled, %zu bytes at N = 16, %zu at N = 64 (%.1f a coordinate); %d loops, %d pair loops\n", na, nb,
+         per_coordinate, loops_b, count(b, "for (c = b"));
+  ck_assert_msg(strstr(a, "U's pair sums as 1 runs"), "the pair sum of the cluster of 16 is not one run");
+  ck_assert_msg(loops_a == loops_b, "%d loops at N = 16, %d at N = 64", loops_a, loops_b);
+  ck_assert_msg(per_coordinate <= 64, "the rolled cluster grows by %.1f bytes a coordinate", per_coordinate);
+  free(a);
+  free(b);
+}
+END_TEST
+
 START_TEST(test_choose)
 {
-  char *eight = cluster_model(8, 2), *sixteen = cluster_model(16, 3);
-  char *a = generate_source(eight, "--multiplier const");
+  char *eight = cluster_model(8, 2), *large = cluster_model(32, 4);
+  char *a = generate_source(eight, "--multiplier const"), *b = generate_source(large, "--multiplier const");
   ck_assert_msg(a && !strstr(a, "(rolled)"), "--rolled auto rolled the cluster of 8");
-  ck_assert_ptr_null(generate_source(sixteen, "--multiplier const --rolled on"));
+  ck_assert_msg(b && strstr(b, "(rolled)"), "--rolled auto did not roll the cluster of 32");
   free(a);
+  free(b);
   free(eight);
-  free(sixteen);
+  free(large);
 }
 END_TEST
 
@@ -137,6 +184,7 @@ Suite *cluster_suite(void)
   tcase_add_test(tc, test_conservation);
   tcase_add_test(tc, test_order);
   tcase_add_test(tc, test_rolled);
+  tcase_add_test(tc, test_size);
   tcase_add_test(tc, test_choose);
   suite_add_tcase(s, tc);
   return s;
