@@ -210,6 +210,8 @@ bench/stiff/run.sh || echo "bench: the stiff benchmark failed"
 echo "== the rolled form on chains of N pendula ($(elapsed) s)"
 bench/rolled/run.sh || echo "bench: the rolled-form benchmark failed"
 bench/rolled/ida.sh || echo "bench: the rolled form against IDA (banded) failed"
+echo "== the rolled form on a cluster of N diatomics with a pair potential ($(elapsed) s)"
+bench/rolled/cluster.sh || echo "bench: the rolled cluster benchmark failed"
 
 echo "load after (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg)" >>"$R/machine.txt"
 echo "bench/run.sh: $(elapsed) s" | tee -a "$R/machine.txt"

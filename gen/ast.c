@@ -73,6 +73,7 @@ typedef struct {
   int momenta;       /* lowering an event: p[i] is momentum i */
   int call_depth;    /* summed depths of the bodies of the calls being expanded */
   int noted_error, notes; /* the error the last "in this call" notes follow, and their number */
+  const Ast *ranging; /* the iterator whose range or list is being lowered (see unbound_index) */
   Sym *free_syms;    /* undefined names, reused by define (loops and calls define many) */
   struct Memo **memo; /* the calls expanded, by function and argument nodes (see find_call) */
   int nmemo, memocap;
@@ -266,6 +267,26 @@ static const Loc *defines(const Stmt *st, const char *name) {
   return NULL;
 }
 
+// Report name, when it is the index variable of the iterator whose range is
+// being lowered or of one inside it in the same sum or comprehension (`j in
+// j + 1..N`, `sum(j in i + 1..N, i in 1..N, e)`): its value is not known
+// yet. Returns whether it reported.
+static int unbound_index(Ctx *cx, const char *name, Loc loc) {
+  for (const Ast *it = cx->ranging; it && (it == cx->ranging || it->op == ','); it = it->c) {
+    if (it->kind != cx->ranging->kind) break;
+    if (strcmp(it->name, name)) continue;
+    if (it == cx->ranging)
+      error_at(loc, "index variable '%s' is used in its own range: a bound may use only the index variables before it",
+               name);
+    else
+      error_at(loc, "index variable '%s' is used in a range before it is bound: index variables are bound left to "
+               "right, so write '%s in ...' first (line %d, column %d)", name, name, it->name_loc.line,
+               it->name_loc.col);
+    return 1;
+  }
+  return 0;
+}
+
 // Find the symbol a name refers to in the statement being analysed, or
 // report why there is none: a name defined by this statement is used in
 // its own definition, one defined by a later statement before its
@@ -282,7 +303,7 @@ static Sym *resolve(Ctx *cx, const char *name, Loc loc) {
     }
   if (later)
     error_at(loc, "'%s' is used before its definition (line %d, column %d)", name, later->line, later->col);
-  else
+  else if (!unbound_index(cx, name, loc))
     error_at(loc, "unknown name '%s'", name);
   return NULL;
 }
@@ -535,7 +556,9 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
   cx->work++;
   f->used = 1;
   int caller = cx->stmt, errors = diag_error_count(), node = -1;
+  const Ast *ranging = cx->ranging; /* the body does not see the caller's iterators */
   cx->stmt = f->stmt;
+  cx->ranging = NULL;
   Sym **bound = xmalloc((size_t)nparams * sizeof *bound);
   int nbound = bind_params(cx, f, vals, bound);
   if (nbound == nparams) {
@@ -548,6 +571,7 @@ static int lower_user_call(Ctx *cx, const Ast *e, Sym *f) {
   while (nbound > 0) undefine(cx, bound[--nbound]);
   free(bound);
   cx->stmt = caller;
+  cx->ranging = ranging;
   if (node >= 0) { /* remembered (its arguments into the arena: once per distinct call) */
     Memo *m = arena_alloc(sizeof *m);
     *m = (Memo){f, cx->momenta, node, nparams, arena_alloc((size_t)nparams * sizeof(int) + 1), NULL};
@@ -583,12 +607,15 @@ static int for_range(Ctx *cx, const Ast *at, const Ast *body, RangeFn fn, void *
   long lo = 0, hi = -1;
   Longs vals = {NULL, 0, 0};
   int rc = 0;
+  const Ast *outer = cx->ranging;
+  cx->ranging = at;
   if (!at->b) {
     rc = iterated_list(cx, at->a, &vals);
     hi = vals.n - 1;
   } else if (lower_int(cx, at->a, "a range bound", &lo) < 0 || lower_int(cx, at->b, "a range bound", &hi) < 0) {
     rc = -1;
   }
+  cx->ranging = outer;
   if (rc == 0 && hi - lo + 1 > MAX_WORK - cx->work) {
     error_at(at->loc, "range %ld..%ld has too many terms: sums and lists may expand to at most %ld terms in all", lo,
              hi, MAX_WORK);

@@ -53,6 +53,9 @@ void format_real(const Emitter *e, char *buf, size_t size, double v);
 void tmpl(Emitter *e, const char *text);
 void tmplf(Emitter *e, const char *fmt, ...); /* tmpl of a printf format's result */
 void emit_kernel(Emitter *e, KernelId k);
+/* emit_rolled_pairs.c: $P_roll_NAME(q, v, prm, out) of the rolled form's pair
+ * runs (roll.h): out[0] = U (value), else out[i] = dU/dq_i. */
+void emit_roll_pairs(Emitter *e, const char *name, const char *what, int value);
 void kernel_signature(Emitter *e, const Kernel *k, int part);
 void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, size_t size);
 void emit_tables(Emitter *e);

@@ -212,10 +212,13 @@ static void emit_helpers(Emitter *e) {
   if (r->T) emit_array(e, "int", "tcon", NULL, r->tcon, m * r->T);
   if (!r->gradU_s.affine.zero) emit_family(e, "gradU_affine", "out[i] = dU/dq_i where it is affine in q, else 0", &r->gradU_s.affine, 0);
   if (!r->gradU_s.lin.zero) emit_family(e, "gradU_lin", "out[i] += sum_k d^2U/dq_i dq_k v_k where dU/dq_i is affine", &r->gradU_s.lin, -1);
-  if (!r->gradU_s.curved.zero) emit_family(e, "gradU_curved", "out[i] = dU/dq_i where it is not affine in q, else 0", &r->gradU_s.curved, 0);
-  emit_family(e, "U", "out[0] = U(q), its terms in the order of its sums", &r->U, 1);
+  if (r->pairs) emit_roll_pairs(e, "gradU_curved", "out[i] = dU/dq_i", 0);
+  else if (!r->gradU_s.curved.zero) emit_family(e, "gradU_curved", "out[i] = dU/dq_i where it is not affine in q, else 0", &r->gradU_s.curved, 0);
+  if (r->pairs) emit_roll_pairs(e, "U", "out[0] = U(q)", 1);
+  else emit_family(e, "U", "out[0] = U(q), its terms in the order of its sums", &r->U, 1);
   if (r->nu) {
-    emit_family(e, "gradU", "out[i] = dU/dq_i", &r->gradU, 0);
+    if (r->pairs) emit_roll_pairs(e, "gradU", "out[i] = dU/dq_i", 0);
+    else emit_family(e, "gradU", "out[i] = dU/dq_i", &r->gradU, 0);
     emit_family(e, "g", "out[a] = g_a(q)", &r->g, 0);
     emit_family(e, "hvv", "out[a] = v' Hess(g_a)(q) v", &r->hvv, 0);
     emit_jacobians(e);

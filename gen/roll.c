@@ -243,6 +243,15 @@ static int *coupling(const Model *mod, Roll *r) {
   return jnode;
 }
 
+// grad U scattered from U's pair runs (roll_pair.c): no per-coordinate
+// family; the whole gradient is evaluated at the stages, as curved entries
+// are (exact for affine ones too).
+static void pair_gradient(Roll *r) {
+  static const RollFamily none = {0, NULL, 0, 1};
+  r->gradU = r->gradU_s.affine = r->gradU_s.lin = none;
+  r->gradU_s.curved = (RollFamily){0, NULL, 0, 0};
+}
+
 // The analysis of a model the rolled form covers, or NULL with *why set.
 static Roll *analyse_roll(Model *mod, const char **why) {
   Dag *d = mod->dag;
@@ -257,13 +266,19 @@ static Roll *analyse_roll(Model *mod, const char **why) {
   Walk w = {d, m, NULL, NULL, 0, 0, {0}, {0}, {0}, {0}, {0}};
   int nterms, *terms = potential_terms(d, mod->U, &nterms), bad = 0;
   const char *what = NULL;
-  if (family(&w, &r->gradU, mod->gradU, coord, m)) bad = 1, what = "the gradient of U";
+  int per_coordinate = !family(&w, &r->gradU, mod->gradU, coord, m);
+  if (!per_coordinate || r->gradU.nruns > ROLL_PAIR_TRY_RUNS) { /* a pair sum? (roll_pair.c) */
+    r->pairs = roll_pairs(d, m, mod->U);
+    if (r->pairs && per_coordinate && r->pairs->nruns >= r->gradU.nruns) r->pairs = NULL;
+    if (!r->pairs && !per_coordinate) bad = 1, what = "the gradient of U";
+  }
+  if (r->pairs) pair_gradient(r);
   r->jac = arena_alloc((size_t)(r->T + 1) * sizeof(RollFamily));
   for (int t = 0; t < r->T && !bad; t++) {
     for (int i = 0; i < m; i++) items[i] = jnode[i * r->T + t];
     if (family(&w, &r->jac[t], items, coord, m)) bad = 1, what = "the Jacobian of g";
   }
-  if (!bad && split_family(&w, &r->gradU_s, mod->gradU, coord, m)) bad = 1, what = "the gradient of U";
+  if (!bad && !r->pairs && split_family(&w, &r->gradU_s, mod->gradU, coord, m)) bad = 1, what = "the gradient of U";
   r->jac_s = arena_alloc((size_t)(r->T + 1) * sizeof(RollSplit));
   for (int t = 0; t < r->T && !bad; t++) {
     for (int i = 0; i < m; i++) items[i] = jnode[i * r->T + t];
@@ -276,7 +291,7 @@ static Roll *analyse_roll(Model *mod, const char **why) {
     r->lin |= !r->jac_s[t].lin.zero;
   }
   if (!bad && family(&w, &r->g, mod->g, NULL, nu)) bad = 1, what = "g";
-  if (!bad && family(&w, &r->U, terms, NULL, nterms)) bad = 1, what = "U";
+  if (!bad && !r->pairs && family(&w, &r->U, terms, NULL, nterms)) bad = 1, what = "U";
   if (!bad && family(&w, &r->hvv, hvv, NULL, nu)) bad = 1, what = "the curvature of g";
   free(w.stamp);
   free(w.local);
@@ -311,6 +326,7 @@ static long sweep_ops(const Model *mod, const Step *st) {
 // form shortens them.
 static double compression(const Roll *r) {
   long items = r->gradU.nitems + r->g.nitems, runs = r->gradU.nruns + r->g.nruns;
+  if (r->pairs) items += r->pairs->nitems, runs += r->pairs->nruns;
   for (int t = 0; t < r->T; t++) {
     items += r->jac[t].nitems;
     runs += r->jac[t].nruns;

@@ -15,6 +15,9 @@ enum { ROLL_OFF, ROLL_ON, ROLL_AUTO };
 
 /* A family with more runs than this is not uniform in its index: not rolled. */
 #define ROLL_MAX_RUNS 64
+/* grad U in more runs than this: try U's terms as pair runs (roll_pair.c),
+ * taken when they are fewer runs. */
+#define ROLL_PAIR_TRY_RUNS 8
 /* --rolled auto rolls a model whose straight-line sweep has at least this many
  * operations (docs/rolled.md, "Crossover": measured on the chain). */
 #define ROLL_AUTO_OPS 4000
@@ -49,6 +52,31 @@ typedef struct {
   RollFamily curved;  /* f, the other items */
 } RollSplit;
 
+/* A pair sum of U rolled (roll_pair.c, docs/rolled.md "Pair sums"): a run
+ * of items, each p consecutive terms of U, that is one double loop, b = B0,
+ * B0 + SB, .. B1 and for each b c = b + D, b + D + SC, .. CE. body[] (post-
+ * order, nbody places) is the first item's value and gradient; an input at
+ * place k is q[b + off[k]] (base[k] = 0) or q[c + off[k]] (base[k] = 1); the
+ * item's value is at place value, its gradient entry e at gplace[e], added
+ * to grad U at b + goff[e] or c + goff[e] (gbase[e]). */
+typedef struct {
+  int nitems;
+  int B0, B1, SB, D, CE, SC;
+  int *body, nbody;
+  int *base, *off;
+  int value;
+  int ngrad, *gplace, *gbase, *goff;
+} RollPairRun;
+
+typedef struct {
+  int period, nitems, nruns;
+  RollPairRun *runs;
+} RollPairs;
+
+/* roll_pair.c: the terms of U (node U, m coordinates) as pair runs, or NULL
+ * when they make more than ROLL_MAX_RUNS runs (or cannot be printed). */
+RollPairs *roll_pairs(Dag *d, int m, int U);
+
 /* The analysis emit_rolled.c prints from. Inputs of the families' nodes:
  * slots 0..m-1 are q (the array q), m..2m-1 are the second array (v). */
 typedef struct Roll {
@@ -64,6 +92,7 @@ typedef struct Roll {
   RollSplit *jac_s;   /* T of them: jac, split */
   int curved;         /* some entry is curved: the stages are evaluated */
   int lin;            /* some affine entry is not constant: h (X gamma)_j is needed */
+  RollPairs *pairs;   /* U as pair runs, grad U scattered from them (gradU, gradU_s unused), or NULL */
 } Roll;
 
 /* Decide the form from eo->rolled and set eo->roll (NULL: straight-line).

@@ -549,9 +549,20 @@ START_TEST(test_iterators)
   assert_close(eval(mod, mod->U, q), 2 + 3 + 6 + 100 * (1 + 3), "U");
   mod = load("variables x, y\nU = sum(b in [], x) + x\ng = [x - y * i * j for i in [1, 2] for j in [i]]\nq0 = [1, 1]\n");
   ck_assert_int_eq(mod->nu, 2);
+  /* a pair sum over i < j (the last inner range empty) and its pairs as a
+   * double comprehension: sum_{i<j} i j = (15^2 - 55) / 2 at q = 1..5 */
+  mod = load("variables x[5]\npairs = [10 * i + j for i in 1..5 for j in i + 1..5]\n"
+             "U = sum(i in 1..5, j in i + 1..5, x[i] * x[j]) + 1000 * pairs[10]\n");
+  const double q5[] = {1, 2, 3, 4, 5};
+  assert_close(eval(mod, mod->U, q5), 85 + 1000 * 45, "pair sum");
   static const char *const bad[] = {"variables x\nU = sum(b in [1, x], x)\n", "variables x\nU = sum(b in [1.5], x)\n",
                                      "variables x\nU = sum(b in 2, x)\n",
-                                     "variables x\ng = [x for i in 1..2 for i in 1..2]\n"};
+                                     "variables x\ng = [x for i in 1..2 for i in 1..2]\n",
+                                     /* bounds of a pair sum: an index bound later, its own, a param */
+                                     "variables x[3]\nU = sum(j in i + 1..3, i in 1..2, x[i] * x[j])\n",
+                                     "variables x[3]\nU = sum(i in 1..2, j in j + 1..3, x[i] * x[j])\n",
+                                     "variables x[3]\nparam k = 1\nU = sum(i in 1..2, j in i + k..3, x[i] * x[j])\n",
+                                     "variables x[3]\nU = sum(i in 1..2, j in i + 0.5..3, x[i] * x[j])\n"};
   assert_refused(bad, NCASES(bad));
 }
 END_TEST
