@@ -43,6 +43,8 @@ void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, 
 
 void build_const_multiplier(Build *b);
 void build_poly_multiplier(Build *b);
+int ***poly_stage_jacobians(Build *b);                        /* grad g at the stages: [l][a][entry] */
+int ****poly_jacobian_moments(Build *b, int ***G, int closed); /* R_jr = sum_l b_l P_j P_r G_l: [j][r][a][entry] */
 void build_mq_sweep(Build *b); /* step_mq.c: M(q), no constraints */
 
 /* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
