@@ -23,7 +23,11 @@
  * Two kernels: "newton_factor" (J at the midpoint of the step's current
  * polynomial, the blocks' LU factors, their pivots) and "newton_solve"
  * (the correction dgam = (I + h^2 A (x) M^-1 J)^-1 r for the residual r,
- * passed as the input gam, with the factor's entries as the input lu). */
+ * passed as the input gam, with the factor's entries as the input lu).
+ * With constraints the multiplier is eliminated from the correction by a
+ * Schur complement (build_schur): the constant family's nu values, or the
+ * poly family's s nu Legendre coefficients, whose columns are the moments
+ * R_jr of step_poly.c (MultCols). */
 #include <complex.h>
 #include <math.h>
 #include <string.h>
@@ -509,7 +513,11 @@ static void build_factor(Build *b, const NewtonBasis *nb, NewtonFactor *nf) {
     step_result(st, K_NFACTOR, "sadiag", sym, 1, nc, sadiag);
   }
   st->kern[K_NFACTOR].what =
-      nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam' g) at the midpoint of the step's\n"
+      nc > nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam_0' g) at the midpoint of the step's\n"
+                " * polynomial gam, as the blocks of A's eigenbasis, factored, with the polynomial multiplier's\n"
+                " * columns W = N^-1 V and the Schur complement S = C W: out = the factors, W, C and S's factor\n"
+                " * (what newton_solve reads as lu), pivots (S*M), diagonal (S*M), S's pivots (S*NU), diagonal (S*NU)."
+      : nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam' g) at the midpoint of the step's\n"
            " * polynomial gam, as the blocks of A's eigenbasis, factored, with the multiplier's columns\n"
            " * W = N^-1 V and the Schur complement S = C W: out = the factors, W, C and S's factor (what\n"
            " * newton_solve reads as lu), pivots (S*M), diagonal (S*M), S's pivots (NU), diagonal (NU)."
@@ -544,16 +552,21 @@ static void build_solve(Build *b, const NewtonBasis *nb, const NewtonFactor *nf)
     for (int c = 0; c < nc; c++) mu[c] = dag_div(d, mu[c], b->h);
     step_result(b->st, K_NSOLVE, "dlam", SZ_SNU, 1, nc, mu);
   }
-  b->st->kern[K_NSOLVE].what = nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+  b->st->kern[K_NSOLVE].what = nc > nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+                                         " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M),\n"
+                                         " * and the multiplier's coefficients' change mu / h (S*NU)."
+                              : nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
                                     " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M)."
                                   : "The Newton correction for the residual r = (new gamma) - gamma given as gam, with the\n"
                                     " * factors lu of newton_factor: out = (I + h^2 A (x) M^-1 J)^-1 r (S*M).";
 }
 
 // The kernels of --iteration newton (after the sweep: it reuses the sweep's
-// inputs, and its input lu is laid out last). With constraints (the
-// constant family only) the input lam (S*NU, of which the first NU are
-// read: the multiplier in J) is laid out before lu.
+// inputs, and its input lu is laid out last). With constraints in the
+// constant family the input lam (S*NU, of which the first NU are read: the
+// multiplier in J) is laid out before lu; the poly family's sweep has both
+// already (lam its coefficients, lu the slots its factor shares with
+// newton_factor's, each kernel called with its own array).
 void build_newton(Build *b) {
   NewtonBasis nb;
   NewtonFactor nf;
