@@ -123,6 +123,7 @@ void emit_newton_helpers(Emitter *e);
 void emit_newton_iteration(Emitter *e);
 void emit_newton_stats(Emitter *e);
 int emit_is_auto(const Emitter *e);
+int emit_has_sweeps(const Emitter *e); /* the fixed-point loop is emitted (not --iteration newton) */
 const char *emit_iteration_name(const Emitter *e);
 void emit_auto_iteration(Emitter *e);
 void emit_auto_slow(Emitter *e);

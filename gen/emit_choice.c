@@ -25,7 +25,7 @@ int mult_err_wanted(const Emitter *e) { return step_order(e) < 2 * e->me->s; }
 // H (the rescale) and the hidden constraint (the projection) whatever the
 // iteration left, and g with Newton steps (emit_end_poly); not under
 // --wide-step, whose iteration is in the wider type.
-int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e->wide_step; }
+int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e->wide_step && emit_has_sweeps(e); }
 
 // Whether the constant family's end of the step rescales p1 to the run's
 // energy H0 (emit_mq_rescale): always with M(q), whose H no k integrates

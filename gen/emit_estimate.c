@@ -253,7 +253,7 @@ void emit_estimators(Emitter *e) {
   emit_err_est(e);
   if (energy_defect_wanted(e)) emit_defect(e);
   emit_tolc(e);
-  if (e->st->kern[K_FACTOR].nout || energy_rescale_wanted(e)) emit_contraction(e);
+  if ((e->st->kern[K_FACTOR].nout || energy_rescale_wanted(e)) && emit_has_sweeps(e)) emit_contraction(e);
   if (itol_wanted(e)) emit_itol(e);
   if (mult_err_wanted(e)) emit_mult_err(e);
 }

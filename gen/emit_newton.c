@@ -29,6 +29,10 @@
 
 int emit_is_newton(const Emitter *e) { return e->st->kern[K_NSOLVE].nout > 0; }
 
+// Whether the Newton loop carries the polynomial family's multiplier
+// coefficients (mlam) and its sweep's frozen factor (mfa).
+static int newton_poly(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0; }
+
 // NAME_newton_factor: the kernel "newton_factor" at gam, its pivots checked
 // (with constraints also those of the multiplier's Schur complement, and J
 // takes the multiplier lam).
@@ -48,11 +52,23 @@ static void emit_factor_checked(Emitter *e) {
           "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
           "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ENOCONV;\n  }\n");
   if (nu)
-    tmpl(e, "  for (i = 0; i < $P_NU; i++) {  /* the multiplier's Schur complement */\n"
-            "    $R piv = nf[$[newton_factor.spivot]i], dia = nf[$[newton_factor.sadiag]i];\n"
+    tmpl(e, newton_poly(e) ? "  for (i = 0; i < $P_S * $P_NU; i++) {  /* the multiplier's Schur complement */\n"
+                           : "  for (i = 0; i < $P_NU; i++) {  /* the multiplier's Schur complement */\n");
+  if (nu)
+    tmpl(e, "    $R piv = nf[$[newton_factor.spivot]i], dia = nf[$[newton_factor.sadiag]i];\n"
             "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
             "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ENOCONV;\n  }\n");
   tmpl(e, "  return $P_OK;  /* (a factor not finite elsewhere makes the correction so: ENONFINITE) */\n}\n\n");
+  if (!newton_poly(e)) return;
+  tmpl(e, "/* The poly family's multiplier matrix (its sweep's frozen factor) at the polynomial gam,\n"
+          " * factored into fa. Returns $P_OK, $P_ENONFINITE, or $P_ESINGULAR for a singular matrix. */\n"
+          "static int $P_mult_factor_checked(const $P_state *x, const $R *gam, $R h, const $P_params *prm, $R *fa)\n"
+          "{\n  int j;\n  $(factor q0=x->q gam=gam h=h out=fa);\n"
+          "  for (j = 0; j < $P_S * $P_NU; j++) {\n"
+          "    $R piv = fa[$[factor.pivot]j], dia = fa[$[factor.adiag]j];\n"
+          "    if (!isfinite(piv) || !isfinite(dia)) return $P_ENONFINITE;\n"
+          "    if (!(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) return $P_ESINGULAR;\n  }\n"
+          "  return $P_OK;\n}\n\n");
 }
 
 // What NAME_step_within needs before its body: the checked factorisation,
@@ -74,7 +90,13 @@ void emit_newton_helpers(Emitter *e) {
 // declared (emit_newton_locals), rc NAME_ENOCONV and inc, inc_min, stall as
 // the step's head sets them.
 static void emit_newton_loop(Emitter *e) {
-  int nu = e->mod->nu;
+  int nu = e->mod->nu, poly = newton_poly(e);
+  if (poly)
+    tmpl(e, "  /* the poly family: its multiplier's coefficients from 0, the sweep's frozen factor of\n"
+            "   * the multiplier matrix at the predicted stages (again with each fresh Newton matrix) */\n"
+            "  for (i = 0; i < $P_S * $P_NU; i++) mlam[i] = 0;\n"
+            "  rc = $P_mult_factor_checked(x, gam, h, prm, mfa);\n"
+            "  if (rc != $P_OK) return rc;\n");
   tmpl(e, "  rate = 0;\n"
           "  if (x->nfh == h && x->nfrate < $P_REUSE) {\n"
           "    fac = x->nf;  /* the last step's factor, at this h, contracted fast: kept */\n"
@@ -86,17 +108,22 @@ static void emit_newton_loop(Emitter *e) {
           "  }\n"
           "  rc = $P_ENOCONV;\n"
           "  for (it = 1; it <= $P_MAXITER; it++) {\n");
-  tmpl(e, nu ? "    $(sweep q0=x->q p0=x->p gam=gam h=h g0=g0 out=sw);\n" : "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n");
-  if (nu) /* as the fixed-point sweep: a zero pivot makes lambda 0/0 */
+  tmpl(e, poly ? "    $(sweep q0=x->q p0=x->p gam=gam h=h g0=g0 lam=mlam lu=mfa out=sw);\n"
+         : nu ? "    $(sweep q0=x->q p0=x->p gam=gam h=h g0=g0 out=sw);\n"
+              : "    $(sweep q0=x->q p0=x->p gam=gam h=h out=sw);\n");
+  if (poly)
+    tmpl(e, "    for (i = 0; i < $<sweep.theta>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+  else if (nu) /* as the fixed-point sweep: a zero pivot makes lambda 0/0 */
     tmpl(e, "    for (i = 0; i < $P_NU; i++) {\n"
             "      $R piv = sw[$[sweep.pivot]i], dia = sw[$[sweep.adiag]i];\n"
             "      if (isfinite(piv) && isfinite(dia) && !(fabs$f(piv) > $P_SINGTOL * fabs$f(dia))) rc = $P_ESINGULAR;\n"
             "    }\n"
             "    if (rc == $P_ESINGULAR) break;\n");
-  tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n"
-          "    if (rc == $P_ENONFINITE) break;\n"
-          "    for (i = 0; i < $P_S * $P_M; i++) res[i] = sw[$[sweep.gam]i] - gam[i];\n"
-          "    $(newton_solve gam=res lu=fac out=dg);\n"
+  if (!poly) tmpl(e, "    for (i = 0; i < $<sweep.pivot>; i++)\n      if (!isfinite(sw[i])) rc = $P_ENONFINITE;\n");
+  tmpl(e, "    if (rc == $P_ENONFINITE) break;\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) res[i] = sw[$[sweep.gam]i] - gam[i];\n");
+  tmpl(e, poly ? "    $(newton_solve gam=res h=h lu=fac out=dg);\n" : "    $(newton_solve gam=res lu=fac out=dg);\n");
+  tmpl(e, ""
           "    /* increment: max |h dgamma| over max |q| + |h gamma_0| */\n"
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
           "    for (i = 0; i < $P_M; i++) {\n"
@@ -116,15 +143,20 @@ static void emit_newton_loop(Emitter *e) {
           "     * round-off ($P_NOISETOL) */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n"
-          "    for (i = 0; i < $P_S * $P_M; i++) gam[i] += dg[i];\n"
-          "    /* contracting by less than 2x (rho > 1/2) above round-off: J refreshed at the\n"
+          "    for (i = 0; i < $P_S * $P_M; i++) gam[i] += dg[i];\n");
+  if (poly)
+    tmpl(e, "    /* the coefficients the sweep took, moved by Newton's change of the multiplier */\n"
+            "    for (i = 0; i < $P_S * $P_NU; i++) mlam[i] = sw[$[sweep.lam]i] + dg[$[newton_solve.dlam]i];\n");
+  tmpl(e, "    /* contracting by less than 2x (rho > 1/2) above round-off: J refreshed at the\n"
           "     * current polynomial */\n"
           "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n");
-  tmpl(e, nu ? "      int rf = $P_newton_factor_checked(x, gam, sw + $[sweep.lambda]0, h, prm, nf);  /* the last lambda */\n"
-             : "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
+  tmpl(e, poly ? "      int rf = $P_newton_factor_checked(x, gam, mlam, h, prm, nf);  /* lambda_0: the mean */\n"
+         : nu ? "      int rf = $P_newton_factor_checked(x, gam, sw + $[sweep.lambda]0, h, prm, nf);  /* the last lambda */\n"
+              : "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
   tmpl(e, "      fac = nf;\n      nfac++;\n"
-          "      if (rf != $P_OK) { rc = rf; break; }\n"
-          "    }\n  }\n"
+          "      if (rf != $P_OK) { rc = rf; break; }\n");
+  if (poly) tmpl(e, "      if ((rf = $P_mult_factor_checked(x, gam, h, prm, mfa)) != $P_OK) { rc = rf; break; }\n");
+  tmpl(e, "    }\n  }\n"
           "  /* the step is the one at the gamma the sweep was evaluated at */\n"
           "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n");
 }
@@ -132,7 +164,12 @@ static void emit_newton_loop(Emitter *e) {
 // The Newton iteration's locals, and its counts in the stats zeroed (a
 // step may return before it writes them). rate < 0: Newton did not run.
 static void emit_newton_locals(Emitter *e) {
-  tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
+  if (newton_poly(e)) /* (dg: the correction of gamma, then of the multiplier's coefficients) */
+    tmpl(e, "  $R mfa[$<factor> + 1], mlam[$P_S * $P_NU];  /* the poly family's sweep: its factor, lam */\n"
+            "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$<newton_solve>], rate = -1;\n");
+  else
+    tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n");
+  tmpl(e, ""
           "  const $R *fac = nf;  /* the factor in use: nf, or the state's */\n"
           "  int nfac = 0;\n"
           "  if (st) st->newton = st->factors = st->jacobians = 0;\n");
@@ -155,6 +192,8 @@ void emit_newton_iteration(Emitter *e) {
 }
 
 int emit_is_auto(const Emitter *e) { return e->me->iteration == ITER_AUTO; }
+
+int emit_has_sweeps(const Emitter *e) { return !emit_is_newton(e) || emit_is_auto(e); }
 
 // What NAME_ENOCONV says did not converge.
 const char *emit_iteration_name(const Emitter *e) {

@@ -64,7 +64,7 @@ static void emit_step_head(Emitter *e) {
           "  $R inc = HUGE_VAL, inc_old, inc_min = HUGE_VAL, scale = 0, d1 = 0, est;\n"
           "  int it, i, stall = 0, rc = $P_ENOCONV;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  if (!(h != 0 && isfinite(h))) return $P_EBADSTEP;\n");
-  if (poly) tmpl(e, "  $R ref[$P_S * $P_M], inc_old2 = HUGE_VAL, rho;\n  int two;\n");
+  if (poly && emit_has_sweeps(e)) tmpl(e, "  $R ref[$P_S * $P_M], inc_old2 = HUGE_VAL, rho;\n  int two;\n");
   if (itol_wanted(e))
     tmpl(e, "  $R tit = $P_TOL;  /* where the iteration stops ($P_itol) */\n"
             "  int attol = 0;  /* it stopped there, above round-off */\n");
@@ -84,7 +84,9 @@ static void emit_step_predict(Emitter *e) {
             "  for (i = 0; i < $P_M; i++) {\n"
             "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
             "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
-  } else
+  } else if (poly && !emit_has_sweeps(e)) /* (Newton's d1 is its first correction) */
+    tmpl(e, "  $P_predict(x, h, cold, prm, gam, 0);\n");
+  else
     tmpl(e, poly ? "  two = $P_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */\n"
                  : "  $P_predict(x, h, cold, prm, gam);\n");
   if (!e->mod->nu) return;

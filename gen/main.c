@@ -60,9 +60,8 @@ static const char usage[] =
     "                with the Hessian of U (+ lambda' g), for stiff models and long steps;\n"
     "                auto (default): fixed's code for a model that is not stiff at q0\n"
     "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
-    "                where they are slow (--check says which). Newton: with constraints\n"
-    "                only with --multiplier const; not with --batch or --wide-step\n"
-    "                (docs/method-newton.md)\n";
+    "                where they are slow (--check says which). Newton: in both multiplier\n"
+    "                families; not with --batch or --wide-step (docs/method-newton.md)\n";
 
 /* (the rest of the usage, apart: a C99 compiler need not take a string over 4095 bytes) */
 static const char usage_more[] =
@@ -674,7 +673,7 @@ static void report_degree(const Model *mod, int s, int k) {
 // default) ITER_AUTO (sweeps first, Newton where they are slow) for a stiff
 // model where Newton can be emitted, else ITER_FIXED, today's code. why
 // receives --check's line (after "iteration: ").
-static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily fam, char *why, size_t n) {
+static IterKind resolve_iteration(const Options *o, const Model *mod, char *why, size_t n) {
   if (o->iteration == ITER_FIXED) {
     snprintf(why, n, "fixed (fixed-point sweeps, given with --iteration fixed)");
     return ITER_FIXED;
@@ -682,7 +681,6 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, MultFamily
   if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
   double wf, ws, r = model_stiffness(mod, &wf, &ws);
   const char *no = mod->mass_q                ? "Newton does not handle an M that depends on q"
-                   : mod->nu && fam == MULT_POLY ? "Newton needs --multiplier const with constraints"
                    : o->batch                  ? "Newton is not emitted with --batch"
                    : o->wide_step              ? "Newton is not emitted with --wide-step"
                    : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
@@ -768,15 +766,10 @@ int main(int argc, char **argv) {
                                      : "U is not a polynomial: k = s, the end of the step rescales p to keep H "
                                        "(--energy auto; --energy quadrature for k = 2s+12 without it, docs/method-const.md)";
   char iter_why[512];
-  IterKind iter = resolve_iteration(&o, mod, fam, iter_why, sizeof iter_why);
+  IterKind iter = resolve_iteration(&o, mod, iter_why, sizeof iter_why);
   if (rescale < 0) {
     rc = 1;
   } else if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step, fam == MULT_CONST)) {
-    rc = 1;
-  } else if (o.iteration == ITER_NEWTON && fam == MULT_POLY) {
-    error_at(mod->g_loc[0], "--iteration newton does not handle the poly family's multiplier yet: "
-                            "use --multiplier const (the constant multiplier, order 2 in p with constraints), "
-                            "or --iteration fixed or auto (fixed-point sweeps in the poly family)");
     rc = 1;
   } else if (k > MAX_K) {
     report_degree(mod, o.s, k);

@@ -45,12 +45,14 @@ void build_const_multiplier(Build *b);
 void build_poly_multiplier(Build *b);
 void build_mq_sweep(Build *b);       /* step_mq.c: M(q), no constraints */
 void build_mq_constrained(Build *b); /* step_mq.c: M(q) with constraints */
-/* step_poly.c, shared with build_mq_constrained */
+/* step_poly.c, shared with build_mq_constrained and step_newton.c */
 typedef struct LuFactor LuFactor;
 int ***build_poly_factor(Build *b, LuFactor *in, int *****Rout); /* the kernel "factor", G at the stages */
 int **force_coefficients(Build *b, int ***G, int ****R, const int *lam); /* Theta_j(lambda) */
 int *conditions(Build *b, int ***G, int ****R, const int *gam);         /* C_i at gamma */
 void build_projection(Build *b);                                        /* the kernel "project_p1" */
+int ***poly_stage_jacobians(Build *b);                        /* grad g at the stages: [l][a][entry] */
+int ****poly_jacobian_moments(Build *b, int ***G, int closed); /* R_jr = sum_l b_l P_j P_r G_l: [j][r][a][entry] */
 
 /* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
  * A[j][r] = sum_i X[j][i] sum_l b_l P_i(c_l) Ihat[l][r] in a real eigenbasis:

@@ -23,7 +23,11 @@
  * Two kernels: "newton_factor" (J at the midpoint of the step's current
  * polynomial, the blocks' LU factors, their pivots) and "newton_solve"
  * (the correction dgam = (I + h^2 A (x) M^-1 J)^-1 r for the residual r,
- * passed as the input gam, with the factor's entries as the input lu). */
+ * passed as the input gam, with the factor's entries as the input lu).
+ * With constraints the multiplier is eliminated from the correction by a
+ * Schur complement (build_schur): the constant family's nu values, or the
+ * poly family's s nu Legendre coefficients, whose columns are the moments
+ * R_jr of step_poly.c (MultCols). */
 #include <complex.h>
 #include <math.h>
 #include <string.h>
@@ -289,15 +293,30 @@ static int *block_matrix(Build *b, const NewtonBlock *blk, const int *B, int hh,
   return N;
 }
 
+// The multiplier's unknowns in the Newton correction: nc of them, nu for
+// the constant family, s nu for the polynomial one (c = r nu + a, the
+// layout of its coefficients lam). Column c belongs to constraint con[c]
+// and has s sparse vectors K[c][j] over the entries of jac[con[c]]: the
+// multiplier's force on gamma is V = (X (x) M^-1) K, the conditions it
+// enforces C dgamma = sum_j K[c][j]' dgamma_j (K[a][j] = rho_j[:, a] for
+// the constant family; K[(r,a)][j] = R_jr[:, a], the moments of step_poly.c,
+// for the polynomial one, whose conditions C_i are sum_j R_ij' gamma_j).
+// vK[c][j] = M^-1 K[c][j], dense.
+typedef struct {
+  int nc, *con;
+  int ***K, ***vK;
+} MultCols;
+
 // What newton_solve reads of newton_factor's results, as its input lu: the
-// blocks' factors; with constraints also W = N^-1 V (s m x nu, column a at
-// a s m), the rho_j of the factorisation (s x nu x the entries of jac[a])
-// and the factor of the Schur complement S (nu x nu).
+// blocks' factors; with constraints also W = N^-1 V (s m x nc, column c at
+// c s m), the vectors K of the factorisation (nc x s x the entries of
+// jac[con[c]]) and the factor of the Schur complement S (nc x nc).
 typedef struct {
   LuFactor *blk;
   int *W;
-  int ***rho;
+  int ***K;
   LuFactor S;
+  MultCols mc;
 } NewtonFactor;
 
 // The input of newton_solve standing for the factor's node v: v itself
@@ -357,51 +376,84 @@ static void newton_apply(Build *b, const NewtonBasis *nb, const LuFactor *fac, c
     }
 }
 
-// sum_j rho_j[:, a]' v_j over the entries of jac[a] (rho: s x nu x entries).
-static int rho_dot(Build *b, int ***rho, int a, const int *v) {
+// sum_j K[c][j]' v_j over the entries of jac[con[c]] (K: nc x s x entries).
+static int cols_dot(Build *b, const MultCols *mc, int ***K, int c, const int *v) {
   Dag *d = b->d;
-  const SparseVec *col = &b->mod->jac[a];
+  const SparseVec *col = &b->mod->jac[mc->con[c]];
   int acc = dag_const(d, 0);
   for (int j = 0; j < b->s; j++)
-    for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, rho[j][a][e], v[j * b->m + col->e[e].coord]));
+    for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, K[c][j][e], v[j * b->m + col->e[e].coord]));
   return acc;
 }
 
-// The constant multiplier in the Newton correction. The sweep's lambda
-// makes C gamma_new = -g0 / h, C = [rho_0' .. rho_{s-1}'], so the Newton
-// system for the correction dg and an auxiliary mu (nu) is
-//     N dg + V mu = r,   C dg = C r,   V = (X (x) M^-1) rho,
-// rho and C frozen with J. Eliminating mu: W = N^-1 V (nu extra right-hand
-// sides of the blocks), S = C W (nu x nu), factored here; the solve is
-// z = N^-1 r, mu = S^-1 C (z - r), dg = z - W mu. Results: W, rho (for C)
-// and S's factor into lu, S's pivots and diagonal into spivot, sadiag (nu).
-static void build_schur(Build *b, const NewtonBasis *nb, const LuFactor *fac, int *lu, int *nlu, NewtonFactor *nf,
-                        int *spivot, int *sadiag) {
+// The multiplier's columns at the factorisation: the constant family's
+// rho_j (step.c) as they are; the polynomial family's moments R_jr of the
+// stage Jacobians at the input gamma, with M^-1 of each.
+static void mult_cols(Build *b, MultCols *mc) {
   Dag *d = b->d;
-  int m = b->m, s = b->s, nu = b->nu, sm = s * m;
-  step_section(b, "the multiplier's columns W = N^-1 (X (x) M^-1) rho_a and S = [rho_0' .. rho_{s-1}'] W, factored");
-  int *V = step_nodes(sm), *W = step_nodes(sm * nu), *S = step_nodes(nu * nu);
-  int **vr = arena_alloc((size_t)s * sizeof *vr);
-  for (int a = 0; a < nu; a++) {
-    for (int j = 0; j < s; j++) vr[j] = b->vrho[j][a];
-    for (int j = 0; j < s; j++)
-      for (int i = 0; i < m; i++) V[j * m + i] = step_apply_x(b, j, i, vr);
-    newton_apply(b, nb, fac, V, W + a * sm);
-  }
-  for (int a = 0; a < nu; a++)
-    for (int c = 0; c < nu; c++) S[a * nu + c] = rho_dot(b, b->rho, a, W + c * sm);
-  LuFactor sf;
-  lu_factor(d, S, nu, &sf, spivot, sadiag);
-  nf->W = step_nodes(sm * nu);
-  for (int t = 0; t < sm * nu; t++) nf->W[t] = stash(b, W[t], lu, nlu);
-  nf->rho = arena_alloc((size_t)s * sizeof *nf->rho);
-  for (int j = 0; j < s; j++) {
-    nf->rho[j] = arena_alloc((size_t)nu * sizeof *nf->rho[j]);
-    for (int a = 0; a < nu; a++) {
-      nf->rho[j][a] = step_nodes(b->mod->jac[a].n);
-      for (int e = 0; e < b->mod->jac[a].n; e++) nf->rho[j][a][e] = stash(b, b->rho[j][a][e], lu, nlu);
+  int m = b->m, s = b->s, nu = b->nu, poly = b->me->family == MULT_POLY;
+  int ****R = poly ? poly_jacobian_moments(b, poly_stage_jacobians(b), 0) : NULL, *dense = step_nodes(m);
+  mc->nc = poly ? s * nu : nu;
+  mc->con = step_nodes(mc->nc);
+  mc->K = arena_alloc((size_t)mc->nc * sizeof *mc->K);
+  mc->vK = arena_alloc((size_t)mc->nc * sizeof *mc->vK);
+  for (int c = 0; c < mc->nc; c++) {
+    int a = c % nu, r = c / nu;
+    const SparseVec *col = &b->mod->jac[a];
+    mc->con[c] = a;
+    mc->K[c] = arena_alloc((size_t)s * sizeof *mc->K[c]);
+    mc->vK[c] = arena_alloc((size_t)s * sizeof *mc->vK[c]);
+    for (int j = 0; j < s; j++) {
+      if (!poly) {
+        mc->K[c][j] = b->rho[j][a];
+        mc->vK[c][j] = b->vrho[j][a];
+        continue;
+      }
+      mc->K[c][j] = R[j][r][a];
+      for (int i = 0; i < m; i++) dense[i] = dag_const(d, 0);
+      for (int e = 0; e < col->n; e++) dense[col->e[e].coord] = R[j][r][a][e];
+      mc->vK[c][j] = step_nodes(m);
+      minv_apply(b->mod, d, dense, mc->vK[c][j]);
     }
   }
+}
+
+// The multiplier in the Newton correction. The sweep's multiplier makes
+// the conditions hold at its new gamma, C gamma_new = -g0 / h (C the rows
+// of K), so the Newton system for the correction dg and an auxiliary mu
+// (nc: the change of h lambda) is
+//     N dg + V mu = r,   C dg = C r,   V = (X (x) M^-1) K,
+// K and C frozen with J. Eliminating mu: W = N^-1 V (nc extra right-hand
+// sides of the blocks), S = C W (nc x nc), factored here; the solve is
+// z = N^-1 r, mu = S^-1 C (z - r), dg = z - W mu. Results: W, K (for C)
+// and S's factor into lu, S's pivots and diagonal into spivot, sadiag (nc).
+static void build_schur(Build *b, const NewtonBasis *nb, const LuFactor *fac, const MultCols *mc, int *lu, int *nlu,
+                        NewtonFactor *nf, int *spivot, int *sadiag) {
+  Dag *d = b->d;
+  int m = b->m, s = b->s, nc = mc->nc, sm = s * m;
+  step_section(b, b->me->family == MULT_POLY
+                      ? "the multiplier's columns W = N^-1 (X (x) M^-1) R_(.r) and S = [R_i0' .. R_i,s-1'] W, factored"
+                      : "the multiplier's columns W = N^-1 (X (x) M^-1) rho_a and S = [rho_0' .. rho_{s-1}'] W, factored");
+  int *V = step_nodes(sm), *W = step_nodes(sm * nc), *S = step_nodes(nc * nc);
+  for (int c = 0; c < nc; c++) {
+    for (int j = 0; j < s; j++)
+      for (int i = 0; i < m; i++) V[j * m + i] = step_apply_x(b, j, i, mc->vK[c]);
+    newton_apply(b, nb, fac, V, W + c * sm);
+  }
+  for (int a = 0; a < nc; a++)
+    for (int c = 0; c < nc; c++) S[a * nc + c] = cols_dot(b, mc, mc->K, a, W + c * sm);
+  LuFactor sf;
+  lu_factor(d, S, nc, &sf, spivot, sadiag);
+  nf->W = step_nodes(sm * nc);
+  for (int t = 0; t < sm * nc; t++) nf->W[t] = stash(b, W[t], lu, nlu);
+  nf->K = arena_alloc((size_t)nc * sizeof *nf->K);
+  for (int c = 0; c < nc; c++) nf->K[c] = arena_alloc((size_t)s * sizeof *nf->K[c]);
+  for (int j = 0; j < s; j++)
+    for (int c = 0; c < nc; c++) {
+      int n = b->mod->jac[mc->con[c]].n;
+      nf->K[c][j] = step_nodes(n);
+      for (int e = 0; e < n; e++) nf->K[c][j][e] = stash(b, mc->K[c][j][e], lu, nlu);
+    }
   nf->S = stash_factor(b, &sf, lu, nlu);
 }
 
@@ -434,8 +486,10 @@ static void build_factor(Build *b, const NewtonBasis *nb, NewtonFactor *nf) {
     for (int i = 0; i < m; i++) B[i * m + c] = bcol[i];
   }
   int hh = dag_mul(d, b->h, b->h), nlu = 0, npiv = 0;
-  int nmax = 4 * m * m * nb->nblocks + nu * (s * m + nu);
-  for (int a = 0; a < nu; a++) nmax += s * b->mod->jac[a].n;
+  MultCols mc = {0, NULL, NULL, NULL};
+  if (nu) mult_cols(b, &mc);
+  int nc = mc.nc, nmax = 4 * m * m * nb->nblocks + nc * (s * m + nc);
+  for (int c = 0; c < nc; c++) nmax += s * b->mod->jac[mc.con[c]].n;
   int *lu = step_nodes(nmax), *pivot = step_nodes(s * m), *adiag = step_nodes(s * m);
   LuFactor *fac = arena_alloc((size_t)nb->nblocks * sizeof *fac);
   nf->blk = arena_alloc((size_t)nb->nblocks * sizeof *nf->blk);
@@ -446,18 +500,24 @@ static void build_factor(Build *b, const NewtonBasis *nb, NewtonFactor *nf) {
     npiv += n;
     nf->blk[q] = stash_factor(b, &fac[q], lu, &nlu);
   }
-  int *spivot = step_nodes(nu), *sadiag = step_nodes(nu);
-  if (nu) build_schur(b, nb, fac, lu, &nlu, nf, spivot, sadiag);
-  st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
+  int *spivot = step_nodes(nc), *sadiag = step_nodes(nc);
+  if (nu) build_schur(b, nb, fac, &mc, lu, &nlu, nf, spivot, sadiag);
+  nf->mc = mc;
+  if (st->in[IN_LU].len < nlu) st->in[IN_LU].len = st->in[IN_LU].coef = nlu; /* (the poly sweep's lu shares it) */
   step_result(st, K_NFACTOR, "lu", SZ_ONE, nlu, nlu, lu);
   step_result(st, K_NFACTOR, "pivot", SZ_SM, 1, s * m, pivot);
   step_result(st, K_NFACTOR, "adiag", SZ_SM, 1, s * m, adiag);
   if (nu) {
-    step_result(st, K_NFACTOR, "spivot", SZ_NU, 1, nu, spivot);
-    step_result(st, K_NFACTOR, "sadiag", SZ_NU, 1, nu, sadiag);
+    SizeSym sym = nc == nu ? SZ_NU : SZ_SNU;
+    step_result(st, K_NFACTOR, "spivot", sym, 1, nc, spivot);
+    step_result(st, K_NFACTOR, "sadiag", sym, 1, nc, sadiag);
   }
   st->kern[K_NFACTOR].what =
-      nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam' g) at the midpoint of the step's\n"
+      nc > nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam_0' g) at the midpoint of the step's\n"
+                " * polynomial gam, as the blocks of A's eigenbasis, factored, with the polynomial multiplier's\n"
+                " * columns W = N^-1 V and the Schur complement S = C W: out = the factors, W, C and S's factor\n"
+                " * (what newton_solve reads as lu), pivots (S*M), diagonal (S*M), S's pivots (S*NU), diagonal (S*NU)."
+      : nu ? "The Newton matrix N = I + h^2 A (x) M^-1 J, J = Hess(U + lam' g) at the midpoint of the step's\n"
            " * polynomial gam, as the blocks of A's eigenbasis, factored, with the multiplier's columns\n"
            " * W = N^-1 V and the Schur complement S = C W: out = the factors, W, C and S's factor (what\n"
            " * newton_solve reads as lu), pivots (S*M), diagonal (S*M), S's pivots (NU), diagonal (NU)."
@@ -477,31 +537,40 @@ static void build_solve(Build *b, const NewtonBasis *nb, const NewtonFactor *nf)
   int *r = step_nodes(sm), *dg = step_nodes(sm);
   for (int i = 0; i < sm; i++) r[i] = step_in(b, IN_GAM, i);
   newton_apply(b, nb, nf->blk, r, dg);
+  int nc = nf->mc.nc, *mu = step_nodes(nc);
   if (nu) {
     step_section(b, "the multiplier eliminated: mu = S^-1 C (z - r), dgam = z - W mu");
-    int *zr = step_nodes(sm), *t = step_nodes(nu), *mu = step_nodes(nu);
+    int *zr = step_nodes(sm), *t = step_nodes(nc);
     for (int i = 0; i < sm; i++) zr[i] = dag_sub(d, dg[i], r[i]);
-    for (int a = 0; a < nu; a++) t[a] = rho_dot(b, nf->rho, a, zr);
+    for (int c = 0; c < nc; c++) t[c] = cols_dot(b, &nf->mc, nf->K, c, zr);
     lu_apply(d, &nf->S, t, mu);
     for (int i = 0; i < sm; i++)
-      for (int a = 0; a < nu; a++) dg[i] = dag_sub(d, dg[i], dag_mul(d, nf->W[a * sm + i], mu[a]));
+      for (int c = 0; c < nc; c++) dg[i] = dag_sub(d, dg[i], dag_mul(d, nf->W[c * sm + i], mu[c]));
   }
   step_result(b->st, K_NSOLVE, "dgam", SZ_SM, 1, sm, dg);
-  b->st->kern[K_NSOLVE].what = nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+  if (nu && b->me->family == MULT_POLY) { /* the multiplier's coefficients move by mu / h with it */
+    for (int c = 0; c < nc; c++) mu[c] = dag_div(d, mu[c], b->h);
+    step_result(b->st, K_NSOLVE, "dlam", SZ_SNU, 1, nc, mu);
+  }
+  b->st->kern[K_NSOLVE].what = nc > nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+                                         " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M),\n"
+                                         " * and the multiplier's coefficients' change mu / h (S*NU)."
+                              : nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
                                     " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M)."
                                   : "The Newton correction for the residual r = (new gamma) - gamma given as gam, with the\n"
                                     " * factors lu of newton_factor: out = (I + h^2 A (x) M^-1 J)^-1 r (S*M).";
 }
 
 // The kernels of --iteration newton (after the sweep: it reuses the sweep's
-// inputs, and its input lu is laid out last). With constraints (the
-// constant family only) the input lam (S*NU, of which the first NU are
-// read: the multiplier in J) is laid out before lu.
+// inputs, and its input lu is laid out last). With constraints in the
+// constant family the input lam (S*NU, of which the first NU are read: the
+// multiplier in J) is laid out before lu; the poly family's sweep has both
+// already (lam its coefficients, lu the slots its factor shares with
+// newton_factor's, each kernel called with its own array).
 void build_newton(Build *b) {
   NewtonBasis nb;
   NewtonFactor nf;
-  ASSERT(!b->nu || b->me->family == MULT_CONST);
-  if (b->nu) {
+  if (b->nu && b->me->family == MULT_CONST) { /* (the poly family's sweep has lam and lu already) */
     b->st->in[IN_LAM].len = b->s * b->nu;
     b->st->in[IN_LU].first = b->st->in[IN_LAM].first + b->st->in[IN_LAM].len;
   }

@@ -34,7 +34,7 @@
 
 // grad g at every stage point, over the structural nonzeros:
 // G[l][a][e] is entry e of column a at Q_l.
-static int ***stage_jacobians(Build *b) {
+int ***poly_stage_jacobians(Build *b) {
   Dag *d = b->d;
   const Model *mod = b->mod;
   int m = b->m, nu = b->nu, nroots = 0;
@@ -90,7 +90,7 @@ static int excursion_moment(Build *b, int j, int r, int i, int *yg) {
 // affine in q (every entry of a quadratic constraint's gradient) has them
 // in closed form, g(q0) [j == r] + grad g . (the excursion's moment),
 // without the stages.
-static int ****jacobian_moments(Build *b, int ***G, int closed) {
+int ****poly_jacobian_moments(Build *b, int ***G, int closed) {
   Dag *d = b->d;
   const Method *me = b->me;
   const Model *mod = b->mod;
@@ -349,13 +349,13 @@ int ***build_poly_factor(Build *b, LuFactor *in, int *****Rout) {
   Step *st = b->st;
   int nu = b->nu, s = b->s, n = s * nu;
   step_section(b, "grad g at the stages");
-  int ***G = stage_jacobians(b);
+  int ***G = poly_stage_jacobians(b);
   b->owners = 1u << K_FACTOR;
   step_section(b, "the multiplier matrix A, factored once per step");
   /* the moments of affine entries in closed form where that makes A shorter:
    * with more stages than s (whole runs: the satellites (6,2) and (6,3) -13%
    * and -11% instructions), not at k = s (chain8 (4,4) would be +2.5%) */
-  int ****R = jacobian_moments(b, G, 0), ****Rc = jacobian_moments(b, G, 1);
+  int ****R = poly_jacobian_moments(b, G, 0), ****Rc = poly_jacobian_moments(b, G, 1);
   int *A = multiplier_matrix(b, R), *Ac = multiplier_matrix(b, Rc), *pivot = step_nodes(n), *adiag = step_nodes(n);
   if (dag_count_ops(d, Ac, n * n) < dag_count_ops(d, A, n * n)) {
     R = Rc;

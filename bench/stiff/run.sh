@@ -2,8 +2,10 @@
 # bench/stiff/run.sh - the stiff benchmark (issue 27; `make bench-stiff`, and
 # part of `make bench`): work against the slow motion's error on the stiff
 # problems of bench/stiff.h, every method side by side in one run:
-#   hbvm         the fixed-point step (--multiplier const), s = 2, 3 at -k auto
-#   hbvm-newton  --iteration newton --multiplier const, the same (k, s)
+#   hbvm         the fixed-point step (--multiplier const), s = 2, 3, 4, 6 at -k auto
+#   hbvm-newton  --iteration newton --multiplier const, the same (k, s): the
+#                higher s (order 2s) for the long steps at tight errors, where
+#                the sweeps need h omega < ~3 at any s
 #   rattle       RATTLE (Stormer-Verlet on the FPU chain)
 #   ida          SUNDIALS IDA (BDF 1-5) on the GGL formulation
 #   gsl-rk4imp, gsl-msbdf, gsl-bsimp   GSL's implicit steppers on the FPU
@@ -21,16 +23,24 @@
 #      stiff_wp_P.png, stiff_summary.txt, stiff_machine.txt
 # The error is the slow motion's (max norm at T = 10, bench/stiff.h): the
 # fast phase is not resolved at h omega >> 1 by any long-step method.
+# A partial run (the environment): STIFF_PROBLEMS (default all five),
+# STIFF_S (the s of the HBVM lines, default "2 3 4 6"), STIFF_PEERS=0 (no
+# RATTLE, IDA, GSL), STIFF_SCAN=0 (no scan of h omega), STIFF_AB_E (the
+# errors of the alternated timings, default "1e-4 1e-6"), STIFF_OUT (the
+# results' directory, default bench/results).
 set -eu
 cd "$(dirname "$0")/../.."
 B=build/bench-stiff
-R=bench/results
+R=${STIFF_OUT:-bench/results}
 GEN=gen/hbvmgen
 [ -x "$GEN" ] || make --no-print-directory all
 start=$(date +%s)
 elapsed() { echo $(($(date +%s) - start)); }
 
-PROBLEMS="fpu50 fpu1000 stiff_bob stiff_bob6 butane"
+PROBLEMS=${STIFF_PROBLEMS:-fpu50 fpu1000 stiff_bob stiff_bob6 butane}
+S_LIST=${STIFF_S:-2 3 4 6}
+PEERS=${STIFF_PEERS:-1}
+SCAN=${STIFF_SCAN:-1}
 
 # The model of a problem, written into $B/models.
 model() {
@@ -72,13 +82,13 @@ GSL_TOLS=1e-3:1e-11:10
 mkdir -p "$B/gen" "$B/models" "$B/res" "$B/scan" "$R"
 rm -f "$B"/res/*.csv "$B"/res/failures.txt "$B"/scan/*.csv "$B"/scan/failures.txt
 
-# ---- 1. generate: s = 2, 3 at -k auto, fixed point (forced: auto would pick Newton on these) and Newton
+# ---- 1. generate: s = 2, 3, 4, 6 at -k auto, fixed point (forced: auto would pick Newton on these) and Newton
 echo "== bench/stiff: generating ($(elapsed) s)"
 : >"$B/configs.txt"
 solvers=""
 for p in $PROBLEMS; do
   model "$p"
-  for s in 2 3; do
+  for s in $S_LIST; do
     k=$("$GEN" --check --multiplier const -s "$s" "$B/models/$p.ham" | sed -n '1s/.* k=\([0-9]*\) s=.*/\1/p')
     "$GEN" --iteration fixed --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}" -o "$B/gen" "$B/models/$p.ham"
     "$GEN" --iteration newton --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}newton" -o "$B/gen" \
@@ -119,6 +129,7 @@ for p in $PROBLEMS; do
     sweep "$B/res" "$p" hbvm-newton "$(newton_from "$p"):1e-6:2" -k "$k" -s "$s"
     sweep "$B/res" "$p" hbvm "$(fixed_from "$p"):1e-6:2" -k "$k" -s "$s" --cap $PEER_CAP
   done <"$B/configs.txt"
+  [ "$PEERS" = 1 ] || continue
   sweep "$B/res" "$p" rattle "$(fixed_from "$p"):2e-6:2" --cap $PEER_CAP
   sweep "$B/res" "$p" ida $IDA_TOLS --cap $PEER_CAP
   case $p in
@@ -129,6 +140,7 @@ done
 # s = 2, until h omega is about 5 (one timed repeat: the times are not used)
 echo "== bench/stiff: scan of h omega ($(elapsed) s)"
 for p in stiff_bob stiff_bob6 butane; do
+  [ "$SCAN" = 1 ] && grep -q "^$p " "$B/configs.txt" || continue
   k=$(awk -v p="$p" '$1 == p && $3 == 2 { print $2 }' "$B/configs.txt")
   from=$(awk -v h="$(newton_from "$p")" 'BEGIN { print 1.6 * h }')
   to=$(awk -v h="$(newton_from "$p")" 'BEGIN { print h / 8 }')
@@ -136,13 +148,13 @@ for p in stiff_bob stiff_bob6 butane; do
 done
 
 # the points of equal error compared, timed again in alternation (bench ab):
-# at E = 1e-4 and 1e-6, newton's, the fixed-point step's, IDA's and RATTLE's points
+# at E = 1e-4 and 1e-6 (STIFF_AB_E), newton's, the fixed-point step's, IDA's and RATTLE's points
 # that reach E fastest (bench/stiff/pick.awk, as summary.sh's section 1)
 echo "== bench/stiff: alternating runs ($(elapsed) s)"
 : >"$B/res/ab.csv"
 awk -F, -f bench/stiff/pick.awk "$B/res/work_precision.csv" >"$B/res/picks.txt"
 for p in $PROBLEMS; do
-  for e in 1e-4 1e-6; do
+  for e in ${STIFF_AB_E:-1e-4 1e-6}; do
     # shellcheck disable=SC2046
     set -- $(awk -v p="$p" -v e="$e" '$1 == p && $2 == e { spec[$3] = $3 ":" $4 ":" $5 ":" $6 }
       END { if ("hbvm-newton" in spec) printf "%s %s %s %s", spec["hbvm-newton"], spec["hbvm"], spec["ida"], spec["rattle"] }' \
@@ -156,11 +168,16 @@ done
 echo "== bench/stiff: results ($(elapsed) s)"
 cp "$B/res/work_precision.csv" "$R/stiff_work_precision.csv"
 cp "$B/res/iterations.csv" "$R/stiff_iterations.csv"
-cp "$B/scan/iterations.csv" "$R/stiff_scan_iterations.csv"
-cp "$B/scan/work_precision.csv" "$R/stiff_scan.csv"
+if [ "$SCAN" = 1 ]; then
+  cp "$B/scan/iterations.csv" "$R/stiff_scan_iterations.csv"
+  cp "$B/scan/work_precision.csv" "$R/stiff_scan.csv"
+else # (a partial run: summary.sh's section 4 left empty)
+  : >"$R/stiff_scan_iterations.csv"
+  : >"$R/stiff_scan.csv"
+fi
 { echo "E,problem,point,rounds,median_seconds,ratio_to_newton"; cat "$B/res/ab.csv"; } >"$R/stiff_ab.csv"
 bench/stiff/count.sh "$B" "$R"
-cat "$B/res/failures.txt" "$B/scan/failures.txt" >"$R/stiff_failures.txt"
+cat "$B/res/failures.txt" "$B/scan/failures.txt" 2>/dev/null >"$R/stiff_failures.txt" || true
 {
   echo "date: $(date -u '+%Y-%m-%d %H:%M UTC'), $(elapsed) s; $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)"
   echo "load (1, 5, 15 min) at the end: $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -13,9 +13,9 @@ echo "one run. newton = hbvmgen --iteration newton --multiplier const, fixed = t
 echo
 
 echo "1. CPU seconds to reach a slow error <= E: each method's fastest point whose error, and that of every"
-echo "   finer point of its line, is <= E (bench/stiff/pick.awk; HBVM: s = 2, 3 at -k auto, the faster"
-echo "   taken, shown as (k,s) [h omega]; - = not reached). Ratios: fixed, ida and rattle over newton (> 1:"
-echo "   newton faster)."
+echo "   finer point of its line, is <= E (bench/stiff/pick.awk; HBVM: every s of the run (2, 3, 4, 6 unless"
+echo "   STIFF_S says otherwise) at -k auto, the fastest taken, shown as (k,s) [h omega]; - = not reached)."
+echo "   Ratios: fixed, ida and rattle over newton (> 1: newton faster)."
 awk -F, -f bench/stiff/pick.awk "$R/stiff_work_precision.csv" | awk -v omegas="$OMEGA" '
   BEGIN { n = split(omegas, o, " "); for (i = 1; i <= n; i++) { split(o[i], kv, "="); om[kv[1]] = kv[2] }
           ne = split("1e-3 1e-4 1e-5 1e-6 1e-7 1e-8", lev, " ")
