@@ -539,6 +539,20 @@ static EmitOptions emit_options(const Options *o) {
   return eo;
 }
 
+// The step to emit, with the form chosen (roll.h) into eo->roll: the
+// rolled form's layout (step_build_layout) where roll_plan tries it first
+// and roll_choose takes it, else the straight-line step. NULL after an
+// error.
+static Step *build_step(Model *mod, const Method *me, EmitOptions *eo) {
+  if (roll_plan(mod, me, eo)) {
+    Step *lay = step_build_layout(mod, me);
+    if (!lay || roll_choose(mod, me, lay, 1, eo)) return NULL;
+    if (eo->roll) return lay;
+  }
+  Step *st = step_build(mod, me);
+  return st && !roll_choose(mod, me, st, 0, eo) ? st : NULL;
+}
+
 // --check's last line: the code the options would write, emitted into
 // temporary files and thrown away: the size of NAME.c (and of NAME.h), and
 // whether the k stages are straight-line code or one loop (--stage-loop).
@@ -547,9 +561,9 @@ static EmitOptions emit_options(const Options *o) {
 static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam, IterKind iter) {
   Method *me = method_new(k, o->s, fam);
   me->iteration = iter;
-  Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
-  if (!st || roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo)) return 1;
+  Step *st = build_step(mod, me, &eo);
+  if (!st || emit_check(mod, st, &eo)) return 1;
   FILE *h = tmpfile(), *c = tmpfile();
   if (!h || !c || emit_solver(h, c, mod, me, st, &eo) != 0) /* the analysis stands; only the size is missing */
     printf("code: not measured (no temporary file: %s)\n", strerror(errno));
@@ -562,13 +576,14 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam,
 }
 
 // Emit the solver files; all or nothing.
-static int write_outputs(const Options *o, Model *mod, const Method *me, const Step *st) {
+static int write_outputs(const Options *o, Model *mod, const Method *me) {
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
   char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
-  int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   EmitOptions eo = emit_options(o);
-  if (!rc && (roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo))) return 1; /* nothing is written yet */
+  Step *st = build_step(mod, me, &eo);
+  if (!st || emit_check(mod, st, &eo)) return 1; /* nothing is written yet */
+  int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   atexit(remove_temporaries);
   mode_t mask = umask(0);
   umask(mask);
@@ -738,8 +753,7 @@ int main(int argc, char **argv) {
   } else {
     Method *me = method_new(k, o.s, fam);
     me->iteration = iter;
-    Step *st = step_build(mod, me);
-    rc = st ? write_outputs(&o, mod, me, st) : 1;
+    rc = write_outputs(&o, mod, me);
   }
   diag_end();
   free(src);

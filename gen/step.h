@@ -23,6 +23,7 @@ typedef struct {
   int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
   int **vpsi;     /* s x m: M^-1 psi_j */
   int **theta;    /* s x m: the force's coefficients Theta_j of the sweep's result */
+  int lean;       /* step_build_layout: the rolled kernels' results as layout only */
 } Build;
 
 void step_section(Build *b, const char *label);       /* dag_section, labelled for b->owners */
@@ -40,8 +41,10 @@ void step_curvature(Build *b, const int *q, const int *v, int *hvv); /* v' Hess(
 void step_force_along(Build *b, const int *q, int **G, int *gmu);    /* grad g_a(q)' M^-1 grad U(q) */
 int step_coupled(Build *b, const IntVec *touch, int *pair, int a, int *out); /* constraints coupled with a */
 void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
+void step_placeholder(Build *b, KernelId k, const char *name, SizeSym sym, int coef, int len); /* zeros: layout only */
 
 void build_const_multiplier(Build *b);
+void layout_const_multiplier(Build *b); /* its results' layout only (step_build_layout) */
 void build_poly_multiplier(Build *b);
 void build_mq_sweep(Build *b); /* step_mq.c: M(q), no constraints */
 

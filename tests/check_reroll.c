@@ -16,17 +16,25 @@
  *             the loops are the same at N = 250 and 1000, only the data grows
  *             (bytes per coordinate bounded), N = 1000 is under 300 KB; bytes,
  *             no timing (bench/rolled/run.sh measures time);
+ *   lean      the generator's peak memory on the rolled chain of 1000 and
+ *             4000 (s = 4): it builds the layout of the step only, not
+ *             the straight-line step beside it, so memory grows linearly
+ *             with N (generous bounds on max RSS, no timing);
  *   choose    --rolled auto keeps a small chain straight-line and rolls a
  *             large one; --rolled on refuses what the form does not cover
  *             (the poly family, a model not uniform in its index), auto
  *             falls back to straight-line there; variables x[30000], refused
  *             as 37.6 MB of straight-line C, is rolled by default.
  * The suite is reroll_suite(); the project's runner adds it. */
+#define _POSIX_C_SOURCE 200809L
 #include <check.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "chain32_rolled_k2s2.h"
 #include "chain32_straight_k2s2.h"
@@ -235,6 +243,46 @@ START_TEST(test_many_coordinates)
 }
 END_TEST
 
+/* The generator's peak resident memory (KB) on the rolled chain of n,
+ * s = 4, const; -1 when it fails. In a child process of its own, so that
+ * ru_maxrss of its children is this run's alone. */
+static long generator_peak_kb(int n)
+{
+  int fd[2];
+  ck_assert_int_eq(pipe(fd), 0);
+  pid_t pid = fork();
+  ck_assert_int_ge(pid, 0);
+  if (pid == 0) {
+    char *text = chain_model(n), *src = generate_source(text, "--multiplier const -s 4 --rolled on");
+    struct rusage ru;
+    long kb = src && getrusage(RUSAGE_CHILDREN, &ru) == 0 ? ru.ru_maxrss : -1;
+    _exit(write(fd[1], &kb, sizeof kb) == sizeof kb ? 0 : 1);
+  }
+  long kb = -1;
+  close(fd[1]);
+  if (read(fd[0], &kb, sizeof kb) != sizeof kb) kb = -1;
+  close(fd[0]);
+  waitpid(pid, NULL, 0);
+  return kb;
+}
+
+/* Issue 29: the generator used to build the straight-line step beside the
+ * rolled kernels, whose dense nu x nu node matrices took 179 MB at N = 1000
+ * and 1.7 GB at N = 4000 (N^1.6); building the layout only it takes 18 and
+ * 61 MB (plain build; the sanitizers add a constant share). The bounds are
+ * generous: 400 MB at N = 4000, and 4000 / 1000 at most 8 times (linear is
+ * 4, the old quadratic growth 9.5). */
+START_TEST(test_generator_memory)
+{
+  long small = generator_peak_kb(1000), large = generator_peak_kb(4000);
+  printf("reroll: generator peak memory, rolled chain s = 4: %.1f MB at N = 1000, %.1f MB at N = 4000\n", small / 1024.0,
+         large / 1024.0);
+  ck_assert_msg(small > 0 && large > 0, "the generator failed on the rolled chain");
+  ck_assert_msg(large <= 400 * 1024, "the generator took %.0f MB on the rolled chain of 4000", large / 1024.0);
+  ck_assert_msg(large <= 8 * small, "the generator's memory grows %.1f times from N = 1000 to 4000", (double)large / small);
+}
+END_TEST
+
 START_TEST(test_choose)
 {
   char *small = chain_model(8), *large = chain_model(64);
@@ -274,6 +322,7 @@ Suite *reroll_suite(void)
   tcase_add_test(tc, test_conservation);
   tcase_add_test(tc, test_size);
   tcase_add_test(tc, test_many_coordinates);
+  tcase_add_test(tc, test_generator_memory);
   tcase_add_test(tc, test_choose);
   suite_add_tcase(s, tc);
   return s;
