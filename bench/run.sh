@@ -209,6 +209,7 @@ echo "== the stiff models: Newton against the fixed-point step, IDA, RATTLE, GSL
 bench/stiff/run.sh || echo "bench: the stiff benchmark failed"
 echo "== the rolled form on chains of N pendula ($(elapsed) s)"
 bench/rolled/run.sh || echo "bench: the rolled-form benchmark failed"
+bench/rolled/gen.sh || echo "bench: the rolled form's generator time and memory failed"
 bench/rolled/ida.sh || echo "bench: the rolled form against IDA (banded) failed"
 
 echo "load after (1, 5, 15 min): $(cut -d' ' -f1-3 /proc/loadavg)" >>"$R/machine.txt"
