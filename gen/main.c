@@ -81,7 +81,8 @@ static const char usage[] =
     "                would take N or more operations (default " STR(STAGE_LOOP_DEFAULT) ", docs/embedding.md)\n"
     "  --rolled auto|on|off  print the model's index as loops (the rolled form,\n"
     "                docs/rolled.md): one loop body per run of uniform terms of U, g\n"
-    "                and their derivatives, and the banded multiplier system as a loop;\n"
+    "                and their derivatives, and the banded multiplier system as a loop\n"
+    "                (both multiplier families);\n"
     "                auto (default) rolls a large model the form covers, on insists\n"
     "                (an error says what it does not cover yet), off never rolls\n"
     "  -h, --help    this text\n"
@@ -528,7 +529,7 @@ static void note_large_output(const char *path) {
           "hbvmgen: note: '%s' is %.1f MB of C: compilers take minutes and gigabytes on a file this size "
           "(gcc -O2: 30 s and 0.4 GB at 3.8 MB, 200 s and 3.2 GB at 19.7 MB; --stage-loop and --mass-loop "
           "shrink what they can, docs/embedding.md, \"Large models\"; a model uniform in its index is a few "
-          "loops with --multiplier const, docs/rolled.md)\n",
+          "loops with --rolled, docs/rolled.md)\n",
           path, (double)sb.st_size / 1e6);
 }
 
@@ -550,7 +551,9 @@ static Step *build_step(Model *mod, const Method *me, EmitOptions *eo) {
     if (eo->roll) return lay;
   }
   Step *st = step_build(mod, me);
-  return st && !roll_choose(mod, me, st, 0, eo) ? st : NULL;
+  if (!st || roll_choose(mod, me, st, 0, eo)) return NULL;
+  /* the poly family's rolled factor is a band: its layout is not the straight-line one */
+  return eo->roll && me->family == MULT_POLY && mod->nu ? step_build_layout(mod, me) : st;
 }
 
 // --check's last line: the code the options would write, emitted into

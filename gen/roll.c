@@ -290,7 +290,6 @@ static Roll *analyse_roll(Model *mod, const char **why) {
 
 // What of the method and options the rolled form does not cover yet, or NULL.
 static const char *not_covered(const Model *mod, const Method *me, const EmitOptions *eo) {
-  if (mod->nu && me->family != MULT_CONST) return "it covers the paper's multiplier only: pass --multiplier const";
   if (me->iteration != ITER_FIXED) return "it covers --iteration fixed only";
   if (eo->wide_step) return "it does not cover --wide-step";
   if (eo->batch) return "it does not cover --batch";

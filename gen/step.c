@@ -641,9 +641,10 @@ static Step *build_step(Model *mod, const Method *me, int lean) {
     build_diagnostics(&b);
     return st;
   }
-  if (lean) { /* the rolled sweep: its layout only */
-    ASSERT(!poly && me->iteration == ITER_FIXED);
-    layout_const_multiplier(&b);
+  if (lean) { /* the rolled kernels: their layout only */
+    ASSERT(me->iteration == ITER_FIXED);
+    if (poly) layout_poly_multiplier(&b);
+    else layout_const_multiplier(&b);
     build_diagnostics(&b);
     return st;
   }

@@ -46,6 +46,7 @@ void step_placeholder(Build *b, KernelId k, const char *name, SizeSym sym, int c
 void build_const_multiplier(Build *b);
 void layout_const_multiplier(Build *b); /* its results' layout only (step_build_layout) */
 void build_poly_multiplier(Build *b);
+void layout_poly_multiplier(Build *b); /* the rolled form's layout only (step_build_layout) */
 void build_mq_sweep(Build *b); /* step_mq.c: M(q), no constraints */
 
 /* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
