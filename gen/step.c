@@ -611,7 +611,7 @@ static const struct {
 static Step *build_step(Model *mod, const Method *me, int lean) {
   Step *st = arena_alloc(sizeof *st);
   int m = mod->m, nu = mod->nu, s = me->s;
-  if (me->family == MULT_POLY && s * nu > MAX_POLY_COEFS) { /* (the analysis caps nu itself) */
+  if (!lean && me->family == MULT_POLY && s * nu > MAX_POLY_COEFS) { /* (the analysis caps nu itself; the rolled band has no cap) */
     error_at(mod->g_loc[0], "%d constraints at s=%d: the polynomial multiplier has at most %d coefficients "
              "(s nu); pass --multiplier const or a smaller -s", nu, s, MAX_POLY_COEFS);
     return NULL;
