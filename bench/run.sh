@@ -209,6 +209,8 @@ echo "== the stiff models: Newton against the fixed-point step, IDA, RATTLE, GSL
 bench/stiff/run.sh || echo "bench: the stiff benchmark failed"
 echo "== the rolled form on chains of N pendula ($(elapsed) s)"
 bench/rolled/run.sh || echo "bench: the rolled-form benchmark failed"
+MULT=poly bench/rolled/run.sh 8 16 32 128 1000 || echo "bench: the rolled-form benchmark of the poly family failed"
+bench/rolled/gen.sh || echo "bench: the rolled form's generator time and memory failed"
 bench/rolled/ida.sh || echo "bench: the rolled form against IDA (banded) failed"
 echo "== the rolled form on a cluster of N diatomics with a pair potential ($(elapsed) s)"
 bench/rolled/cluster.sh || echo "bench: the rolled cluster benchmark failed"

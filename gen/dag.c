@@ -59,7 +59,9 @@ static uint64_t hash_node(const Node *n) {
     h *= 1099511628211ull;
     h ^= h >> 29;
   }
-  return h;
+  h ^= h >> 33; /* mix the high bits down: constants differ there, and the table reads the low ones */
+  h *= 0xff51afd7ed558ccdull;
+  return h ^ (h >> 33);
 }
 
 static int same_node(const Node *x, const Node *y) {

@@ -65,6 +65,13 @@ int emit_kernel_inline(Emitter *e, KernelId k);
 
 /* emit_rolled.c: kernel k in the rolled form (e->roll), 1; 0 when it has none */
 int emit_rolled_kernel(Emitter *e, KernelId k);
+const char *rolled_lit(Emitter *e, double v);  /* a literal of the method's constants */
+void rolled_x_row(Emitter *e, int j, const char *name, int stride, char *buf, size_t size);
+void rolled_projections(Emitter *e, int jac);   /* psi (and with jac rho) into the sweep's locals */
+void rolled_gamma(Emitter *e, int results);     /* gamma from th[] in the loop over i */
+/* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */
+void rolled_poly_helpers(Emitter *e);
+void rolled_poly_kernel(Emitter *e, KernelId k);
 
 /* emit_choice.c: what the model, method and options choose for the step */
 int step_order(const Emitter *e);

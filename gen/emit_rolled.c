@@ -122,7 +122,7 @@ static void emit_jacobians(Emitter *e) {
   const Roll *r = e->roll;
   const RollFamily **f = xmalloc((size_t)(r->T + 1) * sizeof *f);
   for (int part = PART_ALL; part <= PART_CURVED; part++) {
-    if (part != PART_ALL && !jac_used(r, part)) continue;
+    if (part != PART_ALL && (!jac_used(r, part) || e->me->family == MULT_POLY)) continue; /* (poly: moments of the whole) */
     for (int t = 0; t < r->T; t++) f[t] = jac_part(r, t, part);
     emit_tfamily(e, name[part], what[part], f, part == PART_LIN);
   }
@@ -223,12 +223,13 @@ static void emit_helpers(Emitter *e) {
     emit_family(e, "hvv", "out[a] = v' Hess(g_a)(q) v", &r->hvv, 0);
     emit_jacobians(e);
     emit_band(e);
+    if (e->me->family == MULT_POLY) rolled_poly_helpers(e);
   }
   e->roll_helpers = 1;
 }
 
 // A real literal of the method's constants.
-static const char *lit(Emitter *e, double v) {
+const char *rolled_lit(Emitter *e, double v) {
   static char buf[8][48];
   static int next;
   char *b = buf[next++ % 8];
@@ -239,30 +240,30 @@ static const char *lit(Emitter *e, double v) {
 // Print "DST = SRC-combination" of X row j (METHOD.md): xi_j v_{j-1} -
 // xi_{j+1} v_{j+1} (v_0 for j = 0, the second term absent for j = s-1),
 // v_r read as fmt with r * stride (an offset) and name.
-static void x_row(Emitter *e, int j, const char *name, int stride, char *buf, size_t size) {
+void rolled_x_row(Emitter *e, int j, const char *name, int stride, char *buf, size_t size) {
   const double *xi = e->me->xi;
-  int n = snprintf(buf, size, "%s * %s[%d + i]", lit(e, xi[j]), name, (j ? j - 1 : 0) * stride);
-  if (j + 1 < e->me->s) snprintf(buf + n, size - (size_t)n, " - %s * %s[%d + i]", lit(e, xi[j + 1]), name, (j + 1) * stride);
+  int n = snprintf(buf, size, "%s * %s[%d + i]", rolled_lit(e, xi[j]), name, (j ? j - 1 : 0) * stride);
+  if (j + 1 < e->me->s) snprintf(buf + n, size - (size_t)n, " - %s * %s[%d + i]", rolled_lit(e, xi[j + 1]), name, (j + 1) * stride);
 }
 
-// The projections psi_j = sum_l b_l P_j(c_l) grad U(Q_l) and rho_j (R[j M T
-// + i T + t], the Jacobian's entries) of the sweep: the affine entries in
-// closed form, the curved ones summed over the k stages (unrolled: k and s
-// are small; the loops are over the coordinates).
-static void emit_projections(Emitter *e) {
+// The projections psi_j = sum_l b_l P_j(c_l) grad U(Q_l) and, with jac,
+// rho_j (R[j M T + i T + t], the Jacobian's entries) of the sweep: the
+// affine entries in closed form, the curved ones summed over the k stages
+// (unrolled: k and s are small; the loops are over the coordinates).
+void rolled_projections(Emitter *e, int jac) {
   const Roll *r = e->roll;
   const Method *me = e->me;
-  int nu = e->mod->nu, m = e->mod->m, s = me->s, mt = m * r->T;
+  int nu = jac ? e->mod->nu : 0, m = e->mod->m, s = me->s, mt = m * r->T;
   char x[512];
   out(e, "  /* entries affine in q, projected in closed form: delta_j0 f(q0) + f_lin(h (X gamma)_j) */\n");
   if (!r->gradU_s.affine.zero) tmpl(e, "  $P_roll_gradU_affine(q0, 0, prm, psi);\n");
   tmplf(e, "  for (i = %d; i < %d; i++) psi[i] = 0;\n", r->gradU_s.affine.zero ? 0 : m, s * m);
   if (nu && jac_used(r, PART_AFFINE)) tmpl(e, "  $P_roll_jac_affine(q0, 0, prm, R);\n");
   if (nu) tmplf(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
-  if (r->lin) {
+  if (!r->gradU_s.lin.zero || (nu && jac_used(r, PART_LIN))) {
     out(e, "  for (i = 0; i < %d; i++) {\n", m);
     for (int j = 0; j < s; j++) {
-      x_row(e, j, "gam", m, x, sizeof x);
+      rolled_x_row(e, j, "gam", m, x, sizeof x);
       out(e, "    hX[%d + i] = h * (%s);\n", j * m, x);
     }
     out(e, "  }\n  for (j = 0; j < %d; j++) {\n", s);
@@ -272,22 +273,22 @@ static void emit_projections(Emitter *e) {
       tmplf(e, "    $P_roll_jac_lin(0, hX + j * %d, prm, R + j * %d);\n", m, mt);
     out(e, "  }\n");
   }
-  if (!r->curved) return;
+  if (r->gradU_s.curved.zero && !(nu && jac_used(r, PART_CURVED))) return;
   out(e, "  /* the other entries at the k stages: Q = q0 + h sum_j Ihat[l][j] gamma_j, summed with b_l P_j(c_l) */\n");
   for (int l = 0; l < me->k; l++) {
     out(e, "  /* stage %d of %d */\n  for (i = 0; i < %d; i++) Q[i] = q0[i] + h * (", l + 1, me->k, m);
-    for (int j = 0; j < s; j++) out(e, "%s%s * gam[%d + i]", j ? " + " : "", lit(e, me->Ihat[l * s + j]), j * m);
+    for (int j = 0; j < s; j++) out(e, "%s%s * gam[%d + i]", j ? " + " : "", rolled_lit(e, me->Ihat[l * s + j]), j * m);
     out(e, ");\n");
     if (!r->gradU_s.curved.zero) {
       tmpl(e, "  $P_roll_gradU_curved(Q, 0, prm, F);\n");
       out(e, "  for (i = 0; i < %d; i++) {\n", m);
-      for (int j = 0; j < s; j++) out(e, "    psi[%d + i] += %s * F[i];\n", j * m, lit(e, me->W[l * s + j]));
+      for (int j = 0; j < s; j++) out(e, "    psi[%d + i] += %s * F[i];\n", j * m, rolled_lit(e, me->W[l * s + j]));
       out(e, "  }\n");
     }
     if (nu && jac_used(r, PART_CURVED)) {
       tmpl(e, "  $P_roll_jac_curved(Q, 0, prm, J);\n");
       out(e, "  for (i = 0; i < %d; i++) {\n", mt);
-      for (int j = 0; j < s; j++) out(e, "    R[%d + i] += %s * J[i];\n", j * mt, lit(e, me->W[l * s + j]));
+      for (int j = 0; j < s; j++) out(e, "    R[%d + i] += %s * J[i];\n", j * mt, rolled_lit(e, me->W[l * s + j]));
       out(e, "  }\n");
     }
   }
@@ -313,9 +314,9 @@ static void emit_system(Emitter *e) {
     for (int k = 0; k < s; k++) {
       char y[256];
       int n = 0;
-      if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", lit(e, xi[k + 1]), (k + 1) * mt + t, T);
-      if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", lit(e, xi[0]), t, T);
-      else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", lit(e, xi[k]), (k - 1) * mt + t, T);
+      if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", rolled_lit(e, xi[k + 1]), (k + 1) * mt + t, T);
+      if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", rolled_lit(e, xi[0]), t, T);
+      else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", rolled_lit(e, xi[k]), (k - 1) * mt + t, T);
       out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
     }
     out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
@@ -342,11 +343,10 @@ static void emit_system(Emitter *e) {
 static void emit_sweep(Emitter *e) {
   const Roll *r = e->roll;
   int nu = e->mod->nu, m = e->mod->m, s = e->me->s, T = r->T, mt = m * T;
-  char x[512];
   tmplf(e, "  $R Q[%d], F[%d], hX[%d], psi[%d];\n  int i, j = 0;\n  (void)Q; (void)F; (void)hX; (void)j;\n", m, m,
         s * m, s * m);
   if (nu) tmplf(e, "  $R J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
-  emit_projections(e);
+  rolled_projections(e, 1);
   if (nu) emit_system(e);
   out(e, "  for (i = 0; i < %d; i++) {\n", m);
   for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d] < 0 ? %d : %s_tcon[%d * i + %d];\n", t, e->P, T, t, nu, e->P, T, t);
@@ -356,16 +356,28 @@ static void emit_sweep(Emitter *e) {
     for (int t = 0; t < T; t++) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
     out(e, ";\n");
   }
+  rolled_gamma(e, 1);
+  out(e, "  }\n");
+}
+
+// Inside a loop over the coordinates i with th[j] = Theta_j at i: gamma_j =
+// M^-1 [delta_j0 p0 - h sum_r X[j][r] Theta_r] into the sweep's result gam,
+// with p1 - p0 = -h Theta_0 and Theta_1.. (results 1), or into the local
+// array gm (results 0).
+void rolled_gamma(Emitter *e, int results) {
+  int m = e->mod->m, s = e->me->s;
+  char x[512];
   for (int j = 0; j < s; j++) {
-    x_row(e, j, "th", 1, x, sizeof x);
+    rolled_x_row(e, j, "th", 1, x, sizeof x);
     /* th is a local array here: th[r + i] would be wrong, so name its entries */
     char *p;
     while ((p = strstr(x, " + i]"))) memmove(p, p + 4, strlen(p + 4) + 1);
-    tmplf(e, "    out[$[sweep.gam]%d + i] = $P_MINV(i) (%s(h * (%s)));\n", j * m, j ? "-" : "p0[i] - ", x);
+    tmplf(e, results ? "    out[$[sweep.gam]%d + i] = $P_MINV(i) (%s(h * (%s)));\n" : "    gm[%d + i] = $P_MINV(i) (%s(h * (%s)));\n",
+          j * m, j ? "-" : "p0[i] - ", x);
   }
+  if (!results) return;
   tmpl(e, "    out[$[sweep.dp]i] = -(h * th[0]);\n");
   for (int j = 1; j < s; j++) tmplf(e, "    out[$[sweep.theta]%d + i] = th[%d];\n", (j - 1) * m, j);
-  out(e, "  }\n");
 }
 
 // The consistent multiplier: (G' M^-1 G) lambda = [v' Hess(g_a) v]_a - G' M^-1 grad U.
@@ -416,7 +428,7 @@ static void emit_state_kernel(Emitter *e, KernelId id) {
   case K_MINV_P: tmpl(e, "  int i;\n  for (i = 0; i < $P_M; i++) out[i] = $P_MINV(i) p0[i];\n"); break;
   case K_ENERGY:
     tmplf(e, "  $R kin = 0, u;\n  int i;\n  for (i = 0; i < $P_M; i++) kin += p0[i] * ($P_MINV(i) p0[i]);\n"
-             "  $P_roll_U(q0, 0, prm, &u);\n  out[0] = %s * kin + u;\n", lit(e, 0.5));
+             "  $P_roll_U(q0, 0, prm, &u);\n  out[0] = %s * kin + u;\n", rolled_lit(e, 0.5));
     break;
   case K_G: tmpl(e, "  $P_roll_g(q0, 0, prm, out);\n"); break;
   case K_HIDDEN:
@@ -430,15 +442,17 @@ static void emit_state_kernel(Emitter *e, KernelId id) {
 }
 
 int emit_rolled_kernel(Emitter *e, KernelId id) {
+  int poly = e->me->family == MULT_POLY && e->mod->nu;
   if (id != K_SWEEP && id != K_MINV_P && id != K_ENERGY && id != K_G && id != K_HIDDEN && id != K_LAMBDA0 &&
-      id != K_CONSISTENT)
+      id != K_CONSISTENT && !(poly && (id == K_FACTOR || id == K_PROJECT)))
     return 0; /* the params' q0, p0 and the events stay straight-line: they are small or rare */
   if (!e->roll_helpers) emit_helpers(e);
   const Kernel *k = &e->st->kern[id];
   e->kid = id;
   out(e, "\n/* %s (rolled) */\n", k->what);
   kernel_signature(e, k, -1);
-  if (id == K_SWEEP) emit_sweep(e);
+  if (poly && (id == K_SWEEP || id == K_FACTOR || id == K_PROJECT)) rolled_poly_kernel(e, id);
+  else if (id == K_SWEEP) emit_sweep(e);
   else if (id == K_LAMBDA0) emit_lambda0(e);
   else if (id == K_CONSISTENT) emit_consistent(e);
   else emit_state_kernel(e, id);

@@ -14,6 +14,7 @@
 #include <stdlib.h>
 
 #include "emit.h"
+#include "roll.h"
 
 // Check one constant the solver will print: finite, and in range of float
 // for --real float (where below FLT_MIN it becomes 0 or a denormal: a
@@ -29,7 +30,8 @@ static int check_constant(const EmitOptions *o, double v, Loc loc, const char *w
 }
 
 // Before anything is written: every constant the generated code will hold
-// (the kernels' literals, the parameters' defaults, q0 and p0) must be a
+// (the kernels' literals, the rolled form's loop bodies, the parameters'
+// defaults, q0 and p0) must be a
 // finite value of the solver's real type. Returns 0, or 1 after errors.
 int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
   const Dag *d = mod->dag;
@@ -38,6 +40,7 @@ int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
   for (int k = 0; k < K_COUNT; k++)
     for (int b = 0; b < st->kern[k].nout; b++) dag_reach(d, st->kern[k].out[b].nodes, st->kern[k].out[b].len, mark);
   for (int l = 0; l < d->nloops; l++) dag_reach(d, d->loops[l].roots, d->loops[l].nroots, mark); /* their bodies */
+  if (o->roll) roll_reach(o->roll, d, mark); /* the rolled kernels' loop bodies */
   for (int id = 0; id < d->n && !bad; id++)
     if (mark[id] && d->nodes[id].op == OP_CONST) bad = check_constant(o, d->nodes[id].val, (Loc){0, 0}, "a constant of the step", &small);
   for (int i = 0; i < mod->nparams && !bad; i++)

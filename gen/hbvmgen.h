@@ -492,6 +492,14 @@ typedef struct {
 } Step;
 
 Step *step_build(Model *mod, const Method *meth);
+/* The step for the rolled form (roll.h): the layout of the kernels it prints
+ * as loops, their results zeros (nothing of the straight-line step is built,
+ * so the cost is linear in the model), and the kernels that stay
+ * straight-line (events, switches, the params' q0 and p0) as step_build. */
+Step *step_build_layout(Model *mod, const Method *meth);
+/* The half band of the poly family's multiplier matrix in the rolled form
+ * (unknowns a s + r): s (bw + 1) - 1 (step_poly.c). */
+int poly_band(const Model *mod, int s);
 /* The block of kernel k named name; NULL if there is none. */
 const Slots *step_block(const Step *st, KernelId k, const char *name);
 int kernel_size(const Kernel *k);   /* slots of out[] */

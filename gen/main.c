@@ -91,7 +91,8 @@ static const char usage_more[] =
     "                would take N or more operations (default " STR(STAGE_LOOP_DEFAULT) ", docs/embedding.md)\n"
     "  --rolled auto|on|off  print the model's index as loops (the rolled form,\n"
     "                docs/rolled.md): one loop body per run of uniform terms of U, g\n"
-    "                and their derivatives, and the banded multiplier system as a loop;\n"
+    "                and their derivatives, and the banded multiplier system as a loop\n"
+    "                (both multiplier families);\n"
     "                auto (default) rolls a large model the form covers, on insists\n"
     "                (an error says what it does not cover yet), off never rolls\n"
     "  -h, --help    this text\n"
@@ -552,7 +553,7 @@ static void note_large_output(const char *path) {
           "hbvmgen: note: '%s' is %.1f MB of C: compilers take minutes and gigabytes on a file this size "
           "(gcc -O2: 30 s and 0.4 GB at 3.8 MB, 200 s and 3.2 GB at 19.7 MB; --stage-loop and --mass-loop "
           "shrink what they can, docs/embedding.md, \"Large models\"; a model uniform in its index is a few "
-          "loops with --multiplier const, docs/rolled.md)\n",
+          "loops with --rolled, docs/rolled.md)\n",
           path, (double)sb.st_size / 1e6);
 }
 
@@ -561,6 +562,22 @@ static EmitOptions emit_options(const Options *o) {
   EmitOptions eo = {o->name, strrchr(o->model, '/') ? strrchr(o->model, '/') + 1 : o->model, o->single,
                     !o->plain_sum, o->wide_step, o->batch, o->rolled, NULL};
   return eo;
+}
+
+// The step to emit, with the form chosen (roll.h) into eo->roll: the
+// rolled form's layout (step_build_layout) where roll_plan tries it first
+// and roll_choose takes it, else the straight-line step. NULL after an
+// error.
+static Step *build_step(Model *mod, const Method *me, EmitOptions *eo) {
+  if (roll_plan(mod, me, eo)) {
+    Step *lay = step_build_layout(mod, me);
+    if (!lay || roll_choose(mod, me, lay, 1, eo)) return NULL;
+    if (eo->roll) return lay;
+  }
+  Step *st = step_build(mod, me);
+  if (!st || roll_choose(mod, me, st, 0, eo)) return NULL;
+  /* the poly family's rolled factor is a band: its layout is not the straight-line one */
+  return eo->roll && me->family == MULT_POLY && mod->nu ? step_build_layout(mod, me) : st;
 }
 
 // --check's last line: the code the options would write, emitted into
@@ -572,9 +589,9 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam,
   Method *me = method_new(k, o->s, fam);
   me->iteration = iter;
   me->energy_rescale = rescale;
-  Step *st = step_build(mod, me);
   EmitOptions eo = emit_options(o);
-  if (!st || roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo)) return 1;
+  Step *st = build_step(mod, me, &eo);
+  if (!st || emit_check(mod, st, &eo)) return 1;
   FILE *h = tmpfile(), *c = tmpfile();
   if (!h || !c || emit_solver(h, c, mod, me, st, &eo) != 0) /* the analysis stands; only the size is missing */
     printf("code: not measured (no temporary file: %s)\n", strerror(errno));
@@ -587,13 +604,14 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam,
 }
 
 // Emit the solver files; all or nothing.
-static int write_outputs(const Options *o, Model *mod, const Method *me, const Step *st) {
+static int write_outputs(const Options *o, Model *mod, const Method *me) {
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
   char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
-  int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   EmitOptions eo = emit_options(o);
-  if (!rc && (roll_choose(mod, me, st, &eo) || emit_check(mod, st, &eo))) return 1; /* nothing is written yet */
+  Step *st = build_step(mod, me, &eo);
+  if (!st || emit_check(mod, st, &eo)) return 1; /* nothing is written yet */
+  int nfiles = o->emit_main ? 3 : 2, rc = make_dir(o->outdir);
   atexit(remove_temporaries);
   mode_t mask = umask(0);
   umask(mask);
@@ -789,8 +807,7 @@ int main(int argc, char **argv) {
     Method *me = method_new(k, o.s, fam);
     me->iteration = iter;
     me->energy_rescale = rescale;
-    Step *st = step_build(mod, me);
-    rc = st ? write_outputs(&o, mod, me, st) : 1;
+    rc = write_outputs(&o, mod, me);
   }
   diag_end();
   free(src);

@@ -305,7 +305,6 @@ static Roll *analyse_roll(Model *mod, const char **why) {
 
 // What of the method and options the rolled form does not cover yet, or NULL.
 static const char *not_covered(const Model *mod, const Method *me, const EmitOptions *eo) {
-  if (mod->nu && me->family != MULT_CONST) return "it covers the paper's multiplier only: pass --multiplier const";
   if (me->iteration != ITER_FIXED) return "it covers --iteration fixed only";
   if (eo->wide_step) return "it does not cover --wide-step";
   if (eo->batch) return "it does not cover --batch";
@@ -334,12 +333,23 @@ static double compression(const Roll *r) {
   return runs ? (double)items / (double)runs : 0;
 }
 
-int roll_choose(Model *mod, const Method *me, const Step *st, EmitOptions *eo) {
+// Whether the form is tried before the straight-line step is built:
+// --rolled on, or auto on a model of ROLL_LEAN_M coordinates or more.
+static int tried_first(const Model *mod, const EmitOptions *eo) {
+  return eo->rolled == ROLL_ON || (eo->rolled == ROLL_AUTO && mod->m >= ROLL_LEAN_M);
+}
+
+int roll_plan(const Model *mod, const Method *me, const EmitOptions *eo) {
+  if (!tried_first(mod, eo) || not_covered(mod, me, eo)) return 0;
+  return 1;
+}
+
+int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOptions *eo) {
   eo->roll = NULL;
-  if (eo->rolled == ROLL_OFF) return 0;
   int on = eo->rolled == ROLL_ON;
+  if (!layout && (eo->rolled == ROLL_OFF || (tried_first(mod, eo) && !on))) return 0; /* decided on the layout */
   const char *why = not_covered(mod, me, eo);
-  if (!on && (why || sweep_ops(mod, st) < ROLL_AUTO_OPS)) return 0;
+  if (!on && !layout && (why || sweep_ops(mod, st) < ROLL_AUTO_OPS)) return 0;
   Roll *r = why ? NULL : analyse_roll(mod, &why);
   if (r && !on && compression(r) < ROLL_AUTO_COMPRESSION) return 0; /* little repetition: straight-line is as short */
   if (!r && on) {
@@ -348,4 +358,17 @@ int roll_choose(Model *mod, const Method *me, const Step *st, EmitOptions *eo) {
   }
   eo->roll = r;
   return 0;
+}
+
+// Mark (dag_reach) the nodes of every run's body: what the rolled kernels
+// print of the model, for emit_check.
+void roll_reach(const Roll *r, const Dag *d, unsigned char *mark) {
+  const RollFamily *fam[] = {&r->gradU, &r->g, &r->U, &r->hvv, &r->gradU_s.affine, &r->gradU_s.lin, &r->gradU_s.curved};
+  for (size_t f = 0; f < sizeof fam / sizeof *fam; f++)
+    for (int i = 0; i < fam[f]->nruns; i++) dag_reach(d, fam[f]->runs[i].body, fam[f]->runs[i].nbody, mark);
+  for (int t = 0; t < r->T; t++) {
+    const RollFamily *jf[] = {&r->jac[t], &r->jac_s[t].affine, &r->jac_s[t].lin, &r->jac_s[t].curved};
+    for (int f = 0; f < 4; f++)
+      for (int i = 0; i < jf[f]->nruns; i++) dag_reach(d, jf[f]->runs[i].body, jf[f]->runs[i].nbody, mark);
+  }
 }

@@ -23,6 +23,13 @@ enum { ROLL_OFF, ROLL_ON, ROLL_AUTO };
 #define ROLL_AUTO_OPS 4000
 /* ... and whose derivatives it shortens this many times at least (items per run). */
 #define ROLL_AUTO_COMPRESSION 8
+/* From this many coordinates on, --rolled auto decides without building the
+ * straight-line step (whose dense nu x nu node matrices cost O(nu^2) time
+ * and memory: 1.7 GB at the chain of 4000) and so without counting its
+ * operations: a model of this size the rolled form covers, whose
+ * derivatives it shortens ROLL_AUTO_COMPRESSION times, is rolled. (A sweep
+ * under ROLL_AUTO_OPS operations would need fewer than 8 a coordinate.) */
+#define ROLL_LEAN_M 512
 
 /* One maximal run of items that are the same expression up to a shift of
  * the index: item u (u0 <= u < u0 + n) has the base index b0 + stride (u -
@@ -95,8 +102,16 @@ typedef struct Roll {
   RollPairs *pairs;   /* U as pair runs, grad U scattered from them (gradU, gradU_s unused), or NULL */
 } Roll;
 
-/* Decide the form from eo->rolled and set eo->roll (NULL: straight-line).
- * Returns 1 after an error (--rolled on for a model or options the rolled
- * form does not cover), else 0. */
-int roll_choose(Model *mod, const Method *me, const Step *st, EmitOptions *eo);
+/* Choosing the form from eo->rolled. roll_plan says which step to build
+ * first: 1 the layout (step_build_layout: --rolled on, or auto on a model
+ * of ROLL_LEAN_M coordinates or more, which the form covers), 0 the
+ * straight-line step. roll_choose then decides on that step (layout 1 for
+ * the layout) and sets eo->roll (NULL: straight-line; after a layout the
+ * caller then builds the straight-line step and calls it again). Returns 1
+ * after an error (--rolled on for a model or options the rolled form does
+ * not cover), else 0. */
+int roll_plan(const Model *mod, const Method *me, const EmitOptions *eo);
+int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOptions *eo);
+/* Mark (dag_reach) the nodes the rolled kernels print of the model. */
+void roll_reach(const struct Roll *r, const Dag *d, unsigned char *mark);
 #endif

@@ -444,8 +444,47 @@ static void build_initial_multiplier(Build *b, const int *q, const int *v) {
   step_result(b->st, K_LAMBDA0, "lambda", SZ_NU, 1, nu, lambda0);
 }
 
+// The kernels of the state outside the step that grow like nu^2 in the
+// DAG (dense Jacobian columns, LU of G' M^-1 G), as layout only: the same
+// blocks as build_diagnostics, zeros. The rolled form prints them as loops.
+static void layout_constraint_kernels(Build *b) {
+  int m = b->m, nu = b->nu;
+  step_placeholder(b, K_HIDDEN, "hidden", SZ_NU, 1, nu);
+  step_placeholder(b, K_LAMBDA0, "lambda", SZ_NU, 1, nu);
+  step_placeholder(b, K_CONSISTENT, "dq", SZ_M, 1, m);
+  step_placeholder(b, K_CONSISTENT, "dp", SZ_M, 1, m);
+  step_placeholder(b, K_CONSISTENT, "pivot", SZ_NU, 1, nu);
+  step_placeholder(b, K_CONSISTENT, "adiag", SZ_NU, 1, nu);
+}
+
+// The kernels of the model's events and switching functions at (q0, p0).
+static void build_events(Build *b, const int *q, const int *p) {
+  Dag *d = b->d;
+  Model *mod = b->mod;
+  int m = b->m;
+  if (mod->nevents) { /* the model's inputs m..2m-1 are the momenta of the events */
+    int *qp = step_nodes(2 * m), *ev = step_nodes(mod->nevents);
+    memcpy(qp, q, (size_t)m * sizeof(int));
+    memcpy(qp + m, p, (size_t)m * sizeof(int));
+    b->owners = 1u << K_EVENTS;
+    step_section(b, "events");
+    dag_subst(d, mod->event_nodes, mod->nevents, qp, 2 * m, ev);
+    step_result(b->st, K_EVENTS, "values", SZ_ONE, mod->nevents, mod->nevents, ev);
+  }
+  if (mod->nswitch) {
+    int *sw = step_nodes(mod->nswitch);
+    b->owners = 1u << K_SWITCH;
+    step_section(b, "switching functions");
+    dag_subst(d, mod->switch_nodes, mod->nswitch, q, m, sw);
+    step_result(b->st, K_SWITCH, "values", SZ_ONE, mod->nswitch, mod->nswitch, sw);
+  }
+}
+
 // Functions of the state outside the step: g(q), H(q,p), grad g(q)' M^-1 p,
-// the first step's prediction gamma_0 = M^-1 p0, and the consistent multiplier.
+// the first step's prediction gamma_0 = M^-1 p0, and the consistent
+// multiplier; the events and switches. With b->lean, the kernels that grow
+// like nu^2 are layout only (layout_constraint_kernels); g, H and M^-1 p0
+// are built (linear in the model) so that emit_check sees their constants.
 static void build_diagnostics(Build *b) {
   Dag *d = b->d;
   Model *mod = b->mod;
@@ -470,34 +509,23 @@ static void build_diagnostics(Build *b) {
   int H = dag_add(d, dag_mul(d, dag_const(d, 0.5), kin), U);
   b->owners = 1u << K_HIDDEN;
   step_section(b, "hidden constraints");
-  int **G = step_jacobian_at(b, q);
-  for (int a = 0; a < nu; a++) {
+  int **G = b->lean ? NULL : step_jacobian_at(b, q);
+  for (int a = 0; a < nu && G; a++) {
     const SparseVec *col = &mod->jac[a];
     int acc = dag_const(d, 0);
     for (int e = 0; e < col->n; e++) acc = dag_add(d, acc, dag_mul(d, G[a][col->e[e].coord], v[col->e[e].coord]));
     hidden[a] = acc;
   }
-  if (mod->nevents) { /* the model's inputs m..2m-1 are the momenta of the events */
-    int *qp = step_nodes(2 * m), *ev = step_nodes(mod->nevents);
-    memcpy(qp, q, (size_t)m * sizeof(int));
-    memcpy(qp + m, p, (size_t)m * sizeof(int));
-    b->owners = 1u << K_EVENTS;
-    step_section(b, "events");
-    dag_subst(d, mod->event_nodes, mod->nevents, qp, 2 * m, ev);
-    step_result(b->st, K_EVENTS, "values", SZ_ONE, mod->nevents, mod->nevents, ev);
-  }
-  if (mod->nswitch) {
-    int *sw = step_nodes(mod->nswitch);
-    b->owners = 1u << K_SWITCH;
-    step_section(b, "switching functions");
-    dag_subst(d, mod->switch_nodes, mod->nswitch, q, m, sw);
-    step_result(b->st, K_SWITCH, "values", SZ_ONE, mod->nswitch, mod->nswitch, sw);
-  }
+  build_events(b, q, p);
   step_result(b->st, K_MINV_P, "gam0", SZ_M, 1, m, v);
   step_result(b->st, K_ENERGY, "H", SZ_ONE, 1, 1, &H);
   build_initial_values(b);
   if (!nu) return;
   step_result(b->st, K_G, "g", SZ_NU, 1, nu, g);
+  if (b->lean) {
+    layout_constraint_kernels(b);
+    return;
+  }
   step_result(b->st, K_HIDDEN, "hidden", SZ_NU, 1, nu, hidden);
   build_initial_multiplier(b, q, v);
   build_consistent(b, q, p, g);
@@ -515,6 +543,12 @@ void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, 
   bl->len = len;
   bl->nodes = step_nodes(len);
   memcpy(bl->nodes, nodes, (size_t)len * sizeof(int));
+}
+
+// A result block of zeros: its place in the layout only, for a kernel the
+// rolled form prints as loops (step_build_layout).
+void step_placeholder(Build *b, KernelId k, const char *name, SizeSym sym, int coef, int len) {
+  step_result(b->st, k, name, sym, coef, len, zeros(b->d, len));
 }
 
 const Slots *step_block(const Step *st, KernelId k, const char *name) {
@@ -581,10 +615,11 @@ static const struct {
     [K_NSOLVE] = {"newton_solve", NULL, 0},
 };
 
-Step *step_build(Model *mod, const Method *me) {
+// The step of step_build (lean 0) or step_build_layout (lean 1).
+static Step *build_step(Model *mod, const Method *me, int lean) {
   Step *st = arena_alloc(sizeof *st);
   int m = mod->m, nu = mod->nu, s = me->s;
-  if (me->family == MULT_POLY && s * nu > MAX_POLY_COEFS) { /* (the analysis caps nu itself) */
+  if (!lean && me->family == MULT_POLY && s * nu > MAX_POLY_COEFS) { /* (the analysis caps nu itself; the rolled band has no cap) */
     error_at(mod->g_loc[0], "%d constraints at s=%d: the polynomial multiplier has at most %d coefficients "
              "(s nu); pass --multiplier const or a smaller -s", nu, s, MAX_POLY_COEFS);
     return NULL;
@@ -602,7 +637,7 @@ Step *step_build(Model *mod, const Method *me) {
     st->kern[k].wide = kernel_spec[k].wide;
   }
   layout_inputs(st, m, nu, s, 0, 0, 0);
-  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL, NULL};
+  Build b = {mod, me, mod->dag, st, m, nu, s, me->k, -1, 1u << K_SWEEP | 1u << K_FACTOR, NULL, NULL, NULL, NULL, NULL, lean};
   b.h = step_in(&b, IN_H, 0);
   int poly = me->family == MULT_POLY && nu;
   if (poly) layout_inputs(st, m, nu, s, s * nu, 0, 0); /* the factor's length is known once it is built */
@@ -620,6 +655,13 @@ Step *step_build(Model *mod, const Method *me) {
     build_diagnostics(&b);
     return st;
   }
+  if (lean) { /* the rolled kernels: their layout only */
+    ASSERT(me->iteration == ITER_FIXED);
+    if (poly) layout_poly_multiplier(&b);
+    else layout_const_multiplier(&b);
+    build_diagnostics(&b);
+    return st;
+  }
   build_stages(&b);
   if (poly) {
     build_poly_multiplier(&b);
@@ -631,3 +673,7 @@ Step *step_build(Model *mod, const Method *me) {
   if (me->iteration != ITER_FIXED) build_newton(&b);
   return st;
 }
+
+Step *step_build(Model *mod, const Method *me) { return build_step(mod, me, 0); }
+
+Step *step_build_layout(Model *mod, const Method *me) { return build_step(mod, me, 1); }

@@ -23,6 +23,7 @@ typedef struct {
   int ***vrho;    /* s x nu x m: M^-1 rho_j[:, a], dense */
   int **vpsi;     /* s x m: M^-1 psi_j */
   int **theta;    /* s x m: the force's coefficients Theta_j of the sweep's result */
+  int lean;       /* step_build_layout: the rolled kernels' results as layout only */
 } Build;
 
 void step_section(Build *b, const char *label);       /* dag_section, labelled for b->owners */
@@ -40,8 +41,10 @@ void step_curvature(Build *b, const int *q, const int *v, int *hvv); /* v' Hess(
 void step_force_along(Build *b, const int *q, int **G, int *gmu);    /* grad g_a(q)' M^-1 grad U(q) */
 int step_coupled(Build *b, const IntVec *touch, int *pair, int a, int *out); /* constraints coupled with a */
 void step_result(Step *st, KernelId k, const char *name, SizeSym sym, int coef, int len, const int *nodes);
+void step_placeholder(Build *b, KernelId k, const char *name, SizeSym sym, int coef, int len); /* zeros: layout only */
 
 void build_const_multiplier(Build *b);
+void layout_const_multiplier(Build *b); /* its results' layout only (step_build_layout) */
 void build_poly_multiplier(Build *b);
 void build_mq_sweep(Build *b);       /* step_mq.c: M(q), no constraints */
 void build_mq_constrained(Build *b); /* step_mq.c: M(q) with constraints */
@@ -53,6 +56,7 @@ int *conditions(Build *b, int ***G, int ****R, const int *gam);         /* C_i a
 void build_projection(Build *b);                                        /* the kernel "project_p1" */
 int ***poly_stage_jacobians(Build *b);                        /* grad g at the stages: [l][a][entry] */
 int ****poly_jacobian_moments(Build *b, int ***G, int closed); /* R_jr = sum_l b_l P_j P_r G_l: [j][r][a][entry] */
+void layout_poly_multiplier(Build *b); /* the rolled form's layout only (step_build_layout) */
 
 /* step_newton.c: --iteration newton. A = T Lambda T^-1, the method's matrix
  * A[j][r] = sum_i X[j][i] sum_l b_l P_i(c_l) Ihat[l][r] in a real eigenbasis:

@@ -62,6 +62,9 @@ static void build_system(Build *b, int *lambda, int *pivot, int *adiag) {
   lu_solve_ordered(d, A, r, nu, lambda, pivot, adiag);
 }
 
+static const char sweep_what[] = "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
+                                 " * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)).";
+
 // The sweep of the constant-multiplier family: results gam, dp, and with
 // constraints lambda, the pivots of A and the diagonal entries they started
 // from (the step tests them for a singular A).
@@ -88,6 +91,18 @@ void build_const_multiplier(Build *b) {
   step_result(b->st, K_SWEEP, "pivot", SZ_NU, 1, nu, pivot);
   step_result(b->st, K_SWEEP, "adiag", SZ_NU, 1, nu, adiag);
   step_theta_result(b);
-  b->st->kern[K_SWEEP].what = "One fixed-point sweep: out = new gamma (S*M), p1 - p0 (M), lambda (NU),\n"
-                              " * pivots of the LU of A (NU), diagonal of A (NU), Theta_1.. (M*(S-1)).";
+  b->st->kern[K_SWEEP].what = sweep_what;
+}
+
+// The sweep's result blocks as build_const_multiplier lays them out, zeros:
+// for the rolled form, which prints the sweep as loops (emit_rolled.c).
+void layout_const_multiplier(Build *b) {
+  int m = b->m, s = b->s, nu = b->nu;
+  step_placeholder(b, K_SWEEP, "gam", SZ_SM, 1, s * m);
+  step_placeholder(b, K_SWEEP, "dp", SZ_M, 1, m);
+  step_placeholder(b, K_SWEEP, "lambda", SZ_NU, 1, nu);
+  step_placeholder(b, K_SWEEP, "pivot", SZ_NU, 1, nu);
+  step_placeholder(b, K_SWEEP, "adiag", SZ_NU, 1, nu);
+  step_placeholder(b, K_SWEEP, "theta", SZ_M, s - 1, (s - 1) * m);
+  b->st->kern[K_SWEEP].what = sweep_what;
 }

@@ -281,6 +281,16 @@ static long sweep_ops(Build *b, int **theta, const int *lam1) {
   return dag_count_ops(b->d, roots, s * m + n);
 }
 
+static const char project_what[] =
+    "The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the\n"
+    " * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)\n"
+    " * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,\n"
+    " * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its\n"
+    " * round-off scale sum_i |dg/dq_i q_i| (NU).";
+static const char sweep_what[] =
+    "One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),\n"
+    " * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)).";
+
 // The kernel "project_p1": at (q, p) = inputs (q0, p0), which the step sets to
 // (q1, p1), the correction dp = -G1 mu onto grad g(q1)' M^-1 p = 0, the
 // kinetic energy after it, U(q1), and the pivots of G1' M^-1 G1.
@@ -333,11 +343,7 @@ void build_projection(Build *b) {
   }
   step_result(st, K_PROJECT, "g", SZ_NU, 1, nu, g1);
   step_result(st, K_PROJECT, "gscale", SZ_NU, 1, nu, gscale);
-  st->kern[K_PROJECT].what = "The end of the step at (q0, p0) = (q1, p1): out = the correction -G1 mu onto the\n"
-                             " * hidden constraint (M), the kinetic energy after it (1), U(q1) (1), pivots (NU)\n"
-                             " * and diagonal (NU) of G1' M^-1 G1, the multiplier at the rescaled end,\n"
-                             " * beta^2 lamv - lamu, as lamv (NU) and lamu (NU), and g(q1) (NU) with its\n"
-                             " * round-off scale sum_i |dg/dq_i q_i| (NU).";
+  st->kern[K_PROJECT].what = project_what;
 }
 
 // The kernel "factor": the multiplier matrix A from grad g at the stages
@@ -412,7 +418,46 @@ void build_poly_multiplier(Build *b) {
   step_gamma_update(b, theta);
   step_result(st, K_SWEEP, "lam", SZ_SNU, 1, n, lam1);
   step_theta_result(b);
-  st->kern[K_SWEEP].what = "One fixed-point sweep with the frozen factor lu of A: out = new gamma (S*M),\n"
-                           " * p1 - p0 (M), the multiplier's Legendre coefficients (S*NU), Theta_1.. (M*(S-1)).";
+  st->kern[K_SWEEP].what = sweep_what;
   build_projection(b);
+}
+
+// The half band of the rolled form's multiplier matrix (emit_rolled_poly.c):
+// its unknowns in the order (a, r) -> a s + r, two constraints a, c that
+// share a coordinate couple all their s coefficients, so the band is
+// s (bw + 1) - 1 with bw the largest c - a of such a pair.
+int poly_band(const Model *mod, int s) {
+  int bw = 0, *lo = step_nodes(mod->m), *hi = step_nodes(mod->m);
+  for (int i = 0; i < mod->m; i++) lo[i] = hi[i] = -1;
+  for (int a = 0; a < mod->nu; a++)
+    for (int e = 0; e < mod->jac[a].n; e++) {
+      int i = mod->jac[a].e[e].coord;
+      if (lo[i] < 0) lo[i] = a;
+      hi[i] = a; /* (the columns in increasing a) */
+      if (hi[i] - lo[i] > bw) bw = hi[i] - lo[i];
+    }
+  return s * (bw + 1) - 1;
+}
+
+// The results of the polynomial family's kernels as build_poly_multiplier
+// lays them out, zeros, with the factor's lu as the rolled form stores it:
+// the band of the (s nu) x (s nu) matrix, 2 poly_band + 1 entries a row.
+void layout_poly_multiplier(Build *b) {
+  Step *st = b->st;
+  int m = b->m, nu = b->nu, s = b->s, n = s * nu, nlu = n * (2 * poly_band(b->mod, s) + 1);
+  st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
+  step_placeholder(b, K_FACTOR, "lu", SZ_ONE, nlu, nlu);
+  step_placeholder(b, K_FACTOR, "pivot", SZ_SNU, 1, n);
+  step_placeholder(b, K_FACTOR, "adiag", SZ_SNU, 1, n);
+  st->kern[K_FACTOR].what = "The multiplier matrix A at the predicted stages, factored once per step: out = its\n"
+                            " * band LU (rows and columns a S + r, A[u][w] at u W + w - u + BW), pivots (S*NU),\n"
+                            " * diagonal (S*NU).";
+  step_placeholder(b, K_SWEEP, "gam", SZ_SM, 1, s * m);
+  step_placeholder(b, K_SWEEP, "dp", SZ_M, 1, m);
+  step_placeholder(b, K_SWEEP, "lam", SZ_SNU, 1, n);
+  step_placeholder(b, K_SWEEP, "theta", SZ_M, s - 1, (s - 1) * m);
+  st->kern[K_SWEEP].what = sweep_what;
+  static const char *const name[] = {"dp", "kin", "U", "pivot", "adiag", "lamv", "lamu", "g", "gscale"};
+  for (int i = 0; i < 9; i++) step_placeholder(b, K_PROJECT, name[i], i == 0 ? SZ_M : i < 3 ? SZ_ONE : SZ_NU, 1, i == 0 ? m : i < 3 ? 1 : nu);
+  st->kern[K_PROJECT].what = project_what;
 }

@@ -59,8 +59,10 @@ void model_switches(Model *mod) {
   reach_bit(d, &mod->U, 1, mark, 1);
   reach_bit(d, mod->gradU, mod->m, mark, 1);
   reach_bit(d, mod->g, mod->nu, mark, 2);
+  IntVec jac = {0}; /* the Jacobian's entries, reached in one pass (a pass an entry was quadratic) */
   for (int a = 0; a < mod->nu; a++)
-    for (int e = 0; e < mod->jac[a].n; e++) reach_bit(d, &mod->jac[a].e[e].node, 1, mark, 2);
+    for (int e = 0; e < mod->jac[a].n; e++) intvec_push(&jac, mod->jac[a].e[e].node);
+  reach_bit(d, jac.v, jac.n, mark, 2); /* (jac.v is the arena's) */
   for (int id = 0; id < top; id++) most += mark[id] && nonsmooth((Op)d->nodes[id].op);
   mod->switch_nodes = arena_alloc((size_t)(most + 1) * sizeof(int));
   mod->switch_kinds = arena_alloc((size_t)(most + 1) * sizeof(int));

@@ -6,12 +6,19 @@
 # one (--rolled on), the two stepped alternately by bench/step/ab.c (medians
 # of CPU time; with no straight-line form the rolled one is run against
 # itself). Writes bench/results/rolled.csv.
+# With MULT=poly the same for the poly family (straight-line up to N = 16,
+# its straight-line C being about 5 times the const family's), into
+# bench/results/rolled_poly.csv.
 # Usage: bench/rolled/run.sh [N ...]   (default 8 16 32 64 128 256 512 1000)
 set -eu
 ns=${*:-8 16 32 64 128 256 512 1000}
-straight_max=${STRAIGHT_MAX:-128}
+mult=${MULT:-const}
+case $mult in
+  const) straight_max=${STRAIGHT_MAX:-128}; res=bench/results/rolled.csv ;;
+  poly) straight_max=${STRAIGHT_MAX:-16}; res=bench/results/rolled_poly.csv ;;
+  *) echo "rolled/run.sh: MULT is const or poly"; exit 1 ;;
+esac
 d=build/bench/rolled
-res=bench/results/rolled.csv
 mkdir -p "$d"
 gen=gen/hbvmgen
 now() { date +%s.%N; }
@@ -21,11 +28,11 @@ for N in $ns; do
   sed "s/^N = 8$/N = $N/" models/chain8.ham > "$d/chain$N.ham"
   # h: the step the chain's lean benchmark takes; 2000 / N steps (at least 10) a run
   nstep=$(( 2000 / N )); [ "$nstep" -ge 10 ] || nstep=10
-  $gen --multiplier const -s 4 --rolled on -n B -o "$d" "$d/chain$N.ham"
+  $gen --multiplier "$mult" -s 4 --rolled on -n B -o "$d" "$d/chain$N.ham"
   t0=$(now); cc -std=c99 -O2 -c "$d/B.c" -o "$d/B.o"; t1=$(now)
   rb=$(wc -c < "$d/B.c"); rcc=$(echo "$t1 - $t0" | bc)
   if [ "$N" -le "$straight_max" ]; then
-    $gen --multiplier const -s 4 --rolled off -n A -o "$d" "$d/chain$N.ham"
+    $gen --multiplier "$mult" -s 4 --rolled off -n A -o "$d" "$d/chain$N.ham"
     t0=$(now); cc -std=c99 -O2 -c "$d/A.c" -o "$d/A.o"; t1=$(now)
     sb=$(wc -c < "$d/A.c"); scc=$(echo "$t1 - $t0" | bc)
   else # the rolled solver against itself, as A
