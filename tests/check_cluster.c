@@ -35,21 +35,6 @@ static char *cluster_model(int n, int side);
 
 #define CLUSTER_STEPS 4000
 
-/* |H - H0| and max |g| of solver P over CLUSTER_STEPS steps of h. */
-#define CLUSTER_DRIFT(P, h, dH, dg)                                        \
-  do {                                                                     \
-    P##_state x;                                                           \
-    double g_[P##_NU];                                                     \
-    P##_init(&x, NULL, NULL);                                              \
-    double H0 = P##_energy(&x, NULL);                                      \
-    for (int n = 0; n < CLUSTER_STEPS; n++) {                              \
-      ck_assert_int_eq(P##_step(&x, (h), NULL, NULL), 0);                  \
-      P##_constraints(&x, NULL, g_);                                       \
-      (dH) = fmax((dH), fabs(P##_energy(&x, NULL) - H0));                  \
-      for (int i = 0; i < P##_NU; i++) (dg) = fmax((dg), fabs(g_[i]));     \
-    }                                                                      \
-  } while (0)
-
 /* U has degree 4 and g degree 2: k = 4 nodes at s = 2 integrate both
  * exactly (METHOD.md), so what is left is round-off, asserted with the
  * project's bound of issue 10 (1e-13, tests/check_poly.c) on g and on H
@@ -57,8 +42,8 @@ static char *cluster_model(int n, int side);
 START_TEST(test_conservation)
 {
   double dH = 0, dg = 0, dHc = 0, dgc = 0;
-  CLUSTER_DRIFT(cluster_k4s2, 0.02, dH, dg);
-  CLUSTER_DRIFT(cluster_straight_k4s2, 0.02, dHc, dgc);
+  SOLVER_DRIFT(cluster_k4s2, 0.02, CLUSTER_STEPS, dH, dg);
+  SOLVER_DRIFT(cluster_straight_k4s2, 0.02, CLUSTER_STEPS, dHc, dgc);
   printf("cluster: %d steps of 0.02: |H - H0| %.3g (poly), %.3g (const); |g| %.3g, %.3g\n", CLUSTER_STEPS, dH, dHc, dg,
          dgc);
   ck_assert_msg(dH <= 1e-13 && dHc <= 1e-13, "H off round-off: %.3g %.3g", dH, dHc);

@@ -180,21 +180,6 @@ START_TEST(test_same_state_functions)
 }
 END_TEST
 
-/* |H - H0| and max |g| of a rolled solver over NSTEPS steps of h. */
-#define DRIFT(P, h, dH, dg)                                                \
-  do {                                                                     \
-    P##_state x;                                                           \
-    double g_[P##_NU];                                                     \
-    P##_init(&x, NULL, NULL);                                              \
-    double H0 = P##_energy(&x, NULL);                                      \
-    for (int n = 0; n < NSTEPS; n++) {                                     \
-      ck_assert_int_eq(P##_step(&x, (h), NULL, NULL), 0);                  \
-      P##_constraints(&x, NULL, g_);                                       \
-      (dH) = fmax((dH), fabs(P##_energy(&x, NULL) - H0));                  \
-      for (int i = 0; i < P##_NU; i++) (dg) = fmax((dg), fabs(g_[i]));     \
-    }                                                                      \
-  } while (0)
-
 /* H is linear in y plus the kinetic energy and g quadratic, so k = s
  * nodes conserve both exactly (METHOD.md): what is left is round-off, a
  * few ulps of U's terms (|y| <= N) a step. The rolled poly family keeps
@@ -204,10 +189,10 @@ END_TEST
 START_TEST(test_conservation)
 {
   double dH[4] = {0, 0, 0, 0}, dg[4] = {0, 0, 0, 0};
-  DRIFT(chain_rolled_k4s4, 0.01, dH[0], dg[0]);
-  DRIFT(chain32_rolled_k2s2, 0.01, dH[1], dg[1]);
-  DRIFT(chainp_rolled_k4s4, 0.01, dH[2], dg[2]);
-  DRIFT(chain32p_rolled_k2s2, 0.01, dH[3], dg[3]);
+  SOLVER_DRIFT(chain_rolled_k4s4, 0.01, NSTEPS, dH[0], dg[0]);
+  SOLVER_DRIFT(chain32_rolled_k2s2, 0.01, NSTEPS, dH[1], dg[1]);
+  SOLVER_DRIFT(chainp_rolled_k4s4, 0.01, NSTEPS, dH[2], dg[2]);
+  SOLVER_DRIFT(chain32p_rolled_k2s2, 0.01, NSTEPS, dH[3], dg[3]);
   for (int f = 0; f < 4; f += 2) {
     printf("reroll: rolled %s chains: |H - H0| %.3g (8), %.3g (32); |g| %.3g, %.3g\n", f ? "poly" : "const", dH[f],
            dH[f + 1], dg[f], dg[f + 1]);

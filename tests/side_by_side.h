@@ -48,4 +48,20 @@ static inline double max_diff(double worst, const double *a, const double *b, in
     ck_assert_msg(worst_ <= (tol), "%s: the trajectories differ by %.3g", what, worst_);               \
   } while (0)
 
+/* |H - H0| and max |g| (into dH, dg: running maxima) of solver P over n
+ * steps of h from its default state (tests/check_reroll.c, check_cluster.c). */
+#define SOLVER_DRIFT(P, h, n, dH, dg)                                      \
+  do {                                                                     \
+    P##_state x;                                                           \
+    double g_[P##_NU];                                                     \
+    P##_init(&x, NULL, NULL);                                              \
+    double H0 = P##_energy(&x, NULL);                                      \
+    for (int n_ = 0; n_ < (n); n_++) {                                     \
+      ck_assert_int_eq(P##_step(&x, (h), NULL, NULL), 0);                  \
+      P##_constraints(&x, NULL, g_);                                       \
+      (dH) = fmax((dH), fabs(P##_energy(&x, NULL) - H0));                  \
+      for (int i = 0; i < P##_NU; i++) (dg) = fmax((dg), fabs(g_[i]));     \
+    }                                                                      \
+  } while (0)
+
 #endif
