@@ -88,7 +88,7 @@ void emit_mq_rescale(Emitter *e) {
           "    /* near rest a round-off in H is a large change of p (it is that over |v|): a\n"
           "     * discrepancy at round-off is corrected only where the correction is small (s = 2,\n"
           "     * tol 1e-10 from rest: 1000x the error without this test) */\n"
-          "    if (!(fabs$f(beta - 1) <= 1e-6) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n"
+          "    if (!(fabs$f(beta - 1) <= 1e-6$f) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n"
           "    for (i = 0; i < $P_M; i++) $P_add(&x->p[i], &x->pc[i], (beta - 1) * (x->p[i] - x->pc[i]));\n"
           "    x->H0 = H0;\n");
   if (!e->mod->mass_q) tmpl(e, "    x->Hend = $P_energy(x, prm);\n");
@@ -101,5 +101,5 @@ void emit_mq_rescale(Emitter *e) {
 // global error without it, 0.3 tol with it; tests/check_mq_fourbar.c).
 void emit_mq_near_rest(Emitter *e) {
   tmpl(e, "  /* M(q): near rest a round-off in H is a large change of p: corrected only where small */\n"
-          "  if (!(fabs$f(beta - 1) <= 1e-6) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n");
+          "  if (!(fabs$f(beta - 1) <= 1e-6$f) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n");
 }

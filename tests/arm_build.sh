@@ -6,7 +6,7 @@
 # compile for a Cortex-M4 with a single-precision FPU, freestanding and
 # warning-free, and its undefined symbols must be <math.h> functions or the
 # compiler's run-time helpers (__aeabi_*): no malloc, memcpy, printf, ...
-# One model generated with --real float must moreover call no
+# Models generated with --real float (rescaled, constrained, M(q)) must call no
 # double-precision math function (sqrtf, not sqrt), and models generated with
 # --wide-step (long double, which is double on this target) must compile too.
 # Exit status: 0 pass, 1 fail, 77 when arm-none-eabi-gcc is not installed
@@ -65,7 +65,7 @@ echo "arm_build.sh: $n committed solvers compiled for cortex-m4 (fpv4-sp-d16, -f
 # q0, p0, NAME_energy, NAME_constraints, NAME_hidden, NAME_project, the
 # statistics).
 FMATH=$(for f in $MATH; do printf '%sf ' "$f"; done)
-for model in kepler pendulum_angle satellites; do
+for model in kepler pendulum_angle satellites double_pendulum_angles; do
   mkdir -p "$tmp/$model"
   if ! "$GEN" --real float -s 2 -n "${model}_f" -o "$tmp/$model" "../models/$model.ham" 2>"$tmp/log"; then
     echo "arm_build.sh: hbvmgen --real float failed on $model.ham:"
