@@ -64,6 +64,11 @@ void emit_mq_carry(Emitter *e) {
           "      if (ps > 0) pi /= ps;\n      if (pi > inc) inc = pi;\n    }\n");
 }
 
+// Near rest no rescale where beta is not within 1e-6 of 1 and H(q1, p1) -
+// H0 is round-off (a round-off in H is a large change of p there): the test
+// printed by both ends of step that rescale, after their beta.
+static const char near_rest_test[] = "if (!(fabs$f(beta - 1) <= 1e-6$f) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n";
+
 // After the commit (compensated sums): p1 rescaled, p1 = beta p1, so that
 // H(q1, p1) = H0, as the poly family's end of step does (T is quadratic in
 // p for any M(q)). H0 is taken anew on the first step, or where H(q0, p0)
@@ -88,8 +93,9 @@ void emit_mq_rescale(Emitter *e) {
           "    /* near rest a round-off in H is a large change of p (it is that over |v|): a\n"
           "     * discrepancy at round-off is corrected only where the correction is small (s = 2,\n"
           "     * tol 1e-10 from rest: 1000x the error without this test) */\n"
-          "    if (!(fabs$f(beta - 1) <= 1e-6$f) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n"
-          "    for (i = 0; i < $P_M; i++) $P_add(&x->p[i], &x->pc[i], (beta - 1) * (x->p[i] - x->pc[i]));\n"
+          "    ");
+  tmpl(e, near_rest_test);
+  tmpl(e, "    for (i = 0; i < $P_M; i++) $P_add(&x->p[i], &x->pc[i], (beta - 1) * (x->p[i] - x->pc[i]));\n"
           "    x->H0 = H0;\n");
   if (!e->mod->mass_q) tmpl(e, "    x->Hend = $P_energy(x, prm);\n");
   tmpl(e, "  }\n");
@@ -101,5 +107,6 @@ void emit_mq_rescale(Emitter *e) {
 // global error without it, 0.3 tol with it; tests/check_mq_fourbar.c).
 void emit_mq_near_rest(Emitter *e) {
   tmpl(e, "  /* M(q): near rest a round-off in H is a large change of p: corrected only where small */\n"
-          "  if (!(fabs$f(beta - 1) <= 1e-6$f) && fabs$f(H0 - U1 - K) <= 64 * $P_TOL * (K + fabs$f(U1))) beta = 1;\n");
+          "  ");
+  tmpl(e, near_rest_test);
 }
