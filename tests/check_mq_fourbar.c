@@ -268,6 +268,8 @@ START_TEST(fourbar_float_energy_bounded) {
   const Solver *sv = &solvers[FBFLOAT];
   double dH = mq_float_drift(&sv->sv, &state, fourbar_energy, fourbar_potential, 0.05, 2000), H, g[2], hid[2];
   sv->inv(&state, &H, g, hid);
+  if (mq_table())
+    printf("float: four-bar: |g| %.1e, hidden %.1e at the end\n", fmax(fabs(g[0]), fabs(g[1])), fmax(fabs(hid[0]), fabs(hid[1])));
   ck_assert_msg(dH <= 16.0, "float four-bar: |H - H0| %.1f ulps of |K| + |U|", dH);
   for (int a = 0; a < 2; a++) {
     ck_assert_msg(fabs(g[a]) <= 16 * FLT_EPSILON * (L0 + L1 + L2 + L3), "float four-bar: g %.3e", g[a]);
