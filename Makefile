@@ -42,7 +42,7 @@ SOLV_OBJ := $(addprefix $(B)/generated/,$(addsuffix .o,$(SOLVERS)))
 # test-only models (tests/models/LIST), generated at build time
 TSOLVERS := $(shell grep -v '^\#' tests/models/LIST | awk 'NF {sub(/:.*/, "", $$1); print $$1 "_k" $$2 "s" $$3}')
 TSOLV_OBJ:= $(addprefix $(B)/tgen/,$(addsuffix .o,$(TSOLVERS)))
-TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c tests/solvers.c tests/generate.c
+TEST_SRC := $(wildcard tests/check_*.c) tests/ref.c tests/paper.c tests/solvers.c tests/generate.c tests/mq_common.c
 TEST_OBJ := $(patsubst tests/%.c,$(B)/tests/%.o,$(TEST_SRC))
 
 

@@ -116,6 +116,7 @@ void emit_mq_start(Emitter *e);
 void emit_mq_carry(Emitter *e);
 void emit_mq_rescale(Emitter *e);
 void emit_mq_near_rest(Emitter *e); /* with constraints, in emit_end_poly */
+int emit_mq_near_rest_band(const Emitter *e); /* the near-rest test's band, in TOL */
 
 /* emit_step.c: NAME_step_within as named blocks */
 void emit_step(Emitter *e);
