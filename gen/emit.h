@@ -72,6 +72,8 @@ void rolled_gamma(Emitter *e, int results);     /* gamma from th[] in the loop o
 /* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */
 void rolled_poly_helpers(Emitter *e);
 void rolled_poly_kernel(Emitter *e, KernelId k);
+/* emit_rolled_batch.c: NAME_batch_KERNEL of a rolled kernel, the scalar one per lane */
+void emit_rolled_lane_kernel(Emitter *e, KernelId k);
 
 /* emit_choice.c: what the model, method and options choose for the step */
 int step_order(const Emitter *e);

@@ -653,9 +653,10 @@ static int block_first(const Kernel *k, const char *name) {
 
 // Whether the batch sweep prints the lane test's reductions of its results
 // (emit_lane_reductions): when it is one function, so that its results are
-// still at hand in its loop over the lanes.
+// still at hand in its loop over the lanes (not the rolled form's, which
+// runs the scalar sweep in each lane: emit_rolled_batch.c).
 int sweep_reduces(const Emitter *e) {
-  return e->lanes && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES;
+  return e->lanes && !e->roll && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES;
 }
 
 // In the batch sweep's loop over the lanes, after its results: the three
