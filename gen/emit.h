@@ -61,6 +61,7 @@ void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, 
 void emit_tables(Emitter *e);
 int kernel_inlinable(const Emitter *e, KernelId k);
 int sweep_reduces(const Emitter *e);
+int lane_skips(const Emitter *e, const Kernel *k); /* the kernel takes skip[] after out[] */
 int emit_kernel_inline(Emitter *e, KernelId k);
 
 /* emit_rolled.c: kernel k in the rolled form (e->roll), 1; 0 when it has none */

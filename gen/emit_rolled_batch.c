@@ -10,7 +10,11 @@
  * back. Each lane so does exactly the operations of the scalar kernel that
  * NAME_step calls, in its order, and the batch step's lanes stay bitwise
  * NAME_step (docs/api.md, "Batches"). The lanes are not vectorised across:
- * the rolled kernels' loops run over the coordinates (docs/rolled.md). */
+ * the rolled kernels' loops run over the coordinates (docs/rolled.md). So
+ * the sweep does not repeat the last sweep of a lane that has stopped
+ * iterating while others go on, as the straight-line lanes do for free in
+ * SIMD: the batch step passes skip[] (those lanes) and keeps their results
+ * in its buffers (emit_batch_step.c), and the sweep copies them over. */
 #include "emit.h"
 
 // Whether input slot i of the kernels is an argument of their signature.
@@ -31,6 +35,10 @@ void emit_rolled_lane_kernel(Emitter *e, KernelId id) {
     if (in_signature(st, i) && !st->in[i].scalar)
       tmplf(e, "  $R l_%s[%d];  /* the lane's %s */\n", st->in[i].name, st->in[i].len > 0 ? st->in[i].len : 1, st->in[i].name);
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n");
+  if (lane_skips(e, k)) /* the batch step swaps its two buffers: gam is the last sweep's results */
+    tmplf(e, "    if (skip[l]) {  /* the lane stopped iterating: its last sweep's results again */\n"
+             "      for (i = 0; i < %d; i++) out[i * $P_W + l] = gam[i * $P_W + l];\n"
+             "      continue;\n    }\n", kernel_size(k));
   for (int p = 0; p < mod->nparams; p++) out(e, "    pl.%s = prm[%d * %s_W + l];\n", mod->params[p].name, p, e->P);
   if (!mod->nparams) out(e, "    pl.unused_ = 0;\n");
   for (int i = 0; i < IN_COUNT; i++) /* an input the caller passes as 0 the kernel does not read */
