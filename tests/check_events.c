@@ -1,6 +1,6 @@
 /* check_events.c - events, --stop-at and --dt in the driver, on solvers of
  * tests/models/pendulum_events.ham and kepler_events.ham run through hbvmrt_main as a generated driver
- * runs them (the adapters below are emit_main.c's).
+ * runs them (the adapters of driver_adapters.h are emit_main.c's).
  *
  *   pendulum  x = 0 is crossed every half period 2 K(1/2) (amplitude pi/3,
  *             K the complete elliptic integral, GSL's gsl_sf_ellint_Kcomp):
