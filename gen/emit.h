@@ -61,6 +61,7 @@ void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, 
 void emit_tables(Emitter *e);
 int kernel_inlinable(const Emitter *e, KernelId k);
 int sweep_reduces(const Emitter *e);
+int lane_skips(const Emitter *e, const Kernel *k); /* the kernel takes skip[] after out[] */
 int emit_kernel_inline(Emitter *e, KernelId k);
 
 /* emit_rolled.c: kernel k in the rolled form (e->roll), 1; 0 when it has none */
@@ -72,6 +73,8 @@ void rolled_gamma(Emitter *e, int results);     /* gamma from th[] in the loop o
 /* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */
 void rolled_poly_helpers(Emitter *e);
 void rolled_poly_kernel(Emitter *e, KernelId k);
+/* emit_rolled_batch.c: NAME_batch_KERNEL of a rolled kernel, the scalar one per lane */
+void emit_rolled_lane_kernel(Emitter *e, KernelId k);
 
 /* emit_choice.c: what the model, method and options choose for the step */
 int step_order(const Emitter *e);

@@ -123,6 +123,10 @@ static void emit_lane_test(Emitter *e, int poly) {
     tmpl(e, "  *nfresh = 0;\n  if (nrun > 0 && it >= 2) {\n    $M any = 0;\n"
             "    for (l = 0; l < $P_W; l++) any |= fresh[l] = run[l] & (inc[l] > incp[l] / 8);\n"
             "    *nfresh = (int)any;\n  }\n");
+  if (e->roll) { /* the rolled sweep copies a stopped lane's results (skip): nothing to restore */
+    tmpl(e, "  (void)go;\n  (void)ngo;\n  (void)it;\n  return nrun;\n}\n\n");
+    return;
+  }
   tmpl(e, "  if (nrun > 0 && nrun < ngo && it < $P_MAXITER) {  /* the lanes that stopped keep their gamma for the next sweeps */\n"
           "    $M keep[$P_W], any = 0;\n"
           "    for (l = 0; l < $P_W; l++) any |= keep[l] = go[l] & (run[l] == 0);\n"
@@ -435,6 +439,7 @@ static void emit_step_body(Emitter *e, int adaptive) {
           "  $R *in = swb[0], *sw = swb[1];  /* the sweep reads gamma (and lam) in in, writes sw */\n"
           "  $R inc[$P_W], incp[$P_W], inc_min[$P_W];\n");
   if (adaptive) tmpl(e, "  $R ref[$P_S * $P_M * $P_W], d1[$P_W], est[$P_W];\n  $M two[$P_W], cl[$P_W];\n");
+  if (e->roll) tmpl(e, "  $M skip[$P_W];  /* the lanes the rolled sweep does not repeat */\n");
   tmpl(e, "  $M rc[$P_W], stall[$P_W], iters[$P_W];  /* as wide as the reals, as the masks: vectorised with them */\n  $M go[$P_W], act[$P_W];\n"
           "  int it, i, l, nrun = 0, ngo, nfail = 0, idle = 0, bad_h = !(h != 0 && isfinite(h));\n"
           "  $M rc0 = bad_h ? $P_EBADSTEP : $P_ENOCONV;\n");
@@ -475,8 +480,8 @@ static void emit_step_body(Emitter *e, int adaptive) {
             "  for (l = 0; l < $P_W; l++) go[l] = 1;\n"
             "  $P_batch_pivots(fa, go, rc);\n");
   char call[160];
-  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=in h=h%s%s prm=par out=sw);\n", nu ? " g0=g0" : "",
-           poly ? " lam=lin lu=fa" : mq ? " pth=pin" : "");
+  snprintf(call, sizeof call, "    $(sweep q0=x->q p0=x->p gam=in h=h%s%s prm=par out=sw%s);\n", nu ? " g0=g0" : "",
+           poly ? " lam=lin lu=fa" : mq ? " pth=pin" : "", e->roll ? " skip=skip" : "");
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n    go[l] = rc[l] == $P_ENOCONV;  /* first: the lane iterates */\n"
           "    act[l] = go[l];\n    nrun += (int)go[l];\n");
   tmpl(e, adaptive ? "    early |= (rc[l] != $P_OK) & !go[l];\n  }\n"
@@ -498,6 +503,8 @@ static void emit_step_body(Emitter *e, int adaptive) {
             "        $M stop = fresh[l] & (rc[l] != $P_ENOCONV);\n"
             "        iters[l] = stop ? it : iters[l];\n        act[l] = stop ? 0 : act[l];\n        nrun -= (int)stop;\n"
             "      }\n    }\n");
+  if (e->roll) /* the lanes that stopped in this step: the rolled sweep copies their results */
+    tmpl(e, "    for (l = 0; l < $P_W; l++) skip[l] = go[l] & (act[l] == 0);\n");
   tmpl(e, call);
   if (adaptive)
     tmpl(e, "    if (it == 1 && $P_batch_first(x, h, tol, sw, in, ref, two, go, cl, d1, est, rc)) {\n"

@@ -122,8 +122,8 @@ static void offset_of(const Emitter *e, const char *text, const char *end, int p
 static void kernel_call(Emitter *e, const char *text, const char *end) {
   size_t n = strcspn(text, " )");
   KernelId k = kernel_named(e, text, n);
-  const char *val[IN_COUNT + 2] = {0}; /* the inputs, then prm and out */
-  size_t vlen[IN_COUNT + 2] = {0};
+  const char *val[IN_COUNT + 3] = {0}; /* the inputs, then prm, out and skip */
+  size_t vlen[IN_COUNT + 3] = {0};
   for (const char *p = text + n; p < end;) {
     while (*p == ' ') p++;
     size_t nl = strcspn(p, "="), vl = strcspn(p + nl + 1, " )");
@@ -132,6 +132,7 @@ static void kernel_call(Emitter *e, const char *text, const char *end) {
       if (strlen(e->st->in[i].name) == nl && !strncmp(e->st->in[i].name, p, nl)) slot = i;
     if (nl == 3 && !strncmp(p, "prm", 3)) slot = IN_COUNT;
     if (nl == 3 && !strncmp(p, "out", 3)) slot = IN_COUNT + 1;
+    if (nl == 4 && !strncmp(p, "skip", 4)) slot = IN_COUNT + 2; /* the rolled batch sweep's (kernel_signature) */
     if (slot < 0) internal_error("template passes an unknown argument '%.*s'", (int)nl, p);
     val[slot] = p + nl + 1;
     vlen[slot] = vl;
@@ -140,8 +141,10 @@ static void kernel_call(Emitter *e, const char *text, const char *end) {
   fprintf(e->f, "%s_%s%s(", e->P, e->lanes ? "batch_" : "", e->st->kern[k].name);
   for (int i = 0; i < IN_COUNT; i++)
     if (e->st->in[i].len || i < IN_LAM) fprintf(e->f, "%.*s, ", val[i] ? (int)vlen[i] : 1, val[i] ? val[i] : "0");
-  fprintf(e->f, "%.*s, %.*s)", val[IN_COUNT] ? (int)vlen[IN_COUNT] : 3, val[IN_COUNT] ? val[IN_COUNT] : "prm",
+  fprintf(e->f, "%.*s, %.*s", val[IN_COUNT] ? (int)vlen[IN_COUNT] : 3, val[IN_COUNT] ? val[IN_COUNT] : "prm",
           (int)vlen[IN_COUNT + 1], val[IN_COUNT + 1] ? val[IN_COUNT + 1] : "");
+  if (val[IN_COUNT + 2]) fprintf(e->f, ", %.*s", (int)vlen[IN_COUNT + 2], val[IN_COUNT + 2]);
+  fputc(')', e->f);
 }
 
 // Print text, replacing $P by the prefix, $R by the real type name, $M by
@@ -468,6 +471,11 @@ static int lane_inlined(const Emitter *e, const Kernel *k) {
   return 0;
 }
 
+// Whether kernel k takes the lanes to skip after out[]: the rolled form's
+// batch sweep, which copies a skipped lane's last results instead of
+// sweeping it again (emit_rolled_batch.c).
+int lane_skips(const Emitter *e, const Kernel *k) { return e->lanes && e->roll && k == &e->st->kern[K_SWEEP]; }
+
 // The signature of kernel k (of its part-th part when part >= 0): one
 // argument per input block of the Step, then the parameters and out[].
 void kernel_signature(Emitter *e, const Kernel *k, int part) {
@@ -486,7 +494,9 @@ void kernel_signature(Emitter *e, const Kernel *k, int part) {
   if (e->lanes) out(e, "const %s *restrict prm, ", t);
   else tmpl(e, "const $P_params *prm, ");
   if (part >= 0) out(e, "%s %sw, ", t, rs);
-  out(e, "%s %sout)\n{\n ", t, rs);
+  out(e, "%s %sout", t, rs);
+  if (lane_skips(e, k)) tmpl(e, ", const $M *restrict skip");
+  out(e, ")\n{\n ");
   for (int i = 0; i < IN_COUNT; i++)
     if (st->in[i].len || i < IN_LAM) out(e, " (void)%s;", st->in[i].name);
   out(e, " (void)prm;%s\n", part >= 0 ? " (void)w; (void)out;" : "");
@@ -653,9 +663,10 @@ static int block_first(const Kernel *k, const char *name) {
 
 // Whether the batch sweep prints the lane test's reductions of its results
 // (emit_lane_reductions): when it is one function, so that its results are
-// still at hand in its loop over the lanes.
+// still at hand in its loop over the lanes (not the rolled form's, which
+// runs the scalar sweep in each lane: emit_rolled_batch.c).
 int sweep_reduces(const Emitter *e) {
-  return e->lanes && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES;
+  return e->lanes && !e->roll && kernel_ops(e, K_SWEEP, NULL) <= PART_NODES;
 }
 
 // In the batch sweep's loop over the lanes, after its results: the three

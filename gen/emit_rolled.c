@@ -446,6 +446,10 @@ int emit_rolled_kernel(Emitter *e, KernelId id) {
   if (id != K_SWEEP && id != K_MINV_P && id != K_ENERGY && id != K_G && id != K_HIDDEN && id != K_LAMBDA0 &&
       id != K_CONSISTENT && !(poly && (id == K_FACTOR || id == K_PROJECT)))
     return 0; /* the params' q0, p0 and the events stay straight-line: they are small or rare */
+  if (e->lanes) { /* --batch: the scalar kernel above in each lane (emit_rolled_batch.c) */
+    emit_rolled_lane_kernel(e, id);
+    return 1;
+  }
   if (!e->roll_helpers) emit_helpers(e);
   const Kernel *k = &e->st->kern[id];
   e->kid = id;

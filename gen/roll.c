@@ -307,7 +307,6 @@ static Roll *analyse_roll(Model *mod, const char **why) {
 static const char *not_covered(const Model *mod, const Method *me, const EmitOptions *eo) {
   if (me->iteration != ITER_FIXED) return "it covers --iteration fixed only";
   if (eo->wide_step) return "it does not cover --wide-step";
-  if (eo->batch) return "it does not cover --batch";
   if (mod->mass_q || mod->minv_node || mod->mass == MASS_DENSE) return "it covers a constant diagonal mass matrix only";
   return NULL;
 }

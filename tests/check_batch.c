@@ -27,6 +27,12 @@
 #include "bpoly_k3s3.h"
 #include "bsat_k6s2.h"
 #include "bsatpoly_k6s2.h"
+#include "brchain_k4s4.h"
+#include "brchainp_k4s4.h"
+#include "brchain32_k2s2.h"
+#include "brchain32p_k2s2.h"
+#include "brchain32f_k2s2.h"
+#include "brfpu_k2s2.h"
 
 /* Lane l starts from the model's initial values after l scalar steps of
  * h (1 + l / 8), so the lanes differ in state and in the previous step (lane
@@ -114,6 +120,13 @@ BATCH_TEST_FAIL(bdpa_k2s2, 0.05, 12, 1)
 BATCH_TEST_FAIL(bdpafloat_k2s2, 0.05, 12, 1)
 BATCH_TEST_FAIL(barm_k3s3, 0.05, 12, 1)
 BATCH_TEST_FAIL(barmk_k18s3, 0.05, 8, 1) /* the sweep in parts: the lane test's own reductions */
+/* the rolled form (--rolled on, docs/rolled.md): the scalar rolled kernels in each lane */
+BATCH_TEST(brchain_k4s4, 0.005, 8)
+BATCH_TEST(brchainp_k4s4, 0.005, 8)
+BATCH_TEST(brchain32_k2s2, 0.005, 8)
+BATCH_TEST(brchain32p_k2s2, 0.005, 8)
+BATCH_TEST(brchain32f_k2s2, 0.005, 8)
+BATCH_TEST_FAIL(brfpu_k2s2, 0.01, 12, 1) /* params per lane, no constraints */
 
 /* NAME_batch_step_adaptive, lanes sharing h: from the model's initial values
  * with lane l's momenta scaled by 1 + l / 16 (lane 1 idle), NSTEP steps at
@@ -197,6 +210,10 @@ ADAPTIVE_TEST(bfloatpoly_k2s2, 0.5, 1e-4, 20)
 ADAPTIVE_TEST_MQ(bdpa_k2s2, 0.5, 1e-8, 30, 1)
 ADAPTIVE_TEST_MQ(barm_k3s3, 0.5, 1e-8, 30, 1)
 ADAPTIVE_TEST_MQ(bdpafloat_k2s2, 0.5, 1e-4, 20, 1)
+ADAPTIVE_TEST(brchain_k4s4, 0.05, 1e-6, 20)
+ADAPTIVE_TEST(brchainp_k4s4, 0.5, 1e-8, 20)
+ADAPTIVE_TEST(brchain32p_k2s2, 0.05, 1e-6, 20)
+ADAPTIVE_TEST(brfpu_k2s2, 0.05, 1e-6, 20)
 
 /* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
 START_TEST(test_defaults_and_idle) {
@@ -273,6 +290,16 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_adaptive_bdpa_k2s2);
   tcase_add_test(tc, test_adaptive_barm_k3s3);
   tcase_add_test(tc, test_adaptive_bdpafloat_k2s2);
+  tcase_add_test(tc, test_brchain_k4s4);
+  tcase_add_test(tc, test_brchainp_k4s4);
+  tcase_add_test(tc, test_brchain32_k2s2);
+  tcase_add_test(tc, test_brchain32p_k2s2);
+  tcase_add_test(tc, test_brchain32f_k2s2);
+  tcase_add_test(tc, test_brfpu_k2s2);
+  tcase_add_test(tc, test_adaptive_brchain_k4s4);
+  tcase_add_test(tc, test_adaptive_brchainp_k4s4);
+  tcase_add_test(tc, test_adaptive_brchain32p_k2s2);
+  tcase_add_test(tc, test_adaptive_brfpu_k2s2);
   suite_add_tcase(s, tc);
   return s;
 }

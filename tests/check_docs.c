@@ -13,6 +13,9 @@
  *     model's columns; DESTDIR stages without changing the prefix;
  *   - the man page and docs/api.md document every option of `hbvmgen
  *     --help`, and --help every option of the man page;
+ *   - what docs/rolled.md says `--rolled on` refuses is refused, and what
+ *     it, --help and the man page say the rolled form covers (--batch) is
+ *     rolled;
  *   - no source comment cites a section of the retired SPEC (docs/ is the
  *     contract), --check's output names no source file of the generator,
  *     and every relative link of README.md and of the pages in docs/ names
@@ -31,6 +34,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "generate.h"
 #include "hbvmrt.h"
 
 Suite *docs_suite(void);
@@ -482,6 +486,50 @@ START_TEST(stack_bound_holds)
 }
 END_TEST
 
+/* Whether word occurs in the text from a to b. */
+static int span_has(const char *a, const char *b, const char *word)
+{
+  size_t n = strlen(word);
+  for (const char *p = a; p + n <= b; p++)
+    if (!strncmp(p, word, n)) return 1;
+  return 0;
+}
+
+/* The rolled form's coverage (docs/rolled.md, --help, docs/hbvmgen.1) is
+ * the generator's: each option of rolled.md's bullet under "`--rolled on`
+ * refuses" is refused with --rolled on on the chain of 8, and --batch,
+ * which all three say is covered, is rolled. */
+START_TEST(rolled_coverage_documented)
+{
+  char *doc = slurp("../docs/rolled.md"), *man = slurp("../docs/hbvmgen.1"), *chain = slurp("../models/chain8.ham");
+  char flags[160], help[8192];
+  ck_assert(doc && man && chain);
+  const char *list = strstr(doc, "`--rolled on` refuses"), *q;
+  ck_assert_ptr_nonnull(list);
+  list = strstr(list, "\n- `");
+  ck_assert_ptr_nonnull(list);
+  const char *end = strchr(list + 1, '\n');
+  int refused = 0;
+  for (const char *p = strchr(list, '`'); p && p < end && (q = strchr(p + 1, '`')); p = strchr(q + 1, '`')) {
+    snprintf(flags, sizeof flags, "-s 2 --rolled on %.*s", (int)(q - p - 1), p + 1);
+    ck_assert_msg(!generate_source(chain, flags), "docs/rolled.md says --rolled on refuses %.*s; it did not",
+                  (int)(q - p - 1), p + 1);
+    refused++;
+  }
+  ck_assert_int_ge(refused, 2);
+  char *b = generate_source(chain, "-s 2 --rolled on --batch 2");
+  ck_assert_msg(b && strstr(b, "(rolled)"), "the rolled form does not cover --batch");
+  free(b);
+  ck_assert_msg(strstr(doc, "`--batch W`") && !strstr(list, "--batch"), "docs/rolled.md: --batch is covered");
+  ck_assert_int_eq(generator_output("--help", help, sizeof help), 0);
+  const char *entry = strstr(help, "--rolled auto|on|off"), *next = entry ? strstr(entry, "\n  -") : NULL;
+  ck_assert_msg(entry && next && span_has(entry, next, "--batch"), "--help: --rolled covers --batch");
+  const char *mentry = strstr(man, "\\-\\-rolled \" auto|on|off\""), *mnext = mentry ? strstr(mentry, ".TP") : NULL;
+  ck_assert_msg(mentry && mnext && span_has(mentry, mnext, "\\-\\-batch"), "docs/hbvmgen.1: --rolled covers --batch");
+  free(doc), free(man), free(chain);
+}
+END_TEST
+
 Suite *docs_suite(void)
 {
   Suite *s = suite_create("docs");
@@ -493,6 +541,7 @@ Suite *docs_suite(void)
   tcase_add_test(tc, install_and_pkg_config);
   tcase_add_test(tc, man_page_and_api_cover_help);
   tcase_add_test(tc, help_covers_man_page);
+  tcase_add_test(tc, rolled_coverage_documented);
   tcase_add_test(tc, driver_options_documented);
   tcase_add_test(tc, no_pointers_to_sources);
   tcase_add_test(tc, relative_links_resolve);

@@ -3,9 +3,13 @@
  * step and --batch W (W = 1, 3, 4), on 1 and 2 OpenMP threads (also with a
  * mass matrix M(q): models/double_pendulum_angles.ham), and on 1 and 2 MPI
  * ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI);
- * a trajectory ends where a single run ends (-T hit exactly, --tol). */
+ * a trajectory ends where a single run ends (-T hit exactly, --tol); a
+ * rolled model (--rolled on, docs/rolled.md) gives the same summary with
+ * --batch W as without, on 2 threads and 2 MPI ranks, and the straight-line
+ * form's rows to the reordering of sums. */
 #define _POSIX_C_SOURCE 200809L
 #include <check.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -117,6 +121,18 @@ START_TEST(test_independent_of_w_and_threads)
 }
 END_TEST
 
+/* The launcher of the runs on 2 MPI ranks (loopback). */
+static const char mpirun[] = "OMPI_MCA_btl=self,vader OMPI_MCA_plm_rsh_agent=false timeout 120 mpirun --allow-run-as-root "
+                             "--oversubscribe -np 2";
+
+/* Whether MPI is installed; says so on stderr when it is not. */
+static int have_mpi(void)
+{
+  if (sh("command -v mpicc >/dev/null && command -v mpirun >/dev/null") == 0) return 1;
+  fprintf(stderr, "check_ensemble: MPI is not installed (scripts/deps.sh mpi): the test on 2 ranks is skipped\n");
+  return 0;
+}
+
 START_TEST(test_sweep_and_mpi)
 {
   char *one, *got;
@@ -130,15 +146,12 @@ START_TEST(test_sweep_and_mpi)
   got = run("", "mpb", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 2", "s2.csv", 0);
   ck_assert_msg(!strcmp(got, one), "--sweep with --batch 4 on 2 threads differs");
   free(got);
-  if (sh("command -v mpicc >/dev/null && command -v mpirun >/dev/null") != 0) {
-    fprintf(stderr, "check_ensemble: MPI is not installed (scripts/deps.sh mpi): the test on 2 ranks is skipped\n");
+  if (!have_mpi()) {
     free(one);
     return;
   }
   build("mpm", "models/mass_param.ham", "-s 2 --batch 4", 1);
   build("mps", "models/mass_param.ham", "-s 2", 1);
-  const char *mpirun = "OMPI_MCA_btl=self,vader OMPI_MCA_plm_rsh_agent=false timeout 120 mpirun --allow-run-as-root "
-                       "--oversubscribe -np 2";
   got = run(mpirun, "mpm", "--sweep m1=1:3:11 -h 0.05 -N 200 --threads 1", "s3.csv", 0);
   ck_assert_msg(!strcmp(got, one), "--sweep with --batch 4 on 2 MPI ranks differs");
   free(got);
@@ -225,6 +238,77 @@ START_TEST(test_mass_q)
     }
     ck_assert_msg(!strcmp(one, bat), "%s: --batch 4 differs from the scalar step", args);
     free(one), free(bat);
+  }
+}
+END_TEST
+
+/* The largest difference between the summaries a and b (the same header and
+ * trajectories) in the columns t .. H of a row (its final state, multiplier
+ * and energy); each row's trajectory, status and steps must be equal. The
+ * other columns are round-off's maxima and iteration counts. */
+static double rows_apart(const char *a, const char *b)
+{
+  const char *h = strstr(a, ",max_dH,");
+  ck_assert_ptr_nonnull(h);
+  int ncol = 0;
+  for (const char *c = a; c < h; c++) ncol += *c == ',';
+  double worst = 0;
+  const char *ra = strchr(a, '\n'), *rb = strchr(b, '\n');
+  for (; ra && rb && ra[1] && rb[1]; ra = strchr(ra + 1, '\n'), rb = strchr(rb + 1, '\n')) {
+    char *pa = (char *)ra + 1, *pb = (char *)rb + 1;
+    for (int k = 0; k <= ncol; k++) {
+      double x = strtod(pa, &pa), y = strtod(pb, &pb);
+      if (k < 3) ck_assert_msg(x == y, "column %d of a row: %g, %g", k + 1, x, y);
+      else worst = fmax(worst, fabs(x - y));
+      ck_assert(*pa == ',' && *pb == ',');
+      pa++, pb++;
+    }
+  }
+  ck_assert_msg(!ra == !rb, "not the same number of rows");
+  return worst;
+}
+
+/* A rolled model (issue 29): the chain of 8 pendula rolled (--rolled on),
+ * both multiplier families, swept over the last mass's initial momentum with
+ * fixed and adaptive steps. The rolled batch lanes are the rolled step
+ * bitwise, so --batch 4 (const) and 3 (poly) on 2 threads, and on 2 MPI
+ * ranks, write the scalar run's summary byte for byte; the straight-line
+ * form's rows agree to the reordering bound of docs/rolled.md with fixed
+ * steps, and to the runs' error with --tol (below). */
+START_TEST(test_rolled)
+{
+  static const char *const how[] = {"--sweep 'p_y[8]=0:0.5:7' -h 0.01 -N 200 --threads 2",
+                                    "--sweep 'p_y[8]=0:0.5:7' --tol 1e-8 -T 2 --threads 2"};
+  static const char *const fam[] = {"--multiplier const", ""};
+  /* fixed steps: the reordering bound; --tol: the two forms choose their steps
+   * from estimates that differ by round-off, so each is a run within its own
+   * error, at most 30 tol (1 + max|q|) at T as the adaptive suite bounds it
+   * (max|q| <= 8 on the chain): twice that apart */
+  static const double bound[] = {1e-9, 60 * 1e-8 * 9};
+  char flags[256];
+  for (int f = 0; f < 2; f++) {
+    snprintf(flags, sizeof flags, "-s 2 %s --rolled on", fam[f]);
+    build("crs", "../models/chain8.ham", flags, 0);
+    snprintf(flags, sizeof flags, "-s 2 %s --rolled on --batch %d", fam[f], f ? 3 : 4);
+    build("crb", "../models/chain8.ham", flags, 0);
+    snprintf(flags, sizeof flags, "-s 2 %s --rolled off", fam[f]);
+    build("cst", "../models/chain8.ham", flags, 0);
+    for (int i = 0; i < 2; i++) {
+      char *one = run("", "crs", how[i], "r1.csv", 0), *bat = run("", "crb", how[i], "r2.csv", 0);
+      char *str = run("", "cst", how[i], "r3.csv", 0);
+      ck_assert_ptr_nonnull(strstr(one, "\n7,0,"));
+      ck_assert_msg(!strcmp(one, bat), "%s %s: the rolled --batch differs from the rolled step", fam[f], how[i]);
+      double d = rows_apart(one, str);
+      printf("ensemble: chain 8 %s, %s: rolled vs straight-line rows within %.2g\n", f ? "poly" : "const", how[i], d);
+      ck_assert_msg(d <= bound[i], "%s %s: rolled and straight-line rows differ by %g", fam[f], how[i], d);
+      free(one), free(bat), free(str);
+    }
+    if (f == 0 && have_mpi()) { /* the rolled batch on 2 MPI ranks */
+      build("crm", "../models/chain8.ham", "-s 2 --multiplier const --rolled on --batch 4", 1);
+      char *one = run("", "crs", how[0], "r1.csv", 0), *got = run(mpirun, "crm", how[0], "r4.csv", 0);
+      ck_assert_msg(!strcmp(one, got), "%s: the rolled --batch on 2 MPI ranks differs", how[0]);
+      free(one), free(got);
+    }
   }
 }
 END_TEST
@@ -356,6 +440,7 @@ Suite *ensemble_suite(void)
   tcase_add_test(tc, test_sweep_and_mpi);
   tcase_add_test(tc, test_span_and_tol);
   tcase_add_test(tc, test_mass_q);
+  tcase_add_test(tc, test_rolled);
   tcase_add_test(tc, test_errors);
   tcase_add_test(tc, test_input_file);
   suite_add_tcase(s, tc);

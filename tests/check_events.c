@@ -1,6 +1,6 @@
 /* check_events.c - events, --stop-at and --dt in the driver, on solvers of
  * tests/models/pendulum_events.ham and kepler_events.ham run through hbvmrt_main as a generated driver
- * runs them (the adapters below are emit_main.c's).
+ * runs them (the adapters of driver_adapters.h are emit_main.c's).
  *
  *   pendulum  x = 0 is crossed every half period 2 K(1/2) (amplitude pi/3,
  *             K the complete elliptic integral, GSL's gsl_sf_ellint_Kcomp):
@@ -39,18 +39,8 @@ Suite *events_suite(void);
 
 #define PI 3.14159265358979323846
 
-/* The driver's adapters and model description of solver P (as emit_main.c
- * writes them for a double solver without parameters). */
-#define EV_MODEL(P)                                                                                                 \
-  DRIVER_ADAPTERS(P)                                                                                                \
-  static void P##_events_(const void *x, const void *prm, double *v) { P##_events(x, prm, v); }                     \
-  static const hbvmrt_model P##_model = {                                                                           \
-      #P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), sizeof(P##_params), offsetof(P##_state, t),               \
-      offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda), 0, NULL, NULL, NULL, P##_init_,   \
-      P##_pd_, P##_step_, P##_strerror, P##_energy_, P##_g_, P##_hc_, names_xy, NULL, NULL, DBL_EPSILON, P##_adapt_,      \
-      P##_dense_, P##_NEVENTS, P##_event_names, P##_event_dirs, P##_events_, NULL};
-
 static const char *const names_xy[] = {"x", "y"};
+#define EV_MODEL(P) DRIVER_EVENTS_MODEL(P, names_xy)
 
 EV_MODEL(pendulum_events_k4s4)
 EV_MODEL(kepler_events_k4s4)

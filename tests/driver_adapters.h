@@ -7,6 +7,8 @@
 #define HBVM_TESTS_DRIVER_ADAPTERS_H
 
 #include <check.h>
+#include <float.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
@@ -42,6 +44,19 @@
     P##_dense(a, theta, b->q, b->p);                                                                                \
     b->t = a->t - a->hprev * (1 - theta);                                                                           \
   }
+
+/* The driver's adapters and model description P##_model of solver P with
+ * events (as emit_main.c writes them for a double solver without
+ * parameters), its coordinates named by NAMES (check_events.c,
+ * check_reroll.c). */
+#define DRIVER_EVENTS_MODEL(P, NAMES)                                                                               \
+  DRIVER_ADAPTERS(P)                                                                                                \
+  static void P##_events_(const void *x, const void *prm, double *v) { P##_events(x, prm, v); }                     \
+  static const hbvmrt_model P##_model = {                                                                           \
+      #P, P##_M, P##_NU, P##_K, P##_S, sizeof(P##_state), sizeof(P##_params), offsetof(P##_state, t),               \
+      offsetof(P##_state, q), offsetof(P##_state, p), offsetof(P##_state, lambda), 0, NULL, NULL, NULL, P##_init_,   \
+      P##_pd_, P##_step_, P##_strerror, P##_energy_, P##_g_, P##_hc_, NAMES, NULL, NULL, DBL_EPSILON, P##_adapt_,   \
+      P##_dense_, P##_NEVENTS, P##_event_names, P##_event_dirs, P##_events_, NULL};
 
 /* Run the driver of md (hbvmrt_main, or hbvmrt_main_switching where sw is
  * not NULL) on the command line cmd (words between single spaces, the
