@@ -237,8 +237,8 @@ static int parse_args(int argc, char **argv, Options *o) {
   if (o->energy == ENERGY_RESCALE && (o->batch || o->wide_step))
     return fail("--energy rescale cannot be used with %s (not yet: its step has no rescale)",
                 o->batch ? "--batch" : "--wide-step");
-  if (o->iteration == ITER_NEWTON && (o->batch || o->wide_step))
-    return fail("--iteration newton cannot be used with %s (not yet)", o->batch ? "--batch" : "--wide-step");
+  if (o->iteration == ITER_NEWTON && o->wide_step)
+    return fail("%s", "--iteration newton cannot be used with --wide-step (not yet)");
   if (o->iteration == ITER_NEWTON && o->s > NEWTON_MAX_S) {
     char buf[64];
     snprintf(buf, sizeof buf, "s=%d > %d", o->s, NEWTON_MAX_S);
@@ -700,7 +700,6 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, char *why,
   if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
   double wf, ws, r = model_stiffness(mod, &wf, &ws);
   const char *no = mod->mass_q                ? "Newton does not handle an M that depends on q"
-                   : o->batch                  ? "Newton is not emitted with --batch"
                    : o->wide_step              ? "Newton is not emitted with --wide-step"
                    : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
                    : mod->m > AUTO_NEWTON_MAX_M ? "auto emits Newton up to m = " STR(AUTO_NEWTON_MAX_M)
