@@ -8,7 +8,9 @@
  * (emit_step.c) lane by lane: the same prediction, the same sweeps until the
  * lane's own increment is at round-off, the same tests and the same
  * compensated update, so each lane is bitwise the scalar NAME_step from the
- * same state (NAME_batch_step: emit_batch_step.c). */
+ * same state (NAME_batch_step: emit_batch_step.c). With Newton the lanes
+ * take the scalar step itself in turn (emit_batch_newton.c), and only the
+ * observers' kernels are printed over lanes. */
 #include "emit.h"
 
 // The batch declarations of NAME.h.
