@@ -66,6 +66,7 @@ int cmd_ab(int argc, char **argv);
 int hbvm_open(const Setting *set, Stepper *sp);      /* --multiplier const */
 int hbvm_poly_open(const Setting *set, Stepper *sp); /* --multiplier poly */
 int hbvm_newton_open(const Setting *set, Stepper *sp); /* --iteration newton --multiplier const */
+int hbvm_poly_newton_open(const Setting *set, Stepper *sp); /* --iteration newton, the poly family */
 void hbvm_close(Stepper *sp);
 int generic_open(const Setting *set, Stepper *sp);
 void generic_close(Stepper *sp);

@@ -2,7 +2,9 @@
  * problem, (k, s) and multiplier family among those bench/run.sh built
  * (NAME_kKsS: --multiplier const, the paper's method; NAME_kKsSpoly:
  * --multiplier poly, order 2s; NAME_kKsSnewton: --iteration newton
- * --multiplier const, the method "hbvm-newton" of the stiff benchmark). */
+ * --multiplier const, the method "hbvm-newton" of the stiff benchmark;
+ * NAME_kKsSpolynewton: --iteration newton in the poly family, the method
+ * "hbvm-poly-newton"). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,7 +16,8 @@ const GenSolver *gen_solver_find(const char *problem, int k, int s, GenFamily fa
 {
   char name[128];
   int i;
-  snprintf(name, sizeof name, "%s_k%ds%d%s", problem, k, s, family == GEN_POLY ? "poly" : family == GEN_NEWTON ? "newton" : "");
+  static const char *const suffix[] = {"", "poly", "newton", "polynewton"}; /* by GenFamily */
+  snprintf(name, sizeof name, "%s_k%ds%d%s", problem, k, s, suffix[family]);
   for (i = 0; gen_solvers[i]; i++)
     if (strcmp(gen_solvers[i]->name, name) == 0) return gen_solvers[i];
   return NULL;
@@ -63,6 +66,8 @@ int hbvm_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN
 int hbvm_poly_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_POLY); }
 
 int hbvm_newton_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_NEWTON); }
+
+int hbvm_poly_newton_open(const Setting *set, Stepper *sp) { return open_family(set, sp, GEN_POLYNEWTON); }
 
 void hbvm_close(Stepper *sp)
 {

@@ -26,8 +26,9 @@ typedef struct {
 extern const GenSolver *const gen_solvers[];
 
 /* The multiplier family a solver was generated with (hbvmgen --multiplier),
- * or GEN_NEWTON: --iteration newton --multiplier const (NAME_kKsSnewton). */
-typedef enum { GEN_CONST, GEN_POLY, GEN_NEWTON } GenFamily;
+ * or GEN_NEWTON: --iteration newton --multiplier const (NAME_kKsSnewton), or
+ * GEN_POLYNEWTON: --iteration newton, the poly family (NAME_kKsSpolynewton). */
+typedef enum { GEN_CONST, GEN_POLY, GEN_NEWTON, GEN_POLYNEWTON } GenFamily;
 
 /* The generated solver for problem at (k, s) of that family, or NULL. */
 const GenSolver *gen_solver_find(const char *problem, int k, int s, GenFamily family);

@@ -7,6 +7,7 @@ static const MethodDef methods[] = {
     {"hbvm", hbvm_open, hbvm_close, NULL},
     {"hbvm-poly", hbvm_poly_open, hbvm_close, NULL},
     {"hbvm-newton", hbvm_newton_open, hbvm_close, NULL},
+    {"hbvm-poly-newton", hbvm_poly_newton_open, hbvm_close, NULL},
     {"hbvm-generic", generic_open, generic_close, NULL},
     {"rattle", rattle_open, rattle_close, NULL},
     {"ida", NULL, NULL, ida_integrate},

@@ -6,7 +6,8 @@
  * only through those blocks. Layers, each calling only those below it:
  *   emit_solver.c (entry points: emit_check, emit_solver)
  *   emit_step.c, emit_project.c, emit_batch.c
- *   emit_api.c, emit_iterate.c, emit_newton.c, emit_end.c, emit_batch_step.c
+ *   emit_api.c, emit_iterate.c, emit_newton.c, emit_end.c, emit_batch_step.c,
+ *   emit_batch_newton.c
  *   emit_estimate.c, emit_predict.c, emit_mq.c, emit_batch_mq.c
  *   emit_choice.c
  *   emit_kernel.c
@@ -147,6 +148,13 @@ void emit_batch_header(Emitter *e, int lanes);
 void emit_batch_source(Emitter *e, int lanes);
 /* emit_batch_step.c: NAME_batch_step, its lane control as masked loops */
 void emit_batch_step(Emitter *e);
+void emit_batch_adaptive(Emitter *e);
+/* emit_batch_newton.c: --batch with Newton, the scalar step lane by lane (the adaptive
+ * step: emit_batch_adaptive's controller around its NAME_batch_within) */
+void emit_batch_newton_fields(Emitter *e);
+void emit_batch_newton_stats(Emitter *e);
+void emit_batch_newton_set_get(Emitter *e, int get);
+void emit_batch_newton_step(Emitter *e);
 /* emit_batch_mq.c: what the batch adds for M(q) (Theta in the lanes, the rescale) */
 void emit_batch_mq_predict(Emitter *e);
 void emit_batch_mq_increment(Emitter *e);

@@ -8,7 +8,9 @@
  * (emit_step.c) lane by lane: the same prediction, the same sweeps until the
  * lane's own increment is at round-off, the same tests and the same
  * compensated update, so each lane is bitwise the scalar NAME_step from the
- * same state (NAME_batch_step: emit_batch_step.c). */
+ * same state (NAME_batch_step: emit_batch_step.c). With Newton the lanes
+ * take the scalar step itself in turn (emit_batch_newton.c), and only the
+ * observers' kernels are printed over lanes. */
 #include "emit.h"
 
 // The batch declarations of NAME.h.
@@ -26,6 +28,7 @@ void emit_batch_header(Emitter *e, int lanes) {
           "  $P_real pinc[$P_S * $P_M * $P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
   else if (e->mod->mass_q) tmpl(e, "  $P_real H0[$P_W];  /* M(q): the energy the step keeps */\n");
+  if (emit_is_newton(e)) emit_batch_newton_fields(e); /* emit_batch_newton.c */
   /* idle last: every array before it starts at a multiple of W reals, so a
    * vector of one value's lanes never straddles two cache lines more than
    * the struct's own alignment makes it */
@@ -37,8 +40,9 @@ void emit_batch_header(Emitter *e, int lanes) {
           "  $P_real increment[$P_W];  /* last scaled increment */\n"
           "  $P_real err_est[$P_W];    /* $P_batch_step_adaptive: the lane's local error estimate */\n"
           "  $P_real h;                 /* the step taken (0: none) */\n"
-          "  int rejected;              /* $P_batch_step_adaptive: tries rejected before it */\n"
-          "} $P_batch_stats;\n\n"
+          "  int rejected;              /* $P_batch_step_adaptive: tries rejected before it */\n");
+  if (emit_is_newton(e)) emit_batch_newton_stats(e);
+  tmpl(e, "} $P_batch_stats;\n\n"
           "/* Lane `lane` of x from / into a state; set also makes the lane active (idle 0). */\n"
           "void $P_batch_set($P_batch *x, int lane, const $P_state *s);\n"
           "void $P_batch_get(const $P_batch *x, int lane, $P_state *s);\n"
@@ -77,6 +81,7 @@ static void emit_set_get(Emitter *e) {
       else snprintf(line, sizeof line, "  for (i = 0; i < %s; i++) x->%s[i * $P_W + l] = s->%s[i];\n", array[f][1], n, n);
       tmpl(e, line);
     }
+    if (emit_is_newton(e)) emit_batch_newton_set_get(e, get);
     if (get && !e->mod->nu) tmpl(e, "  s->lambda[0] = 0;\n");
     tmpl(e, get ? "}\n\n" : "  x->idle[l] = 0;\n}\n\n");
   }
@@ -187,11 +192,13 @@ static void emit_batch_predict(Emitter *e) {
 }
 
 // Whether the batch step calls kernel id: those of the step and its
-// diagnostics; consistent only for the Newton step after an adaptive
+// diagnostics (with Newton, which steps the lanes with the scalar step, only
+// those of the observers); consistent only for the Newton step after an adaptive
 // iteration stopped at its tolerance (itol_wanted). (The multiplier after a
 // step comes from the sweep, or from project_p1's factors: no lambda0.)
 static int batch_kernel_wanted(const Emitter *e, KernelId id) {
   if (!e->st->kern[id].nout) return 0;
+  if (emit_is_newton(e)) return id == K_ENERGY || id == K_G || id == K_HIDDEN; /* the observers' only */
   return id == K_CONSISTENT ? itol_wanted(e) : 1;
 }
 
@@ -211,6 +218,12 @@ void emit_batch_source(Emitter *e, int lanes) {
   out(e, "\n");
   emit_set_get(e);
   emit_params_observers(e);
+  if (emit_is_newton(e)) { /* the scalar step lane by lane: emit_batch_newton.c */
+    emit_batch_newton_step(e);
+    emit_batch_adaptive(e);
+    e->lanes = 0;
+    return;
+  }
   emit_batch_predict(e);
   if (e->mod->mass_q) emit_batch_mq_predict(e); /* emit_batch_mq.c */
   emit_batch_step(e);

@@ -373,7 +373,7 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // step every active lane fails: ENOCONV, or its own failure. A bad h or tol
 // fails every active lane with EBADSTEP; the return value is then, as after
 // any failure, the number of lanes that failed (never the -1, -2 of a try).
-static void emit_batch_adaptive(Emitter *e) {
+void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
           "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rq, rp, pmax, grow = 2, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"

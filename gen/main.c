@@ -62,7 +62,8 @@ static const char usage[] =
     "                auto (default): fixed's code for a model that is not stiff at q0\n"
     "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
     "                where they are slow (--check says which). Newton: in both multiplier\n"
-    "                families; not with --batch or --wide-step (docs/method-newton.md)\n";
+    "                families and with --batch (each lane the scalar step in turn); not\n"
+    "                with --wide-step (docs/method-newton.md)\n";
 
 /* (the rest of the usage, apart: a C99 compiler need not take a string over 4095 bytes) */
 static const char usage_more[] =
@@ -82,7 +83,8 @@ static const char usage_more[] =
     "  --batch W     also emit NAME_batch_step: W trajectories (1 <= W <= 64) stepped\n"
     "                together in struct-of-arrays lanes that the compiler vectorises,\n"
     "                each lane bitwise equal to NAME_step, and NAME_batch_step_adaptive,\n"
-    "                whose lanes share an error-controlled h (not with --wide-step)\n"
+    "                whose lanes share an error-controlled h (not with --wide-step; with\n"
+    "                Newton the lanes take the scalar step one after another)\n"
     "  --mass-loop N  compute M^-1 v for a dense constant M as a loop over a table of\n"
     "                M^-1 when it takes N or more multiplications, straight-line code\n"
     "                below (default " STR(MASS_LOOP_DEFAULT) ": the measured crossover, docs/embedding.md)\n"
@@ -238,8 +240,8 @@ static int parse_args(int argc, char **argv, Options *o) {
   if (o->energy == ENERGY_RESCALE && (o->batch || o->wide_step))
     return fail("--energy rescale cannot be used with %s (not yet: its step has no rescale)",
                 o->batch ? "--batch" : "--wide-step");
-  if (o->iteration == ITER_NEWTON && (o->batch || o->wide_step))
-    return fail("--iteration newton cannot be used with %s (not yet)", o->batch ? "--batch" : "--wide-step");
+  if (o->iteration == ITER_NEWTON && o->wide_step)
+    return fail("%s", "--iteration newton cannot be used with --wide-step (not yet)");
   if (o->iteration == ITER_NEWTON && o->s > NEWTON_MAX_S) {
     char buf[64];
     snprintf(buf, sizeof buf, "s=%d > %d", o->s, NEWTON_MAX_S);
@@ -701,7 +703,6 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, char *why,
   if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
   double wf, ws, r = model_stiffness(mod, &wf, &ws);
   const char *no = mod->mass_q                ? "Newton does not handle an M that depends on q"
-                   : o->batch                  ? "Newton is not emitted with --batch"
                    : o->wide_step              ? "Newton is not emitted with --wide-step"
                    : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
                    : mod->m > AUTO_NEWTON_MAX_M ? "auto emits Newton up to m = " STR(AUTO_NEWTON_MAX_M)

@@ -33,6 +33,10 @@
 #include "brchain32p_k2s2.h"
 #include "brchain32f_k2s2.h"
 #include "brfpu_k2s2.h"
+#include "bnbob_k16s2.h"
+#include "bnbobauto_k16s2.h"
+#include "bnbobpoly_k16s2.h"
+#include "bnfpu_k4s2.h"
 
 /* Lane l starts from the model's initial values after l scalar steps of
  * h (1 + l / 8), so the lanes differ in state and in the previous step (lane
@@ -43,7 +47,10 @@
  * state's bytes. With params, each lane's first param is scaled by 1 + l / 4.
  * BATCH_TEST: LARGE_P with constraints (Kepler's small q: near the singularity). */
 #define BATCH_TEST(P, HSTEP, NSTEP) BATCH_TEST_FAIL(P, HSTEP, NSTEP, P##_NU)
-#define BATCH_TEST_FAIL(P, HSTEP, NSTEP, LARGE_P)                                                        \
+#define BATCH_TEST_FAIL(P, HSTEP, NSTEP, LARGE_P) BATCH_TEST_LANE(P, HSTEP, NSTEP, LARGE_P, (void)0)
+/* LANE: a statement after each active lane's scalar step (rc, ss its code and stats, bs the
+ * batch's); it may count Newton's factor decisions in fresh and kept (NEWTON_LANE). */
+#define BATCH_TEST_LANE(P, HSTEP, NSTEP, LARGE_P, LANE)                                                  \
   START_TEST(test_##P) {                                                                             \
     P##_batch b;                                                                                     \
     P##_state s[P##_W], y;                                                                           \
@@ -51,7 +58,7 @@
     P##_batch_stats bs;                                                                              \
     P##_stats ss;                                                                                    \
     P##_real *first;                                                                                 \
-    int l, n, i, ok = 0, failed = 0;                                                                 \
+    int l, n, i, ok = 0, failed = 0, fresh, kept, mixed = 0, newton = 0;                             \
     memset(&b, 0xA5, sizeof b); /* garbage where nothing is set */                                 \
     for (l = 0; l < P##_W; l++) {                                                                    \
       P##_params_default(&prm[l]);                                                                   \
@@ -71,11 +78,13 @@
       P##_real h = (P##_real)((HSTEP) * (n < (NSTEP) ? 1 : 1.5));                                        \
       int nf = P##_batch_step(&b, h, prm, &bs), nf2 = 0;                                             \
       if (n == (NSTEP) / 2) b.idle[1] = 0;                                                           \
+      fresh = kept = 0;                                                                              \
       for (l = 0; l < P##_W; l++) {                                                                  \
         int rc = 0;                                                                                  \
         if (!(P##_W > 2 && l == 1 && n <= (NSTEP) / 2)) {                                            \
           rc = P##_step(&s[l], h, &prm[l], &ss);                                                     \
           if (bs.iters[l]) ck_assert_int_eq(bs.iters[l], ss.iters);                                 \
+          LANE;                                                                                      \
         } else                                                                                       \
           ck_assert_int_eq(bs.iters[l], 0);                                                          \
         ck_assert_msg(bs.code[l] == rc, #P " step %d lane %d: code %d, scalar %d", n, l, bs.code[l], rc); \
@@ -86,8 +95,11 @@
         ck_assert_msg(!memcmp(&y, &s[l], sizeof y), #P " step %d lane %d: the state differs", n, l); \
       }                                                                                              \
       ck_assert_int_eq(nf, nf2);                                                                     \
+      mixed += fresh > 0 && kept > 0; /* lanes of one step that factored and that kept theirs */     \
+      newton += fresh + kept;                                                                        \
     }                                                                                                \
     ck_assert_msg(ok > 0 && (P##_W == 1 || failed > 0), #P ": %d lane steps ok, %d failed", ok, failed); \
+    ck_assert_msg(!newton || mixed > 0, #P ": no step where lanes decided differently on the factor"); \
     {                                                                                                \
       P##_real H[P##_W], g[(P##_NU + 1) * P##_W], gs[P##_NU + 1];                                    \
       P##_batch_energy(&b, prm, H);                                                                  \
@@ -101,6 +113,20 @@
     }                                                                                                \
   }                                                                                                  \
   END_TEST
+
+/* Newton (the lanes take the scalar step): its counts as NAME_step's; fresh counts the lanes
+ * that factored the Newton matrix, kept those that iterated on the last step's factor */
+#define NEWTON_LANE(P)                                                                                 \
+  do {                                                                                               \
+    if (rc == 0) {                                                                                   \
+      ck_assert_int_eq(bs.newton[l], ss.newton);                                                     \
+      ck_assert_int_eq(bs.factors[l], ss.factors);                                                   \
+      ck_assert_int_eq(bs.jacobians[l], ss.jacobians);                                               \
+      fresh += ss.factors > 0;                                                                       \
+      kept += ss.factors == 0 && ss.newton > 0;                                                      \
+    }                                                                                                \
+  } while (0)
+#define BATCH_TEST_NEWTON(P, HSTEP, NSTEP) BATCH_TEST_LANE(P, HSTEP, NSTEP, 1, NEWTON_LANE(P))
 
 BATCH_TEST(bconst_k2s2, 0.05, 12)
 BATCH_TEST(bpoly_k3s3, 0.1, 12)
@@ -136,10 +162,12 @@ BATCH_TEST_FAIL(brfpu_k2s2, 0.01, 12, 1) /* params per lane, no constraints */
  * (when the batch's try was not a cold one, after three rejections); the
  * idle lane is untouched; H stays at round-off where the family restores it.
  * Then a lane that cannot step (q NaN): every active lane fails, none is
- * written. ADAPTIVE_TEST_MQ, for M(q) from rest: lane l's coordinates are
- * scaled by 1 + l / 16 too, and H stays at round-off (the rescale). */
+ * written. ADAPTIVE_TEST_MQ (VARY 1), for M(q) from rest: lane l's
+ * coordinates are scaled by 1 + l / 16 too, and H stays at round-off (the
+ * rescale); VARY 2, for a model with constraints from rest (the stiff bob):
+ * lane l's first param is scaled by 1 + l / 4 instead. */
 #define ADAPTIVE_TEST(P, H0, TOL, NSTEP) ADAPTIVE_TEST_MQ(P, H0, TOL, NSTEP, 0)
-#define ADAPTIVE_TEST_MQ(P, H0, TOL, NSTEP, MQ)                                                          \
+#define ADAPTIVE_TEST_MQ(P, H0, TOL, NSTEP, VARY)                                                        \
   START_TEST(test_adaptive_##P) {                                                                      \
     P##_batch b, c;                                                                                    \
     P##_state s[P##_W], y, z;                                                                          \
@@ -151,9 +179,10 @@ BATCH_TEST_FAIL(brfpu_k2s2, 0.01, 12, 1) /* params per lane, no constraints */
     memset(&b, 0, sizeof b);                                                                           \
     for (l = 0; l < P##_W; l++) {                                                                      \
       P##_params_default(&prm[l]);                                                                     \
+      if ((VARY) == 2 && P##_NPARAMS) *(P##_real *)(void *)&prm[l] *= (P##_real)(1 + l / 4.0);          \
       P##_init_params(&s[l], NULL, NULL, &prm[l]);                                                     \
       for (i = 0; i < P##_M; i++) {                                                                    \
-        q[i] = s[l].q[i] * (P##_real)(MQ ? 1 + l / 16.0 : 1);                                          \
+        q[i] = s[l].q[i] * (P##_real)((VARY) == 1 ? 1 + l / 16.0 : 1);                                 \
         p[i] = s[l].p[i] * (P##_real)(1 + l / 16.0);                                                   \
       }                                                                                                \
       P##_init_params(&s[l], q, p, &prm[l]);                                                           \
@@ -187,7 +216,7 @@ BATCH_TEST_FAIL(brfpu_k2s2, 0.01, 12, 1) /* params per lane, no constraints */
     }                                                                                                  \
     ck_assert_msg(rejected > 0 && hmin < hmax && compared > (NSTEP), #P ": rejected %d, h %g..%g, compared %d", \
                   rejected, (double)hmin, (double)hmax, compared);                                      \
-    if ((P##_NU || MQ) && sizeof(P##_real) == sizeof(double))                                          \
+    if ((P##_NU || VARY) && sizeof(P##_real) == sizeof(double))                                        \
       for (l = 0; l < P##_W; l++) {                                                                    \
         P##_batch_get(&b, l, &y);                                                                      \
         ck_assert_msg(fabs(P##_energy(&y, &prm[l]) - H[l]) <= 1e-13, #P " lane %d: H moved", l);       \
@@ -195,7 +224,12 @@ BATCH_TEST_FAIL(brfpu_k2s2, 0.01, 12, 1) /* params per lane, no constraints */
     b.q[P##_W - 1] = (P##_real)NAN; /* coordinate 0 of the last lane */                                \
     memcpy(&c, &b, sizeof b);                                                                          \
     ck_assert_int_eq(P##_batch_step_adaptive(&b, &h, (P##_real)(TOL), prm, &bs), P##_W > 2 ? P##_W - 1 : P##_W); \
-    ck_assert_msg(!memcmp(&b, &c, sizeof b), #P ": a lane was written by a failed step");             \
+    for (l = 0; l < P##_W; l++) { /* every lane's bytes (not Newton's scratch, x->next) */             \
+      P##_batch_get(&b, l, &y);                                                                        \
+      P##_batch_get(&c, l, &z);                                                                        \
+      ck_assert_msg(!memcmp(&y, &z, sizeof y), #P ": lane %d was written by a failed step", l);         \
+    }                                                                                                  \
+    ck_assert(!memcmp(b.idle, c.idle, sizeof b.idle));                                                 \
     ck_assert(bs.h == 0 && bs.code[0] != 0 && bs.code[P##_W - 1] != 0);                                \
   }                                                                                                    \
   END_TEST
@@ -214,6 +248,19 @@ ADAPTIVE_TEST(brchain_k4s4, 0.05, 1e-6, 20)
 ADAPTIVE_TEST(brchainp_k4s4, 0.5, 1e-8, 20)
 ADAPTIVE_TEST(brchain32p_k2s2, 0.05, 1e-6, 20)
 ADAPTIVE_TEST(brfpu_k2s2, 0.05, 1e-6, 20)
+
+/* Newton in the lanes (each the scalar step, its own factor kept or refreshed): the stiff bob
+ * (k = 1e4 x (1 + l / 4), omega = 141 x sqrt(1 + l / 4)) at h omega of about 7-12 in both
+ * families and under auto (its sweeps slow there), the FPU chain (omega = 50 x (1 + l / 4))
+ * at h omega = 10-17 */
+BATCH_TEST_NEWTON(bnbob_k16s2, 0.02, 12)
+BATCH_TEST_NEWTON(bnbobpoly_k16s2, 0.05, 12)
+BATCH_TEST_NEWTON(bnbobauto_k16s2, 0.02, 12)
+BATCH_TEST_NEWTON(bnfpu_k4s2, 0.2, 12)
+ADAPTIVE_TEST_MQ(bnbob_k16s2, 0.5, 1e-6, 20, 2)
+ADAPTIVE_TEST_MQ(bnbobpoly_k16s2, 0.5, 1e-6, 20, 2)
+ADAPTIVE_TEST_MQ(bnbobauto_k16s2, 0.5, 1e-6, 20, 2)
+ADAPTIVE_TEST(bnfpu_k4s2, 0.5, 1e-6, 20)
 
 /* prm NULL is the defaults in every lane; an all-idle batch is untouched. */
 START_TEST(test_defaults_and_idle) {
@@ -301,5 +348,17 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_adaptive_brchain32p_k2s2);
   tcase_add_test(tc, test_adaptive_brfpu_k2s2);
   suite_add_tcase(s, tc);
+  TCase *tn = tcase_create("newton");
+  tcase_set_tags(tn, "sanlong");
+  tcase_set_timeout(tn, 60);
+  tcase_add_test(tn, test_bnbob_k16s2);
+  tcase_add_test(tn, test_bnbobpoly_k16s2);
+  tcase_add_test(tn, test_bnbobauto_k16s2);
+  tcase_add_test(tn, test_bnfpu_k4s2);
+  tcase_add_test(tn, test_adaptive_bnbob_k16s2);
+  tcase_add_test(tn, test_adaptive_bnbobpoly_k16s2);
+  tcase_add_test(tn, test_adaptive_bnbobauto_k16s2);
+  tcase_add_test(tn, test_adaptive_bnfpu_k4s2);
+  suite_add_tcase(s, tn);
   return s;
 }

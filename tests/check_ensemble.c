@@ -1,7 +1,8 @@
 /* check_ensemble.c - the ensemble runner (runtime/ensemble.c): the summary
  * file of --ensemble and --sweep is byte for byte the same for the scalar
  * step and --batch W (W = 1, 3, 4), on 1 and 2 OpenMP threads (also with a
- * mass matrix M(q): models/double_pendulum_angles.ham), and on 1 and 2 MPI
+ * mass matrix M(q): models/double_pendulum_angles.ham, and with Newton: the
+ * stiff bob), and on 1 and 2 MPI
  * ranks (mpirun -np 2 on loopback; skipped, saying so, without MPI);
  * a trajectory ends where a single run ends (-T hit exactly, --tol); a
  * rolled model (--rolled on, docs/rolled.md) gives the same summary with
@@ -209,6 +210,35 @@ START_TEST(test_span_and_tol)
 }
 END_TEST
 
+/* Builds NAMEs (generated with flags) and NAMEb (flags --batch 4) and runs
+ * both with each of the two argument lists how[i] (%s: the file rows_text,
+ * if any, is written to): the summaries byte for byte the same, the exit
+ * status status[i]. one[i] gets the scalar step's summary (free it). */
+static void same_with_batch(const char *name, const char *model, const char *flags, const char *rows_text,
+                            const char *const how[2], const int status[2], char *one[2])
+{
+  char path[256], args[512], sname[64], bname[64], bflags[256];
+  snprintf(path, sizeof path, "%s/%s.csv", dir, name);
+  if (rows_text) {
+    FILE *f = fopen(path, "w");
+    ck_assert_ptr_nonnull(f);
+    fputs(rows_text, f);
+    fclose(f);
+  }
+  snprintf(sname, sizeof sname, "%ss", name);
+  snprintf(bname, sizeof bname, "%sb", name);
+  snprintf(bflags, sizeof bflags, "%s --batch 4", flags);
+  build(sname, model, flags, 0);
+  build(bname, model, bflags, 0);
+  for (int i = 0; i < 2; i++) {
+    snprintf(args, sizeof args, how[i], path);
+    char *bat = run("", bname, args, "m2.csv", status[i]);
+    one[i] = run("", sname, args, "m1.csv", status[i]);
+    ck_assert_msg(!strcmp(one[i], bat), "%s %s: --batch 4 differs from the scalar step", flags, args);
+    free(bat);
+  }
+}
+
 /* M(q) (models/double_pendulum_angles.ham, k = s = 2): --ensemble with fixed
  * steps, where one trajectory's steps are retried as halves (a lane that
  * leaves the batch for the scalar path) and one fails, and --sweep with
@@ -220,25 +250,35 @@ START_TEST(test_mass_q)
                                 "0.5, -0.3, 0, 100\n0.5, -0.3, 0, 1e7\n0.1, 0.1, 0, 0\n";
   static const char *const how[] = {"--ensemble %s -h 0.05 -N 200 --threads 2",
                                     "--sweep p_th2=0:3:7 --tol 1e-9 -T 5 --threads 2"};
-  char path[256], args[512];
-  snprintf(path, sizeof path, "%s/mq.csv", dir);
-  FILE *f = fopen(path, "w");
-  ck_assert_ptr_nonnull(f);
-  fputs(mq_rows, f);
-  fclose(f);
-  build("dps", "../models/double_pendulum_angles.ham", "-s 2", 0);
-  build("dpb", "../models/double_pendulum_angles.ham", "-s 2 --batch 4", 0);
-  for (int i = 0; i < 2; i++) {
-    snprintf(args, sizeof args, how[i], path);
-    char *one = run("", "dps", args, "m1.csv", i ? 0 : 2), *bat = run("", "dpb", args, "m2.csv", i ? 0 : 2);
-    if (!i) {
-      ck_assert_ptr_nonnull(strstr(one, "\n4,0,")); /* from p_th2 = 100: in halves */
-      ck_assert_ptr_nonnull(strstr(one, "\n5,2,0,")); /* ENONFINITE at the first step */
-      ck_assert_ptr_nonnull(strstr(one, "\n6,0,200,10,"));
-    }
-    ck_assert_msg(!strcmp(one, bat), "%s: --batch 4 differs from the scalar step", args);
-    free(one), free(bat);
-  }
+  static const int status[] = {2, 0};
+  char *one[2];
+  same_with_batch("dp", "../models/double_pendulum_angles.ham", "-s 2", mq_rows, how, status, one);
+  ck_assert_ptr_nonnull(strstr(one[0], "\n4,0,")); /* from p_th2 = 100: in halves */
+  ck_assert_ptr_nonnull(strstr(one[0], "\n5,2,0,")); /* ENONFINITE at the first step */
+  ck_assert_ptr_nonnull(strstr(one[0], "\n6,0,200,10,"));
+  free(one[0]), free(one[1]);
+}
+END_TEST
+
+/* Newton (issue 27): the stiff bob swept over k = 1e4..1e6 (omega = 141..1414)
+ * with fixed steps of 0.3 (h omega = 42..424), where the stiffer trajectories'
+ * steps fail and are retried as halves (lanes that leave the batch), and with
+ * adaptive steps: --batch 4 gives the scalar step's summary, byte for byte, in
+ * the constant family under --iteration newton and in the poly family under
+ * auto (which emits Newton for the stiff bob). */
+START_TEST(test_newton)
+{
+  static const char *const how[] = {"--sweep k=1e4:1e6:7 -h 0.3 -N 20 --threads 2",
+                                    "--sweep k=1e4:1e5:3 --tol 1e-6 -T 0.2 --threads 2"};
+  static const int status[] = {0, 0};
+  char *one[2];
+  same_with_batch("bn", "../models/stiff_bob.ham", "-s 2 --iteration newton --multiplier const", NULL, how, status, one);
+  ck_assert_ptr_nonnull(strstr(one[0], "\n1,0,20,6,")); /* k = 1e4: 20 steps of 0.3 */
+  ck_assert_ptr_nonnull(strstr(one[0], "\n7,0,")); /* k = 1e6: in halves */
+  ck_assert_ptr_null(strstr(one[0], "\n7,0,20,"));
+  free(one[0]), free(one[1]);
+  same_with_batch("ba", "../models/stiff_bob.ham", "-s 2", NULL, how, status, one);
+  free(one[0]), free(one[1]);
 }
 END_TEST
 
@@ -441,6 +481,7 @@ Suite *ensemble_suite(void)
   tcase_add_test(tc, test_span_and_tol);
   tcase_add_test(tc, test_mass_q);
   tcase_add_test(tc, test_rolled);
+  tcase_add_test(tc, test_newton);
   tcase_add_test(tc, test_errors);
   tcase_add_test(tc, test_input_file);
   suite_add_tcase(s, tc);

@@ -24,7 +24,7 @@ for p in $(awk -F, 'NR > 1 { print $1 }' "$R/stiff_work_precision.csv" | uniq); 
     t=${f##*__}
     t=${t%.dat}
     case $t in
-    hbvm-newton*) style="lw 3 pt 7" ;;
+    hbvm-newton* | hbvm-poly-newton*) style="lw 3 pt 7" ;;
     hbvm*) style="lw 1.5 pt 6 dt 2" ;;
     *) style="lw 1.5 pt 4" ;;
     esac

@@ -6,6 +6,9 @@
 #   hbvm-newton  --iteration newton --multiplier const, the same (k, s): the
 #                higher s (order 2s) for the long steps at tight errors, where
 #                the sweeps need h omega < ~3 at any s
+#   hbvm-poly-newton  --iteration newton in the default poly family (order 2s
+#                in p too, p projected and rescaled), the same (k, s), on the
+#                problems with constraints (the stiff bob, butane)
 #   rattle       RATTLE (Stormer-Verlet on the FPU chain)
 #   ida          SUNDIALS IDA (BDF 1-5) on the GGL formulation
 #   gsl-rk4imp, gsl-msbdf, gsl-bsimp   GSL's implicit steppers on the FPU
@@ -74,6 +77,7 @@ fixed_from() {
   fpu50) echo 0.08 ;; fpu1000) echo 0.004 ;; stiff_bob) echo 0.03 ;; stiff_bob6) echo 0.003 ;; butane) echo 0.025 ;;
   esac
 }
+has_constraints() { case $1 in stiff_bob* | butane) return 0 ;; *) return 1 ;; esac }
 FLOOR=1e-10 # the slow error where a line stops (the references agree to 4e-11 or better: refcheck)
 PEER_CAP=2  # CPU seconds of one RATTLE / IDA / GSL run (the HBVM lines: 0.25)
 IDA_TOLS=1e-3:1e-11:10 # slow errors of 1e-8 and below by 1e-10 on every problem
@@ -94,6 +98,11 @@ for p in $PROBLEMS; do
     "$GEN" --iteration newton --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}newton" -o "$B/gen" \
       "$B/models/$p.ham"
     solvers="$solvers ${p}_k${k}s${s} ${p}_k${k}s${s}newton"
+    if has_constraints "$p"; then
+      "$GEN" --iteration newton --multiplier poly -k "$k" -s "$s" -n "${p}_k${k}s${s}polynewton" -o "$B/gen" \
+        "$B/models/$p.ham"
+      solvers="$solvers ${p}_k${k}s${s}polynewton"
+    fi
     echo "$p $k $s" >>"$B/configs.txt"
   done
 done
@@ -127,6 +136,7 @@ for p in $PROBLEMS; do
   while read -r q k s; do
     [ "$q" = "$p" ] || continue
     sweep "$B/res" "$p" hbvm-newton "$(newton_from "$p"):1e-6:2" -k "$k" -s "$s"
+    ! has_constraints "$p" || sweep "$B/res" "$p" hbvm-poly-newton "$(newton_from "$p"):1e-6:2" -k "$k" -s "$s"
     sweep "$B/res" "$p" hbvm "$(fixed_from "$p"):1e-6:2" -k "$k" -s "$s" --cap $PEER_CAP
   done <"$B/configs.txt"
   [ "$PEERS" = 1 ] || continue
