@@ -9,7 +9,9 @@
  *   order     the default family's order 2s = 4 against a tiny-step
  *             reference (the same solver at h / 16);
  *   rolled    --rolled on (U's pair sum as one double loop over the pairs,
- *             grad U scattered from it: gen/roll_pair.c) against
+ *             two pairs a pass, what reads only the outer index and the
+ *             gradient there kept out of the inner loop; grad U scattered
+ *             from it: gen/roll_pair.c, emit_rolled_pairs.c) against
  *             straight-line: the same trajectory up to the reordering of
  *             sums (docs/rolled.md);
  *   size      the rolled cluster's C as N grows: the same loops at N = 16
@@ -87,7 +89,13 @@ END_TEST
 START_TEST(test_rolled)
 {
   char *text = cluster_model(4, 2), *src = generate_source(text, "--multiplier const --rolled on");
-  ck_assert_msg(src && strstr(src, "for (c = b + 1; c <= 3; c += 1)"), "the cluster of 4 has no loop over its pairs");
+  const char *inner = src ? strstr(src, "for (c = b + 1; c + 1 <= 3; c += 2) {") : NULL, *end;
+  ck_assert_msg(inner, "the cluster of 4 has no loop over its pairs, two a pass");
+  end = strstr(inner, "\n    }\n");
+  ck_assert_ptr_nonnull(end);
+  /* what reads only b (q[b + o]) and the gradient at b are out of the inner loop */
+  const char *at_b = strstr(inner, "[b");
+  ck_assert_msg(!at_b || at_b > end, "the inner pair loop reads or adds at b: %.40s", at_b);
   free(src);
   free(text);
   SAME_TRAJECTORY(cluster_rolled_k4s2, cluster_straight_k4s2, 0.02, 1e-9, "cluster 4, rolled vs straight-line");
