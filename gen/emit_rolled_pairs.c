@@ -194,7 +194,7 @@ static void emit_pair_run(Emitter *e, const RollPairRun *r, int value) {
 
 void emit_roll_pairs(Emitter *e, const char *name, const char *what, int value) {
   const RollPairs *p = e->roll->pairs;
-  tmplf(e, "\n/* %s: U's pair sums as %d runs of items of %d terms, loops over the pairs (b, c) */\n"
+  tmplf(e, "\n/* %s: U's pair sums as %d runs of items of up to %d terms, loops over the pairs (b, c) */\n"
            "static void $P_roll_%s(const $R *restrict q, const $R *v, const $P_params *prm, $R *restrict out)\n{\n"
            "  int b = 0, c = 0;\n%s  (void)q; (void)v; (void)prm;\n", what, p->nruns, p->period, name,
         value ? "  $R acc = 0;\n" : "");

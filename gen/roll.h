@@ -87,7 +87,7 @@ typedef struct {
 } RollPairRun;
 
 typedef struct {
-  int period, nitems, nruns;
+  int period, nitems, nruns; /* period: the largest of the runs' */
   RollPairRun *runs;
 } RollPairs;
 
