@@ -217,7 +217,7 @@ static void emit_helpers(Emitter *e) {
   if (r->pairs) emit_roll_pairs(e, "U", "out[0] = U(q)", 1);
   else emit_family(e, "U", "out[0] = U(q), its terms in the order of its sums", &r->U, 1);
   if (r->nu) {
-    if (r->pairs) emit_roll_pairs(e, "gradU", "out[i] = dU/dq_i", 0);
+    if (r->pairs) tmpl(e, "#define $P_roll_gradU $P_roll_gradU_curved /* the same pair loops */\n");
     else emit_family(e, "gradU", "out[i] = dU/dq_i", &r->gradU, 0);
     emit_family(e, "g", "out[a] = g_a(q)", &r->g, 0);
     emit_family(e, "hvv", "out[a] = v' Hess(g_a)(q) v", &r->hvv, 0);

@@ -332,6 +332,16 @@ static double compression(const Roll *r) {
   return runs ? (double)items / (double)runs : 0;
 }
 
+// Whether --rolled auto takes the analysed form r: a pair sum of
+// ROLL_AUTO_PAIR_ITEMS items or more in runs of ROLL_AUTO_COMPRESSION items
+// on average; else, when big (the sweep has ROLL_AUTO_OPS operations, or
+// the model ROLL_LEAN_M coordinates), derivatives it shortens
+// ROLL_AUTO_COMPRESSION times.
+static int auto_rolls(const Roll *r, int big) {
+  if (r->pairs) return r->pairs->nitems >= ROLL_AUTO_PAIR_ITEMS && r->pairs->nitems >= ROLL_AUTO_COMPRESSION * r->pairs->nruns;
+  return big && compression(r) >= ROLL_AUTO_COMPRESSION;
+}
+
 // Whether the form is tried before the straight-line step is built:
 // --rolled on, or auto on a model of ROLL_LEAN_M coordinates or more.
 static int tried_first(const Model *mod, const EmitOptions *eo) {
@@ -348,9 +358,10 @@ int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOp
   int on = eo->rolled == ROLL_ON;
   if (!layout && (eo->rolled == ROLL_OFF || (tried_first(mod, eo) && !on))) return 0; /* decided on the layout */
   const char *why = not_covered(mod, me, eo);
-  if (!on && !layout && (why || sweep_ops(mod, st) < ROLL_AUTO_OPS)) return 0;
+  int big = layout || (!on && !why && sweep_ops(mod, st) >= ROLL_AUTO_OPS);
+  if (!on && !layout && (why || (!big && mod->m < ROLL_AUTO_PAIR_M))) return 0;
   Roll *r = why ? NULL : analyse_roll(mod, &why);
-  if (r && !on && compression(r) < ROLL_AUTO_COMPRESSION) return 0; /* little repetition: straight-line is as short */
+  if (r && !on && !auto_rolls(r, big)) return 0; /* little repetition: straight-line is as short */
   if (!r && on) {
     error_at(mod->nu ? mod->g_loc[0] : mod->U_loc, "--rolled on: the rolled form cannot print this model: %s", why);
     return 1;

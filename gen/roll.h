@@ -23,6 +23,17 @@ enum { ROLL_OFF, ROLL_ON, ROLL_AUTO };
 #define ROLL_AUTO_OPS 4000
 /* ... and whose derivatives it shortens this many times at least (items per run). */
 #define ROLL_AUTO_COMPRESSION 8
+/* A pair sum (roll_pair.c) is rolled by --rolled auto from this many items
+ * on, in runs of ROLL_AUTO_COMPRESSION items or more on average, whatever
+ * its sweep's operations (which the stage loop keeps from growing with the
+ * pairs): docs/rolled.md, "Pair sums". The cluster of 8 diatomics has 30
+ * (28 pairs of molecules, 2 of its trap), the cluster of 4 7; the rolled
+ * cluster's step took 0.89-0.99 times the straight-line one's at N = 4-16
+ * (alternated timings) and 1.2-1.3 times its instructions. */
+#define ROLL_AUTO_PAIR_ITEMS 24
+/* ... and is looked for (the model analysed) below ROLL_AUTO_OPS from this
+ * many coordinates on (the cluster of 8), so that small models are not. */
+#define ROLL_AUTO_PAIR_M 48
 /* From this many coordinates on, --rolled auto decides without building the
  * straight-line step (whose dense nu x nu node matrices cost O(nu^2) time
  * and memory: 1.7 GB at the chain of 4000) and so without counting its
@@ -76,7 +87,7 @@ typedef struct {
 } RollPairRun;
 
 typedef struct {
-  int period, nitems, nruns;
+  int period, nitems, nruns; /* period: the largest of the runs' */
   RollPairRun *runs;
 } RollPairs;
 

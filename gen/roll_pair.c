@@ -6,10 +6,12 @@
  * terms are rolled instead, and grad U is scattered from them, as molecular
  * dynamics codes do: one double loop over the pairs computes each pair's term
  * and its partial derivatives once and adds them into grad U at both ends.
- *   - U's terms (in the order of its sums) are cut into items of P
- *     consecutive terms, P the period of the pair sum's body (4 for the atom
- *     pairs of two diatomics): the P of 1..ROLL_PAIR_MAX_PERIOD that gives
- *     the fewest runs;
+ *   - U's terms (in the order of its sums) are cut into runs of items of P
+ *     consecutive terms, P the period of the run's body (8 for the atom
+ *     pairs of two diatomics, whose four phi give two terms each): from the
+ *     first term not in a run, the P of 1..ROLL_PAIR_MAX_PERIOD whose run
+ *     covers the most terms (the largest on a tie), so that a one-body sum
+ *     (a trap) and the pair sum after it each have their own period;
  *   - each input of an item is tied to the outer index b or the inner one
  *     c: against the next item of the same inner loop, the inputs that stay
  *     are tied to b, those that move (all by the same stride) to c. A run is
@@ -149,12 +151,38 @@ typedef struct {
   Tri t;
 } PRun;
 
-// The run starting at item u: the longest triangle of items from it, or
-// the item alone (every input tied to b).
-static PRun find_run(const PItem *items, int n, int u) {
-  const PItem *x = &items[u];
-  PRun r = {u, 1, {xcalloc((size_t)x->n + 1, 1), -1, -1, 0, 0, 0, -1, 1}};
-  int sc = u + 1 < n && same_shape(x, &items[u + 1]) ? inner_stride(x, &items[u + 1], r.t.tie) : 0;
+/* The items of period p from term t0 on, walked as far as a run needs them:
+ * item u is terms t0 + u p .. t0 + (u + 1) p - 1; n of the avail are built. */
+typedef struct {
+  PairWalk *w;
+  const int *terms;
+  int t0, p, avail, n, cap;
+  PItem *v;
+} PItems;
+
+// Whether item u of it exists and is built (walked now if not): 0 past the
+// terms or when it cannot be walked (too large, or what the rolled form
+// cannot print).
+static int has_item(PItems *it, int u) {
+  if (u >= it->avail) return 0;
+  for (; it->n <= u; it->n++) {
+    if (walk_roots(it->w, it->terms + it->t0 + it->n * it->p, it->p) < 0) {
+      it->avail = it->n; /* the items end before it */
+      return 0;
+    }
+    if (it->n == it->cap) it->v = xrealloc(it->v, (size_t)(it->cap = 2 * it->cap + 8) * sizeof *it->v);
+    it->v[it->n] = item_code(it->w);
+  }
+  return 1;
+}
+
+// The run starting at the first item of it (built): the longest triangle
+// of items from it, or the item alone (every input tied to b).
+static PRun find_run(PItems *it) {
+  const PItem *x = &it->v[0];
+  PRun r = {0, 1, {xcalloc((size_t)x->n + 1, 1), -1, -1, 0, 0, 0, -1, 1}};
+  int sc = has_item(it, 1) && same_shape(&it->v[0], &it->v[1]) ? inner_stride(&it->v[0], &it->v[1], r.t.tie) : 0;
+  x = &it->v[0]; /* has_item may move the items */
   if (!sc) memset(r.t.tie, 0, (size_t)x->n + 1);
   for (int k = 0; k < x->n; k++)
     if (x->code[k].op == OP_INPUT) {
@@ -165,38 +193,19 @@ static PRun find_run(const PItem *items, int n, int u) {
   r.t.D = base_c(&r.t, x) - base_b(&r.t, x);
   if (sc) {
     r.t.SC = sc;
-    while (u + r.n < n && continues(&r.t, x, &items[u + r.n - 1], &items[u + r.n])) r.n++;
-    if (r.t.CE >= 0 && base_c(&r.t, &items[u + r.n - 1]) != r.t.CE) { /* the last b is partial: not in the run */
-      int last_b = base_b(&r.t, &items[u + r.n - 1]);
-      while (base_b(&r.t, &items[u + r.n - 1]) == last_b) r.n--;
+    while (has_item(it, r.n) && continues(&r.t, &it->v[0], &it->v[r.n - 1], &it->v[r.n])) r.n++;
+    if (r.t.CE >= 0 && base_c(&r.t, &it->v[r.n - 1]) != r.t.CE) { /* the last b is partial: not in the run */
+      int last_b = base_b(&r.t, &it->v[r.n - 1]);
+      while (base_b(&r.t, &it->v[r.n - 1]) == last_b) r.n--;
     }
   }
-  if (r.t.CE < 0) r.t.CE = base_c(&r.t, &items[u + r.n - 1]);
+  if (r.t.CE < 0) r.t.CE = base_c(&r.t, &it->v[r.n - 1]);
   return r;
 }
 
-// The runs of the items, at most ROLL_MAX_RUNS + 1 (then it stops).
-static int item_runs(const PItem *items, int n, PRun *runs) {
-  int nruns = 0;
-  for (int u = 0; u < n && nruns <= ROLL_MAX_RUNS; u += runs[nruns - 1].n) runs[nruns++] = find_run(items, n, u);
-  return nruns;
-}
-
-// The items of period p: each p consecutive terms walked together.
-static int period_items(PairWalk *w, const int *terms, int nterms, int p, PItem *items) {
-  for (int u = 0; u < nterms / p; u++) {
-    items[u] = (PItem){NULL, 0};
-    if (walk_roots(w, terms + u * p, p) < 0) return -1;
-    items[u] = item_code(w);
-  }
-  return 0;
-}
-
-static void free_found(PItem *items, int nitems, PRun *runs, int nruns) {
-  for (int u = 0; u < nitems; u++) free(items[u].code);
-  for (int i = 0; i < nruns; i++) free(runs[i].t.tie);
-  free(items);
-  free(runs);
+static void free_items(PItems *it) {
+  for (int u = 0; u < it->n; u++) free(it->v[u].code);
+  free(it->v);
 }
 
 // The base (0: b, 1: c) and offset of input slot `slot` of run r's first
@@ -256,39 +265,62 @@ static void sum_terms(Dag *d, int id, double scale, IntVec *terms) {
   }
 }
 
+/* A run chosen: its items (period p from term t0) and triangle. */
+typedef struct {
+  PItems items;
+  PRun run;
+} PChosen;
+
+// The run at term t: of the periods 1..ROLL_PAIR_MAX_PERIOD, the one whose
+// run from t covers the most terms (the longest on a tie: fewer items);
+// 0, or -1 when no item at t can be walked.
+static int choose_run(PairWalk *w, const int *terms, int nterms, int t, PChosen *out) {
+  int best = 0;
+  for (int p = 1; p <= ROLL_PAIR_MAX_PERIOD && t + p <= nterms; p++) {
+    PItems it = {w, terms, t, p, (nterms - t) / p, 0, 0, NULL};
+    if (!has_item(&it, 0)) {
+      free_items(&it);
+      continue;
+    }
+    PRun r = find_run(&it);
+    if (r.n * p >= best) {
+      if (best) free_items(&out->items), free(out->run.t.tie);
+      *out = (PChosen){it, r};
+      best = r.n * p;
+    } else {
+      free_items(&it);
+      free(r.t.tie);
+    }
+  }
+  return best ? 0 : -1;
+}
+
 RollPairs *roll_pairs(Dag *d, int m, int U) {
   IntVec all = {0};
   sum_terms(d, U, 1, &all);
   const int *terms = all.v;
-  int nterms = all.n;
+  int nterms = all.n, nruns = 0, nitems = 0, bad = 0;
   PairWalk w = {d, 0, 0, NULL, NULL, {0}, {0}};
-  PItem *best_items = NULL;
-  PRun *best_runs = NULL;
-  int best_p = 0, best_n = ROLL_MAX_RUNS + 1;
-  for (int p = 1; p <= ROLL_PAIR_MAX_PERIOD && p <= nterms; p++) {
-    if (nterms % p) continue;
-    PItem *items = xcalloc((size_t)(nterms / p), sizeof *items);
-    PRun *runs = xcalloc(ROLL_MAX_RUNS + 1, sizeof *runs);
-    int nruns = period_items(&w, terms, nterms, p, items) < 0 ? ROLL_MAX_RUNS + 1 : item_runs(items, nterms / p, runs);
-    if (nruns < best_n) {
-      if (best_items) free_found(best_items, nterms / best_p, best_runs, best_n);
-      best_items = items, best_runs = runs, best_p = p, best_n = nruns;
-    } else {
-      free_found(items, nterms / p, runs, nruns);
-    }
+  PChosen *runs = xcalloc(ROLL_MAX_RUNS + 1, sizeof *runs);
+  for (int t = 0; t < nterms && !bad; t += runs[nruns - 1].run.n * runs[nruns - 1].items.p) {
+    if (nruns == ROLL_MAX_RUNS || choose_run(&w, terms, nterms, t, &runs[nruns]) < 0) bad = 1;
+    else nitems += runs[nruns++].run.n;
   }
   RollPairs *rp = NULL;
-  if (best_items && 2 * best_n > nterms / best_p) { /* runs of one or two items: no repetition to roll */
-    free_found(best_items, nterms / best_p, best_runs, best_n);
-    best_items = NULL;
-  }
-  if (best_items) {
+  if (!bad && 2 * nruns <= nitems) { /* else runs of one or two items: no repetition to roll */
     rp = arena_alloc(sizeof *rp);
-    *rp = (RollPairs){best_p, nterms / best_p, best_n, arena_alloc((size_t)best_n * sizeof(RollPairRun))};
-    for (int i = 0; i < best_n; i++)
-      run_body(&w, &best_runs[i], best_items, terms + best_runs[i].u0 * best_p, best_p, m, &rp->runs[i]);
-    free_found(best_items, nterms / best_p, best_runs, best_n);
+    *rp = (RollPairs){0, nitems, nruns, arena_alloc((size_t)nruns * sizeof(RollPairRun))};
+    for (int i = 0; i < nruns; i++) {
+      const PChosen *c = &runs[i];
+      run_body(&w, &c->run, c->items.v, terms + c->items.t0, c->items.p, m, &rp->runs[i]);
+      if (c->items.p > rp->period) rp->period = c->items.p;
+    }
   }
+  for (int i = 0; i < nruns; i++) {
+    free_items(&runs[i].items);
+    free(runs[i].run.t.tie);
+  }
+  free(runs);
   free(w.stamp);
   free(w.local); /* order and stack are in the arena */
   return rp;

@@ -9,14 +9,16 @@
  *   order     the default family's order 2s = 4 against a tiny-step
  *             reference (the same solver at h / 16);
  *   rolled    --rolled on (U's pair sum as one double loop over the pairs,
- *             grad U scattered from it: gen/roll_pair.c) against
+ *             two pairs a pass, what reads only the outer index and the
+ *             gradient there kept out of the inner loop; grad U scattered
+ *             from it: gen/roll_pair.c, emit_rolled_pairs.c) against
  *             straight-line: the same trajectory up to the reordering of
  *             sums (docs/rolled.md);
  *   size      the rolled cluster's C as N grows: the same loops at N = 16
  *             and 64, only the data grows (bytes, no timing:
  *             bench/rolled/cluster.sh measures time);
- *   choose    --rolled auto keeps the cluster of 8 straight-line (below the
- *             crossover) and rolls the cluster of 32.
+ *   choose    --rolled auto rolls the cluster of 8 and keeps those of 4 and
+ *             6 straight-line (gen/roll.h, ROLL_AUTO_PAIR_ITEMS).
  * The suite is cluster_suite(); the project's runner adds it. */
 #include <check.h>
 #include <math.h>
@@ -87,7 +89,13 @@ END_TEST
 START_TEST(test_rolled)
 {
   char *text = cluster_model(4, 2), *src = generate_source(text, "--multiplier const --rolled on");
-  ck_assert_msg(src && strstr(src, "for (c = b + 1; c <= 3; c += 1)"), "the cluster of 4 has no loop over its pairs");
+  const char *inner = src ? strstr(src, "for (c = b + 1; c + 1 <= 3; c += 2) {") : NULL, *end;
+  ck_assert_msg(inner, "the cluster of 4 has no loop over its pairs, two a pass");
+  end = strstr(inner, "\n    }\n");
+  ck_assert_ptr_nonnull(end);
+  /* what reads only b (q[b + o]) and the gradient at b are out of the inner loop */
+  const char *at_b = strstr(inner, "[b");
+  ck_assert_msg(!at_b || at_b > end, "the inner pair loop reads or adds at b: %.40s", at_b);
   free(src);
   free(text);
   SAME_TRAJECTORY(cluster_rolled_k4s2, cluster_straight_k4s2, 0.02, 1e-9, "cluster 4, rolled vs straight-line");
@@ -127,8 +135,9 @@ static int count(const char *s, const char *needle)
   return n;
 }
 
-/* The trap and the pair sum are two runs whatever N (measured 46 KB at N = 4, 50 KB at
- * 16, 82 KB at 128, against 1.5 MB of straight-line C at 16): the loops are
+/* The trap and the pair sum are two runs whatever N when 2N is a multiple of 8
+ * (measured 56 KB at N = 4, 65 KB at 16, 79 KB at 64, against 1.5 MB of
+ * straight-line C at 16): the loops are
  * the same at N = 16 and 64, and what grows is q0, p0 and the table tcon:
  * two %.17g literals (up to 25 bytes each with the separator) and one int a
  * coordinate, 64 bytes at most (measured 48). */
@@ -142,6 +151,10 @@ START_TEST(test_size)
          per_coordinate, loops_b, count(b, "for (c = b"));
   /* two runs: the trap's 32 terms as 4 items of 8 (one loop over the atoms), the pairs as one */
   ck_assert_msg(strstr(a, "U's pair sums as 2 runs"), "U of the cluster of 16 is not two runs");
+  /* a trap of 12 terms, no whole number of the pair body's 8: its own period (gen/roll_pair.c) */
+  char *six = rolled_cluster(6, 2);
+  ck_assert_msg(strstr(six, "U's pair sums as 2 runs"), "U of the cluster of 6 is not two runs");
+  free(six);
   ck_assert_msg(loops_a == loops_b, "%d loops at N = 16, %d at N = 64", loops_a, loops_b);
   ck_assert_msg(per_coordinate <= 64, "the rolled cluster grows by %.1f bytes a coordinate", per_coordinate);
   free(a);
@@ -149,16 +162,25 @@ START_TEST(test_size)
 }
 END_TEST
 
+/* --rolled auto's rule for pair sums (gen/roll.h, ROLL_AUTO_PAIR_ITEMS): the
+ * cluster of 8 (30 items in 2 runs) rolls in both families, the clusters of
+ * 4 (7 items) and 6 (18: 3 of its trap, 15 pairs) stay straight-line (the
+ * rolled step of 6 measured 1.17 times the straight-line one). */
 START_TEST(test_choose)
 {
-  char *eight = cluster_model(8, 2), *large = cluster_model(32, 4);
-  char *a = generate_source(eight, "--multiplier const"), *b = generate_source(large, "--multiplier const");
-  ck_assert_msg(a && !strstr(a, "(rolled)"), "--rolled auto rolled the cluster of 8");
-  ck_assert_msg(b && strstr(b, "(rolled)"), "--rolled auto did not roll the cluster of 32");
-  free(a);
-  free(b);
-  free(eight);
-  free(large);
+  static const struct {
+    int n, side, rolled;
+  } cases[] = {{4, 2, 0}, {6, 2, 0}, {8, 2, 1}};
+  static const char *const families[] = {"--multiplier const", ""};
+  for (size_t c = 0; c < sizeof cases / sizeof *cases; c++)
+    for (int f = 0; f < 2; f++) {
+      char *text = cluster_model(cases[c].n, cases[c].side), *src = generate_source(text, families[f]);
+      ck_assert_ptr_nonnull(src);
+      ck_assert_msg((strstr(src, "(rolled)") != NULL) == cases[c].rolled, "--rolled auto %s the cluster of %d (%s)",
+                    cases[c].rolled ? "did not roll" : "rolled", cases[c].n, f ? "poly" : "const");
+      free(src);
+      free(text);
+    }
 }
 END_TEST
 
