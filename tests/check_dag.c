@@ -520,6 +520,29 @@ START_TEST(test_count_ops)
 }
 END_TEST
 
+// dag_positive (bounds.c) proves positivity by interval arithmetic: the
+// second pivot of the double pendulum in angles' M(q), 1 - cos(x - y)^2 / 2,
+// is in [0.5, 1]; where the bounds reach 0 (1 - cos^2, sin^2), a param or an
+// operation it does not bound (a quotient), or only the rounding margin
+// (1e-12 + sin^2 of an input), it proves nothing.
+START_TEST(test_positive)
+{
+  static const struct {
+    const char *e;
+    int positive;
+  } c[] = {{"1 0.5 x y - cos x y - cos * * -", 1}, {"2 x cos +", 1}, {"x x * 1 +", 1}, {"x cos exp", 1},
+           {"3 x sin y cos * -", 1},             {"x sqrt 1 +", 1}, {"x cos 2 ~ * 3 +", 1},
+           {"1 x cos x cos * -", 0},             {"x sin x sin *", 0}, {"p", 0}, {"p p * 1 +", 1},
+           {"1 x /", 0},                         {"x", 0},          {"1e-12 x sin x sin * +", 0},
+           {"1 x cos y cos * -", 0},             {"-1", 0}};
+  for (int i = 0; i < NCASES(c); i++) {
+    Dag *d = dag_new();
+    ck_assert_msg(dag_positive(d, rpn(d, c[i].e)) == c[i].positive, "'%s': positive %d expected", c[i].e,
+                  c[i].positive);
+  }
+}
+END_TEST
+
 Suite *dag_suite(void)
 {
   Suite *s = suite_create("dag");
@@ -538,6 +561,7 @@ Suite *dag_suite(void)
   tcase_add_test(tc, test_eval);
   tcase_add_test(tc, test_subst);
   tcase_add_test(tc, test_count_ops);
+  tcase_add_test(tc, test_positive);
   suite_add_tcase(s, tc);
   return s;
 }
