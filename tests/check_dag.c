@@ -9,8 +9,10 @@
  *     constant, and the algebraic simplifications;
  *   - the polynomial degree of each node;
  *   - method_auto_k on polynomial and non-polynomial degrees;
- *   - dag_eval, dag_eval_many and dag_subst against C evaluation.
+ *   - dag_eval, dag_eval_many and dag_subst against C evaluation;
+ *   - dag_positive (bounds.c), and the M(q) pivot it leaves unguarded.
  * The suite is exposed as dag_suite(); the project's runner calls it. */
+#define _POSIX_C_SOURCE 200809L /* popen */
 #include <check.h>
 #include <ctype.h>
 #include <math.h>
@@ -543,6 +545,29 @@ START_TEST(test_positive)
 }
 END_TEST
 
+// End to end: the double pendulum in angles' M(q) factors without the
+// guard of its second pivot (--check: 13 operations a stage for M(q)^-1 p,
+// 16 with the guard's sqrt, division and product), while the spherical
+// pendulum's sin(th)^2, which can be 0, keeps it (7).
+START_TEST(test_positive_pivot_unguarded)
+{
+  static const struct {
+    const char *model, *want;
+  } c[] = {{"../models/double_pendulum_angles.ham", "a stage takes 13 operations for M(q)^-1 p"},
+           {"../models/spherical_pendulum.ham", "a stage takes 7 operations for M(q)^-1 p"}};
+  for (int i = 0; i < NCASES(c); i++) {
+    char cmd[256], line[512];
+    int found = 0;
+    snprintf(cmd, sizeof cmd, "../gen/hbvmgen --check %s", c[i].model);
+    FILE *f = popen(cmd, "r");
+    ck_assert_ptr_nonnull(f);
+    while (fgets(line, sizeof line, f)) found |= strstr(line, c[i].want) != NULL;
+    ck_assert_int_eq(pclose(f), 0);
+    ck_assert_msg(found, "%s: no '%s'", c[i].model, c[i].want);
+  }
+}
+END_TEST
+
 Suite *dag_suite(void)
 {
   Suite *s = suite_create("dag");
@@ -562,6 +587,7 @@ Suite *dag_suite(void)
   tcase_add_test(tc, test_subst);
   tcase_add_test(tc, test_count_ops);
   tcase_add_test(tc, test_positive);
+  tcase_add_test(tc, test_positive_pivot_unguarded);
   suite_add_tcase(s, tc);
   return s;
 }
