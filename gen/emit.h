@@ -97,6 +97,7 @@ void emit_switches(Emitter *e);
 
 /* emit_predict.c: NAME_predict (the warm start, with NAME_add) and NAME_dense */
 double same_size_coefficient(const Emitter *e, int t);
+void emit_warm_extrapolation(Emitter *e, const char *to, const char *from); /* one-step warm start */
 void emit_two_step_start(Emitter *e, const char *ind, const char *row);
 void emit_predict(Emitter *e);
 void emit_dense(Emitter *e);

@@ -30,17 +30,17 @@ double same_size_coefficient(const Emitter *e, int t) {
   return e->single ? (double)fsum : sum;
 }
 
-// One term of the warm start, to[j] += c gamma_i (the previous step's),
-// with c a literal: without the product where c is 1 (the same sum); ind:
-// the line's indent.
-static void emit_warm_term(Emitter *e, const char *ind, const char *to, int j, int i, double c) {
+// One term of the warm start, to[j] += c from_i (from: the previous
+// step's coefficients, x->gam for gamma), with c a literal: without the
+// product where c is 1 (the same sum); ind: the line's indent.
+static void emit_warm_term(Emitter *e, const char *ind, const char *to, const char *from, int j, int i, double c) {
   char lit[40] = "";
   if (c != 1) {
     format_real(e, lit, sizeof lit, c);
     strcat(lit, " * ");
   }
-  out(e, "%sfor (l = 0; l < %s_M; l++) %s[%d * %s_M + l] += %sx->gam[%d * %s_M + l];\n", ind, e->P, to, j, e->P, lit,
-      i, e->P);
+  out(e, "%sfor (l = 0; l < %s_M; l++) %s[%d * %s_M + l] += %s%s[%d * %s_M + l];\n", ind, e->P, to, j, e->P, lit,
+      from, i, e->P);
 }
 
 // The two-step start into gam, each value summed from 0 over the S steps
@@ -62,23 +62,23 @@ void emit_two_step_start(Emitter *e, const char *ind, const char *row) {
 }
 
 // The warm start of a step as long as the last one, into to:
-// gamma_j += E[j][i](1) gamma_i, the zero terms left out.
-static void emit_predict_same_size(Emitter *e, const char *ind, const char *to) {
+// to_j += E[j][i](1) from_i, the zero terms left out.
+static void emit_predict_same_size(Emitter *e, const char *ind, const char *to, const char *from) {
   for (int t = 0; t < e->me->s * e->me->s; t++) {
     double c = same_size_coefficient(e, t);
-    if (c != 0) emit_warm_term(e, ind, to, t / e->me->s, t % e->me->s, c);
+    if (c != 0) emit_warm_term(e, ind, to, from, t / e->me->s, t % e->me->s, c);
   }
 }
 
 // The warm start of a step whose size differs from the last one's (every
-// step of NAME_step_adaptive): gamma_j += E_ji(r) gamma_i over the last
-// step's gamma_i, r = h / h_previous, each E_ji(r) = sum_d E[(j*S+i)*S+d] r^d
+// step of NAME_step_adaptive): to_j += E_ji(r) from_i over the last
+// step's coefficients from_i (gamma_i: to gam, from x->gam), r = h / h_previous, each E_ji(r) = sum_d E[(j*S+i)*S+d] r^d
 // by Horner's rule from its highest nonzero coefficient, unrolled with the
 // coefficients as literals and the (j, i) whose polynomial is zero left
 // out. The same sums as the table's loop (0 r + c = c and e r + 0 = e r
 // exactly) without its S^3 loads and tests: the loop took 690 of the
 // pendulum's 5540 instructions an adaptive step ((4,4), 2026-11-26).
-static void emit_predict_resized(Emitter *e) {
+static void emit_predict_resized(Emitter *e, const char *to, const char *from) {
   int s = e->me->s, n = s * s * s, degree = 0;
   for (int t = 0; t < n; t++)
     if (e->me->E[t] != 0 && t % s > degree) degree = t % s;
@@ -91,7 +91,7 @@ static void emit_predict_resized(Emitter *e) {
       while (d >= 0 && c[d] == 0) d--;
       if (d < 0) continue;
       if (d == 0) { /* a constant: 0 r + c = c */
-        emit_warm_term(e, "    ", "gam", j, i, c[0]);
+        emit_warm_term(e, "    ", to, from, j, i, c[0]);
         continue;
       }
       format_real(e, lit, sizeof lit, c[d]);
@@ -104,9 +104,21 @@ static void emit_predict_resized(Emitter *e) {
         format_real(e, lit, sizeof lit, c[d]);
         out(e, "    e = e * r + %s;\n", lit);
       }
-      out(e, "    for (l = 0; l < %s_M; l++) gam[%d * %s_M + l] += e * x->gam[%d * %s_M + l];\n", e->P, j, e->P, i,
-          e->P);
+      out(e, "    for (l = 0; l < %s_M; l++) %s[%d * %s_M + l] += e * %s[%d * %s_M + l];\n", e->P, to, j, e->P, from,
+          i, e->P);
     }
+}
+
+// The one-step warm start of to (S*M) from the last step's coefficients
+// from, added into to (zeroed by the caller): the literals of
+// E[j][i](1) where h is the last step's size, else E[j][i](r) by Horner's
+// rule, as NAME_predict extrapolates gamma (M(q): Theta, emit_mq.c).
+void emit_warm_extrapolation(Emitter *e, const char *to, const char *from) {
+  tmpl(e, "  if (h == x->hprev) {\n");
+  emit_predict_same_size(e, "    ", to, from);
+  tmpl(e, "  } else {\n");
+  emit_predict_resized(e, to, from);
+  tmpl(e, "  }\n");
 }
 
 // NAME_predict (the warm start) and NAME_add (the compensated sum) for the step.
@@ -133,7 +145,7 @@ void emit_predict(Emitter *e) {
             "      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */\n"
             "    if (ref) {  /* the one-step start, for the estimate */\n"
             "      for (i = 0; i < $P_S * $P_M; i++) ref[i] = 0;\n");
-    emit_predict_same_size(e, "      ", "ref");
+    emit_predict_same_size(e, "      ", "ref", "x->gam");
     tmpl(e, "    }\n");
     char row[80];
     snprintf(row, sizeof row, "%s_M", e->P);
@@ -145,9 +157,9 @@ void emit_predict(Emitter *e) {
   tmpl(e, poly ? "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return 0;\n  }\n"
                : "  if (cold || x->hprev == 0) {\n    $(minv_p q0=x->q p0=x->p out=gam);\n    return;\n  }\n");
   tmpl(e, "  if (h == x->hprev) {  /* gamma_j += E[j][i](1) gamma_i, the zero terms left out */\n");
-  emit_predict_same_size(e, "    ", "gam");
+  emit_predict_same_size(e, "    ", "gam", "x->gam");
   tmpl(e, "  } else {\n");
-  emit_predict_resized(e);
+  emit_predict_resized(e, "gam", "x->gam");
   tmpl(e, "  }\n");
   if (poly) tmpl(e, "  return 0;\n");
   tmpl(e, "}\n\n");

@@ -279,6 +279,7 @@ double op_apply(Op op, double a, double b);
 void dag_reach(const Dag *d, const int *roots, int nroots, unsigned char *mark);
 long dag_count_ops(const Dag *d, const int *roots, int nroots); /* nodes with an operand */
 double dag_eval(const Dag *d, int root, const double *inputs, const double *params);
+int dag_positive(const Dag *d, int x); /* bounds.c: x > 0 (or NaN) for all inputs and params */
 void dag_eval_many(const Dag *d, const int *roots, int nroots, const double *inputs, const double *params,
                    double *out);
 void dag_subst(Dag *d, const int *roots, int nroots, const int *map, int nmap, int *out);
@@ -388,7 +389,7 @@ int mass_setup_diag(Model *mod, const double *diag, Loc loc); /* M = diag(diag[0
  * M^-1 in the DAG; call before mass_setup* with M at the default params. */
 int mass_setup_params(Model *mod, const int *entries, int dense, Loc loc);
 void minv_apply(const Model *mod, Dag *d, const int *v, int *out); /* out = M^-1 v, nodes */
-long mass_ldl(Dag *d, const int *a, int m, SparseVec *L, int *dinv, Loc loc, const char *what);
+long mass_ldl(Dag *d, const int *a, int m, SparseVec *L, int *dinv, int bounded, Loc loc, const char *what);
 void mass_ldl_solve(Dag *d, const SparseVec *L, const int *dinv, int m, const int *v, int *out);
 /* mass_q.c: M(q) */
 void mass_q_setup(Model *mod, const int *entries, int dense, Loc loc);

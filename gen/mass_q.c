@@ -62,7 +62,7 @@ int mass_q_check(Model *mod, const double *prm) {
 static void solve_with(Model *mod, Dag *d, const int *a, const int *v, int *out) {
   int m = mod->m, *dinv = step_nodes(m);
   SparseVec *L = arena_alloc((size_t)m * sizeof *L);
-  long nl = mass_ldl(d, a, m, L, dinv, mod->mass_loc, "depends on q");
+  long nl = mass_ldl(d, a, m, L, dinv, 1, mod->mass_loc, "depends on q");
   if (nl < 0) { /* (reported: the step is not built) */
     for (int i = 0; i < m; i++) out[i] = dag_const(d, NAN);
     return;

@@ -9,8 +9,10 @@
  *     constant, and the algebraic simplifications;
  *   - the polynomial degree of each node;
  *   - method_auto_k on polynomial and non-polynomial degrees;
- *   - dag_eval, dag_eval_many and dag_subst against C evaluation.
+ *   - dag_eval, dag_eval_many and dag_subst against C evaluation;
+ *   - dag_positive (bounds.c), and the M(q) pivot it leaves unguarded.
  * The suite is exposed as dag_suite(); the project's runner calls it. */
+#define _POSIX_C_SOURCE 200809L /* popen */
 #include <check.h>
 #include <ctype.h>
 #include <math.h>
@@ -520,6 +522,52 @@ START_TEST(test_count_ops)
 }
 END_TEST
 
+// dag_positive (bounds.c) proves positivity by interval arithmetic: the
+// second pivot of the double pendulum in angles' M(q), 1 - cos(x - y)^2 / 2,
+// is in [0.5, 1]; where the bounds reach 0 (1 - cos^2, sin^2), a param or an
+// operation it does not bound (a quotient), or only the rounding margin
+// (1e-12 + sin^2 of an input), it proves nothing.
+START_TEST(test_positive)
+{
+  static const struct {
+    const char *e;
+    int positive;
+  } c[] = {{"1 0.5 x y - cos x y - cos * * -", 1}, {"2 x cos +", 1}, {"x x * 1 +", 1}, {"x cos exp", 1},
+           {"3 x sin y cos * -", 1},             {"x sqrt 1 +", 1}, {"x cos 2 ~ * 3 +", 1},
+           {"1 x cos x cos * -", 0},             {"x sin x sin *", 0}, {"p", 0}, {"p p * 1 +", 1},
+           {"1 x /", 0},                         {"x", 0},          {"1e-12 x sin x sin * +", 0},
+           {"1 x cos y cos * -", 0},             {"-1", 0}};
+  for (int i = 0; i < NCASES(c); i++) {
+    Dag *d = dag_new();
+    ck_assert_msg(dag_positive(d, rpn(d, c[i].e)) == c[i].positive, "'%s': positive %d expected", c[i].e,
+                  c[i].positive);
+  }
+}
+END_TEST
+
+// End to end: the double pendulum in angles' M(q) factors without the
+// guard of its second pivot (--check: 13 operations a stage for M(q)^-1 p,
+// 16 with the guard's sqrt, division and product), while the spherical
+// pendulum's sin(th)^2, which can be 0, keeps it (7).
+START_TEST(test_positive_pivot_unguarded)
+{
+  static const struct {
+    const char *model, *want;
+  } c[] = {{"../models/double_pendulum_angles.ham", "a stage takes 13 operations for M(q)^-1 p"},
+           {"../models/spherical_pendulum.ham", "a stage takes 7 operations for M(q)^-1 p"}};
+  for (int i = 0; i < NCASES(c); i++) {
+    char cmd[256], line[512];
+    int found = 0;
+    snprintf(cmd, sizeof cmd, "../gen/hbvmgen --check %s", c[i].model);
+    FILE *f = popen(cmd, "r");
+    ck_assert_ptr_nonnull(f);
+    while (fgets(line, sizeof line, f)) found |= strstr(line, c[i].want) != NULL;
+    ck_assert_int_eq(pclose(f), 0);
+    ck_assert_msg(found, "%s: no '%s'", c[i].model, c[i].want);
+  }
+}
+END_TEST
+
 Suite *dag_suite(void)
 {
   Suite *s = suite_create("dag");
@@ -538,6 +586,8 @@ Suite *dag_suite(void)
   tcase_add_test(tc, test_eval);
   tcase_add_test(tc, test_subst);
   tcase_add_test(tc, test_count_ops);
+  tcase_add_test(tc, test_positive);
+  tcase_add_test(tc, test_positive_pivot_unguarded);
   suite_add_tcase(s, tc);
   return s;
 }

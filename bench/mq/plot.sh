@@ -1,8 +1,8 @@
 #!/bin/sh
 # bench/mq/plot.sh - bench/results/mq_wp_P.png from bench/results/mq_wp.csv
 # (bench/mq/wp.sh): CPU seconds against the error at T of the gcc -O2 build,
-# rk8pd and the hbvm lines named below, timed points only, in the order of
-# the sweep (tol or N).
+# rk8pd and the hbvm lines named below (dpc_: the Cartesian form), timed
+# points only, in the order of the sweep (tol or N).
 set -e
 csv=bench/results/mq_wp.csv
 dir=$(mktemp -d)
@@ -15,7 +15,7 @@ plot() {
   for line in "$@"; do
     m=${line%%:*} mode=${line#*:}
     awk -F, -v pb="$pb" -v m="$m" -v mode="$mode" \
-      '$1 == "gcc-O2" && $2 == pb && $3 == m && $4 == "" && $5 == mode && $12 > 0 { print $10, $12 }' \
+      '$1 == "gcc-O2" && $2 == pb && $3 == m && $5 == mode && $12 > 0 { print $10, $12 }' \
       "$csv" >"$dir/$m.$mode"
     cmd="$cmd${cmd:+, }'$dir/$m.$mode' using 1:2 with linespoints title '$m $mode'"
   done
@@ -33,4 +33,4 @@ GP
 plot pendulum_angle gsl-rk8pd:adaptive pa_ks_s6:adaptive pa_ks_s6:fixed pa_ks_s4:adaptive \
   pa_kauto_s6:adaptive pa_kauto_s4:adaptive pa_quad_s6:adaptive pa_quad_s4:adaptive
 plot double_pendulum_angles gsl-rk8pd:adaptive dpa_ks_s6:fixed dpa_ks_s6:adaptive dpa_ks_s7:fixed \
-  dpa_ks_s4:fixed dpa_ks_s4:adaptive
+  dpa_ks_s4:fixed dpa_ks_s4:adaptive dpc_ks_s6:fixed dpc_ks_s4:fixed

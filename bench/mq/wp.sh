@@ -5,7 +5,9 @@
 # (-k auto: s for both, the end of the step rescaling p to keep H), the
 # pendulum also at its old default (--energy quadrature: k = 2s+12, no
 # rescale; with -k s the step keeps the plain quadrature), the double pendulum also at
-# s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, each built by
+# s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, and its
+# Cartesian form (models/double_pendulum.ham, k = s = 4..6, variant cartesian,
+# its state mapped to the angles), each built by
 # gcc -O2 and by clang -O3 -march=native -fno-math-errno -ffp-contract=off
 # (docs/api.md, "Flags that are safe"). Writes bench/results/mq_wp.csv and
 # bench/results/mq_ratios.txt (bench/mq/ratios.awk), and with gnuplot the
@@ -38,6 +40,9 @@ gen double_pendulum_angles 1 dpa_kauto_s4 auto 4 ""
 gen double_pendulum_angles 1 dpa_kauto_s6 auto 6 ""
 gen double_pendulum_angles 1 dpa_k11_s6 11 6 ""
 gen double_pendulum_angles 1 dpa_ks_s4_loop 4 4 "stage-loop" --stage-loop 1
+for s in 4 5 6; do  # the Cartesian form (two constraints, the poly family), in the angles' group
+  gen double_pendulum 1 dpc_ks_s$s "$s" "$s" "cartesian"
+done
 W="-std=c99 -Wall -Wextra -pedantic"
 srcs=$(sed -n 's/^S(\([a-z0-9_]*\),.*/\1.c/p' "$dir/solvers.def" | sed "s|^|$dir/|")
 nice -n 5 gcc $W -O2 -DBUILD='"gcc-O2"' -I"$dir" -o "$dir/wp_gcc" bench/mq/wp.c $srcs $(pkg-config --libs gsl) -lm
