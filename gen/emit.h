@@ -105,6 +105,8 @@ void emit_dense(Emitter *e);
 /* emit_estimate.c: the error estimates, NAME_step and NAME_step_adaptive */
 void emit_estimators(Emitter *e);
 void emit_step_factor(Emitter *e);
+void emit_aim_cut(Emitter *e, const char *ind, const char *lv);
+void emit_aim_restore(Emitter *e, const char *ind, const char *lv);
 void emit_root(Emitter *e, const char *dst, const char *err);
 void emit_step_adaptive(Emitter *e);
 

@@ -43,7 +43,7 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   out(e, "  /* private: compensated-summation errors and the last two steps' polynomials */\n");
   int poly = e->st->kern[K_FACTOR].nout > 0;
   out(e, "  %s_real tc, qc[%d], pc[%d], gam[%d], hprev;\n", e->P, m, m, s * m);
-  out(e, "  %s_real gam2[%d], hprev2, errprev;\n", e->P, s * m);
+  out(e, "  %s_real gam2[%d], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */\n", e->P, s * m);
   out(e, "  %s_real pinc[%d];  /* p's polynomial over the last step, for %s_dense */\n", e->P, s * m, e->P);
   if (poly || energy_rescale_wanted(e)) out(e, "  %s_real H0;  /* the energy the step keeps */\n", e->P);
   if (energy_rescale_wanted(e) && !mod->mass_q) out(e, "  %s_real Hend;  /* H where the last step ended */\n", e->P);
@@ -254,7 +254,7 @@ static void emit_init(Emitter *e) {
   if (of_params) tmpl(e, "  $R v[$<initial>];\n");
   tmpl(e, "  $P_DEFAULT_PARAMS(prm)\n");
   if (of_params) tmpl(e, "  $(initial out=v);\n");
-  tmpl(e, "  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;\n"
+  tmpl(e, "  x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;\n  x->aim = 1;\n"
           "  for (i = 0; i < $P_M; i++) {\n");
   if (of_params)
     tmpl(e, "    x->q[i] = q0 ? q0[i] : v[$[initial.q0]i];\n"

@@ -24,7 +24,7 @@ void emit_batch_header(Emitter *e, int lanes) {
   out(e, "%d * %s_W];\n", nu1, e->P);
   tmpl(e, "  /* private, per lane as in $P_state */\n"
           "  $P_real tc[$P_W], qc[$P_M * $P_W], pc[$P_M * $P_W], gam[$P_S * $P_M * $P_W], hprev[$P_W];\n"
-          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W], errprev[$P_W];\n"
+          "  $P_real gam2[$P_S * $P_M * $P_W], hprev2[$P_W], errprev[$P_W], aim[$P_W];\n"
           "  $P_real pinc[$P_S * $P_M * $P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
   else if (e->mod->mass_q) tmpl(e, "  $P_real H0[$P_W];  /* M(q): the energy the step keeps */\n");
@@ -54,7 +54,8 @@ void emit_batch_header(Emitter *e, int lanes) {
           " * in each lane: a try with a lane over its tolerance, or failing, is retried smaller\n"
           " * with no lane written; *h is the next step proposed. Each lane of an accepted step is\n"
           " * bitwise $P_step_adaptive's step of that size (after three tries over the tolerance,\n"
-          " * its cold one). Returns the number of lanes that failed: below the smallest step\n"
+          " * its cold one), but for the controller's aim, the lanes' lowest, which they then\n"
+          " * share. Returns the number of lanes that failed: below the smallest step\n"
           " * every active lane, none written. */\n"
           "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st);\n"
           "/* H (W values), g and the hidden constraints ($P_NU * $P_W values) of every lane. */\n"
@@ -65,7 +66,7 @@ void emit_batch_header(Emitter *e, int lanes) {
 
 // NAME_batch_set and NAME_batch_get: one lane to and from a NAME_state.
 static void emit_set_get(Emitter *e) {
-  static const char *const scalar[] = {"t", "tc", "hprev", "hprev2", "errprev", "H0"}, *const array[][2] = {
+  static const char *const scalar[] = {"t", "tc", "hprev", "hprev2", "errprev", "aim", "H0"}, *const array[][2] = {
       {"q", "$P_M"},   {"p", "$P_M"},   {"qc", "$P_M"}, {"pc", "$P_M"}, {"gam", "$P_S * $P_M"}, {"gam2", "$P_S * $P_M"},
       {"lambda", "$P_NU"}, {"pinc", "$P_S * $P_M"}, {"pcorr", "$P_M"}};
   int poly = e->st->kern[K_FACTOR].nout > 0;
@@ -73,7 +74,7 @@ static void emit_set_get(Emitter *e) {
   for (int get = 0; get < 2; get++) {
     tmpl(e, get ? "void $P_batch_get(const $P_batch *x, int l, $P_state *s)\n{\n  int i;\n"
                 : "void $P_batch_set($P_batch *x, int l, const $P_state *s)\n{\n  int i;\n");
-    for (int f = 0; f < (poly || e->mod->mass_q ? 6 : 5); f++) /* H0 last */
+    for (int f = 0; f < (poly || e->mod->mass_q ? 7 : 6); f++) /* H0 last */
       out(e, get ? "  s->%s = x->%s[l];\n" : "  x->%s[l] = s->%s;\n", scalar[f], scalar[f]);
     for (int f = 0; f < (poly ? 9 : 8); f++) {
       const char *n = array[f][0];

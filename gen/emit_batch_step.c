@@ -375,7 +375,7 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // any failure, the number of lanes that failed (never the -1, -2 of a try).
 void emit_batch_adaptive(Emitter *e) {
   tmpl(e, "int $P_batch_step_adaptive($P_batch *x, $P_real *h, $P_real tol, const $P_params *prm, $P_batch_stats *st)\n{\n"
-          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rq, rp, pmax, grow = 2, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
+          "  $P_batch_stats own, *s = st ? st : &own;  /* no struct copies: no memcpy on a bare target */\n  $R hh = *h, err, fac, r, pq, rq, rp, pmax, ra = 1, grow = 2, tmax = 0;\n  int rc, rejected = 0, misses = 0, nact = 0, first = 1, i, l, l0 = 0;\n"
           "  if (!(tol > 0 && isfinite(tol))) hh = 0;  /* every active lane then fails with $P_EBADSTEP */\n"
           "  if (!(hh != 0 && isfinite(hh))) {  /* every active lane fails: say how many, as below */\n"
           "    $P_batch_within(x, hh, 0, 0, prm, s);\n"
@@ -384,7 +384,9 @@ void emit_batch_adaptive(Emitter *e) {
           "  tol *= $P_TOLC;\n"
           "  for (l = 0; l < $P_W; l++)\n    if (!x->idle[l]) {\n      if (!nact++) l0 = l;  /* the first active lane */\n"
           "      if (fabs$f(x->t[l]) > tmax) tmax = fabs$f(x->t[l]);\n"
-          "      if (x->hprev[l] != 0) first = 0;\n    }\n"
+          "      if (x->hprev[l] != 0) first = 0;\n"
+          "      /* the lowest aim of the lanes (emit_step_factor; 1 for a lane not from $P_init) */\n"
+          "      if (x->aim[l] > 0 && x->aim[l] < ra) ra = x->aim[l];\n    }\n"
           "  if (first) grow = 100;  /* every active lane's first step: from a guess, as $P_step_adaptive */\n"
           "  for (;;) {\n"
           "    rc = $P_batch_within(x, hh, tol * fabs$f(hh), misses >= 3, prm, s);\n"
@@ -406,8 +408,14 @@ void emit_batch_adaptive(Emitter *e) {
           "        x->errprev[l] = rp;\n      }\n"
           "      rq = rc >= 0 && pmax > 0 ? pmax : 0;\n      pq = rq > 0 ? rq * (hh / x->hprev2[l0]) : 0;\n");
   emit_step_factor(e);
-  tmpl(e, "      if (rc >= 0) {\n        *h = hh * fac;\n        s->rejected = rejected;\n"
-          "        return rc;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
+  tmpl(e, "      if (rc >= 0) {\n        *h = hh * fac;\n        s->rejected = rejected;\n");
+  emit_aim_restore(e, "        ", "ra");
+  tmpl(e, "        for (l = 0; l < $P_W; l++)  /* the lanes stepped share the aim from now on */\n"
+          "          if (!x->idle[l] && s->code[l] == $P_OK) x->aim[l] = ra;\n"
+          "        return rc;\n      }\n"
+          "      if (!first) {  /* over the tolerance: a lower aim, as $P_step_adaptive */\n");
+  emit_aim_cut(e, "        ", "ra");
+  tmpl(e, "      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
           "    if (fabs$f(hh) < $P_HMIN * (1 + tmax) || rejected >= $P_MAXTRIES) {\n"
           "      s->h = 0;\n      s->rejected = rejected;\n"

@@ -295,38 +295,85 @@ void emit_root(Emitter *e, const char *dst, const char *err) {
   out(e, ";  /* err^(1/%d) */\n", controller_order(e));
 }
 
+// The aim after a rejected try is AIM_CUT times what it was, and AIM_STEPS
+// accepted steps restore it (at most to rho): the controller learns how far
+// the estimate scatters. Measured (issue 31, item 3, docs/api.md "Adaptive
+// steps"): 0.25 and 40 keep the rejected tries under 5% on every run of more
+// than 40 tries of bench/adaptive/rejections.sh; 0.5, or 20 steps, left the
+// double pendulum in angles at 6-9%.
+#define AIM_CUT 0.25
+#define AIM_STEPS 40
+
+// The aim's factors in the controller's units, err^(1/p): "  LV *= c;" after
+// a rejected try (aim_cut) or "  LV *= c; if (LV > 1) LV = 1;" after an
+// accepted step (aim_restore), each line indented by IND.
+void emit_aim_cut(Emitter *e, const char *ind, const char *lv) {
+  char c[40];
+  format_real(e, c, sizeof c, pow(AIM_CUT, 1.0 / controller_order(e)));
+  out(e, "%s%s *= %s;  /* the aim times %g: a rejected try */\n", ind, lv, c, AIM_CUT);
+}
+
+void emit_aim_restore(Emitter *e, const char *ind, const char *lv) {
+  char c[40];
+  format_real(e, c, sizeof c, pow(1 / AIM_CUT, 1.0 / (AIM_STEPS * controller_order(e))));
+  out(e, "%s%s *= %s;  /* %d accepted steps restore the aim */\n%sif (%s > 1) %s = 1;\n", ind, lv, c, AIM_STEPS, ind, lv,
+      lv);
+}
+
 // The controller's factor for the next step, fac, from err, the error over
-// its tolerance, r = err^(1/p), rq = r_{n-1}, the last step's (0: none), and
-// pq, Gustafsson's prediction (h_n / h_{n-1}) r_{n-1} (0: none)
-// (NAME_step_adaptive, NAME_batch_step_adaptive). The standard step
-// (RHO / err)^(1/p), times the smaller of 1 and a prediction where the
-// error grew (Hairer & Wanner IV.8):
+// its tolerance, r = err^(1/p), rq = r_{n-1}, the last step's (0: none), pq,
+// Gustafsson's prediction (h_n / h_{n-1}) r_{n-1} (0: none), and ra <= 1, the
+// aim's factor (NAME_step_adaptive, NAME_batch_step_adaptive): the standard
+// step (rho ra^p / err)^(1/p) times the smaller of 1 and a prediction where
+// the error grew (Hairer & Wanner IV.8):
 // - Gustafsson's (1994, as in RADAU5), (h_n / h_{n-1}) (err_{n-1} / err_n)^(1/p)
 //   = pq / r, which follows a trend in the step size;
-// - where h grew (at most 2x: not the step after the first, which grows up
-//   to 100x from the caller's guess), the error's own trend, smaller,
-//   (err_{n-1} / err_n)^(1/p) = rq / r: that the error grows again as it
-//   just did, whatever h did. On the way to Kepler's perihelion the error
-//   per unit step at the same h grows 10-200x in one step; a step that grew
-//   1.3x and saw its error grow 15x (h^12 would be 28x) looked to
-//   Gustafsson's rule like an error falling at fixed h, and the next try
-//   was rejected, once an orbit: 5.3% of the tries at (11,6), 8.5% at
-//   (18,3) at tol 1e-6, 5.5% at (4,4) at 1e-10; 4.1%, 0%, 4.5% with it, and
-//   every line of docs/api.md's table under 5%, at 0.91-1.04x the work for
-//   the same error (docs/api.md, "Adaptive steps"). Read after the first
-//   step too, it cut the second step of the double pendulum in angles 10x
-//   and its error at tol 1e-6 fell to 6e-4 tol.
-// Within [0.2, grow]; NaN (an estimate that is not a number) gives 0.2.
+// - once a try was rejected (ra < 1), where h grew (at most 2x), the error's
+//   own trend, smaller, (err_{n-1} / err_n)^(1/p) = rq / r: that the error
+//   grows again as it just did, whatever h did. On the way to Kepler's
+//   perihelion the error per unit step at the same h grows 10-200x in one
+//   step; a step that grew 1.3x and saw its error grow 15x (h^12 would be
+//   28x) looked to Gustafsson's rule like an error falling at fixed h, and
+//   the next try was rejected, once an orbit.
+// The aim, ra^p rho, falls AIM_CUT-fold after each rejected try and climbs
+// back over AIM_STEPS accepted steps, so that it settles where the
+// estimate's own scatter rejects about one try in AIM_STEPS. The scatter is
+// the model's: Kepler's error jumps 10-200x a step near the perihelion, and
+// the double pendulum in angles' energy defect (k = s) 10-1000x between
+// steps of the same h, a projection of the error onto grad H that changes
+// sign; a fixed aim low enough for those (30x lower) cost 1.2-1.5x the work
+// at equal error at p = 6, and the trend read on every step (2026-11-28,
+// issue 31) cost the satellites and the pendulum 1.04 and 1.01-1.03: a step
+// that grew 2x with its error 2^p was cut back, and its error read as a
+// trend. Within [0.2, grow]; NaN (an estimate that is not a number) gives 0.2.
 void emit_step_factor(Emitter *e) {
   char c[40];
   format_real(e, c, sizeof c, pow(control_rho(e), 1.0 / controller_order(e)));
   out(e, "      ");
   emit_root(e, "r", "err");
-  out(e, "      fac = err > 0 ? %s / r : grow;  /* (%.3g / err)^(1/%d) */\n", c, control_rho(e), controller_order(e));
-  tmpl(e, "      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */\n"
-          "      if (rq < pq && pq <= 2 * rq) pq = rq;\n"
+  out(e, "      fac = (err > 0 ? %s / r : grow) * ra;  /* (%.3g aim / err)^(1/%d), ra = aim^(1/%d) */\n", c,
+      control_rho(e), controller_order(e), controller_order(e));
+  tmpl(e, "      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,\n"
+          "       * and a try was rejected (the aim is lowered) */\n"
+          "      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;\n"
           "      if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */\n"
           "      if (fac > grow) fac = grow;\n      if (!(fac >= ($R)0.2)) fac = ($R)0.2;  /* a NaN estimate too */\n");
+}
+
+// Where the estimate adds the energy defect beyond round-off (emit_defect),
+// a defect still under it (NAME_stats.defect, relative, below NAME_NOISETOL)
+// is 0 to the controller, which then grows h until the defect crosses the
+// round-off and appears at once at up to 5x the tolerance (the double
+// pendulum in angles at s = 3, tol 3e-9 .. 1e-10: a try in four rejected).
+// Once the defect is a tenth of the round-off, h grows at most to where it
+// would reach it, the defect growing as h^(2k+1): 24% -> 13% rejected there.
+static void emit_defect_cap(Emitter *e) {
+  if (!energy_defect_wanted(e)) return;
+  tmpl(e, "      if (rc == $P_OK && s.defect >= ($R)0.1 * $P_NOISETOL && s.defect < $P_NOISETOL) {\n"
+          "        /* the energy defect hidden in round-off: grow to where it would appear, at most */\n");
+  out(e, "        %s cap = pow%s(%s_NOISETOL / s.defect, (%s)1 / %d);\n", real_type(e, 0), math_suffix(e, 0), e->P,
+      real_type(e, 0), 2 * e->me->k + 1);
+  tmpl(e, "        if (fac > cap) fac = cap;\n      }\n");
 }
 
 // NAME_step_controlled: NAME_step_adaptive under absolute and relative
@@ -378,7 +425,7 @@ void emit_step_adaptive(Emitter *e) {
            " * (%s_mult_err: q is of order 4, p of order %d across the hidden constraint). */\n",
         controller_order(e), e->P, step_order(e));
   tmpl(e, "int $P_step_adaptive($P_state *x, $P_real *h, $P_real tol, const $P_params *prm, $P_stats *st)\n{\n"
-          "  $P_stats s;\n  $R hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */\n"
+          "  $P_stats s;\n  $R hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */\n"
           "  int rc, rejected = 0, misses = 0, i;\n"
           "  if (!(hh != 0 && isfinite(hh))) return $P_EBADSTEP;\n"
           "  if (!(tol > 0 && isfinite(tol))) return $P_EBADSTEP;\n"
@@ -386,6 +433,8 @@ void emit_step_adaptive(Emitter *e) {
           "  if (!isfinite(x->t)) return $P_ENONFINITE;\n"
           "  for (i = 0; i < $P_M; i++)\n"
           "    if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return $P_ENONFINITE;\n"
+          "  /* the aim (emit_step_factor), written back only with an accepted step */\n"
+          "  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from $P_init */\n"
           "  tol *= $P_TOLC;\n"
           "  for (;;) {\n    s.iters = 0;\n    s.increment = s.err_est = 0;\n"
           "    /* after 3 tries over the tolerance the warm start is dropped: it carries the\n"
@@ -402,14 +451,22 @@ void emit_step_adaptive(Emitter *e) {
           "      rq = rc == $P_OK && x->hprev2 != 0 ? x->errprev : 0;\n"
           "      pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);\n");
   emit_step_factor(e);
-  tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n        x->errprev = r;\n"
+  emit_defect_cap(e);
+  tmpl(e, "      if (rc == $P_OK) {\n        *h = hh * fac;\n        x->errprev = r;\n");
+  emit_aim_restore(e, "        ", "ra");
+  tmpl(e, "        x->aim = ra;\n");
+  tmpl(e, ""
           "        if (st) {\n          st->iters = s.iters;\n          st->increment = s.increment;\n"
           "          st->err_est = s.err_est;\n          st->h = hh;\n          st->rejected = rejected;\n"
           "          st->defect = s.defect;\n");
   if (emit_is_newton(e))
     tmpl(e, "          st->newton = s.newton;\n          st->factors = s.factors;\n          st->jacobians = s.jacobians;\n");
   tmpl(e, "        }\n"
-          "        return $P_OK;\n      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
+          "        return $P_OK;\n      }\n"
+          "      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */\n"
+          "      if (x->hprev != 0) {\n");
+  emit_aim_cut(e, "        ", "ra");
+  tmpl(e, "      }\n    } else {\n      fac = ($R)0.5;\n    }\n"
           "    rejected++;\n    grow = 1;\n    hh *= fac;\n"
           "    if (fabs$f(hh) < $P_HMIN * (1 + fabs$f(x->t)) || rejected >= $P_MAXTRIES) {\n"
           "      if (st) {\n        st->iters = s.iters;\n        st->increment = s.increment;\n"

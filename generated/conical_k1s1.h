@@ -28,7 +28,7 @@ typedef struct {
   conical_k1s1_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k1s1_real tc, qc[3], pc[3], gam[3], hprev;
-  conical_k1s1_real gam2[3], hprev2, errprev;
+  conical_k1s1_real gam2[3], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   conical_k1s1_real pinc[3];  /* p's polynomial over the last step, for conical_k1s1_dense */
 } conical_k1s1_state;
 

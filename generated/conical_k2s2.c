@@ -207,6 +207,7 @@ void conical_k2s2_init_params(conical_k2s2_state *x, const conical_k2s2_real *q0
   int i;
   conical_k2s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < conical_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : conical_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : conical_k2s2_p0[i];
@@ -659,7 +660,7 @@ int conical_k2s2_step(conical_k2s2_state *x, conical_k2s2_real h, const conical_
 int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, conical_k2s2_real tol, const conical_k2s2_params *prm, conical_k2s2_stats *st)
 {
   conical_k2s2_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return conical_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return conical_k2s2_EBADSTEP;
@@ -667,6 +668,8 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
   if (!isfinite(x->t)) return conical_k2s2_ENONFINITE;
   for (i = 0; i < conical_k2s2_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return conical_k2s2_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from conical_k2s2_init */
   tol *= conical_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -686,15 +689,19 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
       rq = rc == conical_k2s2_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(err);  /* err^(1/3) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.90000000000000002 / r : grow) * ra;  /* (0.729 aim / err)^(1/3), ra = aim^(1/3) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == conical_k2s2_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0116194403019225;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -704,6 +711,10 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
           st->defect = s.defect;
         }
         return conical_k2s2_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.6299605249474366;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

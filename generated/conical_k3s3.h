@@ -28,7 +28,7 @@ typedef struct {
   conical_k3s3_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k3s3_real tc, qc[3], pc[3], gam[9], hprev;
-  conical_k3s3_real gam2[9], hprev2, errprev;
+  conical_k3s3_real gam2[9], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   conical_k3s3_real pinc[9];  /* p's polynomial over the last step, for conical_k3s3_dense */
 } conical_k3s3_state;
 

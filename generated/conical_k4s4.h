@@ -28,7 +28,7 @@ typedef struct {
   conical_k4s4_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_k4s4_real tc, qc[3], pc[3], gam[12], hprev;
-  conical_k4s4_real gam2[12], hprev2, errprev;
+  conical_k4s4_real gam2[12], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   conical_k4s4_real pinc[12];  /* p's polynomial over the last step, for conical_k4s4_dense */
 } conical_k4s4_state;
 

@@ -28,7 +28,7 @@ typedef struct {
   conical_poly_k2s2_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   conical_poly_k2s2_real tc, qc[3], pc[3], gam[6], hprev;
-  conical_poly_k2s2_real gam2[6], hprev2, errprev;
+  conical_poly_k2s2_real gam2[6], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   conical_poly_k2s2_real pinc[6];  /* p's polynomial over the last step, for conical_poly_k2s2_dense */
   conical_poly_k2s2_real H0;  /* the energy the step keeps */
   conical_poly_k2s2_real pcorr[3];  /* p1 minus p's polynomial at the end: the projection and rescale */

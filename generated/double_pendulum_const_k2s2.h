@@ -28,7 +28,7 @@ typedef struct {
   double_pendulum_const_k2s2_real t, q[4], p[4], lambda[2];
   /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_const_k2s2_real tc, qc[4], pc[4], gam[8], hprev;
-  double_pendulum_const_k2s2_real gam2[8], hprev2, errprev;
+  double_pendulum_const_k2s2_real gam2[8], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   double_pendulum_const_k2s2_real pinc[8];  /* p's polynomial over the last step, for double_pendulum_const_k2s2_dense */
 } double_pendulum_const_k2s2_state;
 

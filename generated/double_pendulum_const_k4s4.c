@@ -301,6 +301,7 @@ void double_pendulum_const_k4s4_init_params(double_pendulum_const_k4s4_state *x,
   int i;
   double_pendulum_const_k4s4_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < double_pendulum_const_k4s4_M; i++) {
     x->q[i] = q0 ? q0[i] : double_pendulum_const_k4s4_q0[i];
     x->p[i] = p0 ? p0[i] : double_pendulum_const_k4s4_p0[i];
@@ -1080,7 +1081,7 @@ int double_pendulum_const_k4s4_step(double_pendulum_const_k4s4_state *x, double_
 int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x, double_pendulum_const_k4s4_real *h, double_pendulum_const_k4s4_real tol, const double_pendulum_const_k4s4_params *prm, double_pendulum_const_k4s4_stats *st)
 {
   double_pendulum_const_k4s4_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_const_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_const_k4s4_EBADSTEP;
@@ -1088,6 +1089,8 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
   if (!isfinite(x->t)) return double_pendulum_const_k4s4_ENONFINITE;
   for (i = 0; i < double_pendulum_const_k4s4_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return double_pendulum_const_k4s4_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from double_pendulum_const_k4s4_init */
   tol *= double_pendulum_const_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1107,15 +1110,19 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
       rq = rc == double_pendulum_const_k4s4_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(err);  /* err^(1/3) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.90000000000000002 / r : grow) * ra;  /* (0.729 aim / err)^(1/3), ra = aim^(1/3) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == double_pendulum_const_k4s4_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0116194403019225;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1125,6 +1132,10 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
           st->defect = s.defect;
         }
         return double_pendulum_const_k4s4_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.6299605249474366;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

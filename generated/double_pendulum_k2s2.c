@@ -749,6 +749,7 @@ void double_pendulum_k2s2_init_params(double_pendulum_k2s2_state *x, const doubl
   int i;
   double_pendulum_k2s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < double_pendulum_k2s2_M; i++) {
     x->q[i] = q0 ? q0[i] : double_pendulum_k2s2_q0[i];
     x->p[i] = p0 ? p0[i] : double_pendulum_k2s2_p0[i];
@@ -1513,7 +1514,7 @@ int double_pendulum_k2s2_step(double_pendulum_k2s2_state *x, double_pendulum_k2s
 int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pendulum_k2s2_real *h, double_pendulum_k2s2_real tol, const double_pendulum_k2s2_params *prm, double_pendulum_k2s2_stats *st)
 {
   double_pendulum_k2s2_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return double_pendulum_k2s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return double_pendulum_k2s2_EBADSTEP;
@@ -1521,6 +1522,8 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
   if (!isfinite(x->t)) return double_pendulum_k2s2_ENONFINITE;
   for (i = 0; i < double_pendulum_k2s2_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return double_pendulum_k2s2_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from double_pendulum_k2s2_init */
   tol *= double_pendulum_k2s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1540,15 +1543,19 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
       rq = rc == double_pendulum_k2s2_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = sqrt(sqrt(err));  /* err^(1/4) */
-      fac = err > 0 ? 0.74008280449228525 / r : grow;  /* (0.3 / err)^(1/4) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.74008280449228525 / r : grow) * ra;  /* (0.3 aim / err)^(1/4), ra = aim^(1/4) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == double_pendulum_k2s2_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.008701983790399;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1558,6 +1565,10 @@ int double_pendulum_k2s2_step_adaptive(double_pendulum_k2s2_state *x, double_pen
           st->defect = s.defect;
         }
         return double_pendulum_k2s2_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.70710678118654757;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

@@ -28,7 +28,7 @@ typedef struct {
   double_pendulum_k3s3_real t, q[4], p[4], lambda[2];
   /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_k3s3_real tc, qc[4], pc[4], gam[12], hprev;
-  double_pendulum_k3s3_real gam2[12], hprev2, errprev;
+  double_pendulum_k3s3_real gam2[12], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   double_pendulum_k3s3_real pinc[12];  /* p's polynomial over the last step, for double_pendulum_k3s3_dense */
   double_pendulum_k3s3_real H0;  /* the energy the step keeps */
   double_pendulum_k3s3_real pcorr[4];  /* p1 minus p's polynomial at the end: the projection and rescale */

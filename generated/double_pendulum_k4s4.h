@@ -28,7 +28,7 @@ typedef struct {
   double_pendulum_k4s4_real t, q[4], p[4], lambda[2];
   /* private: compensated-summation errors and the last two steps' polynomials */
   double_pendulum_k4s4_real tc, qc[4], pc[4], gam[16], hprev;
-  double_pendulum_k4s4_real gam2[16], hprev2, errprev;
+  double_pendulum_k4s4_real gam2[16], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   double_pendulum_k4s4_real pinc[16];  /* p's polynomial over the last step, for double_pendulum_k4s4_dense */
   double_pendulum_k4s4_real H0;  /* the energy the step keeps */
   double_pendulum_k4s4_real pcorr[4];  /* p1 minus p's polynomial at the end: the projection and rescale */

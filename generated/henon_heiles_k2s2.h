@@ -28,7 +28,7 @@ typedef struct {
   henon_heiles_k2s2_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   henon_heiles_k2s2_real tc, qc[2], pc[2], gam[4], hprev;
-  henon_heiles_k2s2_real gam2[4], hprev2, errprev;
+  henon_heiles_k2s2_real gam2[4], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   henon_heiles_k2s2_real pinc[4];  /* p's polynomial over the last step, for henon_heiles_k2s2_dense */
 } henon_heiles_k2s2_state;
 

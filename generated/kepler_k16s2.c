@@ -106,6 +106,7 @@ void kepler_k16s2_init_params(kepler_k16s2_state *x, const kepler_k16s2_real *q0
   int i;
   kepler_k16s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < kepler_k16s2_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k16s2_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k16s2_p0[i];
@@ -866,7 +867,7 @@ int kepler_k16s2_step(kepler_k16s2_state *x, kepler_k16s2_real h, const kepler_k
 int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepler_k16s2_real tol, const kepler_k16s2_params *prm, kepler_k16s2_stats *st)
 {
   kepler_k16s2_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return kepler_k16s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k16s2_EBADSTEP;
@@ -874,6 +875,8 @@ int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepl
   if (!isfinite(x->t)) return kepler_k16s2_ENONFINITE;
   for (i = 0; i < kepler_k16s2_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return kepler_k16s2_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from kepler_k16s2_init */
   tol *= kepler_k16s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -893,15 +896,24 @@ int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepl
       rq = rc == kepler_k16s2_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = sqrt(sqrt(err));  /* err^(1/4) */
-      fac = err > 0 ? 0.74008280449228525 / r : grow;  /* (0.3 / err)^(1/4) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.74008280449228525 / r : grow) * ra;  /* (0.3 aim / err)^(1/4), ra = aim^(1/4) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
+      if (rc == kepler_k16s2_OK && s.defect >= (double)0.1 * kepler_k16s2_NOISETOL && s.defect < kepler_k16s2_NOISETOL) {
+        /* the energy defect hidden in round-off: grow to where it would appear, at most */
+        double cap = pow(kepler_k16s2_NOISETOL / s.defect, (double)1 / 33);
+        if (fac > cap) fac = cap;
+      }
       if (rc == kepler_k16s2_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.008701983790399;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -911,6 +923,10 @@ int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepl
           st->defect = s.defect;
         }
         return kepler_k16s2_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.70710678118654757;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

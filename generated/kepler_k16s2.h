@@ -28,7 +28,7 @@ typedef struct {
   kepler_k16s2_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k16s2_real tc, qc[2], pc[2], gam[4], hprev;
-  kepler_k16s2_real gam2[4], hprev2, errprev;
+  kepler_k16s2_real gam2[4], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   kepler_k16s2_real pinc[4];  /* p's polynomial over the last step, for kepler_k16s2_dense */
 } kepler_k16s2_state;
 

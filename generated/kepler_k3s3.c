@@ -93,6 +93,7 @@ void kepler_k3s3_init_params(kepler_k3s3_state *x, const kepler_k3s3_real *q0, c
   int i;
   kepler_k3s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < kepler_k3s3_M; i++) {
     x->q[i] = q0 ? q0[i] : kepler_k3s3_q0[i];
     x->p[i] = p0 ? p0[i] : kepler_k3s3_p0[i];
@@ -559,7 +560,7 @@ int kepler_k3s3_step(kepler_k3s3_state *x, kepler_k3s3_real h, const kepler_k3s3
 int kepler_k3s3_step_adaptive(kepler_k3s3_state *x, kepler_k3s3_real *h, kepler_k3s3_real tol, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
 {
   kepler_k3s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return kepler_k3s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return kepler_k3s3_EBADSTEP;
@@ -567,6 +568,8 @@ int kepler_k3s3_step_adaptive(kepler_k3s3_state *x, kepler_k3s3_real *h, kepler_
   if (!isfinite(x->t)) return kepler_k3s3_ENONFINITE;
   for (i = 0; i < kepler_k3s3_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return kepler_k3s3_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from kepler_k3s3_init */
   tol *= kepler_k3s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -586,15 +589,24 @@ int kepler_k3s3_step_adaptive(kepler_k3s3_state *x, kepler_k3s3_real *h, kepler_
       rq = rc == kepler_k3s3_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(sqrt(err));  /* err^(1/6) */
-      fac = err > 0 ? 0.81818882300002704 / r : grow;  /* (0.3 / err)^(1/6) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.81818882300002704 / r : grow) * ra;  /* (0.3 aim / err)^(1/6), ra = aim^(1/6) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
+      if (rc == kepler_k3s3_OK && s.defect >= (double)0.1 * kepler_k3s3_NOISETOL && s.defect < kepler_k3s3_NOISETOL) {
+        /* the energy defect hidden in round-off: grow to where it would appear, at most */
+        double cap = pow(kepler_k3s3_NOISETOL / s.defect, (double)1 / 7);
+        if (fac > cap) fac = cap;
+      }
       if (rc == kepler_k3s3_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0057929410678534;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -604,6 +616,10 @@ int kepler_k3s3_step_adaptive(kepler_k3s3_state *x, kepler_k3s3_real *h, kepler_
           st->defect = s.defect;
         }
         return kepler_k3s3_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.79370052598409979;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

@@ -28,7 +28,7 @@ typedef struct {
   kepler_k4s4_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k4s4_real tc, qc[2], pc[2], gam[8], hprev;
-  kepler_k4s4_real gam2[8], hprev2, errprev;
+  kepler_k4s4_real gam2[8], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   kepler_k4s4_real pinc[8];  /* p's polynomial over the last step, for kepler_k4s4_dense */
 } kepler_k4s4_state;
 

@@ -28,7 +28,7 @@ typedef struct {
   kepler_k6s1_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k6s1_real tc, qc[2], pc[2], gam[2], hprev;
-  kepler_k6s1_real gam2[2], hprev2, errprev;
+  kepler_k6s1_real gam2[2], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   kepler_k6s1_real pinc[2];  /* p's polynomial over the last step, for kepler_k6s1_dense */
 } kepler_k6s1_state;
 

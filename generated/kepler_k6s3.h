@@ -28,7 +28,7 @@ typedef struct {
   kepler_k6s3_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   kepler_k6s3_real tc, qc[2], pc[2], gam[6], hprev;
-  kepler_k6s3_real gam2[6], hprev2, errprev;
+  kepler_k6s3_real gam2[6], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   kepler_k6s3_real pinc[6];  /* p's polynomial over the last step, for kepler_k6s3_dense */
 } kepler_k6s3_state;
 

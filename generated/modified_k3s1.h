@@ -28,7 +28,7 @@ typedef struct {
   modified_k3s1_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_k3s1_real tc, qc[3], pc[3], gam[3], hprev;
-  modified_k3s1_real gam2[3], hprev2, errprev;
+  modified_k3s1_real gam2[3], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   modified_k3s1_real pinc[3];  /* p's polynomial over the last step, for modified_k3s1_dense */
 } modified_k3s1_state;
 

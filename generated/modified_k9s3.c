@@ -237,6 +237,7 @@ void modified_k9s3_init_params(modified_k9s3_state *x, const modified_k9s3_real 
   int i;
   modified_k9s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < modified_k9s3_M; i++) {
     x->q[i] = q0 ? q0[i] : modified_k9s3_q0[i];
     x->p[i] = p0 ? p0[i] : modified_k9s3_p0[i];
@@ -1105,7 +1106,7 @@ int modified_k9s3_step(modified_k9s3_state *x, modified_k9s3_real h, const modif
 int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, modified_k9s3_real tol, const modified_k9s3_params *prm, modified_k9s3_stats *st)
 {
   modified_k9s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return modified_k9s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return modified_k9s3_EBADSTEP;
@@ -1113,6 +1114,8 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
   if (!isfinite(x->t)) return modified_k9s3_ENONFINITE;
   for (i = 0; i < modified_k9s3_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return modified_k9s3_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from modified_k9s3_init */
   tol *= modified_k9s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1132,15 +1135,19 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
       rq = rc == modified_k9s3_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(err);  /* err^(1/3) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.90000000000000002 / r : grow) * ra;  /* (0.729 aim / err)^(1/3), ra = aim^(1/3) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == modified_k9s3_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0116194403019225;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1150,6 +1157,10 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
           st->defect = s.defect;
         }
         return modified_k9s3_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.6299605249474366;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

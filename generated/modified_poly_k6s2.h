@@ -28,7 +28,7 @@ typedef struct {
   modified_poly_k6s2_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_poly_k6s2_real tc, qc[3], pc[3], gam[6], hprev;
-  modified_poly_k6s2_real gam2[6], hprev2, errprev;
+  modified_poly_k6s2_real gam2[6], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   modified_poly_k6s2_real pinc[6];  /* p's polynomial over the last step, for modified_poly_k6s2_dense */
   modified_poly_k6s2_real H0;  /* the energy the step keeps */
   modified_poly_k6s2_real pcorr[3];  /* p1 minus p's polynomial at the end: the projection and rescale */

@@ -28,7 +28,7 @@ typedef struct {
   modified_poly_k9s3_real t, q[3], p[3], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   modified_poly_k9s3_real tc, qc[3], pc[3], gam[9], hprev;
-  modified_poly_k9s3_real gam2[9], hprev2, errprev;
+  modified_poly_k9s3_real gam2[9], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   modified_poly_k9s3_real pinc[9];  /* p's polynomial over the last step, for modified_poly_k9s3_dense */
   modified_poly_k9s3_real H0;  /* the energy the step keeps */
   modified_poly_k9s3_real pcorr[3];  /* p1 minus p's polynomial at the end: the projection and rescale */

@@ -89,6 +89,7 @@ void pendulum_angle_k6s3_init_params(pendulum_angle_k6s3_state *x, const pendulu
   int i;
   pendulum_angle_k6s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < pendulum_angle_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_angle_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_angle_k6s3_p0[i];
@@ -501,7 +502,7 @@ int pendulum_angle_k6s3_step(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_r
 int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real *h, pendulum_angle_k6s3_real tol, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
 {
   pendulum_angle_k6s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_angle_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_angle_k6s3_EBADSTEP;
@@ -509,6 +510,8 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
   if (!isfinite(x->t)) return pendulum_angle_k6s3_ENONFINITE;
   for (i = 0; i < pendulum_angle_k6s3_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return pendulum_angle_k6s3_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from pendulum_angle_k6s3_init */
   tol *= pendulum_angle_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -528,15 +531,24 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
       rq = rc == pendulum_angle_k6s3_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(sqrt(err));  /* err^(1/6) */
-      fac = err > 0 ? 0.81818882300002704 / r : grow;  /* (0.3 / err)^(1/6) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.81818882300002704 / r : grow) * ra;  /* (0.3 aim / err)^(1/6), ra = aim^(1/6) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
+      if (rc == pendulum_angle_k6s3_OK && s.defect >= (double)0.1 * pendulum_angle_k6s3_NOISETOL && s.defect < pendulum_angle_k6s3_NOISETOL) {
+        /* the energy defect hidden in round-off: grow to where it would appear, at most */
+        double cap = pow(pendulum_angle_k6s3_NOISETOL / s.defect, (double)1 / 13);
+        if (fac > cap) fac = cap;
+      }
       if (rc == pendulum_angle_k6s3_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0057929410678534;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -546,6 +558,10 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
           st->defect = s.defect;
         }
         return pendulum_angle_k6s3_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.79370052598409979;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

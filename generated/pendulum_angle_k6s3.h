@@ -28,7 +28,7 @@ typedef struct {
   pendulum_angle_k6s3_real t, q[1], p[1], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_angle_k6s3_real tc, qc[1], pc[1], gam[3], hprev;
-  pendulum_angle_k6s3_real gam2[3], hprev2, errprev;
+  pendulum_angle_k6s3_real gam2[3], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   pendulum_angle_k6s3_real pinc[3];  /* p's polynomial over the last step, for pendulum_angle_k6s3_dense */
 } pendulum_angle_k6s3_state;
 

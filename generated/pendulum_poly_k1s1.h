@@ -28,7 +28,7 @@ typedef struct {
   pendulum_poly_k1s1_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_poly_k1s1_real tc, qc[2], pc[2], gam[2], hprev;
-  pendulum_poly_k1s1_real gam2[2], hprev2, errprev;
+  pendulum_poly_k1s1_real gam2[2], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   pendulum_poly_k1s1_real pinc[2];  /* p's polynomial over the last step, for pendulum_poly_k1s1_dense */
   pendulum_poly_k1s1_real H0;  /* the energy the step keeps */
   pendulum_poly_k1s1_real pcorr[2];  /* p1 minus p's polynomial at the end: the projection and rescale */

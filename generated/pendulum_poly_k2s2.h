@@ -28,7 +28,7 @@ typedef struct {
   pendulum_poly_k2s2_real t, q[2], p[2], lambda[1];
   /* private: compensated-summation errors and the last two steps' polynomials */
   pendulum_poly_k2s2_real tc, qc[2], pc[2], gam[4], hprev;
-  pendulum_poly_k2s2_real gam2[4], hprev2, errprev;
+  pendulum_poly_k2s2_real gam2[4], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   pendulum_poly_k2s2_real pinc[4];  /* p's polynomial over the last step, for pendulum_poly_k2s2_dense */
   pendulum_poly_k2s2_real H0;  /* the energy the step keeps */
   pendulum_poly_k2s2_real pcorr[2];  /* p1 minus p's polynomial at the end: the projection and rescale */

@@ -788,6 +788,7 @@ void pendulum_poly_k4s4_init_params(pendulum_poly_k4s4_state *x, const pendulum_
   int i;
   pendulum_poly_k4s4_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < pendulum_poly_k4s4_M; i++) {
     x->q[i] = q0 ? q0[i] : pendulum_poly_k4s4_q0[i];
     x->p[i] = p0 ? p0[i] : pendulum_poly_k4s4_p0[i];
@@ -1812,7 +1813,7 @@ int pendulum_poly_k4s4_step(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real
 int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_k4s4_real *h, pendulum_poly_k4s4_real tol, const pendulum_poly_k4s4_params *prm, pendulum_poly_k4s4_stats *st)
 {
   pendulum_poly_k4s4_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return pendulum_poly_k4s4_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return pendulum_poly_k4s4_EBADSTEP;
@@ -1820,6 +1821,8 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
   if (!isfinite(x->t)) return pendulum_poly_k4s4_ENONFINITE;
   for (i = 0; i < pendulum_poly_k4s4_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return pendulum_poly_k4s4_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from pendulum_poly_k4s4_init */
   tol *= pendulum_poly_k4s4_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1839,15 +1842,19 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
       rq = rc == pendulum_poly_k4s4_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = sqrt(sqrt(sqrt(err)));  /* err^(1/8) */
-      fac = err > 0 ? 0.68765602193363207 / r : grow;  /* (0.05 / err)^(1/8) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.68765602193363207 / r : grow) * ra;  /* (0.05 aim / err)^(1/8), ra = aim^(1/8) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == pendulum_poly_k4s4_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0043415672919243;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1857,6 +1864,10 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
           st->defect = s.defect;
         }
         return pendulum_poly_k4s4_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.8408964152537145;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

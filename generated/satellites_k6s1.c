@@ -706,6 +706,7 @@ void satellites_k6s1_init_params(satellites_k6s1_state *x, const satellites_k6s1
   int i;
   satellites_k6s1_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < satellites_k6s1_M; i++) {
     x->q[i] = q0 ? q0[i] : satellites_k6s1_q0[i];
     x->p[i] = p0 ? p0[i] : satellites_k6s1_p0[i];
@@ -1860,7 +1861,7 @@ int satellites_k6s1_step(satellites_k6s1_state *x, satellites_k6s1_real h, const
 int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real *h, satellites_k6s1_real tol, const satellites_k6s1_params *prm, satellites_k6s1_stats *st)
 {
   satellites_k6s1_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s1_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s1_EBADSTEP;
@@ -1868,6 +1869,8 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
   if (!isfinite(x->t)) return satellites_k6s1_ENONFINITE;
   for (i = 0; i < satellites_k6s1_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return satellites_k6s1_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from satellites_k6s1_init */
   tol *= satellites_k6s1_TOLC;
   for (;;) {
     s.iters = 0;
@@ -1887,15 +1890,24 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
       rq = rc == satellites_k6s1_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = sqrt(err);  /* err^(1/2) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.81 / err)^(1/2) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.90000000000000002 / r : grow) * ra;  /* (0.81 aim / err)^(1/2), ra = aim^(1/2) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
+      if (rc == satellites_k6s1_OK && s.defect >= (double)0.1 * satellites_k6s1_NOISETOL && s.defect < satellites_k6s1_NOISETOL) {
+        /* the energy defect hidden in round-off: grow to where it would appear, at most */
+        double cap = pow(satellites_k6s1_NOISETOL / s.defect, (double)1 / 13);
+        if (fac > cap) fac = cap;
+      }
       if (rc == satellites_k6s1_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0174796921026863;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -1905,6 +1917,10 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
           st->defect = s.defect;
         }
         return satellites_k6s1_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.5;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

@@ -28,7 +28,7 @@ typedef struct {
   satellites_k6s1_real t, q[9], p[9], lambda[3];
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_k6s1_real tc, qc[9], pc[9], gam[9], hprev;
-  satellites_k6s1_real gam2[9], hprev2, errprev;
+  satellites_k6s1_real gam2[9], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   satellites_k6s1_real pinc[9];  /* p's polynomial over the last step, for satellites_k6s1_dense */
 } satellites_k6s1_state;
 

@@ -1976,6 +1976,7 @@ void satellites_k6s2_init_params(satellites_k6s2_state *x, const satellites_k6s2
   int i;
   satellites_k6s2_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < satellites_k6s2_M; i++) {
     x->q[i] = q0 ? q0[i] : satellites_k6s2_q0[i];
     x->p[i] = p0 ? p0[i] : satellites_k6s2_p0[i];
@@ -2301,7 +2302,7 @@ int satellites_k6s2_step(satellites_k6s2_state *x, satellites_k6s2_real h, const
 int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real *h, satellites_k6s2_real tol, const satellites_k6s2_params *prm, satellites_k6s2_stats *st)
 {
   satellites_k6s2_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return satellites_k6s2_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_k6s2_EBADSTEP;
@@ -2309,6 +2310,8 @@ int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real
   if (!isfinite(x->t)) return satellites_k6s2_ENONFINITE;
   for (i = 0; i < satellites_k6s2_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return satellites_k6s2_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from satellites_k6s2_init */
   tol *= satellites_k6s2_TOLC;
   for (;;) {
     s.iters = 0;
@@ -2328,15 +2331,24 @@ int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real
       rq = rc == satellites_k6s2_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(err);  /* err^(1/3) */
-      fac = err > 0 ? 0.90000000000000002 / r : grow;  /* (0.729 / err)^(1/3) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.90000000000000002 / r : grow) * ra;  /* (0.729 aim / err)^(1/3), ra = aim^(1/3) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
+      if (rc == satellites_k6s2_OK && s.defect >= (double)0.1 * satellites_k6s2_NOISETOL && s.defect < satellites_k6s2_NOISETOL) {
+        /* the energy defect hidden in round-off: grow to where it would appear, at most */
+        double cap = pow(satellites_k6s2_NOISETOL / s.defect, (double)1 / 13);
+        if (fac > cap) fac = cap;
+      }
       if (rc == satellites_k6s2_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0116194403019225;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -2346,6 +2358,10 @@ int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real
           st->defect = s.defect;
         }
         return satellites_k6s2_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.6299605249474366;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

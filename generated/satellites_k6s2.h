@@ -28,7 +28,7 @@ typedef struct {
   satellites_k6s2_real t, q[9], p[9], lambda[3];
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_k6s2_real tc, qc[9], pc[9], gam[18], hprev;
-  satellites_k6s2_real gam2[18], hprev2, errprev;
+  satellites_k6s2_real gam2[18], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   satellites_k6s2_real pinc[18];  /* p's polynomial over the last step, for satellites_k6s2_dense */
 } satellites_k6s2_state;
 

@@ -28,7 +28,7 @@ typedef struct {
   satellites_k6s3_real t, q[9], p[9], lambda[3];
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_k6s3_real tc, qc[9], pc[9], gam[27], hprev;
-  satellites_k6s3_real gam2[27], hprev2, errprev;
+  satellites_k6s3_real gam2[27], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   satellites_k6s3_real pinc[27];  /* p's polynomial over the last step, for satellites_k6s3_dense */
 } satellites_k6s3_state;
 

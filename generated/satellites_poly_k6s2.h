@@ -28,7 +28,7 @@ typedef struct {
   satellites_poly_k6s2_real t, q[9], p[9], lambda[3];
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_poly_k6s2_real tc, qc[9], pc[9], gam[18], hprev;
-  satellites_poly_k6s2_real gam2[18], hprev2, errprev;
+  satellites_poly_k6s2_real gam2[18], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   satellites_poly_k6s2_real pinc[18];  /* p's polynomial over the last step, for satellites_poly_k6s2_dense */
   satellites_poly_k6s2_real H0;  /* the energy the step keeps */
   satellites_poly_k6s2_real pcorr[9];  /* p1 minus p's polynomial at the end: the projection and rescale */

@@ -7227,6 +7227,7 @@ void satellites_poly_k6s3_init_params(satellites_poly_k6s3_state *x, const satel
   int i;
   satellites_poly_k6s3_DEFAULT_PARAMS(prm)
   x->t = x->tc = x->hprev = x->hprev2 = x->errprev = 0;
+  x->aim = 1;
   for (i = 0; i < satellites_poly_k6s3_M; i++) {
     x->q[i] = q0 ? q0[i] : satellites_poly_k6s3_q0[i];
     x->p[i] = p0 ? p0[i] : satellites_poly_k6s3_p0[i];
@@ -7682,7 +7683,7 @@ int satellites_poly_k6s3_step(satellites_poly_k6s3_state *x, satellites_poly_k6s
 int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites_poly_k6s3_real *h, satellites_poly_k6s3_real tol, const satellites_poly_k6s3_params *prm, satellites_poly_k6s3_stats *st)
 {
   satellites_poly_k6s3_stats s;
-  double hh = *h, err, sc, fac, r, pq, rq, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
+  double hh = *h, err, sc, fac, r, pq, rq, ra, grow = x->hprev == 0 ? 100 : 2;  /* the first step: from a guess */
   int rc, rejected = 0, misses = 0, i;
   if (!(hh != 0 && isfinite(hh))) return satellites_poly_k6s3_EBADSTEP;
   if (!(tol > 0 && isfinite(tol))) return satellites_poly_k6s3_EBADSTEP;
@@ -7690,6 +7691,8 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
   if (!isfinite(x->t)) return satellites_poly_k6s3_ENONFINITE;
   for (i = 0; i < satellites_poly_k6s3_M; i++)
     if (!(isfinite(x->q[i]) && isfinite(x->p[i]))) return satellites_poly_k6s3_ENONFINITE;
+  /* the aim (emit_step_factor), written back only with an accepted step */
+  ra = x->aim > 0 && x->aim <= 1 ? x->aim : 1;  /* 1: a state not from satellites_poly_k6s3_init */
   tol *= satellites_poly_k6s3_TOLC;
   for (;;) {
     s.iters = 0;
@@ -7709,15 +7712,19 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
       rq = rc == satellites_poly_k6s3_OK && x->hprev2 != 0 ? x->errprev : 0;
       pq = rq * (x->hprev2 != 0 ? x->hprev / x->hprev2 : 0);
       r = cbrt(sqrt(err));  /* err^(1/6) */
-      fac = err > 0 ? 0.81818882300002704 / r : grow;  /* (0.3 / err)^(1/6) */
-      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x */
-      if (rq < pq && pq <= 2 * rq) pq = rq;
+      fac = (err > 0 ? 0.81818882300002704 / r : grow) * ra;  /* (0.3 aim / err)^(1/6), ra = aim^(1/6) */
+      /* the error's trend, where smaller than Gustafsson's prediction: h grew, at most 2x,
+       * and a try was rejected (the aim is lowered) */
+      if (ra < 1 && rq < pq && pq <= 2 * rq) pq = rq;
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
       if (rc == satellites_poly_k6s3_OK) {
         *h = hh * fac;
         x->errprev = r;
+        ra *= 1.0057929410678534;  /* 40 accepted steps restore the aim */
+        if (ra > 1) ra = 1;
+        x->aim = ra;
         if (st) {
           st->iters = s.iters;
           st->increment = s.increment;
@@ -7727,6 +7734,10 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
           st->defect = s.defect;
         }
         return satellites_poly_k6s3_OK;
+      }
+      /* over the tolerance: a lower aim, but not for the first step's tries from a guess */
+      if (x->hprev != 0) {
+        ra *= 0.79370052598409979;  /* the aim times 0.25: a rejected try */
       }
     } else {
       fac = (double)0.5;

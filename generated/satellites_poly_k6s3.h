@@ -28,7 +28,7 @@ typedef struct {
   satellites_poly_k6s3_real t, q[9], p[9], lambda[3];
   /* private: compensated-summation errors and the last two steps' polynomials */
   satellites_poly_k6s3_real tc, qc[9], pc[9], gam[27], hprev;
-  satellites_poly_k6s3_real gam2[27], hprev2, errprev;
+  satellites_poly_k6s3_real gam2[27], hprev2, errprev, aim;  /* aim: the controller's, 1 until a rejection */
   satellites_poly_k6s3_real pinc[27];  /* p's polynomial over the last step, for satellites_poly_k6s3_dense */
   satellites_poly_k6s3_real H0;  /* the energy the step keeps */
   satellites_poly_k6s3_real pcorr[9];  /* p1 minus p's polynomial at the end: the projection and rescale */
