@@ -7,7 +7,7 @@
  *   emit_solver.c (entry points: emit_check, emit_solver)
  *   emit_step.c, emit_project.c, emit_batch.c
  *   emit_api.c, emit_iterate.c, emit_newton.c, emit_end.c, emit_batch_step.c,
- *   emit_batch_newton.c
+ *   emit_batch_by_lane.c
  *   emit_estimate.c, emit_predict.c, emit_mq.c, emit_batch_mq.c
  *   emit_choice.c
  *   emit_kernel.c
@@ -152,12 +152,13 @@ void emit_batch_source(Emitter *e, int lanes);
 /* emit_batch_step.c: NAME_batch_step, its lane control as masked loops */
 void emit_batch_step(Emitter *e);
 void emit_batch_adaptive(Emitter *e);
-/* emit_batch_newton.c: --batch with Newton, the scalar step lane by lane (the adaptive
+/* emit_batch_by_lane.c: --batch with Newton, or with M(q) and constraints: the scalar step lane by lane (the adaptive
  * step: emit_batch_adaptive's controller around its NAME_batch_within) */
-void emit_batch_newton_fields(Emitter *e);
+int emit_batch_by_lane(const Emitter *e);
+void emit_batch_by_lane_fields(Emitter *e);
 void emit_batch_newton_stats(Emitter *e);
 void emit_batch_newton_set_get(Emitter *e, int get);
-void emit_batch_newton_step(Emitter *e);
+void emit_batch_by_lane_step(Emitter *e);
 /* emit_batch_mq.c: what the batch adds for M(q) (Theta in the lanes, the rescale) */
 void emit_batch_mq_predict(Emitter *e);
 void emit_batch_mq_increment(Emitter *e);

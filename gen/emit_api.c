@@ -210,7 +210,7 @@ void emit_prelude(Emitter *e, const EmitOptions *o) {
   out(e, " * their products with P_j and int_0^c P_j, folded into the code):\n");
   for (int l = 0; l < me->k; l++) out(e, " *   c_%d = %.17g   b_%d = %.17g\n", l + 1, me->c[l], l + 1, me->b[l]);
   out(e, " */\n");
-  if (o->batch && !emit_is_newton(e)) { /* the batch loops' tables (not Newton's: lanes take the scalar step) */
+  if (o->batch && !emit_batch_by_lane(e)) { /* the batch loops' tables (not where lanes take the scalar step) */
     out(e, "/* Warm start: E[j][i](r) = sum_d E[(j*S+i)*S+d] r^d, r = h / h_previous. */\n");
     emit_array(e, "E", me->E, me->s * me->s * me->s);
     double *e1 = xmalloc((size_t)me->s * me->s * sizeof(double));

@@ -8,9 +8,10 @@
  * (emit_step.c) lane by lane: the same prediction, the same sweeps until the
  * lane's own increment is at round-off, the same tests and the same
  * compensated update, so each lane is bitwise the scalar NAME_step from the
- * same state (NAME_batch_step: emit_batch_step.c). With Newton the lanes
- * take the scalar step itself in turn (emit_batch_newton.c), and only the
- * observers' kernels are printed over lanes. */
+ * same state (NAME_batch_step: emit_batch_step.c). With Newton, and where
+ * M depends on q and there are constraints, the lanes take the scalar step
+ * itself in turn (emit_batch_by_lane.c), and only the observers' kernels are
+ * printed over lanes. */
 #include "emit.h"
 
 // The batch declarations of NAME.h.
@@ -28,7 +29,7 @@ void emit_batch_header(Emitter *e, int lanes) {
           "  $P_real pinc[$P_S * $P_M * $P_W];\n");
   if (poly) tmpl(e, "  $P_real H0[$P_W], pcorr[$P_M * $P_W];\n");
   else if (e->mod->mass_q) tmpl(e, "  $P_real H0[$P_W];  /* M(q): the energy the step keeps */\n");
-  if (emit_is_newton(e)) emit_batch_newton_fields(e); /* emit_batch_newton.c */
+  if (emit_batch_by_lane(e)) emit_batch_by_lane_fields(e); /* emit_batch_by_lane.c */
   /* idle last: every array before it starts at a multiple of W reals, so a
    * vector of one value's lanes never straddles two cache lines more than
    * the struct's own alignment makes it */
@@ -193,13 +194,13 @@ static void emit_batch_predict(Emitter *e) {
 }
 
 // Whether the batch step calls kernel id: those of the step and its
-// diagnostics (with Newton, which steps the lanes with the scalar step, only
+// diagnostics (where the lanes take the scalar step, emit_batch_by_lane, only
 // those of the observers); consistent only for the Newton step after an adaptive
 // iteration stopped at its tolerance (itol_wanted). (The multiplier after a
 // step comes from the sweep, or from project_p1's factors: no lambda0.)
 static int batch_kernel_wanted(const Emitter *e, KernelId id) {
   if (!e->st->kern[id].nout) return 0;
-  if (emit_is_newton(e)) return id == K_ENERGY || id == K_G || id == K_HIDDEN; /* the observers' only */
+  if (emit_batch_by_lane(e)) return id == K_ENERGY || id == K_G || id == K_HIDDEN; /* the observers' only */
   return id == K_CONSISTENT ? itol_wanted(e) : 1;
 }
 
@@ -219,8 +220,8 @@ void emit_batch_source(Emitter *e, int lanes) {
   out(e, "\n");
   emit_set_get(e);
   emit_params_observers(e);
-  if (emit_is_newton(e)) { /* the scalar step lane by lane: emit_batch_newton.c */
-    emit_batch_newton_step(e);
+  if (emit_batch_by_lane(e)) { /* the scalar step lane by lane: emit_batch_by_lane.c */
+    emit_batch_by_lane_step(e);
     emit_batch_adaptive(e);
     e->lanes = 0;
     return;

@@ -397,7 +397,7 @@ int mass_q_check(Model *mod, const double *prm);   /* M(q0) SPD: 0, or -1 after 
 void mass_q_kinetic(Model *mod);                   /* mod->mq_v, mod->mq_force */
 void mass_q_inertial(const Model *mod, Dag *d, const int *q, const int *v, int *out); /* grad_q T + Mdot v */
 void minv_apply_at(const Model *mod, Dag *d, const int *q, const int *v, int *out); /* M(q)^-1 v */
-int mass_q_refuse(const Model *mod, int newton, int batch, int wide, int const_mult); /* 1 after an error */
+int mass_q_refuse(const Model *mod, int newton, int wide, int const_mult); /* 1 after an error */
 void mass_q_report(FILE *f, const Model *mod);    /* --check: M's dependence and cost */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);

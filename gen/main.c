@@ -790,7 +790,7 @@ int main(int argc, char **argv) {
   IterKind iter = resolve_iteration(&o, mod, iter_why, sizeof iter_why);
   if (rescale < 0) {
     rc = 1;
-  } else if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.batch, o.wide_step, fam == MULT_CONST)) {
+  } else if (mass_q_refuse(mod, o.iteration == ITER_NEWTON, o.wide_step, fam == MULT_CONST)) {
     rc = 1;
   } else if (k > MAX_K) {
     report_degree(mod, o.s, k);

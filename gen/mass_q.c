@@ -157,14 +157,13 @@ void mass_q_kinetic(Model *mod) {
 }
 
 // What a step with M(q) does not support yet: --iteration newton,
-// --wide-step, and with constraints --batch (its lanes carry Theta as the
-// unconstrained sweep lays it out) and the constant multiplier (--multiplier
-// const: the step is the poly family's). Reports each at M's statement;
+// --wide-step, and with constraints the constant multiplier (--multiplier
+// const: the step is the poly family's). (--batch with constraints steps
+// the lanes with the scalar step: emit_batch_by_lane.c.) Reports each at M's statement;
 // returns 1 after an error.
-int mass_q_refuse(const Model *mod, int newton, int batch, int wide, int const_mult) {
+int mass_q_refuse(const Model *mod, int newton, int wide, int const_mult) {
   if (!mod->mass_q) return 0;
   const char *what = newton ? "--iteration newton" : wide ? "--wide-step"
-                     : mod->nu && batch ? "--batch with constraints"
                      : mod->nu && const_mult ? "--multiplier const (constraints take the poly family's multiplier)" : NULL;
   if (!what) return 0;
   error_at(mod->mass_loc, "M depends on the coordinates: %s with such an M is not supported yet "

@@ -37,6 +37,7 @@
 #include "bnbobauto_k16s2.h"
 #include "bnbobpoly_k16s2.h"
 #include "bnfpu_k4s2.h"
+#include "bfb_k2s2.h"
 
 /* Lane l starts from the model's initial values after l scalar steps of
  * h (1 + l / 8), so the lanes differ in state and in the previous step (lane
@@ -146,6 +147,9 @@ BATCH_TEST_FAIL(bdpa_k2s2, 0.05, 12, 1)
 BATCH_TEST_FAIL(bdpafloat_k2s2, 0.05, 12, 1)
 BATCH_TEST_FAIL(barm_k3s3, 0.05, 12, 1)
 BATCH_TEST_FAIL(barmk_k18s3, 0.05, 8, 1) /* the sweep in parts: the lane test's own reductions */
+/* M(q) with constraints (the four-bar in angles): the lanes take the scalar step, each with
+ * its own ground link l0 x (1 + l / 4) and its loop closed there */
+BATCH_TEST_FAIL(bfb_k2s2, 0.05, 12, 1)
 /* the rolled form (--rolled on, docs/rolled.md): the scalar rolled kernels in each lane */
 BATCH_TEST(brchain_k4s4, 0.005, 8)
 BATCH_TEST(brchainp_k4s4, 0.005, 8)
@@ -247,6 +251,7 @@ ADAPTIVE_TEST(bfloatpoly_k2s2, 0.5, 1e-4, 20)
 ADAPTIVE_TEST_MQ(bdpa_k2s2, 0.5, 1e-8, 30, 1)
 ADAPTIVE_TEST_MQ(barm_k3s3, 0.5, 1e-8, 30, 1)
 ADAPTIVE_TEST_MQ(bdpafloat_k2s2, 0.5, 1e-4, 20, 1)
+ADAPTIVE_TEST(bfb_k2s2, 0.5, 1e-8, 30)
 ADAPTIVE_TEST(brchain_k4s4, 0.05, 1e-6, 20)
 ADAPTIVE_TEST(brchainp_k4s4, 0.5, 1e-8, 20)
 ADAPTIVE_TEST(brchain32p_k2s2, 0.05, 1e-6, 20)
@@ -340,6 +345,8 @@ Suite *batch_suite(void) {
   tcase_add_test(tc, test_adaptive_bdpa_k2s2);
   tcase_add_test(tc, test_adaptive_barm_k3s3);
   tcase_add_test(tc, test_adaptive_bdpafloat_k2s2);
+  tcase_add_test(tc, test_bfb_k2s2);
+  tcase_add_test(tc, test_adaptive_bfb_k2s2);
   tcase_add_test(tc, test_brchain_k4s4);
   tcase_add_test(tc, test_brchainp_k4s4);
   tcase_add_test(tc, test_brchain32_k2s2);

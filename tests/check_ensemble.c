@@ -243,7 +243,8 @@ static void same_with_batch(const char *name, const char *model, const char *fla
  * steps, where one trajectory's steps are retried as halves (a lane that
  * leaves the batch for the scalar path) and one fails, and --sweep with
  * adaptive steps: the summary of --batch 4 is the scalar step's, byte for
- * byte. */
+ * byte; the same for the four-bar in angles (M(q) and constraints, whose
+ * lanes take the scalar step) swept over a mass and over gravity. */
 START_TEST(test_mass_q)
 {
   static const char mq_rows[] = "th1, th2, p_th1, p_th2\n0.5, -0.3, 0, 0\n1, 0.5, 0.2, 0\n2, -1, 0, 0.5\n"
@@ -256,6 +257,14 @@ START_TEST(test_mass_q)
   ck_assert_ptr_nonnull(strstr(one[0], "\n4,0,")); /* from p_th2 = 100: in halves */
   ck_assert_ptr_nonnull(strstr(one[0], "\n5,2,0,")); /* ENONFINITE at the first step */
   ck_assert_ptr_nonnull(strstr(one[0], "\n6,0,200,10,"));
+  free(one[0]), free(one[1]);
+  /* M(q) with constraints (the four-bar in angles): the lanes take the scalar step */
+  static const char *const fb_how[] = {"--sweep m3=1:3:5 -h 0.05 -N 100 --threads 2",
+                                       "--sweep grav=0.5:2:4 --tol 1e-9 -T 3 --threads 2"};
+  static const int fb_status[] = {0, 0};
+  same_with_batch("fb", "../models/fourbar_angles.ham", "-s 2", NULL, fb_how, fb_status, one);
+  ck_assert_ptr_nonnull(strstr(one[0], "\n5,0,100,5,")); /* m3 = 3: 100 steps to t = 5 */
+  ck_assert_ptr_nonnull(strstr(one[1], "\n4,0,")); /* grav = 2: adaptive, to T */
   free(one[0]), free(one[1]);
 }
 END_TEST
