@@ -33,6 +33,7 @@
 #include "hbvmrt_internal.h" /* hbvmrt_eta */
 #include "kepler_events_k4s4.h"
 #include "pendulum_events_k4s4.h"
+#include "pendulum_mq_events_k4s4.h"
 #include "ramp_events_k2s2.h"
 
 Suite *events_suite(void);
@@ -43,6 +44,7 @@ static const char *const names_xy[] = {"x", "y"};
 #define EV_MODEL(P) DRIVER_EVENTS_MODEL(P, names_xy)
 
 EV_MODEL(pendulum_events_k4s4)
+EV_MODEL(pendulum_mq_events_k4s4)
 EV_MODEL(kepler_events_k4s4)
 EV_MODEL(ramp_events_k2s2)
 
@@ -122,13 +124,18 @@ static double half_period(void) { return 2 * gsl_sf_ellint_Kcomp(0.5, GSL_PREC_D
 /* the method's own error at the crossings is below 1e-11 in these runs (s = 4;
  * -h 0.25 gives 3e-9, --tol 1e-11 2e-10: the steps' error, not the location's) */
 static const char *const pendulum_runs[] = {"-h 0.1 -T 30", "-h 0.07 -T 30", "--tol 1e-12 -h 0.1 -T 30"};
+#define NPENDULUM_RUNS (int)(sizeof pendulum_runs / sizeof pendulum_runs[0])
 
+/* Each run on the pendulum with constraints, then on the same pendulum in a
+ * coordinate whose M depends on it (pendulum_mq_events.ham: M(q) events). */
 START_TEST(pendulum_crossings)
 {
   static Row ev[MAXROWS];
   static double rows[MAXROWS * 9];
   int nev, nrows;
-  ck_assert_int_eq(run(&pendulum_events_k4s4_model, pendulum_runs[_i], ev, &nev, rows, 9, &nrows, MAXROWS), 0);
+  const hbvmrt_model *md = _i < NPENDULUM_RUNS ? &pendulum_events_k4s4_model : &pendulum_mq_events_k4s4_model;
+  const char *args = pendulum_runs[_i % NPENDULUM_RUNS];
+  ck_assert_int_eq(run(md, args, ev, &nev, rows, 9, &nrows, MAXROWS), 0);
   double P = half_period(), worst = 0;
   int n = 0, right = 0, left = 0;
   for (int i = 0; i < nev; i++) {
@@ -147,8 +154,8 @@ START_TEST(pendulum_crossings)
   ck_assert_int_eq(right, n / 2);
   ck_assert_int_eq(left, (n + 1) / 2);
   if (getenv("HBVM_EVENTS_TABLE"))
-    printf("pendulum %-26s %d crossings, max |t - n 2K(1/2)| = %.2e\n", pendulum_runs[_i], n, worst);
-  ck_assert_msg(worst <= 1e-10, "%s: crossings off by %g", pendulum_runs[_i], worst);
+    printf("%s %-26s %d crossings, max |t - n 2K(1/2)| = %.2e\n", md->name, args, n, worst);
+  ck_assert_msg(worst <= 1e-10, "%s %s: crossings off by %g", md->name, args, worst);
 }
 END_TEST
 
@@ -559,7 +566,7 @@ Suite *events_suite(void) {
   Suite *s = suite_create("events");
   TCase *tc = tcase_create("events");
   tcase_set_timeout(tc, 60);
-  tcase_add_loop_test(tc, pendulum_crossings, 0, sizeof pendulum_runs / sizeof pendulum_runs[0]);
+  tcase_add_loop_test(tc, pendulum_crossings, 0, 2 * NPENDULUM_RUNS);
   tcase_add_loop_test(tc, kepler_crossings, 0, sizeof kepler_runs / sizeof kepler_runs[0]);
   tcase_add_test(tc, stop_at_event);
   tcase_add_test(tc, bad_options);
