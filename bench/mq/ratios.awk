@@ -36,9 +36,10 @@ END {
     }
   }
   printf "%-16s %-22s %-6s %-24s %-11s %-8s %4s %2s %7s %10s %6s\n", "build", "problem", "err", "method", "variant", "mode", "k", "s", "steps", "seconds", "ratio"
-  for (b = 1; b <= 2; b++) for (p = 1; p <= 2; p++) for (l = 1; l <= 2; l++) {
+  np_ = split("pendulum_angle double_pendulum_angles spherical_pendulum arm3", problems, " ")
+  for (b = 1; b <= 2; b++) for (p = 1; p <= np_; p++) for (l = 1; l <= 2; l++) {
     bn = b == 1 ? "gcc-O2" : "clang-O3-native"
-    pn = p == 1 ? "pendulum_angle" : "double_pendulum_angles"
+    pn = problems[p]
     g = bn SUBSEP pn SUBSEP l
     if (!(g in grp)) continue
     printf "%-16s %-22s %-6s %-24s %-11s %-8s %4s %2s %7.0f %10.3e %6s\n", bn, pn, levels[l], "gsl-rk8pd", "", "adaptive", "", "", rks[g], rk[g], "1.00"

@@ -1,7 +1,8 @@
 /* wp.c - work-precision lines in minimal coordinates against GSL's rk8pd on
  * the same ODE: the pendulum in its angle (models/pendulum_angle.ham, constant
- * M) and the double pendulum in angles (models/double_pendulum_angles.ham,
- * M(q)). Each generated solver is run fixed (h = T/N) and adaptive
+ * M), the double pendulum in angles (models/double_pendulum_angles.ham, M(q)),
+ * the spherical pendulum in its angles (models/spherical_pendulum.ham) and the
+ * 3-link arm in its joint angles (models/arm3.ham). Each generated solver is run fixed (h = T/N) and adaptive
  * (NAME_step_adaptive at tol, the last step shortened to end on T, as
  * bench/hbvm_adaptive.c does); rk8pd adaptive at tol (epsabs = epsrel = tol,
  * as bench/gslpeers.c). The error is the max-norm error of (q, p) at T against
@@ -22,6 +23,7 @@
 #include <gsl/gsl_odeiv2.h>
 
 #include "dpa_ode.h"
+#include "sph_arm_ode.h"
 
 #include "solvers.h"
 
@@ -35,11 +37,13 @@
 #define BUILD "cc"
 #endif
 
-enum { PA, DPA };
-static const char *const problem_name[] = {"pendulum_angle", "double_pendulum_angles"};
-static const int problem_m[] = {1, 2};
+enum { PA, DPA, SPH, ARM, NPROBLEMS };
+static const char *const problem_name[] = {"pendulum_angle", "double_pendulum_angles", "spherical_pendulum",
+                                           "arm3"};
+static const int problem_m[] = {1, 2, 2, 3};
+#define MAXD 6 /* the largest 2 m */
 
-/* -------------------------------------------------------- the two ODEs */
+/* -------------------------------------------------------- the ODEs */
 
 static int pa_rhs(double t, const double *y, double *dy, void *par)
 {
@@ -50,24 +54,29 @@ static int pa_rhs(double t, const double *y, double *dy, void *par)
   return GSL_SUCCESS;
 }
 
+static gsl_odeiv2_system ode(int pb)
+{
+  static int (*const rhs[])(double, const double *, double *, void *) = {pa_rhs, dpa_rhs, sph_rhs, arm_rhs};
+  gsl_odeiv2_system sys = {rhs[pb], NULL, (size_t)(2 * problem_m[pb]), NULL};
+  return sys;
+}
+
 static double energy(int pb, const double *y)
 {
   if (pb == PA) return 0.5 * y[1] * y[1] - cos(y[0]);
+  if (pb == SPH) return sph_energy(y);
+  if (pb == ARM) return arm_energy(y);
   double c = cos(y[0] - y[1]), det = 2 - c * c;
   double v1 = (y[2] - c * y[3]) / det, v2 = (2 * y[3] - c * y[2]) / det;
   return 0.5 * (y[2] * v1 + y[3] * v2) - 2 * cos(y[0]) - cos(y[1]);
 }
 
+/* The models' q0 and p0 (the spherical pendulum's also its Cartesian form's
+ * start, cartesian_start). */
 static void initial(int pb, double *y)
 {
-  if (pb == PA) {
-    y[0] = 0;
-    y[1] = 1;
-  } else {
-    y[0] = 0.5;
-    y[1] = -0.3;
-    y[2] = y[3] = 0;
-  }
+  static const double y0[][MAXD] = {{0, 1}, {0.5, -0.3, 0, 0}, {1, 0, 0, 0.5}, {1, -0.5, 0.8, 0, 0, 0}};
+  for (int c = 0; c < 2 * problem_m[pb]; c++) y[c] = y0[pb][c];
 }
 
 /* ------------------------------------------------------------ methods */
@@ -76,7 +85,7 @@ typedef void (*RunFn)(int pb, double par, double *y, long *steps); /* (q, p) at 
 
 static void run_rk8pd(int pb, double tol, double *y, long *steps)
 {
-  gsl_odeiv2_system sys = {pb == PA ? pa_rhs : dpa_rhs, NULL, (size_t)(2 * problem_m[pb]), NULL};
+  gsl_odeiv2_system sys = ode(pb);
   gsl_odeiv2_driver *dr = gsl_odeiv2_driver_alloc_y_new(&sys, gsl_odeiv2_step_rk8pd, 1e-3 * T_END, tol, tol);
   double t = 0;
   initial(pb, y);
@@ -85,13 +94,35 @@ static void run_rk8pd(int pb, double tol, double *y, long *steps)
   gsl_odeiv2_driver_free(dr);
 }
 
-/* The state of a solver with m coordinates as the problem's y = (q, p): as it
- * is, or for the double pendulum in Cartesian coordinates (m = 4, unit
+/* The start of a solver with m coordinates on problem pb: the model's own q0
+ * and p0 (q0 = p0 = NULL), but for the spherical pendulum in Cartesian
+ * coordinates (m = 3: models/conical.ham, unit mass, rod and gravity as
+ * models/spherical_pendulum.ham) the spherical pendulum's start th = 1,
+ * ph = 0, p_th = 0, p_ph = 0.5 as a position on the sphere and a velocity. */
+static void cartesian_start(int pb, int m, double *q0, double *p0, const double **q, const double **p)
+{
+  *q = *p = NULL;
+  if (pb != SPH || m != 3) return;
+  q0[0] = sin(1.0), q0[1] = 0, q0[2] = -cos(1.0);
+  p0[0] = 0, p0[1] = 0.5 / sin(1.0), p0[2] = 0;
+  *q = q0, *p = p0;
+}
+
+/* The state of a solver with m coordinates as problem pb's y = (q, p): as it
+ * is, or for the spherical pendulum in Cartesian coordinates (m = 3) its
+ * angles (ph in (-pi, pi]: measure_error compares it modulo 2 pi) and
+ * p_th = th', p_ph = x y' - y x', or for the double pendulum in Cartesian coordinates (m = 4, unit
  * masses and rods: models/double_pendulum.ham, its line in the double
  * pendulum's group) the angles from the downward vertical, their rates from
  * the velocities p, and p_th = M(th) th'. */
-static void to_problem(int m, const double *q, const double *p, double *y)
+static void to_problem(int pb, int m, const double *q, const double *p, double *y)
 {
+  if (pb == SPH && m == 3) {
+    double rho = hypot(q[0], q[1]);
+    y[0] = atan2(rho, -q[2]), y[1] = atan2(q[1], q[0]);
+    y[2] = -q[2] * (q[0] * p[0] + q[1] * p[1]) / rho + rho * p[2], y[3] = q[0] * p[1] - q[1] * p[0];
+    return;
+  }
   if (m == 4) {
     double t1 = atan2(q[0], -q[1]), t2 = atan2(q[2] - q[0], -(q[3] - q[1]));
     double w1 = p[0] * cos(t1) + p[1] * sin(t1), w2 = (p[2] - p[0]) * cos(t2) + (p[3] - p[1]) * sin(t2);
@@ -102,36 +133,51 @@ static void to_problem(int m, const double *q, const double *p, double *y)
   for (int c = 0; c < m; c++) y[c] = q[c], y[m + c] = p[c];
 }
 
+/* A run that failed (a fixed step whose Newton does not converge at a long h,
+ * an adaptive step that meets no tol above HMIN): an error of inf. */
+static void failed(int pb, double *y)
+{
+  for (int c = 0; c < 2 * problem_m[pb]; c++) y[c] = HUGE_VAL;
+}
+
 /* run_P_fixed and run_P_adaptive for the generated solver P (m coordinates). */
 #define HBVM_RUNS(P)                                                              \
   static void run_##P##_fixed(int pb, double n_steps, double *y, long *steps)    \
   {                                                                               \
     P##_state x;                                                                  \
     long n = lround(n_steps);                                                     \
-    (void)pb;                                                                     \
-    double h = T_END / (double)n;                                                 \
-    P##_init(&x, 0, 0);                                                           \
-    for (long i = 0; i < n; i++)                                                  \
-      if (P##_step(&x, h, 0, 0)) abort();                                         \
+    double h = T_END / (double)n, q0[3], p0[3];                                   \
+    const double *qs, *ps;                                                        \
+    cartesian_start(pb, P##_M, q0, p0, &qs, &ps);                                 \
+    P##_init(&x, qs, ps);                                                         \
     *steps = n;                                                                   \
-    to_problem(P##_M, x.q, x.p, y);                                               \
+    for (long i = 0; i < n; i++)                                                  \
+      if (P##_step(&x, h, 0, 0)) {                                                \
+        failed(pb, y);                                                            \
+        return;                                                                   \
+      }                                                                           \
+    to_problem(pb, P##_M, x.q, x.p, y);                                           \
   }                                                                               \
   static void run_##P##_adaptive(int pb, double tol, double *y, long *steps)     \
   {                                                                               \
     P##_state x;                                                                  \
-    double h = 1e-3 * T_END;                                                      \
+    double h = 1e-3 * T_END, q0[3], p0[3];                                        \
+    const double *qs, *ps;                                                        \
     long n = 0;                                                                   \
-    (void)pb;                                                                     \
-    P##_init(&x, 0, 0);                                                           \
+    cartesian_start(pb, P##_M, q0, p0, &qs, &ps);                                 \
+    P##_init(&x, qs, ps);                                                         \
     while (x.t < T_END * (1 - 1e-14)) {                                           \
       double rest = T_END - x.t, hh = h >= rest * (1 - 1e-12) ? rest : h;         \
       int last = hh == rest;                                                      \
-      if (P##_step_adaptive(&x, &hh, tol, 0, 0)) abort();                         \
+      if (P##_step_adaptive(&x, &hh, tol, 0, 0)) {                                \
+        failed(pb, y);                                                            \
+        return;                                                                   \
+      }                                                                           \
       if (!last || x.t < T_END * (1 - 1e-14)) h = hh;                             \
       n++;                                                                        \
     }                                                                             \
     *steps = n;                                                                   \
-    to_problem(P##_M, x.q, x.p, y);                                               \
+    to_problem(pb, P##_M, x.q, x.p, y);                                           \
   }
 #define S(P, PB, K, SS, VAR) HBVM_RUNS(P)
 #include "solvers.def"
@@ -170,14 +216,19 @@ static double cpu_now(void)
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* Run point p once untimed: its error at T against ref and |H(T) - H0|. */
+/* Run point p once untimed: its error at T against ref (the spherical
+ * pendulum's azimuth modulo 2 pi) and |H(T) - H0|. */
 static void measure_error(Point *p, const double *ref)
 {
-  double y[4], y0[4];
+  double y[MAXD], y0[MAXD];
   int d = 2 * problem_m[p->pb];
   p->run(p->pb, p->par, y, &p->steps);
   p->err = 0;
-  for (int c = 0; c < d; c++) p->err = fmax(p->err, fabs(y[c] - ref[c]));
+  for (int c = 0; c < d; c++) {
+    double e = y[c] - ref[c];
+    if (p->pb == SPH && c == 1) e = remainder(e, 4 * acos(0.0));
+    p->err = fmax(p->err, fabs(e));
+  }
   initial(p->pb, y0);
   p->dH = fabs(energy(p->pb, y) - energy(p->pb, y0));
 }
@@ -217,9 +268,9 @@ static int timed(const Point *p) { return p->err >= ERR_LO && p->err <= ERR_HI; 
 
 int main(void)
 {
-  double ref[2][4];
+  double ref[NPROBLEMS][MAXD];
   long n;
-  for (int pb = PA; pb <= DPA; pb++) {
+  for (int pb = PA; pb < NPROBLEMS; pb++) {
     run_rk8pd(pb, 1e-15, ref[pb], &n);
     add_line(pb, "gsl-rk8pd", "", "adaptive", 0, 0, run_rk8pd, ref[pb]);
   }
@@ -230,7 +281,7 @@ int main(void)
   }
   for (int r = 0; r < ROUNDS; r++) /* in turns: every timed point once a round */
     for (int i = 0; i < npts; i++) {
-      double y[4], t0, t1;
+      double y[MAXD], t0, t1;
       long steps, reps = 0;
       if (!timed(&pts[i])) continue;
       t0 = cpu_now();

@@ -7,7 +7,10 @@
 # rescale; with -k s the step keeps the plain quadrature), the double pendulum also at
 # s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, and its
 # Cartesian form (models/double_pendulum.ham, k = s = 4..6, variant cartesian,
-# its state mapped to the angles), each built by
+# its state mapped to the angles); the spherical pendulum in its angles and the
+# 3-link arm in its joint angles at s = 2..6, -k auto, and the spherical
+# pendulum's Cartesian form (models/conical.ham started on the spherical
+# pendulum's state, k = s = 4..6, variant cartesian), each built by
 # gcc -O2 and by clang -O3 -march=native -fno-math-errno -ffp-contract=off
 # (docs/api.md, "Flags that are safe"). Writes bench/results/mq_wp.csv and
 # bench/results/mq_ratios.txt (bench/mq/ratios.awk), and with gnuplot the
@@ -19,7 +22,8 @@ trap 'rm -rf "$dir"' EXIT
 G=gen/hbvmgen
 : >"$dir/solvers.def"
 : >"$dir/solvers.h"
-# gen MODEL PROBLEM(0 pendulum angle, 1 double pendulum angles) NAME K S VARIANT [options]
+# gen MODEL PROBLEM(0 pendulum angle, 1 double pendulum angles, 2 spherical
+# pendulum angles, 3 arm joint angles) NAME K S VARIANT [options]
 gen() {
   model=$1 pb=$2 name=$3 k=$4 s=$5 var=$6
   shift 6
@@ -42,6 +46,13 @@ gen double_pendulum_angles 1 dpa_k11_s6 11 6 ""
 gen double_pendulum_angles 1 dpa_ks_s4_loop 4 4 "stage-loop" --stage-loop 1
 for s in 4 5 6; do  # the Cartesian form (two constraints, the poly family), in the angles' group
   gen double_pendulum 1 dpc_ks_s$s "$s" "$s" "cartesian"
+done
+for s in 2 3 4 5 6; do  # -k auto: k = s, the step rescaling p to keep H
+  gen spherical_pendulum 2 sph_kauto_s$s auto "$s" ""
+  gen arm3 3 arm_kauto_s$s auto "$s" ""
+done
+for s in 4 5 6; do  # the spherical pendulum's Cartesian form (one constraint), started on its state
+  gen conical 2 sphc_ks_s$s "$s" "$s" "cartesian"
 done
 W="-std=c99 -Wall -Wextra -pedantic"
 srcs=$(sed -n 's/^S(\([a-z0-9_]*\),.*/\1.c/p' "$dir/solvers.def" | sed "s|^|$dir/|")
