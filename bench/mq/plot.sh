@@ -1,7 +1,7 @@
 #!/bin/sh
 # bench/mq/plot.sh - bench/results/mq_wp_P.png from bench/results/mq_wp.csv
 # (bench/mq/wp.sh): CPU seconds against the error at T of the gcc -O2 build,
-# rk8pd and the hbvm lines named below (dpc_, sphc_: the Cartesian forms), timed
+# rk8pd and the hbvm lines named below (dpc_, sphc_, armc_: the Cartesian forms), timed
 # points only, in the order of the sweep (tol or N).
 set -e
 csv=bench/results/mq_wp.csv
@@ -37,4 +37,4 @@ plot double_pendulum_angles gsl-rk8pd:adaptive dpa_ks_s6:fixed dpa_ks_s6:adaptiv
 plot spherical_pendulum gsl-rk8pd:adaptive sph_kauto_s6:fixed sph_kauto_s6:adaptive sph_kauto_s5:fixed \
   sph_kauto_s4:fixed sph_kauto_s4:adaptive sphc_ks_s5:fixed sphc_ks_s5:adaptive
 plot arm3 gsl-rk8pd:adaptive arm_kauto_s6:fixed arm_kauto_s6:adaptive arm_kauto_s5:fixed \
-  arm_kauto_s4:fixed arm_kauto_s4:adaptive
+  arm_kauto_s4:fixed arm_kauto_s4:adaptive armc_ks_s6:fixed armc_ks_s5:fixed armc_ks_s5:adaptive

@@ -2,7 +2,9 @@
  * the same ODE: the pendulum in its angle (models/pendulum_angle.ham, constant
  * M), the double pendulum in angles (models/double_pendulum_angles.ham, M(q)),
  * the spherical pendulum in its angles (models/spherical_pendulum.ham) and the
- * 3-link arm in its joint angles (models/arm3.ham). Each generated solver is run fixed (h = T/N) and adaptive
+ * 3-link arm in its joint angles (models/arm3.ham), with the Cartesian forms of
+ * three of them (the arm's bench/mq/arm3_cartesian.ham). Each generated solver
+ * is run fixed (h = T/N) and adaptive
  * (NAME_step_adaptive at tol, the last step shortened to end on T, as
  * bench/hbvm_adaptive.c does); rk8pd adaptive at tol (epsabs = epsrel = tol,
  * as bench/gslpeers.c). The error is the max-norm error of (q, p) at T against
@@ -94,14 +96,66 @@ static void run_rk8pd(int pb, double tol, double *y, long *steps)
   gsl_odeiv2_driver_free(dr);
 }
 
+/* The arm's Cartesian form (bench/mq/arm3_cartesian.ham at its defaults: unit
+ * masses and rods) per axis: M_c = [[2/3, 1/6, 0], [1/6, 2/3, 1/6], [0, 1/6, 1/3]]
+ * on (P1, P2, P3). */
+static const double arm_mc[3][3] = {{2.0 / 3, 1.0 / 6, 0}, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {0, 1.0 / 6, 1.0 / 3}};
+
+/* The arm's joint points P = (x1, y1, x2, y2, x3, y3) and momenta p_c = M_c v
+ * from its joint angles and momenta y = (q, p): absolute angles f_j = q1 + .. +
+ * q_j and rates w_j from q' = M(q)^-1 p, P_i = P_(i-1) + (sin f_i, -cos f_i),
+ * v_i = v_(i-1) + w_i (cos f_i, sin f_i). */
+static void arm_to_cartesian(const double *y, double *P, double *pc)
+{
+  double Mq[9], qd[3], f = 0, w = 0, x = 0, z = 0, vx[3], vz[3];
+  arm_velocity(y, y + 3, Mq, qd);
+  for (int i = 0; i < 3; i++) {
+    f += y[i], w += qd[i];
+    P[2 * i] = x += sin(f), P[2 * i + 1] = z -= cos(f);
+    vx[i] = (i ? vx[i - 1] : 0) + w * cos(f), vz[i] = (i ? vz[i - 1] : 0) + w * sin(f);
+  }
+  for (int i = 0; i < 3; i++) {
+    pc[2 * i] = pc[2 * i + 1] = 0;
+    for (int j = 0; j < 3; j++) pc[2 * i] += arm_mc[i][j] * vx[j], pc[2 * i + 1] += arm_mc[i][j] * vz[j];
+  }
+}
+
+/* The inverse of arm_to_cartesian: the link directions' absolute angles f_j
+ * (atan2, from the downward vertical), the relative angles q in (-pi, pi]
+ * (measure_error compares them modulo 2 pi), and p = J' p_c with J = dP/dq:
+ * the momentum of f_j is a_j = e_j . (p_j + .. + p_3), e_j = (cos f_j, sin f_j),
+ * and p_k = a_k + .. + a_3. */
+static void arm_from_cartesian(const double *P, const double *pc, double *y)
+{
+  double f[3], a[3], tx = 0, tz = 0;
+  for (int j = 0; j < 3; j++) {
+    double dx = P[2 * j] - (j ? P[2 * j - 2] : 0), dz = P[2 * j + 1] - (j ? P[2 * j - 1] : 0);
+    f[j] = atan2(dx, -dz);
+    y[j] = j ? remainder(f[j] - f[j - 1], 4 * acos(0.0)) : f[0];
+  }
+  for (int j = 2; j >= 0; j--) {
+    tx += pc[2 * j], tz += pc[2 * j + 1];
+    a[j] = cos(f[j]) * tx + sin(f[j]) * tz;
+  }
+  y[5] = a[2], y[4] = a[1] + a[2], y[3] = a[0] + a[1] + a[2];
+}
+
 /* The start of a solver with m coordinates on problem pb: the model's own q0
  * and p0 (q0 = p0 = NULL), but for the spherical pendulum in Cartesian
  * coordinates (m = 3: models/conical.ham, unit mass, rod and gravity as
  * models/spherical_pendulum.ham) the spherical pendulum's start th = 1,
- * ph = 0, p_th = 0, p_ph = 0.5 as a position on the sphere and a velocity. */
+ * ph = 0, p_th = 0, p_ph = 0.5 as a position on the sphere and a velocity,
+ * and for the arm in Cartesian coordinates (m = 6) the arm's start mapped by
+ * arm_to_cartesian. */
 static void cartesian_start(int pb, int m, double *q0, double *p0, const double **q, const double **p)
 {
+  double y[MAXD];
   *q = *p = NULL;
+  if (pb == ARM && m == 6) {
+    initial(ARM, y);
+    arm_to_cartesian(y, q0, p0);
+    *q = q0, *p = p0;
+  }
   if (pb != SPH || m != 3) return;
   q0[0] = sin(1.0), q0[1] = 0, q0[2] = -cos(1.0);
   p0[0] = 0, p0[1] = 0.5 / sin(1.0), p0[2] = 0;
@@ -114,7 +168,8 @@ static void cartesian_start(int pb, int m, double *q0, double *p0, const double 
  * p_th = th', p_ph = x y' - y x', or for the double pendulum in Cartesian coordinates (m = 4, unit
  * masses and rods: models/double_pendulum.ham, its line in the double
  * pendulum's group) the angles from the downward vertical, their rates from
- * the velocities p, and p_th = M(th) th'. */
+ * the velocities p, and p_th = M(th) th', or for the arm in Cartesian
+ * coordinates (m = 6: bench/mq/arm3_cartesian.ham) arm_from_cartesian. */
 static void to_problem(int pb, int m, const double *q, const double *p, double *y)
 {
   if (pb == SPH && m == 3) {
@@ -128,6 +183,10 @@ static void to_problem(int pb, int m, const double *q, const double *p, double *
     double w1 = p[0] * cos(t1) + p[1] * sin(t1), w2 = (p[2] - p[0]) * cos(t2) + (p[3] - p[1]) * sin(t2);
     double c = cos(t1 - t2);
     y[0] = t1, y[1] = t2, y[2] = 2 * w1 + c * w2, y[3] = c * w1 + w2;
+    return;
+  }
+  if (pb == ARM && m == 6) {
+    arm_from_cartesian(q, p, y);
     return;
   }
   for (int c = 0; c < m; c++) y[c] = q[c], y[m + c] = p[c];
@@ -146,7 +205,7 @@ static void failed(int pb, double *y)
   {                                                                               \
     P##_state x;                                                                  \
     long n = lround(n_steps);                                                     \
-    double h = T_END / (double)n, q0[3], p0[3];                                   \
+    double h = T_END / (double)n, q0[MAXD], p0[MAXD];                             \
     const double *qs, *ps;                                                        \
     cartesian_start(pb, P##_M, q0, p0, &qs, &ps);                                 \
     P##_init(&x, qs, ps);                                                         \
@@ -161,7 +220,7 @@ static void failed(int pb, double *y)
   static void run_##P##_adaptive(int pb, double tol, double *y, long *steps)     \
   {                                                                               \
     P##_state x;                                                                  \
-    double h = 1e-3 * T_END, q0[3], p0[3];                                        \
+    double h = 1e-3 * T_END, q0[MAXD], p0[MAXD];                                  \
     const double *qs, *ps;                                                        \
     long n = 0;                                                                   \
     cartesian_start(pb, P##_M, q0, p0, &qs, &ps);                                 \
@@ -217,7 +276,7 @@ static double cpu_now(void)
 }
 
 /* Run point p once untimed: its error at T against ref (the spherical
- * pendulum's azimuth modulo 2 pi) and |H(T) - H0|. */
+ * pendulum's azimuth and the arm's angles modulo 2 pi) and |H(T) - H0|. */
 static void measure_error(Point *p, const double *ref)
 {
   double y[MAXD], y0[MAXD];
@@ -226,7 +285,7 @@ static void measure_error(Point *p, const double *ref)
   p->err = 0;
   for (int c = 0; c < d; c++) {
     double e = y[c] - ref[c];
-    if (p->pb == SPH && c == 1) e = remainder(e, 4 * acos(0.0));
+    if ((p->pb == SPH && c == 1) || (p->pb == ARM && c < 3)) e = remainder(e, 4 * acos(0.0));
     p->err = fmax(p->err, fabs(e));
   }
   initial(p->pb, y0);

@@ -8,9 +8,11 @@
 # s = 7, 8 and (11,6), fixed and adaptive, one line with --stage-loop, and its
 # Cartesian form (models/double_pendulum.ham, k = s = 4..6, variant cartesian,
 # its state mapped to the angles); the spherical pendulum in its angles and the
-# 3-link arm in its joint angles at s = 2..6, -k auto, and the spherical
+# 3-link arm in its joint angles at s = 2..6, -k auto, the spherical
 # pendulum's Cartesian form (models/conical.ham started on the spherical
-# pendulum's state, k = s = 4..6, variant cartesian), each built by
+# pendulum's state, k = s = 4..6, variant cartesian) and the arm's
+# (bench/mq/arm3_cartesian.ham: its joint points, constant M, three rods;
+# k = s = 4..6, variant cartesian, mapped to the joint angles), each built by
 # gcc -O2 and by clang -O3 -march=native -fno-math-errno -ffp-contract=off
 # (docs/api.md, "Flags that are safe"). Writes bench/results/mq_wp.csv and
 # bench/results/mq_ratios.txt (bench/mq/ratios.awk), and with gnuplot the
@@ -23,11 +25,13 @@ G=gen/hbvmgen
 : >"$dir/solvers.def"
 : >"$dir/solvers.h"
 # gen MODEL PROBLEM(0 pendulum angle, 1 double pendulum angles, 2 spherical
-# pendulum angles, 3 arm joint angles) NAME K S VARIANT [options]
+# pendulum angles, 3 arm joint angles) NAME K S VARIANT [options]; MODEL is
+# models/MODEL.ham, or a path without .ham when it has a slash
 gen() {
   model=$1 pb=$2 name=$3 k=$4 s=$5 var=$6
   shift 6
-  $G "models/$model.ham" -k "$k" -s "$s" -n "$name" -o "$dir" "$@" >/dev/null
+  case $model in */*) ;; *) model=models/$model ;; esac
+  $G "$model.ham" -k "$k" -s "$s" -n "$name" -o "$dir" "$@" >/dev/null
   [ "$k" = auto ] && k=$(sed -n 's/.*_K \([0-9]*\).*/\1/p' "$dir/$name.h" | head -n 1)
   echo "S($name, $pb, ${k:-0}, $s, \"$var\")" >>"$dir/solvers.def"
   echo "#include \"$name.h\"" >>"$dir/solvers.h"
@@ -53,6 +57,9 @@ for s in 2 3 4 5 6; do  # -k auto: k = s, the step rescaling p to keep H
 done
 for s in 4 5 6; do  # the spherical pendulum's Cartesian form (one constraint), started on its state
   gen conical 2 sphc_ks_s$s "$s" "$s" "cartesian"
+done
+for s in 4 5 6; do  # the arm's Cartesian form (three constraints), started on its state
+  gen bench/mq/arm3_cartesian 3 armc_ks_s$s "$s" "$s" "cartesian"
 done
 W="-std=c99 -Wall -Wextra -pedantic"
 srcs=$(sed -n 's/^S(\([a-z0-9_]*\),.*/\1.c/p' "$dir/solvers.def" | sed "s|^|$dir/|")
