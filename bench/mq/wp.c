@@ -12,7 +12,7 @@
  * the time of a point is the median of ROUNDS CPU times taken
  * in turns (every timed point once a round), each at least MIN_SEC long.
  * Only the points whose error lies in [ERR_LO, ERR_HI] are timed (they bracket
- * 1e-10 and 1e-12). bench/mq/run.sh generates the solvers and writes
+ * 1e-10 and 1e-12). bench/mq/wp.sh generates the solvers and writes
  * solvers.def (S(name, problem, k, s, variant)) and solvers.h (their headers),
  * then bench/mq/ratios.awk interpolates the CSV this prints. */
 #define _POSIX_C_SOURCE 200809L
