@@ -80,7 +80,7 @@ void emit_batch_mq_rescale(Emitter *e) {
           "        $M up = (K > 0) & (H0 - u > 0);\n"
           "        $R b = sqrt$f(up ? (H0 - u) / (K > 0 ? K : 1) : 1);\n"
           "        b = up ? b : 1;\n"
-          "        b = (((fabs$f(b - 1) <= 1e-6) == 0) & (fabs$f(H0 - u - K) <= ");
+          "        b = (((fabs$f(b - 1) <= 1e-6$f) == 0) & (fabs$f(H0 - u - K) <= ");
   if (emit_mq_near_rest_band(e) == 64) tmpl(e, "tl"); /* the band of NAME_step's test */
   else tmplf(e, "%d * $P_TOL * (K + fabs$f(u))", emit_mq_near_rest_band(e));
   tmpl(e, ")) ? 1 : b;  /* near rest */\n"
