@@ -85,6 +85,19 @@ static double time_at(const double *err, const double *t, int n, double e) {
   return NAN;
 }
 
+// The time of one solver's line at error level e: time_at over its timed
+// points (tm not NaN; err and tm NPTS long).
+static double line_time_at(const double *err, const double *tm, double e) {
+  double e1[NPTS], t1[NPTS];
+  int n = 0;
+  for (int j = 0; j < NPTS; j++)
+    if (!isnan(tm[j])) {
+      e1[n] = err[j];
+      t1[n++] = tm[j];
+    }
+  return time_at(e1, t1, n, e);
+}
+
 int main(void) {
   static double err[NSOLV][NPTS], tm[NSOLV][NPTS], samples[NSOLV][NPTS][ROUNDS];
   static int nn[NPTS], reps[NSOLV][NPTS];
@@ -139,25 +152,13 @@ int main(void) {
              err[v][j], tm[v][j]);
     }
   for (int v = 0; v < NSOLV; v++) {
-    double e[NPTS], t[NPTS];
-    int n = 0;
-    for (int j = 0; j < NPTS; j++)
-      if (!isnan(tm[v][j])) {
-        e[n] = err[v][j];
-        t[n++] = tm[v][j];
-      }
-    printf("# %s: time at 1e-10 %.3e s, at 1e-12 %.3e s\n", solvers[v].name, time_at(e, t, n, 1e-10), time_at(e, t, n, 1e-12));
+    printf("# %s: time at 1e-10 %.3e s, at 1e-12 %.3e s\n", solvers[v].name, line_time_at(err[v], tm[v], 1e-10),
+           line_time_at(err[v], tm[v], 1e-12));
     for (int w = 0; w < NSOLV; w++) { /* the ratio angles / natural at the same s */
       if (solvers[v].form != 0 || solvers[w].form != 1 || solvers[w].s != solvers[v].s) continue;
-      double e2[NPTS], t2[NPTS];
-      int n2 = 0;
-      for (int j = 0; j < NPTS; j++)
-        if (!isnan(tm[w][j])) {
-          e2[n2] = err[w][j];
-          t2[n2++] = tm[w][j];
-        }
       printf("# s=%d: angles / natural at equal error: %.2f at 1e-10, %.2f at 1e-12\n", solvers[v].s,
-             time_at(e, t, n, 1e-10) / time_at(e2, t2, n2, 1e-10), time_at(e, t, n, 1e-12) / time_at(e2, t2, n2, 1e-12));
+             line_time_at(err[v], tm[v], 1e-10) / line_time_at(err[w], tm[w], 1e-10),
+             line_time_at(err[v], tm[v], 1e-12) / line_time_at(err[w], tm[w], 1e-12));
     }
   }
   return 0;

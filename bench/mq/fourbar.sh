@@ -4,12 +4,7 @@
 # constraints), HBVM(s,s) for s = 2, 3, 4, fixed steps, at equal error
 # (bench/mq/fourbar.c). Writes bench/results/mq_fourbar.csv. Run from the
 # repository's root after `make all`: sh bench/mq/fourbar.sh
-set -e
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-G=gen/hbvmgen
-: >"$dir/solvers.def"
-: >"$dir/solvers.h"
+. bench/mq/solvers.sh
 for s in 2 3 4; do
   for form in 0 1; do
     model=models/fourbar_angles.ham name=fba_s$s
@@ -19,7 +14,7 @@ for s in 2 3 4; do
     echo "#include \"$name.h\"" >>"$dir/solvers.h"
   done
 done
-srcs=$(sed -n 's/^S(\([a-z0-9_]*\),.*/\1.c/p' "$dir/solvers.def" | sed "s|^|$dir/|")
+srcs=$(solver_sources)
 nice -n 5 gcc -std=c99 -Wall -Wextra -pedantic -O2 -I"$dir" -Ibench/mq -o "$dir/fourbar" bench/mq/fourbar.c $srcs \
   $(pkg-config --libs gsl) -lm
 "$dir/fourbar" | tee bench/results/mq_fourbar.csv

@@ -18,12 +18,7 @@
 # bench/results/mq_ratios.txt (bench/mq/ratios.awk), and with gnuplot the
 # figures bench/results/mq_wp_*.png (bench/mq/plot.sh). Run from the repository's
 # root after `make all`: sh bench/mq/wp.sh
-set -e
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-G=gen/hbvmgen
-: >"$dir/solvers.def"
-: >"$dir/solvers.h"
+. bench/mq/solvers.sh
 # gen MODEL PROBLEM(0 pendulum angle, 1 double pendulum angles, 2 spherical
 # pendulum angles, 3 arm joint angles) NAME K S VARIANT [options]; MODEL is
 # models/MODEL.ham, or a path without .ham when it has a slash
@@ -62,7 +57,7 @@ for s in 4 5 6; do  # the arm's Cartesian form (three constraints), started on i
   gen bench/mq/arm3_cartesian 3 armc_ks_s$s "$s" "$s" "cartesian"
 done
 W="-std=c99 -Wall -Wextra -pedantic"
-srcs=$(sed -n 's/^S(\([a-z0-9_]*\),.*/\1.c/p' "$dir/solvers.def" | sed "s|^|$dir/|")
+srcs=$(solver_sources)
 nice -n 5 gcc $W -O2 -DBUILD='"gcc-O2"' -I"$dir" -o "$dir/wp_gcc" bench/mq/wp.c $srcs $(pkg-config --libs gsl) -lm
 nice -n 5 clang $W -O3 -march=native -fno-math-errno -ffp-contract=off -DBUILD='"clang-O3-native"' -I"$dir" \
   -o "$dir/wp_clang" bench/mq/wp.c $srcs $(pkg-config --libs gsl) -lm
