@@ -483,14 +483,19 @@ Suite *ensemble_suite(void)
   tcase_set_timeout(widths, 300);
   tcase_add_test(widths, test_independent_of_w_and_threads);
   suite_add_tcase(s, widths);
+  TCase *models = tcase_create("models");
+  tcase_set_tags(models, "sanlong"); /* M(q), rolled and Newton solvers compiled: sanitized in check-long */
+  tcase_add_checked_fixture(models, setup, teardown);
+  tcase_set_timeout(models, 300);
+  tcase_add_test(models, test_mass_q);
+  tcase_add_test(models, test_rolled);
+  tcase_add_test(models, test_newton);
+  suite_add_tcase(s, models);
   TCase *tc = tcase_create("ensemble");
   tcase_add_checked_fixture(tc, setup, teardown);
   tcase_set_timeout(tc, 300);
   tcase_add_test(tc, test_sweep_and_mpi);
   tcase_add_test(tc, test_span_and_tol);
-  tcase_add_test(tc, test_mass_q);
-  tcase_add_test(tc, test_rolled);
-  tcase_add_test(tc, test_newton);
   tcase_add_test(tc, test_errors);
   tcase_add_test(tc, test_input_file);
   suite_add_tcase(s, tc);
