@@ -58,7 +58,13 @@ static int controller_order(const Emitter *e) { return mult_err_wanted(e) ? 3 : 
 // and (|gamma_{s-2}| / |gamma_{s-4}|)^(1/2): odd and even coefficients can fall
 // at different rates (Kepler's perihelion; from rest, v = a t + O(t^3) makes
 // gamma_2 and gamma_3 both O(h^3)). At s = 2, gamma_1 / gamma_0, which is
-// 1/sqrt(3) from rest whatever h: there (rho >= 0.35) NAME_COLDC_REST.
+// 1/sqrt(3) from rest whatever h: there (rho >= 0.35) the velocity is
+// a t + O(t^3) (no jerk at rest: the force depends on q, and on p
+// quadratically), gamma_0 - sqrt(3) gamma_1 is that O(h^3) part, e, and the
+// same model d1^2 / |h v| with d1 = |h e| reads NAME_COLDC_REST |h| e^2 /
+// |gamma_0|, of the method's order from rest (h^6); it was
+// NAME_COLDC_REST |h gamma_1| rho^3, of order h^2, which sent adaptive runs
+// from rest at tol <= 1e-13 to the step-size floor.
 // The constant multiplier's own error (order 2) is NAME_mult_err's.
 static void emit_err_est(Emitter *e) {
   int s = e->me->s, p = 2 * s;
@@ -79,8 +85,8 @@ static void emit_err_est(Emitter *e) {
     out(e, "#ifndef %s_COLDC\n#define %s_COLDC %s  /* the first step's: measured, docs/api.md */\n#endif\n", e->P,
         e->P, c);
   }
-  if (s == 2) {
-    format_real(e, c, sizeof c, 0.05);
+  if (s == 2) { /* from rest: the largest true / (|h| e^2 / |gamma_0|), rounded up (docs/api.md) */
+    format_real(e, c, sizeof c, 140);
     out(e, "#ifndef %s_COLDC_REST\n#define %s_COLDC_REST %s  /* the same from rest: measured, docs/api.md */\n"
            "#endif\n", e->P, e->P, c);
   }
@@ -93,11 +99,17 @@ static void emit_err_est(Emitter *e) {
     if (s >= 3) out(e, ", a = %s_coef(gam, %d)", e->P, s - 3);
     if (s >= 4) out(e, ", z = %s_coef(gam, %d), t", e->P, s - 4);
     out(e, ";\n    if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < %d */\n", s);
-    if (s == 2)
+    if (s == 2) {
       tmpl(e, "    r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */\n"
               "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"
-              "    v = (r < ($R)0.35 ? $P_COLDC : $P_COLDC_REST) * fabs$f(h) * c;\n");
-    else {
+              "    if (!(r < ($R)0.35)) {  /* near rest: $P_COLDC_REST |h| e^2 / |gamma_0|, */\n"
+              "      $R d, e = 0;  /* e = max |gamma_0 - sqrt(3) gamma_1|: 0 for v = a t */\n"
+              "      for (i = 0; i < $P_M; i++) {\n");
+      out(e, "        d = (%s)fabs%s(gam[i] - (%s)1.7320508075688772 * gam[%s_M + i]);\n", real_type(e, 0), g,
+          real_type(e, e->wide_step), e->P);
+      tmpl(e, "        if (d > e) e = d;\n      }\n      return $P_COLDC_REST * fabs$f(h) * e * e / b;\n    }\n"
+              "    v = $P_COLDC * fabs$f(h) * c;\n");
+    } else {
       out(e, "    r = sqrt%s(c / a);  /* the slower of the two-step decays */\n", math_suffix(e, 0));
       if (s >= 4) out(e, "    t = sqrt%s(b / z);\n    if (t > r) r = t;\n", math_suffix(e, 0));
       tmpl(e, "    if (!(r < 1)) return d1;  /* no decay: no asymptotic range */\n"

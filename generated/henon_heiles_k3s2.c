@@ -198,7 +198,7 @@ static double henon_heiles_k3s2_coef(const double *gam, int j)
 #define henon_heiles_k3s2_COLDC 70.0  /* the first step's: measured, docs/api.md */
 #endif
 #ifndef henon_heiles_k3s2_COLDC_REST
-#define henon_heiles_k3s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
+#define henon_heiles_k3s2_COLDC_REST 140.0  /* the same from rest: measured, docs/api.md */
 #endif
 henon_heiles_k3s2_OUT_OF_LINE double henon_heiles_k3s2_err_est(const double *gam, double h, double d1, int cold)
 {
@@ -210,7 +210,15 @@ henon_heiles_k3s2_OUT_OF_LINE double henon_heiles_k3s2_err_est(const double *gam
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
-    v = (r < (double)0.35 ? henon_heiles_k3s2_COLDC : henon_heiles_k3s2_COLDC_REST) * fabs(h) * c;
+    if (!(r < (double)0.35)) {  /* near rest: henon_heiles_k3s2_COLDC_REST |h| e^2 / |gamma_0|, */
+      double d, e = 0;  /* e = max |gamma_0 - sqrt(3) gamma_1|: 0 for v = a t */
+      for (i = 0; i < henon_heiles_k3s2_M; i++) {
+        d = (double)fabs(gam[i] - (double)1.7320508075688772 * gam[henon_heiles_k3s2_M + i]);
+        if (d > e) e = d;
+      }
+      return henon_heiles_k3s2_COLDC_REST * fabs(h) * e * e / b;
+    }
+    v = henon_heiles_k3s2_COLDC * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }

@@ -2084,7 +2084,7 @@ static double satellites_k6s2_coef(const double *gam, int j)
 #define satellites_k6s2_COLDC 70.0  /* the first step's: measured, docs/api.md */
 #endif
 #ifndef satellites_k6s2_COLDC_REST
-#define satellites_k6s2_COLDC_REST 0.050000000000000003  /* the same from rest: measured, docs/api.md */
+#define satellites_k6s2_COLDC_REST 140.0  /* the same from rest: measured, docs/api.md */
 #endif
 satellites_k6s2_OUT_OF_LINE double satellites_k6s2_err_est(const double *gam, double h, double d1, int cold)
 {
@@ -2096,7 +2096,15 @@ satellites_k6s2_OUT_OF_LINE double satellites_k6s2_err_est(const double *gam, do
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
     r = c / b;  /* from rest 1/sqrt(3) whatever h: the constant of no decay */
     if (!(r < 1)) return d1;  /* no decay: no asymptotic range */
-    v = (r < (double)0.35 ? satellites_k6s2_COLDC : satellites_k6s2_COLDC_REST) * fabs(h) * c;
+    if (!(r < (double)0.35)) {  /* near rest: satellites_k6s2_COLDC_REST |h| e^2 / |gamma_0|, */
+      double d, e = 0;  /* e = max |gamma_0 - sqrt(3) gamma_1|: 0 for v = a t */
+      for (i = 0; i < satellites_k6s2_M; i++) {
+        d = (double)fabs(gam[i] - (double)1.7320508075688772 * gam[satellites_k6s2_M + i]);
+        if (d > e) e = d;
+      }
+      return satellites_k6s2_COLDC_REST * fabs(h) * e * e / b;
+    }
+    v = satellites_k6s2_COLDC * fabs(h) * c;
     for (i = 0; i < 3; i++) v *= r;
     return v;
   }
