@@ -37,7 +37,8 @@ void emit_header(Emitter *e, const EmitOptions *o) {
   tmpl(e, ""
           "#define $P_ENONFINITE 2  /* a non-finite value (outside a function's domain?) */\n"
           "#define $P_ESINGULAR 3   /* the multiplier system is singular (dependent constraints?) */\n"
-          "#define $P_EBADSTEP 4    /* h is zero or not finite */\n\n"
+          "#define $P_EBADSTEP 4    /* h is zero or not finite */\n"
+          "#define $P_ETOL 5        /* adaptive: the error stayed over tol down to the smallest h */\n\n"
           "typedef $R $P_real;\n\n");
   out(e, "typedef struct {\n  %s_real t, q[%d], p[%d], lambda[%d];\n", e->P, m, m, nu ? nu : 1);
   out(e, "  /* private: compensated-summation errors and the last two steps' polynomials */\n");
@@ -295,6 +296,7 @@ void emit_public(Emitter *e) {
           "  case $P_ENONFINITE: return \"non-finite value\";\n"
           "  case $P_ESINGULAR: return \"singular multiplier system\";\n"
           "  case $P_EBADSTEP: return \"step size zero or not finite\";\n"
+          "  case $P_ETOL: return \"error estimate over the tolerance down to the smallest step\";\n"
           "  }\n  return \"unknown error\";\n}\n\n"
           "$P_real $P_energy(const $P_state *x, const $P_params *prm)\n{\n  $R H;\n  $P_DEFAULT_PARAMS(prm)\n"
           "  $(energy_kernel q0=x->q p0=x->p out=&H);\n  return H;\n}\n\n");

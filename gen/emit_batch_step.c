@@ -370,7 +370,7 @@ static void emit_lane_tolerance(Emitter *e, int poly, int mult, int defect) {
 // shared step hh: accepted when every active lane converged within its
 // tolerance, else retried from the unchanged lanes, smaller (halved after a
 // failure), cold after three tries over the tolerance. Below the smallest
-// step every active lane fails: ENOCONV, or its own failure. A bad h or tol
+// step every active lane fails: ETOL, or its own failure. A bad h or tol
 // fails every active lane with EBADSTEP; the return value is then, as after
 // any failure, the number of lanes that failed (never the -1, -2 of a try).
 void emit_batch_adaptive(Emitter *e) {
@@ -420,7 +420,7 @@ void emit_batch_adaptive(Emitter *e) {
           "    if (fabs$f(hh) < $P_HMIN * (1 + tmax) || rejected >= $P_MAXTRIES) {\n"
           "      s->h = 0;\n      s->rejected = rejected;\n"
           "      for (l = 0; l < $P_W; l++)\n"
-          "        if (!x->idle[l] && (s->code[l] == $P_OK || s->code[l] == $P_EREJECT)) s->code[l] = $P_ENOCONV;\n"
+          "        if (!x->idle[l] && (s->code[l] == $P_OK || s->code[l] == $P_EREJECT)) s->code[l] = $P_ETOL;\n"
           "      return nact;\n    }\n  }\n}\n");
 }
 

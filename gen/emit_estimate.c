@@ -487,6 +487,6 @@ void emit_step_adaptive(Emitter *e) {
   if (emit_is_newton(e))
     tmpl(e, "        st->newton = s.newton;\n        st->factors = s.factors;\n        st->jacobians = s.jacobians;\n");
   tmpl(e, "      }\n"
-          "      return rc != $P_EREJECT ? rc : $P_ENOCONV;\n    }\n  }\n}\n");
+          "      return rc != $P_EREJECT ? rc : $P_ETOL;\n    }\n  }\n}\n");
   emit_step_controlled(e);
 }

@@ -234,6 +234,7 @@ const char *conical_k1s1_strerror(int code)
   case conical_k1s1_ENONFINITE: return "non-finite value";
   case conical_k1s1_ESINGULAR: return "singular multiplier system";
   case conical_k1s1_EBADSTEP: return "step size zero or not finite";
+  case conical_k1s1_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -603,7 +604,7 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != conical_k1s1_EREJECT ? rc : conical_k1s1_ENOCONV;
+      return rc != conical_k1s1_EREJECT ? rc : conical_k1s1_ETOL;
     }
   }
 }

@@ -235,6 +235,7 @@ const char *conical_k2s2_strerror(int code)
   case conical_k2s2_ENONFINITE: return "non-finite value";
   case conical_k2s2_ESINGULAR: return "singular multiplier system";
   case conical_k2s2_EBADSTEP: return "step size zero or not finite";
+  case conical_k2s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -739,7 +740,7 @@ int conical_k2s2_step_adaptive(conical_k2s2_state *x, conical_k2s2_real *h, coni
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != conical_k2s2_EREJECT ? rc : conical_k2s2_ENOCONV;
+      return rc != conical_k2s2_EREJECT ? rc : conical_k2s2_ETOL;
     }
   }
 }

@@ -21,6 +21,7 @@ extern "C" {
 #define conical_k2s2_ENONFINITE 2  /* a non-finite value (outside a function's domain?) */
 #define conical_k2s2_ESINGULAR 3   /* the multiplier system is singular (dependent constraints?) */
 #define conical_k2s2_EBADSTEP 4    /* h is zero or not finite */
+#define conical_k2s2_ETOL 5        /* adaptive: the error stayed over tol down to the smallest h */
 
 typedef double conical_k2s2_real;
 

@@ -236,6 +236,7 @@ const char *conical_k3s3_strerror(int code)
   case conical_k3s3_ENONFINITE: return "non-finite value";
   case conical_k3s3_ESINGULAR: return "singular multiplier system";
   case conical_k3s3_EBADSTEP: return "step size zero or not finite";
+  case conical_k3s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -806,7 +807,7 @@ int conical_k3s3_step_adaptive(conical_k3s3_state *x, conical_k3s3_real *h, coni
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != conical_k3s3_EREJECT ? rc : conical_k3s3_ENOCONV;
+      return rc != conical_k3s3_EREJECT ? rc : conical_k3s3_ETOL;
     }
   }
 }

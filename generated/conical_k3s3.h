@@ -21,6 +21,7 @@ extern "C" {
 #define conical_k3s3_ENONFINITE 2  /* a non-finite value (outside a function's domain?) */
 #define conical_k3s3_ESINGULAR 3   /* the multiplier system is singular (dependent constraints?) */
 #define conical_k3s3_EBADSTEP 4    /* h is zero or not finite */
+#define conical_k3s3_ETOL 5        /* adaptive: the error stayed over tol down to the smallest h */
 
 typedef double conical_k3s3_real;
 

@@ -237,6 +237,7 @@ const char *conical_k4s4_strerror(int code)
   case conical_k4s4_ENONFINITE: return "non-finite value";
   case conical_k4s4_ESINGULAR: return "singular multiplier system";
   case conical_k4s4_EBADSTEP: return "step size zero or not finite";
+  case conical_k4s4_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -894,7 +895,7 @@ int conical_k4s4_step_adaptive(conical_k4s4_state *x, conical_k4s4_real *h, coni
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != conical_k4s4_EREJECT ? rc : conical_k4s4_ENOCONV;
+      return rc != conical_k4s4_EREJECT ? rc : conical_k4s4_ETOL;
     }
   }
 }

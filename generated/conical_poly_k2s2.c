@@ -432,6 +432,7 @@ const char *conical_poly_k2s2_strerror(int code)
   case conical_poly_k2s2_ENONFINITE: return "non-finite value";
   case conical_poly_k2s2_ESINGULAR: return "singular multiplier system";
   case conical_poly_k2s2_EBADSTEP: return "step size zero or not finite";
+  case conical_poly_k2s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1125,7 +1126,7 @@ int conical_poly_k2s2_step_adaptive(conical_poly_k2s2_state *x, conical_poly_k2s
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != conical_poly_k2s2_EREJECT ? rc : conical_poly_k2s2_ENOCONV;
+      return rc != conical_poly_k2s2_EREJECT ? rc : conical_poly_k2s2_ETOL;
     }
   }
 }

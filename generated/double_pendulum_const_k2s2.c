@@ -327,6 +327,7 @@ const char *double_pendulum_const_k2s2_strerror(int code)
   case double_pendulum_const_k2s2_ENONFINITE: return "non-finite value";
   case double_pendulum_const_k2s2_ESINGULAR: return "singular multiplier system";
   case double_pendulum_const_k2s2_EBADSTEP: return "step size zero or not finite";
+  case double_pendulum_const_k2s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -929,7 +930,7 @@ int double_pendulum_const_k2s2_step_adaptive(double_pendulum_const_k2s2_state *x
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != double_pendulum_const_k2s2_EREJECT ? rc : double_pendulum_const_k2s2_ENOCONV;
+      return rc != double_pendulum_const_k2s2_EREJECT ? rc : double_pendulum_const_k2s2_ETOL;
     }
   }
 }

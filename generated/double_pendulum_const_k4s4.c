@@ -329,6 +329,7 @@ const char *double_pendulum_const_k4s4_strerror(int code)
   case double_pendulum_const_k4s4_ENONFINITE: return "non-finite value";
   case double_pendulum_const_k4s4_ESINGULAR: return "singular multiplier system";
   case double_pendulum_const_k4s4_EBADSTEP: return "step size zero or not finite";
+  case double_pendulum_const_k4s4_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1152,7 +1153,7 @@ int double_pendulum_const_k4s4_step_adaptive(double_pendulum_const_k4s4_state *x
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != double_pendulum_const_k4s4_EREJECT ? rc : double_pendulum_const_k4s4_ENOCONV;
+      return rc != double_pendulum_const_k4s4_EREJECT ? rc : double_pendulum_const_k4s4_ETOL;
     }
   }
 }

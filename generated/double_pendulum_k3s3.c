@@ -1412,6 +1412,7 @@ const char *double_pendulum_k3s3_strerror(int code)
   case double_pendulum_k3s3_ENONFINITE: return "non-finite value";
   case double_pendulum_k3s3_ESINGULAR: return "singular multiplier system";
   case double_pendulum_k3s3_EBADSTEP: return "step size zero or not finite";
+  case double_pendulum_k3s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -2593,7 +2594,7 @@ int double_pendulum_k3s3_step_adaptive(double_pendulum_k3s3_state *x, double_pen
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != double_pendulum_k3s3_EREJECT ? rc : double_pendulum_k3s3_ENOCONV;
+      return rc != double_pendulum_k3s3_EREJECT ? rc : double_pendulum_k3s3_ETOL;
     }
   }
 }

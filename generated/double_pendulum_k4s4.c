@@ -2660,6 +2660,7 @@ const char *double_pendulum_k4s4_strerror(int code)
   case double_pendulum_k4s4_ENONFINITE: return "non-finite value";
   case double_pendulum_k4s4_ESINGULAR: return "singular multiplier system";
   case double_pendulum_k4s4_EBADSTEP: return "step size zero or not finite";
+  case double_pendulum_k4s4_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -4355,7 +4356,7 @@ int double_pendulum_k4s4_step_adaptive(double_pendulum_k4s4_state *x, double_pen
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != double_pendulum_k4s4_EREJECT ? rc : double_pendulum_k4s4_ENOCONV;
+      return rc != double_pendulum_k4s4_EREJECT ? rc : double_pendulum_k4s4_ETOL;
     }
   }
 }

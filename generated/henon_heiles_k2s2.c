@@ -119,6 +119,7 @@ const char *henon_heiles_k2s2_strerror(int code)
   case henon_heiles_k2s2_ENONFINITE: return "non-finite value";
   case henon_heiles_k2s2_ESINGULAR: return "singular multiplier system";
   case henon_heiles_k2s2_EBADSTEP: return "step size zero or not finite";
+  case henon_heiles_k2s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -555,7 +556,7 @@ int henon_heiles_k2s2_step_adaptive(henon_heiles_k2s2_state *x, henon_heiles_k2s
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != henon_heiles_k2s2_EREJECT ? rc : henon_heiles_k2s2_ENOCONV;
+      return rc != henon_heiles_k2s2_EREJECT ? rc : henon_heiles_k2s2_ETOL;
     }
   }
 }

@@ -120,6 +120,7 @@ const char *henon_heiles_k3s2_strerror(int code)
   case henon_heiles_k3s2_ENONFINITE: return "non-finite value";
   case henon_heiles_k3s2_ESINGULAR: return "singular multiplier system";
   case henon_heiles_k3s2_EBADSTEP: return "step size zero or not finite";
+  case henon_heiles_k3s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -552,7 +553,7 @@ int henon_heiles_k3s2_step_adaptive(henon_heiles_k3s2_state *x, henon_heiles_k3s
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != henon_heiles_k3s2_EREJECT ? rc : henon_heiles_k3s2_ENOCONV;
+      return rc != henon_heiles_k3s2_EREJECT ? rc : henon_heiles_k3s2_ETOL;
     }
   }
 }

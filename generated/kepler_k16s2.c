@@ -129,6 +129,7 @@ const char *kepler_k16s2_strerror(int code)
   case kepler_k16s2_ENONFINITE: return "non-finite value";
   case kepler_k16s2_ESINGULAR: return "singular multiplier system";
   case kepler_k16s2_EBADSTEP: return "step size zero or not finite";
+  case kepler_k16s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -951,7 +952,7 @@ int kepler_k16s2_step_adaptive(kepler_k16s2_state *x, kepler_k16s2_real *h, kepl
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != kepler_k16s2_EREJECT ? rc : kepler_k16s2_ENOCONV;
+      return rc != kepler_k16s2_EREJECT ? rc : kepler_k16s2_ETOL;
     }
   }
 }

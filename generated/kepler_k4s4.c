@@ -117,6 +117,7 @@ const char *kepler_k4s4_strerror(int code)
   case kepler_k4s4_ENONFINITE: return "non-finite value";
   case kepler_k4s4_ESINGULAR: return "singular multiplier system";
   case kepler_k4s4_EBADSTEP: return "step size zero or not finite";
+  case kepler_k4s4_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -759,7 +760,7 @@ int kepler_k4s4_step_adaptive(kepler_k4s4_state *x, kepler_k4s4_real *h, kepler_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != kepler_k4s4_EREJECT ? rc : kepler_k4s4_ENOCONV;
+      return rc != kepler_k4s4_EREJECT ? rc : kepler_k4s4_ETOL;
     }
   }
 }

@@ -119,6 +119,7 @@ const char *kepler_k6s1_strerror(int code)
   case kepler_k6s1_ENONFINITE: return "non-finite value";
   case kepler_k6s1_ESINGULAR: return "singular multiplier system";
   case kepler_k6s1_EBADSTEP: return "step size zero or not finite";
+  case kepler_k6s1_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -568,7 +569,7 @@ int kepler_k6s1_step_adaptive(kepler_k6s1_state *x, kepler_k6s1_real *h, kepler_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != kepler_k6s1_EREJECT ? rc : kepler_k6s1_ENOCONV;
+      return rc != kepler_k6s1_EREJECT ? rc : kepler_k6s1_ETOL;
     }
   }
 }

@@ -119,6 +119,7 @@ const char *kepler_k6s2_strerror(int code)
   case kepler_k6s2_ENONFINITE: return "non-finite value";
   case kepler_k6s2_ESINGULAR: return "singular multiplier system";
   case kepler_k6s2_EBADSTEP: return "step size zero or not finite";
+  case kepler_k6s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -671,7 +672,7 @@ int kepler_k6s2_step_adaptive(kepler_k6s2_state *x, kepler_k6s2_real *h, kepler_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != kepler_k6s2_EREJECT ? rc : kepler_k6s2_ENOCONV;
+      return rc != kepler_k6s2_EREJECT ? rc : kepler_k6s2_ETOL;
     }
   }
 }

@@ -119,6 +119,7 @@ const char *kepler_k6s3_strerror(int code)
   case kepler_k6s3_ENONFINITE: return "non-finite value";
   case kepler_k6s3_ESINGULAR: return "singular multiplier system";
   case kepler_k6s3_EBADSTEP: return "step size zero or not finite";
+  case kepler_k6s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -751,7 +752,7 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != kepler_k6s3_EREJECT ? rc : kepler_k6s3_ENOCONV;
+      return rc != kepler_k6s3_EREJECT ? rc : kepler_k6s3_ETOL;
     }
   }
 }

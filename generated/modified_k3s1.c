@@ -259,6 +259,7 @@ const char *modified_k3s1_strerror(int code)
   case modified_k3s1_ENONFINITE: return "non-finite value";
   case modified_k3s1_ESINGULAR: return "singular multiplier system";
   case modified_k3s1_EBADSTEP: return "step size zero or not finite";
+  case modified_k3s1_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -676,7 +677,7 @@ int modified_k3s1_step_adaptive(modified_k3s1_state *x, modified_k3s1_real *h, m
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != modified_k3s1_EREJECT ? rc : modified_k3s1_ENOCONV;
+      return rc != modified_k3s1_EREJECT ? rc : modified_k3s1_ETOL;
     }
   }
 }

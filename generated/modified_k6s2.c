@@ -262,6 +262,7 @@ const char *modified_k6s2_strerror(int code)
   case modified_k6s2_ENONFINITE: return "non-finite value";
   case modified_k6s2_ESINGULAR: return "singular multiplier system";
   case modified_k6s2_EBADSTEP: return "step size zero or not finite";
+  case modified_k6s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -933,7 +934,7 @@ int modified_k6s2_step_adaptive(modified_k6s2_state *x, modified_k6s2_real *h, m
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != modified_k6s2_EREJECT ? rc : modified_k6s2_ENOCONV;
+      return rc != modified_k6s2_EREJECT ? rc : modified_k6s2_ETOL;
     }
   }
 }

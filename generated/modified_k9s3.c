@@ -265,6 +265,7 @@ const char *modified_k9s3_strerror(int code)
   case modified_k9s3_ENONFINITE: return "non-finite value";
   case modified_k9s3_ESINGULAR: return "singular multiplier system";
   case modified_k9s3_EBADSTEP: return "step size zero or not finite";
+  case modified_k9s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1177,7 +1178,7 @@ int modified_k9s3_step_adaptive(modified_k9s3_state *x, modified_k9s3_real *h, m
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != modified_k9s3_EREJECT ? rc : modified_k9s3_ENOCONV;
+      return rc != modified_k9s3_EREJECT ? rc : modified_k9s3_ETOL;
     }
   }
 }

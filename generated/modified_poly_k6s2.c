@@ -622,6 +622,7 @@ const char *modified_poly_k6s2_strerror(int code)
   case modified_poly_k6s2_ENONFINITE: return "non-finite value";
   case modified_poly_k6s2_ESINGULAR: return "singular multiplier system";
   case modified_poly_k6s2_EBADSTEP: return "step size zero or not finite";
+  case modified_poly_k6s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1520,7 +1521,7 @@ int modified_poly_k6s2_step_adaptive(modified_poly_k6s2_state *x, modified_poly_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != modified_poly_k6s2_EREJECT ? rc : modified_poly_k6s2_ENOCONV;
+      return rc != modified_poly_k6s2_EREJECT ? rc : modified_poly_k6s2_ETOL;
     }
   }
 }

@@ -1034,6 +1034,7 @@ const char *modified_poly_k9s3_strerror(int code)
   case modified_poly_k9s3_ENONFINITE: return "non-finite value";
   case modified_poly_k9s3_ESINGULAR: return "singular multiplier system";
   case modified_poly_k9s3_EBADSTEP: return "step size zero or not finite";
+  case modified_poly_k9s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -2394,7 +2395,7 @@ int modified_poly_k9s3_step_adaptive(modified_poly_k9s3_state *x, modified_poly_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != modified_poly_k9s3_EREJECT ? rc : modified_poly_k9s3_ENOCONV;
+      return rc != modified_poly_k9s3_EREJECT ? rc : modified_poly_k9s3_ETOL;
     }
   }
 }

@@ -112,6 +112,7 @@ const char *pendulum_angle_k6s3_strerror(int code)
   case pendulum_angle_k6s3_ENONFINITE: return "non-finite value";
   case pendulum_angle_k6s3_ESINGULAR: return "singular multiplier system";
   case pendulum_angle_k6s3_EBADSTEP: return "step size zero or not finite";
+  case pendulum_angle_k6s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -578,7 +579,7 @@ int pendulum_angle_k6s3_step_adaptive(pendulum_angle_k6s3_state *x, pendulum_ang
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != pendulum_angle_k6s3_EREJECT ? rc : pendulum_angle_k6s3_ENOCONV;
+      return rc != pendulum_angle_k6s3_EREJECT ? rc : pendulum_angle_k6s3_ETOL;
     }
   }
 }

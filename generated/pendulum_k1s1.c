@@ -209,6 +209,7 @@ const char *pendulum_k1s1_strerror(int code)
   case pendulum_k1s1_ENONFINITE: return "non-finite value";
   case pendulum_k1s1_ESINGULAR: return "singular multiplier system";
   case pendulum_k1s1_EBADSTEP: return "step size zero or not finite";
+  case pendulum_k1s1_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -553,7 +554,7 @@ int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, p
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != pendulum_k1s1_EREJECT ? rc : pendulum_k1s1_ENOCONV;
+      return rc != pendulum_k1s1_EREJECT ? rc : pendulum_k1s1_ETOL;
     }
   }
 }

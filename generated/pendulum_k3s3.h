@@ -21,6 +21,7 @@ extern "C" {
 #define pendulum_k3s3_ENONFINITE 2  /* a non-finite value (outside a function's domain?) */
 #define pendulum_k3s3_ESINGULAR 3   /* the multiplier system is singular (dependent constraints?) */
 #define pendulum_k3s3_EBADSTEP 4    /* h is zero or not finite */
+#define pendulum_k3s3_ETOL 5        /* adaptive: the error stayed over tol down to the smallest h */
 
 typedef double pendulum_k3s3_real;
 

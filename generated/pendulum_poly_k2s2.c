@@ -364,6 +364,7 @@ const char *pendulum_poly_k2s2_strerror(int code)
   case pendulum_poly_k2s2_ENONFINITE: return "non-finite value";
   case pendulum_poly_k2s2_ESINGULAR: return "singular multiplier system";
   case pendulum_poly_k2s2_EBADSTEP: return "step size zero or not finite";
+  case pendulum_poly_k2s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -995,7 +996,7 @@ int pendulum_poly_k2s2_step_adaptive(pendulum_poly_k2s2_state *x, pendulum_poly_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != pendulum_poly_k2s2_EREJECT ? rc : pendulum_poly_k2s2_ENOCONV;
+      return rc != pendulum_poly_k2s2_EREJECT ? rc : pendulum_poly_k2s2_ETOL;
     }
   }
 }

@@ -525,6 +525,7 @@ const char *pendulum_poly_k3s3_strerror(int code)
   case pendulum_poly_k3s3_ENONFINITE: return "non-finite value";
   case pendulum_poly_k3s3_ESINGULAR: return "singular multiplier system";
   case pendulum_poly_k3s3_EBADSTEP: return "step size zero or not finite";
+  case pendulum_poly_k3s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1332,7 +1333,7 @@ int pendulum_poly_k3s3_step_adaptive(pendulum_poly_k3s3_state *x, pendulum_poly_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != pendulum_poly_k3s3_EREJECT ? rc : pendulum_poly_k3s3_ENOCONV;
+      return rc != pendulum_poly_k3s3_EREJECT ? rc : pendulum_poly_k3s3_ETOL;
     }
   }
 }

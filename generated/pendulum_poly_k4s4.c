@@ -818,6 +818,7 @@ const char *pendulum_poly_k4s4_strerror(int code)
   case pendulum_poly_k4s4_ENONFINITE: return "non-finite value";
   case pendulum_poly_k4s4_ESINGULAR: return "singular multiplier system";
   case pendulum_poly_k4s4_EBADSTEP: return "step size zero or not finite";
+  case pendulum_poly_k4s4_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1884,7 +1885,7 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != pendulum_poly_k4s4_EREJECT ? rc : pendulum_poly_k4s4_ENOCONV;
+      return rc != pendulum_poly_k4s4_EREJECT ? rc : pendulum_poly_k4s4_ETOL;
     }
   }
 }

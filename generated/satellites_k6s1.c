@@ -734,6 +734,7 @@ const char *satellites_k6s1_strerror(int code)
   case satellites_k6s1_ENONFINITE: return "non-finite value";
   case satellites_k6s1_ESINGULAR: return "singular multiplier system";
   case satellites_k6s1_EBADSTEP: return "step size zero or not finite";
+  case satellites_k6s1_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -1937,7 +1938,7 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != satellites_k6s1_EREJECT ? rc : satellites_k6s1_ENOCONV;
+      return rc != satellites_k6s1_EREJECT ? rc : satellites_k6s1_ETOL;
     }
   }
 }

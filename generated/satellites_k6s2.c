@@ -2004,6 +2004,7 @@ const char *satellites_k6s2_strerror(int code)
   case satellites_k6s2_ENONFINITE: return "non-finite value";
   case satellites_k6s2_ESINGULAR: return "singular multiplier system";
   case satellites_k6s2_EBADSTEP: return "step size zero or not finite";
+  case satellites_k6s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -2386,7 +2387,7 @@ int satellites_k6s2_step_adaptive(satellites_k6s2_state *x, satellites_k6s2_real
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != satellites_k6s2_EREJECT ? rc : satellites_k6s2_ENOCONV;
+      return rc != satellites_k6s2_EREJECT ? rc : satellites_k6s2_ETOL;
     }
   }
 }

@@ -21,6 +21,7 @@ extern "C" {
 #define satellites_k6s2_ENONFINITE 2  /* a non-finite value (outside a function's domain?) */
 #define satellites_k6s2_ESINGULAR 3   /* the multiplier system is singular (dependent constraints?) */
 #define satellites_k6s2_EBADSTEP 4    /* h is zero or not finite */
+#define satellites_k6s2_ETOL 5        /* adaptive: the error stayed over tol down to the smallest h */
 
 typedef double satellites_k6s2_real;
 

@@ -2481,6 +2481,7 @@ const char *satellites_k6s3_strerror(int code)
   case satellites_k6s3_ENONFINITE: return "non-finite value";
   case satellites_k6s3_ESINGULAR: return "singular multiplier system";
   case satellites_k6s3_EBADSTEP: return "step size zero or not finite";
+  case satellites_k6s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -2867,7 +2868,7 @@ int satellites_k6s3_step_adaptive(satellites_k6s3_state *x, satellites_k6s3_real
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != satellites_k6s3_EREJECT ? rc : satellites_k6s3_ENOCONV;
+      return rc != satellites_k6s3_EREJECT ? rc : satellites_k6s3_ETOL;
     }
   }
 }

@@ -3746,6 +3746,7 @@ const char *satellites_poly_k6s2_strerror(int code)
   case satellites_poly_k6s2_ENONFINITE: return "non-finite value";
   case satellites_poly_k6s2_ESINGULAR: return "singular multiplier system";
   case satellites_poly_k6s2_EBADSTEP: return "step size zero or not finite";
+  case satellites_poly_k6s2_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -4227,7 +4228,7 @@ int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != satellites_poly_k6s2_EREJECT ? rc : satellites_poly_k6s2_ENOCONV;
+      return rc != satellites_poly_k6s2_EREJECT ? rc : satellites_poly_k6s2_ETOL;
     }
   }
 }

@@ -7257,6 +7257,7 @@ const char *satellites_poly_k6s3_strerror(int code)
   case satellites_poly_k6s3_ENONFINITE: return "non-finite value";
   case satellites_poly_k6s3_ESINGULAR: return "singular multiplier system";
   case satellites_poly_k6s3_EBADSTEP: return "step size zero or not finite";
+  case satellites_poly_k6s3_ETOL: return "error estimate over the tolerance down to the smallest step";
   }
   return "unknown error";
 }
@@ -7754,7 +7755,7 @@ int satellites_poly_k6s3_step_adaptive(satellites_poly_k6s3_state *x, satellites
         st->rejected = rejected;
         st->defect = s.defect;
       }
-      return rc != satellites_poly_k6s3_EREJECT ? rc : satellites_poly_k6s3_ENOCONV;
+      return rc != satellites_poly_k6s3_EREJECT ? rc : satellites_poly_k6s3_ETOL;
     }
   }
 }
