@@ -569,6 +569,20 @@ int conical_k1s1_step_adaptive(conical_k1s1_state *x, conical_k1s1_real *h, coni
       if (pq > 0 && pq < r) fac *= pq / r;  /* the prediction, where smaller than the standard */
       if (fac > grow) fac = grow;
       if (!(fac >= (double)0.2)) fac = (double)0.2;  /* a NaN estimate too */
+      if (rc == conical_k1s1_OK && fac > 1) {
+        /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
+         * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^2) */
+        double v = 0, rr, cap;
+        for (i = 0; i < conical_k1s1_M; i++)
+          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        v *= conical_k1s1_ERRC * fabs(hh);
+        if (v > 0 && s.err_est > 0) {
+          rr = sqrt(s.err_est / v);  /* r of this step, at most */
+          cap = pow(0.10000000000000001 / rr, (double)1 / 2);
+          if (cap < 1) cap = 1;
+          if (fac > cap) fac = cap;
+        }
+      }
       if (rc == conical_k1s1_OK) {
         *h = hh * fac;
         x->errprev = r;

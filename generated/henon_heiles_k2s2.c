@@ -521,6 +521,20 @@ int henon_heiles_k2s2_step_adaptive(henon_heiles_k2s2_state *x, henon_heiles_k2s
         double cap = pow(henon_heiles_k2s2_NOISETOL / s.defect, (double)1 / 5);
         if (fac > cap) fac = cap;
       }
+      if (rc == henon_heiles_k2s2_OK && fac > 1) {
+        /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
+         * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^3) */
+        double v = 0, rr, cap;
+        for (i = 0; i < henon_heiles_k2s2_M; i++)
+          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        v *= (grow > 2 ? henon_heiles_k2s2_COLDC : henon_heiles_k2s2_ERRC) * fabs(hh);
+        if (v > 0 && s.err_est > 0) {
+          rr = sqrt(s.err_est / v);  /* r of this step, at most */
+          cap = pow(0.10000000000000001 / rr, (double)1 / 3);
+          if (cap < 1) cap = 1;
+          if (fac > cap) fac = cap;
+        }
+      }
       if (rc == henon_heiles_k2s2_OK) {
         *h = hh * fac;
         x->errprev = r;

@@ -717,6 +717,20 @@ int kepler_k6s3_step_adaptive(kepler_k6s3_state *x, kepler_k6s3_real *h, kepler_
         double cap = pow(kepler_k6s3_NOISETOL / s.defect, (double)1 / 13);
         if (fac > cap) fac = cap;
       }
+      if (rc == kepler_k6s3_OK && fac > 1) {
+        /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
+         * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^4) */
+        double v = 0, rr, cap;
+        for (i = 0; i < kepler_k6s3_M; i++)
+          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        v *= (grow > 2 ? kepler_k6s3_COLDC : kepler_k6s3_ERRC) * fabs(hh);
+        if (v > 0 && s.err_est > 0) {
+          rr = sqrt(s.err_est / v);  /* r of this step, at most */
+          cap = pow(0.10000000000000001 / rr, (double)1 / 4);
+          if (cap < 1) cap = 1;
+          if (fac > cap) fac = cap;
+        }
+      }
       if (rc == kepler_k6s3_OK) {
         *h = hh * fac;
         x->errprev = r;

@@ -1903,6 +1903,20 @@ int satellites_k6s1_step_adaptive(satellites_k6s1_state *x, satellites_k6s1_real
         double cap = pow(satellites_k6s1_NOISETOL / s.defect, (double)1 / 13);
         if (fac > cap) fac = cap;
       }
+      if (rc == satellites_k6s1_OK && fac > 1) {
+        /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
+         * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^2) */
+        double v = 0, rr, cap;
+        for (i = 0; i < satellites_k6s1_M; i++)
+          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        v *= satellites_k6s1_ERRC * fabs(hh);
+        if (v > 0 && s.err_est > 0) {
+          rr = sqrt(s.err_est / v);  /* r of this step, at most */
+          cap = pow(0.10000000000000001 / rr, (double)1 / 2);
+          if (cap < 1) cap = 1;
+          if (fac > cap) fac = cap;
+        }
+      }
       if (rc == satellites_k6s1_OK) {
         *h = hh * fac;
         x->errprev = r;

@@ -223,6 +223,7 @@ Suite *errest_suite(void) {
 #include "double_pendulum_k2s2.h"
 #include "double_pendulum_k4s4.h"
 #include "solar_k16s2.h"
+#include "solar_k11s6.h"
 #include "kepler_k3s3.h"
 #include "kepler_k4s4.h"
 #include "kepler_k11s6.h"
@@ -273,6 +274,7 @@ RUN_ADAPTIVE(satellites_poly_k6s3)
 RUN_ADAPTIVE(pendulum_k3s3)
 RUN_ADAPTIVE(double_pendulum_const_k2s2)
 RUN_ADAPTIVE(double_pendulum_k2s2)
+RUN_ADAPTIVE(solar_k11s6)
 
 static const struct {
   const char *problem;
@@ -498,6 +500,28 @@ START_TEST(adaptive_rejections_under_5_percent)
 }
 END_TEST
 
+// The estimate's asymptotic range (issue 31, item 3): the outer solar system
+// at (11,6) over 20000 days grew its 1000-day steps 1.8x past r = d1 / |h v|
+// = 1, where NAME_err_est becomes d1 and jumps 4e4-fold, and each such try
+// was rejected: 3 of 34, 3 of 34, 2 of 32 tries at tol 1e-4, 3e-5, 1e-5
+// (measured with this loop); the steps now grow at most to r = 0.1
+// (emit_range_cap): 0 of 27, 27, 28. The error at T stays within 30 tol,
+// as in adaptive_proportional (measured 0.2-1.8 tol, 1-4.9 before),
+// against the same solver at tol 1e-11 (its own error ~1e-9 here).
+START_TEST(adaptive_asymptotic_range)
+{
+  double q[solar_k11s6_M], p[solar_k11s6_M], qT[solar_k11s6_M], pT[solar_k11s6_M];
+  adaptive_solar_k11s6(20000, 1e-11, q, p);
+  for (double tol = 1e-4; tol > 1e-5 / 2; tol /= sqrt(10)) {
+    Adaptive a = adaptive_solar_k11s6(20000, tol, qT, pT);
+    for (int i = 0; i < solar_k11s6_M; i++) a.err = fmax(a.err, fmax(fabs(qT[i] - q[i]), fabs(pT[i] - p[i])));
+    ck_assert_msg(a.rejected * 20 <= a.steps + a.rejected, "solar (11,6), tol %g: %ld of %ld tries rejected", tol,
+                  a.rejected, a.steps + a.rejected);
+    ck_assert_msg(a.err <= 30 * tol, "solar (11,6), tol %g: error %g", tol, a.err);
+  }
+}
+END_TEST
+
 // NAME_step_controlled: atol = rtol = tol takes NAME_step_adaptive's steps
 // (to the rounding of (tol + tol s) / (1 + s), which the controller carried
 // to 3.5e-6 of t over 76 steps of Kepler; since the error's trend, a rounding
@@ -613,6 +637,7 @@ Suite *adaptive_suite(void) {
   tcase_add_test(tc, adaptive_nonfinite_state);
   tcase_add_test(tc, adaptive_few_rejections);
   tcase_add_test(tc, adaptive_rejections_under_5_percent);
+  tcase_add_test(tc, adaptive_asymptotic_range);
   tcase_add_test(tc, adaptive_controls);
   tcase_add_test(tc, adaptive_iteration_stops_at_tolerance);
   tcase_add_test(tc, adaptive_quadrature_defect);

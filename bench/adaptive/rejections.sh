@@ -13,7 +13,10 @@
 # tolerances (default 1e-4 .. 1e-12, half a decade apart); GEN=... another
 # generator (into build/rejections-NAME, NAME its directory's name). Prints a
 # line per run and writes bench/results/rejections.csv (OUT=... another file)
-# and, with bench/adaptive/rejections.awk, bench/results/rejections.txt.
+# and, with bench/adaptive/rejections.awk, bench/results/rejections.txt. The
+# CSV's error is the run's at T (max over q and p) against the same solver at
+# tol 1e-14, for bench/adaptive/equal_error.awk (two such files: the tries at
+# equal error).
 set -eu
 cd "$(dirname "$0")/../.."
 GEN=${GEN:-gen/hbvmgen}
@@ -23,19 +26,29 @@ OUT=${OUT:-bench/results/rejections.csv}
 [ -x "$GEN" ] || make --no-print-directory all
 TOLS=${TOLS:-"1e-4 3e-5 1e-5 3e-6 1e-6 3e-7 1e-7 3e-8 1e-8 3e-9 1e-9 3e-10 1e-10 3e-11 1e-11 3e-12 1e-12"}
 mkdir -p "$B"
-echo "name,tol,steps,rejected,percent" >"$OUT"
+echo "name,tol,steps,rejected,percent,error" >"$OUT"
+ROW=$B/row.csv
+# the q and p of the last row of the driver's CSV (not t, lambda, H, g, hc), a line
+last_qp() {
+  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) keep[i] = $i !~ /^(t|H|lambda_.*|g_.*|hc_.*)$/; next }
+    { last = $0 } END { n = split(last, v, ","); s = ""; for (i = 1; i <= n; i++) if (keep[i]) s = s " " v[i]; print s }' "$1"
+}
 # name model k s T
 while read -r n m k s T; do
   if [ -z "$(find "$B/$n" -newer "$GEN" 2>/dev/null)" ]; then # built by an older generator, or not at all
     "$GEN" --main -o "$B" -n "$n" -k "$k" -s "$s" "$m" 2>/dev/null
     cc -O2 -std=c99 -Iruntime -I"$B" "$B/$n.c" "$B/${n}_main.c" runtime/libhbvmrt.a -lm -o "$B/$n"
   fi
+  "$B/$n" -h 0.01 -T "$T" --tol 1e-14 --every 100000000 --quiet --csv "$ROW" 2>/dev/null || : >"$ROW"
+  ref=$(last_qp "$ROW")
   for tol in $TOLS; do
-    "$B/$n" -h 0.01 -T "$T" --tol "$tol" --every 100000000 --quiet 2>&1 >/dev/null |
-      sed -n 's/.*steps=\([0-9]*\) .*steps_rejected=\([0-9]*\).*/\1 \2/p' |
-      awk -v n="$n" -v tol="$tol" -v out="$OUT" '{
-        printf "%-18s tol %-6s steps %6d rejected %5d  %5.1f%%\n", n, tol, $1, $2, 100 * $2 / ($1 + $2)
-        printf "%s,%s,%d,%d,%.2f\n", n, tol, $1, $2, 100 * $2 / ($1 + $2) >>out }'
+    sum=$("$B/$n" -h 0.01 -T "$T" --tol "$tol" --every 100000000 --quiet --csv "$ROW" 2>&1 >/dev/null)
+    echo "$sum" | sed -n 's/.*steps=\([0-9]*\) .*steps_rejected=\([0-9]*\).*/\1 \2/p' |
+      awk -v n="$n" -v tol="$tol" -v out="$OUT" -v ref="$ref" -v row="$(last_qp "$ROW")" '{
+        e = 0; nr = split(ref, a, " "); split(row, b, " ")
+        for (i = 1; i <= nr; i++) if ((d = a[i] - b[i]) * (d < 0 ? -1 : 1) > e) e = d < 0 ? -d : d
+        printf "%-18s tol %-6s steps %6d rejected %5d  %5.1f%%  error %.3g\n", n, tol, $1, $2, 100 * $2 / ($1 + $2), e
+        printf "%s,%s,%d,%d,%.2f,%.6g\n", n, tol, $1, $2, 100 * $2 / ($1 + $2), e >>out }'
   done
 done <<LIST
 pendulum_k4s4 models/pendulum.ham 4 4 10
