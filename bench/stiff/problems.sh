@@ -1,3 +1,4 @@
+# shellcheck shell=sh disable=SC2034
 # bench/stiff/problems.sh - sourced by bench/stiff/run.sh and bound.sh: the
 # stiff problems' models (written into $B/models) and the h each method's
 # line starts from.
@@ -66,6 +67,6 @@ generate() {
 sweep() { # outdir problem method range [options]
   _o=$1 _p=$2 _m=$3 _r=$4
   shift 4
-  "$B/bench" sweep "$_p" "$_m" "$_o" "$B/ref_$_p.txt" "$_r" --floor $FLOOR --keep-going "$@" 2>>"$_o/failures.txt" ||
+  "$B/bench" sweep "$_p" "$_m" "$_o" "$B/ref_$_p.txt" "$_r" --floor "$FLOOR" --keep-going "$@" 2>>"$_o/failures.txt" ||
     echo "   ($_m on $_p: see $_o/failures.txt)"
 }
