@@ -38,7 +38,12 @@ static int newton_poly(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0
 // takes the multiplier lam).
 static void emit_factor_checked(Emitter *e) {
   int nu = e->mod->nu;
-  tmpl(e, "#ifndef $P_REFRESH\n#define $P_REFRESH 4  /* factorisations of the Newton matrix a step, at most */\n#endif\n"
+  tmpl(e, "#ifndef $P_REFRESH\n#define $P_REFRESH 4  /* factorisations of the Newton matrix a step, at most */\n#endif\n");
+  /* (the accelerated iteration contracts at about 1/2 on the stiff bob with J frozen for
+   * the step, and a fresh J there buys few iterations: refreshed only where it stalls) */
+  tmpl(e, newton_poly(e) ? "#ifndef $P_SLOW\n#define $P_SLOW 0.5$f  /* a contraction above this refreshes J */\n#endif\n"
+                         : "#ifndef $P_SLOW\n#define $P_SLOW 0.9$f  /* a contraction above this refreshes J */\n#endif\n");
+  tmpl(e, ""
           "/* The Newton matrix I + h^2 A (x) M^-1 J at the polynomial gam, factored into nf.\n");
   if (nu) tmpl(e, " * J = Hess(U + lam' g), lam the multiplier (its first $P_NU entries are read).\n");
   tmpl(e, " * Returns $P_OK, $P_ENONFINITE, or $P_ENOCONV for a singular matrix (a pivot below\n"
@@ -71,6 +76,43 @@ static void emit_factor_checked(Emitter *e) {
           "  return $P_OK;\n}\n\n");
 }
 
+// NAME_anderson: the next iterate of the simplified Newton iteration,
+// Anderson-accelerated (depth 2, "type II"), for the loop of the constant
+// family and of models without constraints (the poly family's multiplier
+// coefficients move with the sweep, and it keeps the plain update).
+static void emit_anderson(Emitter *e) {
+  tmpl(e, "/* The next Newton iterate from x and its correction dx, Anderson-accelerated (depth 2):\n"
+          " * x + dx - sum_a theta_a (DX_a + DF_a), DX_a and DF_a the last two changes of the iterate\n"
+          " * and of its correction, theta the least-squares fit of dx by the DF_a. A Newton matrix\n"
+          " * frozen over the step (one J for every stage: on the stiff bob a spring that turns\n"
+          " * during the step) leaves an error that decays slowly and turns from one iteration to\n"
+          " * the next; the fit removes most of it. h (4 rows of S M: the last x, its dx, and the\n"
+          " * last DX, DF) and *nh (0, 1 or 2 changes known) carry the history, kept across a\n"
+          " * refresh of J (measured: fewer iterations than with the history dropped). */\n"
+          "static void $P_anderson($R *x, const $R *dx, $R *h, int *nh)\n{\n"
+          "  enum { N = $P_S * $P_M };\n"
+          "  $R *xp = h, *fp = h + N, *dx1 = h + 2 * N, *df1 = h + 3 * N, dx0[N], df0[N], t0 = 0, t1 = 0;\n"
+          "  $R g00 = 0, g01 = 0, g11 = 0, r0 = 0, r1 = 0;\n"
+          "  int i, n = *nh;\n"
+          "  for (i = 0; i < N; i++) {\n"
+          "    dx0[i] = n ? x[i] - xp[i] : 0;\n    df0[i] = n ? dx[i] - fp[i] : 0;\n"
+          "    g00 += df0[i] * df0[i];\n    r0 += df0[i] * dx[i];\n"
+          "    if (n == 2) {  /* (dx1, df1 unset before) */\n"
+          "      g01 += df0[i] * df1[i];\n      g11 += df1[i] * df1[i];\n      r1 += df1[i] * dx[i];\n    }\n  }\n"
+          "  if (n == 2 && g00 * g11 - g01 * g01 > sqrt$f($P_TOL) * g00 * g11) {  /* two columns, well conditioned */\n"
+          "    t0 = (r0 * g11 - r1 * g01) / (g00 * g11 - g01 * g01);\n"
+          "    t1 = (g00 * r1 - g01 * r0) / (g00 * g11 - g01 * g01);\n"
+          "  } else if (n >= 1 && g00 > 0) {\n    t0 = r0 / g00;\n  }\n"
+          "  if (!isfinite(t0) || !isfinite(t1)) t0 = t1 = 0;\n"
+          "  for (i = 0; i < N; i++) {\n"
+          "    $R next = x[i] + dx[i] - t0 * (dx0[i] + df0[i]);\n"
+          "    if (n == 2) next -= t1 * (dx1[i] + df1[i]);\n"
+          "    xp[i] = x[i];\n    fp[i] = dx[i];\n"
+          "    if (n) {\n      dx1[i] = dx0[i];\n      df1[i] = df0[i];\n    }\n"
+          "    x[i] = next;\n  }\n"
+          "  *nh = n < 2 ? n + 1 : 2;\n}\n\n");
+}
+
 // What NAME_step_within needs before its body: the checked factorisation,
 // NAME_REUSE (and under --iteration auto the limit of the sweeps, NAME_SWITCH).
 void emit_newton_helpers(Emitter *e) {
@@ -78,6 +120,7 @@ void emit_newton_helpers(Emitter *e) {
   if (emit_is_auto(e))
     tmpl(e, "#ifndef $P_SWITCH\n#define $P_SWITCH 12  /* sweeps foreseen above which Newton takes over (auto) */\n#endif\n");
   emit_factor_checked(e);
+  if (!newton_poly(e)) emit_anderson(e);
 }
 
 // The Newton loop of NAME_step_within: from gam to the converged gamma,
@@ -143,13 +186,15 @@ static void emit_newton_loop(Emitter *e) {
           "     * round-off ($P_NOISETOL) */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
           "      rc = inc_min <= $P_NOISETOL ? $P_OK : $P_ENOCONV;\n      break;\n    }\n"
-          "    for (i = 0; i < $P_S * $P_M; i++) gam[i] += dg[i];\n");
+          "");
+  tmpl(e, poly ? "    for (i = 0; i < $P_S * $P_M; i++) gam[i] += dg[i];\n"
+               : "    $P_anderson(gam, dg, ah, &na);  /* gam += dg, accelerated */\n");
   if (poly)
     tmpl(e, "    /* the coefficients the sweep took, moved by Newton's change of the multiplier */\n"
             "    for (i = 0; i < $P_S * $P_NU; i++) mlam[i] = sw[$[sweep.lam]i] + dg[$[newton_solve.dlam]i];\n");
-  tmpl(e, "    /* contracting by less than 2x (rho > 1/2) above round-off: J refreshed at the\n"
+  tmpl(e, "    /* contracting slowly (rho > $P_SLOW) above round-off: J refreshed at the\n"
           "     * current polynomial */\n"
-          "    if (it > 1 && 2 * inc > inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n");
+          "    if (it > 1 && inc > $P_SLOW * inc_old && inc > $P_NOISETOL && nfac < $P_REFRESH) {\n");
   tmpl(e, poly ? "      int rf = $P_newton_factor_checked(x, gam, mlam, h, prm, nf);  /* lambda_0: the mean */\n"
          : nu ? "      int rf = $P_newton_factor_checked(x, gam, sw + $[sweep.lambda]0, h, prm, nf);  /* the last lambda */\n"
               : "      int rf = $P_newton_factor_checked(x, gam, h, prm, nf);\n");
@@ -168,7 +213,9 @@ static void emit_newton_locals(Emitter *e) {
     tmpl(e, "  $R mfa[$<factor> + 1], mlam[$P_S * $P_NU];  /* the poly family's sweep: its factor, lam */\n"
             "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$<newton_solve>], rate = -1;\n");
   else
-    tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n");
+    tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
+            "  $R ah[4 * $P_S * $P_M];  /* $P_anderson's history */\n"
+            "  int na = 0;\n");
   tmpl(e, ""
           "  const $R *fac = nf;  /* the factor in use: nf, or the state's */\n"
           "  int nfac = 0;\n"

@@ -45,39 +45,7 @@ S_LIST=${STIFF_S:-2 3 4 6}
 PEERS=${STIFF_PEERS:-1}
 SCAN=${STIFF_SCAN:-1}
 
-# The model of a problem, written into $B/models.
-model() {
-  case $1 in
-  fpu50) cp models/fpu.ham "$B/models/$1.ham" ;;
-  fpu1000) sed 's/^param omega = 50$/param omega = 1000/' models/fpu.ham >"$B/models/$1.ham" ;;
-  stiff_bob) cp models/stiff_bob.ham "$B/models/$1.ham" ;;
-  stiff_bob6) sed 's/^param k = 1e4$/param k = 1e6/' models/stiff_bob.ham >"$B/models/$1.ham" ;;
-  butane) cp models/butane.ham "$B/models/$1.ham" ;;
-  esac
-  grep -q "$(omega_param "$1")" "$B/models/$1.ham" || { echo "bench/stiff: $1's parameter not set" >&2; exit 1; }
-}
-omega_param() {
-  case $1 in
-  fpu1000) echo "param omega = 1000" ;;
-  stiff_bob6) echo "param k = 1e6" ;;
-  *) echo "param" ;;
-  esac
-}
-
-# The largest h of each method's line (T = 10, h halving): Newton from
-# h omega of about 1000 (FPU), 40 (bob, butane), 140 (bob at k = 1e6);
-# the fixed-point step from h omega of about 4, where it starts to fail.
-newton_from() {
-  case $1 in
-  fpu50) echo 0.5 ;; fpu1000) echo 1 ;; stiff_bob) echo 0.3 ;; stiff_bob6) echo 0.1 ;; butane) echo 0.2 ;;
-  esac
-}
-fixed_from() {
-  case $1 in
-  fpu50) echo 0.08 ;; fpu1000) echo 0.004 ;; stiff_bob) echo 0.03 ;; stiff_bob6) echo 0.003 ;; butane) echo 0.025 ;;
-  esac
-}
-has_constraints() { case $1 in stiff_bob* | butane) return 0 ;; *) return 1 ;; esac }
+. bench/stiff/problems.sh
 FLOOR=1e-10 # the slow error where a line stops (the references agree to 4e-11 or better: refcheck)
 PEER_CAP=2  # CPU seconds of one RATTLE / IDA / GSL run (the HBVM lines: 0.25)
 IDA_TOLS=1e-3:1e-11:10 # slow errors of 1e-8 and below by 1e-10 on every problem
@@ -93,16 +61,9 @@ solvers=""
 for p in $PROBLEMS; do
   model "$p"
   for s in $S_LIST; do
-    k=$("$GEN" --check --multiplier const -s "$s" "$B/models/$p.ham" | sed -n '1s/.* k=\([0-9]*\) s=.*/\1/p')
-    "$GEN" --iteration fixed --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}" -o "$B/gen" "$B/models/$p.ham"
-    "$GEN" --iteration newton --multiplier const -k "$k" -s "$s" -n "${p}_k${k}s${s}newton" -o "$B/gen" \
-      "$B/models/$p.ham"
-    solvers="$solvers ${p}_k${k}s${s} ${p}_k${k}s${s}newton"
-    if has_constraints "$p"; then
-      "$GEN" --iteration newton --multiplier poly -k "$k" -s "$s" -n "${p}_k${k}s${s}polynewton" -o "$B/gen" \
-        "$B/models/$p.ham"
-      solvers="$solvers ${p}_k${k}s${s}polynewton"
-    fi
+    generate "$p" "$s"
+    solvers="$solvers $GENERATED"
+    k=$GEN_K
     echo "$p $k $s" >>"$B/configs.txt"
   done
 done
@@ -125,12 +86,6 @@ for p in $PROBLEMS; do
 done
 
 # ---- 4. sweeps, problem by problem, every method side by side
-sweep() { # outdir problem method range [options]
-  _o=$1 _p=$2 _m=$3 _r=$4
-  shift 4
-  "$B/bench" sweep "$_p" "$_m" "$_o" "$B/ref_$_p.txt" "$_r" --floor $FLOOR --keep-going "$@" 2>>"$_o/failures.txt" ||
-    echo "   ($_m on $_p: see $_o/failures.txt)"
-}
 for p in $PROBLEMS; do
   echo "== bench/stiff: $p ($(elapsed) s)"
   while read -r q k s; do

@@ -4,7 +4,8 @@
 # stiff_scan.csv and stiff_scan_iterations.csv (bench/stiff/run.sh), to stdout.
 set -eu
 R=$1
-OMEGA='fpu50=50 fpu1000=1000 stiff_bob=141.42 stiff_bob6=1414.2 butane=175.1'
+. "$(dirname "$0")/problems.sh"
+OMEGA=$STIFF_OMEGA
 
 echo "Stiff benchmark (bench/stiff/run.sh; stiff_machine.txt). Error: the slow motion's at T = 10 (bench/stiff.h:"
 echo "FPU x0 and its momenta, the bob's centre of mass, butane's dihedral), max norm, against the index-1"
