@@ -29,15 +29,16 @@
 #define NAME_SIZE 256
 
 // The C name of node id inside a run's body: a literal, a parameter, an
-// input at its offset from the base b, or the temporary rK of its place k.
-static void body_name(Emitter *e, const RollRun *r, int id, char *buf, size_t size) {
+// input at its offset from the base b (the second array's shifted by
+// vshift), or the temporary rK of its place k.
+static void body_name(Emitter *e, const RollRun *r, int id, int vshift, char *buf, size_t size) {
   const Node *n = &e->mod->dag->nodes[id];
   int m = e->mod->m;
   switch ((Op)n->op) {
   case OP_CONST: format_real(e, buf, size, n->val); return;
   case OP_PARAM: snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name); return;
   case OP_INPUT: {
-    int off = n->idx % m - r->b0;
+    int off = n->idx % m - r->b0 + (n->idx < m ? 0 : vshift);
     snprintf(buf, size, off ? "%s[b %c %d]" : "%s[b]", n->idx < m ? "q" : "v", off < 0 ? '-' : '+', off < 0 ? -off : off);
     return;
   }
@@ -53,8 +54,11 @@ static void body_name(Emitter *e, const RollRun *r, int id, char *buf, size_t si
 
 // One run of a family: its items' loop (or one block for a single item),
 // the body once, and what is done with the root's value: out[U * os + oo]
-// = value, or with os = 0, acc += value.
-static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
+// = value, or with os = 0, acc += value. With reps > 1 the body is printed
+// reps times in the loop, the j-th in a block of its own with the second
+// array read at vstride j further on and out at ostride j further on (the s
+// projections of the linear part in one loop).
+static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int vstride, int ostride) {
   const Dag *d = e->mod->dag;
   char a[NAME_SIZE], b[NAME_SIZE], rhs[8 * NAME_SIZE];
   if (r->n == 1) out(e, "  { /* item %d */\n    const int u = %d, b = %d;\n", r->u0, r->u0, r->b0);
@@ -64,17 +68,23 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
     out(e, "  for (u = %d; u < %d; u++) { /* items %d..%d */\n    const int b = %d + %d * (u - %d);\n", r->u0, r->u0 + r->n,
         r->u0, r->u0 + r->n - 1, r->b0, r->stride, r->u0);
   out(e, "    (void)u; (void)b;\n");
-  for (int k = 0; k < r->nbody; k++) {
-    const Node *n = &d->nodes[r->body[k]];
-    if (n->a < 0) continue; /* leaves are named where they are read */
-    body_name(e, r, n->a, a, sizeof a);
-    if (n->b >= 0) body_name(e, r, n->b, b, sizeof b);
-    op_rhs(e, n, a, b, rhs, sizeof rhs);
-    out(e, "    const %s r%d = %s;\n", real_type(e, 0), k, rhs);
+  for (int j = 0; j < reps; j++) {
+    const char *in = reps > 1 ? "  " : "";
+    if (reps > 1) out(e, "    {\n");
+    for (int k = 0; k < r->nbody; k++) {
+      const Node *n = &d->nodes[r->body[k]];
+      if (n->a < 0) continue; /* leaves are named where they are read */
+      body_name(e, r, n->a, j * vstride, a, sizeof a);
+      if (n->b >= 0) body_name(e, r, n->b, j * vstride, b, sizeof b);
+      op_rhs(e, n, a, b, rhs, sizeof rhs);
+      out(e, "    %sconst %s r%d = %s;\n", in, real_type(e, 0), k, rhs);
+    }
+    body_name(e, r, r->body[r->nbody - 1], j * vstride, a, sizeof a);
+    if (os) out(e, "    %sout[%d * u + %d] %s= %s;\n", in, os < 0 ? -os : os, oo + j * ostride, os < 0 ? "+" : "", a);
+    else out(e, "    %sacc += %s;\n", in, a);
+    if (reps > 1) out(e, "    }\n");
   }
-  body_name(e, r, r->body[r->nbody - 1], a, sizeof a);
-  if (os) out(e, "    out[%d * u + %d] %s= %s;\n  }\n", os < 0 ? -os : os, oo, os < 0 ? "+" : "", a);
-  else out(e, "    acc += %s;\n  }\n", a);
+  out(e, "  }\n");
 }
 
 // A family as the function $P_roll_NAME(q, v, prm, out): out[i] for its
@@ -83,18 +93,22 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
 static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int mode) {
   tmplf(e, "\n/* %s */\nstatic void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  $R acc = 0;\n" : "");
-  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0);
+  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0, 1, 0, 0);
   out(e, mode == 1 ? "  out[0] = acc;\n}\n" : "}\n");
 }
 
 // A family per t of the Jacobian's entries (fams[t]) as the function
-// $P_roll_NAME: out[T i + t] = item i of family t.
+// $P_roll_NAME: out[T i + t] = item i of family t. With add (the linear
+// part), out[j M T + T i + t] += item i at v + j M, for the s projections j
+// at once (one loop per run, not s).
 static void emit_tfamily(Emitter *e, const char *name, const char *what, const RollFamily *const *fams, int add) {
-  tmplf(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
+  int T = e->roll->T, m = e->mod->m, reps = add ? e->me->s : 1;
+  tmplf(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0)%s */\n"
            "static void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
-           "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what, name);
-  for (int t = 0; t < e->roll->T; t++)
-    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -e->roll->T : e->roll->T, t);
+           "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what,
+        add ? ", at v + j M into out + j M T for j = 0..S-1" : "", name);
+  for (int t = 0; t < T; t++)
+    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -T : T, t, reps, m, m * T);
   out(e, "}\n");
 }
 
@@ -266,12 +280,10 @@ void rolled_projections(Emitter *e, int jac) {
       rolled_x_row(e, j, "gam", m, x, sizeof x);
       out(e, "    hX[%d + i] = h * (%s);\n", j * m, x);
     }
-    out(e, "  }\n  for (j = 0; j < %d; j++) {\n", s);
-    if (!r->gradU_s.lin.zero)
-      tmplf(e, "    $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", m, m);
-    if (nu && jac_used(r, PART_LIN))
-      tmplf(e, "    $P_roll_jac_lin(0, hX + j * %d, prm, R + j * %d);\n", m, mt);
     out(e, "  }\n");
+    if (!r->gradU_s.lin.zero)
+      tmplf(e, "  for (j = 0; j < %d; j++) $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", s, m, m);
+    if (nu && jac_used(r, PART_LIN)) tmpl(e, "  $P_roll_jac_lin(0, hX, prm, R);\n");
   }
   if (r->gradU_s.curved.zero && !(nu && jac_used(r, PART_CURVED))) return;
   out(e, "  /* the other entries at the k stages: Q = q0 + h sum_j Ihat[l][j] gamma_j, summed with b_l P_j(c_l) */\n");
@@ -307,29 +319,37 @@ static void emit_system(Emitter *e) {
           "   * - rho_j-1' M^-1 rho_j)], r = rho_0' M^-1 (p0 - h xi_0 psi_0) - h sum_j xi_j (...) + g0, a sum over i */\n"
           "  for (i = 0; i < $P_NU * $P_RW; i++) A[i] = 0;\n"
           "  for (i = 0; i < $P_NU; i++) r[i] = 0;\n");
-  out(e, "  for (i = 0; i < %d; i++) {\n", m);
-  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d];\n", t, e->P, T, t);
-  for (int t = 0; t < T; t++) {
-    out(e, "    if (a%d >= 0) {\n", t);
-    for (int k = 0; k < s; k++) {
-      char y[256];
-      int n = 0;
-      if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", rolled_lit(e, xi[k + 1]), (k + 1) * mt + t, T);
-      if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", rolled_lit(e, xi[0]), t, T);
-      else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", rolled_lit(e, xi[k]), (k - 1) * mt + t, T);
-      out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
-    }
-    out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
-    for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
-    out(e, ");\n");
-    for (int u = 0; u < T; u++) {
-      out(e, "      if (a%d >= 0) A[a%d * %d + a%d - a%d + %d] += h * (", u, t, W, u, t, r->bw);
-      for (int k = 0; k < s; k++) out(e, "%sY%d * R[%d + %d * i]", k ? " + " : "", k, k * mt + u, T);
+  int nseg;
+  TconSeg *seg = rolled_tcon_segments(r, &nseg);
+  for (int g = 0; g < nseg; g++) {
+    rolled_tcon_open(e, &seg[g], 0);
+    for (int t = 0; t < T; t++) {
+      const char *gt = rolled_tcon_guard(&seg[g], t);
+      if (!gt) continue;
+      out(e, "    %s{\n", gt);
+      for (int k = 0; k < s; k++) {
+        char y[256];
+        int n = 0;
+        if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", rolled_lit(e, xi[k + 1]), (k + 1) * mt + t, T);
+        if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", rolled_lit(e, xi[0]), t, T);
+        else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", rolled_lit(e, xi[k]), (k - 1) * mt + t, T);
+        out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
+      }
+      out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
+      for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
       out(e, ");\n");
+      for (int u = 0; u < T; u++) {
+        const char *gu = rolled_tcon_guard(&seg[g], u);
+        if (!gu) continue;
+        out(e, "      %sA[a%d * %d + a%d - a%d + %d] += h * (", gu, t, W, u, t, r->bw);
+        for (int k = 0; k < s; k++) out(e, "%sY%d * R[%d + %d * i]", k ? " + " : "", k, k * mt + u, T);
+        out(e, ");\n");
+      }
+      out(e, "    }\n");
     }
-    out(e, "    }\n");
+    out(e, "  }\n");
   }
-  out(e, "  }\n");
+  rolled_tcon_free(seg);
   tmpl(e, "  for (i = 0; i < $P_NU; i++) r[i] += g0[i];  /* g(q0) / h, or 0 */\n"
           "  $P_band_factor(A, out + $<sweep.pivot>, out + $<sweep.adiag>);\n"
           "  $P_band_solve(A, r);\n"
@@ -348,16 +368,21 @@ static void emit_sweep(Emitter *e) {
   if (nu) tmplf(e, "  $R J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
   rolled_projections(e, 1);
   if (nu) emit_system(e);
-  out(e, "  for (i = 0; i < %d; i++) {\n", m);
-  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d] < 0 ? %d : %s_tcon[%d * i + %d];\n", t, e->P, T, t, nu, e->P, T, t);
-  out(e, "    %s th[%d];\n", real_type(e, 0), s);
-  for (int j = 0; j < s; j++) {
-    out(e, "    th[%d] = psi[%d + i]", j, j * m);
-    for (int t = 0; t < T; t++) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
-    out(e, ";\n");
+  int nseg;
+  TconSeg *seg = rolled_tcon_segments(r, &nseg);
+  for (int g = 0; g < nseg; g++) {
+    rolled_tcon_open(e, &seg[g], 1);
+    out(e, "    %s th[%d];\n", real_type(e, 0), s);
+    for (int j = 0; j < s; j++) {
+      out(e, "    th[%d] = psi[%d + i]", j, j * m);
+      for (int t = 0; t < T; t++)
+        if (rolled_tcon_guard(&seg[g], t)) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
+      out(e, ";\n");
+    }
+    rolled_gamma(e, 1);
+    out(e, "  }\n");
   }
-  rolled_gamma(e, 1);
-  out(e, "  }\n");
+  rolled_tcon_free(seg);
 }
 
 // Inside a loop over the coordinates i with th[j] = Theta_j at i: gamma_j =
