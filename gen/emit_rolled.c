@@ -306,14 +306,82 @@ void rolled_projections(Emitter *e, int jac) {
   }
 }
 
-// The multiplier system, assembled by one loop over the coordinates: for
-// each constraint a on coordinate i (t unrolled), Y_k = M^-1 times the
-// coefficient of y_k in xi_0 x_0'y_0 + sum_j xi_j (x_j'y_j-1 - x_j-1'y_j), x
-// = rho[i, a], then r[a] += rho_0 M^-1 p0 - h Y'psi, A[a][c] += h Y'rho[i, c].
-static void emit_system(Emitter *e) {
+// R[j M T + T i + t]: rho_j at coordinate i, constraint slot t.
+static void rho(char *buf, size_t size, int j, int t, int mt, int T) {
+  snprintf(buf, size, "R[%d + %d * i]", j * mt + t, T);
+}
+
+// The right-hand side's share of coordinate i, slot t (in a segment's loop):
+// Y_k = M^-1 times the coefficient of y_k in B(x, y) = xi_0 x_0 y_0 + sum_j
+// xi_j (x_j y_j-1 - x_j-1 y_j), x = rho[i, t], and r[a] += rho_0 M^-1 p0 - h
+// Y'psi (only Y_0 when psi_j = 0 for j >= 1).
+static void emit_system_rhs(Emitter *e, const TconSeg *g, int t, int psi_const) {
   const Roll *r = e->roll;
   const double *xi = e->me->xi;
-  int m = e->mod->m, s = e->me->s, T = r->T, mt = m * T, W = 2 * r->bw + 1;
+  int m = e->mod->m, s = e->me->s, T = r->T, mt = m * T;
+  const char *gt = rolled_tcon_guard(g, t), *minv = r->identity ? "" : "_rminv[i] * ";
+  char a[64], b[64];
+  if (!gt) return;
+  out(e, "    %s{\n", gt);
+  for (int k = 0; k < (psi_const ? 1 : s); k++) {
+    char y[256];
+    int n = 0;
+    if (k + 1 < s) rho(b, sizeof b, k + 1, t, mt, T), n = snprintf(y, sizeof y, "%s * %s", rolled_lit(e, xi[k + 1]), b);
+    rho(a, sizeof a, k ? k - 1 : 0, t, mt, T);
+    if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * %s", n ? " + " : "", rolled_lit(e, xi[0]), a);
+    else snprintf(y + n, sizeof y - (size_t)n, "%s%s * %s", n ? " - " : "-", rolled_lit(e, xi[k]), a);
+    out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, minv, y);
+  }
+  out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, minv);
+  for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
+  out(e, ");\n    }\n");
+}
+
+// A's share of coordinate i (in a segment's loop), h B(rho[i, t], rho[i, u])
+// M^-1_i into A[a_t][a_u]: on the diagonal B(x, x) = xi_0 x_0^2 (the skew
+// part cancels), and for a pair t < u the symmetric part S = xi_0 x_0 y_0
+// and the skew part K = sum_j xi_j (x_j y_j-1 - x_j-1 y_j) once, A[a_t][a_u]
+// += h (S + K), A[a_u][a_t] += h (S - K).
+static void emit_system_matrix(Emitter *e, const TconSeg *g) {
+  const Roll *r = e->roll;
+  const double *xi = e->me->xi;
+  int s = e->me->s, T = r->T, mt = e->mod->m * T, W = 2 * r->bw + 1;
+  char pre[64], x0[64], y0[64], xj[64], xl[64], yj[64], yl[64];
+  snprintf(pre, sizeof pre, "%s%s", r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
+  for (int t = 0; t < T; t++) {
+    const char *gt = rolled_tcon_guard(g, t);
+    if (!gt) continue;
+    rho(x0, sizeof x0, 0, t, mt, T);
+    out(e, *pre ? "    %sA[a%d * %d + %d] += h * (%s(%s * %s * %s));\n" : "    %sA[a%d * %d + %d] += h * (%s%s * %s * %s);\n", gt, t, W,
+        r->bw, pre, rolled_lit(e, xi[0]), x0, x0);
+  }
+  for (int t = 0; t < T; t++)
+    for (int u = t + 1; u < T; u++) {
+      int table = g->off[t] == TCON_TABLE;
+      if (!rolled_tcon_guard(g, t) || !rolled_tcon_guard(g, u)) continue;
+      out(e, table ? "    if (a%d >= 0 && a%d >= 0) {\n" : "    {\n", t, u);
+      rho(x0, sizeof x0, 0, t, mt, T);
+      rho(y0, sizeof y0, 0, u, mt, T);
+      out(e, *pre ? "      const %s S = %s(%s * %s * %s);\n" : "      const %s S = %s%s * %s * %s;\n", real_type(e, 0), pre,
+          rolled_lit(e, xi[0]), x0, y0);
+      out(e, "      const %s K = %s(", real_type(e, 0), pre);
+      for (int j = 1; j < s; j++) {
+        rho(xj, sizeof xj, j, t, mt, T), rho(xl, sizeof xl, j - 1, t, mt, T);
+        rho(yj, sizeof yj, j, u, mt, T), rho(yl, sizeof yl, j - 1, u, mt, T);
+        out(e, "%s%s * (%s * %s - %s * %s)", j > 1 ? " + " : "", rolled_lit(e, xi[j]), xj, yl, xl, yj);
+      }
+      out(e, s > 1 ? ");\n" : "0);\n");
+      out(e, "      A[a%d * %d + a%d - a%d + %d] += h * (S + K);\n", t, W, u, t, r->bw);
+      out(e, "      A[a%d * %d + a%d - a%d + %d] += h * (S - K);\n    }\n", u, W, t, u, r->bw);
+    }
+}
+
+// The multiplier system, assembled by one loop over the coordinates (per
+// segment of rolled_tcon_segments): r (emit_system_rhs) and A
+// (emit_system_matrix), in band storage.
+static void emit_system(Emitter *e) {
+  const Roll *r = e->roll;
+  int T = r->T;
   int psi_const = r->gradU_s.lin.zero && r->gradU_s.curved.zero; /* psi_j = 0 for j >= 1 */
   tmpl(e, "  /* the multiplier system A lambda = r (band): A = h [xi_0 rho_0' M^-1 rho_0 + sum_j xi_j (rho_j' M^-1 rho_j-1\n"
           "   * - rho_j-1' M^-1 rho_j)], r = rho_0' M^-1 (p0 - h xi_0 psi_0) - h sum_j xi_j (...) + g0, a sum over i */\n"
@@ -323,30 +391,8 @@ static void emit_system(Emitter *e) {
   TconSeg *seg = rolled_tcon_segments(r, &nseg);
   for (int g = 0; g < nseg; g++) {
     rolled_tcon_open(e, &seg[g], 0);
-    for (int t = 0; t < T; t++) {
-      const char *gt = rolled_tcon_guard(&seg[g], t);
-      if (!gt) continue;
-      out(e, "    %s{\n", gt);
-      for (int k = 0; k < s; k++) {
-        char y[256];
-        int n = 0;
-        if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", rolled_lit(e, xi[k + 1]), (k + 1) * mt + t, T);
-        if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", rolled_lit(e, xi[0]), t, T);
-        else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", rolled_lit(e, xi[k]), (k - 1) * mt + t, T);
-        out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
-      }
-      out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
-      for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
-      out(e, ");\n");
-      for (int u = 0; u < T; u++) {
-        const char *gu = rolled_tcon_guard(&seg[g], u);
-        if (!gu) continue;
-        out(e, "      %sA[a%d * %d + a%d - a%d + %d] += h * (", gu, t, W, u, t, r->bw);
-        for (int k = 0; k < s; k++) out(e, "%sY%d * R[%d + %d * i]", k ? " + " : "", k, k * mt + u, T);
-        out(e, ");\n");
-      }
-      out(e, "    }\n");
-    }
+    for (int t = 0; t < T; t++) emit_system_rhs(e, &seg[g], t, psi_const);
+    emit_system_matrix(e, &seg[g]);
     out(e, "  }\n");
   }
   rolled_tcon_free(seg);
