@@ -57,8 +57,8 @@ static void body_name(Emitter *e, const RollRun *r, int id, int vshift, char *bu
 // = value, or with os = 0, acc += value. With reps > 1 the body is printed
 // reps times in the loop, the j-th in a block of its own with the second
 // array read at vstride j further on and out at ostride j further on (the s
-// projections of the linear part in one loop).
-static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int vstride, int ostride) {
+// projections of the linear part in one loop), out[] = for j >= 1 with set.
+static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int vstride, int ostride, int set) {
   const Dag *d = e->mod->dag;
   char a[NAME_SIZE], b[NAME_SIZE], rhs[8 * NAME_SIZE];
   if (r->n == 1) out(e, "  { /* item %d */\n    const int u = %d, b = %d;\n", r->u0, r->u0, r->b0);
@@ -80,7 +80,7 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int
       out(e, "    %sconst %s r%d = %s;\n", in, real_type(e, 0), k, rhs);
     }
     body_name(e, r, r->body[r->nbody - 1], j * vstride, a, sizeof a);
-    if (os) out(e, "    %sout[%d * u + %d] %s= %s;\n", in, os < 0 ? -os : os, oo + j * ostride, os < 0 ? "+" : "", a);
+    if (os) out(e, "    %sout[%d * u + %d] %s= %s;\n", in, os < 0 ? -os : os, oo + j * ostride, os < 0 && !(set && j) ? "+" : "", a);
     else out(e, "    %sacc += %s;\n", in, a);
     if (reps > 1) out(e, "    }\n");
   }
@@ -93,22 +93,34 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int
 static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int mode) {
   tmplf(e, "\n/* %s */\nstatic void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  $R acc = 0;\n" : "");
-  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0, 1, 0, 0);
+  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0, 1, 0, 0, 0);
   out(e, mode == 1 ? "  out[0] = acc;\n}\n" : "}\n");
+}
+
+// Whether the runs of the T families fams[t] cover every coordinate's item.
+static int tfamily_covers(const Roll *r, const RollFamily *const *fams) {
+  for (int t = 0; t < r->T; t++) {
+    int n = 0;
+    for (int i = 0; i < fams[t]->nruns; i++) n += fams[t]->runs[i].n;
+    if (n != r->m) return 0;
+  }
+  return 1;
 }
 
 // A family per t of the Jacobian's entries (fams[t]) as the function
 // $P_roll_NAME: out[T i + t] = item i of family t. With add (the linear
 // part), out[j M T + T i + t] += item i at v + j M, for the s projections j
-// at once (one loop per run, not s).
+// at once (one loop per run, not s); where its runs cover every item, =
+// for j >= 1 (the sweep does not zero them first: lin_sets).
 static void emit_tfamily(Emitter *e, const char *name, const char *what, const RollFamily *const *fams, int add) {
-  int T = e->roll->T, m = e->mod->m, reps = add ? e->me->s : 1;
+  int T = e->roll->T, m = e->mod->m, reps = add ? e->me->s : 1, set = add && tfamily_covers(e->roll, fams);
   tmplf(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0)%s */\n"
            "static void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what,
-        add ? ", at v + j M into out + j M T for j = 0..S-1" : "", name);
+        add ? (set ? ", at v + j M into out + j M T for j = 0..S-1 (= for j >= 1)" : ", at v + j M into out + j M T for j = 0..S-1") : "",
+        name);
   for (int t = 0; t < T; t++)
-    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -T : T, t, reps, m, m * T);
+    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -T : T, t, reps, m, m * T, set);
   out(e, "}\n");
 }
 
@@ -125,6 +137,16 @@ static int jac_used(const Roll *r, int part) {
   int used = 0;
   for (int t = 0; t < r->T; t++) used |= !jac_part(r, t, part)->zero;
   return used;
+}
+
+// Whether $P_roll_jac_lin sets rho_j for j >= 1 (emit_tfamily), so that the
+// sweep of the const family need not zero them.
+static int lin_sets(const Roll *r) {
+  const RollFamily **f = xmalloc((size_t)(r->T + 1) * sizeof *f);
+  for (int t = 0; t < r->T; t++) f[t] = &r->jac_s[t].lin;
+  int set = jac_used(r, PART_LIN) && tfamily_covers(r, f);
+  free(f);
+  return set;
 }
 
 // The Jacobian's families: the whole, and the parts the sweep uses.
@@ -273,7 +295,7 @@ void rolled_projections(Emitter *e, int jac) {
   if (!r->gradU_s.affine.zero) tmpl(e, "  $P_roll_gradU_affine(q0, 0, prm, psi);\n");
   tmplf(e, "  for (i = %d; i < %d; i++) psi[i] = 0;\n", r->gradU_s.affine.zero ? 0 : m, s * m);
   if (nu && jac_used(r, PART_AFFINE)) tmpl(e, "  $P_roll_jac_affine(q0, 0, prm, R);\n");
-  if (nu) tmplf(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
+  if (nu && !lin_sets(r)) tmplf(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
   if (!r->gradU_s.lin.zero || (nu && jac_used(r, PART_LIN))) {
     out(e, "  for (i = 0; i < %d; i++) {\n", m);
     for (int j = 0; j < s; j++) {
@@ -304,6 +326,11 @@ void rolled_projections(Emitter *e, int jac) {
       out(e, "  }\n");
     }
   }
+}
+
+// Whether psi_j = 0 for j >= 1 (grad U is affine with no linear part: constant).
+static int psi_zero(const Roll *r) {
+  return r->gradU_s.lin.zero && r->gradU_s.curved.zero;
 }
 
 // R[j M T + T i + t]: rho_j at coordinate i, constraint slot t.
@@ -382,7 +409,7 @@ static void emit_system_matrix(Emitter *e, const TconSeg *g) {
 static void emit_system(Emitter *e) {
   const Roll *r = e->roll;
   int T = r->T;
-  int psi_const = r->gradU_s.lin.zero && r->gradU_s.curved.zero; /* psi_j = 0 for j >= 1 */
+  int psi_const = psi_zero(r);
   tmpl(e, "  /* the multiplier system A lambda = r (band): A = h [xi_0 rho_0' M^-1 rho_0 + sum_j xi_j (rho_j' M^-1 rho_j-1\n"
           "   * - rho_j-1' M^-1 rho_j)], r = rho_0' M^-1 (p0 - h xi_0 psi_0) - h sum_j xi_j (...) + g0, a sum over i */\n"
           "  for (i = 0; i < $P_NU * $P_RW; i++) A[i] = 0;\n"
@@ -419,11 +446,12 @@ static void emit_sweep(Emitter *e) {
   for (int g = 0; g < nseg; g++) {
     rolled_tcon_open(e, &seg[g], 1);
     out(e, "    %s th[%d];\n", real_type(e, 0), s);
-    for (int j = 0; j < s; j++) {
-      out(e, "    th[%d] = psi[%d + i]", j, j * m);
+    for (int j = 0; j < s; j++) { /* (psi_j = 0 for j >= 1 is not read) */
+      int terms = j == 0 || !psi_zero(r);
+      out(e, terms ? "    th[%d] = psi[%d + i]" : "    th[%d] =", j, j * m);
       for (int t = 0; t < T; t++)
-        if (rolled_tcon_guard(&seg[g], t)) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
-      out(e, ";\n");
+        if (rolled_tcon_guard(&seg[g], t)) out(e, "%sR[%d + %d * i] * r[a%d]", terms++ ? " + " : " ", j * mt + t, T, t);
+      out(e, terms ? ";\n" : " 0;\n");
     }
     rolled_gamma(e, 1);
     out(e, "  }\n");
