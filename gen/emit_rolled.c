@@ -13,7 +13,9 @@
  *     products with M^-1 (diagonal) are loops over the coordinates;
  *   - G' M^-1 G and the multiplier system of the paper are assembled by a
  *     loop over the coordinates and the constraints on each (the table
- *     tcon) into band storage, A[a][c] at A[a * W + c - a + BW], and factored
+ *     tcon; in the sweep one loop per segment of coordinates whose
+ *     constraints are affine in i, emit_rolled_tcon.c) into band storage,
+ *     A[a][c] at A[a * W + c - a + BW], and factored
  *     and solved by LU without pivoting over the band (the same elimination
  *     lu.c prints unrolled: its symmetric part is positive definite).
  * The sums are those of the straight-line kernels, but some are taken in
