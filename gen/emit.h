@@ -71,6 +71,14 @@ const char *rolled_lit(Emitter *e, double v);  /* a literal of the method's cons
 void rolled_x_row(Emitter *e, int j, const char *name, int stride, char *buf, size_t size);
 void rolled_projections(Emitter *e, int jac);   /* psi (and with jac rho) into the sweep's locals */
 void rolled_gamma(Emitter *e, int results);     /* gamma from th[] in the loop over i */
+/* emit_rolled_tcon.c: the coordinates cut into segments on which each
+ * constraint slot t is absent or a = i + off[t] (or read from the table) */
+typedef struct { int i0, i1, *off; } TconSeg;
+enum { TCON_ABSENT = -0x40000000, TCON_TABLE = -0x3fffffff }; /* off[t] besides offsets */
+TconSeg *rolled_tcon_segments(const struct Roll *r, int *n);
+void rolled_tcon_free(TconSeg *s);
+void rolled_tcon_open(Emitter *e, const TconSeg *s, int pad); /* for (i ...) { and a0.. */
+const char *rolled_tcon_guard(const TconSeg *s, int t);       /* "", "if (a >= 0) " or NULL */
 /* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */
 void rolled_poly_helpers(Emitter *e);
 void rolled_poly_kernel(Emitter *e, KernelId k);

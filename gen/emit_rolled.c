@@ -13,7 +13,9 @@
  *     products with M^-1 (diagonal) are loops over the coordinates;
  *   - G' M^-1 G and the multiplier system of the paper are assembled by a
  *     loop over the coordinates and the constraints on each (the table
- *     tcon) into band storage, A[a][c] at A[a * W + c - a + BW], and factored
+ *     tcon; in the sweep one loop per segment of coordinates whose
+ *     constraints are affine in i, emit_rolled_tcon.c) into band storage,
+ *     A[a][c] at A[a * W + c - a + BW], and factored
  *     and solved by LU without pivoting over the band (the same elimination
  *     lu.c prints unrolled: its symmetric part is positive definite).
  * The sums are those of the straight-line kernels, but some are taken in
@@ -29,15 +31,16 @@
 #define NAME_SIZE 256
 
 // The C name of node id inside a run's body: a literal, a parameter, an
-// input at its offset from the base b, or the temporary rK of its place k.
-static void body_name(Emitter *e, const RollRun *r, int id, char *buf, size_t size) {
+// input at its offset from the base b (the second array's shifted by
+// vshift), or the temporary rK of its place k.
+static void body_name(Emitter *e, const RollRun *r, int id, int vshift, char *buf, size_t size) {
   const Node *n = &e->mod->dag->nodes[id];
   int m = e->mod->m;
   switch ((Op)n->op) {
   case OP_CONST: format_real(e, buf, size, n->val); return;
   case OP_PARAM: snprintf(buf, size, "prm->%s", e->mod->params[n->idx].name); return;
   case OP_INPUT: {
-    int off = n->idx % m - r->b0;
+    int off = n->idx % m - r->b0 + (n->idx < m ? 0 : vshift);
     snprintf(buf, size, off ? "%s[b %c %d]" : "%s[b]", n->idx < m ? "q" : "v", off < 0 ? '-' : '+', off < 0 ? -off : off);
     return;
   }
@@ -53,8 +56,11 @@ static void body_name(Emitter *e, const RollRun *r, int id, char *buf, size_t si
 
 // One run of a family: its items' loop (or one block for a single item),
 // the body once, and what is done with the root's value: out[U * os + oo]
-// = value, or with os = 0, acc += value.
-static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
+// = value, or with os = 0, acc += value. With reps > 1 the body is printed
+// reps times in the loop, the j-th in a block of its own with the second
+// array read at vstride j further on and out at ostride j further on (the s
+// projections of the linear part in one loop), out[] = for j >= 1 with set.
+static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int vstride, int ostride, int set) {
   const Dag *d = e->mod->dag;
   char a[NAME_SIZE], b[NAME_SIZE], rhs[8 * NAME_SIZE];
   if (r->n == 1) out(e, "  { /* item %d */\n    const int u = %d, b = %d;\n", r->u0, r->u0, r->b0);
@@ -64,17 +70,23 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
     out(e, "  for (u = %d; u < %d; u++) { /* items %d..%d */\n    const int b = %d + %d * (u - %d);\n", r->u0, r->u0 + r->n,
         r->u0, r->u0 + r->n - 1, r->b0, r->stride, r->u0);
   out(e, "    (void)u; (void)b;\n");
-  for (int k = 0; k < r->nbody; k++) {
-    const Node *n = &d->nodes[r->body[k]];
-    if (n->a < 0) continue; /* leaves are named where they are read */
-    body_name(e, r, n->a, a, sizeof a);
-    if (n->b >= 0) body_name(e, r, n->b, b, sizeof b);
-    op_rhs(e, n, a, b, rhs, sizeof rhs);
-    out(e, "    const %s r%d = %s;\n", real_type(e, 0), k, rhs);
+  for (int j = 0; j < reps; j++) {
+    const char *in = reps > 1 ? "  " : "";
+    if (reps > 1) out(e, "    {\n");
+    for (int k = 0; k < r->nbody; k++) {
+      const Node *n = &d->nodes[r->body[k]];
+      if (n->a < 0) continue; /* leaves are named where they are read */
+      body_name(e, r, n->a, j * vstride, a, sizeof a);
+      if (n->b >= 0) body_name(e, r, n->b, j * vstride, b, sizeof b);
+      op_rhs(e, n, a, b, rhs, sizeof rhs);
+      out(e, "    %sconst %s r%d = %s;\n", in, real_type(e, 0), k, rhs);
+    }
+    body_name(e, r, r->body[r->nbody - 1], j * vstride, a, sizeof a);
+    if (os) out(e, "    %sout[%d * u + %d] %s= %s;\n", in, os < 0 ? -os : os, oo + j * ostride, os < 0 && !(set && j) ? "+" : "", a);
+    else out(e, "    %sacc += %s;\n", in, a);
+    if (reps > 1) out(e, "    }\n");
   }
-  body_name(e, r, r->body[r->nbody - 1], a, sizeof a);
-  if (os) out(e, "    out[%d * u + %d] %s= %s;\n  }\n", os < 0 ? -os : os, oo, os < 0 ? "+" : "", a);
-  else out(e, "    acc += %s;\n  }\n", a);
+  out(e, "  }\n");
 }
 
 // A family as the function $P_roll_NAME(q, v, prm, out): out[i] for its
@@ -83,18 +95,34 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo) {
 static void emit_family(Emitter *e, const char *name, const char *what, const RollFamily *f, int mode) {
   tmplf(e, "\n/* %s */\nstatic void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
            "  int u = 0;\n%s  (void)q; (void)v; (void)prm; (void)u;\n", what, name, mode == 1 ? "  $R acc = 0;\n" : "");
-  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0);
+  for (int i = 0; i < f->nruns; i++) emit_run(e, &f->runs[i], mode == 1 ? 0 : mode ? -1 : 1, 0, 1, 0, 0, 0);
   out(e, mode == 1 ? "  out[0] = acc;\n}\n" : "}\n");
 }
 
+// Whether the runs of the T families fams[t] cover every coordinate's item.
+static int tfamily_covers(const Roll *r, const RollFamily *const *fams) {
+  for (int t = 0; t < r->T; t++) {
+    int n = 0;
+    for (int i = 0; i < fams[t]->nruns; i++) n += fams[t]->runs[i].n;
+    if (n != r->m) return 0;
+  }
+  return 1;
+}
+
 // A family per t of the Jacobian's entries (fams[t]) as the function
-// $P_roll_NAME: out[T i + t] = item i of family t.
+// $P_roll_NAME: out[T i + t] = item i of family t. With add (the linear
+// part), out[j M T + T i + t] += item i at v + j M, for the s projections j
+// at once (one loop per run, not s); where its runs cover every item, =
+// for j >= 1 (the sweep does not zero them first: lin_sets).
 static void emit_tfamily(Emitter *e, const char *name, const char *what, const RollFamily *const *fams, int add) {
-  tmplf(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0) */\n"
+  int T = e->roll->T, m = e->mod->m, reps = add ? e->me->s : 1, set = add && tfamily_covers(e->roll, fams);
+  tmplf(e, "\n/* %s: out[$P_RT * i + t] for a = $P_tcon[$P_RT * i + t] (0 where a < 0)%s */\n"
            "static void $P_roll_%s(const $R *q, const $R *v, const $P_params *prm, $R *out)\n{\n"
-           "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what, name);
-  for (int t = 0; t < e->roll->T; t++)
-    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -e->roll->T : e->roll->T, t);
+           "  int u = 0;\n  (void)q; (void)v; (void)prm; (void)u;\n", what,
+        add ? (set ? ", at v + j M into out + j M T for j = 0..S-1 (= for j >= 1)" : ", at v + j M into out + j M T for j = 0..S-1") : "",
+        name);
+  for (int t = 0; t < T; t++)
+    for (int i = 0; i < fams[t]->nruns; i++) emit_run(e, &fams[t]->runs[i], add ? -T : T, t, reps, m, m * T, set);
   out(e, "}\n");
 }
 
@@ -111,6 +139,16 @@ static int jac_used(const Roll *r, int part) {
   int used = 0;
   for (int t = 0; t < r->T; t++) used |= !jac_part(r, t, part)->zero;
   return used;
+}
+
+// Whether $P_roll_jac_lin sets rho_j for j >= 1 (emit_tfamily), so that the
+// sweep of the const family need not zero them.
+static int lin_sets(const Roll *r) {
+  const RollFamily **f = xmalloc((size_t)(r->T + 1) * sizeof *f);
+  for (int t = 0; t < r->T; t++) f[t] = &r->jac_s[t].lin;
+  int set = jac_used(r, PART_LIN) && tfamily_covers(r, f);
+  free(f);
+  return set;
 }
 
 // The Jacobian's families: the whole, and the parts the sweep uses.
@@ -259,19 +297,17 @@ void rolled_projections(Emitter *e, int jac) {
   if (!r->gradU_s.affine.zero) tmpl(e, "  $P_roll_gradU_affine(q0, 0, prm, psi);\n");
   tmplf(e, "  for (i = %d; i < %d; i++) psi[i] = 0;\n", r->gradU_s.affine.zero ? 0 : m, s * m);
   if (nu && jac_used(r, PART_AFFINE)) tmpl(e, "  $P_roll_jac_affine(q0, 0, prm, R);\n");
-  if (nu) tmplf(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
+  if (nu && !lin_sets(r)) tmplf(e, "  for (i = %d; i < %d; i++) R[i] = 0;\n", jac_used(r, PART_AFFINE) ? mt : 0, s * mt);
   if (!r->gradU_s.lin.zero || (nu && jac_used(r, PART_LIN))) {
     out(e, "  for (i = 0; i < %d; i++) {\n", m);
     for (int j = 0; j < s; j++) {
       rolled_x_row(e, j, "gam", m, x, sizeof x);
       out(e, "    hX[%d + i] = h * (%s);\n", j * m, x);
     }
-    out(e, "  }\n  for (j = 0; j < %d; j++) {\n", s);
-    if (!r->gradU_s.lin.zero)
-      tmplf(e, "    $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", m, m);
-    if (nu && jac_used(r, PART_LIN))
-      tmplf(e, "    $P_roll_jac_lin(0, hX + j * %d, prm, R + j * %d);\n", m, mt);
     out(e, "  }\n");
+    if (!r->gradU_s.lin.zero)
+      tmplf(e, "  for (j = 0; j < %d; j++) $P_roll_gradU_lin(0, hX + j * %d, prm, psi + j * %d);\n", s, m, m);
+    if (nu && jac_used(r, PART_LIN)) tmpl(e, "  $P_roll_jac_lin(0, hX, prm, R);\n");
   }
   if (r->gradU_s.curved.zero && !(nu && jac_used(r, PART_CURVED))) return;
   out(e, "  /* the other entries at the k stages: Q = q0 + h sum_j Ihat[l][j] gamma_j, summed with b_l P_j(c_l) */\n");
@@ -294,42 +330,101 @@ void rolled_projections(Emitter *e, int jac) {
   }
 }
 
-// The multiplier system, assembled by one loop over the coordinates: for
-// each constraint a on coordinate i (t unrolled), Y_k = M^-1 times the
-// coefficient of y_k in xi_0 x_0'y_0 + sum_j xi_j (x_j'y_j-1 - x_j-1'y_j), x
-// = rho[i, a], then r[a] += rho_0 M^-1 p0 - h Y'psi, A[a][c] += h Y'rho[i, c].
-static void emit_system(Emitter *e) {
+// Whether psi_j = 0 for j >= 1 (grad U is affine with no linear part: constant).
+static int psi_zero(const Roll *r) {
+  return r->gradU_s.lin.zero && r->gradU_s.curved.zero;
+}
+
+// R[j M T + T i + t]: rho_j at coordinate i, constraint slot t.
+static void rho(char *buf, size_t size, int j, int t, int mt, int T) {
+  snprintf(buf, size, "R[%d + %d * i]", j * mt + t, T);
+}
+
+// The right-hand side's share of coordinate i, slot t (in a segment's loop):
+// Y_k = M^-1 times the coefficient of y_k in B(x, y) = xi_0 x_0 y_0 + sum_j
+// xi_j (x_j y_j-1 - x_j-1 y_j), x = rho[i, t], and r[a] += rho_0 M^-1 p0 - h
+// Y'psi (only Y_0 when psi_j = 0 for j >= 1).
+static void emit_system_rhs(Emitter *e, const TconSeg *g, int t, int psi_const) {
   const Roll *r = e->roll;
   const double *xi = e->me->xi;
-  int m = e->mod->m, s = e->me->s, T = r->T, mt = m * T, W = 2 * r->bw + 1;
-  int psi_const = r->gradU_s.lin.zero && r->gradU_s.curved.zero; /* psi_j = 0 for j >= 1 */
+  int m = e->mod->m, s = e->me->s, T = r->T, mt = m * T;
+  const char *gt = rolled_tcon_guard(g, t), *minv = r->identity ? "" : "_rminv[i] * ";
+  char a[64], b[64];
+  if (!gt) return;
+  out(e, "    %s{\n", gt);
+  for (int k = 0; k < (psi_const ? 1 : s); k++) {
+    char y[256];
+    int n = 0;
+    if (k + 1 < s) rho(b, sizeof b, k + 1, t, mt, T), n = snprintf(y, sizeof y, "%s * %s", rolled_lit(e, xi[k + 1]), b);
+    rho(a, sizeof a, k ? k - 1 : 0, t, mt, T);
+    if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * %s", n ? " + " : "", rolled_lit(e, xi[0]), a);
+    else snprintf(y + n, sizeof y - (size_t)n, "%s%s * %s", n ? " - " : "-", rolled_lit(e, xi[k]), a);
+    out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, minv, y);
+  }
+  out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, minv);
+  for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
+  out(e, ");\n    }\n");
+}
+
+// A's share of coordinate i (in a segment's loop), h B(rho[i, t], rho[i, u])
+// M^-1_i into A[a_t][a_u]: on the diagonal B(x, x) = xi_0 x_0^2 (the skew
+// part cancels), and for a pair t < u the symmetric part S = xi_0 x_0 y_0
+// and the skew part K = sum_j xi_j (x_j y_j-1 - x_j-1 y_j) once, A[a_t][a_u]
+// += h (S + K), A[a_u][a_t] += h (S - K).
+static void emit_system_matrix(Emitter *e, const TconSeg *g) {
+  const Roll *r = e->roll;
+  const double *xi = e->me->xi;
+  int s = e->me->s, T = r->T, mt = e->mod->m * T, W = 2 * r->bw + 1;
+  char pre[64], x0[64], y0[64], xj[64], xl[64], yj[64], yl[64];
+  snprintf(pre, sizeof pre, "%s%s", r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
+  for (int t = 0; t < T; t++) {
+    const char *gt = rolled_tcon_guard(g, t);
+    if (!gt) continue;
+    rho(x0, sizeof x0, 0, t, mt, T);
+    out(e, *pre ? "    %sA[a%d * %d + %d] += h * (%s(%s * %s * %s));\n" : "    %sA[a%d * %d + %d] += h * (%s%s * %s * %s);\n", gt, t, W,
+        r->bw, pre, rolled_lit(e, xi[0]), x0, x0);
+  }
+  for (int t = 0; t < T; t++)
+    for (int u = t + 1; u < T; u++) {
+      int table = g->off[t] == TCON_TABLE;
+      if (!rolled_tcon_guard(g, t) || !rolled_tcon_guard(g, u)) continue;
+      out(e, table ? "    if (a%d >= 0 && a%d >= 0) {\n" : "    {\n", t, u);
+      rho(x0, sizeof x0, 0, t, mt, T);
+      rho(y0, sizeof y0, 0, u, mt, T);
+      out(e, *pre ? "      const %s S = %s(%s * %s * %s);\n" : "      const %s S = %s%s * %s * %s;\n", real_type(e, 0), pre,
+          rolled_lit(e, xi[0]), x0, y0);
+      out(e, "      const %s K = %s(", real_type(e, 0), pre);
+      for (int j = 1; j < s; j++) {
+        rho(xj, sizeof xj, j, t, mt, T), rho(xl, sizeof xl, j - 1, t, mt, T);
+        rho(yj, sizeof yj, j, u, mt, T), rho(yl, sizeof yl, j - 1, u, mt, T);
+        out(e, "%s%s * (%s * %s - %s * %s)", j > 1 ? " + " : "", rolled_lit(e, xi[j]), xj, yl, xl, yj);
+      }
+      out(e, s > 1 ? ");\n" : "0);\n");
+      out(e, "      A[a%d * %d + a%d - a%d + %d] += h * (S + K);\n", t, W, u, t, r->bw);
+      out(e, "      A[a%d * %d + a%d - a%d + %d] += h * (S - K);\n    }\n", u, W, t, u, r->bw);
+    }
+}
+
+// The multiplier system, assembled by one loop over the coordinates (per
+// segment of rolled_tcon_segments): r (emit_system_rhs) and A
+// (emit_system_matrix), in band storage.
+static void emit_system(Emitter *e) {
+  const Roll *r = e->roll;
+  int T = r->T;
+  int psi_const = psi_zero(r);
   tmpl(e, "  /* the multiplier system A lambda = r (band): A = h [xi_0 rho_0' M^-1 rho_0 + sum_j xi_j (rho_j' M^-1 rho_j-1\n"
           "   * - rho_j-1' M^-1 rho_j)], r = rho_0' M^-1 (p0 - h xi_0 psi_0) - h sum_j xi_j (...) + g0, a sum over i */\n"
           "  for (i = 0; i < $P_NU * $P_RW; i++) A[i] = 0;\n"
           "  for (i = 0; i < $P_NU; i++) r[i] = 0;\n");
-  out(e, "  for (i = 0; i < %d; i++) {\n", m);
-  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d];\n", t, e->P, T, t);
-  for (int t = 0; t < T; t++) {
-    out(e, "    if (a%d >= 0) {\n", t);
-    for (int k = 0; k < s; k++) {
-      char y[256];
-      int n = 0;
-      if (k + 1 < s) n = snprintf(y, sizeof y, "%s * R[%d + %d * i]", rolled_lit(e, xi[k + 1]), (k + 1) * mt + t, T);
-      if (k == 0) snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " + " : "", rolled_lit(e, xi[0]), t, T);
-      else snprintf(y + n, sizeof y - (size_t)n, "%s%s * R[%d + %d * i]", n ? " - " : "-", rolled_lit(e, xi[k]), (k - 1) * mt + t, T);
-      out(e, "      const %s Y%d = %s%s(%s);\n", real_type(e, 0), k, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ", y);
-    }
-    out(e, "      r[a%d] += R[%d + %d * i] * (%s%sp0[i]) - h * (", t, t, T, r->identity ? "" : e->P, r->identity ? "" : "_rminv[i] * ");
-    for (int k = 0; k < (psi_const ? 1 : s); k++) out(e, "%sY%d * psi[%d + i]", k ? " + " : "", k, k * m);
-    out(e, ");\n");
-    for (int u = 0; u < T; u++) {
-      out(e, "      if (a%d >= 0) A[a%d * %d + a%d - a%d + %d] += h * (", u, t, W, u, t, r->bw);
-      for (int k = 0; k < s; k++) out(e, "%sY%d * R[%d + %d * i]", k ? " + " : "", k, k * mt + u, T);
-      out(e, ");\n");
-    }
-    out(e, "    }\n");
+  int nseg;
+  TconSeg *seg = rolled_tcon_segments(r, &nseg);
+  for (int g = 0; g < nseg; g++) {
+    rolled_tcon_open(e, &seg[g], 0);
+    for (int t = 0; t < T; t++) emit_system_rhs(e, &seg[g], t, psi_const);
+    emit_system_matrix(e, &seg[g]);
+    out(e, "  }\n");
   }
-  out(e, "  }\n");
+  rolled_tcon_free(seg);
   tmpl(e, "  for (i = 0; i < $P_NU; i++) r[i] += g0[i];  /* g(q0) / h, or 0 */\n"
           "  $P_band_factor(A, out + $<sweep.pivot>, out + $<sweep.adiag>);\n"
           "  $P_band_solve(A, r);\n"
@@ -348,16 +443,22 @@ static void emit_sweep(Emitter *e) {
   if (nu) tmplf(e, "  $R J[%d], R[%d], A[%d], r[%d];\n  (void)J;\n", mt, s * mt, nu * (2 * r->bw + 1), nu + 1);
   rolled_projections(e, 1);
   if (nu) emit_system(e);
-  out(e, "  for (i = 0; i < %d; i++) {\n", m);
-  for (int t = 0; t < T; t++) out(e, "    const int a%d = %s_tcon[%d * i + %d] < 0 ? %d : %s_tcon[%d * i + %d];\n", t, e->P, T, t, nu, e->P, T, t);
-  out(e, "    %s th[%d];\n", real_type(e, 0), s);
-  for (int j = 0; j < s; j++) {
-    out(e, "    th[%d] = psi[%d + i]", j, j * m);
-    for (int t = 0; t < T; t++) out(e, " + R[%d + %d * i] * r[a%d]", j * mt + t, T, t);
-    out(e, ";\n");
+  int nseg;
+  TconSeg *seg = rolled_tcon_segments(r, &nseg);
+  for (int g = 0; g < nseg; g++) {
+    rolled_tcon_open(e, &seg[g], 1);
+    out(e, "    %s th[%d];\n", real_type(e, 0), s);
+    for (int j = 0; j < s; j++) { /* (psi_j = 0 for j >= 1 is not read) */
+      int terms = j == 0 || !psi_zero(r);
+      out(e, terms ? "    th[%d] = psi[%d + i]" : "    th[%d] =", j, j * m);
+      for (int t = 0; t < T; t++)
+        if (rolled_tcon_guard(&seg[g], t)) out(e, "%sR[%d + %d * i] * r[a%d]", terms++ ? " + " : " ", j * mt + t, T, t);
+      out(e, terms ? ";\n" : " 0;\n");
+    }
+    rolled_gamma(e, 1);
+    out(e, "  }\n");
   }
-  rolled_gamma(e, 1);
-  out(e, "  }\n");
+  rolled_tcon_free(seg);
 }
 
 // Inside a loop over the coordinates i with th[j] = Theta_j at i: gamma_j =

@@ -252,6 +252,30 @@ START_TEST(test_size)
 }
 END_TEST
 
+/* Issue 29, the chain of 8 at 1.32 times the straight-line step: the sweep's
+ * loops over the coordinates read the constraints on each from the table
+ * tcon, with a branch per constraint. Now a chain's constraints are affine
+ * in i on four segments of coordinates (x and y, the last of each apart),
+ * and the sweep is printed per segment with the constraint indices as i +
+ * offset: no table, no test of a constraint's presence. */
+START_TEST(test_sweep_segments)
+{
+  char *text = chain_model(250), *src = generate_source(text, "--multiplier const -s 4 --rolled on");
+  free(text);
+  ck_assert_ptr_nonnull(src);
+  char *sweep = strstr(src, "_sweep(const double *q0");
+  ck_assert_ptr_nonnull(sweep);
+  char *end = strstr(sweep, "\n}\n");
+  ck_assert_ptr_nonnull(end);
+  *end = 0;
+  ck_assert_msg(!strstr(sweep, "_tcon["), "the rolled chain's sweep reads the table tcon");
+  ck_assert_msg(!strstr(sweep, ">= 0)"), "the rolled chain's sweep tests a constraint's presence");
+  ck_assert_int_eq(count(sweep, "/* coordinates 0..248 */"), 2); /* the system and Theta, x */
+  ck_assert_int_eq(count(sweep, "/* coordinates 250..498 */"), 2); /* and y */
+  free(src);
+}
+END_TEST
+
 /* variables x[30000] with a sum of squares: 37.6 MB of straight-line C,
  * refused (tests/check_lean.c); rolled by default, a third of a megabyte,
  * most of it q0 and p0. */
@@ -428,6 +452,7 @@ Suite *reroll_suite(void)
   tcase_add_test(tc, test_conservation);
   tcase_add_test(tc, test_events);
   tcase_add_test(tc, test_size);
+  tcase_add_test(tc, test_sweep_segments);
   tcase_add_test(tc, test_many_coordinates);
   tcase_add_test(tc, test_generator_memory);
   tcase_add_test(tc, test_choose);
