@@ -580,8 +580,10 @@ static Step *build_step(Model *mod, const Method *me, EmitOptions *eo) {
   }
   Step *st = step_build(mod, me);
   if (!st || roll_choose(mod, me, st, 0, eo)) return NULL;
-  /* the poly family's rolled factor is a band: its layout is not the straight-line one */
-  return eo->roll && me->family == MULT_POLY && mod->nu ? step_build_layout(mod, me) : st;
+  /* the poly family's rolled factor, and the Newton matrix's, are bands: their layout is
+   * not the straight-line one */
+  return eo->roll && ((me->family == MULT_POLY && mod->nu) || me->iteration != ITER_FIXED) ? step_build_layout(mod, me)
+                                                                                            : st;
 }
 
 // --check's last line: the code the options would write, emitted into
