@@ -73,7 +73,7 @@ void rolled_projections(Emitter *e, int jac);   /* psi (and with jac rho) into t
 void rolled_gamma(Emitter *e, int results);     /* gamma from th[] in the loop over i */
 struct RollRun;
 void rolled_run(Emitter *e, const struct RollRun *r, int os, int oo); /* one run: out[os u + oo] = item u */
-void rolled_int_table(Emitter *e, const char *name, const int *v, int n); /* static const int $P_name[n] */
+void rolled_int_table(Emitter *e, const char *type, const char *name, const int *v, int n); /* static const TYPE $P_name[n] */
 /* emit_rolled_newton.c: the Newton matrix's kernels as band loops */
 void rolled_newton_kernel(Emitter *e, KernelId k);
 /* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */

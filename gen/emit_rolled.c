@@ -143,7 +143,7 @@ static void emit_array(Emitter *e, const char *type, const char *name, const dou
   out(e, n > 0 ? "\n};\n" : "0};\n");
 }
 
-void rolled_int_table(Emitter *e, const char *name, const int *v, int n) { emit_array(e, "int", name, NULL, v, n); }
+void rolled_int_table(Emitter *e, const char *type, const char *name, const int *v, int n) { emit_array(e, type, name, NULL, v, n); }
 
 // B = G' M^-1 G in band storage from the Jacobian's entries, one loop over
 // the coordinates with the T constraints on each unrolled.

@@ -38,10 +38,10 @@ static void emit_hessian_family(Emitter *e) {
   const Roll *r = e->roll;
   int m = e->mod->m;
   tmpl(e, "\n/* Where row i's t-th entry of Hess U goes in the band of its row, or -1 */\n");
-  rolled_int_table(e, "hoff", r->hoff, m * r->ht);
+  rolled_int_table(e, "signed char", "hoff", r->hoff, m * r->ht); /* (2 HB + 1 <= 33: roll_newton.c) */
   if (r->hpos) {
     tmpl(e, "/* The place of coordinate i among the band's rows (Cuthill-McKee: a narrower band) */\n");
-    rolled_int_table(e, "npos", r->hpos, m);
+    rolled_int_table(e, "int", "npos", r->hpos, m);
     tmpl(e, "#define $P_NPOS(i) $P_npos[i]\n");
   } else {
     tmpl(e, "#define $P_NPOS(i) (i)  /* the band's rows in the natural order */\n");
@@ -74,21 +74,24 @@ static void emit_band_lu(Emitter *e, const NewtonBasis *nb) {
           "    $R *Ak = A + k * $P_NW + $P_NHB;  /* Ak[c] = A[k][k + c] */\n"
           "    const $R inv = 1 / Ak[0];\n"
           "    pivot[k] = Ak[0];\n"
+          "    const int nd = $P_M - 1 - k < $P_NHB ? $P_M - 1 - k : $P_NHB;  /* the band's rows below k */\n"
           "    Ak[0] = inv;\n"
-          "    for (d = 1; d <= $P_NHB && k + d < $P_M; d++) {\n"
+          "    for (d = 1; d <= nd; d++) {\n"
           "      $R *Ai = A + (k + d) * $P_NW + $P_NHB - d;  /* Ai[c] = A[k + d][k + c] */\n"
           "      const $R f = Ai[0] * inv;\n"
           "      Ai[0] = f;\n"
-          "      for (c = 1; c <= $P_NHB && k + c < $P_M; c++) Ai[c] -= f * Ak[c];\n"
+          "      for (c = 1; c <= nd; c++) Ai[c] -= f * Ak[c];\n"
           "    }\n  }\n}\n\n"
           "/* x = A^-1 x for A factored by $P_nband_factor. */\n"
           "static void $P_nband_solve(const $R *A, $R *x)\n{\n"
           "  int k, d;\n"
-          "  for (k = 0; k < $P_M; k++)\n"
-          "    for (d = 1; d <= $P_NHB && k + d < $P_M; d++) x[k + d] -= A[(k + d) * $P_NW + $P_NHB - d] * x[k];\n"
+          "  for (k = 0; k < $P_M; k++) {\n"
+          "    const int nd = $P_M - 1 - k < $P_NHB ? $P_M - 1 - k : $P_NHB;  /* the band's rows below k */\n"
+          "    for (d = 1; d <= nd; d++) x[k + d] -= A[(k + d) * $P_NW + $P_NHB - d] * x[k];\n  }\n"
           "  for (k = $P_M - 1; k >= 0; k--) {\n"
+          "    const int nd = $P_M - 1 - k < $P_NHB ? $P_M - 1 - k : $P_NHB;\n"
           "    $R acc = x[k];\n"
-          "    for (d = 1; d <= $P_NHB && k + d < $P_M; d++) acc -= A[k * $P_NW + $P_NHB + d] * x[k + d];\n"
+          "    for (d = 1; d <= nd; d++) acc -= A[k * $P_NW + $P_NHB + d] * x[k + d];\n"
           "    x[k] = acc * A[k * $P_NW + $P_NHB];\n  }\n}\n");
   if (pair) /* (every s >= 2) */
   tmpl(e, "\n/* The same for a complex A, entry (i, c) at A[2 (i * $P_NW + c - i + $P_NHB)] (re) and + 1 (im):\n"
@@ -102,27 +105,30 @@ static void emit_band_lu(Emitter *e, const NewtonBasis *nb) {
           "    $R *Ak = A + 2 * (k * $P_NW + $P_NHB);  /* Ak[2 c], Ak[2 c + 1] = A[k][k + c] */\n"
           "    const $R nn = Ak[0] * Ak[0] + Ak[1] * Ak[1], ir = Ak[0] / nn, ii = -Ak[1] / nn;\n"
           "    pivot[k] = sqrt$f(nn);\n"
+          "    const int nd = $P_M - 1 - k < $P_NHB ? $P_M - 1 - k : $P_NHB;\n"
           "    Ak[0] = ir;\n    Ak[1] = ii;\n"
-          "    for (d = 1; d <= $P_NHB && k + d < $P_M; d++) {\n"
+          "    for (d = 1; d <= nd; d++) {\n"
           "      $R *Ai = A + 2 * ((k + d) * $P_NW + $P_NHB - d);  /* Ai[2 c] .. = A[k + d][k + c] */\n"
           "      const $R fr = Ai[0] * ir - Ai[1] * ii, fi = Ai[0] * ii + Ai[1] * ir;\n"
           "      Ai[0] = fr;\n      Ai[1] = fi;\n"
-          "      for (c = 1; c <= $P_NHB && k + c < $P_M; c++) {\n"
+          "      for (c = 1; c <= nd; c++) {\n"
           "        Ai[2 * c] -= fr * Ak[2 * c] - fi * Ak[2 * c + 1];\n"
           "        Ai[2 * c + 1] -= fr * Ak[2 * c + 1] + fi * Ak[2 * c];\n"
           "      }\n    }\n  }\n}\n\n"
           "/* x = A^-1 x for A factored by $P_nband_factor_c, x complex (re, im side by side). */\n"
           "static void $P_nband_solve_c(const $R *A, $R *x)\n{\n"
           "  int k, d;\n"
-          "  for (k = 0; k < $P_M; k++)\n"
-          "    for (d = 1; d <= $P_NHB && k + d < $P_M; d++) {\n"
+          "  for (k = 0; k < $P_M; k++) {\n"
+          "    const int nd = $P_M - 1 - k < $P_NHB ? $P_M - 1 - k : $P_NHB;\n"
+          "    for (d = 1; d <= nd; d++) {\n"
           "      const $R *f = A + 2 * ((k + d) * $P_NW + $P_NHB - d);\n"
           "      x[2 * (k + d)] -= f[0] * x[2 * k] - f[1] * x[2 * k + 1];\n"
-          "      x[2 * (k + d) + 1] -= f[0] * x[2 * k + 1] + f[1] * x[2 * k];\n    }\n"
+          "      x[2 * (k + d) + 1] -= f[0] * x[2 * k + 1] + f[1] * x[2 * k];\n    }\n  }\n"
           "  for (k = $P_M - 1; k >= 0; k--) {\n"
           "    const $R *Ak = A + 2 * (k * $P_NW + $P_NHB);\n"
+          "    const int nd = $P_M - 1 - k < $P_NHB ? $P_M - 1 - k : $P_NHB;\n"
           "    $R re = x[2 * k], im = x[2 * k + 1];\n"
-          "    for (d = 1; d <= $P_NHB && k + d < $P_M; d++) {\n"
+          "    for (d = 1; d <= nd; d++) {\n"
           "      re -= Ak[2 * d] * x[2 * (k + d)] - Ak[2 * d + 1] * x[2 * (k + d) + 1];\n"
           "      im -= Ak[2 * d] * x[2 * (k + d) + 1] + Ak[2 * d + 1] * x[2 * (k + d)];\n    }\n"
           "    x[2 * k] = re * Ak[0] - im * Ak[1];\n"
