@@ -34,7 +34,7 @@ CHECK   := $(shell pkg-config --cflags check 2>/dev/null)
 CHECKLIB:= $(shell pkg-config --libs check 2>/dev/null)
 ALLCFLAGS = $(WARN) $(CFLAGS) $(SAN) -MMD -MP
 
-GEN_SRC  := util.c ast.c dag.c bounds.c ad.c mass.c model.c stiffness.c switch.c method.c lu.c step.c step_const.c step_poly.c step_newton.c mass_q.c step_mq.c emit_kernel.c emit_choice.c emit_api.c emit_predict.c emit_estimate.c emit_iterate.c emit_newton.c emit_mq.c emit_end.c emit_step.c emit_project.c emit_batch.c emit_batch_step.c emit_batch_mq.c emit_batch_by_lane.c emit_solver.c emit_main.c roll.c roll_pair.c emit_rolled.c emit_rolled_poly.c emit_rolled_pairs.c emit_rolled_batch.c emit_rolled_tcon.c
+GEN_SRC  := util.c ast.c dag.c bounds.c ad.c mass.c model.c stiffness.c switch.c method.c lu.c step.c step_const.c step_poly.c step_newton.c mass_q.c step_mq.c emit_kernel.c emit_choice.c emit_api.c emit_predict.c emit_estimate.c emit_iterate.c emit_newton.c emit_mq.c emit_end.c emit_step.c emit_project.c emit_batch.c emit_batch_step.c emit_batch_mq.c emit_batch_by_lane.c emit_solver.c emit_main.c roll.c roll_pair.c roll_newton.c emit_rolled.c emit_rolled_poly.c emit_rolled_pairs.c emit_rolled_batch.c emit_rolled_newton.c emit_rolled_tcon.c
 GEN_OBJ  := $(addprefix $(B)/gen/,$(GEN_SRC:.c=.o) parser.o lexer.o)
 RT_OBJ   := $(patsubst runtime/%.c,$(B)/runtime/%.o,$(wildcard runtime/*.c))
 SOLVERS  := $(shell grep -v '^\#' generated/LIST | awk 'NF {sub(/:.*/, "", $$1); print $$1 "_k" $$2 "s" $$3}')

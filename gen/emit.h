@@ -79,6 +79,11 @@ TconSeg *rolled_tcon_segments(const struct Roll *r, int *n);
 void rolled_tcon_free(TconSeg *s);
 void rolled_tcon_open(Emitter *e, const TconSeg *s, int pad); /* for (i ...) { and a0.. */
 const char *rolled_tcon_guard(const TconSeg *s, int t);       /* "", "if (a >= 0) " or NULL */
+struct RollRun;
+void rolled_run(Emitter *e, const struct RollRun *r, int os, int oo); /* one run: out[os u + oo] = item u */
+void rolled_int_table(Emitter *e, const char *type, const char *name, const int *v, int n); /* static const TYPE $P_name[n] */
+/* emit_rolled_newton.c: the Newton matrix's kernels as band loops */
+void rolled_newton_kernel(Emitter *e, KernelId k);
 /* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */
 void rolled_poly_helpers(Emitter *e);
 void rolled_poly_kernel(Emitter *e, KernelId k);

@@ -89,6 +89,8 @@ static void emit_run(Emitter *e, const RollRun *r, int os, int oo, int reps, int
   out(e, "  }\n");
 }
 
+void rolled_run(Emitter *e, const RollRun *r, int os, int oo) { emit_run(e, r, os, oo, 1, 0, 0, 0); }
+
 // A family as the function $P_roll_NAME(q, v, prm, out): out[i] for its
 // items; with mode 1 out[0] = the sum of them in order, with mode -1 out[i]
 // += item i.
@@ -178,6 +180,8 @@ static void emit_array(Emitter *e, const char *type, const char *name, const dou
   }
   out(e, n > 0 ? "\n};\n" : "0};\n");
 }
+
+void rolled_int_table(Emitter *e, const char *type, const char *name, const int *v, int n) { emit_array(e, type, name, NULL, v, n); }
 
 // B = G' M^-1 G in band storage from the Jacobian's entries, one loop over
 // the coordinates with the T constraints on each unrolled.
@@ -545,13 +549,14 @@ static void emit_state_kernel(Emitter *e, KernelId id) {
 int emit_rolled_kernel(Emitter *e, KernelId id) {
   int poly = e->me->family == MULT_POLY && e->mod->nu;
   if (id != K_SWEEP && id != K_MINV_P && id != K_ENERGY && id != K_G && id != K_HIDDEN && id != K_LAMBDA0 &&
-      id != K_CONSISTENT && !(poly && (id == K_FACTOR || id == K_PROJECT)))
+      id != K_CONSISTENT && !(poly && (id == K_FACTOR || id == K_PROJECT)) && id != K_NFACTOR && id != K_NSOLVE)
     return 0; /* the params' q0, p0 and the events stay straight-line: they are small or rare */
   if (e->lanes) { /* --batch: the scalar kernel above in each lane (emit_rolled_batch.c) */
     emit_rolled_lane_kernel(e, id);
     return 1;
   }
   if (!e->roll_helpers) emit_helpers(e);
+  if (id == K_NFACTOR || id == K_NSOLVE) return rolled_newton_kernel(e, id), 1; /* emit_rolled_newton.c */
   const Kernel *k = &e->st->kern[id];
   e->kid = id;
   out(e, "\n/* %s (rolled) */\n", k->what);

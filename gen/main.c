@@ -62,8 +62,9 @@ static const char usage[] =
     "                auto (default): fixed's code for a model that is not stiff at q0\n"
     "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
     "                where they are slow (--check says which). Newton: in both multiplier\n"
-    "                families and with --batch (each lane the scalar step in turn); not\n"
-    "                with --wide-step (docs/method-newton.md)\n";
+    "                families and with --batch (each lane the scalar step in turn), and\n"
+    "                rolled (--rolled) without constraints where the Hessian of U is a\n"
+    "                band; not with --wide-step (docs/method-newton.md)\n";
 
 /* (the rest of the usage, apart: a C99 compiler need not take a string over 4095 bytes) */
 static const char usage_more[] =
@@ -96,7 +97,9 @@ static const char usage_more[] =
     "                docs/rolled.md): one loop body per run of uniform terms of U, g\n"
     "                and their derivatives, and the banded multiplier system as a loop\n"
     "                (both multiplier families, float, adaptive steps, dense output,\n"
-    "                events and --batch, whose lanes run the rolled kernels one by one);\n"
+    "                events and --batch, whose lanes run the rolled kernels one by one;\n"
+    "                --iteration newton without constraints, the Newton matrix factored\n"
+    "                over its band);\n"
     "                auto (default) rolls a large model the form covers, on insists\n"
     "                (an error says what it does not cover yet), off never rolls\n"
     "  -h, --help    this text\n"
@@ -580,8 +583,10 @@ static Step *build_step(Model *mod, const Method *me, EmitOptions *eo) {
   }
   Step *st = step_build(mod, me);
   if (!st || roll_choose(mod, me, st, 0, eo)) return NULL;
-  /* the poly family's rolled factor is a band: its layout is not the straight-line one */
-  return eo->roll && me->family == MULT_POLY && mod->nu ? step_build_layout(mod, me) : st;
+  /* the poly family's rolled factor, and the Newton matrix's, are bands: their layout is
+   * not the straight-line one */
+  return eo->roll && ((me->family == MULT_POLY && mod->nu) || me->iteration != ITER_FIXED) ? step_build_layout(mod, me)
+                                                                                            : st;
 }
 
 // --check's last line: the code the options would write, emitted into

@@ -158,6 +158,14 @@ static int family(Walk *w, RollFamily *f, const int *nodes, const int *base, int
   return 0;
 }
 
+int roll_family(Dag *d, int m, RollFamily *f, const int *nodes, const int *base, int n) {
+  Walk w = {d, m, NULL, NULL, 0, 0, {0}, {0}, {0}, {0}, {0}};
+  int rc = family(&w, f, nodes, base, n);
+  free(w.stamp);
+  free(w.local);
+  return rc;
+}
+
 // The family of the n items nodes[] split into affine, linear part and
 // curved (RollSplit), the items one per coordinate (base[u] = u). Returns 0
 // or -1 as family does.
@@ -305,7 +313,8 @@ static Roll *analyse_roll(Model *mod, const char **why) {
 
 // What of the method and options the rolled form does not cover yet, or NULL.
 static const char *not_covered(const Model *mod, const Method *me, const EmitOptions *eo) {
-  if (me->iteration != ITER_FIXED) return "it covers --iteration fixed only";
+  if (me->iteration != ITER_FIXED && mod->nu)
+    return "it covers --iteration newton and auto on models without constraints only (docs/rolled.md)";
   if (eo->wide_step) return "it does not cover --wide-step";
   if (mod->mass_q || mod->minv_node || mod->mass == MASS_DENSE) return "it covers a constant diagonal mass matrix only";
   return NULL;
@@ -361,6 +370,7 @@ int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOp
   int big = layout || (!on && !why && sweep_ops(mod, st) >= ROLL_AUTO_OPS);
   if (!on && !layout && (why || (!big && mod->m < ROLL_AUTO_PAIR_M))) return 0;
   Roll *r = why ? NULL : analyse_roll(mod, &why);
+  if (r && me->iteration != ITER_FIXED && roll_hessian(mod, r, &why)) r = NULL; /* the Newton matrix's band */
   if (r && !on && !auto_rolls(r, big)) return 0; /* little repetition: straight-line is as short */
   if (!r && on) {
     error_at(mod->nu ? mod->g_loc[0] : mod->U_loc, "--rolled on: the rolled form cannot print this model: %s", why);
@@ -376,6 +386,8 @@ void roll_reach(const Roll *r, const Dag *d, unsigned char *mark) {
   const RollFamily *fam[] = {&r->gradU, &r->g, &r->U, &r->hvv, &r->gradU_s.affine, &r->gradU_s.lin, &r->gradU_s.curved};
   for (size_t f = 0; f < sizeof fam / sizeof *fam; f++)
     for (int i = 0; i < fam[f]->nruns; i++) dag_reach(d, fam[f]->runs[i].body, fam[f]->runs[i].nbody, mark);
+  for (int t = 0; r->hess && t < r->ht; t++)
+    for (int i = 0; i < r->hess[t].nruns; i++) dag_reach(d, r->hess[t].runs[i].body, r->hess[t].runs[i].nbody, mark);
   for (int t = 0; t < r->T; t++) {
     const RollFamily *jf[] = {&r->jac[t], &r->jac_s[t].affine, &r->jac_s[t].lin, &r->jac_s[t].curved};
     for (int f = 0; f < 4; f++)

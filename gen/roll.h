@@ -46,7 +46,7 @@ enum { ROLL_OFF, ROLL_ON, ROLL_AUTO };
  * the index: item u (u0 <= u < u0 + n) has the base index b0 + stride (u -
  * u0), and its expression is body[] (in post-order, the root last) with
  * each input at its offset from the base. */
-typedef struct {
+typedef struct RollRun {
   int u0, n;
   int b0, stride;
   int *body, nbody;
@@ -111,6 +111,12 @@ typedef struct Roll {
   int curved;         /* some entry is curved: the stages are evaluated */
   int lin;            /* some affine entry is not constant: h (X gamma)_j is needed */
   RollPairs *pairs;   /* U as pair runs, grad U scattered from them (gradU, gradU_s unused), or NULL */
+  /* --iteration newton, auto (roll_newton.c): Hess U, row i's t-th structural nonzero
+   * (t < ht) in family hess[t], at column hcol; in the Newton matrix's band (half band
+   * hb) row i is row hpos[i] (NULL: i), the entry at hoff[i ht + t] from the row's
+   * start (-1: none) */
+  int hb, ht, *hoff, *hpos;
+  RollFamily *hess;
 } Roll;
 
 /* Choosing the form from eo->rolled. roll_plan says which step to build
@@ -123,6 +129,14 @@ typedef struct Roll {
  * not cover), else 0. */
 int roll_plan(const Model *mod, const Method *me, const EmitOptions *eo);
 int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOptions *eo);
+/* The n items nodes[] (base[u] their base indices, or NULL: the lowest
+ * coordinate each reads) split into runs (roll.c). Returns 0, or -1 when an
+ * item cannot be printed or there are more than ROLL_MAX_RUNS runs. */
+int roll_family(Dag *d, int m, RollFamily *f, const int *nodes, const int *base, int n);
+/* roll_newton.c: Hess U as band families into r->hb, r->hess, for the rolled
+ * Newton kernels; -1 with *why set where the rolled form cannot (a pair sum,
+ * a band too wide, a diagonal not uniform in the index). */
+int roll_hessian(Model *mod, Roll *r, const char **why);
 /* Mark (dag_reach) the nodes the rolled kernels print of the model. */
 void roll_reach(const struct Roll *r, const Dag *d, unsigned char *mark);
 #endif

@@ -656,10 +656,10 @@ static Step *build_step(Model *mod, const Method *me, int lean) {
     return st;
   }
   if (lean) { /* the rolled kernels: their layout only */
-    ASSERT(me->iteration == ITER_FIXED);
     if (poly) layout_poly_multiplier(&b);
     else layout_const_multiplier(&b);
     build_diagnostics(&b);
+    if (me->iteration != ITER_FIXED) layout_newton_rolled(&b); /* (no constraints: roll.c) */
     return st;
   }
   build_stages(&b);

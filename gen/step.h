@@ -75,7 +75,9 @@ typedef struct {
 
 void newton_method_matrix(const Method *me, double *A); /* s x s */
 void newton_basis(const Method *me, NewtonBasis *nb);
+double newton_midpoint_weight(const Method *me, int j); /* int_0^{1/2} P_j: J's point in the step */
 void build_newton(Build *b);
+void layout_newton_rolled(Build *b); /* roll_newton.c: the rolled Newton kernels' layout */
 
 /* lu.c: linear systems of DAG nodes, solved at generation time in structure */
 void lu_solve_ordered(Dag *d, const int *A, const int *r, int n, int *x, int *pivot, int *diag);

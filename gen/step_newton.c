@@ -238,6 +238,8 @@ static double half_integral(const Method *me, int j) {
   return me->xi[j + 1] * pp - me->xi[j] * pm;
 }
 
+double newton_midpoint_weight(const Method *me, int j) { return half_integral(me, j); }
+
 // The Hessian of the Lagrangian U + lambda' g as dense m x m nodes at the
 // point q, lambda the input lam (the first nu entries: the state's
 // multiplier; none without constraints, where it is Hess U).

@@ -1,0 +1,253 @@
+/* check_rollnewton.c - Check suite for --iteration newton on the rolled form
+ * (gen/roll_newton.c, gen/emit_rolled_newton.c, docs/rolled.md "Newton"):
+ * the Newton matrix's blocks as bands, on the stiff FPU chain without
+ * constraints (tests/models/fpu_n8.ham, fpu_n500.ham: models/fpu.ham with N
+ * = 8 and 500, omega a param).
+ *
+ *   same      the rolled Newton step against the straight-line Newton step
+ *             (chain of 8, s = 2 and 3, omega = 1000, h omega = 10 and 100,
+ *             T = 4): the same trajectory up to the reordering of the
+ *             elimination (REORDER_TOL), and the same Newton iterations and
+ *             factorisations in all;
+ *   converge  every step of the rolled chains of 8 and 500 (m = 1000)
+ *             converges at h omega = 10, 100, 1000 (omega = 1000) and 10,
+ *             100 (omega = 50; h omega = 1000 is h = 20, the step the
+ *             rollback test makes fail) in a bounded number of iterations
+ *             and factorisations, H at round-off (the bound of
+ *             tests/check_newton.c);
+ *   fixed     on the chain of 500 at h omega = 1 (where the sweeps converge)
+ *             the rolled Newton step follows the rolled fixed-point step to
+ *             round-off;
+ *   rollback  a step that fails (h = 20) leaves the state byte-identical;
+ *   batch     --batch 2: each lane is bitwise the rolled scalar Newton step;
+ *   refused   what the rolled form does not cover under Newton (constraints,
+ *             a pair sum, whose Hessian is full) is a located error, and
+ *             --rolled auto falls back; a chain x[i] rolls with its band in
+ *             the natural order.
+ * The suite is rollnewton_suite(); the project's runner adds it. */
+#include <check.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "generate.h"
+#include "rn500_fixed_k4s2.h"
+#include "rn500_k4s2.h"
+#include "rn8_k4s2.h"
+#include "rn8_straight_k4s2.h"
+#include "rn8s3_k6s3.h"
+#include "rn8s3_straight_k6s3.h"
+#include "rnb8_k4s2.h"
+
+Suite *rollnewton_suite(void);
+
+/* The two forms compute the same Newton matrix and solve it by eliminations
+ * in another order (band in Cuthill-McKee order, a pair's block in complex
+ * arithmetic, against lu.c's minimum-degree order of its real form): the
+ * corrections differ by a few ulps of gamma each iteration, and the converged
+ * steps by round-off (measured at most 8e-14 over the runs below). */
+#define REORDER_TOL 1e-11
+
+typedef struct {
+  int steps, failed, max_iters, max_factors;
+  long iters, factors;
+  double dH, H0, diff;
+} Run;
+
+/* Step solver P and solver C beside it (the largest difference of q, p
+ * into r.diff) at omega = w in steps of h to T; counts and |H - H0|. */
+#define RUN(P, C, w, h, T, r)                                                                     \
+  do {                                                                                             \
+    P##_params prm_;                                                                               \
+    P##_state x_;                                                                                  \
+    C##_params cprm_;                                                                              \
+    C##_state y_;                                                                                  \
+    memset(&(r), 0, sizeof(r));                                                                    \
+    P##_params_default(&prm_);                                                                     \
+    C##_params_default(&cprm_);                                                                    \
+    prm_.omega = cprm_.omega = (w);                                                                \
+    P##_init_params(&x_, NULL, NULL, &prm_);                                                       \
+    C##_init_params(&y_, NULL, NULL, &cprm_);                                                      \
+    (r).H0 = P##_energy(&x_, &prm_);                                                               \
+    (r).steps = (int)lround((T) / (h));                                                            \
+    for (int n_ = 0; n_ < (r).steps; n_++) {                                                       \
+      P##_stats st_;                                                                               \
+      C##_stats ct_;                                                                               \
+      if (P##_step(&x_, (h), &prm_, &st_) != P##_OK) {                                             \
+        (r).failed++;                                                                              \
+        break;                                                                                     \
+      }                                                                                            \
+      if (C##_step(&y_, (h), &cprm_, &ct_) != C##_OK) {                                            \
+        (r).failed++;                                                                              \
+        break;                                                                                     \
+      }                                                                                            \
+      (r).iters += st_.newton;                                                                     \
+      (r).factors += st_.factors;                                                                  \
+      if (st_.iters > (r).max_iters) (r).max_iters = st_.iters;                                    \
+      if (st_.factors > (r).max_factors) (r).max_factors = st_.factors;                            \
+      (r).dH = fmax((r).dH, fabs(P##_energy(&x_, &prm_) - (r).H0));                                \
+      for (int i_ = 0; i_ < P##_M; i_++)                                                           \
+        (r).diff = fmax((r).diff, fmax(fabs(x_.q[i_] - y_.q[i_]), fabs(x_.p[i_] - y_.p[i_])));     \
+    }                                                                                              \
+  } while (0)
+
+/* Rolled against straight-line Newton on the chain of 8: measured at most
+ * 3.2e-14 (s = 2) and 7.2e-14 (s = 3) apart over T = 4, the same counts. */
+START_TEST(test_same_as_straight)
+{
+  static const double h[2] = {0.01, 0.1};
+  for (int c = 0; c < 2; c++) {
+    Run a, b, a3, b3;
+    RUN(rn8_k4s2, rn8_straight_k4s2, 1000, h[c], 4.0, a);
+    RUN(rn8_straight_k4s2, rn8_straight_k4s2, 1000, h[c], 4.0, b);
+    RUN(rn8s3_k6s3, rn8s3_straight_k6s3, 1000, h[c], 4.0, a3);
+    RUN(rn8s3_straight_k6s3, rn8s3_straight_k6s3, 1000, h[c], 4.0, b3);
+    printf("rolled vs straight-line Newton, h omega = %g: s = 2 %.3g apart (%ld / %ld iterations), s = 3 %.3g\n",
+           1000 * h[c], a.diff, a.iters, b.iters, a3.diff);
+    ck_assert_msg(!a.failed && !b.failed && !a3.failed && !b3.failed, "h omega = %g: a step failed", 1000 * h[c]);
+    ck_assert_msg(a.diff <= REORDER_TOL && a3.diff <= REORDER_TOL, "h omega = %g: the forms are %.3g (s = 2), %.3g (s = 3) apart",
+                  1000 * h[c], a.diff, a3.diff);
+    ck_assert_msg(a.factors == b.factors && a3.factors == b3.factors, "h omega = %g: %ld / %ld factorisations",
+                  1000 * h[c], a.factors, b.factors);
+    ck_assert_msg(labs(a.iters - b.iters) <= a.steps / 10 && labs(a3.iters - b3.iters) <= a3.steps / 10,
+                  "h omega = %g: %ld / %ld iterations (s = 2), %ld / %ld (s = 3)", 1000 * h[c], a.iters, b.iters, a3.iters, b3.iters);
+  }
+}
+END_TEST
+
+/* Every step converges, in at most 12 iterations up to h omega = 100 at
+ * omega = 1000, 40 at h omega = 1000 and at omega = 50 (measured, chain of
+ * 8 / of 500: 5 / 5, 8 / 8 and 25 / 26 at omega = 1000; 10 / 11 at omega =
+ * 50, h omega = 10; 14 on the chain of 8 at h omega = 30, h = 0.6, the
+ * longest step check_stiff.c takes at omega = 50), within NAME_REFRESH = 4
+ * factorisations; H within 8 ulps of (1 + h omega) H0 a step as a random
+ * walk (measured at most 0.062 of that bound). The chain of 500 starts with
+ * every site moving (H0 = 750). Not tested: omega = 50 at h = 2 (h omega =
+ * 100), where the soft springs' nonlinearity over the step, not the
+ * stiffness, sets the contraction (a local error estimate of 7: no step a
+ * user would take); there the chain of 8 took 37 and 58 iterations before
+ * the accelerated update (docs/method-newton.md), 71 and 95 with it, and the
+ * rolled step's rounding then fails one step, which the driver halves. */
+START_TEST(test_converges)
+{
+  static const struct {
+    double omega, hw, T;
+    int iters, large;
+  } cases[] = {{1000, 10, 2, 12, 1}, {1000, 100, 2, 12, 1}, {1000, 1000, 2, 40, 1}, {50, 10, 2, 40, 1}, {50, 30, 4, 40, 0}};
+  for (size_t c = 0; c < sizeof cases / sizeof *cases; c++) {
+    Run r[2];
+    double h = cases[c].hw / cases[c].omega;
+    RUN(rn8_k4s2, rn8_k4s2, cases[c].omega, h, cases[c].T, r[0]);
+    if (cases[c].large) RUN(rn500_k4s2, rn500_k4s2, cases[c].omega, h, cases[c].T, r[1]);
+    for (int n = 0; n < 1 + cases[c].large; n++) {
+      double bound = 8 * DBL_EPSILON * (1 + cases[c].hw) * fabs(r[n].H0) * sqrt(r[n].steps);
+      printf("rolled Newton, m = %d, omega = %g, h omega = %g: %d steps, %d iterations at most, %d factorisations, "
+             "|H - H0| %.3g\n", n ? 1000 : 16, cases[c].omega, cases[c].hw, r[n].steps, r[n].max_iters, r[n].max_factors, r[n].dH);
+      ck_assert_msg(!r[n].failed, "m = %d, omega = %g, h omega = %g: a step failed", n ? 1000 : 16, cases[c].omega, cases[c].hw);
+      ck_assert_msg(r[n].max_iters <= cases[c].iters && r[n].max_factors <= 4, "omega = %g, h omega = %g: %d iterations, %d factorisations",
+                    cases[c].omega, cases[c].hw, r[n].max_iters, r[n].max_factors);
+      ck_assert_msg(r[n].dH <= bound, "omega = %g, h omega = %g: |H - H0| = %.3g > %.3g", cases[c].omega, cases[c].hw, r[n].dH, bound);
+    }
+  }
+}
+END_TEST
+
+/* At h omega = 1 the rolled fixed-point step converges too: the chain of 500
+ * under Newton follows it over T = 1 (1000 steps) to the round-off of two
+ * iterations that both converge, each committing its own last iterate
+ * (measured 9.4e-13; asserted 1e-10). */
+START_TEST(test_same_as_fixed)
+{
+  Run r;
+  RUN(rn500_k4s2, rn500_fixed_k4s2, 1000, 0.001, 1.0, r);
+  printf("rolled Newton vs rolled fixed point, m = 1000, h omega = 1: %.3g apart\n", r.diff);
+  ck_assert_msg(!r.failed, "a step failed");
+  ck_assert_msg(r.diff <= 1e-10, "the iterations' steps are %.3g apart", r.diff);
+}
+END_TEST
+
+/* A step too long for the soft springs' nonlinearity (h = 20) fails; the
+ * state, the kept factor and the compensations included, is unchanged to
+ * the byte. */
+START_TEST(test_failed_step_rolls_back)
+{
+  rn500_k4s2_state x, before;
+  rn500_k4s2_params prm;
+  rn500_k4s2_params_default(&prm);
+  memset(&x, 0, sizeof x);
+  rn500_k4s2_init_params(&x, NULL, NULL, &prm);
+  for (int n = 0; n < 3; n++) ck_assert_int_eq(rn500_k4s2_step(&x, 0.1, &prm, NULL), rn500_k4s2_OK);
+  memcpy(&before, &x, sizeof x);
+  int rc = rn500_k4s2_step(&x, 20, &prm, NULL);
+  ck_assert_int_ne(rc, rn500_k4s2_OK);
+  ck_assert_msg(!memcmp(&before, &x, sizeof x), "the failed step (%s) changed the state", rn500_k4s2_strerror(rc));
+}
+END_TEST
+
+/* --batch 2 on the rolled Newton step: lanes at omega = 1000 and 500 (h
+ * omega = 10 and 5), then a step of h = 20 that fails in both; each lane's
+ * state and code bitwise the scalar step's. */
+START_TEST(test_batch_lanes)
+{
+  rnb8_k4s2_batch b;
+  rnb8_k4s2_state s[2], y;
+  rnb8_k4s2_params prm[2];
+  rnb8_k4s2_batch_stats bs;
+  memset(&b, 0, sizeof b);
+  for (int l = 0; l < 2; l++) {
+    rnb8_k4s2_params_default(&prm[l]);
+    prm[l].omega = l ? 500 : 1000;
+    rnb8_k4s2_init_params(&s[l], NULL, NULL, &prm[l]);
+    rnb8_k4s2_batch_set(&b, l, &s[l]);
+  }
+  for (int n = 0; n < 21; n++) {
+    double h = n < 20 ? 0.01 : 20;
+    rnb8_k4s2_batch_step(&b, h, prm, &bs);
+    for (int l = 0; l < 2; l++) {
+      int rc = rnb8_k4s2_step(&s[l], h, &prm[l], NULL);
+      ck_assert_msg(bs.code[l] == rc, "step %d lane %d: code %d, scalar %d", n, l, bs.code[l], rc);
+      ck_assert(n < 20 || rc != rnb8_k4s2_OK);
+      rnb8_k4s2_batch_get(&b, l, &y);
+      ck_assert_msg(!memcmp(&y, &s[l], sizeof y), "step %d lane %d: the state differs from the scalar step's", n, l);
+    }
+  }
+}
+END_TEST
+
+/* What the rolled form does not cover under Newton is refused, at the
+ * model's line; --rolled auto falls back to straight-line code there. */
+START_TEST(test_refused)
+{
+  char out[4096];
+  ck_assert_int_ne(generator_output("--check --rolled on --iteration newton ../models/chain8.ham", out, sizeof out), 0);
+  ck_assert_msg(strstr(out, "chain8.ham:") && strstr(out, "without constraints only"), "constraints: %s", out);
+  static const char pairs[] = "N = 12\nvariables x[N]\nU = sum(i in 1..N - 1, j in i + 1..N, ((x[i] - x[j])^2 - 1)^2)\n"
+                              "q0 = [0.1 * i for i in 1..N]\np0 = [0 for i in 1..N]\n";
+  ck_assert_ptr_null(generate_source(pairs, "-s 2 --iteration newton --rolled on")); /* the band would be full */
+  char *a = generate_source(pairs, "-s 2 --iteration newton");
+  ck_assert_msg(a && !strstr(a, "(rolled)"), "--rolled auto rolled a pair sum under Newton");
+  free(a);
+  char *c = generate_source("N = 64\nvariables x[N]\nU = sum(i in 1..N - 1, (x[i + 1] - x[i])^4) + sum(i in 1..N, x[i]^2)\n"
+                            "q0 = [0.1 for i in 1..N]\np0 = [0 for i in 1..N]\n", "-s 2 --iteration newton --rolled on");
+  ck_assert_msg(c && strstr(c, "_nband_factor_c") && strstr(c, "(i)  /* the band's rows in the natural order"),
+                "the chain x[64] under Newton was not rolled with its band in the natural order");
+  free(c);
+}
+END_TEST
+
+Suite *rollnewton_suite(void)
+{
+  Suite *s = suite_create("rollnewton");
+  TCase *tc = tcase_create("rolled Newton");
+  tcase_set_timeout(tc, 600);
+  tcase_add_test(tc, test_same_as_straight);
+  tcase_add_test(tc, test_converges);
+  tcase_add_test(tc, test_same_as_fixed);
+  tcase_add_test(tc, test_failed_step_rolls_back);
+  tcase_add_test(tc, test_batch_lanes);
+  tcase_add_test(tc, test_refused);
+  suite_add_tcase(s, tc);
+  return s;
+}
