@@ -116,7 +116,7 @@ static void emit_anderson(Emitter *e) {
 // What NAME_step_within needs before its body: the checked factorisation,
 // NAME_REUSE (and under --iteration auto the limit of the sweeps, NAME_SWITCH).
 void emit_newton_helpers(Emitter *e) {
-  tmpl(e, "#ifndef $P_REUSE\n#define $P_REUSE 1e-3  /* a factor kept across steps while it contracts below this */\n#endif\n");
+  tmpl(e, "#ifndef $P_REUSE\n#define $P_REUSE 1e-3$f  /* a factor kept across steps while it contracts below this */\n#endif\n");
   if (emit_is_auto(e))
     tmpl(e, "#ifndef $P_SWITCH\n#define $P_SWITCH 12  /* sweeps foreseen above which Newton takes over (auto) */\n#endif\n");
   emit_factor_checked(e);
@@ -282,7 +282,7 @@ void emit_auto_iteration(Emitter *e) {
 // then ends with rc not NAME_OK, and Newton takes over.
 void emit_auto_slow(Emitter *e) {
   tmpl(e, "    /* slow: more than $P_SWITCH sweeps foreseen at the contraction of the last two */\n"
-          "    if (it >= 3 && !(inc < inc_pp && it + 2 * log(inc * 256 / $P_TOL) / log(inc_pp / inc) <= $P_SWITCH)) {\n"
+          "    if (it >= 3 && !(inc < inc_pp && it + 2 * log$f(inc * 256 / $P_TOL) / log$f(inc_pp / inc) <= $P_SWITCH)) {\n"
           "      rc = $P_ENOCONV;\n      break;\n    }\n"
           "    inc_pp = inc_old;\n");
 }

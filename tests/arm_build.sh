@@ -65,7 +65,7 @@ echo "arm_build.sh: $n committed solvers compiled for cortex-m4 (fpv4-sp-d16, -f
 # q0, p0, NAME_energy, NAME_constraints, NAME_hidden, NAME_project, the
 # statistics).
 FMATH=$(for f in $MATH; do printf '%sf ' "$f"; done)
-for model in kepler pendulum_angle satellites double_pendulum_angles; do
+for model in kepler pendulum_angle satellites double_pendulum_angles stiff_bob; do
   mkdir -p "$tmp/$model"
   if ! "$GEN" --real float -s 2 -n "${model}_f" -o "$tmp/$model" "../models/$model.ham" 2>"$tmp/log"; then
     echo "arm_build.sh: hbvmgen --real float failed on $model.ham:"
