@@ -41,8 +41,8 @@ static void emit_factor_checked(Emitter *e) {
   tmpl(e, "#ifndef $P_REFRESH\n#define $P_REFRESH 4  /* factorisations of the Newton matrix a step, at most */\n#endif\n");
   /* (the accelerated iteration contracts at about 1/2 on the stiff bob with J frozen for
    * the step, and a fresh J there buys few iterations: refreshed only where it stalls) */
-  tmpl(e, newton_poly(e) ? "#ifndef $P_SLOW\n#define $P_SLOW 0.5$f  /* a contraction above this refreshes J */\n#endif\n"
-                         : "#ifndef $P_SLOW\n#define $P_SLOW 0.9$f  /* a contraction above this refreshes J */\n#endif\n");
+  tmplf(e, "#ifndef $P_SLOW\n#define $P_SLOW %s$f  /* a contraction above this refreshes J */\n#endif\n",
+        newton_poly(e) ? "0.5" : "0.9");
   tmpl(e, ""
           "/* The Newton matrix I + h^2 A (x) M^-1 J at the polynomial gam, factored into nf.\n");
   if (nu) tmpl(e, " * J = Hess(U + lam' g), lam the multiplier (its first $P_NU entries are read).\n");
@@ -92,16 +92,17 @@ static void emit_anderson(Emitter *e) {
           "static void $P_anderson($R *x, const $R *dx, $R *h, int *nh)\n{\n"
           "  enum { N = $P_S * $P_M };\n"
           "  $R *xp = h, *fp = h + N, *dx1 = h + 2 * N, *df1 = h + 3 * N, dx0[N], df0[N], t0 = 0, t1 = 0;\n"
-          "  $R g00 = 0, g01 = 0, g11 = 0, r0 = 0, r1 = 0;\n"
+          "  $R g00 = 0, g01 = 0, g11 = 0, r0 = 0, r1 = 0, det;\n"
           "  int i, n = *nh;\n"
           "  for (i = 0; i < N; i++) {\n"
           "    dx0[i] = n ? x[i] - xp[i] : 0;\n    df0[i] = n ? dx[i] - fp[i] : 0;\n"
           "    g00 += df0[i] * df0[i];\n    r0 += df0[i] * dx[i];\n"
           "    if (n == 2) {  /* (dx1, df1 unset before) */\n"
           "      g01 += df0[i] * df1[i];\n      g11 += df1[i] * df1[i];\n      r1 += df1[i] * dx[i];\n    }\n  }\n"
-          "  if (n == 2 && g00 * g11 - g01 * g01 > sqrt$f($P_TOL) * g00 * g11) {  /* two columns, well conditioned */\n"
-          "    t0 = (r0 * g11 - r1 * g01) / (g00 * g11 - g01 * g01);\n"
-          "    t1 = (g00 * r1 - g01 * r0) / (g00 * g11 - g01 * g01);\n"
+          "  det = g00 * g11 - g01 * g01;\n"
+          "  if (n == 2 && det > sqrt$f($P_TOL) * g00 * g11) {  /* two columns, well conditioned */\n"
+          "    t0 = (r0 * g11 - r1 * g01) / det;\n"
+          "    t1 = (g00 * r1 - g01 * r0) / det;\n"
           "  } else if (n >= 1 && g00 > 0) {\n    t0 = r0 / g00;\n  }\n"
           "  if (!isfinite(t0) || !isfinite(t1)) t0 = t1 = 0;\n"
           "  for (i = 0; i < N; i++) {\n"
