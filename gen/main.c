@@ -691,8 +691,10 @@ static void report_degree(const Model *mod, int s, int k) {
  * sets h. The paper's models are at most 56 (satellites), the stiff bob at
  * k = 1e4 is 107, the FPU chain 47 at omega = 50 and 945 at omega = 1000. */
 #define STIFF_RATIO 75
-/* ... and auto emits Newton only up to this m: its factorisation is unrolled
- * (m^3 operations for a dense Hessian; the loop form is not done), and a
+/* ... and auto emits Newton only up to this m: its straight-line factorisation
+ * is unrolled (m^3 operations for a dense Hessian; the band loops of the
+ * rolled form, docs/rolled.md "Newton", cover models without constraints but
+ * are not chosen by auto, which decides the iteration before the form), and a
  * long chain's frequencies alone spread like m (tests/check_lean.c's dense
  * chain of m = 160 would have taken more than 4 MB of C). */
 #define AUTO_NEWTON_MAX_M 32
