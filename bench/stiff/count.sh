@@ -22,6 +22,6 @@ while IFS=, read -r e p point _; do
   valgrind --tool=callgrind --toggle-collect=count_steps --callgrind-out-file="$B/callgrind.out" \
     "$B/bench" count "$p" "$m" "$k" "$s" "$h" 0 "$n" >/dev/null 2>&1 || { echo "   (callgrind $point on $p failed)"; continue; }
   ir=$(sed -n 's/^summary: *//p' "$B/callgrind.out")
-  [ "$m" = hbvm-newton ] && base=$ir
+  case $m in *newton) base=$ir ;; esac # (newton's point is each E's first row)
   echo "$e,$p,$point,$n,$ir" | awk -F, -v b="$base" '{ printf "%s,%.3f\n", $0, $5 / b }' >>"$R/stiff_instructions.csv"
 done <"$R/stiff_ab.csv"

@@ -41,8 +41,8 @@ has_constraints() { case $1 in stiff_bob* | butane) return 0 ;; *) return 1 ;; e
 
 # The solvers of problem P at degree S (-k auto, the constant family's k)
 # into $B/gen: the fixed-point step P_kKsS, Newton P_kKsSnewton and, with
-# constraints, the poly family's Newton P_kKsSpolynewton. Sets GEN_K to K
-# and GENERATED to their names. A file whose text is unchanged keeps its
+# constraints, the poly family's fixed-point step P_kKsSpoly and Newton
+# P_kKsSpolynewton. Sets GEN_K to K and GENERATED to their names. A file whose text is unchanged keeps its
 # time stamp, so that make does not compile it again.
 generate() {
   GEN_K=$("$GEN" --check --multiplier const -s "$2" "$B/models/$1.ham" | sed -n '1s/.* k=\([0-9]*\) s=.*/\1/p')
@@ -52,9 +52,10 @@ generate() {
   "$GEN" --iteration newton --multiplier const -k "$GEN_K" -s "$2" -n "${_n}newton" -o "$B/gen.new" "$B/models/$1.ham"
   GENERATED="$_n ${_n}newton"
   if has_constraints "$1"; then
+    "$GEN" --iteration fixed --multiplier poly -k "$GEN_K" -s "$2" -n "${_n}poly" -o "$B/gen.new" "$B/models/$1.ham"
     "$GEN" --iteration newton --multiplier poly -k "$GEN_K" -s "$2" -n "${_n}polynewton" -o "$B/gen.new" \
       "$B/models/$1.ham"
-    GENERATED="$GENERATED ${_n}polynewton"
+    GENERATED="$GENERATED ${_n}poly ${_n}polynewton"
   fi
   for _f in "$B"/gen.new/*; do
     cmp -s "$_f" "$B/gen/${_f##*/}" || mv "$_f" "$B/gen/"

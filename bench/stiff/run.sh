@@ -9,6 +9,8 @@
 #   hbvm-poly-newton  --iteration newton in the default poly family (order 2s
 #                in p too, p projected and rescaled), the same (k, s), on the
 #                problems with constraints (the stiff bob, butane)
+#   hbvm-poly    the poly family's fixed-point step there, so that the
+#                fastest fixed-point step of either family is the baseline
 #   rattle       RATTLE (Stormer-Verlet on the FPU chain)
 #   ida          SUNDIALS IDA (BDF 1-5) on the GGL formulation
 #   gsl-rk4imp, gsl-msbdf, gsl-bsimp   GSL's implicit steppers on the FPU
@@ -93,6 +95,7 @@ for p in $PROBLEMS; do
     sweep "$B/res" "$p" hbvm-newton "$(newton_from "$p"):1e-6:2" -k "$k" -s "$s"
     ! has_constraints "$p" || sweep "$B/res" "$p" hbvm-poly-newton "$(newton_from "$p"):1e-6:2" -k "$k" -s "$s"
     sweep "$B/res" "$p" hbvm "$(fixed_from "$p"):1e-6:2" -k "$k" -s "$s" --cap $PEER_CAP
+    ! has_constraints "$p" || sweep "$B/res" "$p" hbvm-poly "$(fixed_from "$p"):1e-6:2" -k "$k" -s "$s" --cap $PEER_CAP
   done <"$B/configs.txt"
   [ "$PEERS" = 1 ] || continue
   sweep "$B/res" "$p" rattle "$(fixed_from "$p"):2e-6:2" --cap $PEER_CAP
@@ -113,16 +116,16 @@ for p in stiff_bob stiff_bob6 butane; do
 done
 
 # the points of equal error compared, timed again in alternation (bench ab):
-# at E = 1e-4 and 1e-6 (STIFF_AB_E), newton's, the fixed-point step's, IDA's and RATTLE's points
-# that reach E fastest (bench/stiff/pick.awk, as summary.sh's section 1)
+# at E = 1e-4 and 1e-6 (STIFF_AB_E), newton's, the fixed-point step's (either family: best.awk),
+# IDA's and RATTLE's points that reach E fastest (bench/stiff/pick.awk, as summary.sh's section 1)
 echo "== bench/stiff: alternating runs ($(elapsed) s)"
 : >"$B/res/ab.csv"
-awk -F, -f bench/stiff/pick.awk "$B/res/work_precision.csv" >"$B/res/picks.txt"
+awk -F, -f bench/stiff/pick.awk "$B/res/work_precision.csv" | awk -f bench/stiff/best.awk >"$B/res/picks.txt"
 for p in $PROBLEMS; do
   for e in ${STIFF_AB_E:-1e-4 1e-6}; do
     # shellcheck disable=SC2046
-    set -- $(awk -v p="$p" -v e="$e" '$1 == p && $2 == e { spec[$3] = $3 ":" $4 ":" $5 ":" $6 }
-      END { if ("hbvm-newton" in spec) printf "%s %s %s %s", spec["hbvm-newton"], spec["hbvm"], spec["ida"], spec["rattle"] }' \
+    set -- $(awk -v p="$p" -v e="$e" '$1 == p && $2 == e { spec[$10] = $3 ":" $4 ":" $5 ":" $6 }
+      END { if ("newton" in spec) printf "%s %s %s %s", spec["newton"], spec["fixed"], spec["ida"], spec["rattle"] }' \
       "$B/res/picks.txt")
     [ $# -ge 2 ] || continue
     "$B/bench" ab "$p" 11 "$@" | sed "s/^/$e,/" >>"$B/res/ab.csv" || echo "   (bench ab on $p failed)"

@@ -10,21 +10,23 @@ OMEGA=$STIFF_OMEGA
 echo "Stiff benchmark (bench/stiff/run.sh; stiff_machine.txt). Error: the slow motion's at T = 10 (bench/stiff.h:"
 echo "FPU x0 and its momenta, the bob's centre of mass, butane's dihedral), max norm, against the index-1"
 echo "formulation by GSL rk8pd at 1e-15. Seconds: CPU, median of 5 timed repeats of the whole run, all lines in"
-echo "one run. newton = hbvmgen --iteration newton --multiplier const, fixed = the fixed-point step (hbvm)."
+echo "one run. newton = hbvmgen --iteration newton, fixed = the fixed-point step (--iteration fixed), each the"
+echo "faster of the constant family (hbvm-newton, hbvm) and, on the problems with constraints, the poly family"
+echo "(hbvm-poly-newton, hbvm-poly: marked p) at each E (bench/stiff/best.awk)."
 echo
 
 echo "1. CPU seconds to reach a slow error <= E: each method's fastest point whose error, and that of every"
 echo "   finer point of its line, is <= E (bench/stiff/pick.awk; HBVM: every s of the run (2, 3, 4, 6 unless"
 echo "   STIFF_S says otherwise) at -k auto, the fastest taken, shown as (k,s) [h omega]; - = not reached)."
 echo "   Ratios: fixed, ida and rattle over newton (> 1: newton faster)."
-awk -F, -f bench/stiff/pick.awk "$R/stiff_work_precision.csv" | awk -v omegas="$OMEGA" '
+awk -F, -f bench/stiff/pick.awk "$R/stiff_work_precision.csv" | awk -f bench/stiff/best.awk | awk -v omegas="$OMEGA" '
   BEGIN { n = split(omegas, o, " "); for (i = 1; i <= n; i++) { split(o[i], kv, "="); om[kv[1]] = kv[2] }
           ne = split("1e-3 1e-4 1e-5 1e-6 1e-7 1e-8", lev, " ")
-          nm = split("hbvm-newton hbvm rattle ida gsl-rk4imp gsl-msbdf gsl-bsimp", meth, " ") }
+          nm = split("newton fixed rattle ida gsl-rk4imp gsl-msbdf gsl-bsimp", meth, " ") }
   {
     if (!($1 in seen)) { seen[$1] = 1; probs[++np] = $1 }
-    key = $1 SUBSEP $2 SUBSEP $3
-    best[key] = $7; hw[key] = $6 * om[$1]; ks[key] = "(" $4 "," $5 ")"; dH[key] = $9
+    key = $1 SUBSEP $2 SUBSEP $10
+    best[key] = $7; hw[key] = $6 * om[$1]; ks[key] = "(" $4 "," $5 ")" ($3 ~ /^hbvm-poly/ ? "p" : ""); dH[key] = $9
   }
   END {
     printf "%-10s %-5s %-24s %-24s %-9s %-9s %-9s %-9s %-9s %8s %8s %8s\n", "problem", "E", "newton [h omega]", \
@@ -37,8 +39,8 @@ awk -F, -f bench/stiff/pick.awk "$R/stiff_work_precision.csv" | awk -v omegas="$
         else cell = (key in best) ? sprintf("%.2e", best[key]) : "-"
         line = line sprintf(m <= 2 ? " %-24s" : " %-9s", cell)
       }
-      kn = probs[p] SUBSEP lev[e] SUBSEP "hbvm-newton"
-      kf = probs[p] SUBSEP lev[e] SUBSEP "hbvm"
+      kn = probs[p] SUBSEP lev[e] SUBSEP "newton"
+      kf = probs[p] SUBSEP lev[e] SUBSEP "fixed"
       ki = probs[p] SUBSEP lev[e] SUBSEP "ida"
       kr = probs[p] SUBSEP lev[e] SUBSEP "rattle"
       line = line sprintf(" %8s %8s %8s", (kn in best && kf in best) ? sprintf("%.1f", best[kf] / best[kn]) : "-", \
