@@ -401,8 +401,13 @@ int mass_q_refuse(const Model *mod, int newton, int wide, int const_mult); /* 1 
 void mass_q_report(FILE *f, const Model *mod);    /* --check: M's dependence and cost */
 void model_differentiate(Model *mod);
 void model_check_initial(const Model *mod);
-/* stiffness.c: omega_fast / omega_slow of the linearisation at q0 (0: not estimated) */
-double model_stiffness(const Model *mod, double *wfast, double *wslow);
+/* stiffness.c: the frequencies of the linearisation at q0 */
+typedef struct {
+  double fast, slow;          /* the largest and the smallest nonzero frequency */
+  double gap_below, gap_above; /* either side of the largest ratio between consecutive ones */
+} Frequencies;
+double model_stiffness(const Model *mod, Frequencies *f); /* fast / slow, 0: not estimated */
+int model_stiffness_estimated(const Model *mod);          /* whether model_stiffness estimates */
 
 /* ---- method.c: HBVM(k,s) constants and the choice of k ---- */
 
