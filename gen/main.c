@@ -60,7 +60,8 @@ static const char usage[] =
     "                fastest frequency of the linearised model); newton: simplified Newton\n"
     "                with the Hessian of U (+ lambda' g), for stiff models and long steps;\n"
     "                auto (default): fixed's code for a model that is not stiff at q0\n"
-    "                (omega_fast / omega_slow < 75), else sweeps that hand over to Newton\n"
+    "                (omega_fast / omega_slow < 75; rolled, above m = 32: the widest gap\n"
+    "                between its frequencies < 75), else sweeps that hand over to Newton\n"
     "                where they are slow (--check says which). Newton: in both multiplier\n"
     "                families and with --batch (each lane the scalar step in turn), and\n"
     "                rolled (--rolled) without constraints where the Hessian of U is a\n"
@@ -573,13 +574,21 @@ static EmitOptions emit_options(const Options *o) {
 
 // The step to emit, with the form chosen (roll.h) into eo->roll: the
 // rolled form's layout (step_build_layout) where roll_plan tries it first
-// and roll_choose takes it, else the straight-line step. NULL after an
+// and roll_choose takes it, else the straight-line step. Where auto chose
+// Newton for the rolled form (rolled_newton_candidate) and the form is not
+// taken, me->iteration falls back to ITER_FIXED, with a note. NULL after an
 // error.
-static Step *build_step(Model *mod, const Method *me, EmitOptions *eo) {
+static Step *build_step(Model *mod, Method *me, EmitOptions *eo) {
   if (roll_plan(mod, me, eo)) {
     Step *lay = step_build_layout(mod, me);
     if (!lay || roll_choose(mod, me, lay, 1, eo)) return NULL;
     if (eo->roll) return lay;
+    if (me->iteration == ITER_AUTO) { /* above m = 32 only: resolve_iteration counted on the form */
+      fprintf(stderr, "hbvmgen: note: --iteration auto: the rolled form does not take this model's Newton matrix "
+                      "(docs/rolled.md, \"What the rolled form covers\"): the step is the fixed-point one\n");
+      me->iteration = ITER_FIXED;
+      return build_step(mod, me, eo);
+    }
   }
   Step *st = step_build(mod, me);
   if (!st || roll_choose(mod, me, st, 0, eo)) return NULL;
@@ -613,7 +622,7 @@ static int print_check_code(const Options *o, Model *mod, int k, MultFamily fam,
 }
 
 // Emit the solver files; all or nothing.
-static int write_outputs(const Options *o, Model *mod, const Method *me) {
+static int write_outputs(const Options *o, Model *mod, Method *me) {
   const char *suffix[NFILES] = {".h", ".c", "_main.c"};
   char *final[NFILES] = {NULL, NULL, NULL};
   FILE *f[NFILES] = {NULL, NULL, NULL};
@@ -691,13 +700,25 @@ static void report_degree(const Model *mod, int s, int k) {
  * sets h. The paper's models are at most 56 (satellites), the stiff bob at
  * k = 1e4 is 107, the FPU chain 47 at omega = 50 and 945 at omega = 1000. */
 #define STIFF_RATIO 75
-/* ... and auto emits Newton only up to this m: its straight-line factorisation
- * is unrolled (m^3 operations for a dense Hessian; the band loops of the
- * rolled form, docs/rolled.md "Newton", cover models without constraints but
- * are not chosen by auto, which decides the iteration before the form), and a
- * long chain's frequencies alone spread like m (tests/check_lean.c's dense
- * chain of m = 160 would have taken more than 4 MB of C). */
+/* ... and auto emits the straight-line Newton only up to this m: its
+ * factorisation is unrolled (m^3 operations for a dense Hessian; tests/
+ * check_lean.c's dense chain of m = 160 would have taken more than 4 MB of C).
+ * Above, auto emits Newton where the rolled form's band loops take it
+ * (rolled_newton_candidate; docs/rolled.md, "Newton"), and there the
+ * frequencies must split: a long chain's omega_fast / omega_slow grows like
+ * m whether it is stiff or not, so the ratio across the widest gap between
+ * consecutive frequencies decides (the FPU chain of 500 pairs at omega =
+ * 1000: 1e3 and more; a chain of equal soft springs: 2). */
 #define AUTO_NEWTON_MAX_M 32
+
+// Whether auto may emit Newton on a model above AUTO_NEWTON_MAX_M: where
+// the rolled form is tried first (roll_plan) and covers Newton (no
+// constraints, a constant diagonal M). build_step falls back to the
+// fixed-point step where the form is not taken after all.
+static int rolled_newton_candidate(const Options *o, const Model *mod) {
+  return !mod->nu && !mod->mass_q && !mod->minv_node && mod->mass != MASS_DENSE && !o->wide_step &&
+         o->s <= NEWTON_MAX_S && (o->rolled == ROLL_ON || (o->rolled == ROLL_AUTO && mod->m >= ROLL_LEAN_M));
+}
 
 // What --iteration resolves to: fixed and newton as given; auto (the
 // default) ITER_AUTO (sweeps first, Newton where they are slow) for a stiff
@@ -709,26 +730,41 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, char *why,
     return ITER_FIXED;
   }
   if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
-  double wf, ws, r = model_stiffness(mod, &wf, &ws);
+  Frequencies f;
+  double r = model_stiffness(mod, &f);
+  if (r > 0 && mod->m > AUTO_NEWTON_MAX_M && rolled_newton_candidate(o, mod)) {
+    double gap = f.gap_above / f.gap_below;
+    if (gap < STIFF_RATIO)
+      snprintf(why, n, "auto: fixed (fixed-point sweeps; not stiff: the widest gap between the frequencies at q0 is "
+               "%.3g / %.3g = %.3g < %d; omega_fast / omega_slow = %.3g, wide without a gap)",
+               f.gap_above, f.gap_below, gap, STIFF_RATIO, r);
+    else
+      snprintf(why, n, "auto: sweeps, then newton where they contract slowly, in the rolled form's band loops (stiff: "
+               "the frequencies at q0 split at %.3g / %.3g = %.3g >= %d; docs/rolled.md, \"Newton\")",
+               f.gap_above, f.gap_below, gap, STIFF_RATIO);
+    return gap < STIFF_RATIO ? ITER_FIXED : ITER_AUTO;
+  }
   const char *no = mod->mass_q                ? "Newton does not handle an M that depends on q"
                    : o->wide_step              ? "Newton is not emitted with --wide-step"
                    : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
                    : mod->m > AUTO_NEWTON_MAX_M ? "auto emits Newton up to m = " STR(AUTO_NEWTON_MAX_M)
-                                                  " (its factorisation is unrolled: --iteration newton)"
+                                                  " (its factorisation is unrolled: --iteration newton), and above "
+                                                  "on the rolled form without constraints"
                                                : NULL;
   if (r == 0)
     snprintf(why, n, "auto: fixed (fixed-point sweeps; stiffness not estimated: %s)",
-             mod->mass_q ? "M depends on q" : mod->minv_node ? "M has params" : mod->m > 200 ? "m > 200"
-                                                                                : "no nonzero frequency at q0");
+             mod->mass_q ? "M depends on q" : mod->minv_node ? "M has params"
+             : !model_stiffness_estimated(mod) ? "m > 200, or m > 1200 without constraints and with a diagonal M"
+                                               : "no nonzero frequency at q0");
   else if (r < STIFF_RATIO)
     snprintf(why, n, "auto: fixed (fixed-point sweeps; not stiff: omega_fast / omega_slow = %.3g / %.3g = %.3g < %d "
-             "at q0)", wf, ws, r, STIFF_RATIO);
+             "at q0)", f.fast, f.slow, r, STIFF_RATIO);
   else if (no)
     snprintf(why, n, "auto: fixed (fixed-point sweeps, converging while h < ~3 / %.3g; stiff, omega_fast / omega_slow "
-             "= %.3g >= %d at q0, but %s)", wf, r, STIFF_RATIO, no);
+             "= %.3g >= %d at q0, but %s)", f.fast, r, STIFF_RATIO, no);
   else
     snprintf(why, n, "auto: sweeps, then newton where they contract slowly (stiff: omega_fast / omega_slow = %.3g / "
-             "%.3g = %.3g >= %d at q0; docs/method-newton.md)", wf, ws, r, STIFF_RATIO);
+             "%.3g = %.3g >= %d at q0; docs/method-newton.md)", f.fast, f.slow, r, STIFF_RATIO);
   return r >= STIFF_RATIO && !no ? ITER_AUTO : ITER_FIXED;
 }
 

@@ -25,12 +25,14 @@
  *             byte-identical (the kept factor included); NAME_strerror
  *             names both iterations.
  * The suite is auto_suite(); the project's runner adds it. */
+#define _POSIX_C_SOURCE 200809L /* mkstemp */
 #include <check.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bob_auto_k16s2.h"
 #include "bob_polyauto_k16s2.h"
@@ -76,6 +78,73 @@ START_TEST(test_large_stiff_is_fixed) {
   ck_assert_msg(!strcmp(a, b), "m = 40: auto's code is not --iteration fixed's");
   free(a);
   free(b);
+}
+END_TEST
+
+/* Above m = 32 the rolled form's band loops take Newton (no constraints):
+ * the FPU chain of 500 pairs at omega = 1000 (m = 1000), whose frequencies
+ * at q0 split at 1000 / 1.98, gets the auto step with the rolled Newton
+ * kernels, not the fixed-point code. Fails on a generator that does not
+ * estimate m > 200 or caps auto at m = 32. */
+START_TEST(test_large_rolled_stiff_is_auto) {
+  char out[8192];
+  ck_assert_int_eq(generator_output("--check models/fpu_n500.ham", out, sizeof out), 0);
+  ck_assert_msg(strstr(out, "iteration: auto: sweeps, then newton where they contract slowly, in the rolled form's band "
+                            "loops (stiff: the frequencies at q0 split at 1e+03 / 1.98 = 504 >= 75") != NULL,
+                "said:\n%s", out);
+  char *text = read_text("models/fpu_n500.ham");
+  ck_assert_ptr_nonnull(text);
+  char *a = generate_source(text, "-s 2"), *b = generate_source(text, "-s 2 --iteration fixed");
+  ck_assert_ptr_nonnull(a);
+  ck_assert_ptr_nonnull(b);
+  ck_assert_msg(strstr(a, "_nband_factor_c(") && strstr(a, "_anderson("), "no rolled Newton kernels under auto");
+  ck_assert_ptr_null(strstr(b, "_nband_factor_c("));
+  free(a);
+  free(b);
+  free(text);
+}
+END_TEST
+
+/* A long chain of equal soft springs (m = 600, the rolled form's size) has
+ * omega_fast / omega_slow of about 2 m / pi = 380, but no gap between its
+ * frequencies wider than 2: not stiff, the code of --iteration fixed byte
+ * for byte, and --check says why. A 25 x 25 lattice of stiff springs is
+ * stiff (its frequencies split at 126 / 1) but its Hess U is a band of about
+ * 25 each side at best, over the rolled Newton's 16: the form does not take
+ * its Newton matrix and auto falls back to the fixed-point code, with a
+ * note (the straight-line Newton would be 4 MB of C). */
+START_TEST(test_large_wide_spectrum_is_fixed) {
+  static const char soft[] = "N = 600\nvariables q[N]\n"
+                             "U = sum(i in 2..N, (q[i] - q[i-1])^2) / 2 + q[1]^2 / 2\n"
+                             "q0 = [0.001 * i for i in 1..N]\np0 = [0 for i in 1..N]\n";
+  static const char wide[] =
+      "N = 25\nvariables q[N * N]\n"
+      "U = 1e6 * sum(i in 1..N, j in 1..N - 1, (q[N * (i - 1) + j + 1] - q[N * (i - 1) + j])^2) / 2\n"
+      "  + 1e6 * sum(i in 1..N - 1, j in 1..N, (q[N * i + j] - q[N * (i - 1) + j])^2) / 2 + sum(i in 1..N * N, q[i]^2) / 2\n"
+      "q0 = [0.001 * i for i in 1..N * N]\np0 = [0 for i in 1..N * N]\n";
+  const char *const texts[] = {soft, wide};
+  for (int t = 0; t < 2; t++) {
+    char *a = generate_source(texts[t], "-s 2"), *b = generate_source(texts[t], "-s 2 --iteration fixed");
+    ck_assert_ptr_nonnull(a);
+    ck_assert_ptr_nonnull(b);
+    ck_assert_msg(!strcmp(a, b), "chain %d: auto's code is not --iteration fixed's", t);
+    free(a);
+    free(b);
+  }
+  char path[] = "/tmp/hbvm-chain-XXXXXX", args[128], out[8192];
+  int fd = mkstemp(path);
+  ck_assert_int_ge(fd, 0);
+  close(fd);
+  FILE *f = fopen(path, "w");
+  ck_assert_ptr_nonnull(f);
+  fputs(soft, f);
+  fclose(f);
+  snprintf(args, sizeof args, "--check %s", path);
+  int rc = generator_output(args, out, sizeof out);
+  remove(path);
+  ck_assert_int_eq(rc, 0);
+  ck_assert_msg(strstr(out, "iteration: auto: fixed (fixed-point sweeps; not stiff: the widest gap between the "
+                            "frequencies at q0 is ") && strstr(out, "wide without a gap)"), "said:\n%s", out);
 }
 END_TEST
 
@@ -304,6 +373,8 @@ Suite *auto_suite(void) {
   tcase_set_timeout(tc, 120);
   tcase_add_test(tc, test_not_stiff_is_fixed);
   tcase_add_test(tc, test_large_stiff_is_fixed);
+  tcase_add_test(tc, test_large_rolled_stiff_is_auto);
+  tcase_add_test(tc, test_large_wide_spectrum_is_fixed);
   tcase_add_test(tc, test_check_says);
   suite_add_tcase(s, tc);
   TCase *fpu = tcase_create("fpu");

@@ -18,6 +18,12 @@
  *   fixed     on the chain of 500 at h omega = 1 (where the sweeps converge)
  *             the rolled Newton step follows the rolled fixed-point step to
  *             round-off;
+ *   auto      --iteration auto on the rolled form: on the chain of 8 the
+ *             rolled sweeps-then-Newton step against the straight-line one
+ *             (the same trajectory to REORDER_TOL at h omega = 0.1, where
+ *             Newton never runs, and at 10 and 100, where it takes over);
+ *             the chain of 500 with the generator's defaults follows the
+ *             rolled Newton step at h omega = 10;
  *   rollback  a step that fails (h = 20) leaves the state byte-identical;
  *   batch     --batch 2: each lane is bitwise the rolled scalar Newton step;
  *   refused   what the rolled form does not cover under Newton (constraints,
@@ -35,7 +41,10 @@
 #include "generate.h"
 #include "rn500_fixed_k4s2.h"
 #include "rn500_k4s2.h"
+#include "rn500auto_k4s2.h"
 #include "rn8_k4s2.h"
+#include "rn8auto_k4s2.h"
+#include "rn8auto_straight_k4s2.h"
 #include "rn8_straight_k4s2.h"
 #include "rn8s3_k6s3.h"
 #include "rn8s3_straight_k6s3.h"
@@ -168,6 +177,37 @@ START_TEST(test_same_as_fixed)
 }
 END_TEST
 
+/* --iteration auto, rolled: the sweeps run first and hand over to Newton
+ * where they are slow, as in the straight-line auto step (check_auto.c),
+ * so the two forms take the same path and reach the same steps up to the
+ * reordered eliminations; at h omega = 0.1 Newton never runs. The chain of
+ * 500 under the defaults (gen/main.c's rolled_newton_candidate) hands over
+ * in its first step and then matches the rolled Newton step to the
+ * round-off of two converged iterations (as test_same_as_fixed). */
+START_TEST(test_auto)
+{
+  static const double hw[3] = {0.1, 10, 100};
+  for (int c = 0; c < 3; c++) {
+    Run a, b;
+    double h = hw[c] / 1000;
+    RUN(rn8auto_k4s2, rn8auto_straight_k4s2, 1000, h, 500 * h, a);
+    RUN(rn8auto_straight_k4s2, rn8auto_straight_k4s2, 1000, h, 500 * h, b);
+    printf("rolled vs straight-line auto, h omega = %g: %.3g apart, %ld / %ld Newton iterations\n", hw[c], a.diff, a.iters,
+           b.iters);
+    ck_assert_msg(!a.failed && !b.failed, "h omega = %g: a step failed", hw[c]);
+    ck_assert_msg(a.diff <= REORDER_TOL, "h omega = %g: the forms are %.3g apart", hw[c], a.diff);
+    ck_assert_msg(c == 0 ? a.iters == 0 && b.iters == 0 : a.iters >= a.steps && labs(a.iters - b.iters) <= a.steps / 10,
+                  "h omega = %g: %ld / %ld Newton iterations in %d steps", hw[c], a.iters, b.iters, a.steps);
+  }
+  Run r;
+  RUN(rn500auto_k4s2, rn500_k4s2, 1000, 0.01, 0.5, r);
+  printf("chain of 500, defaults vs rolled Newton, h omega = 10: %.3g apart, %ld Newton iterations in %d steps\n", r.diff,
+         r.iters, r.steps);
+  ck_assert_msg(!r.failed && r.iters >= r.steps && r.diff <= 1e-10, "defaults: %d failed, %ld iterations, %.3g apart",
+                r.failed, r.iters, r.diff);
+}
+END_TEST
+
 /* A step too long for the soft springs' nonlinearity (h = 20) fails; the
  * state, the kept factor and the compensations included, is unchanged to
  * the byte. */
@@ -245,6 +285,7 @@ Suite *rollnewton_suite(void)
   tcase_add_test(tc, test_same_as_straight);
   tcase_add_test(tc, test_converges);
   tcase_add_test(tc, test_same_as_fixed);
+  tcase_add_test(tc, test_auto);
   tcase_add_test(tc, test_failed_step_rolls_back);
   tcase_add_test(tc, test_batch_lanes);
   tcase_add_test(tc, test_refused);
