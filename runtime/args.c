@@ -241,16 +241,23 @@ static const Option *match(const char *arg, const char **val)
   return NULL;
 }
 
+/* Help's default of --q0 or --p0: all n values, or for a long vector (more
+ * than HELP_VECTOR_MAX) the first few and a count, so that --help of a
+ * chain of 1000 bodies stays a screen and not 40 KB of digits. */
+#define HELP_VECTOR_MAX 12
+#define HELP_VECTOR_HEAD 4
 static void print_vector(FILE *out, const double *v, int n)
 {
-  int i;
+  int i, shown = n > HELP_VECTOR_MAX ? HELP_VECTOR_HEAD : n;
 
   if (!v) {
     fputs("model default", out);
     return;
   }
-  for (i = 0; i < n; i++)
+  for (i = 0; i < shown; i++)
     fprintf(out, "%s%.17g", i ? "," : "", v[i]);
+  if (shown < n)
+    fprintf(out, ",.. (the model's %d values)", n);
 }
 
 /* Usage, the model's sizes and its parameters with their defaults. */

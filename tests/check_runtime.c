@@ -1282,6 +1282,26 @@ START_TEST(help)
 }
 END_TEST
 
+/* A long q0 and p0 (m = 20 here; 1000 on a chain of 500 pairs, 40 KB of
+ * digits before) are shown by their first values and a count. Fails on a
+ * driver that prints them whole. */
+START_TEST(help_long_vectors)
+{
+  static const double v[20] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20};
+  hbvmrt_model md = ring;
+  Result r;
+
+  md.m = 20;
+  md.q0 = md.p0 = v;
+  r = run(&md, "--help");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_ptr_nonnull(strstr(r.out, "initial positions, 20 values (default 1,2,3,4,.. (the model's 20 values))"));
+  ck_assert_ptr_nonnull(strstr(r.out, "initial momenta, 20 values (default 1,2,3,4,.. (the model's 20 values))"));
+  ck_assert_ptr_null(strstr(r.out, ",5,"));
+  done(&r);
+}
+END_TEST
+
 /* A run of 1.5 s with stderr on a file: no progress line, the summary */
 START_TEST(no_progress_off_terminal)
 {
@@ -1362,6 +1382,7 @@ Suite *runtime_suite(void)
   tcase_add_test(args, param_last_wins);
   tcase_add_test(args, q0_alone);
   tcase_add_test(args, help);
+  tcase_add_test(args, help_long_vectors);
   tcase_add_test(args, column_exact_name);
   suite_add_tcase(s, args);
 
