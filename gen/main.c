@@ -60,8 +60,8 @@ static const char usage[] =
     "                fastest frequency of the linearised model); newton: simplified Newton\n"
     "                with the Hessian of U (+ lambda' g), for stiff models and long steps;\n"
     "                auto (default): fixed's code for a model that is not stiff at q0\n"
-    "                (omega_fast / omega_slow < 75; rolled, above m = 32: the widest gap\n"
-    "                between its frequencies < 75), else sweeps that hand over to Newton\n"
+    "                (omega_fast / omega_slow < 75; rolled by auto from m = 512: the widest\n"
+    "                gap between its frequencies < 75), else sweeps that hand over to Newton\n"
     "                where they are slow (--check says which). Newton: in both multiplier\n"
     "                families and with --batch (each lane the scalar step in turn), and\n"
     "                rolled (--rolled) without constraints where the Hessian of U is a\n"
@@ -572,24 +572,48 @@ static EmitOptions emit_options(const Options *o) {
   return eo;
 }
 
+/* --iteration auto emits the straight-line Newton only up to this m: its
+ * factorisation is unrolled (m^3 operations for a dense Hessian; tests/
+ * check_lean.c's dense chain of m = 160 would have taken more than 4 MB of C).
+ * Above, auto emits Newton where the rolled form's band loops take it
+ * (rolled_newton_candidate; docs/rolled.md, "Newton"), and there the
+ * frequencies must split: a long chain's omega_fast / omega_slow grows like
+ * m whether it is stiff or not, so the ratio across the widest gap between
+ * consecutive frequencies decides (the FPU chain of 500 pairs at omega =
+ * 1000: 1e3 and more; a chain of equal soft springs: 2). */
+#define AUTO_NEWTON_MAX_M 32
+
+static Step *build_step(Model *mod, Method *me, EmitOptions *eo);
+
+// Whether auto's Newton counts on the rolled form: above AUTO_NEWTON_MAX_M
+// (rolled_newton_candidate), where the straight-line factorisation would
+// be unrolled.
+static int newton_needs_roll(const Model *mod, const Method *me) {
+  return me->iteration == ITER_AUTO && mod->m > AUTO_NEWTON_MAX_M;
+}
+
+// The fixed-point step where auto chose Newton for the rolled form and the
+// form did not take the model, with a note.
+static Step *fixed_after_all(Model *mod, Method *me, EmitOptions *eo) {
+  fprintf(stderr, "hbvmgen: note: --iteration auto: the rolled form does not take this model's Newton matrix "
+                  "(docs/rolled.md, \"What the rolled form covers\"): the step is the fixed-point one\n");
+  me->iteration = ITER_FIXED;
+  return build_step(mod, me, eo);
+}
+
 // The step to emit, with the form chosen (roll.h) into eo->roll: the
 // rolled form's layout (step_build_layout) where roll_plan tries it first
 // and roll_choose takes it, else the straight-line step. Where auto chose
 // Newton for the rolled form (rolled_newton_candidate) and the form is not
-// taken, me->iteration falls back to ITER_FIXED, with a note. NULL after an
-// error.
+// taken, me->iteration falls back to ITER_FIXED (fixed_after_all). NULL
+// after an error.
 static Step *build_step(Model *mod, Method *me, EmitOptions *eo) {
   if (roll_plan(mod, me, eo)) {
     Step *lay = step_build_layout(mod, me);
     if (!lay || roll_choose(mod, me, lay, 1, eo)) return NULL;
     if (eo->roll) return lay;
-    if (me->iteration == ITER_AUTO) { /* above m = 32 only: resolve_iteration counted on the form */
-      fprintf(stderr, "hbvmgen: note: --iteration auto: the rolled form does not take this model's Newton matrix "
-                      "(docs/rolled.md, \"What the rolled form covers\"): the step is the fixed-point one\n");
-      me->iteration = ITER_FIXED;
-      return build_step(mod, me, eo);
-    }
   }
+  if (newton_needs_roll(mod, me)) return fixed_after_all(mod, me, eo); /* before the unrolled Newton is built */
   Step *st = step_build(mod, me);
   if (!st || roll_choose(mod, me, st, 0, eo)) return NULL;
   /* the poly family's rolled factor, and the Newton matrix's, are bands: their layout is
@@ -700,24 +724,19 @@ static void report_degree(const Model *mod, int s, int k) {
  * sets h. The paper's models are at most 56 (satellites), the stiff bob at
  * k = 1e4 is 107, the FPU chain 47 at omega = 50 and 945 at omega = 1000. */
 #define STIFF_RATIO 75
-/* ... and auto emits the straight-line Newton only up to this m: its
- * factorisation is unrolled (m^3 operations for a dense Hessian; tests/
- * check_lean.c's dense chain of m = 160 would have taken more than 4 MB of C).
- * Above, auto emits Newton where the rolled form's band loops take it
- * (rolled_newton_candidate; docs/rolled.md, "Newton"), and there the
- * frequencies must split: a long chain's omega_fast / omega_slow grows like
- * m whether it is stiff or not, so the ratio across the widest gap between
- * consecutive frequencies decides (the FPU chain of 500 pairs at omega =
- * 1000: 1e3 and more; a chain of equal soft springs: 2). */
-#define AUTO_NEWTON_MAX_M 32
 
 // Whether auto may emit Newton on a model above AUTO_NEWTON_MAX_M: where
-// the rolled form is tried first (roll_plan) and covers Newton (no
-// constraints, a constant diagonal M). build_step falls back to the
-// fixed-point step where the form is not taken after all.
+// --rolled auto tries the rolled form first (roll_plan: from ROLL_LEAN_M)
+// and it covers Newton (no constraints, a constant diagonal M). build_step
+// falls back to the fixed-point step where the form is not taken after all
+// (a pair sum's full Hessian, a band over 16). Not below ROLL_LEAN_M, where
+// --rolled auto decides on the straight-line step, and building that step
+// with Newton is what must not happen (a dense Hessian of m = 120 exceeds
+// the node limit); not with --rolled on, which makes a Newton matrix the
+// form cannot take an error (as up to m = 32).
 static int rolled_newton_candidate(const Options *o, const Model *mod) {
   return !mod->nu && !mod->mass_q && !mod->minv_node && mod->mass != MASS_DENSE && !o->wide_step &&
-         o->s <= NEWTON_MAX_S && (o->rolled == ROLL_ON || (o->rolled == ROLL_AUTO && mod->m >= ROLL_LEAN_M));
+         o->s <= NEWTON_MAX_S && o->rolled == ROLL_AUTO && mod->m >= ROLL_LEAN_M;
 }
 
 // What --iteration resolves to: fixed and newton as given; auto (the
