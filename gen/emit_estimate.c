@@ -40,16 +40,39 @@ static double cold_constant(const Emitter *e) {
 // constraint, docs/api.md).
 static int controller_order(const Emitter *e) { return mult_err_wanted(e) ? 3 : step_order(e); }
 
+// Print "IND DST = 0; for (...) ... DST = the largest speed;": over the
+// coordinates, NAME_speed of ARR's gamma_0 and gamma_1 (s >= 2; |gamma_0| at
+// s = 1), each cast to the solver's real by CAST ("" or "($R)"). The
+// velocity's size in NAME_err_est and the range cap (emit_range_cap).
+static void emit_speed_max(Emitter *e, const char *ind, const char *dst, const char *arr, const char *cast) {
+  const char *R = real_type(e, 0), *f = math_suffix(e, 0);
+  char c[40];
+  snprintf(c, sizeof c, *cast ? "(%s)" : "", R);
+  out(e, "%s%s = 0;\n%sfor (i = 0; i < %s_M; i++) {\n", ind, dst, ind, e->P);
+  if (e->me->s >= 2)
+    out(e, "%s  %s w = %s_speed(%s%s[i], %s%s[%s_M + i]);\n", ind, R, e->P, c, arr, c, arr, e->P);
+  else
+    out(e, "%s  %s w = fabs%s(%s%s[i]);\n", ind, R, f, c, arr);
+  out(e, "%s  if (w > %s) %s = w;\n%s}\n", ind, dst, dst, ind);
+}
+
 // NAME_err_est: the local error estimate of a converged step from what the
 // step has anyway (docs/api.md, "The local error estimate"). The Legendre
 // coefficients of the velocity of a smooth solution fall like
 // |gamma_j| ~ |v| rho^j, rho ~ h / (its time scale), and the local error of
 // the order 2s is ~ h |v| rho^2s. The predictor's error d1 (the first sweep's
 // increment) is the first coefficient the extrapolation lacks,
-// d1 ~ h |v| rho^s, so with v = max |gamma_0| (a norm over the whole vector)
+// d1 ~ h |v| rho^s, so with v the velocity's size over the step (a norm over
+// the whole vector)
 //   local error ~ h |v| (d1 / |h v|)^2 = d1^2 / |h v|.
-// Where the velocity vanishes (a pendulum's turning point) this is too large,
-// never too small; beyond the asymptotic range (d1 >= |h v|) it is d1 itself.
+// Where the velocity vanishes this is too large, never too small; beyond the
+// asymptotic range (d1 >= |h v|) it is d1 itself. v is, over the coordinates,
+// the larger of |gamma_0| and sqrt(3) |gamma_1| (NAME_speed; |gamma_0| at
+// s = 1): gamma_0 alone, the mean velocity, vanishes for a step with a turning
+// point in its middle, where the velocity either side does not, and the
+// pendulum in its angle (6,6) had such tries rejected with r = d1 / |h gamma_0|
+// at 0.15-2.2 where the step before had 0.003 (1 of 17-33 tries at tol
+// 1e-4..3e-6, 3e-8; tests/check_errest.c, adaptive_turning_point).
 // The first step after NAME_init has no warm start (its predictor is
 // gamma_0 = M^-1 p, the rest 0: d1 is no longer ~ h |v| rho^s, and from rest it
 // is the whole velocity): there, at s >= 2, the estimate is the same model
@@ -73,6 +96,12 @@ static void emit_err_est(Emitter *e) {
           "static $R $P_coef(const $W *gam, int j)\n{\n  $R c = 0;\n  int i;\n  for (i = 0; i < $P_M; i++)\n");
   out(e, "    if (fabs%s(gam[j * %s_M + i]) > c) c = (%s)fabs%s(gam[j * %s_M + i]);\n  return c;\n}\n\n", g, e->P,
       real_type(e, 0), g, e->P);
+  if (s >= 2)
+    tmpl(e, "/* The size of a coordinate's velocity over the step: the larger of its mean gamma_0\n"
+            " * and sqrt(3) gamma_1, half its change across the step (gamma_0 vanishes where the\n"
+            " * velocity changes sign mid-step; the change does not) */\n"
+            "static $R $P_speed($R g0, $R g1)\n{\n"
+            "  g0 = fabs$f(g0);\n  g1 = ($R)1.7320508075688772 * fabs$f(g1);\n  return g1 > g0 ? g1 : g0;\n}\n\n");
   tmpl(e, "/* The local error estimate of a step (max norm in q) from its converged gamma and\n"
           " * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:\n");
   out(e, " * |h v| (d1 / |h v|)^(%d/%d), v = gamma_0 (docs/api.md). */\n", p, s);
@@ -91,7 +120,11 @@ static void emit_err_est(Emitter *e) {
            "#endif\n", e->P, e->P, c);
   }
   tmpl(e, "$P_OUT_OF_LINE $R $P_err_est(const $W *gam, $R h, $R d1, int cold)\n{\n  $R v, r;\n  int i;\n");
-  tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
+  if (s >= 2) {
+    emit_speed_max(e, "  ", "v", "gam", e->wide_step ? "cast" : "");
+    tmpl(e, "  v *= fabs$f(h);\n");
+  } else
+    tmpl(e, "  v = fabs$f(h) * $P_coef(gam, 0);\n");
   if (s >= 2) {
     out(e, "  if (cold) {  /* no warm start: %s_COLDC |h gamma_%d| rho^%d */\n", e->P, s - 1, s + 1);
     out(e, "    %s c = %s_coef(gam, %d)", real_type(e, 0), e->P, s - 1);
@@ -399,8 +432,8 @@ static void emit_defect_cap(Emitter *e) {
 // So h grows at most to where r would reach RANGE_MAX: r scatters 10x
 // between steps of the same h there (the planets take turns in the max
 // norm), and 0.25 still let 2 of 30 tries through (measured). r is read off
-// the accepted step's estimate and gamma_0, r <= sqrt(err_est / (C |h
-// gamma_0|)) (the estimate's other parts only raise it), C = NAME_ERRC, or
+// the accepted step's estimate and v (NAME_speed's, as NAME_err_est's),
+// r <= sqrt(err_est / (C |h v|)) (the estimate's other parts only raise it), C = NAME_ERRC, or
 // NAME_COLDC after the first step, whose estimate is the cold one (~ C |h v|
 // rho^2s as well); never a cut (at least 1), and not where the estimate is
 // NAME_mult_err's (order 3, bounded a step). Where the tolerance keeps r
@@ -424,9 +457,8 @@ static void emit_range_cap(Emitter *e) {
           "        /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold\n");
   out(e, "         * model after the first step, grow > 2), at most %g after the next (r ~ h^%d) */\n", RANGE_MAX,
       e->me->s + 1);
-  tmpl(e, "        $R v = 0, rr, cap;\n"
-          "        for (i = 0; i < $P_M; i++)\n"
-          "          if (fabs$f(($R)x->gam[i]) > v) v = fabs$f(($R)x->gam[i]);\n");
+  tmpl(e, "        $R v, rr, cap;\n");
+  emit_speed_max(e, "        ", "v", "x->gam", "cast");
   out(e, "        v *= %s * fabs%s(hh);\n", k, f);
   tmpl(e, "        if (v > 0 && s.err_est > 0) {\n");
   out(e, "          rr = sqrt%s(s.err_est / v);  /* r of this step, at most */\n", f);

@@ -347,6 +347,16 @@ static double conical_k4s4_coef(const double *gam, int j)
   return c;
 }
 
+/* The size of a coordinate's velocity over the step: the larger of its mean gamma_0
+ * and sqrt(3) gamma_1, half its change across the step (gamma_0 vanishes where the
+ * velocity changes sign mid-step; the change does not) */
+static double conical_k4s4_speed(double g0, double g1)
+{
+  g0 = fabs(g0);
+  g1 = (double)1.7320508075688772 * fabs(g1);
+  return g1 > g0 ? g1 : g0;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(8/4), v = gamma_0 (docs/api.md). */
@@ -360,7 +370,12 @@ conical_k4s4_OUT_OF_LINE double conical_k4s4_err_est(const double *gam, double h
 {
   double v, r;
   int i;
-  v = fabs(h) * conical_k4s4_coef(gam, 0);
+  v = 0;
+  for (i = 0; i < conical_k4s4_M; i++) {
+    double w = conical_k4s4_speed(gam[i], gam[conical_k4s4_M + i]);
+    if (w > v) v = w;
+  }
+  v *= fabs(h);
   if (cold) {  /* no warm start: conical_k4s4_COLDC |h gamma_3| rho^5 */
     double c = conical_k4s4_coef(gam, 3), b = conical_k4s4_coef(gam, 2), a = conical_k4s4_coef(gam, 1), z = conical_k4s4_coef(gam, 0), t;
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 4 */

@@ -522,9 +522,12 @@ int pendulum_k1s1_step_adaptive(pendulum_k1s1_state *x, pendulum_k1s1_real *h, p
       if (rc == pendulum_k1s1_OK && fac > 1) {
         /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
          * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^2) */
-        double v = 0, rr, cap;
-        for (i = 0; i < pendulum_k1s1_M; i++)
-          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        double v, rr, cap;
+        v = 0;
+        for (i = 0; i < pendulum_k1s1_M; i++) {
+          double w = fabs((double)x->gam[i]);
+          if (w > v) v = w;
+        }
         v *= pendulum_k1s1_ERRC * fabs(hh);
         if (v > 0 && s.err_est > 0) {
           rr = sqrt(s.err_est / v);  /* r of this step, at most */

@@ -281,6 +281,16 @@ static double pendulum_k2s2_coef(const double *gam, int j)
   return c;
 }
 
+/* The size of a coordinate's velocity over the step: the larger of its mean gamma_0
+ * and sqrt(3) gamma_1, half its change across the step (gamma_0 vanishes where the
+ * velocity changes sign mid-step; the change does not) */
+static double pendulum_k2s2_speed(double g0, double g1)
+{
+  g0 = fabs(g0);
+  g1 = (double)1.7320508075688772 * fabs(g1);
+  return g1 > g0 ? g1 : g0;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(4/2), v = gamma_0 (docs/api.md). */
@@ -297,7 +307,12 @@ pendulum_k2s2_OUT_OF_LINE double pendulum_k2s2_err_est(const double *gam, double
 {
   double v, r;
   int i;
-  v = fabs(h) * pendulum_k2s2_coef(gam, 0);
+  v = 0;
+  for (i = 0; i < pendulum_k2s2_M; i++) {
+    double w = pendulum_k2s2_speed(gam[i], gam[pendulum_k2s2_M + i]);
+    if (w > v) v = w;
+  }
+  v *= fabs(h);
   if (cold) {  /* no warm start: pendulum_k2s2_COLDC |h gamma_1| rho^3 */
     double c = pendulum_k2s2_coef(gam, 1), b = pendulum_k2s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */

@@ -981,6 +981,16 @@ static double pendulum_poly_k4s4_coef(const double *gam, int j)
   return c;
 }
 
+/* The size of a coordinate's velocity over the step: the larger of its mean gamma_0
+ * and sqrt(3) gamma_1, half its change across the step (gamma_0 vanishes where the
+ * velocity changes sign mid-step; the change does not) */
+static double pendulum_poly_k4s4_speed(double g0, double g1)
+{
+  g0 = fabs(g0);
+  g1 = (double)1.7320508075688772 * fabs(g1);
+  return g1 > g0 ? g1 : g0;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(8/4), v = gamma_0 (docs/api.md). */
@@ -994,7 +1004,12 @@ pendulum_poly_k4s4_OUT_OF_LINE double pendulum_poly_k4s4_err_est(const double *g
 {
   double v, r;
   int i;
-  v = fabs(h) * pendulum_poly_k4s4_coef(gam, 0);
+  v = 0;
+  for (i = 0; i < pendulum_poly_k4s4_M; i++) {
+    double w = pendulum_poly_k4s4_speed(gam[i], gam[pendulum_poly_k4s4_M + i]);
+    if (w > v) v = w;
+  }
+  v *= fabs(h);
   if (cold) {  /* no warm start: pendulum_poly_k4s4_COLDC |h gamma_3| rho^5 */
     double c = pendulum_poly_k4s4_coef(gam, 3), b = pendulum_poly_k4s4_coef(gam, 2), a = pendulum_poly_k4s4_coef(gam, 1), z = pendulum_poly_k4s4_coef(gam, 0), t;
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 4 */
@@ -1853,9 +1868,12 @@ int pendulum_poly_k4s4_step_adaptive(pendulum_poly_k4s4_state *x, pendulum_poly_
       if (rc == pendulum_poly_k4s4_OK && fac > 1) {
         /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
          * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^5) */
-        double v = 0, rr, cap;
-        for (i = 0; i < pendulum_poly_k4s4_M; i++)
-          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        double v, rr, cap;
+        v = 0;
+        for (i = 0; i < pendulum_poly_k4s4_M; i++) {
+          double w = pendulum_poly_k4s4_speed((double)x->gam[i], (double)x->gam[pendulum_poly_k4s4_M + i]);
+          if (w > v) v = w;
+        }
         v *= (grow > 2 ? pendulum_poly_k4s4_COLDC : pendulum_poly_k4s4_ERRC) * fabs(hh);
         if (v > 0 && s.err_est > 0) {
           rr = sqrt(s.err_est / v);  /* r of this step, at most */

@@ -3843,6 +3843,16 @@ static double satellites_poly_k6s2_coef(const double *gam, int j)
   return c;
 }
 
+/* The size of a coordinate's velocity over the step: the larger of its mean gamma_0
+ * and sqrt(3) gamma_1, half its change across the step (gamma_0 vanishes where the
+ * velocity changes sign mid-step; the change does not) */
+static double satellites_poly_k6s2_speed(double g0, double g1)
+{
+  g0 = fabs(g0);
+  g1 = (double)1.7320508075688772 * fabs(g1);
+  return g1 > g0 ? g1 : g0;
+}
+
 /* The local error estimate of a step (max norm in q) from its converged gamma and
  * the predictor's error d1 = max |h (gamma after one sweep - predicted gamma)|:
  * |h v| (d1 / |h v|)^(4/2), v = gamma_0 (docs/api.md). */
@@ -3859,7 +3869,12 @@ satellites_poly_k6s2_OUT_OF_LINE double satellites_poly_k6s2_err_est(const doubl
 {
   double v, r;
   int i;
-  v = fabs(h) * satellites_poly_k6s2_coef(gam, 0);
+  v = 0;
+  for (i = 0; i < satellites_poly_k6s2_M; i++) {
+    double w = satellites_poly_k6s2_speed(gam[i], gam[satellites_poly_k6s2_M + i]);
+    if (w > v) v = w;
+  }
+  v *= fabs(h);
   if (cold) {  /* no warm start: satellites_poly_k6s2_COLDC |h gamma_1| rho^3 */
     double c = satellites_poly_k6s2_coef(gam, 1), b = satellites_poly_k6s2_coef(gam, 0);
     if (!(c > 0)) return d1;  /* ~0 when the motion is a polynomial of degree < 2 */
@@ -4196,9 +4211,12 @@ int satellites_poly_k6s2_step_adaptive(satellites_poly_k6s2_state *x, satellites
       if (rc == satellites_poly_k6s2_OK && fac > 1) {
         /* the estimate's asymptotic range: r = d1 / |h v|, from this step's estimate (its cold
          * model after the first step, grow > 2), at most 0.1 after the next (r ~ h^3) */
-        double v = 0, rr, cap;
-        for (i = 0; i < satellites_poly_k6s2_M; i++)
-          if (fabs((double)x->gam[i]) > v) v = fabs((double)x->gam[i]);
+        double v, rr, cap;
+        v = 0;
+        for (i = 0; i < satellites_poly_k6s2_M; i++) {
+          double w = satellites_poly_k6s2_speed((double)x->gam[i], (double)x->gam[satellites_poly_k6s2_M + i]);
+          if (w > v) v = w;
+        }
         v *= (grow > 2 ? satellites_poly_k6s2_COLDC : satellites_poly_k6s2_ERRC) * fabs(hh);
         if (v > 0 && s.err_est > 0) {
           rr = sqrt(s.err_est / v);  /* r of this step, at most */
