@@ -16,8 +16,13 @@
  * Stopping: as the fixed-point step of the constant family, on the scaled
  * increment |h dgamma| / (max |q| + |h gamma_0|): far below an ulp
  * (TOL / 256), or within 2 ulps and no longer falling 4x (round-off noise);
- * a stall (STALL iterations without a new smallest increment) is converged
- * only at round-off (NOISETOL). The step commits the gamma the last sweep
+ * in the poly family, whose end of step projects p1 and rescales it to H0,
+ * below an eighth of an ulp (TOL / 16) where the constant family goes to
+ * TOL / 256 (g(q1), which the end does not restore, stays within 2 ulps; at
+ * TOL it reached 64 ulps on the stiff bob); a stall (STALL iterations
+ * without a new smallest increment) is converged only at round-off
+ * (NOISETOL). The poly family's loop starts from the one-step start, not
+ * the two-step one the sweeps take (emit_predict.c). The step commits the gamma the last sweep
  * was evaluated at (not Phi of it, which in a stiff component magnifies
  * gamma's round-off by (h omega)^2), with p1 - p0 from that same sweep: the
  * discrete energy balance then holds up to the residual's round-off. So the
@@ -179,10 +184,14 @@ static void emit_newton_loop(Emitter *e) {
           "    if (scale > 0) inc /= scale;\n"
           "    if (!isfinite(inc)) { rc = $P_ENONFINITE; break; }\n"
           "    if (it > 1 && inc > $P_NOISETOL && inc > rate * inc_old) rate = inc / inc_old;  /* above round-off */\n"
-          "    /* converged at the gamma of this sweep (whose error is this increment): the\n"
-          "     * increment far below an ulp, or within 2 ulps and no longer falling 4x (noise) */\n"
-          "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) {\n"
-          "      rc = $P_OK;\n      break;\n    }\n"
+          "    /* converged at the gamma of this sweep (whose error is this increment): the\n");
+  tmpl(e, poly ? "     * increment below an eighth of an ulp (g(q1) within an ulp or two: the end of the\n"
+                 "     * step restores H and the hidden constraint, not g), or within 2 ulps and no longer\n"
+                 "     * falling 4x (noise) */\n"
+                 "    if (inc <= $P_TOL / 16 || (inc <= $P_TOL && 4 * inc > inc_old)) {\n"
+               : "     * increment far below an ulp, or within 2 ulps and no longer falling 4x (noise) */\n"
+                 "    if (inc <= $P_TOL / 256 || (inc <= $P_TOL && 4 * inc > inc_old)) {\n");
+  tmpl(e, "      rc = $P_OK;\n      break;\n    }\n"
           "    /* a stall ($P_STALL iterations without a new smallest increment): converged only at\n"
           "     * round-off ($P_NOISETOL) */\n"
           "    if (inc < inc_min) {\n      inc_min = inc;\n      stall = 0;\n    } else if (++stall >= $P_STALL) {\n"
@@ -262,7 +271,9 @@ void emit_auto_iteration(Emitter *e) {
           "  $R gpred[$P_S * $P_M], inc_pp = HUGE_VAL, hnewton = x->hnewton;\n"
           "  int sweeps = 0;\n");
   emit_newton_locals(e);
-  tmpl(e, "  for (i = 0; i < $P_S * $P_M; i++) gpred[i] = gam[i];\n"
+  tmpl(e, newton_poly(e) ? "  for (i = 0; i < $P_S * $P_M; i++) gpred[i] = two ? ref[i] : gam[i];  /* the one-step start */\n"
+                         : "  for (i = 0; i < $P_S * $P_M; i++) gpred[i] = gam[i];\n");
+  tmpl(e, ""
           "  if (!(hnewton > 0 && fabs$f(h) >= hnewton)) {\n");
   emit_fixed_point(e);
   tmpl(e, "  sweeps = it > $P_MAXITER ? $P_MAXITER : it;\n"

@@ -136,11 +136,15 @@ void emit_predict(Emitter *e) {
   else
     tmpl(e, "$P_OUT_OF_LINE void $P_predict(const $P_state *x, $R h, int cold, const $P_params *prm, $R *gam)\n{\n");
   tmpl(e, "  int i, l;\n");
+  if (poly && !emit_has_sweeps(e)) tmpl(e, "  (void)ref;  /* (the one-step start always: --iteration newton) */\n");
   /* The two-step start saves 7-25% of the sweeps (bench/README.md), in the
    * polynomial family only: it changes where the iteration stops, and the
    * constant family's |H - H0| then drifted 2.3x further over 10^7 steps
-   * (pendulum, h = 0.1); the polynomial family restores H every step. */
-  if (poly) {
+   * (pendulum, h = 0.1); the polynomial family restores H every step.
+   * Not under --iteration newton, whose loop starts from the one-step start
+   * (emit_newton.c: the two-step start's coefficients, up to 166 at s = 3,
+   * magnify the stiff motion a long step does not resolve). */
+  if (poly && emit_has_sweeps(e)) {
     tmpl(e, "  if (!cold && x->hprev != 0 && h == x->hprev && h == x->hprev2) { /* from the last two steps:\n"
             "      * gamma_j = sum_i E2[j][i] gamma_i + E2[j][S + i] gamma_prev_i, every gamma_j written once */\n"
             "    if (ref) {  /* the one-step start, for the estimate */\n"

@@ -85,7 +85,9 @@ static void emit_step_predict(Emitter *e) {
             "    q0w[i] = ($W)x->q[i] - x->qc[i];\n"
             "    p0w[i] = ($W)x->p[i] - x->pc[i];\n  }\n");
   } else if (poly && !emit_has_sweeps(e)) /* (Newton's d1 is its first correction) */
-    tmpl(e, "  $P_predict(x, h, cold, prm, gam, 0);\n");
+    tmpl(e, "  $P_predict(x, h, cold, prm, gam, 0);  /* (the one-step start: no sweeps) */\n");
+  else if (poly && emit_is_newton(e)) /* auto: ref is where Newton starts, if it runs */
+    tmpl(e, "  two = $P_predict(x, h, cold, prm, gam, ref);  /* ref: for d1, and Newton's start */\n");
   else
     tmpl(e, poly ? "  two = $P_predict(x, h, cold, prm, gam, st || tol > 0 ? ref : 0);  /* ref: for d1 */\n"
                  : "  $P_predict(x, h, cold, prm, gam);\n");
