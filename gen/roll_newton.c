@@ -238,12 +238,12 @@ static void newton_pattern(Model *mod, const Method *me, NewtonPattern *np) {
 
 int roll_hessian(Model *mod, const Method *me, Roll *r, const char **why) {
   int m = mod->m;
-  if (r->pairs) {
+  NewtonPattern np;
+  newton_pattern(mod, me, &np);
+  if (r->pairs && np.hb >= m - 1) { /* (U's terms rolled as pairs, yet local: a polymer's angles, its band) */
     *why = "--iteration newton or auto: the Newton matrix of a pair sum is full, not a band";
     return -1;
   }
-  NewtonPattern np;
-  newton_pattern(mod, me, &np);
   SparseVec *rows = np.rows;
   int *pos = np.pos, permuted = np.permuted;
   r->hb = np.hb;
