@@ -315,22 +315,29 @@ static void emit_block_entry(Emitter *e, const NewtonBlock *blk, int entry, cons
 static void emit_factor_kkt(Emitter *e, const NewtonBasis *nb) {
   const Roll *r = e->roll;
   int s = e->me->s, m = e->mod->m, nu = e->mod->nu, T = r->T, mt = m * T, ht = r->ht > 0 ? r->ht : 1;
+  int poly = e->me->family == MULT_POLY, nrc = poly ? s : 1;
   char x[2048];
-  tmplf(e, "  $R qm[%d], Hs[%d], Q[%d], F[%d], hX[%d], psi[%d], J[%d], cs[%d];\n"
-           "  $R *A = out, *R = out + $P_KN * $P_KW;\n"
-           "  int i, j = 0, t;\n  (void)Q; (void)F; (void)hX; (void)J; (void)j; (void)psi;\n",
-        m, m * ht, m, m, s * m, s * m, mt, nu);
-  out(e, "  /* rho_j at gam, as the sweep takes them */\n");
-  rolled_projections(e, 1);
+  if (poly) {
+    tmplf(e, "  $R qm[%d], Hs[%d], cs[%d];\n  $R *A = out, *R = out + $P_KN * $P_KW;\n  int i, j, t;\n"
+             "  /* the moments R_jr of the stage Jacobians at gam, as the sweep takes them */\n"
+             "  $P_roll_moments(q0, gam, h, prm, R);\n", m, m * ht, nu * nrc);
+  } else {
+    tmplf(e, "  $R qm[%d], Hs[%d], Q[%d], F[%d], hX[%d], psi[%d], J[%d], cs[%d];\n"
+             "  $R *A = out, *R = out + $P_KN * $P_KW;\n"
+             "  int i, j = 0, t;\n  (void)Q; (void)F; (void)hX; (void)J; (void)j; (void)psi;\n",
+          m, m * ht, m, m, s * m, s * m, mt, nu);
+    out(e, "  /* rho_j at gam, as the sweep takes them */\n");
+    rolled_projections(e, 1);
+  }
   int n = 0;
   for (int j = 0; j < s; j++)
     n += snprintf(x + n, sizeof x - (size_t)n, "%s%s * gam[%d + i]", j ? " + " : "", rolled_lit(e, newton_midpoint_weight(e->me, j)), j * m);
   tmplf(e, "  for (i = 0; i < $P_M; i++) qm[i] = q0[i] + h * (%s);\n", x);
   if (r->ht) tmpl(e, "  $P_roll_hess(qm, 0, prm, Hs);\n");
   else tmpl(e, "  Hs[0] = 0;\n");
-  tmpl(e, "  for (i = 0; i < $P_KN * $P_KW; i++) A[i] = 0;\n"
-          "  for (i = 0; i < $P_NU; i++) cs[i] = 0;\n"
-          "  for (i = 0; i < $P_M; i++) {  /* the blocks I + h^2 a M^-1 J, e^{-i phi} (I + h^2 (a + ib) M^-1 J) */\n"
+  tmplf(e, "  for (i = 0; i < $P_KN * $P_KW; i++) A[i] = 0;\n"
+           "  for (i = 0; i < %d; i++) cs[i] = 0;\n", nu * nrc);
+  tmpl(e, "  for (i = 0; i < $P_M; i++) {  /* the blocks I + h^2 a M^-1 J, e^{-i phi} (I + h^2 (a + ib) M^-1 J) */\n"
           "    $R *Ar = A + $P_krow[i] * $P_KW;\n");
   char khb[64];
   snprintf(khb, sizeof khb, "%s_KHB", e->P);
@@ -347,32 +354,43 @@ static void emit_factor_kkt(Emitter *e, const NewtonBasis *nb) {
           "      if (a < 0) continue;\n"
           "      $R *Ar = A + $P_krow[i] * $P_KW, *Ac = A + $P_kcon[a] * $P_KW;\n"
           "      const int dv = $P_kcon[a] - $P_krow[i] + $P_KHB, dc = $P_krow[i] - $P_kcon[a] + $P_KHB;\n");
-  for (int j = 0; j < s; j++) tmplf(e, "      const $R x%d = R[%d + %d * i + t];\n", j, j * mt, T);
-  for (int j = 0; j < s; j++) { /* V = (X (x) M^-1) rho: X's row j is xi_j x_j-1 - xi_j+1 x_j+1 (xi_0 x_0 for j = 0) */
-    int n = snprintf(x, sizeof x, "%s * x%d", rolled_lit(e, e->me->xi[j]), j ? j - 1 : 0);
-    if (j + 1 < s) snprintf(x + n, sizeof x - (size_t)n, " - %s * x%d", rolled_lit(e, e->me->xi[j + 1]), j + 1);
-    tmplf(e, "      const $R v%d = $P_MINV(i) (%s);\n", j, x);
-  }
-  for (int c = 0; c < s; c++) {
-    basis_col(e, nb->Tinv, c, 0, "v", x, sizeof x);
-    tmplf(e, "      const $R vt%d = %s;\n", c, x);
-    basis_col(e, nb->T, c, 1, "x", x, sizeof x);
-    tmplf(e, "      const $R ct%d = %s;\n", c, x);
-  }
-  for (int q = 0; q < nb->nblocks; q++) {
-    const NewtonBlock *blk = &nb->blk[q];
-    int c = blk->col;
-    if (!blk->pair) {
-      tmplf(e, "      Ar[%d * $P_KW + dv - %d] += vt%d;\n      Ac[dc + %d] += ct%d;\n", c, c, c, c, c);
-      tmplf(e, "      cs[a] += fabs$f(vt%d * ct%d);\n", c, c);
-      continue;
+  for (int rr = 0; rr < nrc; rr++) { /* the constraint's rows: 1, or the poly family's coefficient r = rr */
+    const char *pad = poly ? "  " : "";
+    if (poly) out(e, "      {  /* coefficient %d: rho_j = R_j%d */\n", rr, rr);
+    for (int j = 0; j < s; j++)
+      tmplf(e, "%s      const $R x%d = R[%d + %d * i + t];\n", pad, j, (poly ? rolled_poly_pair(s, j, rr) : j) * mt, T);
+    for (int j = 0; j < s; j++) { /* V = (X (x) M^-1) rho: X's row j is xi_j x_j-1 - xi_j+1 x_j+1 (xi_0 x_0 for j = 0) */
+      int n = snprintf(x, sizeof x, "%s * x%d", rolled_lit(e, e->me->xi[j]), j ? j - 1 : 0);
+      if (j + 1 < s) snprintf(x + n, sizeof x - (size_t)n, " - %s * x%d", rolled_lit(e, e->me->xi[j + 1]), j + 1);
+      tmplf(e, "%s      const $R v%d = $P_MINV(i) (%s);\n", pad, j, x);
     }
-    double phi = pair_phi(blk);
-    const char *cp = rolled_lit(e, cos(phi)), *sp = rolled_lit(e, sin(phi));
-    tmplf(e, "      Ar[%d * $P_KW + dv - %d] += %s * vt%d - %s * vt%d;  /* e^{-i phi} (Vt_c - i Vt_c+1) */\n", c, c, cp, c, sp, c + 1);
-    tmplf(e, "      Ar[%d * $P_KW + dv - %d] -= %s * vt%d + %s * vt%d;\n", c + 1, c + 1, sp, c, cp, c + 1);
-    tmplf(e, "      Ac[dc + %d] += ct%d;\n      Ac[dc + %d] -= ct%d;  /* z_c = x, z_c+1 = -y */\n", c, c, c + 1, c + 1);
-    tmplf(e, "      cs[a] += fabs$f(vt%d * ct%d) + fabs$f(vt%d * ct%d);\n", c, c, c + 1, c + 1);
+    for (int c = 0; c < s; c++) {
+      basis_col(e, nb->Tinv, c, 0, "v", x, sizeof x);
+      tmplf(e, "%s      const $R vt%d = %s;\n", pad, c, x);
+      basis_col(e, nb->T, c, 1, "x", x, sizeof x);
+      tmplf(e, "%s      const $R ct%d = %s;\n", pad, c, x);
+    }
+    char cs[32];
+    snprintf(cs, sizeof cs, poly ? "cs[%d * %s_NU + a]" : "cs[a]", rr, e->P);
+    for (int q = 0; q < nb->nblocks; q++) {
+      const NewtonBlock *blk = &nb->blk[q];
+      int c = blk->col;
+      if (!blk->pair) {
+        tmplf(e, "%s      Ar[%d * $P_KW + dv + %d] += vt%d;\n%s      Ac[%d * $P_KW + dc + %d] += ct%d;\n", pad, c, rr - c, c, pad, rr,
+              c - rr, c);
+        tmplf(e, "%s      %s += fabs$f(vt%d * ct%d);\n", pad, cs, c, c);
+        continue;
+      }
+      double phi = pair_phi(blk);
+      const char *cp = rolled_lit(e, cos(phi)), *sp = rolled_lit(e, sin(phi));
+      tmplf(e, "%s      Ar[%d * $P_KW + dv + %d] += %s * vt%d - %s * vt%d;  /* e^{-i phi} (Vt_c - i Vt_c+1) */\n", pad, c, rr - c,
+            cp, c, sp, c + 1);
+      tmplf(e, "%s      Ar[%d * $P_KW + dv + %d] -= %s * vt%d + %s * vt%d;\n", pad, c + 1, rr - c - 1, sp, c, cp, c + 1);
+      tmplf(e, "%s      Ac[%d * $P_KW + dc + %d] += ct%d;\n%s      Ac[%d * $P_KW + dc + %d] -= ct%d;  /* z_c = x, z_c+1 = -y */\n",
+            pad, rr, c - rr, c, pad, rr, c + 1 - rr, c + 1);
+      tmplf(e, "%s      %s += fabs$f(vt%d * ct%d) + fabs$f(vt%d * ct%d);\n", pad, cs, c, c, c + 1, c + 1);
+    }
+    if (poly) out(e, "      }\n");
   }
   tmpl(e, "    }\n");
   /* the factor's pivots in the band's rows into a scratch of KN, then to their places */
@@ -382,9 +400,10 @@ static void emit_factor_kkt(Emitter *e, const NewtonBasis *nb) {
           "      for (j = 0; j < $P_S; j++) {\n"
           "        out[$[newton_factor.pivot]0 + j * $P_M + i] = kp[$P_krow[i] + j];\n"
           "        out[$[newton_factor.adiag]0 + j * $P_M + i] = kp[$P_KN + $P_krow[i] + j];\n      }\n"
-          "    for (i = 0; i < $P_NU; i++) {\n"
-          "      out[$[newton_factor.spivot]0 + i] = kp[$P_kcon[i]];\n"
-          "      out[$[newton_factor.sadiag]0 + i] = cs[i];\n    }\n  }\n");
+          "    for (i = 0; i < $P_NU; i++)\n");
+  tmplf(e, "      for (j = 0; j < %d; j++) {  /* the constraint's rows: coefficient j */\n"
+           "        out[$[newton_factor.spivot]0 + j * $P_NU + i] = kp[$P_kcon[i] + j];\n"
+           "        out[$[newton_factor.sadiag]0 + j * $P_NU + i] = cs[j * $P_NU + i];\n      }\n  }\n", nrc);
 }
 
 // The kernel "newton_solve" with constraints: the right-hand side w = (T^-1
@@ -392,7 +411,7 @@ static void emit_factor_kkt(Emitter *e, const NewtonBasis *nb) {
 // C r = sum_j rho_j' r_j in the constraints', the band solve, and dgam =
 // (T (x) I) z from the coordinates' rows (the multiplier's mu unused).
 static void emit_solve_kkt(Emitter *e, const NewtonBasis *nb) {
-  int s = e->me->s, m = e->mod->m, mt = m * e->roll->T;
+  int s = e->me->s, m = e->mod->m, mt = m * e->roll->T, poly = e->me->family == MULT_POLY, nrc = poly ? s : 1;
   char x[2048];
   tmplf(e, "  $R w[%d], z[$P_KN];\n  const $R *R = lu + $P_KN * $P_KW;\n  int i, t;\n"
            "  for (i = 0; i < $P_M; i++) {  /* w = (T^-1 (x) I) r */\n", s * m);
@@ -413,16 +432,23 @@ static void emit_solve_kkt(Emitter *e, const NewtonBasis *nb) {
     out(e, "    zi[%d] = %s * w[%d + i] - %s * w[%d + i];  /* e^{-i phi} (w_c - i w_c+1) */\n", c, cp, c * m, sp, (c + 1) * m);
     out(e, "    zi[%d] = -(%s * w[%d + i] + %s * w[%d + i]);\n", c + 1, sp, c * m, cp, (c + 1) * m);
   }
-  tmpl(e, "  }\n  for (i = 0; i < $P_NU; i++) z[$P_kcon[i]] = 0;\n"
-          "  for (i = 0; i < $P_M; i++)  /* C r */\n"
-          "    for (t = 0; t < $P_RT; t++) {\n"
-          "      const int a = $P_tcon[$P_RT * i + t];\n"
-          "      if (a < 0) continue;\n");
-  int n = 0;
-  for (int j = 0; j < s; j++)
-    n += snprintf(x + n, sizeof x - (size_t)n, "%sR[%d + $P_RT * i + t] * gam[%d + i]", j ? " + " : "", j * mt, j * m);
-  tmplf(e, "      z[$P_kcon[a]] += %s;\n    }\n  $P_kkt_solve(lu, z);\n"
-           "  for (i = 0; i < $P_M; i++) {\n    const $R *zi = z + $P_krow[i];\n", x);
+  tmplf(e, "  }\n  for (i = 0; i < $P_NU; i++)\n    for (t = 0; t < %d; t++) z[$P_kcon[i] + t] = 0;\n"
+           "  for (i = 0; i < $P_M; i++)  /* C r */\n"
+           "    for (t = 0; t < $P_RT; t++) {\n"
+           "      const int a = $P_tcon[$P_RT * i + t];\n"
+           "      if (a < 0) continue;\n", nrc);
+  for (int rr = 0; rr < nrc; rr++) {
+    int n = 0;
+    for (int j = 0; j < s; j++)
+      n += snprintf(x + n, sizeof x - (size_t)n, "%sR[%d + $P_RT * i + t] * gam[%d + i]", j ? " + " : "",
+                    (poly ? rolled_poly_pair(s, j, rr) : j) * mt, j * m);
+    tmplf(e, "      z[$P_kcon[a] + %d] += %s;\n", rr, x);
+  }
+  tmpl(e, "    }\n  $P_kkt_solve(lu, z);\n");
+  if (poly)
+    tmplf(e, "  for (i = 0; i < $P_NU; i++)  /* the coefficients move by mu / h */\n"
+             "    for (t = 0; t < %d; t++) out[$[newton_solve.dlam]0 + t * $P_NU + i] = z[$P_kcon[i] + t] / h;\n", nrc);
+  tmpl(e, "  for (i = 0; i < $P_M; i++) {\n    const $R *zi = z + $P_krow[i];\n");
   for (int q = 0; q < nb->nblocks; q++) {
     const NewtonBlock *blk = &nb->blk[q];
     int c = blk->col;

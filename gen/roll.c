@@ -313,9 +313,7 @@ static Roll *analyse_roll(Model *mod, const char **why) {
 
 // What of the method and options the rolled form does not cover yet, or NULL.
 static const char *not_covered(const Model *mod, const Method *me, const EmitOptions *eo) {
-  if (me->iteration != ITER_FIXED && mod->nu && me->family != MULT_CONST)
-    return "it covers --iteration newton and auto with constraints in the constant multiplier family only "
-           "(--multiplier const; docs/rolled.md)";
+  (void)me;
   if (eo->wide_step) return "it does not cover --wide-step";
   if (mod->mass_q || mod->minv_node || mod->mass == MASS_DENSE) return "it covers a constant diagonal mass matrix only";
   return NULL;

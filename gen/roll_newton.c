@@ -182,9 +182,10 @@ static SparseVec *order_rows(const Model *mod, const NewtonPattern *np) {
 
 // The saddle point's rows (the file's comment): in the band's order, the s
 // rows of each coordinate, then those of the constraints whose last
-// coordinate it is; its half band, with pair (A has a complex pair) the
-// pair's re row one further from its im column.
-static void kkt_rows(const Model *mod, int s, int pair, NewtonPattern *np) {
+// coordinate it is, nrc a constraint (1, or the poly family's s
+// coefficients); its half band, with pair (A has a complex pair) the pair's
+// re row one further from its im column.
+static void kkt_rows(const Model *mod, int s, int pair, int nrc, NewtonPattern *np) {
   int m = mod->m, nu = mod->nu, *order = step_nodes(m), *last = step_nodes(nu + 1), row = 0;
   IntVec *after = arena_alloc((size_t)m * sizeof *after);
   for (int i = 0; i < m; i++) order[np->pos[i]] = i;
@@ -199,7 +200,7 @@ static void kkt_rows(const Model *mod, int s, int pair, NewtonPattern *np) {
   for (int p = 0; p < m; p++) {
     np->krow[order[p]] = row;
     row += s;
-    for (int k = 0; k < after[p].n; k++) np->kcon[after[p].v[k]] = row++;
+    for (int k = 0; k < after[p].n; k++, row += nrc) np->kcon[after[p].v[k]] = row;
   }
   np->kn = row;
   np->khb = 0;
@@ -210,7 +211,7 @@ static void kkt_rows(const Model *mod, int s, int pair, NewtonPattern *np) {
     }
   for (int a = 0; a < nu; a++)
     for (int e = 0; e < mod->jac[a].n; e++) {
-      int d = np->kcon[a] - np->krow[mod->jac[a].e[e].coord]; /* > 0: the row comes after its coordinates */
+      int d = np->kcon[a] + nrc - 1 - np->krow[mod->jac[a].e[e].coord]; /* > 0: the rows come after its coordinates */
       if (d > np->khb) np->khb = d;
     }
 }
@@ -233,7 +234,7 @@ static void newton_pattern(Model *mod, const Method *me, NewtonPattern *np) {
   hessian_rows(mod, np->rows);
   if (mod->nu) lagrangian_rows(mod, np);
   np->hb = band_order(order_rows(mod, np), m, np->pos, &np->permuted);
-  if (mod->nu) kkt_rows(mod, me->s, has_pair(me), np);
+  if (mod->nu) kkt_rows(mod, me->s, has_pair(me), me->family == MULT_POLY ? me->s : 1, np);
 }
 
 int roll_hessian(Model *mod, const Method *me, Roll *r, const char **why) {
@@ -308,19 +309,19 @@ void layout_newton_rolled(Build *b) {
   int m = b->m, s = b->s, nu = b->nu;
   NewtonPattern np;
   newton_pattern(b->mod, b->me, &np);
-  int nlu = nu ? np.kn * (2 * np.khb + 1) + s * m * np.T : s * m * (2 * np.hb + 1);
-  ASSERT(!nu || b->me->family == MULT_CONST);
-  if (nu) {
+  int poly = nu && b->me->family == MULT_POLY, nc = poly ? s * nu : nu;
+  int nlu = nu ? np.kn * (2 * np.khb + 1) + (poly ? s * (s + 1) / 2 : s) * m * np.T : s * m * (2 * np.hb + 1);
+  if (nu && !poly) {
     st->in[IN_LAM].len = s * nu;
     st->in[IN_LU].first = st->in[IN_LAM].first + st->in[IN_LAM].len;
   }
-  st->in[IN_LU].len = st->in[IN_LU].coef = nlu;
+  if (!poly || st->in[IN_LU].len < nlu) st->in[IN_LU].len = st->in[IN_LU].coef = nlu; /* (the poly sweep's lu shares it) */
   step_placeholder(b, K_NFACTOR, "lu", SZ_ONE, nlu, nlu);
   step_placeholder(b, K_NFACTOR, "pivot", SZ_SM, 1, s * m);
   step_placeholder(b, K_NFACTOR, "adiag", SZ_SM, 1, s * m);
   if (nu) {
-    step_placeholder(b, K_NFACTOR, "spivot", SZ_NU, 1, nu);
-    step_placeholder(b, K_NFACTOR, "sadiag", SZ_NU, 1, nu);
+    step_placeholder(b, K_NFACTOR, "spivot", poly ? SZ_SNU : SZ_NU, 1, nc);
+    step_placeholder(b, K_NFACTOR, "sadiag", poly ? SZ_SNU : SZ_NU, 1, nc);
   }
   st->kern[K_NFACTOR].what =
       nu ? "The Newton matrix I + h^2 A (x) M^-1 J, J = Hess(U + lam' g) at the midpoint of the step's\n"
@@ -332,8 +333,19 @@ void layout_newton_rolled(Build *b) {
            " * polynomial gam, as the blocks of A's eigenbasis in band storage, factored by LU\n"
            " * without pivoting over the band: out = their factors, pivots (S*M), diagonal (S*M).";
   step_placeholder(b, K_NSOLVE, "dgam", SZ_SM, 1, s * m);
+  if (poly) step_placeholder(b, K_NSOLVE, "dlam", SZ_SNU, 1, nc);
+  if (poly)
+    st->kern[K_NFACTOR].what =
+        "The Newton matrix I + h^2 A (x) M^-1 J, J = Hess(U + lam_0' g) at the midpoint of the step's\n"
+        " * polynomial gam, as the blocks of A's eigenbasis, with the polynomial multiplier's columns V and\n"
+        " * rows C (S a constraint): the saddle point [[D, Vt], [Ct, 0]] as one band, factored by LU without\n"
+        " * pivoting: out = its factor and the moments R_jr (what newton_solve reads as lu), pivots (S*M),\n"
+        " * diagonal (S*M), the constraints' pivots (S*NU) and scale (S*NU).";
   st->kern[K_NSOLVE].what =
-      nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+      poly ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
+             " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M),\n"
+             " * and the multiplier's coefficients' change mu / h (S*NU)."
+      : nu ? "The Newton correction for the residual r = (new gamma) - gamma given as gam, with\n"
            " * what newton_factor left in lu: out = dgam, N dgam + V mu = r, C dgam = C r (S*M)."
          : "The Newton correction for the residual r = (new gamma) - gamma given as gam, with the\n"
            " * band factors lu of newton_factor: out = (I + h^2 A (x) M^-1 J)^-1 r (S*M).";
