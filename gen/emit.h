@@ -86,6 +86,7 @@ void rolled_int_table(Emitter *e, const char *type, const char *name, const int 
 void rolled_newton_kernel(Emitter *e, KernelId k);
 /* emit_rolled_poly.c: the poly family's kernels factor, sweep, project_p1 as loops */
 void rolled_poly_helpers(Emitter *e);
+int rolled_poly_pair(int s, int j, int r); /* the moment R_jr's place among the s (s + 1) / 2 kept */
 void rolled_poly_kernel(Emitter *e, KernelId k);
 /* emit_rolled_batch.c: NAME_batch_KERNEL of a rolled kernel, the scalar one per lane */
 void emit_rolled_lane_kernel(Emitter *e, KernelId k);

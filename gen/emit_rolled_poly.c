@@ -34,7 +34,7 @@
 #include "roll.h"
 
 // The place of the moment (j, r) among the s (s + 1) / 2 kept: (min, max).
-static int pair_of(int s, int j, int r) {
+int rolled_poly_pair(int s, int j, int r) {
   int lo = j < r ? j : r, hi = j < r ? r : j;
   return lo * s - lo * (lo - 1) / 2 + (hi - lo);
 }
@@ -42,7 +42,7 @@ static int pair_of(int s, int j, int r) {
 // "Rm[...]": the moment (j, r) at entry t of coordinate i.
 static void moment(const Emitter *e, int j, int r, int t, char *buf, size_t size) {
   int s = e->me->s, mt = e->mod->m * e->roll->T;
-  snprintf(buf, size, "Rm[%d + %d * i]", pair_of(s, j, r) * mt + t, e->roll->T);
+  snprintf(buf, size, "Rm[%d + %d * i]", rolled_poly_pair(s, j, r) * mt + t, e->roll->T);
 }
 
 // "sum_l X[j][l] R_lr" at entry t of coordinate i (row j of X, METHOD.md).
@@ -84,7 +84,7 @@ void rolled_poly_helpers(Emitter *e) {
     out(e, "  for (i = 0; i < %d; i++) {\n", mt);
     for (int j = 0; j < s; j++)
       for (int r = j; r < s; r++)
-        out(e, "    Rm[%d + i] += %s * J[i];\n", pair_of(s, j, r) * mt,
+        out(e, "    Rm[%d + i] += %s * J[i];\n", rolled_poly_pair(s, j, r) * mt,
             rolled_lit(e, me->W[l * s + j] * me->Phat[l * s + r]));
     out(e, "  }\n");
   }

@@ -64,8 +64,8 @@ static const char usage[] =
     "                gap between its frequencies < 75), else sweeps that hand over to Newton\n"
     "                where they are slow (--check says which). Newton: in both multiplier\n"
     "                families and with --batch (each lane the scalar step in turn), and\n"
-    "                rolled (--rolled) without constraints where the Hessian of U is a\n"
-    "                band; not with --wide-step (docs/method-newton.md)\n";
+    "                rolled (--rolled) where the Hessian of U (+ lambda' g) is a band;\n"
+    "                not with --wide-step (docs/method-newton.md)\n";
 
 /* (the rest of the usage, apart: a C99 compiler need not take a string over 4095 bytes) */
 static const char usage_more[] =
@@ -99,8 +99,8 @@ static const char usage_more[] =
     "                and their derivatives, and the banded multiplier system as a loop\n"
     "                (both multiplier families, float, adaptive steps, dense output,\n"
     "                events and --batch, whose lanes run the rolled kernels one by one;\n"
-    "                --iteration newton without constraints, the Newton matrix factored\n"
-    "                over its band);\n"
+    "                --iteration newton, the Newton matrix (with constraints and the\n"
+    "                multiplier's rows) factored over its band);\n"
     "                auto (default) rolls a large model the form covers, on insists\n"
     "                (an error says what it does not cover yet), off never rolls\n"
     "  -h, --help    this text\n"
@@ -768,7 +768,7 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, char *why,
                    : o->s > NEWTON_MAX_S       ? "Newton needs s <= " STR(NEWTON_MAX_S)
                    : mod->m > AUTO_NEWTON_MAX_M ? "auto emits Newton up to m = " STR(AUTO_NEWTON_MAX_M)
                                                   " (its factorisation is unrolled: --iteration newton), and above "
-                                                  "on the rolled form without constraints"
+                                                  "on a model without constraints that --rolled auto rolls (m >= 512)"
                                                : NULL;
   if (r == 0)
     snprintf(why, n, "auto: fixed (fixed-point sweeps; stiffness not estimated: %s)",

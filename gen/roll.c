@@ -313,8 +313,7 @@ static Roll *analyse_roll(Model *mod, const char **why) {
 
 // What of the method and options the rolled form does not cover yet, or NULL.
 static const char *not_covered(const Model *mod, const Method *me, const EmitOptions *eo) {
-  if (me->iteration != ITER_FIXED && mod->nu)
-    return "it covers --iteration newton and auto on models without constraints only (docs/rolled.md)";
+  (void)me;
   if (eo->wide_step) return "it does not cover --wide-step";
   if (mod->mass_q || mod->minv_node || mod->mass == MASS_DENSE) return "it covers a constant diagonal mass matrix only";
   return NULL;
@@ -370,7 +369,7 @@ int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOp
   int big = layout || (!on && !why && sweep_ops(mod, st) >= ROLL_AUTO_OPS);
   if (!on && !layout && (why || (!big && mod->m < ROLL_AUTO_PAIR_M))) return 0;
   Roll *r = why ? NULL : analyse_roll(mod, &why);
-  if (r && me->iteration != ITER_FIXED && roll_hessian(mod, r, &why)) r = NULL; /* the Newton matrix's band */
+  if (r && me->iteration != ITER_FIXED && roll_hessian(mod, me, r, &why)) r = NULL; /* the Newton matrix's band */
   if (r && !on && !auto_rolls(r, big)) return 0; /* little repetition: straight-line is as short */
   if (!r && on) {
     error_at(mod->nu ? mod->g_loc[0] : mod->U_loc, "--rolled on: the rolled form cannot print this model: %s", why);

@@ -117,6 +117,12 @@ typedef struct Roll {
    * start (-1: none) */
   int hb, ht, *hoff, *hpos;
   RollFamily *hess;
+  /* with constraints (the constant family): row i's t-th entry is Hess U's, or
+   * lambda_a's share of Hess g_a (hlam[i ht + t] = a, else -1); the Newton system
+   * with the multiplier is one real band (roll_newton.c, "the saddle point"): kn
+   * rows, khb each side, coordinate i's s unknowns from row krow[i], constraint
+   * a's row kcon[a], and hoff the entry's offset in its row's band (-1: none) */
+  int *hlam, *krow, *kcon, kn, khb;
 } Roll;
 
 /* Choosing the form from eo->rolled. roll_plan says which step to build
@@ -133,10 +139,11 @@ int roll_choose(Model *mod, const Method *me, const Step *st, int layout, EmitOp
  * coordinate each reads) split into runs (roll.c). Returns 0, or -1 when an
  * item cannot be printed or there are more than ROLL_MAX_RUNS runs. */
 int roll_family(Dag *d, int m, RollFamily *f, const int *nodes, const int *base, int n);
-/* roll_newton.c: Hess U as band families into r->hb, r->hess, for the rolled
- * Newton kernels; -1 with *why set where the rolled form cannot (a pair sum,
- * a band too wide, a diagonal not uniform in the index). */
-int roll_hessian(Model *mod, Roll *r, const char **why);
+/* roll_newton.c: Hess U (with constraints Hess(U + lambda' g)) as band
+ * families into r->hb, r->hess, for the rolled Newton kernels; -1 with *why
+ * set where the rolled form cannot (a pair sum, a band too wide, a diagonal
+ * not uniform in the index). */
+int roll_hessian(Model *mod, const Method *me, Roll *r, const char **why);
 /* Mark (dag_reach) the nodes the rolled kernels print of the model. */
 void roll_reach(const struct Roll *r, const Dag *d, unsigned char *mark);
 #endif

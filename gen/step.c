@@ -659,7 +659,7 @@ static Step *build_step(Model *mod, const Method *me, int lean) {
     if (poly) layout_poly_multiplier(&b);
     else layout_const_multiplier(&b);
     build_diagnostics(&b);
-    if (me->iteration != ITER_FIXED) layout_newton_rolled(&b); /* (no constraints: roll.c) */
+    if (me->iteration != ITER_FIXED) layout_newton_rolled(&b); /* (with constraints the const family: roll.c) */
     return st;
   }
   build_stages(&b);

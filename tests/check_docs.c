@@ -516,7 +516,7 @@ START_TEST(rolled_coverage_documented)
                   (int)(q - p - 1), p + 1);
     refused++;
   }
-  ck_assert_int_ge(refused, 2);
+  ck_assert_int_ge(refused, 1); /* (--wide-step; Newton with constraints is covered since the rolled saddle point) */
   char *b = generate_source(chain, "-s 2 --rolled on --batch 2");
   ck_assert_msg(b && strstr(b, "(rolled)"), "the rolled form does not cover --batch");
   free(b);

@@ -26,10 +26,24 @@
  *             rolled Newton step at h omega = 10;
  *   rollback  a step that fails (h = 20) leaves the state byte-identical;
  *   batch     --batch 2: each lane is bitwise the rolled scalar Newton step;
- *   refused   what the rolled form does not cover under Newton (constraints,
- *             a pair sum, whose Hessian is full) is a located error, and
- *             --rolled auto falls back; a chain x[i] rolls with its band in
- *             the natural order.
+ *   refused   what the rolled form does not cover under Newton (a pair sum
+ *             whose Hessian is full) is a located error, and --rolled auto
+ *             falls back; constraints in both families are covered; a
+ *             chain x[i] rolls with its band in the natural order.
+ * With constraints (both families, rp* const and rp*p poly; tcase
+ * "constrained"), on the stiff
+ * polymer (tests/models/polymer_stiff6.ham, polymer_stiff100.ham; omega =
+ * 205 at ka = 1e4, the largest frequency auto's estimate finds at q0):
+ *   kkt_same      rolled against straight-line Newton, 6 beads, h omega = 10
+ *                 and 30, T = 2 (REORDER_KKT_TOL), in both families, the
+ *                 same iterations and
+ *                 factorisations within a tenth, H and g at round-off; an
+ *                 adaptive run of the rolled step keeps g at round-off;
+ *   kkt_long      the polymer of 100 beads (m = 300, nu = 99; both families) converges at h
+ *                 omega = 10 in a bounded number of iterations, H and g at
+ *                 round-off; its rolled C is at most twice the 6 beads' C;
+ *   kkt_rollback  a step too long for the iteration (h omega = 100) leaves
+ *                 the state byte-identical.
  * The suite is rollnewton_suite(); the project's runner adds it. */
 #include <check.h>
 #include <float.h>
@@ -49,6 +63,12 @@
 #include "rn8s3_k6s3.h"
 #include "rn8s3_straight_k6s3.h"
 #include "rnb8_k4s2.h"
+#include "rp100_k4s2.h"
+#include "rp100p_k4s2.h"
+#include "rp6_k4s2.h"
+#include "rp6_straight_k4s2.h"
+#include "rp6p_k4s2.h"
+#include "rp6p_straight_k4s2.h"
 
 Suite *rollnewton_suite(void);
 
@@ -256,13 +276,207 @@ START_TEST(test_batch_lanes)
 }
 END_TEST
 
+/* The stiff polymer's fastest frequency at ka = 1e4 (auto's estimate at q0,
+ * `hbvmgen --check`: 205 for 6 beads). */
+#define POLY_OMEGA 205.0
+
+/* Rolled and straight-line Newton with constraints factor the same saddle
+ * point in other orders (one band in the order of the coordinates, against
+ * the blocks and the dense Schur complement of step_newton.c). Each step
+ * stops when its increment is at round-off, so each commits its own last
+ * iterate: the first step's results differ by 1e-13 (h omega = 10) to 2e-13
+ * (30), a few times NAME_NOISETOL, and the difference grows along the run
+ * with the polymer's sensitivity to its initial state (measured 1.5e-12 and
+ * 1.2e-11 at T = 2). Asserted 1e-10: round-off times a growth of 1e3. */
+#define REORDER_KKT_TOL 1e-10
+
+typedef struct {
+  int steps, failed, max_iters;
+  long iters, factors, citers, cfactors;
+  double dH, H0, g, diff;
+} KktRun;
+
+/* The largest |g_a| of solver P's state x, and the scale of its round-off:
+ * 64 ulps of the largest 1 + |q_i| (g's terms are squares of the bonds'
+ * coordinates, differences of coordinates of the size of q rounded to ulps
+ * of it). */
+#define G_ROUNDOFF(P, x, prm, gmax, gscale)                                \
+  do {                                                                     \
+    P##_real g_[P##_NU];                                                   \
+    P##_constraints(&(x), &(prm), g_);                                     \
+    for (int a_ = 0; a_ < P##_NU; a_++) (gmax) = fmax((gmax), fabs(g_[a_])); \
+    for (int i_ = 0; i_ < P##_M; i_++)                                     \
+      (gscale) = fmax((gscale), 64 * DBL_EPSILON * (1 + fabs((x).q[i_]))); \
+  } while (0)
+
+/* Step the polymer P (default params) and C beside it in steps of h to T:
+ * counts of both, |H - H0| and max |g| over gscale (g's round-off) of P, the
+ * largest difference of q, p into r.diff. */
+#define RUN_KKT(P, C, h, T, r)                                                                     \
+  do {                                                                                             \
+    static P##_state x_;                                                                           \
+    static C##_state y_;                                                                           \
+    P##_params prm_;                                                                               \
+    C##_params cprm_;                                                                              \
+    double gs_ = 0;                                                                                \
+    memset(&(r), 0, sizeof(r));                                                                    \
+    P##_params_default(&prm_);                                                                     \
+    C##_params_default(&cprm_);                                                                    \
+    P##_init_params(&x_, NULL, NULL, &prm_);                                                       \
+    C##_init_params(&y_, NULL, NULL, &cprm_);                                                      \
+    (r).H0 = P##_energy(&x_, &prm_);                                                               \
+    (r).steps = (int)lround((T) / (h));                                                            \
+    for (int n_ = 0; n_ < (r).steps; n_++) {                                                       \
+      P##_stats st_;                                                                               \
+      C##_stats ct_;                                                                               \
+      if (P##_step(&x_, (h), &prm_, &st_) != P##_OK || C##_step(&y_, (h), &cprm_, &ct_) != C##_OK) { \
+        (r).failed++;                                                                              \
+        break;                                                                                     \
+      }                                                                                            \
+      (r).iters += st_.newton;                                                                     \
+      (r).factors += st_.factors;                                                                  \
+      (r).citers += ct_.newton;                                                                    \
+      (r).cfactors += ct_.factors;                                                                 \
+      if (st_.newton > (r).max_iters) (r).max_iters = st_.newton;                                  \
+      (r).dH = fmax((r).dH, fabs(P##_energy(&x_, &prm_) - (r).H0));                                \
+      G_ROUNDOFF(P, x_, prm_, (r).g, gs_);                                                         \
+      for (int i_ = 0; i_ < P##_M; i_++)                                                           \
+        (r).diff = fmax((r).diff, fmax(fabs(x_.q[i_] - y_.q[i_]), fabs(x_.p[i_] - y_.p[i_])));     \
+    }                                                                                              \
+    (r).g /= gs_ > 0 ? gs_ : 1;                                                                    \
+  } while (0)
+
+/* The bound of |H - H0| of tests/check_newton.c: 8 ulps of (1 + h omega)
+ * |H0| a step, as a random walk. */
+static double h_bound(double hw, double H0, int steps) { return 8 * DBL_EPSILON * (1 + hw) * fabs(H0) * sqrt(steps); }
+
+/* The polymer of 6 beads, rolled against straight-line, at h omega = 10 and
+ * 30, in both families (measured, const / poly: 1.5e-12 / 1.5e-12 and 1.2e-11 /
+ * 4.1e-11 apart; 10.2 / 13.9 and 23.0 / 35.7 iterations a step, at most 11 /
+ * 18 and 37 / 56, the straight-line step within 2 %; the same
+ * factorisations; max |g| 1.3e-15 / 1.1e-15, 1.7e-15 / 2e-15). Then 40
+ * adaptive steps (tol 1e-4) of the rolled const step from the same state
+ * (measured: h omega up to 0.49, where the error control holds the step, 148
+ * Newton iterations). */
+START_TEST(test_kkt_same_as_straight)
+{
+  static const double hw[2] = {10, 30};
+  static const int max_iters[2] = {25, 80};
+  for (int c = 0; c < 2; c++) {
+    KktRun r[2];
+    RUN_KKT(rp6_k4s2, rp6_straight_k4s2, hw[c] / POLY_OMEGA, 2.0, r[0]);
+    RUN_KKT(rp6p_k4s2, rp6p_straight_k4s2, hw[c] / POLY_OMEGA, 2.0, r[1]);
+    for (int f = 0; f < 2; f++) {
+      const char *fam = f ? "poly" : "const";
+      printf("rolled vs straight-line Newton with constraints (%s), h omega = %g: %.3g apart, %.3g (max %d) / %.3g iterations "
+             "a step, %ld / %ld factorisations, |H - H0| %.3g, max |g| %.3g of its round-off\n",
+             fam, hw[c], r[f].diff, (double)r[f].iters / r[f].steps, r[f].max_iters, (double)r[f].citers / r[f].steps, r[f].factors,
+             r[f].cfactors, r[f].dH, r[f].g);
+      ck_assert_msg(!r[f].failed, "%s, h omega = %g: a step failed", fam, hw[c]);
+      ck_assert_msg(r[f].diff <= REORDER_KKT_TOL, "%s, h omega = %g: the forms are %.3g apart", fam, hw[c], r[f].diff);
+      ck_assert_msg(r[f].max_iters <= max_iters[c], "%s, h omega = %g: %d iterations in a step", fam, hw[c], r[f].max_iters);
+      ck_assert_msg(labs(r[f].iters - r[f].citers) <= r[f].iters / 10 && labs(r[f].factors - r[f].cfactors) <= r[f].factors / 10 + 1,
+                    "%s, h omega = %g: %ld / %ld iterations, %ld / %ld factorisations", fam, hw[c], r[f].iters, r[f].citers,
+                    r[f].factors, r[f].cfactors);
+      ck_assert_msg(r[f].dH <= h_bound(hw[c], r[f].H0, r[f].steps), "%s, h omega = %g: |H - H0| = %.3g", fam, hw[c], r[f].dH);
+      ck_assert_msg(r[f].g <= 1, "%s, h omega = %g: max |g| is %.3g times its round-off", fam, hw[c], r[f].g);
+    }
+  }
+  rp6_k4s2_state x;
+  rp6_k4s2_params prm;
+  rp6_k4s2_stats st;
+  double h = 0.01, gmax = 0, gs = 0, hmax = 0;
+  long newton = 0;
+  rp6_k4s2_params_default(&prm);
+  rp6_k4s2_init_params(&x, NULL, NULL, &prm);
+  for (int n = 0; n < 40; n++) {
+    ck_assert_int_eq(rp6_k4s2_step_adaptive(&x, &h, 1e-4, &prm, &st), rp6_k4s2_OK);
+    G_ROUNDOFF(rp6_k4s2, x, prm, gmax, gs);
+    newton += st.newton;
+    hmax = fmax(hmax, st.h);
+  }
+  printf("rolled Newton with constraints, adaptive (tol 1e-4): t = %.3g after 40 steps, h omega up to %.3g, %ld Newton "
+         "iterations, max |g| %.3g\n", x.t, hmax * POLY_OMEGA, newton, gmax);
+  ck_assert_msg(gmax <= gs, "adaptive: max |g| = %.3g", gmax);
+  ck_assert_msg(newton > 0, "adaptive: no Newton iteration");
+}
+END_TEST
+
+/* The polymer of 100 beads P at h omega = 10, T = 0.5: every step converges
+ * in a bounded number of iterations, H and g at round-off. */
+#define LONG_CHAIN(P, fam)                                                                                            \
+  do {                                                                                                               \
+    KktRun r_;                                                                                                       \
+    RUN_KKT(P, P, 10 / POLY_OMEGA, 0.5, r_);                                                                         \
+    printf("rolled Newton with constraints (%s), 100 beads, h omega = 10: %.3g (max %d) iterations, %.3g "            \
+           "factorisations a step, |H - H0| %.3g, max |g| %.3g of its round-off\n", fam, (double)r_.iters / r_.steps,  \
+           r_.max_iters, (double)r_.factors / r_.steps, r_.dH, r_.g);                                                  \
+    ck_assert_msg(!r_.failed, "%s: a step failed", fam);                                                             \
+    ck_assert_msg(r_.max_iters <= 25 && r_.factors <= 4 * r_.steps, "%s: %d iterations, %ld factorisations", fam,    \
+                  r_.max_iters, r_.factors);                                                                          \
+    ck_assert_msg(r_.dH <= h_bound(10, r_.H0, r_.steps), "%s: |H - H0| = %.3g", fam, r_.dH);                         \
+    ck_assert_msg(r_.g <= 1, "%s: max |g| is %.3g times its round-off", fam, r_.g);                                  \
+  } while (0)
+
+/* The polymer of 100 beads (m = 300, nu = 99) at h omega = 10, T = 0.5 (10
+ * steps; measured const / poly: 10.9 / 10.7 iterations a step, at most 11,
+ * one factorisation a step, |H - H0| 2.1e-12 / 0 of H0 = 158); its C,
+ * generated from the model, at most twice that of the 6 beads (measured 406
+ * KB and 310 KB: the loops do not grow with N, the tables of the band and of
+ * q0, p0 do). */
+START_TEST(test_kkt_long_chain)
+{
+  LONG_CHAIN(rp100_k4s2, "const");
+  LONG_CHAIN(rp100p_k4s2, "poly");
+  char *t6 = read_text("models/polymer_stiff6.ham"), *t100 = read_text("models/polymer_stiff100.ham");
+  ck_assert(t6 && t100);
+  const char *flags = "-s 2 -k 4 --multiplier const --iteration newton --rolled on";
+  char *c6 = generate_source(t6, flags), *c100 = generate_source(t100, flags);
+  ck_assert_msg(c6 && c100, "generation failed (or wrote more than 4 MiB)");
+  printf("rolled Newton with constraints: C of 6 beads %zu bytes, of 100 beads %zu\n", strlen(c6), strlen(c100));
+  ck_assert_msg(strlen(c100) <= 2 * strlen(c6), "the C of 100 beads is %zu bytes against %zu for 6", strlen(c100), strlen(c6));
+  free(t6);
+  free(t100);
+  free(c6);
+  free(c100);
+}
+END_TEST
+
+/* Two steps of h omega = 10, then one of h omega = 100 that fails (the
+ * iteration does not converge: measured from h omega = 60 on); the state,
+ * the kept factor included, unchanged to the byte. */
+#define ROLLBACK(P)                                                                                       \
+  do {                                                                                                   \
+    static P##_state x_, before_;                                                                        \
+    P##_params prm_;                                                                                     \
+    P##_params_default(&prm_);                                                                           \
+    memset(&x_, 0, sizeof x_);                                                                           \
+    P##_init_params(&x_, NULL, NULL, &prm_);                                                             \
+    for (int n_ = 0; n_ < 2; n_++) ck_assert_int_eq(P##_step(&x_, 10 / POLY_OMEGA, &prm_, NULL), P##_OK); \
+    memcpy(&before_, &x_, sizeof x_);                                                                    \
+    int rc_ = P##_step(&x_, 100 / POLY_OMEGA, &prm_, NULL);                                              \
+    ck_assert_int_ne(rc_, P##_OK);                                                                       \
+    ck_assert_msg(!memcmp(&before_, &x_, sizeof x_), #P ": the failed step (%s) changed the state",      \
+                  P##_strerror(rc_));                                                                    \
+  } while (0)
+
+START_TEST(test_kkt_failed_step_rolls_back)
+{
+  ROLLBACK(rp100_k4s2);
+  ROLLBACK(rp100p_k4s2);
+}
+END_TEST
+
 /* What the rolled form does not cover under Newton is refused, at the
  * model's line; --rolled auto falls back to straight-line code there. */
 START_TEST(test_refused)
 {
   char out[4096];
-  ck_assert_int_ne(generator_output("--check --rolled on --iteration newton ../models/chain8.ham", out, sizeof out), 0);
-  ck_assert_msg(strstr(out, "chain8.ham:") && strstr(out, "without constraints only"), "constraints: %s", out);
+  ck_assert_msg(!generator_output("--check --rolled on --iteration newton ../models/chain8.ham", out, sizeof out),
+                "poly family: %s", out);
+  ck_assert_msg(!generator_output("--check --rolled on --iteration newton --multiplier const ../models/chain8.ham", out, sizeof out),
+                "const family: %s", out);
+  ck_assert_int_ne(generator_output("--check --rolled on --iteration newton --wide-step ../models/chain8.ham", out, sizeof out), 0);
   static const char pairs[] = "N = 12\nvariables x[N]\nU = sum(i in 1..N - 1, j in i + 1..N, ((x[i] - x[j])^2 - 1)^2)\n"
                               "q0 = [0.1 * i for i in 1..N]\np0 = [0 for i in 1..N]\n";
   ck_assert_ptr_null(generate_source(pairs, "-s 2 --iteration newton --rolled on")); /* the band would be full */
@@ -290,5 +504,11 @@ Suite *rollnewton_suite(void)
   tcase_add_test(tc, test_batch_lanes);
   tcase_add_test(tc, test_refused);
   suite_add_tcase(s, tc);
+  TCase *kkt = tcase_create("constrained");
+  tcase_set_timeout(kkt, 600);
+  tcase_add_test(kkt, test_kkt_same_as_straight);
+  tcase_add_test(kkt, test_kkt_long_chain);
+  tcase_add_test(kkt, test_kkt_failed_step_rolls_back);
+  suite_add_tcase(s, kkt);
   return s;
 }
