@@ -85,6 +85,21 @@ typedef struct {
   double dH, H0, diff;
 } Run;
 
+/* The start of RUN and RUN_KKT: solvers P and C (states x_, y_, params
+ * prm_, cprm_ in the caller's block) at their default params changed by
+ * SETUP, initialised; r zeroed but for H0 and the number of steps to T. */
+#define START_PAIR(P, C, h, T, r, SETUP)                                                          \
+  do {                                                                                             \
+    memset(&(r), 0, sizeof(r));                                                                    \
+    P##_params_default(&prm_);                                                                     \
+    C##_params_default(&cprm_);                                                                    \
+    SETUP;                                                                                         \
+    P##_init_params(&x_, NULL, NULL, &prm_);                                                       \
+    C##_init_params(&y_, NULL, NULL, &cprm_);                                                      \
+    (r).H0 = P##_energy(&x_, &prm_);                                                               \
+    (r).steps = (int)lround((T) / (h));                                                            \
+  } while (0)
+
 /* Step solver P and solver C beside it (the largest difference of q, p
  * into r.diff) at omega = w in steps of h to T; counts and |H - H0|. */
 #define RUN(P, C, w, h, T, r)                                                                     \
@@ -93,14 +108,7 @@ typedef struct {
     P##_state x_;                                                                                  \
     C##_params cprm_;                                                                              \
     C##_state y_;                                                                                  \
-    memset(&(r), 0, sizeof(r));                                                                    \
-    P##_params_default(&prm_);                                                                     \
-    C##_params_default(&cprm_);                                                                    \
-    prm_.omega = cprm_.omega = (w);                                                                \
-    P##_init_params(&x_, NULL, NULL, &prm_);                                                       \
-    C##_init_params(&y_, NULL, NULL, &cprm_);                                                      \
-    (r).H0 = P##_energy(&x_, &prm_);                                                               \
-    (r).steps = (int)lround((T) / (h));                                                            \
+    START_PAIR(P, C, h, T, r, prm_.omega = cprm_.omega = (w));                                   \
     for (int n_ = 0; n_ < (r).steps; n_++) {                                                       \
       P##_stats st_;                                                                               \
       C##_stats ct_;                                                                               \
@@ -319,13 +327,7 @@ typedef struct {
     P##_params prm_;                                                                               \
     C##_params cprm_;                                                                              \
     double gs_ = 0;                                                                                \
-    memset(&(r), 0, sizeof(r));                                                                    \
-    P##_params_default(&prm_);                                                                     \
-    C##_params_default(&cprm_);                                                                    \
-    P##_init_params(&x_, NULL, NULL, &prm_);                                                       \
-    C##_init_params(&y_, NULL, NULL, &cprm_);                                                      \
-    (r).H0 = P##_energy(&x_, &prm_);                                                               \
-    (r).steps = (int)lround((T) / (h));                                                            \
+    START_PAIR(P, C, h, T, r, (void)0);                                                            \
     for (int n_ = 0; n_ < (r).steps; n_++) {                                                       \
       P##_stats st_;                                                                               \
       C##_stats ct_;                                                                               \
