@@ -158,6 +158,11 @@ void emit_auto_iteration(Emitter *e);
 void emit_auto_slow(Emitter *e);
 void emit_newton_commit(Emitter *e);
 void emit_newton_state(Emitter *e);
+/* A Newton factor over this many bytes is not a local of the step but the
+ * state's scratch member nfw (emit_newton.c: the rolled Newton matrix of a
+ * long chain is megabytes, and the step's stack is a thread's). */
+#define NEWTON_LOCAL_MAX_BYTES (256 * 1024)
+double newton_factor_bytes(const Step *st, int single); /* 0 without Newton */
 void emit_newton_init(Emitter *e);
 
 /* emit_batch.c: --batch W, W trajectories stepped together in SIMD lanes */

@@ -216,16 +216,33 @@ static void emit_newton_loop(Emitter *e) {
           "  for (i = 0; i < $P_S * $P_M; i++) sw[$[sweep.gam]i] = gam[i];\n");
 }
 
+double newton_factor_bytes(const Step *st, int single) {
+  return (double)kernel_size(&st->kern[K_NFACTOR]) * (single ? sizeof(float) : sizeof(double));
+}
+
+// Whether the factor being made is the state's scratch nfw rather than a
+// local of the step (NEWTON_LOCAL_MAX_BYTES): the rolled polymer of 1000
+// beads at s = 4 has a factor of 15 MB, whose local overflowed the 8 MB
+// stack (a segmentation fault on the first step).
+static int factor_in_state(const Emitter *e) {
+  return newton_factor_bytes(e->st, e->single) > NEWTON_LOCAL_MAX_BYTES;
+}
+
 // The Newton iteration's locals, and its counts in the stats zeroed (a
 // step may return before it writes them). rate < 0: Newton did not run.
 static void emit_newton_locals(Emitter *e) {
-  if (newton_poly(e)) /* (dg: the correction of gamma, then of the multiplier's coefficients) */
-    tmpl(e, "  $R mfa[$<factor> + 1], mlam[$P_S * $P_NU];  /* the poly family's sweep: its factor, lam */\n"
-            "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$<newton_solve>], rate = -1;\n");
-  else
-    tmpl(e, "  $R nf[$<newton_factor> + 1], res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
+  const char *nf = factor_in_state(e) ? "*nf = x->nfw" : "nf[$<newton_factor> + 1]";
+  if (newton_poly(e)) { /* (dg: the correction of gamma, then of the multiplier's coefficients) */
+    tmpl(e, "  $R mfa[$<factor> + 1], mlam[$P_S * $P_NU];  /* the poly family's sweep: its factor, lam */\n  $R ");
+    tmpl(e, nf);
+    tmpl(e, ", res[$P_S * $P_M], dg[$<newton_solve>], rate = -1;\n");
+  } else {
+    tmpl(e, "  $R ");
+    tmpl(e, nf);
+    tmpl(e, ", res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
             "  $R ah[4 * $P_S * $P_M];  /* $P_anderson's history */\n"
             "  int na = 0;\n");
+  }
   tmpl(e, ""
           "  const $R *fac = nf;  /* the factor in use: nf, or the state's */\n"
           "  int nfac = 0;\n"
@@ -315,12 +332,16 @@ void emit_newton_commit(Emitter *e) {
 void emit_newton_state(Emitter *e) {
   tmpl(e, "  $R nf[$<newton_factor> + 1];  /* the Newton matrix's factor kept across steps ... */\n"
           "  $R nfh, nfrate;  /* ... taken at h = nfh (0: none); the last contraction with it */\n");
+  if (factor_in_state(e))
+    tmpl(e, "  $R nfw[$<newton_factor> + 1];  /* the factor being made: the step's scratch, which a failed\n"
+            "                                    step may change (too large for the step's stack) */\n");
   if (emit_is_auto(e)) tmpl(e, "  $R hnewton;  /* the shortest |h| whose sweeps were slow: Newton from it on (0: none) */\n");
 }
 
 // Their values after NAME_init: no factor.
 void emit_newton_init(Emitter *e) {
   tmpl(e, "  x->nfh = x->nfrate = 0;\n  for (i = 0; i <= $<newton_factor>; i++) x->nf[i] = 0;\n");
+  if (factor_in_state(e)) tmpl(e, "  for (i = 0; i <= $<newton_factor>; i++) x->nfw[i] = 0;\n");
   if (emit_is_auto(e)) tmpl(e, "  x->hnewton = 0;\n");
 }
 

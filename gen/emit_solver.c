@@ -48,6 +48,13 @@ int emit_check(const Model *mod, const Step *st, const EmitOptions *o) {
   for (int i = 0; i < mod->m && !bad; i++)
     bad = check_constant(o, mod->q0[i], mod->q0_loc, "q0", &small) || check_constant(o, mod->p0[i], mod->p0_loc, "p0", &small);
   free(mark);
+  double nfb = newton_factor_bytes(st, o->single);
+  if (!bad && o->batch && nfb > NEWTON_LOCAL_MAX_BYTES) { /* each lane's scalar state is a local of the batch step */
+    fprintf(stderr, "hbvmgen: error: --batch with Newton: the Newton matrix's factor is %.1f MB, and each lane steps "
+                    "a copy of the scalar state on the stack (at most %d KB of factor): leave out --batch, or pass "
+                    "--iteration fixed\n", nfb / 1e6, NEWTON_LOCAL_MAX_BYTES / 1024);
+    bad = 1;
+  }
   return bad;
 }
 
