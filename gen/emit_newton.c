@@ -231,18 +231,15 @@ static int factor_in_state(const Emitter *e) {
 // The Newton iteration's locals, and its counts in the stats zeroed (a
 // step may return before it writes them). rate < 0: Newton did not run.
 static void emit_newton_locals(Emitter *e) {
-  const char *nf = factor_in_state(e) ? "*nf = x->nfw" : "nf[$<newton_factor> + 1]";
-  if (newton_poly(e)) { /* (dg: the correction of gamma, then of the multiplier's coefficients) */
-    tmpl(e, "  $R mfa[$<factor> + 1], mlam[$P_S * $P_NU];  /* the poly family's sweep: its factor, lam */\n  $R ");
-    tmpl(e, nf);
-    tmpl(e, ", res[$P_S * $P_M], dg[$<newton_solve>], rate = -1;\n");
-  } else {
-    tmpl(e, "  $R ");
-    tmpl(e, nf);
-    tmpl(e, ", res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
-            "  $R ah[4 * $P_S * $P_M];  /* $P_anderson's history */\n"
-            "  int na = 0;\n");
-  }
+  int poly = newton_poly(e);
+  if (poly) tmpl(e, "  $R mfa[$<factor> + 1], mlam[$P_S * $P_NU];  /* the poly family's sweep: its factor, lam */\n");
+  tmpl(e, "  $R ");
+  tmpl(e, factor_in_state(e) ? "*nf = x->nfw" : "nf[$<newton_factor> + 1]");
+  /* (dg: in the poly family the correction of gamma, then of the multiplier's coefficients) */
+  tmpl(e, poly ? ", res[$P_S * $P_M], dg[$<newton_solve>], rate = -1;\n"
+               : ", res[$P_S * $P_M], dg[$P_S * $P_M], rate = -1;\n"
+                 "  $R ah[4 * $P_S * $P_M];  /* $P_anderson's history */\n"
+                 "  int na = 0;\n");
   tmpl(e, ""
           "  const $R *fac = nf;  /* the factor in use: nf, or the state's */\n"
           "  int nfac = 0;\n"

@@ -751,7 +751,7 @@ static IterKind resolve_iteration(const Options *o, const Model *mod, char *why,
   if (o->iteration == ITER_NEWTON) return ITER_NEWTON;
   Frequencies f;
   double r = model_stiffness(mod, &f);
-  if (r > 0 && mod->m > AUTO_NEWTON_MAX_M && rolled_newton_candidate(o, mod)) {
+  if (r > 0 && rolled_newton_candidate(o, mod)) { /* (m >= ROLL_LEAN_M > AUTO_NEWTON_MAX_M) */
     double gap = f.gap_above / f.gap_below;
     if (gap < STIFF_RATIO)
       snprintf(why, n, "auto: fixed (fixed-point sweeps; not stiff: the widest gap between the frequencies at q0 is "

@@ -121,15 +121,14 @@ static double frequencies_of(double *ev, int n, Frequencies *f) {
   qsort(ev, (size_t)n, sizeof *ev, by_value);
   double big = n ? ev[n - 1] : 0;
   if (!(isfinite(big) && big > 0)) return 0;
-  int lo = 0;
+  int lo = 0, gap = 0; /* the gap between ev[gap - 1] and ev[gap] (none: 0) */
   while (!(ev[lo] > STIFF_ZERO * big)) lo++;
-  f->fast = sqrt(big);
-  f->slow = f->gap_below = f->gap_above = sqrt(ev[lo]);
   for (int i = lo + 1; i < n; i++)
-    if (ev[i] / ev[i - 1] > f->gap_above * f->gap_above / (f->gap_below * f->gap_below)) {
-      f->gap_below = sqrt(ev[i - 1]);
-      f->gap_above = sqrt(ev[i]);
-    }
+    if (!gap || ev[i] / ev[i - 1] > ev[gap] / ev[gap - 1]) gap = i;
+  f->fast = sqrt(big);
+  f->slow = sqrt(ev[lo]);
+  f->gap_below = sqrt(ev[gap ? gap - 1 : lo]);
+  f->gap_above = sqrt(ev[gap ? gap : lo]);
   return f->fast / f->slow;
 }
 
@@ -183,7 +182,7 @@ static int minv_cholesky(const Model *mod, double *R) {
   }
   for (int j = 0; j < m; j++)
     for (int i = j; i < m; i++) {
-      double a = mod->mass == MASS_DENSE ? mod->minv[(size_t)i * m + j] : (i == j ? mod->minv_diag[i] : 0);
+      double a = mod->minv[(size_t)i * m + j];
       for (int k = 0; k < j; k++) a -= R[i * m + k] * R[j * m + k];
       if (i == j) {
         if (!(a > 0)) return 0;
