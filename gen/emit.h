@@ -62,6 +62,8 @@ void op_rhs(Emitter *e, const Node *n, const char *a, const char *b, char *rhs, 
 void emit_tables(Emitter *e);
 int kernel_inlinable(const Emitter *e, KernelId k);
 int sweep_reduces(const Emitter *e);
+int noise_per_coordinate(const Emitter *e); /* emit_iterate.c: the round-off test per coordinate */
+void emit_settled(Emitter *e);             /* emit_iterate.c: NAME_settled, that test */
 int lane_skips(const Emitter *e, const Kernel *k); /* the kernel takes skip[] after out[] */
 int emit_kernel_inline(Emitter *e, KernelId k);
 

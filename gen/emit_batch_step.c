@@ -51,6 +51,27 @@ static void emit_pivots(Emitter *e) {
 // polynomial family's fresh[l] (whether any, in *nfresh): lane
 // l iterates on with increments that fell by less than 8x, so its factor is
 // refreshed before the next sweep, as in $P_step.
+// In the lane test, NAME_settled's test (noise_per_coordinate, gen/emit_iterate.c)
+// into settled[l], in the lanes whose increment falls by less than 4x (1 in
+// the others): each coordinate's largest increment and its
+// size over the step from sw and gam, summed in NAME_step's order.
+static void emit_lane_settled(Emitter *e) {
+  tmpl(e, "  $M settled[$P_W], cand = 0;\n"
+          "  for (l = 0; l < $P_W; l++) {\n"
+          "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s;\n"
+          "    cand |= (in > $P_TOL / 256) & (4 * in > inc[l]);\n"
+          "    settled[l] = 1;\n  }\n"
+          "  if (cand)  /* each coordinate: its largest increment d, its size over the step o */\n"
+          "    for (int c = 0; c < $P_M; c++)\n      for (l = 0; l < $P_W; l++) {\n"
+          "        $R o = fabs$f(x->q[c * $P_W + l]) + fabs$f(h * sw[($[sweep.gam]c) * $P_W + l]);\n"
+          "        $R d = fabs$f(h * (sw[($[sweep.gam]c) * $P_W + l] - gam[c * $P_W + l]));\n"
+          "        for (i = $P_M + c; i < $P_S * $P_M; i += $P_M) {\n"
+          "          $R v = fabs$f(h * (sw[($[sweep.gam]i) * $P_W + l] - gam[i * $P_W + l]));\n"
+          "          o += fabs$f(h * sw[($[sweep.gam]i) * $P_W + l]);\n"
+          "          d = v > d ? v : d;\n        }\n"
+          "        settled[l] &= (d <= $P_TOL * o) | (d <= $P_TOL / 256 * scale[l]);\n      }\n");
+}
+
 static void emit_lane_test(Emitter *e, int poly) {
   int mq = e->mod->mass_q != NULL; /* M(q): Theta in lam, the contraction test (emit_batch_mq.c) */
   tmpl(e, "/* After a sweep: the increment and tests of $P_step in every lane that iterates (act);\n"
@@ -92,6 +113,7 @@ static void emit_lane_test(Emitter *e, int poly) {
   if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
     tmpl(e, "  if (itl && it == 1)  /* once a step, at the first sweep's scale (a loop of its own: a division) */\n"
             "    for (l = 0; l < $P_W; l++) itl[l] = $P_itol(tol, scale[l]);\n");
+  if (!poly && !mq && noise_per_coordinate(e)) emit_lane_settled(e);
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n");
   if (mq) tmpl(e, "    in = thi[l] > in ? thi[l] : in;  /* M(q): Theta's increment joins gamma's */\n");
@@ -103,7 +125,8 @@ static void emit_lane_test(Emitter *e, int poly) {
   else
     tmpl(e, poly || mq ? "    $R rh = $P_contraction(in, old, incp[l], it);\n"
                    "    ok[l] = (in <= $P_TOL) | ((rh < 1) & (in * rh <= $P_TOL * (1 - rh)));\n"
-                 : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
+                 : noise_per_coordinate(e) ? "    ok[l] = (in <= $P_TOL / 256) | ((4 * in > old) & settled[l]);\n"
+                                           : "    ok[l] = (in <= $P_TOL / 256) | ((in <= $P_TOL) & (4 * in > old));\n");
   tmpl(e, "    better[l] = in < inc_min[l];\n    noise[l] = inc_min[l] <= $P_NOISETOL;\n");
   if (poly)
     tmpl(e, "    incp[l] = act[l] ? old : incp[l];  /* for the factor's refresh (fresh) */\n"

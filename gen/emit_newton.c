@@ -13,9 +13,10 @@
  * loop of emit_iterate.c, which ends early where it is slow
  * (emit_auto_slow), and Newton restarts from the predicted gamma.
  *
- * Stopping: as the fixed-point step of the constant family, on the scaled
- * increment |h dgamma| / (max |q| + |h gamma_0|): far below an ulp
- * (TOL / 256), or within 2 ulps and no longer falling 4x (round-off noise);
+ * Stopping: on the scaled increment |h dgamma| / (max |q| + |h gamma_0|): far
+ * below an ulp (TOL / 256), or within 2 ulps and no longer falling 4x
+ * (round-off noise; the constant family's sweeps judge that per coordinate,
+ * emit_iterate.c, and Newton, which contracts fast, ends far below an ulp);
  * in the poly family, whose end of step projects p1 and rescales it to H0,
  * below an eighth of an ulp (TOL / 16) where the constant family goes to
  * TOL / 256 (g(q1), which the end does not restore, stays within 2 ulps; at

@@ -271,6 +271,21 @@ static double henon_heiles_k2s2_defect(const henon_heiles_k2s2_state *x, const d
 #define henon_heiles_k2s2_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* Whether the sweep's increments are round-off coordinate by coordinate: each one's
+ * largest, dm[i], within 2 ulps (henon_heiles_k2s2_TOL) of its size over the step, |q0| + |h| sum_j
+ * |gamma_j| (gam: the sweep's), or far below an ulp of the state's scale (gen/emit_iterate.c,
+ * noise_per_coordinate: 2 ulps of the largest coordinate left a small stiff one unconverged) */
+static int henon_heiles_k2s2_settled(const henon_heiles_k2s2_state *x, const double *gam, const double *dm, double h, double scale)
+{
+  int i, j;
+  for (i = 0; i < henon_heiles_k2s2_M; i++) {
+    double o = fabs(x->q[i]) + fabs(h * gam[i]);
+    for (j = 1; j < henon_heiles_k2s2_S; j++) o += fabs(h * gam[j * henon_heiles_k2s2_M + i]);
+    if (!(dm[i] <= henon_heiles_k2s2_TOL * o || dm[i] <= henon_heiles_k2s2_TOL / 256 * scale)) return 0;
+  }
+  return 1;
+}
+
 /* One step of HBVM(2,2). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heiles_k2s2_real h_, double tol, int cold, const henon_heiles_k2s2_params *prm, henon_heiles_k2s2_stats *st)
@@ -285,6 +300,8 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0;
+  double dm[henon_heiles_k2s2_M];  /* each coordinate's largest increment in the sweep */
+  double dm0 = 0,  dm1 = 0;  /* (dm in locals, for the fused sweeps) */
   for (it = 1; it <= henon_heiles_k2s2_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 2: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -372,18 +389,18 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
       if (v > scale) scale = v;
       v = fabs(x->q[1]) + fabs(h * sw1);
       if (v > scale) scale = v;
-      v = fabs(h * (sw0 - gm0));
-      if (v > inc) inc = v;
+      dm0 = fabs(h * (sw0 - gm0));
       gm0 = sw0;
-      v = fabs(h * (sw1 - gm1));
-      if (v > inc) inc = v;
+      dm1 = fabs(h * (sw1 - gm1));
       gm1 = sw1;
       v = fabs(h * (sw2 - gm2));
-      if (v > inc) inc = v;
+      if (v > dm0) dm0 = v;
       gm2 = sw2;
       v = fabs(h * (sw3 - gm3));
-      if (v > inc) inc = v;
+      if (v > dm1) dm1 = v;
       gm3 = sw3;
+      if (dm0 > inc) inc = dm0;
+      if (dm1 > inc) inc = dm1;
     }
     if (it == 1 && (st || tol > 0)) {  /* for henon_heiles_k2s2_err_est: only when someone reads it */
       d1 = inc;  /* the predictor's error */
@@ -409,11 +426,21 @@ static int henon_heiles_k2s2_step_within(henon_heiles_k2s2_state *x, henon_heile
     if (scale > 0) inc /= scale;
     if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5)) rc = henon_heiles_k2s2_ENONFINITE;
     if (rc == henon_heiles_k2s2_ENONFINITE || !isfinite(inc)) { rc = henon_heiles_k2s2_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (henon_heiles_k2s2_TOL / 256), or
-     * within 2 ulps (henon_heiles_k2s2_TOL) and falling by less than 4x (round-off noise). Iterating
-     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
-     * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= henon_heiles_k2s2_TOL / 256 || (inc <= henon_heiles_k2s2_TOL && 4 * inc > inc_old)) { rc = henon_heiles_k2s2_OK; break; }
+    /* converged: the increment is far below an ulp of the state (henon_heiles_k2s2_TOL / 256), or it
+     * falls by less than 4x and is round-off coordinate by coordinate (henon_heiles_k2s2_settled: within
+     * 2 ulps of the coordinate's own size over the step, or far below an ulp of the
+     * state). Iterating this far, rather than stopping at 2 ulps, makes |H - H0|
+     * grow like a random walk over millions of steps (bench/results/longrun.txt). */
+    if (inc <= henon_heiles_k2s2_TOL / 256) { rc = henon_heiles_k2s2_OK; break; }
+    if (4 * inc > inc_old) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      dm[0] = dm0;
+      dm[1] = dm1;
+      if (henon_heiles_k2s2_settled(x, gam, dm, h, scale)) { rc = henon_heiles_k2s2_OK; break; }
+    }
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. henon_heiles_k2s2_STALL sweeps without one are a stall: converged if it is at

@@ -272,6 +272,21 @@ static double kepler_k3s3_defect(const kepler_k3s3_state *x, const double *sw, d
 #define kepler_k3s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* Whether the sweep's increments are round-off coordinate by coordinate: each one's
+ * largest, dm[i], within 2 ulps (kepler_k3s3_TOL) of its size over the step, |q0| + |h| sum_j
+ * |gamma_j| (gam: the sweep's), or far below an ulp of the state's scale (gen/emit_iterate.c,
+ * noise_per_coordinate: 2 ulps of the largest coordinate left a small stiff one unconverged) */
+static int kepler_k3s3_settled(const kepler_k3s3_state *x, const double *gam, const double *dm, double h, double scale)
+{
+  int i, j;
+  for (i = 0; i < kepler_k3s3_M; i++) {
+    double o = fabs(x->q[i]) + fabs(h * gam[i]);
+    for (j = 1; j < kepler_k3s3_S; j++) o += fabs(h * gam[j * kepler_k3s3_M + i]);
+    if (!(dm[i] <= kepler_k3s3_TOL * o || dm[i] <= kepler_k3s3_TOL / 256 * scale)) return 0;
+  }
+  return 1;
+}
+
 /* One step of HBVM(3,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, double tol, int cold, const kepler_k3s3_params *prm, kepler_k3s3_stats *st)
@@ -287,6 +302,8 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2], gm3 = gam[3], gm4 = gam[4], gm5 = gam[5];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0, sw6 = 0, sw7 = 0,
     sw8 = 0, sw9 = 0, sw10 = 0, sw11 = 0;
+  double dm[kepler_k3s3_M];  /* each coordinate's largest increment in the sweep */
+  double dm0 = 0,  dm1 = 0;  /* (dm in locals, for the fused sweeps) */
   for (it = 1; it <= kepler_k3s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 3: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -438,24 +455,24 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
       if (v > scale) scale = v;
       v = fabs(x->q[1]) + fabs(h * sw1);
       if (v > scale) scale = v;
-      v = fabs(h * (sw0 - gm0));
-      if (v > inc) inc = v;
+      dm0 = fabs(h * (sw0 - gm0));
       gm0 = sw0;
-      v = fabs(h * (sw1 - gm1));
-      if (v > inc) inc = v;
+      dm1 = fabs(h * (sw1 - gm1));
       gm1 = sw1;
       v = fabs(h * (sw2 - gm2));
-      if (v > inc) inc = v;
+      if (v > dm0) dm0 = v;
       gm2 = sw2;
       v = fabs(h * (sw3 - gm3));
-      if (v > inc) inc = v;
+      if (v > dm1) dm1 = v;
       gm3 = sw3;
       v = fabs(h * (sw4 - gm4));
-      if (v > inc) inc = v;
+      if (v > dm0) dm0 = v;
       gm4 = sw4;
       v = fabs(h * (sw5 - gm5));
-      if (v > inc) inc = v;
+      if (v > dm1) dm1 = v;
       gm5 = sw5;
+      if (dm0 > inc) inc = dm0;
+      if (dm1 > inc) inc = dm1;
     }
     if (it == 1 && (st || tol > 0)) {  /* for kepler_k3s3_err_est: only when someone reads it */
       d1 = inc;  /* the predictor's error */
@@ -484,11 +501,23 @@ static int kepler_k3s3_step_within(kepler_k3s3_state *x, kepler_k3s3_real h_, do
     if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3) || !isfinite(sw4) || !isfinite(sw5) ||
         !isfinite(sw6) || !isfinite(sw7)) rc = kepler_k3s3_ENONFINITE;
     if (rc == kepler_k3s3_ENONFINITE || !isfinite(inc)) { rc = kepler_k3s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (kepler_k3s3_TOL / 256), or
-     * within 2 ulps (kepler_k3s3_TOL) and falling by less than 4x (round-off noise). Iterating
-     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
-     * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= kepler_k3s3_TOL / 256 || (inc <= kepler_k3s3_TOL && 4 * inc > inc_old)) { rc = kepler_k3s3_OK; break; }
+    /* converged: the increment is far below an ulp of the state (kepler_k3s3_TOL / 256), or it
+     * falls by less than 4x and is round-off coordinate by coordinate (kepler_k3s3_settled: within
+     * 2 ulps of the coordinate's own size over the step, or far below an ulp of the
+     * state). Iterating this far, rather than stopping at 2 ulps, makes |H - H0|
+     * grow like a random walk over millions of steps (bench/results/longrun.txt). */
+    if (inc <= kepler_k3s3_TOL / 256) { rc = kepler_k3s3_OK; break; }
+    if (4 * inc > inc_old) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      gam[3] = gm3;
+      gam[4] = gm4;
+      gam[5] = gm5;
+      dm[0] = dm0;
+      dm[1] = dm1;
+      if (kepler_k3s3_settled(x, gam, dm, h, scale)) { rc = kepler_k3s3_OK; break; }
+    }
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. kepler_k3s3_STALL sweeps without one are a stall: converged if it is at

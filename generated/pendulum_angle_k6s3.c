@@ -268,6 +268,21 @@ static double pendulum_angle_k6s3_defect(const pendulum_angle_k6s3_state *x, con
 #define pendulum_angle_k6s3_TOLC 0.01  /* the local error allowed per unit step, over tol */
 #endif
 
+/* Whether the sweep's increments are round-off coordinate by coordinate: each one's
+ * largest, dm[i], within 2 ulps (pendulum_angle_k6s3_TOL) of its size over the step, |q0| + |h| sum_j
+ * |gamma_j| (gam: the sweep's), or far below an ulp of the state's scale (gen/emit_iterate.c,
+ * noise_per_coordinate: 2 ulps of the largest coordinate left a small stiff one unconverged) */
+static int pendulum_angle_k6s3_settled(const pendulum_angle_k6s3_state *x, const double *gam, const double *dm, double h, double scale)
+{
+  int i, j;
+  for (i = 0; i < pendulum_angle_k6s3_M; i++) {
+    double o = fabs(x->q[i]) + fabs(h * gam[i]);
+    for (j = 1; j < pendulum_angle_k6s3_S; j++) o += fabs(h * gam[j * pendulum_angle_k6s3_M + i]);
+    if (!(dm[i] <= pendulum_angle_k6s3_TOL * o || dm[i] <= pendulum_angle_k6s3_TOL / 256 * scale)) return 0;
+  }
+  return 1;
+}
+
 /* One step of HBVM(6,3). Iterates the sweep until the increment reaches round-off
  * or stops decreasing; commits to *x only on success. */
 static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulum_angle_k6s3_real h_, double tol, int cold, const pendulum_angle_k6s3_params *prm, pendulum_angle_k6s3_stats *st)
@@ -282,6 +297,8 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
   /* the iteration's values in locals: gamma, the sweep's results */
   double gm0 = gam[0], gm1 = gam[1], gm2 = gam[2];
   double sw0 = 0, sw1 = 0, sw2 = 0, sw3 = 0, sw4 = 0, sw5 = 0;
+  double dm[pendulum_angle_k6s3_M];  /* each coordinate's largest increment in the sweep */
+  double dm0 = 0;  /* (dm in locals, for the fused sweeps) */
   for (it = 1; it <= pendulum_angle_k6s3_MAXITER; it++) {
     { /* the kernel sweep, inline */
       /* stage 1 of 6: Q = q0 + h sum_j Ihat[1][j] gamma_j, grad U(Q), grad g(Q) */
@@ -402,15 +419,15 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
       double v;
       v = fabs(x->q[0]) + fabs(h * sw0);
       if (v > scale) scale = v;
-      v = fabs(h * (sw0 - gm0));
-      if (v > inc) inc = v;
+      dm0 = fabs(h * (sw0 - gm0));
       gm0 = sw0;
       v = fabs(h * (sw1 - gm1));
-      if (v > inc) inc = v;
+      if (v > dm0) dm0 = v;
       gm1 = sw1;
       v = fabs(h * (sw2 - gm2));
-      if (v > inc) inc = v;
+      if (v > dm0) dm0 = v;
       gm2 = sw2;
+      if (dm0 > inc) inc = dm0;
     }
     if (it == 1 && (st || tol > 0)) {  /* for pendulum_angle_k6s3_err_est: only when someone reads it */
       d1 = inc;  /* the predictor's error */
@@ -435,11 +452,19 @@ static int pendulum_angle_k6s3_step_within(pendulum_angle_k6s3_state *x, pendulu
     if (scale > 0) inc /= scale;
     if (!isfinite(sw0) || !isfinite(sw1) || !isfinite(sw2) || !isfinite(sw3)) rc = pendulum_angle_k6s3_ENONFINITE;
     if (rc == pendulum_angle_k6s3_ENONFINITE || !isfinite(inc)) { rc = pendulum_angle_k6s3_ENONFINITE; break; }
-    /* converged: the increment is far below an ulp of the state (pendulum_angle_k6s3_TOL / 256), or
-     * within 2 ulps (pendulum_angle_k6s3_TOL) and falling by less than 4x (round-off noise). Iterating
-     * this far, rather than stopping at 2 ulps, makes |H - H0| grow like a
-     * random walk over millions of steps (bench/results/longrun.txt). */
-    if (inc <= pendulum_angle_k6s3_TOL / 256 || (inc <= pendulum_angle_k6s3_TOL && 4 * inc > inc_old)) { rc = pendulum_angle_k6s3_OK; break; }
+    /* converged: the increment is far below an ulp of the state (pendulum_angle_k6s3_TOL / 256), or it
+     * falls by less than 4x and is round-off coordinate by coordinate (pendulum_angle_k6s3_settled: within
+     * 2 ulps of the coordinate's own size over the step, or far below an ulp of the
+     * state). Iterating this far, rather than stopping at 2 ulps, makes |H - H0|
+     * grow like a random walk over millions of steps (bench/results/longrun.txt). */
+    if (inc <= pendulum_angle_k6s3_TOL / 256) { rc = pendulum_angle_k6s3_OK; break; }
+    if (4 * inc > inc_old) {
+      gam[0] = gm0;
+      gam[1] = gm1;
+      gam[2] = gm2;
+      dm[0] = dm0;
+      if (pendulum_angle_k6s3_settled(x, gam, dm, h, scale)) { rc = pendulum_angle_k6s3_OK; break; }
+    }
     /* otherwise progress is a new smallest increment: those of a converging sweep
      * need not fall every time (X_s has complex eigenvalues), so a rise alone is
      * no failure. pendulum_angle_k6s3_STALL sweeps without one are a stall: converged if it is at

@@ -16,6 +16,8 @@
 #include "top_k3s3.h"
 #include "chain32_straight_k2s2.h"
 #include "chain32f_straight_k2s2.h"
+#include "fpu_ffixed_k4s2.h"
+#include "fpu_fixed_k4s2.h"
 
 Suite *float_suite(void);
 
@@ -124,11 +126,55 @@ START_TEST(float_chain_follows_double)
 }
 END_TEST
 
+/* max |H - H0| / |H0| over N steps of h of the FPU chain at omega = 1000 from
+ * its initial values (x1[1] = 1 / omega: the stiff spring's energy is half of
+ * H), the fixed-point step of float (single) or double. */
+#define FPU_STIFF_RUN(NAME, REAL, N, H, OUT)                                                    \
+  do {                                                                                          \
+    NAME##_params prm;                                                                          \
+    NAME##_state x;                                                                             \
+    REAL q0[6] = {1, 0, 0, (REAL)1e-3, 0, 0}, p0[6] = {1, 0, 0, 1, 0, 0}, h0, dh = 0;           \
+    NAME##_params_default(&prm);                                                                \
+    prm.omega = 1000;                                                                           \
+    NAME##_init_params(&x, q0, p0, &prm);                                                       \
+    h0 = NAME##_energy(&x, &prm);                                                               \
+    for (int step_ = 0; step_ < (N); step_++) {                                                 \
+      ck_assert_int_eq(NAME##_step(&x, (REAL)(H), &prm, NULL), 0);                              \
+      if (fabs((double)(NAME##_energy(&x, &prm) - h0)) > dh) dh = (REAL)fabs((double)(NAME##_energy(&x, &prm) - h0)); \
+    }                                                                                           \
+    (OUT) = dh / fabs((double)h0);                                                              \
+  } while (0)
+
+/* The fixed-point step keeps H of the stiff FPU chain (omega = 1000) at h omega
+ * = 1 and 2 to round-off in float and in double. Its round-off test judged
+ * the increments against 2 ulps of the largest coordinate (1), where the
+ * stiff one is 1e-3: that one then stopped 2000 of its own ulps off, and H
+ * drifted to 1.7e-3 and 7.0e-3 (float), 3.1e-13 and 1.9e-12 (double) in
+ * 500 and 250 steps. Each coordinate is now judged against its own size
+ * (NAME_settled, gen/emit_iterate.c): 2.8e-5 and 2.3e-6 (float), 2.2e-15
+ * and 5.6e-15 (double). The float bound is 6x what Newton, converged far below
+ * an ulp, leaves at h omega = 1 (1.6e-5: the stiff spring's energy,
+ * omega^2 x1^2 / 2 with x1 rounded to an ulp of 1e-3, over 500 steps); the
+ * double one, 100 ulps, the same walk's 22 x 2 ulps with a margin. */
+START_TEST(float_stiff_energy) {
+  static const double hs[] = {0.001, 0.002};
+  for (int k = 0; k < 2; k++) {
+    int n = (int)(0.5 / hs[k] + 0.5);
+    double df, dd;
+    FPU_STIFF_RUN(fpu_ffixed_k4s2, float, n, hs[k], df);
+    FPU_STIFF_RUN(fpu_fixed_k4s2, double, n, hs[k], dd);
+    ck_assert_msg(df <= 1e-4, "float, h omega %g: max |H - H0| / H0 %.2e", 1000 * hs[k], df);
+    ck_assert_msg(dd <= 100 * DBL_EPSILON, "double, h omega %g: max |H - H0| / H0 %.2e", 1000 * hs[k], dd);
+  }
+}
+END_TEST
+
 Suite *float_suite(void) {
   Suite *s = suite_create("float");
   TCase *tc = tcase_create("adaptive");
   tcase_add_loop_test(tc, float_adaptive_as_fixed, 0, (int)(sizeof tols / sizeof tols[0]));
   tcase_add_test(tc, float_chain_follows_double);
+  tcase_add_test(tc, float_stiff_energy);
   suite_add_tcase(s, tc);
   return s;
 }
