@@ -28,6 +28,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -45,6 +46,7 @@ typedef struct {
   void *x, *prm;
   double *g, *hc;             /* nu values each (one spare) */
   double H0, H;               /* energy at t=0 and now */
+  double scale0;              /* |K| + |U| at t=0: the energy's size where H0 is round-off */
   double max_dh, max_g, max_hc;
   double iters_sum;
   int iters_max;
@@ -189,6 +191,25 @@ static int check_initial(Run *r)
   return status;
 }
 
+/* |K| + |U| of the state x whose energy is H: U from a copy of x with p = 0
+ * (K = p' M(q)^-1 p / 2 vanishes there), K = H - U; the size the summary's
+ * max_dH_rel is taken against where H0 is round-off (summary). 0 where the
+ * copy cannot be made. */
+static double energy_scale(const hbvmrt_model *md, const void *x, const void *prm, double H)
+{
+  size_t real = md->eps > 2 * DBL_EPSILON ? sizeof(float) : sizeof(double);
+  unsigned char *y = malloc(md->state_size);
+  double U;
+
+  if (!y)
+    return 0;
+  memcpy(y, x, md->state_size);
+  memset(y + md->off_p, 0, (size_t)md->m * real);  /* all-zero bits: 0 in float and double */
+  U = md->energy(y, prm);
+  free(y);
+  return fabs(H - U) + fabs(U);
+}
+
 /* Allocate the blocks, set the params and the initial state (docs/api.md:
  * NULL q0/p0 means the model defaults, at the run's params when the driver
  * can say so), checked against the constraints.  The exit status after
@@ -239,6 +260,7 @@ static int setup(Run *r, const hbvmrt_model *md, const hbvmrt_switching *sw, con
   }
   status = check_initial(r);
   r->H0 = md->energy(r->x, r->prm);
+  r->scale0 = energy_scale(md, r->x, r->prm, r->H0);
   return status;
 }
 
@@ -699,13 +721,18 @@ static const char *solver_ran(const Run *r)
 
 /* The summary line (docs/api.md, "The standalone driver"); without constraints max_g
  * and max_hc are kept, as a plain 0, so every run's line has the same
- * fields.  max_dH_rel is max_dH / |H0| (0 when both are 0); solver says
+ * fields.  max_dH_rel is max_dH / |H0|, or over |K0| + |U0| where H0 is
+ * within 64 ulps of that (0 when max_dH is 0); solver says
  * which iteration ran, and where Newton did, its counts follow; status says
  * how the run ended, t where. */
 static void summary(const Run *r, double seconds, const char *status)
 {
   double mean = r->steps > 0 ? r->iters_sum / (double)r->steps : 0.0;
-  double rel = r->max_dh == 0 ? 0 : r->max_dh / fabs(r->H0);
+  double eps = r->md->eps > 0 ? r->md->eps : DBL_EPSILON;
+  /* against |H0|, or |K0| + |U0| where H0 is round-off of it (64 ulps): a bound
+   * motion's H0 can be 0, or 3e-17 (the satellites), and max_dH over that said 5 or inf */
+  double den = fabs(r->H0) > 64 * eps * r->scale0 ? fabs(r->H0) : r->scale0;
+  double rel = r->max_dh == 0 ? 0 : r->max_dh / den;
 
   fprintf(stderr, "steps=%ld iters_mean=%.3g iters_max=%d max_dH=%.3e ",
           r->steps, mean, r->iters_max, r->max_dh);

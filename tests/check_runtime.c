@@ -903,6 +903,31 @@ START_TEST(summary_truth)
 }
 END_TEST
 
+/* osc's energy less 1/2: H0 = 0 exactly from q = 0, p = 1 (K0 = 1/2, U0 = -1/2) */
+static double osc_energy_shifted(const void *x, const void *prm)
+{
+  return osc_energy(x, prm) - 0.5;
+}
+
+/* max_dH_rel where H0 is round-off: over |K0| + |U0| (1 here), where max_dH / |H0|
+ * said inf (H0 = 0; the satellites' H0 = 3e-17 gave 5). Forty rotations leave
+ * max_dH at round-off, not 0. */
+START_TEST(summary_relative_to_energy_size)
+{
+  hbvmrt_model zero = osc;
+  Result r;
+
+  zero.energy = osc_energy_shifted;
+  r = run(&zero, "-h 0.1 -N 40 --q0 0 --p0 1");
+  ck_assert_int_eq(r.status, 0);
+  ck_assert_double_eq(summary_field(r.err, "H0"), 0);
+  ck_assert_double_gt(summary_of(r.err).max_dH, 0);
+  ck_assert_double_eq_tol(summary_field(r.err, "max_dH_rel"), summary_of(r.err).max_dH,
+                          1e-3 * summary_of(r.err).max_dH);
+  done(&r);
+}
+END_TEST
+
 /* Issue 30 item 5: Kepler (k = 16) at h = 300 converged to steps whose
  * quadrature does not resolve H, |H - H0| = 1.456, and exited 0. Its steps'
  * energy defect (NAME_stats.defect) now flags the run: exit status 3. At
@@ -1392,6 +1417,7 @@ Suite *runtime_suite(void)
   tcase_add_test(run_, ring_default_run);
   tcase_add_test(run_, inconsistent_start);
   tcase_add_test(run_, summary_truth);
+  tcase_add_test(run_, summary_relative_to_energy_size);
   tcase_add_test(run_, summary_solver);
   tcase_add_test(run_, kepler_energy_defect);
   tcase_add_test(run_, messages_rate_limited);
