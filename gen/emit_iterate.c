@@ -34,23 +34,23 @@ static void emit_factor(Emitter *e, const char *indent) {
 }
 
 // Whether the iteration's round-off test is per coordinate: in the family
-// whose end of step does not restore H (no multiplier factor, no rescale).
-// There the increment within 2 ulps of the largest coordinate, falling by
-// less than 4x, is round-off noise only if each coordinate's largest
-// increment dm is within 2 ulps of its own size over the step,
-// |q0| + |h| sum_j |gamma_j| (NAME_TOL), or far below an ulp of the largest
-// (NAME_TOL / 256). 2 ulps of the largest left a small stiff coordinate 2000
-// of its own ulps off (the FPU chain at omega = 1000, x1 = 1e-3), and H
-// drifted: 1.7e-3 in float, 3.1e-13 in double at h omega = 1 (docs/api.md,
-// "Cost per step and the iteration limits"). With the size |q0| + |h
-// gamma_0| alone, a coordinate at a turning point mid-step looked small, and
-// the two oscillators of tests/check_stress.c failed at h omega = 2.8. Not
-// with constraints: the multiplier's force puts the round-off of the large
-// coordinates into every one, and the conical pendulum and the satellites
-// then reached NAME_MAXITER at the h where they had converged. dm
-// replaces the one running maximum of the increments (their largest is the
-// same): the sizes are summed only when the test is reached, so the sweeps
-// cost what they did.
+// whose end of step does not restore H (no multiplier factor, no rescale),
+// without constraints. There increments that fall by less than 4x are
+// round-off noise only if each coordinate's largest increment dm is within
+// 2 ulps (NAME_TOL) of its own size over the step, |q0| + |h| sum_j
+// |gamma_j|, or far below an ulp of the largest (NAME_TOL / 256), where the
+// global test took them as noise within 2 ulps of the largest coordinate:
+// that left a small stiff one 2000 of its own ulps off (the FPU chain at
+// omega = 1000, x1 = 1e-3), and H drifted, 1.7e-3 in float and 3.1e-13 in
+// double at h omega = 1 (docs/api.md, "Cost per step and the iteration
+// limits"). With the size |q0| + |h gamma_0| alone, a coordinate at a
+// turning point mid-step looked small, and the two oscillators of
+// tests/check_stress.c failed at h omega = 2.8. Not with constraints: the
+// multiplier's force puts the round-off of the large coordinates into every
+// one, and the conical pendulum and the satellites then reached NAME_MAXITER
+// at the h where they had converged. dm replaces the one running maximum of
+// the increments (their largest is the same), and the sizes are summed only
+// where the increments fall by less than 4x, so a sweep costs what it did.
 int noise_per_coordinate(const Emitter *e) {
   return !(e->st->kern[K_FACTOR].nout > 0 || energy_rescale_wanted(e)) && e->mod->nu == 0;
 }
@@ -174,8 +174,7 @@ static void emit_sweep_checks(Emitter *e) {
           "    inc_old = inc;\n    inc = 0;\n    scale = 0;\n"
           "    for (i = 0; i < $P_M; i++) {\n"
           "      $R v = fabs$f(x->q[i]) + fabs$g(h * sw[$[sweep.gam]i]);\n"
-          "      if (v > scale) scale = v;\n    }\n"
-          "");
+          "      if (v > scale) scale = v;\n    }\n");
   if (noise_per_coordinate(e)) /* each coordinate's largest increment, dm (noise_per_coordinate) */
     tmpl(e, "    for (i = 0; i < $P_M; i++) {\n"
             "      dm[i] = fabs$g(h * (sw[$[sweep.gam]i] - gam[i]));\n"
