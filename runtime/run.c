@@ -191,22 +191,29 @@ static int check_initial(Run *r)
   return status;
 }
 
-/* |K| + |U| of the state x whose energy is H: U from a copy of x with p = 0
- * (K = p' M(q)^-1 p / 2 vanishes there), K = H - U; the size the summary's
- * max_dH_rel is taken against where H0 is round-off (summary). 0 where the
- * copy cannot be made. */
+/* |K| + |U| of the state x whose energy is H: U from a state initialised at
+ * x's q with p = 0 (K = p' M(q)^-1 p / 2 vanishes there; through init, as a
+ * float driver's energy reads its own state, not the double q and p the
+ * runtime sees), K = H - U; the size the summary's max_dH_rel is taken
+ * against where H0 is round-off (summary). 0 where that state cannot be made. */
 static double energy_scale(const hbvmrt_model *md, const void *x, const void *prm, double H)
 {
-  size_t real = md->eps > 2 * DBL_EPSILON ? sizeof(float) : sizeof(double);
-  unsigned char *y = malloc(md->state_size);
-  double U;
+  void *y = calloc(1, md->state_size + 1);
+  double *zero = calloc((size_t)md->m + 1, sizeof *zero), U;
+  const double *q = (const double *)(const void *)((const char *)x + md->off_q);
 
-  if (!y)
+  if (!y || !zero) {
+    free(y);
+    free(zero);
     return 0;
-  memcpy(y, x, md->state_size);
-  memset(y + md->off_p, 0, (size_t)md->m * real);  /* all-zero bits: 0 in float and double */
+  }
+  if (md->init_params)
+    md->init_params(y, q, zero, prm);
+  else
+    md->init(y, q, zero);
   U = md->energy(y, prm);
   free(y);
+  free(zero);
   return fabs(H - U) + fabs(U);
 }
 

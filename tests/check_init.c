@@ -284,6 +284,27 @@ START_TEST(project_without_constraints)
 END_TEST
 
 /* The float interface: NAME_real in and out, and project to float round-off. */
+/* The summary's max_dH_rel where H0 is round-off (the satellites: 2.8e-17 in
+ * double, 0 in float): over |K0| + |U0|, so at round-off too, 64 ulps at most
+ * (measured 4.6e-16 and 1.5e-7). max_dH / |H0| said 5 and inf; a float driver's
+ * U0 must come from its own float state, which a copy of the double q and p
+ * the runtime sees with p zeroed does not change (inf again). */
+START_TEST(summary_relative_where_H0_is_roundoff)
+{
+  static const char *const flags[2] = {"-k 6 -s 2", "-k 6 -s 2 --real float"};
+  static const double eps[2] = {DBL_EPSILON, FLT_EPSILON};
+  setup_dir();
+  build("satrel", "../models/satellites.ham", NULL, flags[_i]);
+  Run r = run("satrel", "-h 0.05 -T 50");
+  ck_assert_int_eq(r.status, 0);
+  const char *p = strstr(r.err, "max_dH_rel=");
+  ck_assert_msg(p != NULL, "no summary: %s", r.err);
+  double rel = strtod(p + 11, NULL);
+  ck_assert_msg(rel <= 64 * eps[_i], "%s: max_dH_rel = %g over 1000 steps (max_dH = %g)", flags[_i], rel, max_dH(&r));
+  remove_dir();
+}
+END_TEST
+
 START_TEST(float_interface)
 {
   polyfloat_k3s3_state x;
@@ -314,6 +335,7 @@ Suite *init_suite(void)
   tcase_add_loop_test(tc, failed_projection_leaves_state, 0, (int)(sizeof projs / sizeof projs[0]));
   tcase_add_test(tc, project_without_constraints);
   tcase_add_test(tc, float_interface);
+  tcase_add_loop_test(tc, summary_relative_where_H0_is_roundoff, 0, 2);
   suite_add_tcase(s, tc);
   return s;
 }
