@@ -99,6 +99,7 @@ int mult_err_wanted(const Emitter *e);
 int itol_wanted(const Emitter *e);
 int energy_defect_wanted(const Emitter *e);
 int energy_rescale_wanted(const Emitter *e);
+int step_end_restores_energy(const Emitter *e);
 
 /* emit_api.c: NAME.h, and NAME.c's prelude, kernels and public functions */
 void emit_header(Emitter *e, const EmitOptions *o);

@@ -113,7 +113,7 @@ static void emit_lane_test(Emitter *e, int poly) {
   if (itol_wanted(e)) /* where $P_step_within stops: at its tolerance under $P_batch_step_adaptive */
     tmpl(e, "  if (itl && it == 1)  /* once a step, at the first sweep's scale (a loop of its own: a division) */\n"
             "    for (l = 0; l < $P_W; l++) itl[l] = $P_itol(tol, scale[l]);\n");
-  if (!poly && !mq && noise_per_coordinate(e)) emit_lane_settled(e);
+  if (noise_per_coordinate(e)) emit_lane_settled(e); /* (never poly or M(q)) */
   tmpl(e, "  for (l = 0; l < $P_W; l++) {\n"
           "    $R s = scale[l] > 0 ? scale[l] : 1, in = incn[l] / s, old = inc[l];\n");
   if (mq) tmpl(e, "    in = thi[l] > in ? thi[l] : in;  /* M(q): Theta's increment joins gamma's */\n");

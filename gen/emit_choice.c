@@ -34,6 +34,12 @@ int itol_wanted(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 && !e-
 // iteration may then stop at 2 ulps (the contraction test, emit_iterate.c).
 int energy_rescale_wanted(const Emitter *e) { return e->mod->mass_q || e->me->energy_rescale; }
 
+// Whether the end of the step restores H, whatever the last ulps of the
+// iteration: the polynomial family's projection and rescale (its multiplier
+// factor), or the constant family's rescale. The iteration's tests differ
+// by it (emit_iterate.c: the contraction test, or the round-off test).
+int step_end_restores_energy(const Emitter *e) { return e->st->kern[K_FACTOR].nout > 0 || energy_rescale_wanted(e); }
+
 // Whether the step's error estimate must take the quadrature's part from
 // the energy defect: k nodes do not integrate H exactly for this model (U or
 // g not polynomial, or k below -k auto), and no rescale restores H (the

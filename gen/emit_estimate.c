@@ -298,7 +298,7 @@ void emit_estimators(Emitter *e) {
   emit_err_est(e);
   if (energy_defect_wanted(e)) emit_defect(e);
   emit_tolc(e);
-  if ((e->st->kern[K_FACTOR].nout || energy_rescale_wanted(e)) && emit_has_sweeps(e)) emit_contraction(e);
+  if (step_end_restores_energy(e) && emit_has_sweeps(e)) emit_contraction(e);
   if (itol_wanted(e)) emit_itol(e);
   emit_settled(e); /* emit_iterate.c */
   if (mult_err_wanted(e)) emit_mult_err(e);

@@ -52,7 +52,7 @@ static void emit_factor(Emitter *e, const char *indent) {
 // the increments (their largest is the same), and the sizes are summed only
 // where the increments fall by less than 4x, so a sweep costs what it did.
 int noise_per_coordinate(const Emitter *e) {
-  return !(e->st->kern[K_FACTOR].nout > 0 || energy_rescale_wanted(e)) && e->mod->nu == 0;
+  return !step_end_restores_energy(e) && e->mod->nu == 0;
 }
 
 // NAME_settled, before the step (noise_per_coordinate's test).
@@ -229,7 +229,7 @@ static void emit_fused_checks(Emitter *e) {
 
 // The end of an iteration: failure, convergence or a stall.
 static void emit_convergence(Emitter *e) {
-  int poly = e->st->kern[K_FACTOR].nout > 0 || energy_rescale_wanted(e); /* (its end rescales p to H0 too) */
+  int poly = step_end_restores_energy(e); /* (the constant family with the rescale, too) */
   tmpl(e, "    if (rc == $P_ENONFINITE || !isfinite(inc)) { rc = $P_ENONFINITE; break; }\n");
   if (poly) { /* the end of the step restores H and the hidden constraint */
     tmpl(e, "    /* converged: the increment is within 2 ulps of the state ($P_TOL), or the error it\n"
